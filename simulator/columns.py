@@ -1,0 +1,72 @@
+"""Dataset column names and their units (SPEC section 5), defined once and imported everywhere.
+
+Each stream is a mapping from column name to unit; the dataset writer stores the unit in the
+Parquet field metadata. Extra columns a model adds must be declared here too.
+
+Public names
+------------
+TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV, BARO, MAG, EVENTS, TRUTH_GNSS, STREAMS,
+IMU_AXES, SOLUTION, SOLUTION_STD, DATASET_FORMAT.
+"""
+
+from __future__ import annotations
+
+DATASET_FORMAT = "landnav-dataset/1"
+
+TRUTH = {
+    "t": "s", "lat": "deg", "lon": "deg", "alt": "m",
+    "vn": "m/s", "ve": "m/s", "vd": "m/s",
+    "roll": "rad", "pitch": "rad", "yaw": "rad",
+    "wx": "rad/s", "wy": "rad/s", "wz": "rad/s",
+    "fx": "m/s^2", "fy": "m/s^2", "fz": "m/s^2",
+    "speed": "m/s", "distance": "m", "zone": "",
+}
+
+IMU_AXES = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
+IMU = {"t": "s", **{a: "rad/s" for a in IMU_AXES[:3]}, **{a: "m/s^2" for a in IMU_AXES[3:]}}
+IMU_INCREMENT_UNITS = {**{a: "rad" for a in IMU_AXES[:3]}, **{a: "m/s" for a in IMU_AXES[3:]}}
+
+ODOMETER = {"t": "s", "speed": "m/s", "ticks": "1"}
+
+GNSS_FIX = {
+    "t": "s", "lat": "deg", "lon": "deg", "alt": "m",
+    "vn": "m/s", "ve": "m/s", "vd": "m/s", "speed": "m/s", "course": "rad",
+    "num_sats": "1", "hdop": "1", "vdop": "1", "fix": "1",
+}
+
+GNSS_RAW = {
+    "t": "s", "sv": "1", "pseudorange": "m", "pseudorange_rate": "m/s", "doppler": "Hz",
+    "cn0": "dB-Hz", "sat_x": "m", "sat_y": "m", "sat_z": "m",
+    "sat_vx": "m/s", "sat_vy": "m/s", "sat_vz": "m/s",
+    "sat_clock": "m", "sat_clock_drift": "m/s", "iono": "m", "tropo": "m",
+    "elevation": "rad", "azimuth": "rad",
+}
+
+BARO = {"t": "s", "pressure": "Pa", "altitude": "m"}
+MAG = {"t": "s", "mag_x": "T", "mag_y": "T", "mag_z": "T"}
+EVENTS = {"t_start": "s", "t_end": "s", "kind": "", "detail": ""}
+
+SOLUTION = {
+    "t": "s", "lat": "deg", "lon": "deg", "alt": "m", "vn": "m/s", "ve": "m/s", "vd": "m/s",
+    "roll": "rad", "pitch": "rad", "yaw": "rad",
+}
+SOLUTION_STD = {
+    "std_n": "m", "std_e": "m", "std_d": "m", "std_vn": "m/s", "std_ve": "m/s", "std_vd": "m/s",
+    "std_roll": "rad", "std_pitch": "rad", "std_yaw": "rad",
+}
+
+# stream name -> (file name, columns); files whose name starts with "truth" and events.parquet
+# are for scoring only and never reach an estimator.
+STREAMS = {
+    "truth": ("truth.parquet", TRUTH),
+    "imu": ("imu.parquet", IMU),
+    "odometer": ("odometer.parquet", ODOMETER),
+    "gnss_fix": ("gnss_fix.parquet", GNSS_FIX),
+    "gnss_raw": ("gnss_raw.parquet", GNSS_RAW),
+    "gnss_nav": ("gnss_nav.parquet", {}),
+    "baro": ("baro.parquet", BARO),
+    "mag": ("mag.parquet", MAG),
+    "events": ("events.parquet", EVENTS),
+    "truth_gnss": ("truth_gnss.parquet", {}),
+}
+SCORING_ONLY = ("truth", "truth_gnss", "events")

@@ -1,0 +1,127 @@
+"""Reading scenario YAML with the line of every key, and applying ``--set key.path=value``.
+
+Public functions
+----------------
+read_yaml, apply_overrides.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path as FsPath
+from typing import Any
+
+import yaml
+
+from simulator.errors import InputError, Problem
+
+
+def _construct(node: yaml.Node, loader: yaml.SafeLoader, path: tuple, lines: dict,
+               file: str) -> Any:
+    lines.setdefault(path, node.start_mark.line + 1)
+    if isinstance(node, yaml.MappingNode):
+        loader.flatten_mapping(node)
+        out: dict[Any, Any] = {}
+        for key_node, value_node in node.value:
+            key = loader.construct_object(key_node, deep=True)
+            if not isinstance(key, (str, int, float, bool)):
+                raise InputError([Problem(file, key_node.start_mark.line + 1, ".".join(
+                    map(str, path)), f"a key must be plain text, got {key!r}")])
+            if key in out:
+                raise InputError([Problem(file, key_node.start_mark.line + 1,
+                                          ".".join(map(str, path + (key,))), "duplicate key")])
+            lines[path + (key,)] = key_node.start_mark.line + 1
+            out[key] = _construct(value_node, loader, path + (key,), lines, file)
+        return out
+    if isinstance(node, yaml.SequenceNode):
+        return [_construct(item, loader, path + (i,), lines, file)
+                for i, item in enumerate(node.value)]
+    return loader.construct_object(node, deep=True)
+
+
+def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
+    """Read a YAML file; return its content and a map from key path to line number (1-based).
+
+    Raises
+    ------
+    InputError
+        If the file is missing, unreadable or not valid YAML (with the line of the fault).
+    """
+    file = str(path)
+    try:
+        text = FsPath(path).read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise InputError([Problem(file, None, "", "file not found")]) from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise InputError([Problem(file, None, "", f"cannot read the file: {exc}")]) from None
+    loader = yaml.SafeLoader(text)
+    try:
+        node = loader.get_single_node()
+        lines: dict[tuple, int] = {}
+        data = {} if node is None else _construct(node, loader, (), lines, file)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else None
+        message = " ".join(str(x) for x in (exc.context, exc.problem) if x)
+        raise InputError([Problem(file, line, "", f"malformed YAML: {message}")]) from None
+    except yaml.YAMLError as exc:
+        raise InputError([Problem(file, None, "", f"malformed YAML: {exc}")]) from None
+    finally:
+        loader.dispose()
+    return data, lines
+
+
+def apply_overrides(data: Any, overrides: list[str], file: str) -> tuple[Any, set[tuple]]:
+    """Apply ``key.path=value`` overrides (values read as YAML) to loaded scenario data.
+
+    List items are addressed by index (``faults.0.duration=90``); missing mappings are created.
+    Returns the changed data and the set of key paths that were overridden.
+    """
+    problems: list[Problem] = []
+    touched: set[tuple] = set()
+    for text in overrides:
+        if "=" not in text:
+            problems.append(Problem(file, "--set", text, "expected key.path=value"))
+            continue
+        key, raw = text.split("=", 1)
+        try:
+            value = yaml.safe_load(raw) if raw.strip() else ""
+        except yaml.YAMLError:
+            value = raw
+        parts: list[Any] = [int(p) if p.lstrip("-").isdigit() else p for p in key.split(".")]
+        if not all(str(p) for p in parts):
+            problems.append(Problem(file, "--set", key, "empty part in the key path"))
+            continue
+        node = data
+        for i, part in enumerate(parts[:-1]):
+            nxt = parts[i + 1]
+            if isinstance(node, list) and isinstance(part, int) and -len(node) <= part < len(node):
+                node = node[part]
+            elif isinstance(node, dict):
+                if part not in node or node[part] is None:
+                    node[part] = [] if isinstance(nxt, int) else {}
+                node = node[part]
+            else:
+                problems.append(Problem(file, "--set", key,
+                                        f"{'.'.join(map(str, parts[:i + 1]))} does not exist"))
+                node = None
+                break
+        if node is None:
+            continue
+        last = parts[-1]
+        if isinstance(node, list) and isinstance(last, int):
+            if -len(node) <= last < len(node):
+                node[last] = value
+            elif last == len(node):
+                node.append(value)
+            else:
+                problems.append(Problem(file, "--set", key, f"list index {last} out of range"))
+                continue
+        elif isinstance(node, dict):
+            node[last] = value
+        else:
+            problems.append(Problem(file, "--set", key, "cannot set a key inside a plain value"))
+            continue
+        touched.add(tuple(parts))
+    if problems:
+        raise InputError(problems)
+    return data, touched

@@ -1,0 +1,415 @@
+"""Parametric drives (trajectory kind ``segments``): the SPEC section 4 segment table turned into
+exact road geometry and a jerk-limited speed profile.
+
+A drive is described by two sets of piecewise polynomials (``RoadProfile``):
+
+* along the road, as functions of the travelled distance s (m): curvature kappa(s) = dpsi/ds
+  (rad/m, + right), road grade angle gamma(s) (rad, + climbing) and road bank (rad, + right side
+  down);
+* in time: the travelled distance s(t), piecewise cubic (constant jerk pieces).
+
+Geometry choices (a navigation researcher would expect them; they are documented in README):
+
+* ``turn`` and ``helix`` are entered and left through transition curves (curvature a smoothstep
+  in s, a clothoid with rounded ends) whose
+  length gives a lateral jerk of ``limits.lateral_jerk`` at the segment's speed, but at most half
+  the turn angle each, so yaw rate and lateral acceleration are continuous.
+* ``slope`` and ``helix`` change grade through vertical curves (grade angle a smoothstep in s) whose
+  length gives a vertical acceleration of ``limits.vertical_accel``; every segment other than
+  ``slope``, ``helix`` and ``speed_bump`` is level, so a slope climbs and returns to level.
+* ``speed_bump`` is the smooth bump z = H 64 u^3 (1-u)^3 (u = s/L), crossed at the current speed.
+* ``lane_change`` deflects the heading by c 140 u^3 (1-u)^3 with c solved so the lateral shift is
+  ``offset`` exactly (heading and curvature continuous).
+* ``accelerate`` changes speed with a trapezoidal acceleration (jerk ``limits.jerk``); a segment
+  that says ``speed`` while the vehicle moves at another speed, and a ``stop`` reached while
+  moving, are preceded by such a change at ``limits.accel``.
+
+Public names
+------------
+SEGMENT_FIELD, LIMITS_FIELD, RoadProfile, build_road_profile.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import PPoly
+from scipy.optimize import brentq
+
+from simulator.earth import G0_M_S2
+from simulator.scenario.schema import (
+    Context,
+    Number,
+    OneKey,
+    Path,
+    Record,
+    Text,
+)
+
+MAX_GRADE = 0.3  # steepest grade a car is allowed to drive (SPEC section 4)
+
+LIMITS_FIELD = Record(
+    {
+        "lateral_accel": Number("m/s^2", 0.8 * G0_M_S2, gt=0,
+                                doc="largest lateral acceleration a turn may ask for"),
+        "grade": Number("", MAX_GRADE, gt=0, max=1.0, doc="steepest grade (rise/run)"),
+        "accel": Number("m/s^2", 1.0, gt=0, doc="acceleration used for automatic speed changes"),
+        "jerk": Number("m/s^3", 1.5, gt=0, doc="longitudinal jerk of speed changes"),
+        "lateral_jerk": Number("m/s^3", 0.5, gt=0, doc="lateral jerk setting clothoid length"),
+        "vertical_accel": Number("m/s^2", 0.5, gt=0,
+                                 doc="vertical acceleration setting vertical-curve length"),
+        "roll_gradient": Number("rad*s^2/m", np.radians(4.0) / G0_M_S2, min=0,
+                                doc="body roll per lateral acceleration (4 deg/g)"),
+    },
+    default={},
+)
+
+_speed = Number("m/s", None, min=0)
+SEGMENT_FIELD = OneKey(
+    {
+        "stop": Record({"duration": Number("s", gt=0)}),
+        "accelerate": Record({"to_speed": Number("m/s", min=0),
+                              "accel": Number("m/s^2", gt=0)}),
+        "straight": Record({"length": Number("m", None, gt=0),
+                            "duration": Number("s", None, gt=0), "speed": _speed}),
+        "turn": Record({"angle": Number(angle=True), "radius": Number("m", gt=0),
+                        "speed": _speed, "bank": Number(default=0.0, angle=True,
+                                                        min=-45, max=45)}),
+        "slope": Record({"grade": Number(""), "length": Number("m", gt=0), "speed": _speed}),
+        "helix": Record({"turns": Number("", gt=0), "radius": Number("m", gt=0),
+                         "rise": Number("m"), "speed": _speed,
+                         "direction": Text("right", choices=["left", "right"]),
+                         "bank": Number(default=0.0, angle=True, min=-45, max=45)}),
+        "speed_bump": Record({"height": Number("m", gt=0, max=0.5),
+                              "length": Number("m", gt=0)}),
+        "lane_change": Record({"offset": Number("m"), "length": Number("m", gt=0),
+                               "speed": _speed}),
+    },
+    shared={"zone": Text(None)},
+    what="segment",
+)
+
+
+@dataclass
+class _PathPiece:
+    """A stretch of road of ``length`` m; polynomials in local s (highest power first)."""
+
+    length: float
+    kappa: np.ndarray
+    grade: np.ndarray
+    bank: np.ndarray
+
+
+@dataclass
+class _TimePiece:
+    """A stretch of time with constant jerk."""
+
+    duration: float
+    jerk: float
+
+
+@dataclass
+class RoadProfile:
+    """Road geometry along s and the travelled distance in time, as piecewise polynomials."""
+
+    distance_of_time: PPoly  # s(t), m
+    curvature: PPoly  # kappa(s), rad/m, + right
+    heading: PPoly  # psi(s) - psi0, rad
+    grade: PPoly  # gamma(s), rad
+    bank: PPoly  # road bank angle (s), rad
+    duration_s: float
+    zones: list[tuple[float, float, str]] = field(default_factory=list)
+
+
+_ZERO = np.zeros(1)
+
+
+def _poly(*coeffs: float) -> np.ndarray:
+    return np.asarray(coeffs, dtype=float)
+
+
+def _ramp(start: float, end: float, length: float) -> np.ndarray:
+    """Smoothstep from ``start`` to ``end`` over ``length``: value and slope continuous at both
+    ends, so the rates and accelerations it drives are continuous too. Its mean is the mean of
+    the two ends, as for a linear ramp."""
+    d = end - start
+    return _poly(-2 * d / length**3, 3 * d / length**2, 0.0, start)
+
+
+def _speed_change(v0: float, v1: float, accel: float, jerk: float) -> list[_TimePiece]:
+    """Jerk-limited change of speed: trapezoidal (or triangular) acceleration profile."""
+    dv = v1 - v0
+    if abs(dv) < 1e-12:
+        return []
+    sign = np.sign(dv)
+    if abs(dv) >= accel**2 / jerk:
+        tj, tc = accel / jerk, abs(dv) / accel - accel / jerk
+    else:
+        tj, tc = np.sqrt(abs(dv) / jerk), 0.0
+    pieces = [_TimePiece(tj, sign * jerk), _TimePiece(tc, 0.0), _TimePiece(tj, -sign * jerk)]
+    return [p for p in pieces if p.duration > 0]
+
+
+def _distance_of(pieces: list[_TimePiece], v0: float) -> float:
+    s, v, a = 0.0, v0, 0.0
+    for p in pieces:
+        t, j = p.duration, p.jerk
+        s += v * t + a * t**2 / 2 + j * t**3 / 6
+        v += a * t + j * t**2 / 2
+        a += j * t
+    return s
+
+
+def _clothoid_turn(angle_rad: float, kappa0: float, v: float, lim: dict,
+                   bank_rad: float) -> list[_PathPiece]:
+    """Clothoid - arc - clothoid with total heading change ``angle_rad`` (sign = direction)."""
+    k0, total = abs(kappa0), abs(angle_rad)
+    lc = max(v**3 * k0 / lim["lateral_jerk"], 0.5)
+    if lc * k0 >= total:  # the two clothoids alone cover the turn: curvature peaks at the apex
+        lc = total / k0
+    arc = total / k0 - lc
+    k = np.sign(angle_rad) * k0
+    bank_per_kappa = bank_rad / abs(k) if k else 0.0
+    bank = bank_per_kappa * k
+    pieces = [_PathPiece(lc, _ramp(0.0, k, lc), _ZERO, _ramp(0.0, bank, lc))]
+    if arc > 1e-9:
+        pieces.append(_PathPiece(arc, _poly(k), _ZERO, _poly(bank)))
+    pieces.append(_PathPiece(lc, _ramp(k, 0.0, lc), _ZERO, _ramp(bank, 0.0, lc)))
+    return pieces
+
+
+def _with_grade(pieces: list[_PathPiece], gamma: float, lvc: float) -> list[_PathPiece]:
+    """Overlay a grade profile 0 -> gamma (over lvc) -> gamma -> 0 (over lvc) on path pieces."""
+    total = sum(p.length for p in pieces)
+    cuts = sorted({0.0, lvc, total - lvc, total, *np.cumsum([p.length for p in pieces])})
+    cuts = [c for c in cuts if 0.0 <= c <= total]
+    out, starts = [], np.concatenate([[0.0], np.cumsum([p.length for p in pieces])])
+    for a, b in zip(cuts[:-1], cuts[1:], strict=True):
+        if b - a < 1e-9:
+            continue
+        i = min(int(np.searchsorted(starts, a, side="right")) - 1, len(pieces) - 1)
+        base = pieces[i]
+        off = a - starts[i]
+        if b <= lvc + 1e-12:
+            g = _shift(_ramp(0.0, gamma, lvc), a)
+        elif a >= total - lvc - 1e-12:
+            g = _shift(_ramp(gamma, 0.0, lvc), a - (total - lvc))
+        else:
+            g = _poly(gamma)
+        out.append(_PathPiece(b - a, _shift(base.kappa, off), g, _shift(base.bank, off)))
+    return out
+
+
+def _shift(coeffs: np.ndarray, offset: float) -> np.ndarray:
+    """Coefficients of p(x + offset) given those of p(x) (highest power first)."""
+    if offset == 0.0 or len(coeffs) == 1:
+        return coeffs
+    return np.polynomial.polynomial.Polynomial(coeffs[::-1])(
+        np.polynomial.polynomial.Polynomial([offset, 1.0])).coef[::-1]
+
+
+def _grade_ramp_length(v: float, gamma: float, lim: dict, available: float) -> float:
+    return float(np.clip(v**2 * abs(gamma) / lim["vertical_accel"], 1.0, available / 2))
+
+
+def _helix(seg: dict, v: float, lim: dict) -> list[_PathPiece]:
+    theta = 2 * np.pi * seg["turns"] * (1 if seg["direction"] == "right" else -1)
+    radius, rise = seg["radius"], seg["rise"]
+
+    def build(gamma: float) -> list[_PathPiece]:
+        kappa0 = np.cos(gamma) / radius
+        turn = _clothoid_turn(theta, kappa0, v, lim, np.radians(seg["bank"]))
+        total = sum(p.length for p in turn)
+        return _with_grade(turn, gamma, _grade_ramp_length(v, gamma, lim, total))
+
+    def rise_error(gamma: float) -> float:
+        pieces = build(gamma)
+        return sum(_rise_of(p) for p in pieces) - rise
+
+    if abs(rise) < 1e-9:
+        return build(0.0)
+    bound = np.arctan(1.0) * np.sign(rise)
+    gamma = brentq(rise_error, 1e-9 * np.sign(rise), bound, xtol=1e-14)
+    return build(gamma)
+
+
+def _rise_of(piece: _PathPiece) -> float:
+    """Height gained over a piece: integral of sin(gamma(s)) ds (Gauss-Legendre, 8 nodes)."""
+    x, w = np.polynomial.legendre.leggauss(8)
+    s = 0.5 * piece.length * (x + 1)
+    return float(0.5 * piece.length * np.sum(w * np.sin(np.polyval(piece.grade, s))))
+
+
+def _speed_bump(height: float, length: float) -> list[_PathPiece]:
+    # z = H 64 u^3 (1-u)^3, so dz/ds = 192 H / L u^2 (1-u)^2 (1-2u), u = s / L
+    u = np.polynomial.polynomial.Polynomial([0.0, 1.0 / length])
+    dz = 192.0 * height / length * u**2 * (1 - u) ** 2 * (1 - 2 * u)
+    return [_PathPiece(length, _ZERO, dz.coef[::-1], _ZERO)]
+
+
+def _lane_change(offset: float, length: float) -> list[_PathPiece]:
+    x, w = np.polynomial.legendre.leggauss(16)
+    u = 0.5 * (x + 1)
+    shape = 140.0 * u**3 * (1 - u) ** 3  # integrates to 1 over [0, 1]
+
+    def shift(c: float) -> float:
+        return float(0.5 * length * np.sum(w * np.sin(c * shape))) - offset
+
+    c = 0.0 if offset == 0 else brentq(shift, 0.0, np.sign(offset) * 0.8, xtol=1e-15)
+    uu = np.polynomial.polynomial.Polynomial([0.0, 1.0 / length])
+    kappa = 420.0 * c / length * uu**2 * (1 - uu) ** 2 * (1 - 2 * uu)
+    return [_PathPiece(length, kappa.coef[::-1], _ZERO, _ZERO)]
+
+
+def _lateral_accel_problem(kind: str, v: float, radius: float, lim: dict) -> str | None:
+    a_lat = v**2 / radius
+    if a_lat > lim["lateral_accel"] * (1 + 1e-9):
+        return (f"the {kind} asks for {a_lat:.2f} m/s^2 of lateral acceleration "
+                f"({v:.1f} m/s on a {radius:g} m radius), over limits.lateral_accel = "
+                f"{lim['lateral_accel']:.2f} m/s^2; slow down or widen the radius")
+    return None
+
+
+def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None = None,
+                       path: Path = ("trajectory", "segments")) -> RoadProfile | None:
+    """Turn validated segments into a ``RoadProfile``.
+
+    With a ``Context``, every manoeuvre the car cannot drive is reported there (naming its
+    segment) and None is returned if there was any; without one, a ValueError is raised.
+    """
+    path_pieces: list[_PathPiece] = []
+    time_pieces: list[_TimePiece] = []
+    zones: list[tuple[float, float, str]] = []
+    v = 0.0
+    t = 0.0
+    failed = False
+
+    def fail(i: int, kind: str, message: str) -> None:
+        nonlocal failed
+        failed = True
+        if ctx is None:
+            raise ValueError(f"{'.'.join(map(str, path))}.{i}.{kind}: {message}")
+        ctx.error(path + (i, kind), message)
+
+    def drive_time(pieces: list[_TimePiece]) -> float:
+        return sum(p.duration for p in pieces)
+
+    def change_speed(target: float, accel: float) -> None:
+        nonlocal v
+        pieces = _speed_change(v, target, accel, limits["jerk"])
+        dist = _distance_of(pieces, v)
+        if dist > 0:
+            path_pieces.append(_PathPiece(dist, _ZERO, _ZERO, _ZERO))
+        time_pieces.extend(pieces)
+        v = target
+
+    for i, item in enumerate(segments):
+        (kind, seg), = item.items()
+        t_start = t + 0.0
+        n_time = len(time_pieces)
+        if seg.get("speed") is not None:
+            change_speed(seg["speed"], limits["accel"])
+        if kind == "stop":
+            change_speed(0.0, limits["accel"])
+            time_pieces.append(_TimePiece(seg["duration"], 0.0))
+        elif kind == "accelerate":
+            change_speed(seg["to_speed"], seg["accel"])
+        else:
+            if v <= 0.0:
+                fail(i, kind, f"the vehicle is standing still here; a {kind} needs speed "
+                              "(add an accelerate segment or give speed)")
+                continue
+            if kind == "straight":
+                if (seg["length"] is None) == (seg["duration"] is None):
+                    fail(i, kind, "give exactly one of length or duration")
+                    continue
+                length = seg["length"] if seg["length"] is not None else seg["duration"] * v
+                pieces = [_PathPiece(length, _ZERO, _ZERO, _ZERO)]
+            elif kind == "turn":
+                problem = _lateral_accel_problem("turn", v, seg["radius"], limits)
+                if problem:
+                    fail(i, kind, problem)
+                    continue
+                if seg["angle"] == 0:
+                    fail(i, kind, "angle must not be zero")
+                    continue
+                pieces = _clothoid_turn(np.radians(seg["angle"]), 1.0 / seg["radius"], v,
+                                        limits, np.radians(seg["bank"]))
+            elif kind == "slope":
+                if abs(seg["grade"]) > limits["grade"]:
+                    fail(i, kind, f"grade {seg['grade']:g} is steeper than limits.grade = "
+                                  f"{limits['grade']:g}")
+                    continue
+                gamma = float(np.arctan(seg["grade"]))
+                pieces = _with_grade([_PathPiece(seg["length"], _ZERO, _ZERO, _ZERO)], gamma,
+                                     _grade_ramp_length(v, gamma, limits, seg["length"]))
+            elif kind == "helix":
+                grade = abs(seg["rise"]) / (2 * np.pi * seg["radius"] * seg["turns"])
+                problem = _lateral_accel_problem("helix", v, seg["radius"], limits)
+                if grade > limits["grade"]:
+                    problem = (f"a rise of {seg['rise']:g} m over {seg['turns']:g} turn(s) of "
+                               f"radius {seg['radius']:g} m is a grade of {grade:.3f}, steeper "
+                               f"than limits.grade = {limits['grade']:g}")
+                if problem:
+                    fail(i, kind, problem)
+                    continue
+                pieces = _helix(seg, v, limits)
+            elif kind == "speed_bump":
+                pieces = _speed_bump(seg["height"], seg["length"])
+            else:  # lane_change
+                if abs(seg["offset"]) > 0.4 * seg["length"]:
+                    fail(i, kind, "offset is too large for the length (at most 0.4 x length)")
+                    continue
+                pieces = _lane_change(seg["offset"], seg["length"])
+            path_pieces.extend(pieces)
+            time_pieces.append(_TimePiece(sum(p.length for p in pieces) / v, 0.0))
+        t = t_start + drive_time(time_pieces[n_time:])
+        if seg.get("zone"):
+            zones.append((t_start, t, seg["zone"]))
+    if failed:
+        return None
+    return _assemble(path_pieces, time_pieces, zones)
+
+
+def _ppoly(lengths: list[float], polys: list[np.ndarray]) -> PPoly:
+    degree = max(len(p) for p in polys)
+    c = np.zeros((degree, len(polys)))
+    for j, p in enumerate(polys):
+        c[degree - len(p):, j] = p
+    x = np.concatenate([[0.0], np.cumsum(lengths)])
+    return PPoly(c, x)
+
+
+def _assemble(path_pieces: list[_PathPiece], time_pieces: list[_TimePiece],
+              zones: list[tuple[float, float, str]]) -> RoadProfile:
+    path_pieces = [p for p in path_pieces if p.length > 1e-9]
+    if not path_pieces:
+        path_pieces = [_PathPiece(1.0, _ZERO, _ZERO, _ZERO)]
+    lengths = [p.length for p in path_pieces]
+    curvature = _ppoly(lengths, [p.kappa for p in path_pieces])
+    grade = _ppoly(lengths, [p.grade for p in path_pieces])
+    bank = _ppoly(lengths, [p.bank for p in path_pieces])
+
+    time_pieces = [p for p in time_pieces if p.duration > 1e-12]
+    if not time_pieces:
+        raise ValueError("the drive has no duration")
+    c = np.zeros((4, len(time_pieces)))
+    s = v = a = 0.0
+    for j, p in enumerate(time_pieces):
+        c[:, j] = [p.jerk / 6, a / 2, v, s]
+        tt = p.duration
+        s += v * tt + a * tt**2 / 2 + p.jerk * tt**3 / 6
+        v += a * tt + p.jerk * tt**2 / 2
+        a += p.jerk * tt
+    breaks = np.concatenate([[0.0], np.cumsum([p.duration for p in time_pieces])])
+    return RoadProfile(
+        distance_of_time=PPoly(c, breaks),
+        curvature=curvature,
+        heading=curvature.antiderivative(),
+        grade=grade,
+        bank=bank,
+        duration_s=float(breaks[-1]),
+        zones=zones,
+    )
+

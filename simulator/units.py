@@ -1,0 +1,88 @@
+"""Unit parsing for scenario values: datasheet strings to SI floats, with pint.
+
+A scenario value may be a plain number (SI, or degrees for plain angles) or a string with its unit
+as datasheets print it: ``"0.02 deg/s/sqrt(Hz)"``, ``"70 mg"``, ``"10 deg/h"``, ``"1.3 Pa"``,
+``"2 %"``. Datasheet habits pint does not know are rewritten first: ``sqrt(X)`` and ``√X`` become
+``(X)**0.5``, and where an acceleration is expected ``g``/``mg``/``ug`` mean standard gravity
+(9.80665 m/s^2), not grams.
+
+Public functions
+----------------
+to_si, UnitError.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+
+import pint
+
+from simulator.earth import G0_M_S2
+
+
+class UnitError(ValueError):
+    """A value whose unit cannot be read or has the wrong dimension."""
+
+
+@functools.cache
+def _registry() -> pint.UnitRegistry:
+    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+    ureg.define(f"gee = {G0_M_S2} * meter / second ** 2")
+    ureg.define("ppb = 1e-9 = _ = parts_per_billion")
+    return ureg
+
+
+_SQRT = re.compile(r"(?:sqrt|√)\s*\(([^()]*)\)")
+_SQRT_BARE = re.compile(r"√\s*([A-Za-z]+)")
+_GRAVITY_G = re.compile(r"(?<![A-Za-z_])([mµu]?)g(?![A-Za-z_0-9])")
+
+
+def _rewrite(text: str, gravity: bool) -> str:
+    text = _SQRT.sub(r"(\1)**0.5", text)
+    text = _SQRT_BARE.sub(r"(\1)**0.5", text)
+    text = text.replace("%", " percent ").replace("°", " deg ")
+    if gravity:
+        text = _GRAVITY_G.sub(lambda m: f"{m.group(1).replace('µ', 'u')}gee", text)
+    return text
+
+
+@functools.cache
+def _dimensionality(unit: str):
+    return _registry().parse_expression(_rewrite(unit, False)).dimensionality
+
+
+def to_si(value: str, si_unit: str) -> float:
+    """Convert a string with a unit to a float in ``si_unit``.
+
+    Parameters
+    ----------
+    value : str
+        For example ``"0.02 deg/s/sqrt(Hz)"``.
+    si_unit : str
+        The unit the result is expressed in, which also fixes the expected dimension, e.g.
+        ``"rad/s/sqrt(Hz)"``. Use ``""`` for dimensionless values (``"2 %"`` gives 0.02).
+
+    Raises
+    ------
+    UnitError
+        If the string cannot be parsed or its dimension differs from ``si_unit``'s.
+    """
+    ureg = _registry()
+    target = _dimensionality(si_unit) if si_unit else ureg.dimensionless.dimensionality
+    last_error = ""
+    for gravity in (False, True):
+        try:
+            quantity = ureg.parse_expression(_rewrite(value.strip(), gravity))
+        except Exception as exc:  # pint raises several unrelated exception types
+            last_error = f"cannot read {value!r} as a quantity ({exc})"
+            continue
+        if not isinstance(quantity, pint.Quantity):
+            quantity = ureg.Quantity(float(quantity))
+        if quantity.dimensionality == target:
+            return float(quantity.to(_rewrite(si_unit, False) or "dimensionless").magnitude)
+        last_error = (
+            f"{value!r} has the dimension {quantity.dimensionality}, "
+            f"expected a value in {si_unit or 'dimensionless units'} ({target})"
+        )
+    raise UnitError(last_error)
