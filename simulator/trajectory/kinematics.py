@@ -20,6 +20,7 @@ Kinematics, kinematics_from_profile.
 
 from __future__ import annotations
 
+import datetime as dt
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +36,7 @@ from simulator.earth import (
     transport_rate_ned,
     wrap_angle,
 )
+from simulator.timebase import utc_to_gps
 from simulator.trajectory.segments import RoadProfile
 
 
@@ -71,6 +73,11 @@ class Kinematics:
         n = int(np.floor(self.duration_s * self.rate_hz + 1e-9)) + 1
         self.t_grid = np.arange(n) / self.rate_hz
         self._breaks: np.ndarray | None = None
+        # set by the dataset generator from the scenario: when the drive starts, and the
+        # resolved ``environment`` block (zones and their sky, canyon and magnetic settings)
+        self.utc_start: dt.datetime = dt.datetime(2020, 1, 1)
+        self.gps_week, self.gps_tow = utc_to_gps(self.utc_start)
+        self.environment: dict = {"zones": {}}
         self._integrate_position()
 
     # -- along-road quantities --------------------------------------------------------------

@@ -1,0 +1,24 @@
+"""The environment the drive happens in: named zones (tunnel, garage, urban canyon) and what each
+does to the sky, signals and fields.
+
+Public names
+------------
+ENVIRONMENT_FIELD, ZONE_FIELD.
+"""
+
+from __future__ import annotations
+
+from simulator.scenario.schema import MapOf, Number, Record, Text
+
+ZONE_FIELD = Record(
+    {
+        "sky": Text("open", choices=["open", "none", "canyon"],
+                    doc="open sky, no sky (tunnel, garage: every satellite blocked), or an "
+                        "urban canyon"),
+        "building_height": Number("m", 30.0, min=0, doc="canyon: height of the buildings"),
+        "street_width": Number("m", 20.0, gt=0, doc="canyon: width between the facades"),
+    },
+    default={},
+)
+
+ENVIRONMENT_FIELD = Record({"zones": MapOf(ZONE_FIELD, {})}, default={})
