@@ -8,6 +8,7 @@ SensorModel, sample_times, integrate_over_samples.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -38,14 +39,27 @@ def sample_times(duration_s: float, rate_hz: float, first: int = 0) -> np.ndarra
     return np.arange(first, n + 1) / rate_hz
 
 
-def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
-                           keys: tuple[str, ...] = ("w_body", "f_body")) -> dict[str, np.ndarray]:
+def integrate_over_samples(
+    truth: Kinematics, t_end: np.ndarray, dt: float | np.ndarray,
+    keys: tuple[str, ...] = ("w_body", "f_body"),
+    derive: Callable[[dict[str, np.ndarray]], dict[str, np.ndarray]] | None = None,
+) -> dict[str, np.ndarray]:
     """Integrals of truth vectors over each sample interval (t_end - dt, t_end].
 
     Three-point Gauss-Legendre quadrature of the exact kinematics (exact for polynomials up to
     degree 5): this is the anti-aliased increment an integrating IMU outputs.
+
+    Parameters
+    ----------
+    truth : the exact kinematics.
+    t_end : ndarray, shape (n,), interval end times, s.
+    dt : interval length(s), s: a number or shape (n,).
+    keys : vector quantities of ``truth.inertial`` to integrate.
+    derive : optional function of the ``truth.inertial`` dict at the quadrature nodes returning
+        further integrands (each shape (m, 3)), which are integrated too.
     """
     n_nodes = len(GL_NODES)
+    dt = np.broadcast_to(np.asarray(dt, dtype=float), np.shape(t_end))
     lo, hi = t_end - dt, t_end
     # intervals holding a breakpoint of the piecewise kinematics are split there, so every
     # quadrature runs over a smooth stretch and stays exact
@@ -53,12 +67,12 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
     first = np.searchsorted(breaks, lo, side="right")
     last = np.searchsorted(breaks, hi, side="left")
     split = np.flatnonzero(last > first)
-    starts, lengths, owner = [lo], [np.full(len(t_end), dt)], [np.arange(len(t_end))]
+    starts, lengths, owner = [lo], [dt], [np.arange(len(t_end))]
     if len(split):
         starts.pop(), lengths.pop(), owner.pop()
         smooth = np.flatnonzero(last <= first)
         starts.append(lo[smooth])
-        lengths.append(np.full(len(smooth), dt))
+        lengths.append(dt[smooth])
         owner.append(smooth)
         for i in split:
             edges = np.concatenate([[lo[i]], breaks[first[i]:last[i]], [hi[i]]])
@@ -68,6 +82,10 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
     start, length, idx = (np.concatenate(a) for a in (starts, lengths, owner))
     nodes = (start[:, None] + length[:, None] * GL_NODES[None, :]).ravel()
     k = truth.inertial(nodes)
+    if derive is not None:
+        extra = derive(k)
+        k.update(extra)
+        keys = tuple(keys) + tuple(extra)
     out = {}
     for key in keys:
         values = k[key].reshape(len(start), n_nodes, -1)

@@ -1,23 +1,72 @@
-"""Inertial measurement unit: samples the exact body rate and specific force as rates or as
-increments integrated over each sample interval.
+"""Inertial measurement unit: the exact body rate and specific force with a per-axis MEMS error
+model, sampled as rates or as increments integrated over each sample interval.
 
-The ``ideal`` preset turns every error term off: its rate output is the truth sampled at the IMU
-rate and its increment output is the exact integral over each interval (Gauss-Legendre on the
-analytic kinematics), which is what the strapdown closure test integrates.
+Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the sensor frame::
+
+    y = x + (S + M) x + b0 + b_in(t) + b_rw(t) + k_T dT(t) + G f  (gyro only) + n
+
+* ``x``: the true rate (w_ib, rad/s) or specific force (m/s^2) at the unit, rotated by the
+  ``mounting`` (roll, pitch, yaw of the unit in the vehicle, degrees): x_s = C_v^s x_v, with the
+  lever-arm terms dw/dt x r + w x (w x r) added to the specific force (Groves eq. 6.43 rearranged).
+  dw/dt is a central difference (step 1 ms) of the analytic body rate.
+* ``S + M``: diagonal scale-factor errors and off-diagonal misalignment / cross-axis coupling,
+  each drawn once per run, N(0, ``scale_factor``^2) and N(0, ``misalignment``^2).
+* ``b0``: turn-on bias, N(0, ``bias``^2) per axis.
+* ``b_in``: in-run bias instability B. With ``bias_correlation_time`` tau_c: a first-order
+  Gauss-Markov process whose Allan-deviation peak (at 1.89 tau_c) is 0.664 B, i.e. its stationary
+  std is 0.664 B / 0.6174; without: a flicker process (sum of Gauss-Markov processes, see
+  ``simulator.sensors.noise``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
+  discretised exactly, so their statistics do not depend on the rate.
+* ``b_rw``: rate / acceleration random walk of density ``random_walk`` (rad/s^2/sqrt(Hz),
+  m/s^3/sqrt(Hz)), starting at zero.
+* ``k_T dT``: bias change with temperature; k_T per axis is drawn N(0, ``temperature_coefficient``
+  ^2) and dT(t) = offset + warmup (1 - exp(-t / warmup_time)) is the unit's temperature profile
+  (``temperature`` block, kelvin from the calibration temperature).
+* ``G f``: gyro g-sensitivity, a 3 x 3 matrix with elements N(0, ``g_sensitivity``^2),
+  rad/s per m/s^2.
+* ``n``: white noise of density N: sigma = N sqrt(rate) on rate output and N sqrt(dt) on the
+  increment (IEEE Std 952 angle / velocity random walk).
+
+Then saturation at +-``range`` and quantisation to ``resolution``. Increment output (``output:
+increment``) integrates the truth exactly over each interval (anti-aliased, Gauss-Legendre on the
+analytic kinematics); its error terms are the rate terms times dt, its saturation limit is
+range x dt and its quantum resolution x dt, with the rounding remainder carried to the next
+sample as integrating IMUs do (so the summed increments are exact to one quantum).
+``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t.
+
+Every parameter of a group is one number for all three axes or a list of three (x, y, z).
+Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 mrad" accepted).
+``axes`` lists the channels the unit has, or names a reduced unit of the seeds: ``riss3d``
+(Karamat 2015: vertical gyro, forward and lateral accelerometers), ``drm1`` (Cho 2006: two
+accelerometers and a yaw gyro) and ``drm2`` (Cho 2006: forward accelerometer, pitch and yaw gyros).
+The drawn values (turn-on biases, scale factors, misalignment and g-sensitivity matrices,
+temperature coefficients) are in ``drawn``. The ``ideal`` preset turns every error off: its rate
+output is the truth sampled at the IMU rate and its increment output the exact integral.
 
 Public names
 ------------
-IMU_FIELD, Imu.
+IMU_FIELD, REDUCED_UNITS, Imu.
+
+References
+----------
+Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed.,
+2013, section 4.4 (eqs. 4.16-4.17). IEEE Std 952-1997, Annex C.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from simulator import columns as col
+from simulator.earth import euler_to_dcm
 from simulator.scenario.schema import (
+    INVALID,
     Context,
+    Either,
+    Field,
     ListOf,
     Number,
     Path,
@@ -26,30 +75,126 @@ from simulator.scenario.schema import (
     Vector,
 )
 from simulator.sensors.base import integrate_over_samples, sample_times
+from simulator.sensors.imu_presets import IMU_PRESETS
+from simulator.sensors.noise import (
+    FLICKER_ADEV_FACTOR,
+    GM_ADEV_PEAK,
+    flicker,
+    gauss_markov,
+    random_walk,
+    white,
+)
 from simulator.trajectory.kinematics import Kinematics
 
-PRESETS: dict[str, dict] = {"ideal": {}}
+REDUCED_UNITS = {
+    "full": list(col.IMU_AXES),
+    "riss3d": ["gyro_z", "accel_x", "accel_y"],
+    "drm1": ["gyro_z", "accel_x", "accel_y"],
+    "drm2": ["gyro_y", "gyro_z", "accel_x"],
+}
+_LEVER_ARM_STEP_S = 1e-3  # central-difference step for the angular acceleration, s
+
+
+class AxisNumber(Field):
+    """One number for all three axes, or a list of three (x, y, z), in ``unit``."""
+
+    def __init__(self, unit: str, default: Any = None, **limits: float):
+        super().__init__(default)
+        self.number = Number(unit, **limits)
+        self.vector = Vector(3, self.number)
+
+    def check(self, value: Any, path: Path, ctx: Context) -> Any:
+        if isinstance(value, (list, tuple)):
+            return self.vector.check(value, path, ctx)
+        return self.number.check(value, path, ctx)
+
+
+def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Field]:
+    fields: dict[str, Field] = {
+        "bias": AxisNumber(unit, min=0),
+        "bias_instability": AxisNumber(unit, min=0),
+        "bias_correlation_time": Number("s", None, gt=0),
+        "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
+        "random_walk": AxisNumber(random_walk_unit, min=0),
+        "scale_factor": AxisNumber("", min=0),
+        "misalignment": AxisNumber("rad", min=0),
+        "range": AxisNumber(unit, gt=0),
+        "resolution": AxisNumber(unit, min=0),
+        "temperature_coefficient": AxisNumber(f"{unit}/K", min=0),
+    }
+    if gyro:
+        fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0)
+    return fields
+
+
+_GROUPS = {
+    "gyro": _group_fields("rad/s", "rad/s^2/sqrt(Hz)", gyro=True),
+    "accel": _group_fields("m/s^2", "m/s^3/sqrt(Hz)", gyro=False),
+}
+_UNSET_IS_NONE = ("bias_correlation_time", "range")  # absent means "no such term", not zero
 
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
-    if value["preset"] not in PRESETS:
-        ctx.error(path + ("preset",), f"unknown IMU preset {value['preset']!r}; known: "
-                                      f"{', '.join(sorted(PRESETS))}")
-    return value
+    """Merge the preset into the resolved block (explicit values win) and expand ``axes``."""
+    name = value["preset"]
+    if name not in IMU_PRESETS:
+        return ctx.error(path + ("preset",), f"unknown IMU preset {name!r}; known: "
+                                             f"{', '.join(sorted(IMU_PRESETS))}")
+    preset = IMU_PRESETS[name]
+    out = dict(value)
+    out["rate"] = value["rate"] if value["rate"] is not None else float(preset.get("rate", 100.0))
+    out["output"] = value["output"] or preset.get("output", "rate")
+    for group, fields in _GROUPS.items():
+        given = dict(value[group] or {})
+        for key, field in fields.items():
+            if given.get(key) is not None:
+                continue
+            raw = preset.get(group, {}).get(key)
+            if raw is not None:
+                given[key] = field.check(raw, path + (group, key), ctx)
+            else:
+                given[key] = None if key in _UNSET_IS_NONE else 0.0
+        out[group] = given
+    axes = value["axes"]
+    out["axes"] = list(REDUCED_UNITS[axes]) if isinstance(axes, str) else axes
+    failed = any(v is INVALID for group in _GROUPS for v in out[group].values())
+    for group in _GROUPS:
+        limit, res = out[group]["range"], out[group]["resolution"]
+        if limit is not None and np.any(np.asarray(res) >= np.asarray(limit)):
+            ctx.error(path + (group, "resolution"), "must be smaller than range")
+            failed = True
+    return INVALID if failed else out
 
 
 IMU_FIELD = Record(
     {
         "preset": Text("ideal", doc="named parameter set; 'ideal' turns every error off"),
-        "rate": Number("Hz", 100.0, gt=0, max=10000),
-        "output": Text("rate", choices=["rate", "increment"]),
-        "axes": ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1),
-        "lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
-        "mounting": Vector(3, Number(angle=True), [0.0, 0.0, 0.0]),
+        "rate": Number("Hz", None, gt=0, max=10000, doc="sample rate (default: the preset's, "
+                                                        "else 100 Hz)"),
+        "output": Text(None, choices=["rate", "increment"]),
+        "axes": Either(Text(choices=list(REDUCED_UNITS)),
+                       ListOf(Text(choices=list(col.IMU_AXES)), min_len=1), default="full",
+                       doc="channels of the unit, or a reduced unit: " + ", ".join(REDUCED_UNITS)),
+        "lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
+                            doc="position of the unit from the vehicle reference point, FRD"),
+        "mounting": Vector(3, Number(angle=True), [0.0, 0.0, 0.0],
+                           doc="roll, pitch, yaw of the unit in the vehicle"),
+        "timestamp_jitter": Number("s", 0.0, min=0, doc="1-sigma sampling-time error"),
+        "temperature": Record({
+            "offset": Number("K", 0.0, doc="temperature at t = 0 minus calibration temperature"),
+            "warmup": Number("K", 0.0, doc="temperature rise during the warm-up"),
+            "warmup_time": Number("s", 600.0, gt=0, doc="time constant of the warm-up"),
+        }, default={}),
+        "gyro": Record(_GROUPS["gyro"], default=None),
+        "accel": Record(_GROUPS["accel"], default=None),
     },
     default=None,
     post=_resolve,
 )
+
+
+def _per_axis(value: float | list[float] | None) -> np.ndarray:
+    return np.broadcast_to(np.asarray(0.0 if value is None else value, dtype=float), (3,))
 
 
 class Imu:
@@ -60,19 +205,110 @@ class Imu:
     def __init__(self, config: dict):
         self.config = config
         self.rate_hz = float(config["rate"])
+        self.increment = config["output"] == "increment"
         self.drawn: dict = {"preset": config["preset"]}
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    # -- truth at the unit ------------------------------------------------------------------
+    def _true_values(self, truth: Kinematics, t: np.ndarray,
+                     rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """True rate and specific force (or their increments) at the unit, sensor frame."""
         dt = 1.0 / self.rate_hz
-        if self.config["output"] == "increment":
-            t = sample_times(truth.duration_s, self.rate_hz, first=1)
-            k = integrate_over_samples(truth, t, dt)
+        jitter = float(self.config["timestamp_jitter"])
+        t_true = t + jitter * rng.standard_normal(len(t)) if jitter > 0 else t
+        lever = np.asarray(self.config["lever_arm"], dtype=float)
+        if self.increment:
+            t_start = np.concatenate([[t_true[0] - dt], t_true[:-1]]) if jitter > 0 else t - dt
+            k = integrate_over_samples(truth, t_true, t_true - t_start,
+                                       derive=_centripetal(lever) if lever.any() else None)
+            w, f = k["w_body"], k["f_body"]
+            if lever.any():
+                dw = truth.inertial(t_true)["w_body"] - truth.inertial(t_start)["w_body"]
+                f = f + np.cross(dw, lever) + k["centripetal"]
         else:
-            t = sample_times(truth.duration_s, self.rate_hz)
-            k = truth.inertial(t)
-        values = np.concatenate([k["w_body"], k["f_body"]], axis=1)
+            k = truth.inertial(t_true)
+            w, f = k["w_body"], k["f_body"]
+            if lever.any():
+                h = _LEVER_ARM_STEP_S
+                dw = (truth.inertial(t_true + h)["w_body"]
+                      - truth.inertial(t_true - h)["w_body"]) / (2 * h)
+                f = f + np.cross(dw, lever) + np.cross(w, np.cross(w, lever))
+        mount = self.config["mounting"]
+        if any(mount):
+            c_sv = euler_to_dcm(*np.radians(mount)).T
+            w, f = w @ c_sv.T, f @ c_sv.T
+        return w, f
+
+    # -- errors -----------------------------------------------------------------------------
+    def _errors(self, group: str, x: np.ndarray, t: np.ndarray, f_true: np.ndarray,
+                rng: np.random.Generator) -> np.ndarray:
+        """Apply the group's error model to the true values x (n, 3); returns the output."""
+        p = self.config[group]
+        n = len(t)
+        dt = 1.0 / self.rate_hz
+        scale = dt if self.increment else 1.0  # rate terms -> increment terms
+        bias0 = _per_axis(p["bias"]) * rng.standard_normal(3)
+        sf = _per_axis(p["scale_factor"]) * rng.standard_normal(3)
+        mis = _per_axis(p["misalignment"])[:, None] * rng.standard_normal((3, 3))
+        np.fill_diagonal(mis, 0.0)
+        k_temp = _per_axis(p["temperature_coefficient"]) * rng.standard_normal(3)
+        drawn = {"bias": bias0.tolist(), "scale_factor": sf.tolist(),
+                 "misalignment": mis.tolist(), "temperature_coefficient": k_temp.tolist()}
+        y = x + x @ (np.diag(sf) + mis).T
+        bias = np.broadcast_to(bias0, (n, 3)).copy()
+        instability = _per_axis(p["bias_instability"])
+        if instability.any():
+            if p["bias_correlation_time"]:
+                sigma = FLICKER_ADEV_FACTOR * instability / GM_ADEV_PEAK
+                bias += gauss_markov(n, dt, sigma, p["bias_correlation_time"], rng)
+            else:
+                bias += flicker(n, dt, instability, rng)
+        walk = _per_axis(p["random_walk"])
+        if walk.any():
+            bias += random_walk(n, dt, walk, rng)
+        temp = self.config["temperature"]
+        if k_temp.any() and (temp["offset"] or temp["warmup"]):
+            d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
+            bias += d_temp[:, None] * k_temp
+        y = y + bias * scale
+        if group == "gyro":
+            g_matrix = float(p["g_sensitivity"]) * rng.standard_normal((3, 3))
+            drawn["g_sensitivity"] = g_matrix.tolist()
+            if g_matrix.any():
+                y = y + f_true @ g_matrix.T
+        density = _per_axis(p["noise_density"])
+        if density.any():
+            y = y + white(n, dt, density, rng, increment=self.increment)
+        if p["range"] is not None:
+            limit = _per_axis(p["range"]) * scale
+            y = np.clip(y, -limit, limit)
+        quantum = _per_axis(p["resolution"]) * scale
+        if quantum.any():
+            q = np.where(quantum > 0, quantum, 1.0)
+            if self.increment:
+                counts = np.round(np.cumsum(y, axis=0) / q)
+                stepped = np.diff(counts, axis=0, prepend=0.0) * q
+            else:
+                stepped = np.round(y / q) * q
+            y = np.where(quantum > 0, stepped, y)
+        self.drawn[group] = drawn
+        return y
+
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+        t = sample_times(truth.duration_s, self.rate_hz, first=1 if self.increment else 0)
+        w, f = self._true_values(truth, t, rng)
+        gyro = self._errors("gyro", w, t, f, rng)
+        accel = self._errors("accel", f, t, f, rng)
+        values = np.concatenate([gyro, accel], axis=1)
         table = {"t": t}
         for i, axis in enumerate(col.IMU_AXES):
             if axis in self.config["axes"]:
                 table[axis] = values[:, i]
         return {"imu": pd.DataFrame(table)}
+
+
+def _centripetal(lever_arm: np.ndarray):
+    """Integrand w x (w x r) of the lever-arm specific force, for ``integrate_over_samples``."""
+    def derive(k: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        w = k["w_body"]
+        return {"centripetal": np.cross(w, np.cross(w, lever_arm))}
+    return derive
