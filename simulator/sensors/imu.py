@@ -18,7 +18,8 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
   ``simulator.sensors.noise``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
   discretised exactly, so their statistics do not depend on the rate.
 * ``b_rw``: rate / acceleration random walk of density ``random_walk`` (rad/s^2/sqrt(Hz),
-  m/s^3/sqrt(Hz)), starting at zero.
+  m/s^3/sqrt(Hz)), starting at zero, plus a rate ramp R t (IEEE Std 952 "rate ramp", Allan
+  deviation R tau / sqrt(2)) of magnitude ``ramp`` (rad/s^2, m/s^3) and a drawn sign.
 * ``k_T dT``: bias change with temperature; k_T per axis is drawn N(0, ``temperature_coefficient``
   ^2) and dT(t) = offset + warmup (1 - exp(-t / warmup_time)) is the unit's temperature profile
   (``temperature`` block, kelvin from the calibration temperature).
@@ -27,7 +28,8 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
 * ``n``: white noise of density N: sigma = N sqrt(rate) on rate output and N sqrt(dt) on the
   increment (IEEE Std 952 angle / velocity random walk).
 
-Then saturation at +-``range`` and quantisation to ``resolution``. Increment output (``output:
+Then the sensor's internal first-order low-pass of corner ``bandwidth`` (Hz; none when unset),
+saturation at +-``range`` and quantisation to ``resolution``. Increment output (``output:
 increment``) integrates the truth exactly over each interval (anti-aliased, Gauss-Legendre on the
 analytic kinematics); its error terms are the rate terms times dt, its saturation limit is
 range x dt and its quantum resolution x dt, with the rounding remainder carried to the next
@@ -59,6 +61,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from scipy.signal import lfilter
 
 from simulator import columns as col
 from simulator.earth import euler_to_dcm
@@ -116,11 +119,13 @@ def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Fie
         "bias_correlation_time": Number("s", None, gt=0),
         "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
         "random_walk": AxisNumber(random_walk_unit, min=0),
+        "ramp": AxisNumber(f"{unit}/s", min=0),
         "scale_factor": AxisNumber("", min=0),
         "misalignment": AxisNumber("rad", min=0),
         "range": AxisNumber(unit, gt=0),
         "resolution": AxisNumber(unit, min=0),
         "temperature_coefficient": AxisNumber(f"{unit}/K", min=0),
+        "bandwidth": AxisNumber("Hz", gt=0),
     }
     if gyro:
         fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0)
@@ -131,7 +136,8 @@ _GROUPS = {
     "gyro": _group_fields("rad/s", "rad/s^2/sqrt(Hz)", gyro=True),
     "accel": _group_fields("m/s^2", "m/s^3/sqrt(Hz)", gyro=False),
 }
-_UNSET_IS_NONE = ("bias_correlation_time", "range")  # absent means "no such term", not zero
+# keys whose absence means "no such term" rather than zero
+_UNSET_IS_NONE = ("bias_correlation_time", "range", "bandwidth")
 
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
@@ -265,6 +271,10 @@ class Imu:
         walk = _per_axis(p["random_walk"])
         if walk.any():
             bias += random_walk(n, dt, walk, rng)
+        ramp = _per_axis(p["ramp"]) * rng.choice([-1.0, 1.0], size=3)
+        drawn["ramp"] = ramp.tolist()
+        if ramp.any():
+            bias += t[:, None] * ramp
         temp = self.config["temperature"]
         if k_temp.any() and (temp["offset"] or temp["warmup"]):
             d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
@@ -278,6 +288,8 @@ class Imu:
         density = _per_axis(p["noise_density"])
         if density.any():
             y = y + white(n, dt, density, rng, increment=self.increment)
+        if p["bandwidth"] is not None:
+            y = _low_pass(y, _per_axis(p["bandwidth"]), dt)
         if p["range"] is not None:
             limit = _per_axis(p["range"]) * scale
             y = np.clip(y, -limit, limit)
@@ -304,6 +316,16 @@ class Imu:
             if axis in self.config["axes"]:
                 table[axis] = values[:, i]
         return {"imu": pd.DataFrame(table)}
+
+
+def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarray:
+    """First-order low-pass y[k] = a y[k-1] + (1 - a) x[k], a = exp(-2 pi f_c dt), per column,
+    started in steady state on the first sample (the sensor's internal digital filter)."""
+    out = np.empty_like(y)
+    for j, f_c in enumerate(bandwidth_hz):
+        a = np.exp(-2 * np.pi * f_c * dt_s)
+        out[:, j], _ = lfilter([1 - a], [1, -a], y[:, j], zi=[a * y[0, j]])
+    return out
 
 
 def _centripetal(lever_arm: np.ndarray):

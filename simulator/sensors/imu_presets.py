@@ -26,7 +26,9 @@ Sources
   are assumed (0.5 deg/s, 10 mg, 0.5 %).
 - ``bosch-bmi160``, ``adis16448``: fitted to the 2 h static Allan-deviation curves of real units
   (imu_utils data, ``shared/refdata/allan/imu_utils_real_imus/``) by ``tools/fit_imu_presets.py``:
-  per-axis white noise, flicker bias instability and random walk.
+  per-axis white noise, flicker bias instability, random walk, rate ramp and output bandwidth.
+  Only the noise terms are fitted: the static curves say nothing about turn-on bias or scale
+  factor, which are left at zero (override them in the scenario).
 - ``consumer``, ``automotive``, ``tactical``, ``navigation``: representative values inside the
   grade ranges of Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation
   Systems*, 2nd ed., 2013, section 4.4 (Tables 4.1 and 4.2).
@@ -118,5 +120,32 @@ IMU_PRESETS: dict[str, dict] = {
                  "noise_density": "0.1 deg/s/sqrt(Hz)", "range": "300 deg/s"},
         "accel": {"bias": "10 mg", "scale_factor": "0.5 %", "noise_density": "0.2 mg/sqrt(Hz)",
                   "range": "10 g"},
+    },
+    # fitted by tools/fit_imu_presets.py (SI units, per axis x, y, z)
+    "bosch-bmi160": {
+        "rate": 200.0,
+        "gyro": {"noise_density": [8.68e-05, 7.52e-05, 7.85e-05],
+                 "bias_instability": [5.51e-05, 2.82e-05, 2.15e-05],
+                 "random_walk": [3.23e-06, 0.0, 2.39e-06],
+                 "ramp": [1.22e-08, 7.14e-08, 7.2e-08],
+                 "bandwidth": [61.4, 58.1, 60.4]},
+        "accel": {"noise_density": [0.00136, 0.00114, 0.00157],
+                  "bias_instability": [0.000287, 0.000741, 0.00089],
+                  "random_walk": [6.09e-05, 1.5e-05, 0.0],
+                  "ramp": [4.21e-06, 2.86e-06, 1.64e-06],
+                  "bandwidth": [73.8, 56.6, 67.4]},
+    },
+    "adis16448": {
+        "rate": 200.0,
+        "gyro": {"noise_density": [0.000162, 0.000165, 0.00017],
+                 "bias_instability": [0.00013, 9.7e-05, 8.59e-05],
+                 "random_walk": [4.69e-06, 1.13e-05, 1.24e-05],
+                 "ramp": [0.0, 0.0, 1.15e-07],
+                 "bandwidth": [57.1, 56.4, 55.7]},
+        "accel": {"noise_density": [0.00174, 0.00162, 0.00153],
+                  "bias_instability": [0.00112, 0.00316, 0.00112],
+                  "random_walk": [0.000158, 0.000197, 0.00012],
+                  "ramp": [4.68e-07, 0.0, 0.0],
+                  "bandwidth": [56.3, 74.6, 59.8]},
     },
 }

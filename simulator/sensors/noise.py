@@ -34,9 +34,14 @@ from scipy.signal import lfilter
 FLICKER_ADEV_FACTOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
 
 # time constants of the Gauss-Markov processes whose sum makes the flicker floor: two per decade
-# from 0.01 s to 1e5 s, fixed (not tied to the sample rate, so the process is rate independent)
-FLICKER_TAUS_S = 10.0 ** (np.arange(-4, 11) / 2.0)
+# from 0.1 s to 1e5 s, fixed (not tied to the sample rate, so the process is rate independent);
+# the floor is flat within 1 % from about 1 s to 1e4 s
+FLICKER_TAUS_S = 10.0 ** (np.arange(-2, 11) / 2.0)
 _FLICKER_RATIO = 10.0 ** 0.5  # ratio of consecutive time constants
+# a flicker component slower than this many samples per correlation time is generated exactly on
+# a coarser grid of this many points per correlation time and interpolated linearly (the part of
+# its variance the interpolation misses is about 1 / (2 x 64), under 1 %)
+_POINTS_PER_TAU = 64
 
 
 def _gm_avar_unit(x: np.ndarray) -> np.ndarray:
@@ -108,14 +113,44 @@ def flicker(n: int, dt_s: float, instability: np.ndarray, rng: np.random.Generat
 
     Lorentzians with log-uniformly spaced time constants (``FLICKER_TAUS_S``, ratio r between
     neighbours) each of variance B^2 ln(r) / pi sum to the two-sided spectrum B^2 / (2 pi f)
-    between 1 / (2 pi tau_max) and 1 / (2 pi tau_min) (Keshner 1982). Returns shape (n, m).
+    between 1 / (2 pi tau_max) and 1 / (2 pi tau_min) (Keshner 1982). Components with more than
+    128 samples per correlation time run exactly on a grid of tau / 64 and are interpolated.
+
+    Parameters
+    ----------
+    n : number of samples.
+    dt_s : sample interval, s.
+    instability : bias instability B per axis, shape (m,).
+
+    Returns
+    -------
+    ndarray, shape (n, m)
     """
     instability = np.atleast_1d(np.asarray(instability, dtype=float))
     sigma = instability * np.sqrt(np.log(_FLICKER_RATIO) / np.pi)
     total = np.zeros((n, instability.size))
-    for tau in FLICKER_TAUS_S:
-        total += gauss_markov(n, dt_s, sigma, tau, rng)
+    t = np.arange(n) * dt_s
+    # slow components, slowest first, each on its own grid of tau / 64; the running sum is carried
+    # down to each finer grid, and to the sample times once at the end
+    grid, slow = None, None
+    for tau in sorted(FLICKER_TAUS_S, reverse=True):
+        step = tau / _POINTS_PER_TAU
+        if step < 2 * dt_s:
+            total += gauss_markov(n, dt_s, sigma, tau, rng)
+            continue
+        fine = np.arange(int(np.ceil(t[-1] / step)) + 2) * step
+        part = gauss_markov(len(fine), step, sigma, tau, rng)
+        if slow is not None:
+            part += _interp_columns(fine, grid, slow)
+        grid, slow = fine, part
+    if slow is not None:
+        total += _interp_columns(t, grid, slow)
     return total
+
+
+def _interp_columns(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """Linear interpolation of each column of fp (len(xp), m) at x."""
+    return np.stack([np.interp(x, xp, fp[:, j]) for j in range(fp.shape[1])], axis=1)
 
 
 def gauss_markov_avar(tau_s: np.ndarray, sigma: float, corr_time_s: float) -> np.ndarray:
@@ -133,15 +168,17 @@ def flicker_avar(tau_s: np.ndarray, instability: float) -> np.ndarray:
 
 
 def adev_model(tau_s: np.ndarray, noise_density: float = 0.0, bias_instability: float = 0.0,
-               random_walk_density: float = 0.0,
+               random_walk_density: float = 0.0, ramp: float = 0.0,
                correlation_time_s: float | None = None) -> np.ndarray:
-    """Allan deviation of white noise + bias instability + random walk (IEEE Std 952, Annex C).
+    """Allan deviation of white noise + bias instability + random walk + rate ramp
+    (IEEE Std 952, Annex C: N^2 / tau, K^2 tau / 3, R^2 tau^2 / 2).
 
     The bias instability B is a Gauss-Markov process whose Allan peak is 0.664 B when a
     correlation time is given, and the flicker sum of ``flicker`` otherwise.
     """
     tau_s = np.asarray(tau_s, dtype=float)
-    avar = noise_density**2 / tau_s + random_walk_density**2 * tau_s / 3.0
+    avar = (noise_density**2 / tau_s + random_walk_density**2 * tau_s / 3.0
+            + ramp**2 * tau_s**2 / 2.0)
     if bias_instability > 0:
         if correlation_time_s:
             sigma = FLICKER_ADEV_FACTOR * bias_instability / GM_ADEV_PEAK
