@@ -56,10 +56,10 @@ _AUTOMOTIVE = {
 IMU_PRESETS: dict[str, dict] = {
     "ideal": {},
     "consumer": {
-        "gyro": {"bias": "1 deg/s", "bias_instability": "30 deg/h",
-                 "noise_density": "0.01 deg/s/sqrt(Hz)", "random_walk": "5e-4 deg/s^2/sqrt(Hz)",
-                 "scale_factor": "1 %", "misalignment": "5 mrad", "range": "2000 deg/s",
-                 "resolution": "0.06 deg/s", "temperature_coefficient": "0.015 deg/s/K",
+        "gyro": {"bias": "1 deg/s", "bias_instability": "12 deg/h",
+                 "noise_density": "0.007 deg/s/sqrt(Hz)", "random_walk": "2e-4 deg/s^2/sqrt(Hz)",
+                 "scale_factor": "1 %", "misalignment": "5 mrad", "range": "500 deg/s",
+                 "resolution": "0.015 deg/s", "temperature_coefficient": "0.015 deg/s/K",
                  "g_sensitivity": "0.1 deg/s/g"},
         "accel": {"bias": "40 mg", "bias_instability": "0.1 mg",
                   "noise_density": "0.2 mg/sqrt(Hz)", "random_walk": "4e-3 mg/s/sqrt(Hz)",
