@@ -107,9 +107,15 @@ class Kinematics:
 
     # -- position ---------------------------------------------------------------------------
     def _integrate_position(self) -> None:
-        """Geodetic position on the grid: Simpson's rule on dlat/dt, dlon/dt, dh/dt."""
+        """Geodetic position on the grid: Simpson's rule on dlat/dt, dlon/dt, dh/dt.
+
+        The integration grid is the base grid plus the drive's end time, so positions are
+        exact up to the last instant of the drive.
+        """
         t = self.t_grid
-        dt = 1.0 / self.rate_hz
+        if t[-1] < self.duration_s - 1e-9:
+            t = np.append(t, self.duration_s)
+        dt = np.diff(t)
         node = self._motion(t)["v_ned"]
         mid = self._motion(t[:-1] + dt / 2)["v_ned"]
         lat0, lon0 = np.radians(self.origin.lat_deg), np.radians(self.origin.lon_deg)
@@ -135,6 +141,7 @@ class Kinematics:
         rates = np.stack([node[:, 0] / (rn + alt), node[:, 1] / ((re + alt) * np.cos(lat)),
                           -node[:, 2]], axis=-1)
         values = np.stack([lat, lon, alt], axis=-1)
+        self._t_end = t[-1]
         if len(t) > 1:
             self._position = CubicHermiteSpline(t, values, rates, axis=0)
         else:
@@ -142,8 +149,7 @@ class Kinematics:
 
     def position(self, t: np.ndarray) -> np.ndarray:
         """Latitude (rad), longitude (rad), altitude (m) at times t, shape (n, 3)."""
-        return np.atleast_2d(self._position(np.clip(np.asarray(t, float), 0.0,
-                                                    self.t_grid[-1])))
+        return np.atleast_2d(self._position(np.clip(np.asarray(t, float), 0.0, self._t_end)))
 
     # -- the truth columns ------------------------------------------------------------------
     def inertial(self, t: np.ndarray) -> dict[str, np.ndarray]:
