@@ -33,7 +33,7 @@ START_FIELD = Record({
     "lat": Number(angle=True, min=-89.0, max=89.0, doc="latitude, deg"),
     "lon": Number(angle=True, min=-180.0, max=180.0, doc="longitude, deg"),
     "alt": Number("m", 0.0, min=-500.0, max=9000.0, doc="ellipsoidal height, m"),
-    "heading": Number(0.0, angle=True, min=-360.0, max=360.0,
+    "heading": Number(default=0.0, angle=True, min=-360.0, max=360.0,
                       doc="initial heading from true north, deg"),
 })
 
@@ -41,7 +41,7 @@ _INIT_FIELD = Record({
     "position_error": Vector(3, Number("m"), None, doc="north, east, down, m"),
     "velocity_error": Vector(3, Number("m/s"), None, doc="north, east, down, m/s"),
     "attitude_error": Vector(3, Number(angle=True), None, doc="roll, pitch, yaw, deg"),
-    "heading_error": Number(None, angle=True, doc="deg (adds to attitude_error's yaw)"),
+    "heading_error": Number(default=None, angle=True, doc="deg (adds to attitude_error's yaw)"),
 }, default=None)
 
 ESTIMATOR_ENTRY_FIELD = Either(
