@@ -111,3 +111,11 @@ def test_attitude_helpers_against_scipy(angles):
 def test_wrap_angle():
     np.testing.assert_allclose(earth.wrap_angle(np.array([3 * np.pi / 2, -3 * np.pi / 2, 0.1])),
                                [-np.pi / 2, np.pi / 2, 0.1])
+
+
+def test_ned_to_body_is_the_transposed_dcm():
+    rng = np.random.default_rng(3)
+    roll, pitch, yaw = rng.uniform(-3, 3, (3, 50))
+    v = rng.normal(size=(50, 3))
+    expected = np.einsum("nji,nj->ni", earth.euler_to_dcm(roll, pitch, yaw), v)
+    np.testing.assert_allclose(earth.ned_to_body(roll, pitch, yaw, v), expected, atol=1e-14)

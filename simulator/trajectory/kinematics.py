@@ -28,13 +28,12 @@ import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import (
-    earth_rate_ned,
-    ned_to_body,
+    OMEGA_E_RAD_S,
     normal_gravity,
     radii_of_curvature,
-    transport_rate_ned,
     wrap_angle,
 )
+from simulator.earth import ned_to_body_trig as ned_to_body
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.piecewise import PiecewisePolynomial
 from simulator.trajectory.segments import RoadProfile
@@ -106,7 +105,8 @@ class Kinematics:
         a_ned[:, 1] = a * cg * sp + v * (cg * cp * yaw_rate - sg * sp * pitch_rate)
         a_ned[:, 2] = -a * sg - v * cg * pitch_rate
         return dict(s=s, v=v, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
-                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned)
+                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
+                    cos_pitch=cg, sin_pitch=sg, cos_yaw=cp, sin_yaw=sp)
 
     # -- position ---------------------------------------------------------------------------
     def _integrate_position(self) -> None:
@@ -171,27 +171,40 @@ class Kinematics:
 
     # -- the truth columns ------------------------------------------------------------------
     def inertial(self, t: np.ndarray, motion: dict | None = None) -> dict[str, np.ndarray]:
-        """Everything at times t: position, velocity, attitude, w_ib^b and f_ib^b (FRD)."""
+        """Everything at times t: position, velocity, attitude, w_ib^b and f_ib^b (FRD).
+
+        f^n = dv/dt - g^n + (w_en + 2 w_ie) x v (Groves eq. 5.54) and
+        w_ib^b = w_nb^b + C_n^b (w_ie + w_en), written component-wise for speed.
+        """
         t = np.atleast_1d(np.asarray(t, dtype=float))
         m = self._motion(t) if motion is None else motion
         pos = self.position(t)
         lat, alt = pos[:, 0], pos[:, 2]
-        v_ned = m["v_ned"]
-        w_ie = earth_rate_ned(lat)
-        w_en = transport_rate_ned(lat, alt, v_ned)
-        w_in = w_ie + w_en
-        f_ned = m["a_ned"] + np.cross(w_en + 2 * w_ie, v_ned)
-        f_ned[:, 2] -= normal_gravity(lat, alt)
-        roll, pitch, yaw = m["roll"], m["pitch"], m["yaw"]
-        f_body = ned_to_body(roll, pitch, yaw, f_ned)
+        v = m["v_ned"]
+        rn, re = radii_of_curvature(lat)
+        cos_lat, sin_lat = np.cos(lat), np.sin(lat)
+        # Earth rate (Groves eq. 5.41) and transport rate (eq. 5.44) in NED
+        rate_n = v[:, 1] / (re + alt)
+        rate_e = -v[:, 0] / (rn + alt)
+        rate_d = -rate_n * sin_lat / cos_lat
+        ie_n, ie_d = OMEGA_E_RAD_S * cos_lat, -OMEGA_E_RAD_S * sin_lat
+        w_in = np.stack([ie_n + rate_n, rate_e, ie_d + rate_d], axis=-1)
+        cn, ce, cd = 2 * ie_n + rate_n, rate_e, 2 * ie_d + rate_d  # w_en + 2 w_ie
+        f_ned = m["a_ned"].copy()
+        f_ned[:, 0] += ce * v[:, 2] - cd * v[:, 1]
+        f_ned[:, 1] += cd * v[:, 0] - cn * v[:, 2]
+        f_ned[:, 2] += cn * v[:, 1] - ce * v[:, 0] - normal_gravity(lat, alt)
+        roll = m["roll"]
         sr, cr = np.sin(roll), np.cos(roll)
-        sp, cp = np.sin(pitch), np.cos(pitch)
-        w_body = ned_to_body(roll, pitch, yaw, w_in)
+        sp, cp = m["sin_pitch"], m["cos_pitch"]
+        trig = (cr, sr, cp, sp, m["cos_yaw"], m["sin_yaw"])
+        f_body = ned_to_body(*trig, f_ned)
+        w_body = ned_to_body(*trig, w_in)
         w_body[:, 0] += m["roll_rate"] - m["yaw_rate"] * sp
         w_body[:, 1] += m["pitch_rate"] * cr + m["yaw_rate"] * cp * sr
         w_body[:, 2] += -m["pitch_rate"] * sr + m["yaw_rate"] * cp * cr
-        return dict(t=t, lat=lat, lon=pos[:, 1], alt=alt, v_ned=v_ned, roll=roll,
-                    pitch=pitch, yaw=yaw, w_body=w_body, f_body=f_body, speed=m["v"],
+        return dict(t=t, lat=lat, lon=pos[:, 1], alt=alt, v_ned=v, roll=roll,
+                    pitch=m["pitch"], yaw=m["yaw"], w_body=w_body, f_body=f_body, speed=m["v"],
                     distance=m["s"])
 
     def grid_inertial(self, midpoints: bool = False) -> dict[str, np.ndarray]:
