@@ -7,11 +7,14 @@ takes; their second-order error is ~d^2 / R, below 1e-5 m for offsets of a few m
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
 from simulator import columns as col
 from simulator.dataset.generate import build_truth
+from simulator.dataset.io import atomic_output_dir, write_dataset
 from simulator.earth import radii_of_curvature, wrap_angle
 from simulator.scenario import load_scenario
 
@@ -46,3 +49,12 @@ def events(*outages: tuple[float, float]) -> pd.DataFrame:
     rows = [{"t_start": a, "t_end": b, "kind": "gnss_outage", "detail": ""} for a, b in outages]
     rows.append({"t_start": 0.0, "t_end": 5.0, "kind": "zone", "detail": "garage"})
     return pd.DataFrame(rows, columns=list(col.EVENTS))
+
+
+def write_scoring_dataset(directory: Path, truth: pd.DataFrame,
+                          outages: tuple[tuple[float, float], ...]) -> Path:
+    """A minimal dataset on disk (manifest, truth, events) as ``landnav generate`` lays it out."""
+    with atomic_output_dir(directory, force=False) as tmp:
+        write_dataset(tmp, {"scenario": {"name": "test"}, "seed": 0},
+                      {"truth": truth, "events": events(*outages)})
+    return directory
