@@ -43,6 +43,19 @@ class Evaluation:
         """The JSON-ready scores keyed by label."""
         return {label: r.scores for label, r in self.results.items()}
 
+    def warnings(self) -> list[str]:
+        """One line per solution with rows that could not be scored."""
+        out = []
+        for label, r in self.results.items():
+            rows = r.scores["rows"]
+            if rows["outside_truth"]:
+                out.append(f"{label}: {rows['outside_truth']} of {rows['total']} solution rows "
+                           "lie outside the truth's time span and were ignored")
+            if rows["position"] < rows["total"] - rows["outside_truth"]:
+                out.append(f"{label}: {rows['total'] - rows['outside_truth'] - rows['position']}"
+                           " rows without a finite position were skipped")
+        return out
+
 
 def score_solutions(dataset: Dataset,
                     solutions: dict[str, tuple[pd.DataFrame, dict | None]]) -> Evaluation:
