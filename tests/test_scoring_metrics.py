@@ -147,3 +147,17 @@ def test_runtime_is_reported_when_given(truth):
     s = score_solution(truth, events(), truth.iloc[::100],
                        runtime={"runtime_s": 1.5, "realtime_factor": 129.0})
     assert s["runtime"] == {"seconds": 1.5, "realtime_factor": 129.0}
+
+
+def test_outage_without_rows_or_motion_gives_nulls(truth):
+    sol = offset_solution(truth.iloc[::10], dpos=(0.0, 1.0, 0.0))
+    sol = sol.loc[(sol["t"] < 40.0) | (sol["t"] >= 60.0)]  # nothing during the first outage
+    s = score_solution(truth, events((1.0, 5.0), (40.0, 60.0)), sol)
+    standing, gap = s["outages"]
+    assert standing["distance"] == 0.0  # the drive starts with a 10 s stop
+    assert standing["end_horizontal"] == pytest.approx(1.0, abs=ATOL_M)
+    assert standing["end_percent"] is None
+    assert gap["distance"] > 0
+    assert gap["max_horizontal"] is None and gap["end_horizontal"] is None
+    assert gap["end_percent"] is None
+    json.dumps(s, allow_nan=False)
