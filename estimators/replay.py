@@ -177,7 +177,17 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
     if refused:
         raise InputError(f"estimator {cls.name!r} asks for scoring-only stream(s) {refused}")
     names.sort(key=_stream_rank)
-    return [_Stream(s, dataset.read(s), dataset.units(s)) for s in names]
+    return [_Stream(s, dataset.read(s), _units(dataset, s)) for s in names]
+
+
+def _units(dataset: Dataset, name: str) -> dict[str, str]:
+    """Column units of a stream; an IMU configured for increment output has rad and m/s
+    increments whatever its files say (the manifest's resolved scenario is authoritative)."""
+    units = dataset.units(name)
+    imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
+    if name == "imu" and imu.get("output") == "increment":
+        units.update({c: u for c, u in col.IMU_INCREMENT_UNITS.items() if c in units})
+    return units
 
 
 def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from functools import partialmethod
+
 import numpy as np
 
 from estimators.base import Estimator
@@ -26,23 +28,12 @@ class Recorder(Estimator):
     def _record(self, stream: str, t: float, row: np.ndarray) -> None:
         self.seen.append((stream, t, np.array(row)))
 
-    def on_imu(self, t, row):
-        self._record("imu", t, row)
-
-    def on_odometer(self, t, row):
-        self._record("odometer", t, row)
-
-    def on_baro(self, t, row):
-        self._record("baro", t, row)
-
-    def on_mag(self, t, row):
-        self._record("mag", t, row)
-
-    def on_gnss_fix(self, t, row):
-        self._record("gnss_fix", t, row)
-
-    def on_gnss_raw(self, t, rows):
-        self._record("gnss_raw", t, rows)
+    on_imu = partialmethod(_record, "imu")
+    on_odometer = partialmethod(_record, "odometer")
+    on_baro = partialmethod(_record, "baro")
+    on_mag = partialmethod(_record, "mag")
+    on_gnss_fix = partialmethod(_record, "gnss_fix")
+    on_gnss_raw = partialmethod(_record, "gnss_raw")
 
     def solution(self, t):
         self.asked.append((t, len(self.seen)))
