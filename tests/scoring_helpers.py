@@ -1,8 +1,9 @@
 """Test helpers for scoring: a real truth table and solutions built from it with known errors.
 
-Offsets are applied with the curvilinear small-offset formulas (Groves eq. 2.119: dlat = dn /
-(R_N + h), dlon = de / ((R_E + h) cos lat), dh = -dd), independent of the ECEF path the scorer
-takes; their second-order error is ~d^2 / R, below 1e-5 m for offsets of a few metres.
+Offsets are applied with the curvilinear small-offset relations dlat = dn / (R_N + h),
+dlon = de / ((R_E + h) cos lat), dh = -dd (R_N, R_E the meridian and transverse radii of
+curvature), independent of the ECEF path the scorer takes; their second-order error is about
+d^2 / R, below 1e-5 m for offsets of a few metres.
 """
 
 from __future__ import annotations

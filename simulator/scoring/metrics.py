@@ -4,7 +4,8 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
 
 * ``horizontal`` {rms, mean, max, cep50, cep95}: statistics of the horizontal error
   sqrt(err_n^2 + err_e^2); cep50 and cep95 are its empirical 50th and 95th percentiles (linear
-  interpolation between order statistics), the radius of the circle holding that share of fixes;
+  interpolation between order statistics): the radius of the circle about the truth that holds
+  that share of the solution's epochs;
 * ``vertical`` {rms, max}: of |err_d|;
 * ``velocity`` {rms}: RMS of the 3-D velocity error norm;
 * ``attitude`` {roll_rms, pitch_rms, yaw_rms}: RMS of the wrapped Euler-angle errors, deg;
@@ -17,7 +18,8 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   squared of each 3-axis group, e^T P^-1 e with the diagonal covariance of the 1-sigma columns
   (``position``: std_n/e/d, ``velocity``: std_vn/ve/vd, ``attitude``: std_roll/pitch/yaw;
   ``None`` for a group whose three columns are not all present), and ``expected`` = 3, its value
-  for a consistent estimator (Bar-Shalom, Li and Kirubarajan 2001, section 5.4.2);
+  for a consistent estimator (Bar-Shalom, Li and Kirubarajan 2001, section 5.4); the file gives
+  no cross-covariances, so P is taken diagonal;
 * ``runtime`` {seconds, realtime_factor} when the estimator ran inside landnav;
 * ``rows`` {total, outside_truth, position, velocity, attitude}: rows in the solution, rows
   dropped outside the truth's time span, and rows scored in each group (a group's row is scored
@@ -30,8 +32,7 @@ score_errors, score_solution.
 References
 ----------
 Bar-Shalom, Li, Kirubarajan, *Estimation with Applications to Tracking and Navigation*, Wiley,
-2001 (NEES). Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*,
-2nd ed., 2013, section 1.4 (CEP).
+2001 (NEES and filter consistency).
 """
 
 from __future__ import annotations
