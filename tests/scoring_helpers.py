@@ -20,7 +20,7 @@ from simulator.dataset.io import atomic_output_dir, write_dataset
 from simulator.earth import radii_of_curvature, wrap_angle
 from simulator.scenario import load_scenario
 
-QUICKSTART = "scenarios/quickstart.yaml"
+QUICKSTART = Path(__file__).resolve().parents[1] / "scenarios" / "quickstart.yaml"
 
 
 def quickstart_truth() -> pd.DataFrame:
