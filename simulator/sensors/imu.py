@@ -34,7 +34,9 @@ increment``) integrates the truth exactly over each interval (anti-aliased, Gaus
 analytic kinematics); its error terms are the rate terms times dt, its saturation limit is
 range x dt and its quantum resolution x dt, with the rounding remainder carried to the next
 sample as integrating IMUs do (so the summed increments are exact to one quantum).
-``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t.
+``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t (for
+increments: the interval ends move by e, to first order in e). On increment output the lever-arm
+term integrates to dw x r + the three-point Gauss-Legendre integral of w x (w x r).
 
 Every parameter of a group is one number for all three axes or a list of three (x, y, z).
 Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 mrad" accepted).
@@ -77,7 +79,7 @@ from simulator.scenario.schema import (
     Text,
     Vector,
 )
-from simulator.sensors.base import integrate_over_samples, sample_times
+from simulator.sensors.base import GL_NODES, GL_WEIGHTS, integrate_over_samples, sample_times
 from simulator.sensors.imu_presets import IMU_PRESETS
 from simulator.sensors.noise import (
     FLICKER_ADEV_FACTOR,
@@ -209,10 +211,15 @@ class Imu:
     name = "imu"
 
     def __init__(self, config: dict):
-        self.config = config
-        self.rate_hz = float(config["rate"])
-        self.increment = config["output"] == "increment"
-        self.drawn: dict = {"preset": config["preset"]}
+        # a partial block (as built in code rather than read from a scenario) is completed by the
+        # schema; a resolved block passes through unchanged
+        ctx = Context("sensors.imu")
+        self.config = IMU_FIELD.check(config, ("sensors", "imu"), ctx)
+        if ctx.problems:
+            raise ValueError("; ".join(str(p) for p in ctx.problems))
+        self.rate_hz = float(self.config["rate"])
+        self.increment = self.config["output"] == "increment"
+        self.drawn: dict = {"preset": self.config["preset"]}
 
     # -- truth at the unit ------------------------------------------------------------------
     def _true_values(self, truth: Kinematics, t: np.ndarray,
@@ -220,17 +227,23 @@ class Imu:
         """True rate and specific force (or their increments) at the unit, sensor frame."""
         dt = 1.0 / self.rate_hz
         jitter = float(self.config["timestamp_jitter"])
-        t_true = t + jitter * rng.standard_normal(len(t)) if jitter > 0 else t
         lever = np.asarray(self.config["lever_arm"], dtype=float)
         if self.increment:
-            t_start = np.concatenate([[t_true[0] - dt], t_true[:-1]]) if jitter > 0 else t - dt
-            k = integrate_over_samples(truth, t_true, t_true - t_start,
-                                       derive=_centripetal(lever) if lever.any() else None)
+            k = integrate_over_samples(truth, t, dt)
             w, f = k["w_body"], k["f_body"]
+            if jitter > 0 or lever.any():
+                ends = truth.inertial(np.concatenate([[t[0] - dt], t]))
+            if jitter > 0:
+                # interval (t - dt + e0, t + e1]: to first order in e, the exact increment plus
+                # x(t) e1 - x(t - dt) e0
+                e = jitter * rng.standard_normal(len(t) + 1)[:, None]
+                w = w + ends["w_body"][1:] * e[1:] - ends["w_body"][:-1] * e[:-1]
+                f = f + ends["f_body"][1:] * e[1:] - ends["f_body"][:-1] * e[:-1]
             if lever.any():
-                dw = truth.inertial(t_true)["w_body"] - truth.inertial(t_start)["w_body"]
-                f = f + np.cross(dw, lever) + k["centripetal"]
+                dw = np.diff(ends["w_body"], axis=0)
+                f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
         else:
+            t_true = t + jitter * rng.standard_normal(len(t)) if jitter > 0 else t
             k = truth.inertial(t_true)
             w, f = k["w_body"], k["f_body"]
             if lever.any():
@@ -305,7 +318,11 @@ class Imu:
         self.drawn[group] = drawn
         return y
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    def generate(self, truth: Kinematics,
+                 rng: np.random.Generator | None) -> dict[str, pd.DataFrame]:
+        """The ``imu`` stream. ``rng`` may be None only for a unit without random terms (the
+        ideal unit): a fresh generator then makes the (zero-size) draws."""
+        rng = rng if rng is not None else np.random.default_rng()
         t = sample_times(truth.duration_s, self.rate_hz, first=1 if self.increment else 0)
         w, f = self._true_values(truth, t, rng)
         gyro = self._errors("gyro", w, t, f, rng)
@@ -328,9 +345,10 @@ def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarra
     return out
 
 
-def _centripetal(lever_arm: np.ndarray):
-    """Integrand w x (w x r) of the lever-arm specific force, for ``integrate_over_samples``."""
-    def derive(k: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
-        w = k["w_body"]
-        return {"centripetal": np.cross(w, np.cross(w, lever_arm))}
-    return derive
+def _centripetal_increment(truth: Kinematics, t_end: np.ndarray, dt_s: float,
+                           lever_arm: np.ndarray) -> np.ndarray:
+    """Integral of w x (w x r) over each interval (t - dt, t], three-point Gauss-Legendre."""
+    nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
+    w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
+    centripetal = np.cross(w, np.cross(w, lever_arm))
+    return dt_s * np.einsum("j,njk->nk", GL_WEIGHTS, centripetal)
