@@ -89,6 +89,7 @@ from simulator.sensors.noise import (
     random_walk,
     white,
 )
+from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.trajectory.kinematics import Kinematics
 
 REDUCED_UNITS = {
@@ -139,33 +140,27 @@ _GROUPS = {
     "accel": _group_fields("m/s^2", "m/s^3/sqrt(Hz)", gyro=False),
 }
 # keys whose absence means "no such term" rather than zero
-_UNSET_IS_NONE = ("bias_correlation_time", "range", "bandwidth")
+_UNSET_IS_NONE = {"bias_correlation_time": None, "range": None, "bandwidth": None}
 
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
     """Merge the preset into the resolved block (explicit values win) and expand ``axes``."""
-    name = value["preset"]
-    if name not in IMU_PRESETS:
-        return ctx.error(path + ("preset",), f"unknown IMU preset {name!r}; known: "
-                                             f"{', '.join(sorted(IMU_PRESETS))}")
-    preset = IMU_PRESETS[name]
-    out = dict(value)
-    out["rate"] = value["rate"] if value["rate"] is not None else float(preset.get("rate", 100.0))
-    out["output"] = value["output"] or preset.get("output", "rate")
+    if not known_preset(value["preset"], IMU_PRESETS, "IMU", path, ctx):
+        return INVALID
+    preset = IMU_PRESETS[value["preset"]]
+    out = fill_from_preset(value, preset, {"rate": IMU_FIELD.fields["rate"],
+                                           "output": IMU_FIELD.fields["output"]},
+                           path, ctx, {"rate": 100.0, "output": "rate"})
+    if out is INVALID:
+        return INVALID
     for group, fields in _GROUPS.items():
-        given = dict(value[group] or {})
-        for key, field in fields.items():
-            if given.get(key) is not None:
-                continue
-            raw = preset.get(group, {}).get(key)
-            if raw is not None:
-                given[key] = field.check(raw, path + (group, key), ctx)
-            else:
-                given[key] = None if key in _UNSET_IS_NONE else 0.0
-        out[group] = given
+        out[group] = fill_from_preset(value[group] or {}, preset.get(group, {}), fields,
+                                      path + (group,), ctx, _UNSET_IS_NONE)
+        if out[group] is INVALID:
+            return INVALID
     axes = value["axes"]
     out["axes"] = list(REDUCED_UNITS[axes]) if isinstance(axes, str) else axes
-    failed = any(v is INVALID for group in _GROUPS for v in out[group].values())
+    failed = False
     for group in _GROUPS:
         limit, res = out[group]["range"], out[group]["resolution"]
         if limit is not None and np.any(np.asarray(res) >= np.asarray(limit)):
