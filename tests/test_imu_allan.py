@@ -118,8 +118,8 @@ def real_curve(device: str, group: str, axis: str) -> tuple[np.ndarray, np.ndarr
 REAL_UNITS = [(preset, device, group, axis)
               for preset, device in (("bosch-bmi160", "BMI160"), ("adis16448", "16448"))
               for group in ("gyr", "acc") for axis in "xyz"]
-# the ADIS16448 y accelerometer has a bump between 2 s and 200 s (up to 40 % over the fitted
-# white + flicker + random-walk curve) that these noise terms cannot represent
+# the ADIS16448 y accelerometer has a bump between 2 s and 200 s that white noise + flicker +
+# random walk + ramp cannot follow: the best fit (tools/fit_imu_presets.py) is 28 % off
 KNOWN_MISFIT = {("adis16448", "acc", "y")}
 
 

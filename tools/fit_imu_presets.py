@@ -4,7 +4,8 @@ Reads the imu_utils curves in ``shared/refdata/allan/imu_utils_real_imus/`` (2 h
 gyro in deg/h with imu_utils' factor 57.3 * 3600, accelerometer in m/s^2) and fits, per axis:
 
 * the white-noise density N, flicker bias instability B, random-walk density K and rate ramp R of
-  ``simulator.sensors.noise.adev_model`` by least squares on log ADEV over tau >= 5 samples;
+  ``simulator.sensors.noise.adev_model``, minimising the largest log misfit (from a least-squares
+  start) over tau from 5 samples to a tenth of the record;
 * the corner of the sensor's first-order output low-pass (``bandwidth``) from the one-sample
   point, where the filter lowers the white-noise Allan deviation by (1 - a) / sqrt(1 + a),
   a = exp(-2 pi f_c dt) (Allan variance of an AR(1) process at one sample).
@@ -19,7 +20,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from scipy.optimize import brentq, least_squares
+from scipy.optimize import brentq, least_squares, minimize
 
 from simulator.sensors.noise import adev_model
 
@@ -36,15 +37,19 @@ def real_curve(device: str, group: str, axis: str) -> tuple[np.ndarray, np.ndarr
 
 
 def fit_axis(tau: np.ndarray, adev: np.ndarray) -> tuple[np.ndarray, float]:
-    """([N, B, K, R], bandwidth in Hz) for one axis."""
-    use = tau >= 4.5 * tau[0]
+    """([N, B, K, R], bandwidth in Hz) for one axis: least squares, then the largest log misfit
+    minimised over tau from 5 samples to a tenth of the record (twice the longest tau)."""
+    use = (tau >= 4.5 * tau[0]) & (tau <= tau[-1] / 5)
 
     def residual(log_p: np.ndarray) -> np.ndarray:
         return np.log(adev_model(tau[use], *np.exp(log_p))) - np.log(adev[use])
 
     n0 = adev[np.argmin(np.abs(tau - 1.0))]
     start = np.log([n0, adev.min() / 0.664, n0 * 1e-3, n0 * 1e-5])
-    params = np.exp(least_squares(residual, start).x)
+    least = least_squares(residual, start).x
+    params = np.exp(minimize(lambda p: np.max(np.abs(residual(p))), least,
+                             method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-6,
+                                                            "maxiter": 4000}).x)
     ratio = adev[0] / adev_model(tau[:1], *params)[0]
     a = brentq(lambda a: (1 - a) / np.sqrt(1 + a) - ratio, 0.0, 1.0 - 1e-9) if ratio < 1 else 0.0
     bandwidth = -np.log(a) / (2 * np.pi * tau[0]) if a > 0 else np.inf
