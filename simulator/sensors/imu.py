@@ -36,7 +36,8 @@ range x dt and its quantum resolution x dt, with the rounding remainder carried 
 sample as integrating IMUs do (so the summed increments are exact to one quantum).
 ``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t (for
 increments: the interval ends move by e, to first order in e). On increment output the lever-arm
-term integrates to dw x r + the three-point Gauss-Legendre integral of w x (w x r).
+term integrates to dw x r + the integral of w x (w x r) (Simpson on the truth grid, else
+three-point Gauss-Legendre).
 
 Every parameter of a group is one number for all three axes or a list of three (x, y, z).
 Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 mrad" accepted).
@@ -79,7 +80,13 @@ from simulator.scenario.schema import (
     Text,
     Vector,
 )
-from simulator.sensors.base import GL_NODES, GL_WEIGHTS, integrate_over_samples, sample_times
+from simulator.sensors.base import (
+    GL_NODES,
+    GL_WEIGHTS,
+    grid_index,
+    integrate_over_samples,
+    sample_times,
+)
 from simulator.sensors.imu_presets import IMU_PRESETS
 from simulator.sensors.noise import (
     FLICKER_ADEV_FACTOR,
@@ -227,7 +234,7 @@ class Imu:
             k = integrate_over_samples(truth, t, dt)
             w, f = k["w_body"], k["f_body"]
             if jitter > 0 or lever.any():
-                ends = truth.inertial(np.concatenate([[t[0] - dt], t]))
+                ends = _truth_at(truth, np.concatenate([[t[0] - dt], t]))
             if jitter > 0:
                 # interval (t - dt + e0, t + e1]: to first order in e, the exact increment plus
                 # x(t) e1 - x(t - dt) e0
@@ -239,7 +246,7 @@ class Imu:
                 f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
         else:
             t_true = t + jitter * rng.standard_normal(len(t)) if jitter > 0 else t
-            k = truth.inertial(t_true)
+            k = _truth_at(truth, t_true)
             w, f = k["w_body"], k["f_body"]
             if lever.any():
                 h = _LEVER_ARM_STEP_S
@@ -279,7 +286,7 @@ class Imu:
         walk = _per_axis(p["random_walk"])
         if walk.any():
             bias += random_walk(n, dt, walk, rng)
-        ramp = _per_axis(p["ramp"]) * rng.choice([-1.0, 1.0], size=3)
+        ramp = _per_axis(p["ramp"]) * rng.choice([-1.0, 1.0], size=3) + 0.0  # no -0.0
         drawn["ramp"] = ramp.tolist()
         if ramp.any():
             bias += t[:, None] * ramp
@@ -340,10 +347,29 @@ def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarra
     return out
 
 
+def _truth_at(truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
+    """``truth.inertial(t)``, from the truth's cached grid evaluation when t lies on its grid."""
+    k = grid_index(truth, t)
+    if k is None:
+        return truth.inertial(t)
+    grid = truth.grid_inertial()
+    return {key: grid[key][k] for key in ("w_body", "f_body")}
+
+
 def _centripetal_increment(truth: Kinematics, t_end: np.ndarray, dt_s: float,
                            lever_arm: np.ndarray) -> np.ndarray:
-    """Integral of w x (w x r) over each interval (t - dt, t], three-point Gauss-Legendre."""
-    nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
-    w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
+    """Integral of w x (w x r) over each interval (t - dt, t]: Simpson's rule on the truth's
+    cached grid and midpoint values when the intervals are its grid intervals, three-point
+    Gauss-Legendre otherwise."""
+    k = grid_index(truth, t_end)
+    if k is not None and abs(dt_s * truth.rate_hz - 1.0) < 1e-12 and k.min() >= 1:
+        grid = truth.grid_inertial()["w_body"]
+        mid = truth.grid_inertial(midpoints=True)["w_body"]
+        w = np.stack([grid[k - 1], mid[k - 1], grid[k]], axis=1)
+        weights = np.array([1.0, 4.0, 1.0]) / 6.0
+    else:
+        nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
+        w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
+        weights = GL_WEIGHTS
     centripetal = np.cross(w, np.cross(w, lever_arm))
-    return dt_s * np.einsum("j,njk->nk", GL_WEIGHTS, centripetal)
+    return dt_s * np.einsum("j,njk->nk", weights, centripetal)
