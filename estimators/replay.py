@@ -22,6 +22,7 @@ run_estimator, initial_state, merge_streams, output_times, write_solution, read_
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Mapping
 from pathlib import Path
@@ -277,13 +278,20 @@ def _solution_problems(frame: pd.DataFrame) -> list[str]:
 
 
 def write_solution(frame: pd.DataFrame, path: str | Path) -> None:
-    """Write a solution table as Parquet (SPEC section 7); extra columns get unit ""."""
+    """Write a solution table as Parquet (SPEC section 7), atomically; extra columns get unit
+    ""."""
     problems = _solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     units = {**col.SOLUTION, **col.SOLUTION_STD}
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    write_table(frame, Path(path), {c: units.get(c, "") for c in frame.columns})
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"  # never a half-written file
+    try:
+        write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns})
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def read_solution(path: str | Path) -> pd.DataFrame:
