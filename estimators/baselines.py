@@ -76,8 +76,7 @@ class DeadReckoning(Estimator):
         self._t_odo: float | None = None
         # integrals since the last odometer sample of the unit heading vector, A = int u dt, and
         # of its time-weighted version, B = int u (t - t_odo) dt, north and east
-        self._a = np.zeros(2)
-        self._b = np.zeros(2)
+        self._a_n = self._a_e = self._b_n = self._b_e = 0.0
         rn, re = radii_of_curvature(self._lat)
         self._rn, self._re = float(rn), float(re)
 
@@ -102,10 +101,13 @@ class DeadReckoning(Estimator):
             dpsi -= self._level_frame_rate() * dt
         yaw_mid = self._yaw + 0.5 * dpsi
         self._yaw += dpsi
-        u = np.array([math.cos(yaw_mid), math.sin(yaw_mid)])
+        c, s = math.cos(yaw_mid) * dt, math.sin(yaw_mid) * dt
         t_ref = self._t_odo if self._t_odo is not None else self._t_imu
-        self._a += u * dt
-        self._b += u * (0.5 * (self._t_imu + t) - t_ref) * dt
+        lag = 0.5 * (self._t_imu + t) - t_ref
+        self._a_n += c
+        self._a_e += s
+        self._b_n += c * lag
+        self._b_e += s * lag
         self._t_imu = t
 
     def _move(self, d_north: float, d_east: float) -> None:
@@ -116,21 +118,19 @@ class DeadReckoning(Estimator):
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         speed = float(row[self._speed_col])
-        if self._t_odo is None:  # before the first sample the initial speed was held
-            self._move(*(self._speed * self._a))
-        else:
-            span = t - self._t_odo
-            slope = (speed - self._speed) / span if span > 0 else 0.0
-            self._move(*(self._speed * self._a + slope * self._b))
-        self._a[:] = 0.0
-        self._b[:] = 0.0
+        slope = 0.0  # before the first sample the initial speed was held
+        if self._t_odo is not None and t > self._t_odo:
+            slope = (speed - self._speed) / (t - self._t_odo)
+        self._move(self._speed * self._a_n + slope * self._b_n,
+                   self._speed * self._a_e + slope * self._b_e)
+        self._a_n = self._a_e = self._b_n = self._b_e = 0.0
         self._speed = speed
         self._t_odo = t
 
     def solution(self, t: float) -> list[float]:
-        d_north, d_east = self._speed * self._a  # held speed since the last odometer sample
-        lat = self._lat + d_north / (self._rn + self._alt)
-        lon = self._lon + d_east / ((self._re + self._alt) * math.cos(lat))
+        # the speed is held since the last odometer sample
+        lat = self._lat + self._speed * self._a_n / (self._rn + self._alt)
+        lon = self._lon + self._speed * self._a_e / ((self._re + self._alt) * math.cos(lat))
         return [math.degrees(lat), math.degrees(lon), self._alt,
                 self._speed * math.cos(self._yaw), self._speed * math.sin(self._yaw), 0.0,
                 0.0, 0.0, float(wrap_angle(self._yaw))]

@@ -227,6 +227,10 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                   f"{name!r} in streams {[s.name for s in streams]}")])
     initial = None
     if not cls.initialises_itself:
+        if not dataset.has("truth"):
+            raise InputError([Problem(str(dataset.path), None, "", f"estimator {name!r} starts "
+                                      "from the true state, and the dataset has no truth "
+                                      "stream; use an estimator that initialises itself")])
         initial = initial_state(dataset.read("truth"), float(t[0]), init)
     estimator = cls(config, initial, {s.name: s.columns for s in streams},
                     {s.name: s.units for s in streams})
@@ -249,7 +253,12 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
             k += 1
         row = solution(t_out)
         if row is not None:
-            out[j] = row
+            try:
+                out[j] = row
+            except ValueError:
+                raise ValueError(f"estimator {name!r} returned {len(row)} values at t = "
+                                 f"{t_out} s; its output_columns has {out.shape[1]}: "
+                                 f"{', '.join(cls.output_columns)}") from None
             kept[j] = True
     runtime = time.perf_counter() - start
 

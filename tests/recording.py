@@ -50,3 +50,10 @@ class Peeker(Estimator):
 
     def on_truth(self, t, row):
         pass
+
+
+class Miscounted(Recorder):
+    """Returns fewer values than its output columns: a plug-in bug reported clearly."""
+
+    def solution(self, t):
+        return [0.0, 0.0, 0.0]

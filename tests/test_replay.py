@@ -167,3 +167,18 @@ def test_read_solution_rejects_bad_files(tmp_path):
     frame.assign(t=[0.0, 1.0, 2.0]).drop(columns="yaw").to_parquet(no_yaw)
     with pytest.raises(InputError, match=r"no_yaw.parquet: missing column\(s\) yaw"):
         read_solution(no_yaw)
+
+
+def test_wrong_number_of_solution_values_names_the_columns(dataset):
+    with pytest.raises(ValueError, match=r"returned 3 values at t = .* output_columns has 9"):
+        run_estimator(dataset, "tests.recording:Miscounted", show_progress=False)
+
+
+def test_dataset_without_truth_only_runs_self_initialising_estimators(tmp_path, dataset):
+    with atomic_output_dir(tmp_path / "no_truth", force=False) as tmp:
+        write_dataset(tmp, {}, {"imu": dataset.read("imu"), "gnss_fix": dataset.read("gnss_fix")})
+    no_truth = open_dataset(tmp_path / "no_truth")
+    with pytest.raises(InputError, match="starts from the true state.*no truth stream"):
+        run_estimator(no_truth, "tests.recording:Recorder", show_progress=False)
+    frame, _ = run_estimator(no_truth, "gnss_only", show_progress=False)
+    assert len(frame) > 0
