@@ -102,16 +102,18 @@ def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None
 class _Stream:
     """One stream as a float64 array, with the message times and how to index messages."""
 
-    def __init__(self, name: str, frame: pd.DataFrame, units: dict[str, str]):
+    def __init__(self, name: str, frame: pd.DataFrame, units: dict[str, str], where: Path):
         numeric = [c for c in frame.columns if pd.api.types.is_numeric_dtype(frame[c])]
+        if "t" not in numeric:
+            raise InputError([Problem(str(where), None, name, "no numeric time column t")])
         self.name = name
         self.data = np.ascontiguousarray(frame[numeric].to_numpy(dtype=np.float64))
         self.data.flags.writeable = False
         self.columns = {c: i for i, c in enumerate(numeric)}
         self.units = {c: units.get(c, "") for c in numeric}
         t = self.data[:, self.columns["t"]]
-        if len(t) > 1 and np.any(np.diff(t) < 0):
-            raise InputError(f"stream {name!r}: time t decreases")
+        if not np.all(np.diff(t) >= 0):
+            raise InputError([Problem(str(where), None, name, "time t decreases or is missing")])
         if name == "gnss_raw":  # one message per epoch: a 2-D block of its satellites
             starts = np.flatnonzero(np.r_[True, np.diff(t) > 0])
             bounds = np.r_[starts, len(t)]
@@ -174,11 +176,8 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
                                   f"not have (it has: {', '.join(dataset.stream_names)})")
                           for s in missing])
     names = [s for s in dict.fromkeys((*cls.needs, *cls.uses)) if dataset.has(s)]
-    refused = [s for s in names if s in col.SCORING_ONLY]
-    if refused:
-        raise InputError(f"estimator {cls.name!r} asks for scoring-only stream(s) {refused}")
-    names.sort(key=_stream_rank)
-    return [_Stream(s, dataset.read(s), _units(dataset, s)) for s in names]
+    names.sort(key=_stream_rank)  # scoring-only streams were refused by get_estimator
+    return [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
 
 
 def _units(dataset: Dataset, name: str) -> dict[str, str]:

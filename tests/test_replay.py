@@ -182,3 +182,13 @@ def test_dataset_without_truth_only_runs_self_initialising_estimators(tmp_path, 
         run_estimator(no_truth, "tests.recording:Recorder", show_progress=False)
     frame, _ = run_estimator(no_truth, "gnss_only", show_progress=False)
     assert len(frame) > 0
+
+
+def test_stream_with_decreasing_time_is_refused(tmp_path, dataset):
+    imu = dataset.read("imu").iloc[:50]
+    imu.loc[10, "t"] = 100.0
+    with atomic_output_dir(tmp_path / "bad", force=False) as tmp:
+        write_dataset(tmp, {}, {"imu": imu, "truth": dataset.read("truth")})
+    with pytest.raises(InputError, match=r"bad: imu: time t decreases"):
+        run_estimator(open_dataset(tmp_path / "bad"), "tests.recording:Recorder",
+                      show_progress=False)
