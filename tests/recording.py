@@ -57,3 +57,13 @@ class Miscounted(Recorder):
 
     def solution(self, t):
         return [0.0, 0.0, 0.0]
+
+
+class Mute(Estimator):
+    """Takes the IMU but never reports: refused, it has no solution method."""
+
+    name = "mute"
+    needs = ("imu",)
+
+    def on_imu(self, t, row):
+        pass

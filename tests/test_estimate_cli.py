@@ -137,3 +137,26 @@ def test_scenario_validation_checks_estimator_names(tmp_path):
     assert ("estimators.3.name: estimator 'no_such_module:Filter': cannot import module "
             "'no_such_module': ModuleNotFoundError") in text
     assert "dead_reckoning" not in text.split("known:")[0]
+
+
+def test_incomplete_plugin_class_is_refused(dataset, tmp_path, capsys):
+    _fails(capsys, ["estimate", str(dataset), "-e", "tests.recording:Mute", "-o",
+                    str(tmp_path / "x")], "has no solution(t) method")
+    _fails(capsys, ["estimate", str(dataset), "-e", "tests.recording:np", "-o",
+                    str(tmp_path / "x")], "is not an estimators.base.Estimator subclass")
+
+
+def test_generated_dataset_round_trip(tmp_path, capsys):
+    """generate -> estimate on a shipped scenario: the estimator gets the IMU the generator
+    wrote, and the solution file reads back."""
+    from tests.conftest import REPO
+    from tests.recording import Recorder
+    data = tmp_path / "quick"
+    assert main(["generate", str(REPO / "scenarios" / "quickstart.yaml"), "-o", str(data)]) == 0
+    out = tmp_path / "rec.parquet"
+    assert main(["estimate", str(data), "-e", "tests.recording:Recorder", "-o", str(out)]) == 0
+    imu = open_dataset(data).read("imu").to_numpy(dtype=float)
+    seen = np.array([row for stream, _, row in Recorder.last.seen if stream == "imu"])
+    np.testing.assert_array_equal(seen, imu)
+    assert set(Recorder.last.columns) == {"imu"}
+    assert len(read_solution(out)) == len(Recorder.last.asked)
