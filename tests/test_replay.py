@@ -192,3 +192,14 @@ def test_stream_with_decreasing_time_is_refused(tmp_path, dataset):
     with pytest.raises(InputError, match=r"bad: imu: time t decreases"):
         run_estimator(open_dataset(tmp_path / "bad"), "tests.recording:Recorder",
                       show_progress=False)
+
+
+def test_replay_benchmark_dataset_runs(tmp_path):
+    """The benchmark's synthetic streams (here 72 s of them) replay into its do-nothing
+    estimator: 10 Hz output from the first to the last message."""
+    from benchmarks.bench_replay import make_dataset
+    make_dataset(tmp_path, hours=0.02)
+    frame, info = run_estimator(open_dataset(tmp_path), "benchmarks.bench_replay:DoNothing",
+                                show_progress=False)
+    assert len(frame) == 721 and frame["t"].iloc[-1] == 72.0
+    assert info["realtime_factor"] > 1.0
