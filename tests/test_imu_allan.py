@@ -181,3 +181,14 @@ def test_fitted_presets_follow_real_curves_long(preset, device):
         for axis in "xyz":
             if (preset, group, axis) not in KNOWN_MISFIT:
                 check_real(preset, device, group, axis, simulated, duration / 10)
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.3, 0.905, 0.999999])
+def test_ar1_filter_matches_scipy_lfilter(phi):
+    from scipy.signal import lfilter
+
+    from simulator.sensors.noise import ar1_filter
+
+    u = np.random.default_rng(3).standard_normal((50_000, 3))
+    np.testing.assert_allclose(ar1_filter(u, phi), lfilter([1.0], [1.0, -phi], u, axis=0),
+                               rtol=1e-9, atol=1e-9)

@@ -88,13 +88,16 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
             d4[:2], d4[-2:] = np.inf, np.inf
             error = dt / 180 * np.max(np.abs(d4[2 * k - 1]), axis=1)
             gauss |= error > SIMPSON_TOLERANCE[key]
-    starts, lengths, owner = [], [], []
-    for i in np.flatnonzero(gauss):
+    # intervals without a breakpoint in one vectorised piece; only those holding breakpoints
+    # (a few per manoeuvre) are split one by one
+    smooth = np.flatnonzero(gauss & (last <= first))
+    starts, lengths, owner = [lo[smooth]], [np.full(len(smooth), dt)], [smooth]
+    for i in np.flatnonzero(gauss & (last > first)):
         edges = np.concatenate([[lo[i]], breaks[first[i]:last[i]], [hi[i]]])
         starts.append(edges[:-1])
         lengths.append(np.diff(edges))
         owner.append(np.full(len(edges) - 1, i))
-    if not starts:
+    if not gauss.any():
         return out
     start, length, idx = (np.concatenate(a) for a in (starts, lengths, owner))
     nodes = (start[:, None] + length[:, None] * GL_NODES[None, :]).ravel()

@@ -64,7 +64,6 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.signal import lfilter
 
 from simulator import columns as col
 from simulator.earth import euler_to_dcm
@@ -91,6 +90,7 @@ from simulator.sensors.imu_presets import IMU_PRESETS
 from simulator.sensors.noise import (
     FLICKER_ADEV_FACTOR,
     GM_ADEV_PEAK,
+    ar1_filter,
     flicker,
     gauss_markov,
     random_walk,
@@ -343,7 +343,9 @@ def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarra
     out = np.empty_like(y)
     for j, f_c in enumerate(bandwidth_hz):
         a = np.exp(-2 * np.pi * f_c * dt_s)
-        out[:, j], _ = lfilter([1 - a], [1, -a], y[:, j], zi=[a * y[0, j]])
+        u = (1 - a) * y[:, j]
+        u[0] = y[0, j]  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]
+        out[:, j] = ar1_filter(u, a)
     return out
 
 

@@ -33,7 +33,6 @@ import datetime as dt
 
 import numpy as np
 import pandas as pd
-import ppigrf
 
 from simulator.earth import euler_to_dcm
 from simulator.scenario.schema import INVALID, Context, Number, Path, Record, Text
@@ -80,6 +79,8 @@ MAG_FIELD = Record(
 def earth_field_ned(lat_deg: np.ndarray, lon_deg: np.ndarray, alt_m: np.ndarray,
                     date: dt.datetime) -> np.ndarray:
     """IGRF main field (north, east, down), tesla, shape (n, 3), at geodetic positions."""
+    import ppigrf  # imported here: it costs most of a second, and only this sensor needs it
+
     east, north, up = ppigrf.igrf(np.asarray(lon_deg, float), np.asarray(lat_deg, float),
                                   np.asarray(alt_m, float) / 1000.0, date)
     return np.stack([np.ravel(north), np.ravel(east), -np.ravel(up)], axis=-1) * NT_TO_T
