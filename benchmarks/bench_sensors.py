@@ -30,14 +30,15 @@ from simulator.scenario import validate_data
 from simulator.sensors import SENSOR_MODELS
 
 HERE = Path(__file__).resolve().parent
+# plain SI numbers: a unit string anywhere in a scenario loads pint, about 1 s once
 SENSORS = {
     "imu": {"preset": "automotive", "rate": 100, "output": "increment",
             "lever_arm": [0.8, 0.2, -0.3], "mounting": [0.5, -0.3, 1.0],
-            "timestamp_jitter": "20 us", "temperature": {"offset": 2.0, "warmup": 8.0},
-            "gyro": {"bandwidth": 40.0, "ramp": "1e-8 rad/s^2"},
-            "accel": {"bandwidth": 40.0, "ramp": "1e-6 m/s^3"}},
+            "timestamp_jitter": 2e-5, "temperature": {"offset": 2.0, "warmup": 8.0},
+            "gyro": {"bandwidth": 40.0, "ramp": 1e-8},
+            "accel": {"bandwidth": 40.0, "ramp": 1e-6}},
     "odometer": {"preset": "abs-wheel-speed"},
-    "baro": {"preset": "bosch-bmp280", "drift": "-0.5 hPa/h"},
+    "baro": {"preset": "bosch-bmp280", "drift": -50.0 / 3600.0},
     "mag": {"preset": "automotive"},
 }
 

@@ -38,11 +38,12 @@ from simulator.scenario.schema import INVALID, Context, Number, Path, Record, Te
 from simulator.sensors.base import sample_times
 from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.trajectory.kinematics import Kinematics
+from simulator.units import HPA
 
 BARO_PRESETS: dict[str, dict] = {
     "ideal": {},
-    "bosch-bmp280": {"rate": 20.0, "noise": "1.3 Pa", "bias": "1 hPa", "resolution": "0.16 Pa",
-                     "range": ["300 hPa", "1100 hPa"]},
+    "bosch-bmp280": {"rate": 20.0, "noise": 1.3, "bias": 1 * HPA, "resolution": 0.16,
+                     "range": [300 * HPA, 1100 * HPA]},
 }
 
 _FIELDS = {

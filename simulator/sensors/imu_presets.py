@@ -1,9 +1,11 @@
 """Named IMU parameter sets (``sensors.imu.preset``), written as the data sheets print them.
 
 Each preset gives values for the ``gyro`` and ``accel`` groups (SPEC section 4 names) and may set
-the unit's ``rate`` and ``output``. The schema converts the unit strings to SI when it merges a
-preset into the resolved scenario; keys a preset leaves out are zero (error off). Every "+-" data
-sheet bound is used as the 1-sigma value (conservative). A value given as a list of three is per
+the unit's ``rate`` and ``output``. Values are SI, written as datasheet number times unit factor
+(``simulator.units``: ``0.02 * DEG_S_RT_HZ`` is 0.02 deg/s/sqrt(Hz)); temperature coefficients
+are per kelvin, g-sensitivities per g (``/ G0_M_S2``), ranges in g as ``8 * G0_M_S2``. Keys a
+preset leaves out are zero (off). Every "+-" data sheet bound is used as the 1-sigma value
+(conservative). A value given as a list of three is per
 axis (x, y, z).
 
 Sources
@@ -41,85 +43,101 @@ IMU_PRESETS.
 
 from __future__ import annotations
 
+from simulator.earth import G0_M_S2
+from simulator.units import (
+    DEG_H,
+    DEG_RT_H,
+    DEG_S,
+    DEG_S2_RT_HZ,
+    DEG_S_RT_HZ,
+    M_S_RT_H,
+    MILLI,
+    MILLI_G,
+    MILLI_G_RT_HZ,
+    MILLI_G_S_RT_HZ,
+    PERCENT,
+    PPM,
+)
+
 _AUTOMOTIVE = {
-    "gyro": {"bias": "0.2 deg/s", "bias_instability": "10 deg/h",
-             "noise_density": "0.005 deg/s/sqrt(Hz)", "random_walk": "1e-4 deg/s^2/sqrt(Hz)",
-             "scale_factor": "0.5 %", "misalignment": "1 mrad", "range": "250 deg/s",
-             "resolution": "0.01 deg/s", "temperature_coefficient": "0.005 deg/s/K",
-             "g_sensitivity": "0.05 deg/s/g"},
-    "accel": {"bias": "10 mg", "bias_instability": "0.05 mg",
-              "noise_density": "0.1 mg/sqrt(Hz)", "random_walk": "1e-3 mg/s/sqrt(Hz)",
-              "scale_factor": "0.3 %", "misalignment": "1 mrad", "range": "8 g",
-              "resolution": "0.25 mg", "temperature_coefficient": "0.2 mg/K"},
+    "gyro": {"bias": 0.2 * DEG_S, "bias_instability": 10 * DEG_H,
+             "noise_density": 0.005 * DEG_S_RT_HZ, "random_walk": 1e-4 * DEG_S2_RT_HZ,
+             "scale_factor": 0.5 * PERCENT, "misalignment": 1 * MILLI, "range": 250 * DEG_S,
+             "resolution": 0.01 * DEG_S, "temperature_coefficient": 0.005 * DEG_S,
+             "g_sensitivity": 0.05 * DEG_S / G0_M_S2},
+    "accel": {"bias": 10 * MILLI_G, "bias_instability": 0.05 * MILLI_G,
+              "noise_density": 0.1 * MILLI_G_RT_HZ, "random_walk": 1e-3 * MILLI_G_S_RT_HZ,
+              "scale_factor": 0.3 * PERCENT, "misalignment": 1 * MILLI, "range": 8 * G0_M_S2,
+              "resolution": 0.25 * MILLI_G, "temperature_coefficient": 0.2 * MILLI_G},
 }
 
 IMU_PRESETS: dict[str, dict] = {
     "ideal": {},
     "consumer": {
-        "gyro": {"bias": "1 deg/s", "bias_instability": "12 deg/h",
-                 "noise_density": "0.007 deg/s/sqrt(Hz)", "random_walk": "2e-4 deg/s^2/sqrt(Hz)",
-                 "scale_factor": "1 %", "misalignment": "5 mrad", "range": "500 deg/s",
-                 "resolution": "0.015 deg/s", "temperature_coefficient": "0.015 deg/s/K",
-                 "g_sensitivity": "0.1 deg/s/g"},
-        "accel": {"bias": "40 mg", "bias_instability": "0.1 mg",
-                  "noise_density": "0.2 mg/sqrt(Hz)", "random_walk": "4e-3 mg/s/sqrt(Hz)",
-                  "scale_factor": "1 %", "misalignment": "5 mrad", "range": "16 g",
-                  "resolution": "0.5 mg", "temperature_coefficient": "1 mg/K"},
+        "gyro": {"bias": 1 * DEG_S, "bias_instability": 12 * DEG_H,
+                 "noise_density": 0.007 * DEG_S_RT_HZ, "random_walk": 2e-4 * DEG_S2_RT_HZ,
+                 "scale_factor": 1 * PERCENT, "misalignment": 5 * MILLI, "range": 500 * DEG_S,
+                 "resolution": 0.015 * DEG_S, "temperature_coefficient": 0.015 * DEG_S,
+                 "g_sensitivity": 0.1 * DEG_S / G0_M_S2},
+        "accel": {"bias": 40 * MILLI_G, "bias_instability": 0.1 * MILLI_G,
+                  "noise_density": 0.2 * MILLI_G_RT_HZ, "random_walk": 4e-3 * MILLI_G_S_RT_HZ,
+                  "scale_factor": 1 * PERCENT, "misalignment": 5 * MILLI, "range": 16 * G0_M_S2,
+                  "resolution": 0.5 * MILLI_G, "temperature_coefficient": 1 * MILLI_G},
     },
     "automotive": _AUTOMOTIVE,
     "tactical": {
-        "gyro": {"bias": "1 deg/h", "bias_instability": "0.3 deg/h",
-                 "noise_density": "0.1 deg/sqrt(h)", "random_walk": "1e-6 deg/s^2/sqrt(Hz)",
-                 "scale_factor": "150 ppm", "misalignment": "0.1 mrad", "range": "1000 deg/s",
-                 "g_sensitivity": "1 deg/h/g"},
-        "accel": {"bias": "1 mg", "bias_instability": "0.05 mg",
-                  "noise_density": "0.03 m/s/sqrt(h)", "random_walk": "1e-4 mg/s/sqrt(Hz)",
-                  "scale_factor": "300 ppm", "misalignment": "0.1 mrad", "range": "50 g"},
+        "gyro": {"bias": 1 * DEG_H, "bias_instability": 0.3 * DEG_H,
+                 "noise_density": 0.1 * DEG_RT_H, "random_walk": 1e-6 * DEG_S2_RT_HZ,
+                 "scale_factor": 150 * PPM, "misalignment": 0.1 * MILLI, "range": 1000 * DEG_S,
+                 "g_sensitivity": 1 * DEG_H / G0_M_S2},
+        "accel": {"bias": 1 * MILLI_G, "bias_instability": 0.05 * MILLI_G,
+                  "noise_density": 0.03 * M_S_RT_H, "random_walk": 1e-4 * MILLI_G_S_RT_HZ,
+                  "scale_factor": 300 * PPM, "misalignment": 0.1 * MILLI, "range": 50 * G0_M_S2},
     },
     "navigation": {
-        "gyro": {"bias": "0.01 deg/h", "bias_instability": "0.003 deg/h",
-                 "noise_density": "0.002 deg/sqrt(h)", "scale_factor": "5 ppm",
-                 "misalignment": "0.02 mrad", "range": "500 deg/s"},
-        "accel": {"bias": "0.03 mg", "bias_instability": "0.01 mg",
-                  "noise_density": "0.02 mg/sqrt(Hz)", "scale_factor": "50 ppm",
-                  "misalignment": "0.02 mrad", "range": "30 g"},
+        "gyro": {"bias": 0.01 * DEG_H, "bias_instability": 0.003 * DEG_H,
+                 "noise_density": 0.002 * DEG_RT_H, "scale_factor": 5 * PPM,
+                 "misalignment": 0.02 * MILLI, "range": 500 * DEG_S},
+        "accel": {"bias": 0.03 * MILLI_G, "bias_instability": 0.01 * MILLI_G,
+                  "noise_density": 0.02 * MILLI_G_RT_HZ, "scale_factor": 50 * PPM,
+                  "misalignment": 0.02 * MILLI, "range": 30 * G0_M_S2},
     },
     "bosch-smi130": {
         "rate": 20.0,
-        "gyro": {**_AUTOMOTIVE["gyro"], "bias": "1 deg/s",
-                 "temperature_coefficient": "0.015 deg/s/K",
-                 "noise_density": "0.02 deg/s/sqrt(Hz)"},
-        "accel": {**_AUTOMOTIVE["accel"], "bias": "70 mg", "temperature_coefficient": "1 mg/K",
-                  "noise_density": "0.19 mg/sqrt(Hz)"},
+        "gyro": {**_AUTOMOTIVE["gyro"], "bias": 1 * DEG_S,
+                 "temperature_coefficient": 0.015 * DEG_S,
+                 "noise_density": 0.02 * DEG_S_RT_HZ},
+        "accel": {**_AUTOMOTIVE["accel"], "bias": 70 * MILLI_G,
+                  "temperature_coefficient": 1 * MILLI_G, "noise_density": 0.19 * MILLI_G_RT_HZ},
     },
     "crossbow-imu300cc": {
         "rate": 200.0,
-        "gyro": {"bias": "2 deg/s", "scale_factor": "1 %", "noise_density": "2.25 deg/sqrt(h)",
-                 "range": "100 deg/s"},
-        "accel": {"bias": "30 mg", "scale_factor": "1 %", "noise_density": "0.15 m/s/sqrt(h)",
-                  "range": "2 g"},
+        "gyro": {"bias": 2 * DEG_S, "scale_factor": 1 * PERCENT, "noise_density": 2.25 * DEG_RT_H,
+                 "range": 100 * DEG_S},
+        "accel": {"bias": 30 * MILLI_G, "scale_factor": 1 * PERCENT,
+                  "noise_density": 0.15 * M_S_RT_H, "range": 2 * G0_M_S2},
     },
     "crossbow-dmu300cc": {
         "rate": 10.0,
-        "gyro": {"bias": "2 deg/s", "scale_factor": "1 %", "noise_density": "2.25 deg/sqrt(h)",
-                 "range": "100 deg/s"},
-        "accel": {"bias": "30 mg", "scale_factor": "1 %", "noise_density": "0.15 m/s/sqrt(h)",
-                  "range": "2 g"},
+        "gyro": {"bias": 2 * DEG_S, "scale_factor": 1 * PERCENT, "noise_density": 2.25 * DEG_RT_H,
+                 "range": 100 * DEG_S},
+        "accel": {"bias": 30 * MILLI_G, "scale_factor": 1 * PERCENT,
+                  "noise_density": 0.15 * M_S_RT_H, "range": 2 * G0_M_S2},
     },
     "honeywell-hg1700": {
         "rate": 100.0,
-        "gyro": {"bias": "1 deg/h", "scale_factor": "150 ppm",
-                 "noise_density": "0.125 deg/sqrt(h)", "range": "1000 deg/s"},
-        "accel": {"bias": "1 mg", "scale_factor": "300 ppm", "noise_density": "0.198 m/s/sqrt(h)",
-                  "range": "50 g"},
+        "gyro": {"bias": 1 * DEG_H, "scale_factor": 150 * PPM,
+                 "noise_density": 0.125 * DEG_RT_H, "range": 1000 * DEG_S},
+        "accel": {"bias": 1 * MILLI_G, "scale_factor": 300 * PPM,
+                  "noise_density": 0.198 * M_S_RT_H, "range": 50 * G0_M_S2},
     },
     "bp3010": {
         "rate": 64.0,
         "output": "increment",
-        "gyro": {"bias": "0.5 deg/s", "scale_factor": "0.5 %",
-                 "noise_density": "0.1 deg/s/sqrt(Hz)", "range": "300 deg/s"},
-        "accel": {"bias": "10 mg", "scale_factor": "0.5 %", "noise_density": "0.2 mg/sqrt(Hz)",
-                  "range": "10 g"},
+        "gyro": {"bias": 0.5 * DEG_S, "scale_factor": 0.5 * PERCENT,
+                 "noise_density": 0.1 * DEG_S_RT_HZ, "range": 300 * DEG_S},
+        "accel": {"bias": 10 * MILLI_G, "scale_factor": 0.5 * PERCENT,
+                  "noise_density": 0.2 * MILLI_G_RT_HZ, "range": 10 * G0_M_S2},
     },
     # fitted by tools/fit_imu_presets.py (SI units, per axis x, y, z)
     "bosch-bmi160": {

@@ -40,6 +40,7 @@ from simulator.sensors.base import sample_times
 from simulator.sensors.noise import gauss_markov
 from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.trajectory.kinematics import Kinematics
+from simulator.units import MICRO_T
 
 NT_TO_T = 1e-9
 _FIELD_STEP_S = 10.0  # spacing of the IGRF evaluations along the drive, s
@@ -47,8 +48,8 @@ _FIELD_STEP_S = 10.0  # spacing of the IGRF evaluations along the drive, s
 MAG_PRESETS: dict[str, dict] = {
     "ideal": {},
     # a MEMS magnetometer in a car: representative values, not a data sheet
-    "automotive": {"rate": 10.0, "noise": "0.3 uT", "hard_iron": "5 uT", "soft_iron": 0.02,
-                   "disturbance": "10 uT", "disturbance_time": "2 s"},
+    "automotive": {"rate": 10.0, "noise": 0.3 * MICRO_T, "hard_iron": 5 * MICRO_T,
+                   "soft_iron": 0.02, "disturbance": 10 * MICRO_T, "disturbance_time": 2.0},
 }
 
 _FIELDS = {

@@ -34,13 +34,14 @@ from simulator.sensors.base import sample_times
 from simulator.sensors.noise import random_walk
 from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.trajectory.kinematics import Kinematics
+from simulator.units import MILLI, PERCENT_RT_H
 
 ODOMETER_PRESETS: dict[str, dict] = {
     "ideal": {},
     # an ABS wheel-speed sensor: 48-tooth tone wheel on a 0.65 m tyre (common passenger-car
     # values), 10 Hz as in the DR of Cho & Choi 2006, tyre radius known to 1 %
-    "abs-wheel-speed": {"rate": 10.0, "scale_factor": 1.01, "scale_drift": "0.1 %/sqrt(h)",
-                        "ticks_per_meter": 48 / (np.pi * 0.65), "latency": "20 ms"},
+    "abs-wheel-speed": {"rate": 10.0, "scale_factor": 1.01, "scale_drift": 0.1 * PERCENT_RT_H,
+                        "ticks_per_meter": 48 / (np.pi * 0.65), "latency": 20 * MILLI},
 }
 
 _FIELDS = {
