@@ -7,8 +7,9 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
 
 * ``x``: the true rate (w_ib, rad/s) or specific force (m/s^2) at the unit, rotated by the
   ``mounting`` (roll, pitch, yaw of the unit in the vehicle, degrees): x_s = C_v^s x_v, with the
-  lever-arm terms dw/dt x r + w x (w x r) added to the specific force (Groves eq. 6.43 rearranged).
-  dw/dt is a central difference (step 1 ms) of the analytic body rate.
+  lever-arm terms dw/dt x r + w x (w x r) added to the specific force (Groves eq. 6.43 rearranged;
+  dw/dt a central difference, step 1 ms, of the analytic body rate), plus the engine and road
+  ``vibration`` of the unit on its mount (``simulator.sensors.vibration``), in the sensor frame.
 * ``S + M``: diagonal scale-factor errors and off-diagonal misalignment / cross-axis coupling,
   each drawn once per run, N(0, ``scale_factor``^2) and N(0, ``misalignment``^2).
 * ``b0``: turn-on bias, N(0, ``bias``^2) per axis.
@@ -97,6 +98,7 @@ from simulator.sensors.noise import (
     white,
 )
 from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.vibration import VIBRATION_FIELD, vibration
 from simulator.trajectory.kinematics import Kinematics
 
 REDUCED_UNITS = {
@@ -195,6 +197,7 @@ IMU_FIELD = Record(
             "warmup": Number("K", 0.0, doc="temperature rise during the warm-up"),
             "warmup_time": Number("s", 600.0, gt=0, doc="time constant of the warm-up"),
         }, default={}),
+        "vibration": VIBRATION_FIELD,
         "gyro": Record(_GROUPS["gyro"], default=None),
         "accel": Record(_GROUPS["accel"], default=None),
     },
@@ -327,6 +330,14 @@ class Imu:
         rng = rng if rng is not None else np.random.default_rng()
         t = sample_times(truth.duration_s, self.rate_hz, first=1 if self.increment else 0)
         w, f = self._true_values(truth, t, rng)
+        vib = self.config["vibration"]
+        if any(vib[k] > 0 for k in ("engine_accel", "engine_gyro", "road_accel", "road_gyro")):
+            dt = 1.0 / self.rate_hz
+            t_speed = t - dt / 2 if self.increment else t
+            speed = np.maximum(truth.profile.distance_of_time(np.clip(t_speed, 0, None), 1), 0)
+            # its own child stream: switching vibration on leaves every other draw unchanged
+            dw, df = vibration(t, speed, dt, vib, self.increment, rng.spawn(1)[0])
+            w, f = w + dw, f + df
         gyro = self._errors("gyro", w, t, f, rng)
         accel = self._errors("accel", f, t, f, rng)
         values = np.concatenate([gyro, accel], axis=1)
