@@ -128,6 +128,19 @@ def test_turn_on_bias_temperature_and_ramp(truth):
     assert np.all(np.abs(d["ramp"]) == 1e-5)
 
 
+def test_scale_factor_temperature_coefficient(truth):
+    block = {"accel": {"scale_factor_temperature_coefficient": "100 ppm/K"},
+             "temperature": {"offset": -5.0, "warmup": 20.0, "warmup_time": 40.0}}
+    out, imu = run(truth, block)
+    t = out["t"].to_numpy()
+    k = truth.inertial(t)
+    s_t = np.array(imu.drawn["accel"]["scale_factor_temperature_coefficient"])
+    d_temp = -5.0 + 20.0 * (1 - np.exp(-t / 40.0))
+    np.testing.assert_allclose(out[list(col.IMU_AXES[3:])].to_numpy(),
+                               k["f_body"] * (1 + d_temp[:, None] * s_t), atol=1e-12)
+    assert np.all(s_t != 0)
+
+
 def test_g_sensitivity(truth):
     out, imu = run(truth, {"gyro": {"g_sensitivity": "0.1 deg/s/g"}})
     k = truth.inertial(out["t"].to_numpy())

@@ -23,7 +23,8 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
   deviation R tau / sqrt(2)) of magnitude ``ramp`` (rad/s^2, m/s^3) and a drawn sign.
 * ``k_T dT``: bias change with temperature; k_T per axis is drawn N(0, ``temperature_coefficient``
   ^2) and dT(t) = offset + warmup (1 - exp(-t / warmup_time)) is the unit's temperature profile
-  (``temperature`` block, kelvin from the calibration temperature).
+  (``temperature`` block, kelvin from the calibration temperature); the scale factor changes too,
+  by s_T dT with s_T drawn N(0, ``scale_factor_temperature_coefficient``^2) (1/K).
 * ``G f``: gyro g-sensitivity, a 3 x 3 matrix with elements N(0, ``g_sensitivity``^2),
   rad/s per m/s^2.
 * ``n``: white noise of density N: sigma = N sqrt(rate) on rate output and N sqrt(dt) on the
@@ -137,6 +138,7 @@ def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Fie
         "range": AxisNumber(unit, gt=0),
         "resolution": AxisNumber(unit, min=0),
         "temperature_coefficient": AxisNumber(f"{unit}/K", min=0),
+        "scale_factor_temperature_coefficient": AxisNumber("1/K", min=0),
         "bandwidth": AxisNumber("Hz", gt=0),
     }
     if gyro:
@@ -275,9 +277,15 @@ class Imu:
         mis = _per_axis(p["misalignment"])[:, None] * rng.standard_normal((3, 3))
         np.fill_diagonal(mis, 0.0)
         k_temp = _per_axis(p["temperature_coefficient"]) * rng.standard_normal(3)
+        k_sf_temp = _per_axis(p["scale_factor_temperature_coefficient"]) * rng.standard_normal(3)
         drawn = {"bias": bias0.tolist(), "scale_factor": sf.tolist(),
-                 "misalignment": mis.tolist(), "temperature_coefficient": k_temp.tolist()}
+                 "misalignment": mis.tolist(), "temperature_coefficient": k_temp.tolist(),
+                 "scale_factor_temperature_coefficient": k_sf_temp.tolist()}
         y = x + x @ (np.diag(sf) + mis).T
+        temp = self.config["temperature"]
+        d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
+        if k_sf_temp.any():
+            y += x * (d_temp[:, None] * k_sf_temp)
         bias = np.broadcast_to(bias0, (n, 3)).copy()
         instability = _per_axis(p["bias_instability"])
         if instability.any():
@@ -293,9 +301,7 @@ class Imu:
         drawn["ramp"] = ramp.tolist()
         if ramp.any():
             bias += t[:, None] * ramp
-        temp = self.config["temperature"]
-        if k_temp.any() and (temp["offset"] or temp["warmup"]):
-            d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
+        if k_temp.any():
             bias += d_temp[:, None] * k_temp
         y = y + bias * scale
         if group == "gyro":
