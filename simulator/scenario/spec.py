@@ -33,7 +33,7 @@ START_FIELD = Record({
     "lat": Number(angle=True, min=-89.0, max=89.0, doc="latitude, deg"),
     "lon": Number(angle=True, min=-180.0, max=180.0, doc="longitude, deg"),
     "alt": Number("m", 0.0, min=-500.0, max=9000.0, doc="ellipsoidal height, m"),
-    "heading": Number(0.0, angle=True, min=-360.0, max=360.0,
+    "heading": Number(default=0.0, angle=True, min=-360.0, max=360.0,
                       doc="initial heading from true north, deg"),
 })
 

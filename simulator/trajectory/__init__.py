@@ -13,12 +13,14 @@ from collections.abc import Callable
 
 from simulator.scenario.schema import Context, ListOf, Number, Record
 from simulator.trajectory.segments import SEGMENT_FIELD, RoadProfile, build_road_profile
+from simulator.trajectory.sumo import SUMO_FIELD, build_sumo_profile
 
 _RATE = Number("Hz", None, gt=0, max=10000,
                doc="base rate of the truth table (default: the IMU rate, or 100 Hz)")
 
 TRAJECTORY_KINDS: dict[str, Record] = {
     "segments": Record({"segments": ListOf(SEGMENT_FIELD, min_len=1), "rate": _RATE}),
+    "sumo": SUMO_FIELD,
 }
 
 
@@ -28,4 +30,5 @@ def _segments_profile(scenario: dict, ctx: Context | None) -> RoadProfile | None
 
 PROFILE_BUILDERS: dict[str, Callable[[dict, Context | None], RoadProfile | None]] = {
     "segments": _segments_profile,
+    "sumo": build_sumo_profile,
 }

@@ -1,0 +1,168 @@
+"""The smoothing fit shared by the ``sumo`` and ``recorded`` trajectory sources: from sampled 3-D
+positions of a vehicle to a ``RoadProfile`` (road geometry along the distance travelled and the
+distance in time) that the exact kinematics can differentiate.
+
+The fit separates where the vehicle goes (geometry) from when it gets there (timing):
+
+* geometry: the positions are stripped of standstill repeats and resampled every
+  ``_RESAMPLE_M`` of chord length u; east, north and up are fitted as least-squares quintic
+  B-splines of u with knots every ``knot_spacing`` metres (de Boor, *A Practical Guide to
+  Splines*, ch. XIV; ``scipy.interpolate.make_lsq_spline``). The knot spacing bounds how sharp a
+  corner can be, so a kink in SUMO's lane polylines or its non-smooth headings become a short
+  smooth curve, never a yaw-rate spike. The spline's own arc length sigma(u) is integrated
+  (Gauss-Legendre), and its heading psi and grade angle gamma (both C4 in u) are re-interpolated
+  as quintic splines of sigma, so that integrating the unit tangent along sigma reproduces the
+  spline curve and curvature dpsi/dsigma is C3;
+* timing: each sample's distance sigma_k is the arc length at its chord length; the piecewise
+  linear distance S(t) through (t_k, sigma_k) is convolved with a triangle kernel of half-width
+  ``time_window`` (two box filters). The result s(t) = (S2(t+W) - 2 S2(t) + S2(t-W)) / W^2, with
+  S2 the second antiderivative of S, is a piecewise cubic with continuous acceleration, is
+  non-decreasing because the kernel is non-negative, and is exactly flat wherever the vehicle
+  stood still for longer than 2 W (so there is no heading change, hence no yaw rate, at rest).
+  Its deviation from S is at most about a W^2 / 6 for an acceleration a.
+
+Public names
+------------
+FittedDrive, fit_drive.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.interpolate import PPoly, make_interp_spline, make_lsq_spline
+
+from simulator.trajectory.segments import RoadProfile
+
+_RESAMPLE_M = 1.0  # spacing of the resampled path used for the geometry fit, m
+_DENSE_M = 0.25  # spacing of the arc-length grid the heading and grade are sampled on, m
+_GL_X, _GL_W = np.polynomial.legendre.leggauss(4)  # arc-length quadrature per dense interval
+
+
+@dataclass
+class FittedDrive:
+    """A fitted drive: its road profile and where it starts.
+
+    ``start_enu`` (m, shape (3,)) is the fitted position at t = 0 in the frame of the input
+    positions; ``heading_deg`` the absolute heading there (from north, clockwise), which
+    ``profile.heading`` (starting at 0) is relative to.
+    """
+
+    profile: RoadProfile
+    start_enu: np.ndarray
+    heading_deg: float
+
+
+def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
+              time_window: float = 0.5, standstill_m: float = 1e-3,
+              zones: list[tuple[float, float, str]] | None = None) -> FittedDrive:
+    """Fit a smooth road profile to sampled positions.
+
+    Parameters
+    ----------
+    t : array, shape (n,)
+        Sample times, s, strictly increasing; the profile's t = 0 is ``t[0]``.
+    enu : array, shape (n, 3)
+        Positions in a local level frame (east, north, up), m.
+    knot_spacing : float
+        Knot spacing of the geometry splines, m (larger = smoother path, looser fit).
+    time_window : float
+        Half-width W of the triangle kernel that smooths the distance in time, s.
+    standstill_m : float
+        Steps shorter than this (m) count as standing still (removes jitter at rest).
+    zones : list of (t_start, t_end, name), optional
+        Zone intervals in the input's time; shifted with it.
+
+    Returns
+    -------
+    FittedDrive
+
+    Raises
+    ------
+    ValueError
+        When the samples are not increasing in time or the vehicle never moves.
+    """
+    t = np.asarray(t, dtype=float)
+    enu = np.asarray(enu, dtype=float)
+    if len(t) < 2 or np.any(np.diff(t) <= 0):
+        raise ValueError("the position samples must have at least two strictly increasing times")
+    step = np.linalg.norm(np.diff(enu, axis=0), axis=1)
+    step[step < standstill_m] = 0.0
+    chord = np.concatenate([[0.0], np.cumsum(step)])
+    total = chord[-1]
+    if total < 4 * knot_spacing:
+        raise ValueError(f"the vehicle moves only {total:.1f} m; at least {4 * knot_spacing:g} m "
+                         "are needed to fit a road")
+    moving = np.concatenate([[True], step > 0])
+    u_grid = np.linspace(0.0, total, int(np.ceil(total / _RESAMPLE_M)) + 1)
+    path = np.stack([np.interp(u_grid, chord[moving], enu[moving, i]) for i in range(3)], -1)
+    curve = _lsq_quintic(u_grid, path, knot_spacing)
+
+    u_dense = np.linspace(0.0, total, int(np.ceil(total / _DENSE_M)) + 1)
+    sigma = _arc_length(curve, u_dense)
+    d = curve(u_dense, 1)
+    horizontal = np.hypot(d[:, 0], d[:, 1])
+    psi = np.unwrap(np.arctan2(d[:, 0], d[:, 1]))
+    gamma = np.arctan2(d[:, 2], horizontal)
+    heading_abs = PPoly.from_spline(make_interp_spline(sigma, psi, k=5))
+    curvature = heading_abs.derivative()
+    grade = PPoly.from_spline(make_interp_spline(sigma, gamma, k=5))
+    bank = PPoly(np.zeros((1, 1)), [0.0, sigma[-1]])
+
+    sigma_k = np.interp(chord, u_dense, sigma)
+    tt = t - t[0]
+    distance = _smoothed_distance(tt, sigma_k, time_window)
+    shifted = [(a - t[0], b - t[0], name) for a, b, name in (zones or [])]
+    profile = RoadProfile(distance_of_time=distance, curvature=curvature,
+                          heading=curvature.antiderivative(), grade=grade, bank=bank,
+                          duration_s=float(tt[-1]), zones=shifted)
+    u0 = float(np.interp(distance(0.0), sigma, u_dense))
+    return FittedDrive(profile, curve(u0), float(np.degrees(heading_abs(0.0))))
+
+
+def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: float):
+    """Least-squares quintic B-spline of ``points`` (n, 3) over ``u`` with uniform knots."""
+    k = 5
+    n_int = max(1, int(round(u[-1] / spacing)))
+    inner = np.linspace(u[0], u[-1], n_int + 1)
+    knots = np.concatenate([[u[0]] * k, inner, [u[-1]] * k])
+    return make_lsq_spline(u, points, knots, k=k, axis=0)
+
+
+def _arc_length(curve, u: np.ndarray) -> np.ndarray:
+    """Arc length of a 3-D spline curve at ``u`` (cumulative from u[0]), Gauss-Legendre."""
+    a, b = u[:-1], u[1:]
+    nodes = 0.5 * (a + b)[:, None] + 0.5 * (b - a)[:, None] * _GL_X[None, :]
+    speed = np.linalg.norm(curve(nodes.ravel(), 1), axis=1).reshape(nodes.shape)
+    pieces = 0.5 * (b - a) * (speed @ _GL_W)
+    return np.concatenate([[0.0], np.cumsum(pieces)])
+
+
+def _smoothed_distance(t: np.ndarray, s: np.ndarray, w: float) -> PPoly:
+    """Triangle-kernel smoothing (half-width w) of the piecewise linear s(t), as a C2 PPoly.
+
+    S is extended linearly beyond both ends with its first and last slopes.
+    """
+    slope0 = (s[1] - s[0]) / (t[1] - t[0])
+    slope1 = (s[-1] - s[-2]) / (t[-1] - t[-2])
+    tx = np.concatenate([[t[0] - 2 * w], t, [t[-1] + 2 * w]])
+    sx = np.concatenate([[s[0] - 2 * w * slope0], s, [s[-1] + 2 * w * slope1]])
+    linear = PPoly(np.stack([np.diff(sx) / np.diff(tx), sx[:-1]]), tx)
+    s2 = linear.antiderivative(2)
+
+    def smoothed(x: np.ndarray, nu: int) -> np.ndarray:
+        return (s2(x + w, nu) - 2 * s2(x, nu) + s2(x - w, nu)) / w**2
+
+    breaks = np.unique(np.round(np.concatenate([t, t - w, t + w]), 9))
+    breaks = breaks[(breaks >= t[0]) & (breaks <= t[-1])]
+    mid = 0.5 * (breaks[:-1] + breaks[1:])
+    a = [smoothed(mid, nu) / f for nu, f in zip(range(4), (1, 1, 2, 6), strict=True)]
+    d = mid - breaks[:-1]  # re-expand the Taylor polynomial at mid about the left break
+    coeffs = np.stack([
+        a[3],
+        a[2] - 3 * a[3] * d,
+        a[1] - 2 * a[2] * d + 3 * a[3] * d**2,
+        a[0] - a[1] * d + a[2] * d**2 - a[3] * d**3,
+    ])
+    return PPoly(coeffs, breaks)
