@@ -21,9 +21,15 @@ The fit separates where the vehicle goes (geometry) from when it gets there (tim
   stood still for longer than 2 W (so there is no heading change, hence no yaw rate, at rest).
   Its deviation from S is at most about a W^2 / 6 for an acceleration a.
 
+Positions come in a local frame (``local_frame``): east and north on the tangent plane at the
+first sample, and up as the geodetic height above that sample (not the plane's up, so a level
+road stays level however far it runs). Headings in that plane are turned into true headings with
+the meridian convergence (Groves section 2.4.2): at a point e metres east of the reference the
+true azimuth of the plane's north is e tan(L0) / R_E.
+
 Public names
 ------------
-FittedDrive, fit_drive.
+FittedDrive, LocalFrame, fit_drive, local_frame, start_block.
 """
 
 from __future__ import annotations
@@ -33,6 +39,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import PPoly, make_interp_spline, make_lsq_spline
 
+from simulator.earth import (
+    ecef_to_geodetic,
+    ecef_to_ned,
+    geodetic_to_ecef,
+    ned_to_ecef,
+    radii_of_curvature,
+)
 from simulator.trajectory.segments import RoadProfile
 
 _RESAMPLE_M = 1.0  # spacing of the resampled path used for the geometry fit, m
@@ -54,9 +67,40 @@ class FittedDrive:
     heading_deg: float
 
 
+@dataclass
+class LocalFrame:
+    """Positions in the local frame of ``local_frame``: ``enu`` (n, 3), m; ``reference`` the
+    (lat rad, lon rad, alt m) of its origin; ``convergence`` the true-heading change per metre
+    east, rad/m."""
+
+    enu: np.ndarray
+    reference: tuple[float, float, float]
+    convergence: float
+
+
+def local_frame(lat_rad: np.ndarray, lon_rad: np.ndarray, alt_m: np.ndarray) -> LocalFrame:
+    """Geodetic positions (n,) each to the local frame about the first one (see module doc)."""
+    alt = np.asarray(alt_m, dtype=float)
+    reference = (float(lat_rad[0]), float(lon_rad[0]), float(alt[0]))
+    ned = ecef_to_ned(geodetic_to_ecef(lat_rad, lon_rad, np.full_like(alt, alt[0])), *reference)
+    _, r_e = radii_of_curvature(reference[0])
+    enu = np.stack([ned[:, 1], ned[:, 0], alt - alt[0]], axis=-1)
+    return LocalFrame(enu, reference, float(np.tan(reference[0]) / (r_e + alt[0])))
+
+
+def start_block(frame: LocalFrame, fitted: FittedDrive) -> dict:
+    """The ``start`` (lat, lon deg, alt m, heading deg) of a fitted drive in ``frame``."""
+    e, n, up = fitted.start_enu
+    lat, lon, _ = (float(np.ravel(v)[0]) for v in ecef_to_geodetic(
+        ned_to_ecef(np.array([[n, e, 0.0]]), *frame.reference)))
+    return {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)),
+            "alt": float(frame.reference[2] + up), "heading": fitted.heading_deg}
+
+
 def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
               time_window: float = 0.5, standstill_m: float = 1e-3,
-              zones: list[tuple[float, float, str]] | None = None) -> FittedDrive:
+              zones: list[tuple[float, float, str]] | None = None,
+              convergence: float = 0.0) -> FittedDrive:
     """Fit a smooth road profile to sampled positions.
 
     Parameters
@@ -73,6 +117,8 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
         Steps shorter than this (m) count as standing still (removes jitter at rest).
     zones : list of (t_start, t_end, name), optional
         Zone intervals in the input's time; shifted with it.
+    convergence : float
+        True-heading change per metre east of the frame's origin, rad/m (``LocalFrame``).
 
     Returns
     -------
@@ -103,7 +149,7 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
     sigma = _arc_length(curve, u_dense)
     d = curve(u_dense, 1)
     horizontal = np.hypot(d[:, 0], d[:, 1])
-    psi = np.unwrap(np.arctan2(d[:, 0], d[:, 1]))
+    psi = np.unwrap(np.arctan2(d[:, 0], d[:, 1])) + convergence * curve(u_dense)[:, 0]
     gamma = np.arctan2(d[:, 2], horizontal)
     heading_abs = PPoly.from_spline(make_interp_spline(sigma, psi, k=5))
     curvature = heading_abs.derivative()

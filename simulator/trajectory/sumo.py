@@ -52,9 +52,9 @@ from pathlib import Path
 
 import numpy as np
 
-from simulator.earth import ecef_to_geodetic, ecef_to_ned, geodetic_to_ecef, ned_to_ecef
+from simulator.earth import ecef_to_geodetic, ned_to_ecef
 from simulator.scenario.schema import Context, Integer, ListOf, Number, Record, Text
-from simulator.trajectory.fit import fit_drive
+from simulator.trajectory.fit import LocalFrame, fit_drive, local_frame, start_block
 from simulator.trajectory.segments import RoadProfile
 from simulator.trajectory.sumo_network import (
     NETWORK_FIELD,
@@ -343,28 +343,20 @@ def zone_intervals(t: np.ndarray, zone: np.ndarray) -> list[tuple[float, float, 
             for a, b in zip(starts, ends, strict=True) if zone[a]]
 
 
-def place_drive(xyz: np.ndarray, network: Network, start: dict) -> tuple[np.ndarray, tuple]:
-    """Network positions (n, 3) to local east-north-up about the first sample, and the
-    geodetic reference (lat rad, lon rad, alt m) of that frame."""
+def place_drive(xyz: np.ndarray, network: Network, start: dict) -> LocalFrame:
+    """Network positions (n, 3) to the fit's local frame.
+
+    x, y go to latitude and longitude through the network's projection, or, without one, as
+    east and north on the tangent plane at ``start``; the height is ``start.alt`` + z.
+    """
     if network.georeferenced:
         lon, lat = network.to_lonlat(xyz[:, :2])
-        ecef = geodetic_to_ecef(np.radians(lat), np.radians(lon), start["alt"] + xyz[:, 2])
+        lat, lon = np.radians(lat), np.radians(lon)
     else:
-        ned = np.stack([xyz[:, 1], xyz[:, 0], -xyz[:, 2]], axis=-1)
-        ecef = ned_to_ecef(ned, np.radians(start["lat"]), np.radians(start["lon"]),
-                           start["alt"])
-    lat0, lon0, alt0 = (float(v) for v in ecef_to_geodetic(ecef[0]))
-    ned = ecef_to_ned(ecef, lat0, lon0, alt0)
-    return np.stack([ned[:, 1], ned[:, 0], -ned[:, 2]], axis=-1), (lat0, lon0, alt0)
-
-
-def enu_to_start(enu: np.ndarray, reference: tuple, heading_deg: float) -> dict:
-    """The ``start`` block (deg, m) of a point given in east-north-up about ``reference``."""
-    ned = np.array([[enu[1], enu[0], -enu[2]]])
-    lat, lon, alt = (float(np.ravel(v)[0]) for v in ecef_to_geodetic(ned_to_ecef(ned,
-                                                                                   *reference)))
-    return {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": alt,
-            "heading": float(heading_deg)}
+        ned = np.stack([xyz[:, 1], xyz[:, 0], np.zeros(len(xyz))], axis=-1)
+        lat, lon, _ = ecef_to_geodetic(ned_to_ecef(ned, np.radians(start["lat"]),
+                                                   np.radians(start["lon"]), start["alt"]))
+    return local_frame(lat, lon, start["alt"] + xyz[:, 2])
 
 
 def _resolve_paths(traj: dict, base: Path) -> None:
@@ -390,10 +382,10 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
         _resolve_paths(traj, base)
         network = prepare_network(traj["network"], base)
         drive = run_sumo(traj, network)
-        enu, reference = place_drive(drive.xyz, network, scenario["start"])
-        fitted = fit_drive(drive.t, enu, traj["fit"]["knot_spacing"],
-                           traj["fit"]["time_window"],
-                           zones=zone_intervals(drive.t, drive.zone))
+        frame = place_drive(drive.xyz, network, scenario["start"])
+        fitted = fit_drive(drive.t, frame.enu, traj["fit"]["knot_spacing"],
+                           traj["fit"]["time_window"], zones=zone_intervals(drive.t, drive.zone),
+                           convergence=frame.convergence)
     except (NetworkError, RouteError) as exc:
         key = ("trajectory",) + (exc.key if isinstance(exc, NetworkError)
                                  else ("route",) + exc.key)
@@ -406,5 +398,5 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
             raise ValueError(f"trajectory: {exc}") from None
         ctx.error(("trajectory",), str(exc))
         return None
-    fitted.profile.start = enu_to_start(fitted.start_enu, reference, fitted.heading_deg)
+    fitted.profile.start = start_block(frame, fitted)
     return fitted.profile

@@ -14,7 +14,8 @@ Network sources (``trajectory.network``):
 
 Networks built here have no turnarounds (``--no-turnarounds``): SUMO drives a turnaround as a
 U-turn of half a lane width in radius, which no car can follow and which would put a yaw-rate
-spike of several rad/s into the truth.
+spike of several rad/s into the truth. They also limit junction speeds to an average lateral
+acceleration of 2.5 m/s^2 (SUMO's default, 5.5, gives peaks over 1 g in tight turns).
 
 Built networks are cached by content (inputs, options and SUMO version) under
 ``$LANDNAV_CACHE`` (default: ``landnav-cache`` in the system temporary folder), so validating and
@@ -63,6 +64,7 @@ NETGENERATE_FIELD = Record({
     "lanes": Integer(1, min=1, max=6, doc="lanes per direction"),
     "speed": Number("m/s", 13.89, gt=0, doc="speed limit of every street"),
     "traffic_lights": Boolean(True, doc="junctions controlled by traffic lights"),
+    "junction_radius": Number("m", 10.0, gt=0, max=100.0, doc="turning radius at junctions"),
     "seed": Integer(1, min=0, doc="random: seed of the generator"),
 })
 
@@ -76,6 +78,9 @@ NETWORK_FIELD = Either(
     }),
 )
 
+# SUMO's default junction speed limit (5.5 m/s^2 average lateral acceleration) lets cars take
+# 10 m radius turns at over 1 g peak; 2.5 m/s^2 average keeps the peak near 0.6 g
+_TURN_SPEED = "--junctions.limit-turn-speed=2.5"
 _TUNNEL_TAGS = {"yes", "building_passage", "culvert", "avalanche_protector"}
 _ZONE_WORDS = ("tunnel", "garage", "parking", "underground")
 
@@ -162,7 +167,8 @@ def prepare_network(spec: str | dict, base: Path) -> Network:
             net = _build([f"--osm-files={src}", "--osm.elevation", "--osm.all-attributes",
                           "--osm.extra-attributes=tunnel,bridge,layer,covered",
                           "--tls.guess-signals", "--junctions.join",
-                          "--keep-edges.by-vclass=passenger", "--no-turnarounds"], [src],
+                          "--keep-edges.by-vclass=passenger", "--no-turnarounds", _TURN_SPEED],
+                         [src],
                          ("network",))
             return _read_network(net)
         if name.endswith(".xodr"):
@@ -182,7 +188,7 @@ def prepare_network(spec: str | dict, base: Path) -> Network:
     files = {k: _existing(base, spec[k], ("network", k))
              for k in ("nodes", "edges", "connections") if spec.get(k)}
     args = [f"--node-files={files['nodes']}", f"--edge-files={files['edges']}",
-            "--offset.disable-normalization", "--no-turnarounds"]
+            "--offset.disable-normalization", "--no-turnarounds", _TURN_SPEED]
     if "connections" in files:
         args.append(f"--connection-files={files['connections']}")
     return _read_network(_build(args, list(files.values()), ("network",)))
@@ -199,7 +205,8 @@ def _netgenerate(recipe: dict) -> Path:
     kind = recipe["type"]
     args = [f"--{kind}", f"--default.lanenumber={recipe['lanes']}",
             f"--default.speed={recipe['speed']}", f"--seed={recipe['seed']}",
-            "--no-turnarounds"]
+            "--no-turnarounds", f"--default.junctions.radius={recipe['junction_radius']}",
+            "--junctions.internal-link-detail=10", _TURN_SPEED]
     if kind == "grid":
         args += [f"--grid.number={recipe['number']}", f"--grid.length={recipe['length']}"]
     elif kind == "spider":
