@@ -6,10 +6,12 @@ The fit separates where the vehicle goes (geometry) from when it gets there (tim
 
 * geometry: the positions are stripped of standstill repeats and resampled every
   ``_RESAMPLE_M`` of chord length u; east, north and up are fitted as least-squares quintic
-  B-splines of u with knots every ``knot_spacing`` metres (de Boor, *A Practical Guide to
-  Splines*, ch. XIV; ``scipy.interpolate.make_lsq_spline``). The knot spacing bounds how sharp a
-  corner can be, so a kink in SUMO's lane polylines or its non-smooth headings become a short
-  smooth curve, never a yaw-rate spike. The spline's own arc length sigma(u) is integrated
+  B-splines of u with knots every ``knot_spacing`` metres, or every ``knot_time`` seconds of
+  travel where that is longer (de Boor, *A Practical Guide to Splines*, ch. XIV;
+  ``scipy.interpolate.make_lsq_spline``). The knot spacing bounds how sharp a corner can be, so a
+  kink in SUMO's lane polylines (or in an OpenStreetMap way) or SUMO's non-smooth headings
+  become a smooth curve as long as the car needs ``knot_time`` to drive it, never a yaw-rate
+  spike. The spline's own arc length sigma(u) is integrated
   (Gauss-Legendre), and its heading psi and grade angle gamma (both C4 in u) are re-interpolated
   as quintic splines of sigma, so that integrating the unit tangent along sigma reproduces the
   spline curve and curvature dpsi/dsigma is C3;
@@ -98,7 +100,7 @@ def start_block(frame: LocalFrame, fitted: FittedDrive) -> dict:
 
 
 def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
-              time_window: float = 0.5, standstill_m: float = 1e-3,
+              time_window: float = 0.5, knot_time: float = 0.4, standstill_m: float = 1e-3,
               zones: list[tuple[float, float, str]] | None = None,
               convergence: float = 0.0) -> FittedDrive:
     """Fit a smooth road profile to sampled positions.
@@ -110,7 +112,9 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
     enu : array, shape (n, 3)
         Positions in a local level frame (east, north, up), m.
     knot_spacing : float
-        Knot spacing of the geometry splines, m (larger = smoother path, looser fit).
+        Smallest knot spacing of the geometry splines, m (larger = smoother path, looser fit).
+    knot_time : float
+        Knots are at least this many seconds of travel apart at the local speed, s.
     time_window : float
         Half-width W of the triangle kernel that smooths the distance in time, s.
     standstill_m : float
@@ -143,7 +147,9 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
     moving = np.concatenate([[True], step > 0])
     u_grid = np.linspace(0.0, total, int(np.ceil(total / _RESAMPLE_M)) + 1)
     path = np.stack([np.interp(u_grid, chord[moving], enu[moving, i]) for i in range(3)], -1)
-    curve = _lsq_quintic(u_grid, path, knot_spacing)
+    dt = np.diff(t)
+    speed = np.interp(u_grid, chord[1:][step > 0], (step / dt)[step > 0])
+    curve = _lsq_quintic(u_grid, path, np.maximum(knot_spacing, knot_time * speed))
 
     u_dense = np.linspace(0.0, total, int(np.ceil(total / _DENSE_M)) + 1)
     sigma = _arc_length(curve, u_dense)
@@ -167,11 +173,13 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
     return FittedDrive(profile, curve(u0), float(np.degrees(heading_abs(0.0))))
 
 
-def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: float):
-    """Least-squares quintic B-spline of ``points`` (n, 3) over ``u`` with uniform knots."""
+def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: np.ndarray):
+    """Least-squares quintic B-spline of ``points`` (n, 3) over ``u`` (uniform) with knots
+    ``spacing`` (n,) metres apart locally."""
     k = 5
-    n_int = max(1, int(round(u[-1] / spacing)))
-    inner = np.linspace(u[0], u[-1], n_int + 1)
+    count = np.concatenate([[0.0], np.cumsum(np.diff(u) / spacing[1:])])
+    n_int = max(1, int(round(count[-1])))
+    inner = np.interp(np.linspace(0.0, count[-1], n_int + 1), count, u)
     knots = np.concatenate([[u[0]] * k, inner, [u[-1]] * k])
     return make_lsq_spline(u, points, knots, k=k, axis=0)
 

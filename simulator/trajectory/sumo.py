@@ -15,7 +15,8 @@ The scenario block::
 How it runs: the network is prepared (``sumo_network``), SUMO starts through libsumo with
 continuous lane changes (``--lanechange.duration``, so a lane change is a smooth lateral move,
 not a jump) and no teleporting; the ego vehicle departs at rest at the start of its route's first
-edge and is followed until it arrives (or ``max_duration``). Each step reads only the ego's 3-D
+edge, is followed until it arrives and stops at the end of its last edge (or until
+``max_duration``). Each step reads only the ego's 3-D
 position, lane and lane position (one subscription). ``traffic.vehicles`` other cars drive random
 trips. Everything random (trips, SUMO's driver imperfection) follows ``trajectory.seed``, not the
 scenario seed, so a Monte Carlo campaign over seeds keeps the same drive.
@@ -65,8 +66,10 @@ from simulator.trajectory.sumo_network import (
 )
 
 FIT_FIELD = Record({
-    "knot_spacing": Number("m", 3.0, min=0.5, max=100.0,
-                           doc="knot spacing of the path splines (larger: smoother corners)"),
+    "knot_spacing": Number("m", 3.0, min=2.0, max=100.0,
+                           doc="smallest knot spacing of the path splines (larger: smoother)"),
+    "knot_time": Number("s", 0.4, min=0, max=10.0,
+                        doc="knots at least this much travel time apart"),
     "time_window": Number("s", 0.5, gt=0, max=10.0,
                           doc="half-width of the kernel smoothing the distance in time"),
 }, default={})
@@ -97,6 +100,7 @@ SUMO_FIELD = Record({
                    doc="base rate of the truth table (default: the IMU rate, or 100 Hz)"),
 })
 
+_RUN_VERSION = "2"  # part of the run cache key: change it when the simulation set-up changes
 _SUMO_LOCK = threading.Lock()  # libsumo is one simulation per process
 _LANE_CHANGE_S = 3.0  # duration of a lane change, s (continuous lateral motion)
 
@@ -143,7 +147,7 @@ def run_sumo(traj: dict, network: Network) -> SumoDrive:
 
 
 def _run_key(traj: dict, network: Network) -> str:
-    digest = hashlib.sha256(network.path.read_bytes())
+    digest = hashlib.sha256(_RUN_VERSION.encode() + network.path.read_bytes())
     block = {k: traj[k] for k in ("route", "traffic", "step_length", "ego", "initial_stop",
                                   "max_duration", "seed")}
     digest.update(json.dumps(block, sort_keys=True).encode())
@@ -193,7 +197,7 @@ def _drive(sumo, traj: dict, network: Network) -> SumoDrive:
     route = _ego_route(sumo, traj["route"], edges, rng)
     sumo.route.add("ego_route", route)
     sumo.vehicle.add("ego", "ego_route", typeID="ego_type", depart="0", departLane="best",
-                     departPos="base", departSpeed="0")
+                     departPos="base", departSpeed="0", arrivalSpeed="0")
     length = max(2000.0, _route_length(sumo, route))
     for i in range(traj["traffic"]["vehicles"]):
         trip = _random_trip(sumo, edges, length, rng)
@@ -384,7 +388,8 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
         drive = run_sumo(traj, network)
         frame = place_drive(drive.xyz, network, scenario["start"])
         fitted = fit_drive(drive.t, frame.enu, traj["fit"]["knot_spacing"],
-                           traj["fit"]["time_window"], zones=zone_intervals(drive.t, drive.zone),
+                           traj["fit"]["time_window"], traj["fit"]["knot_time"],
+                           zones=zone_intervals(drive.t, drive.zone),
                            convergence=frame.convergence)
     except (NetworkError, RouteError) as exc:
         key = ("trajectory",) + (exc.key if isinstance(exc, NetworkError)
