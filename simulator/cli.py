@@ -12,7 +12,7 @@ import sys
 
 from simulator.errors import InputError
 
-COMMANDS = ["validate", "generate"]
+COMMANDS = ["validate", "generate", "score", "run"]
 
 DESCRIPTION = """\
 landnav: synthetic land-vehicle drives and navigation-sensor datasets, with estimator replay

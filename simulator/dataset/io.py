@@ -41,7 +41,11 @@ def write_table(frame: pd.DataFrame, path: Path, units: dict[str, str]) -> None:
     table = pa.Table.from_pandas(frame, preserve_index=False)
     fields = [f.with_metadata({"unit": units.get(f.name, "")}) for f in table.schema]
     table = table.cast(pa.schema(fields, metadata={}))
-    pq.write_table(table, path, compression="zstd")
+    # dictionary encoding only for text columns: on float columns it costs time and no space
+    text_columns = [f.name for f in table.schema if pa.types.is_string(f.type)
+                    or pa.types.is_large_string(f.type)]
+    pq.write_table(table, path, compression="zstd", compression_level=1,
+                   use_dictionary=text_columns)
 
 
 def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:

@@ -97,7 +97,9 @@ class Number(Field):
             try:
                 return to_si(value, self.unit)
             except UnitError as exc:
-                return ctx.error(path, str(exc))
+                if "dimension" in str(exc):
+                    return ctx.error(path, str(exc))
+                return ctx.error(path, f"expected a number{self._unit_hint()}; {exc}")
         return ctx.error(path, f"expected a number{self._unit_hint()}, got {value!r}")
 
     def _unit_hint(self) -> str:
@@ -235,7 +237,9 @@ class Record(Field):
                 ctx.error(path + (key,), _unknown_key(key, list(self.fields)))
                 failed = True
         for key, field in self.fields.items():
-            if key in value:
+            if key in value and value[key] is None and field.default is None:
+                got = None  # an optional value given explicitly as null
+            elif key in value:
                 got = field.check(value[key], path + (key,), ctx)
             else:
                 got = field.resolve_missing(path + (key,), ctx)

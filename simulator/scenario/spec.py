@@ -41,7 +41,7 @@ _INIT_FIELD = Record({
     "position_error": Vector(3, Number("m"), None, doc="north, east, down, m"),
     "velocity_error": Vector(3, Number("m/s"), None, doc="north, east, down, m/s"),
     "attitude_error": Vector(3, Number(angle=True), None, doc="roll, pitch, yaw, deg"),
-    "heading_error": Number(None, angle=True, doc="deg (adds to attitude_error's yaw)"),
+    "heading_error": Number(default=None, angle=True, doc="deg (adds to attitude_error's yaw)"),
 }, default=None)
 
 ESTIMATOR_ENTRY_FIELD = Either(

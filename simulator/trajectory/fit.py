@@ -48,6 +48,7 @@ from simulator.earth import (
     ned_to_ecef,
     radii_of_curvature,
 )
+from simulator.trajectory.piecewise import PiecewisePolynomial
 from simulator.trajectory.segments import RoadProfile
 
 _RESAMPLE_M = 1.0  # spacing of the resampled path used for the geometry fit, m
@@ -157,10 +158,10 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
     horizontal = np.hypot(d[:, 0], d[:, 1])
     psi = np.unwrap(np.arctan2(d[:, 0], d[:, 1])) + convergence * curve(u_dense)[:, 0]
     gamma = np.arctan2(d[:, 2], horizontal)
-    heading_abs = PPoly.from_spline(make_interp_spline(sigma, psi, k=5))
+    heading_abs = _piecewise(make_interp_spline(sigma, psi, k=5))
     curvature = heading_abs.derivative()
-    grade = PPoly.from_spline(make_interp_spline(sigma, gamma, k=5))
-    bank = PPoly(np.zeros((1, 1)), [0.0, sigma[-1]])
+    grade = _piecewise(make_interp_spline(sigma, gamma, k=5))
+    bank = PiecewisePolynomial(np.zeros((1, 1)), np.array([0.0, sigma[-1]]))
 
     sigma_k = np.interp(chord, u_dense, sigma)
     tt = t - t[0]
@@ -171,6 +172,13 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
                           duration_s=float(tt[-1]), zones=shifted)
     u0 = float(np.interp(distance(0.0), sigma, u_dense))
     return FittedDrive(profile, curve(u0), float(np.degrees(heading_abs(0.0))))
+
+
+def _piecewise(spline) -> PiecewisePolynomial:
+    """A B-spline as a piecewise polynomial without its zero-width end intervals."""
+    pp = PPoly.from_spline(spline)
+    keep = np.diff(pp.x) > 0
+    return PiecewisePolynomial(pp.c[:, keep], np.concatenate([pp.x[:-1][keep], pp.x[-1:]]))
 
 
 def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: np.ndarray):
@@ -193,7 +201,7 @@ def _arc_length(curve, u: np.ndarray) -> np.ndarray:
     return np.concatenate([[0.0], np.cumsum(pieces)])
 
 
-def _smoothed_distance(t: np.ndarray, s: np.ndarray, w: float) -> PPoly:
+def _smoothed_distance(t: np.ndarray, s: np.ndarray, w: float) -> PiecewisePolynomial:
     """Triangle-kernel smoothing (half-width w) of the piecewise linear s(t), as a C2 PPoly.
 
     S is extended linearly beyond both ends with its first and last slopes.
@@ -219,4 +227,4 @@ def _smoothed_distance(t: np.ndarray, s: np.ndarray, w: float) -> PPoly:
         a[1] - 2 * a[2] * d + 3 * a[3] * d**2,
         a[0] - a[1] * d + a[2] * d**2 - a[3] * d**3,
     ])
-    return PPoly(coeffs, breaks)
+    return PiecewisePolynomial(coeffs, breaks)
