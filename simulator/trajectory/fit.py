@@ -5,16 +5,16 @@ distance in time) that the exact kinematics can differentiate.
 The fit separates where the vehicle goes (geometry) from when it gets there (timing):
 
 * geometry: the positions are stripped of standstill repeats and resampled every
-  ``_RESAMPLE_M`` of chord length u; east, north and up are fitted as least-squares quintic
-  B-splines of u with knots every ``knot_spacing`` metres, or every ``knot_time`` seconds of
-  travel where that is longer (de Boor, *A Practical Guide to Splines*, ch. XIV;
-  ``scipy.interpolate.make_lsq_spline``). The knot spacing bounds how sharp a corner can be, so a
-  kink in SUMO's lane polylines (or in an OpenStreetMap way) or SUMO's non-smooth headings
-  become a smooth curve as long as the car needs ``knot_time`` to drive it, never a yaw-rate
-  spike. The spline's own arc length sigma(u) is integrated
-  (Gauss-Legendre), and its heading psi and grade angle gamma (both C4 in u) are re-interpolated
-  as quintic splines of sigma, so that integrating the unit tangent along sigma reproduces the
-  spline curve and curvature dpsi/dsigma is C3;
+  ``_RESAMPLE_M`` of chord length u; east, north and up are fitted as penalised least-squares
+  quintic B-splines (P-splines, Eilers and Marx 1996) of u with knots every ``knot_spacing``
+  metres, or every ``knot_time`` seconds of travel where that is longer (de Boor, *A Practical
+  Guide to Splines*, ch. XIV). The knot spacing bounds how sharp a corner can be, so a kink in
+  SUMO's lane polylines (or in an OpenStreetMap way) or SUMO's non-smooth headings become a
+  smooth curve, never a yaw-rate spike; the penalty damps the ringing next to a kink. The
+  spline's own arc length sigma(u) is integrated (Gauss-Legendre), and its heading psi and grade
+  angle gamma (both C4 in u) are re-interpolated as quintic splines of sigma, so that
+  integrating the unit tangent along sigma reproduces the spline curve and curvature
+  dpsi/dsigma is C3;
 * timing: each sample's distance sigma_k is the arc length at its chord length; the piecewise
   linear distance S(t) through (t_k, sigma_k) is convolved with a triangle kernel of half-width
   ``time_window`` (two box filters). The result s(t) = (S2(t+W) - 2 S2(t) + S2(t-W)) / W^2, with
@@ -29,6 +29,9 @@ road stays level however far it runs). Headings in that plane are turned into tr
 the meridian convergence (Groves section 2.4.2): at a point e metres east of the reference the
 true azimuth of the plane's north is e tan(L0) / R_E.
 
+References: P. H. C. Eilers and B. D. Marx, "Flexible smoothing with B-splines and penalties",
+Statistical Science 11(2), 1996.
+
 Public names
 ------------
 FittedDrive, LocalFrame, fit_drive, local_frame, start_block.
@@ -39,7 +42,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.interpolate import PPoly, make_interp_spline, make_lsq_spline
+from scipy import sparse
+from scipy.interpolate import BSpline, PPoly, make_interp_spline
+from scipy.sparse.linalg import spsolve
 
 from simulator.earth import (
     ecef_to_geodetic,
@@ -53,6 +58,7 @@ from simulator.trajectory.segments import RoadProfile
 
 _RESAMPLE_M = 1.0  # spacing of the resampled path used for the geometry fit, m
 _DENSE_M = 0.25  # spacing of the arc-length grid the heading and grade are sampled on, m
+_PENALTY = 0.1  # weight of the P-spline roughness penalty (per squared metre of residual)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)  # arc-length quadrature per dense interval
 
 
@@ -182,14 +188,21 @@ def _piecewise(spline) -> PiecewisePolynomial:
 
 
 def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: np.ndarray):
-    """Least-squares quintic B-spline of ``points`` (n, 3) over ``u`` (uniform) with knots
-    ``spacing`` (n,) metres apart locally."""
+    """Penalised least-squares quintic B-spline (P-spline) of ``points`` (n, 3) over ``u``, with
+    knots ``spacing`` (n,) metres apart locally and a ``_PENALTY`` on the third differences of
+    the coefficients (Eilers and Marx 1996, eq. 8), which damps the ringing a plain least-squares
+    fit shows next to a kink."""
     k = 5
     count = np.concatenate([[0.0], np.cumsum(np.diff(u) / spacing[1:])])
     n_int = max(1, int(round(count[-1])))
     inner = np.interp(np.linspace(0.0, count[-1], n_int + 1), count, u)
     knots = np.concatenate([[u[0]] * k, inner, [u[-1]] * k])
-    return make_lsq_spline(u, points, knots, k=k, axis=0)
+    basis = BSpline.design_matrix(u, knots, k).tocsr()
+    diff = sparse.eye(basis.shape[1], format="csr")
+    for _ in range(3):
+        diff = diff[1:] - diff[:-1]
+    normal = (basis.T @ basis + _PENALTY * (diff.T @ diff)).tocsc()
+    return BSpline(knots, spsolve(normal, basis.T @ points), k, axis=0)
 
 
 def _arc_length(curve, u: np.ndarray) -> np.ndarray:
