@@ -201,6 +201,9 @@ def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: np.ndarray):
     diff = sparse.eye(basis.shape[1], format="csr")
     for _ in range(3):
         diff = diff[1:] - diff[:-1]
+    # the coefficients next to the clamped ends sit on coincident knots, where differences are
+    # not derivatives: penalising them would bend the path's ends
+    diff = diff[k:-k] if diff.shape[0] > 2 * k else diff[:0]
     normal = (basis.T @ basis + _PENALTY * (diff.T @ diff)).tocsc()
     return BSpline(knots, spsolve(normal, basis.T @ points), k, axis=0)
 
