@@ -236,6 +236,12 @@ def _smoothed_distance(t: np.ndarray, s: np.ndarray, w: float) -> PiecewisePolyn
     breaks = breaks[(breaks >= t[0]) & (breaks <= t[-1])]
     mid = 0.5 * (breaks[:-1] + breaks[1:])
     a = [smoothed(mid, nu) / f for nu, f in zip(range(4), (1, 1, 2, 6), strict=True)]
+    for coeff in a[1:]:  # exactly flat where the vehicle stands (no creeping at 1e-13 m/s)
+        coeff[np.abs(coeff) < 1e-9] = 0.0
+    # and there S itself is the smoothed value: this avoids the rounding of the second
+    # differences of S2 (about 1e-7 m after a few kilometres), so a stop has one exact distance
+    flat = (a[1] == 0.0) & (a[2] == 0.0) & (a[3] == 0.0)
+    a[0][flat] = np.interp(mid[flat], t, s)
     d = mid - breaks[:-1]  # re-expand the Taylor polynomial at mid about the left break
     coeffs = np.stack([
         a[3],

@@ -285,25 +285,29 @@ def _route_length(sumo, route: list[str]) -> float:
 
 
 def _random_trip(sumo, edges: list[str], length: float, rng: np.random.Generator,
-                 tries: int = 200, no_uturn: bool = False) -> list[str]:
-    """A chain of fastest routes between random edges, at least ``length`` m long ([] if the
-    network has no route at all); with ``no_uturn``, legs that turn back onto the reverse
-    edge (a U-turn of a few metres radius in SUMO) are skipped."""
-    here = edges[rng.integers(len(edges))]
-    trip, total = [here], 0.0
-    for _ in range(tries):
-        there = edges[rng.integers(len(edges))]
-        if there == here:
-            continue
-        leg = sumo.simulation.findRoute(here, there)
-        if len(leg.edges) < 2 or (no_uturn and _has_uturn(sumo, [trip[-1], *leg.edges[1:]])):
-            continue
-        trip += list(leg.edges)[1:]
-        total += leg.length
-        here = there
+                 no_uturn: bool = False, starts: int = 20, tries: int = 20) -> list[str]:
+    """A chain of fastest routes between random edges, at least ``length`` m long if the
+    network allows (else the longest found; [] when there is no route at all). A chain that
+    gets stuck (a dead end) starts again from another edge. With ``no_uturn``, legs that turn
+    back onto the reverse edge (a U-turn of a few metres radius in SUMO) are skipped."""
+    best: list[str] = []
+    for _ in range(starts):
+        here = edges[rng.integers(len(edges))]
+        trip, total, fails = [here], 0.0, 0
+        while total < length and fails < tries:
+            there = edges[rng.integers(len(edges))]
+            leg = sumo.simulation.findRoute(here, there) if there != here else None
+            if leg is None or len(leg.edges) < 2 or (
+                    no_uturn and _has_uturn(sumo, [trip[-1], *leg.edges[1:]])):
+                fails += 1
+                continue
+            trip += list(leg.edges)[1:]
+            total += leg.length
+            here, fails = there, 0
         if total >= length:
             return trip
-    return trip if len(trip) > 1 else []
+        best = max(best, trip, key=len)
+    return best if len(best) > 1 else []
 
 
 def _has_uturn(sumo, route: list[str]) -> bool:

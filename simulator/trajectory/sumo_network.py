@@ -203,7 +203,7 @@ def _existing(base: Path, name: str, key: tuple) -> Path:
 
 def _netgenerate(recipe: dict) -> Path:
     kind = recipe["type"]
-    args = [f"--{kind}", f"--default.lanenumber={recipe['lanes']}",
+    args = [f"--{'rand' if kind == 'random' else kind}", f"--default.lanenumber={recipe['lanes']}",
             f"--default.speed={recipe['speed']}", f"--seed={recipe['seed']}",
             "--no-turnarounds", f"--default.junctions.radius={recipe['junction_radius']}",
             "--junctions.internal-link-detail=10", _TURN_SPEED]
