@@ -42,10 +42,12 @@ SUMO documentation, "TraCI/Interfacing TraCI from Python", "Libsumo", "Simulatio
 
 from __future__ import annotations
 
+import contextlib
 import difflib
 import hashlib
 import json
 import os
+import sys
 import tempfile
 import threading
 from dataclasses import dataclass
@@ -166,23 +168,48 @@ def _simulate(traj: dict, network: Network) -> SumoDrive:
         os.environ.setdefault("LIBSUMO_AS_TRACI", "quiet")  # no pyarrow-version banner
         import libsumo
 
-        try:
-            libsumo.start(["sumo", "--net-file", str(network.path),
-                           "--step-length", repr(traj["step_length"]),
-                           "--seed", str(traj["seed"]), "--no-step-log", "true",
-                           "--no-warnings", "true", "--time-to-teleport", "-1",
-                           "--lanechange.duration", repr(_LANE_CHANGE_S),
-                           "--collision.action", "warn"])
-        except Exception as exc:  # libsumo raises its own exception types
-            raise NetworkError(("network",), f"SUMO cannot load the network: {exc}") from None
-        try:
-            return _drive(libsumo, traj, network)
-        except libsumo.TraCIException as exc:
-            raise NetworkError(("network",), f"SUMO failed during the drive: {exc}") from None
-        finally:
-            libsumo.close()
+        with _sumo_messages() as messages:
+            try:
+                libsumo.start(["sumo", "--net-file", str(network.path),
+                               "--step-length", repr(traj["step_length"]),
+                               "--seed", str(traj["seed"]), "--no-step-log", "true",
+                               "--no-warnings", "true", "--time-to-teleport", "-1",
+                               "--lanechange.duration", repr(_LANE_CHANGE_S),
+                               "--collision.action", "warn"])
+            except Exception as exc:  # libsumo raises its own exception types
+                raise NetworkError(("network",), "SUMO cannot load the network: "
+                                   f"{messages() or exc}") from None
+            try:
+                return _drive(libsumo, traj, network)
+            except libsumo.TraCIException as exc:
+                raise NetworkError(("network",), "SUMO failed during the drive: "
+                                   f"{messages() or exc}") from None
+            finally:
+                libsumo.close()
     finally:
         _SUMO_LOCK.release()
+
+
+@contextlib.contextmanager
+def _sumo_messages():
+    """Capture what SUMO's C++ core writes to stderr (file descriptor 2) while it runs; yields
+    a function returning its error lines joined (so they end up in one clear message)."""
+    sys.stderr.flush()
+    saved = os.dup(2)
+    with tempfile.TemporaryFile(mode="w+b") as log:
+        os.dup2(log.fileno(), 2)
+
+        def errors() -> str:
+            log.seek(0)
+            lines = log.read().decode(errors="replace").splitlines()
+            return "; ".join(ln.strip().removeprefix("Error: ").rstrip(".") for ln in lines
+                             if ln.startswith("Error"))[:500]
+
+        try:
+            yield errors
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
 
 
 def _drive(sumo, traj: dict, network: Network) -> SumoDrive:
