@@ -5,7 +5,8 @@ distance in time) that the exact kinematics can differentiate.
 The fit separates where the vehicle goes (geometry) from when it gets there (timing):
 
 * geometry: the positions are stripped of standstill repeats and resampled every
-  ``_RESAMPLE_M`` of chord length u; east, north and up are fitted as penalised least-squares
+  ``_RESAMPLE_M`` of chord length u (linearly, or with Akima's cubic when the samples are
+  sparse, as in a 1 Hz log); east, north and up are fitted as penalised least-squares
   quintic B-splines (P-splines, Eilers and Marx 1996) of u with knots every ``knot_spacing``
   metres, or every ``knot_time`` seconds of travel where that is longer (de Boor, *A Practical
   Guide to Splines*, ch. XIV). The knot spacing bounds how sharp a corner can be, so a kink in
@@ -34,7 +35,7 @@ Statistical Science 11(2), 1996.
 
 Public names
 ------------
-FittedDrive, LocalFrame, fit_drive, local_frame, start_block.
+FittedDrive, LocalFrame, fit_drive, local_frame, start_block, zone_intervals.
 """
 
 from __future__ import annotations
@@ -43,7 +44,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy import sparse
-from scipy.interpolate import BSpline, PPoly, make_interp_spline
+from scipy.interpolate import Akima1DInterpolator, BSpline, PPoly, make_interp_spline
 from scipy.sparse.linalg import spsolve
 
 from simulator.earth import (
@@ -153,7 +154,12 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
                          "are needed to fit a road")
     moving = np.concatenate([[True], step > 0])
     u_grid = np.linspace(0.0, total, int(np.ceil(total / _RESAMPLE_M)) + 1)
-    path = np.stack([np.interp(u_grid, chord[moving], enu[moving, i]) for i in range(3)], -1)
+    if np.median(step[step > 0]) > 2 * _RESAMPLE_M:
+        # sparse samples (a 1 Hz log): chords would cut every bend, so interpolate with Akima's
+        # local cubic (no overshoot next to a corner)
+        path = Akima1DInterpolator(chord[moving], enu[moving], axis=0)(u_grid)
+    else:
+        path = np.stack([np.interp(u_grid, chord[moving], enu[moving, i]) for i in range(3)], -1)
     dt = np.diff(t)
     speed = np.interp(u_grid, chord[1:][step > 0], (step / dt)[step > 0])
     curve = _lsq_quintic(u_grid, path, np.maximum(knot_spacing, knot_time * speed))
@@ -178,6 +184,15 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
                           duration_s=float(tt[-1]), zones=shifted)
     u0 = float(np.interp(distance(0.0), sigma, u_dense))
     return FittedDrive(profile, curve(u0), float(np.degrees(heading_abs(0.0))))
+
+
+def zone_intervals(t: np.ndarray, zone: np.ndarray) -> list[tuple[float, float, str]]:
+    """Runs of equal, non-empty zone names as (t_start, t_end, name)."""
+    change = np.flatnonzero(zone[1:] != zone[:-1]) + 1
+    starts = np.concatenate([[0], change])
+    ends = np.concatenate([change, [len(zone)]])
+    return [(float(t[a]), float(t[min(b, len(t) - 1)]), str(zone[a]))
+            for a, b in zip(starts, ends, strict=True) if zone[a]]
 
 
 def _piecewise(spline) -> PiecewisePolynomial:

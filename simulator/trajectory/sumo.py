@@ -57,7 +57,13 @@ import numpy as np
 
 from simulator.earth import ecef_to_geodetic, ned_to_ecef
 from simulator.scenario.schema import Context, Integer, ListOf, Number, Record, Text
-from simulator.trajectory.fit import LocalFrame, fit_drive, local_frame, start_block
+from simulator.trajectory.fit import (
+    LocalFrame,
+    fit_drive,
+    local_frame,
+    start_block,
+    zone_intervals,
+)
 from simulator.trajectory.segments import RoadProfile
 from simulator.trajectory.sumo_network import (
     NETWORK_FIELD,
@@ -367,15 +373,6 @@ def _zone_per_sample(network: Network, lanes: list[str], lane_pos: np.ndarray,
     fill = inside & (before == after) & (before != "")
     zone[fill] = before[fill]
     return zone
-
-
-def zone_intervals(t: np.ndarray, zone: np.ndarray) -> list[tuple[float, float, str]]:
-    """Runs of equal, non-empty zone names as (t_start, t_end, name)."""
-    change = np.flatnonzero(zone[1:] != zone[:-1]) + 1
-    starts = np.concatenate([[0], change])
-    ends = np.concatenate([change, [len(zone)]])
-    return [(float(t[a]), float(t[min(b, len(t) - 1)]), str(zone[a]))
-            for a, b in zip(starts, ends, strict=True) if zone[a]]
 
 
 def place_drive(xyz: np.ndarray, network: Network, start: dict) -> LocalFrame:
