@@ -294,3 +294,24 @@ def test_netgenerate_recipes(tmp_path, recipe):
                                      "route": {"length": 800}, "traffic": {"vehicles": 3}})
     truth = build_truth(load_scenario(path).data)
     assert truth.table().distance.iloc[-1] > 700.0
+
+
+def test_zone_tags_of_network_edges(tmp_path):
+    """Every way an edge can be marked: a zone parameter, OSM tunnel/covered tags, an edge type;
+    junction-internal edges and untagged edges are no zone; the projection is read."""
+    net = tmp_path / "tags.net.xml"
+    net.write_text(
+        '<net><location netOffset="-10.00,-20.00" projParameter="+proj=utm +zone=32 '
+        '+ellps=WGS84"/>'
+        '<edge id="a"><param key="zone" value="garage"/></edge>'
+        '<edge id="b"><param key="tunnel" value="building_passage"/></edge>'
+        '<edge id="c"><param key="covered" value="yes"/></edge>'
+        '<edge id="d" type="highway.parking_garage"/>'
+        '<edge id="e" type="highway.primary"><param key="bridge" value="yes"/></edge>'
+        '<edge id=":j_0" function="internal"><param key="zone" value="garage"/></edge></net>')
+    network = prepare_network(str(net), tmp_path)
+    assert network.zones == {"a": [(0.0, 1.0, "garage")], "b": [(0.0, 1.0, "tunnel")],
+                             "c": [(0.0, 1.0, "underpass")], "d": [(0.0, 1.0, "garage")]}
+    assert network.georeferenced
+    lon, lat = network.to_lonlat(np.array([[500000.0 + 10.0, 20.0]]))
+    assert lon[0] == pytest.approx(9.0) and lat[0] == pytest.approx(0.0, abs=1e-9)
