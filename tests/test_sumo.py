@@ -313,5 +313,5 @@ def test_zone_tags_of_network_edges(tmp_path):
     assert network.zones == {"a": [(0.0, 1.0, "garage")], "b": [(0.0, 1.0, "tunnel")],
                              "c": [(0.0, 1.0, "underpass")], "d": [(0.0, 1.0, "garage")]}
     assert network.georeferenced
-    lon, lat = network.to_lonlat(np.array([[500000.0 + 10.0, 20.0]]))
+    lon, lat = network.to_lonlat(np.array([[500000.0 - 10.0, -20.0]]))  # x, y minus netOffset
     assert lon[0] == pytest.approx(9.0) and lat[0] == pytest.approx(0.0, abs=1e-9)
