@@ -22,7 +22,7 @@ chords between samples.
 
 Public names
 ------------
-RECORDED_FIELD, build_recorded_profile, read_log.
+RECORDED_FIELD, LogError, read_log, build_recorded_profile.
 """
 
 from __future__ import annotations
@@ -64,7 +64,7 @@ class LogError(Exception):
 
 
 def read_log(path: Path) -> pd.DataFrame:
-    """The rows of a position log (CSV or Parquet) with a complete position, sorted checks done.
+    """The rows of a position log (CSV or Parquet) that have a complete position.
 
     Raises
     ------

@@ -32,7 +32,7 @@ SUMO runs are cached by content (like the networks), so ``landnav validate`` fol
 
 Public names
 ------------
-SUMO_FIELD, build_sumo_profile, run_sumo, SumoDrive.
+SUMO_FIELD, FIT_FIELD, SumoDrive, RouteError, run_sumo, place_drive, build_sumo_profile.
 
 References
 ----------

@@ -28,7 +28,7 @@ part of its road. Zone names apply through the environment's zone settings.
 
 Public names
 ------------
-NETWORK_FIELD, NETGENERATE_FIELD, Network, prepare_network, sumo_binary.
+NETWORK_FIELD, NETGENERATE_FIELD, Network, NetworkError, prepare_network, sumo_binary, cache_dir.
 
 References
 ----------
