@@ -315,3 +315,17 @@ def test_zone_tags_of_network_edges(tmp_path):
     assert network.georeferenced
     lon, lat = network.to_lonlat(np.array([[500000.0 - 10.0, -20.0]]))  # x, y minus netOffset
     assert lon[0] == pytest.approx(9.0) and lat[0] == pytest.approx(0.0, abs=1e-9)
+
+
+def test_same_scenario_gives_identical_truth_without_cache(tmp_path, monkeypatch):
+    """SUMO is seeded by trajectory.seed: two generations from empty caches write byte-identical
+    truth files (SPEC section 2)."""
+    from simulator.cli import main
+
+    scenario = REPO / "scenarios" / "sumo_lakeside_osm.yaml"
+    for run in ("a", "b"):
+        monkeypatch.setenv("LANDNAV_CACHE", str(tmp_path / f"cache-{run}"))
+        assert main(["generate", str(scenario), "-o", str(tmp_path / run)]) == 0
+    assert (tmp_path / "a" / "truth.parquet").read_bytes() == (
+        tmp_path / "b" / "truth.parquet").read_bytes()
+    assert any((tmp_path / "cache-a" / "sumo").glob("run-*.npz"))
