@@ -35,7 +35,7 @@ Statistical Science 11(2), 1996.
 
 Public names
 ------------
-FittedDrive, LocalFrame, fit_drive, local_frame, start_block, zone_intervals.
+FittedDrive, LocalFrame, fit_drive, fit_along, local_frame, start_block, zone_intervals.
 """
 
 from __future__ import annotations
@@ -184,6 +184,22 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
                           duration_s=float(tt[-1]), zones=shifted)
     u0 = float(np.interp(distance(0.0), sigma, u_dense))
     return FittedDrive(profile, curve(u0), float(np.degrees(heading_abs(0.0))))
+
+
+def fit_along(sigma: np.ndarray, values: np.ndarray, spacing: float) -> PiecewisePolynomial:
+    """A smooth (C4) function of the distance through samples: the P-spline of the path fit.
+
+    Parameters
+    ----------
+    sigma : array, shape (n,)
+        Distances along the road, m, strictly increasing.
+    values : array, shape (n,)
+        Samples (a road bank angle, rad).
+    spacing : float
+        Knot spacing, m.
+    """
+    return _piecewise(_lsq_quintic(sigma, np.asarray(values, dtype=float),
+                                   np.full(len(sigma), float(spacing))))
 
 
 def zone_intervals(t: np.ndarray, zone: np.ndarray) -> list[tuple[float, float, str]]:

@@ -10,9 +10,13 @@ The scenario block::
       fit: {knot_spacing: 3.0, knot_time: null, time_window: null}
 
 File columns: ``t`` (s, any origin, increasing), ``lat``, ``lon`` (deg), ``alt`` (m, ellipsoidal
-height) and optionally ``zone`` (a zone name per row, empty outside zones). Other columns (an
-attitude, velocities) are allowed and ignored: the truth's attitude follows the fitted road (yaw
-= path heading, pitch = grade, roll from bank and lateral acceleration). Rows with a missing
+height), optionally ``roll`` (rad) and ``zone`` (a zone name per row, empty outside zones). Other
+columns (pitch, yaw, velocities) are allowed and ignored. The truth's attitude follows the
+fitted road: yaw is the path heading and pitch the grade (a car does not slip), and roll is the
+road bank minus ``limits.roll_gradient`` v^2 kappa. With a ``roll`` column, the bank is fitted
+so that the truth's roll reproduces the logged roll: bank = roll + roll_gradient v^2 kappa at the
+moving samples, smoothed along the road (P-spline, knots every ``_BANK_KNOTS_M`` or two sample
+spacings). Rows with a missing
 position are dropped. The drive starts at the first row: the scenario's ``start`` lat, lon, alt
 and heading are replaced by the log's (``start.utc`` still sets the time).
 
@@ -33,10 +37,18 @@ import numpy as np
 import pandas as pd
 
 from simulator.scenario.schema import Context, Number, Record, Text
-from simulator.trajectory.fit import fit_drive, local_frame, start_block, zone_intervals
+from simulator.trajectory.fit import (
+    fit_along,
+    fit_drive,
+    local_frame,
+    start_block,
+    zone_intervals,
+)
 from simulator.trajectory.segments import RoadProfile
 
 REQUIRED_COLUMNS = ("t", "lat", "lon", "alt")
+_BANK_KNOTS_M = 10.0  # smallest knot spacing of the bank fitted to a logged roll, m
+_BANK_MIN_SPEED = 1.0  # samples slower than this (m/s) do not set the bank
 
 RECORDED_FIELD = Record({
     "file": Text(doc="CSV or Parquet log with columns t, lat, lon, alt (and optionally zone)"),
@@ -124,5 +136,28 @@ def build_recorded_profile(scenario: dict, ctx: Context | None) -> RoadProfile |
             raise ValueError(f"{'.'.join(key)}: {exc}") from None
         ctx.error(key, str(exc))
         return None
+    if "roll" in log.columns:
+        fitted.profile.bank = _bank_from_roll(fitted.profile, t - t[0],
+                                              log["roll"].to_numpy(float),
+                                              scenario["limits"]["roll_gradient"])
     fitted.profile.start = start_block(frame, fitted)
     return fitted.profile
+
+
+def _bank_from_roll(profile: RoadProfile, t: np.ndarray, roll: np.ndarray,
+                    roll_gradient: float):
+    """Road bank along s that makes the kinematic roll (bank - roll_gradient v^2 kappa) the
+    logged roll at the moving samples."""
+    s = profile.distance_of_time(t)
+    v = profile.distance_of_time(t, 1)
+    use = (v > _BANK_MIN_SPEED) & np.isfinite(roll)
+    use[1:] &= np.diff(s) > 0
+    if use.sum() < 10:
+        return profile.bank
+    s, v, roll = s[use], v[use], roll[use]
+    bank = roll + roll_gradient * v**2 * profile.curvature(s)
+    spacing = max(_BANK_KNOTS_M, 2.0 * float(np.median(np.diff(s))))
+    # resampled every metre along the whole road (held constant before the first and after
+    # the last moving sample), so every knot interval of the spline has data
+    grid = np.arange(0.0, float(profile.distance_of_time(t[-1])) + spacing, 1.0)
+    return fit_along(grid, np.interp(grid, s, bank), spacing)
