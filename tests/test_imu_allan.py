@@ -50,18 +50,22 @@ def adev(series: np.ndarray, rate: float, taus: np.ndarray) -> tuple[np.ndarray,
 @pytest.mark.parametrize("rate, output", [(20.0, "rate"), (100.0, "increment")])
 def test_noise_density_and_flicker_floor(hour, preset, rate, output):
     cfg, values, rate = static_record(hour, {"preset": preset, "rate": rate, "output": output})
-    # up to a hundredth of the record, where a one-hour flicker curve is known to about 10 %
-    taus = np.logspace(0, np.log10(36), 15)
+    # floor read up to a hundredth of the record, where a one-hour flicker curve is known to
+    # about 10 %
+    taus = np.concatenate([[0.2], np.logspace(0, np.log10(36), 15)])
     for g, (group, axes) in enumerate(GROUPS.items()):
         density = cfg[group]["noise_density"]
         floor = FLICKER_ADEV_FACTOR * cfg[group]["bias_instability"]
         for i in range(3):
             t, dev = adev(values[:, 3 * g + i], rate, taus)
-            assert t[0] == pytest.approx(1.0, rel=0.05)
-            # white noise: ADEV(1 s) = N (IEEE Std 952, Annex C)
-            assert dev[0] == pytest.approx(density, rel=0.10), axes[i]
+            assert t[0] == pytest.approx(0.2) and t[1] == pytest.approx(1.0, rel=0.05)
+            # white noise: the slope -1/2 line sigma(tau) = N / sqrt(tau) read at tau = 1 s
+            # (IEEE Std 952, Annex C), through its value at 0.2 s where the floor adds < 2 %
+            assert dev[0] * np.sqrt(t[0]) == pytest.approx(density, rel=0.10), axes[i]
+            # ... and the curve itself at 1 s, where the floor adds its share
+            assert dev[1] == pytest.approx(np.hypot(density, floor), rel=0.10), axes[i]
             # bias instability: the flat floor of the curve is 0.664 B
-            assert dev.min() == pytest.approx(floor, rel=0.30), axes[i]
+            assert dev[1:].min() == pytest.approx(floor, rel=0.30), axes[i]
 
 
 @pytest.mark.parametrize("rate", [20.0, 200.0])
