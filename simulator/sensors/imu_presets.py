@@ -74,8 +74,8 @@ _AUTOMOTIVE = {
 IMU_PRESETS: dict[str, dict] = {
     "ideal": {},
     "consumer": {
-        "gyro": {"bias": 1 * DEG_S, "bias_instability": 12 * DEG_H,
-                 "noise_density": 0.007 * DEG_S_RT_HZ, "random_walk": 2e-4 * DEG_S2_RT_HZ,
+        "gyro": {"bias": 1 * DEG_S, "bias_instability": 15 * DEG_H,
+                 "noise_density": 0.007 * DEG_S_RT_HZ, "random_walk": 1e-4 * DEG_S2_RT_HZ,
                  "scale_factor": 1 * PERCENT, "misalignment": 5 * MILLI, "range": 500 * DEG_S,
                  "resolution": 0.015 * DEG_S, "temperature_coefficient": 0.015 * DEG_S,
                  "g_sensitivity": 0.1 * DEG_S / G0_M_S2},
