@@ -30,6 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from estimators.gauss_markov import gauss_markov_discrete
+
 # Allan deviation floor of flicker noise per unit bias instability, sqrt(2 ln 2 / pi) (IEEE 952)
 FLICKER_ADEV_FACTOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
 
@@ -114,8 +116,8 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float,
     ndarray, shape (n, m)
     """
     sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
-    phi = np.exp(-dt_s / tau_s)
-    drive = rng.standard_normal((n, sigma.size)) * np.sqrt(-np.expm1(-2 * dt_s / tau_s))
+    phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
+    drive = rng.standard_normal((n, sigma.size)) * np.sqrt(q_unit)
     drive[0] = rng.standard_normal(sigma.size)
     return ar1_filter(drive, phi) * sigma
 
