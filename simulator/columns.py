@@ -42,6 +42,16 @@ GNSS_RAW = {
     "elevation": "rad", "azimuth": "rad",
 }
 
+# broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of GPS week
+# ``week`` (toc may fall just outside [0, 604800) when the clock epoch is in the adjacent week)
+GNSS_NAV = {
+    "sv": "1", "week": "1", "toe": "s", "toc": "s",
+    "af0": "s", "af1": "s/s", "af2": "s/s^2", "tgd": "s", "iode": "1", "health": "1",
+    "sqrt_a": "m^0.5", "e": "1", "i0": "rad", "omega0": "rad", "omega": "rad", "m0": "rad",
+    "delta_n": "rad/s", "omega_dot": "rad/s", "idot": "rad/s",
+    "cuc": "rad", "cus": "rad", "crc": "m", "crs": "m", "cic": "rad", "cis": "rad",
+}
+
 BARO = {"t": "s", "pressure": "Pa", "altitude": "m"}
 MAG = {"t": "s", "mag_x": "T", "mag_y": "T", "mag_z": "T"}
 EVENTS = {"t_start": "s", "t_end": "s", "kind": "", "detail": ""}
