@@ -27,7 +27,7 @@ from scipy.signal import lfilter
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S
-from simulator.gnss.receiver import rotate_to_reception_frame
+from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
 
@@ -122,13 +122,15 @@ def solve_velocity(rate_m_s: np.ndarray, sat_pos_m: np.ndarray, sat_vel_m_s: np.
                    ) -> tuple[np.ndarray, np.ndarray]:
     """Weighted least-squares ECEF velocity and clock drift (c d(dt_r)/dt, m/s) from pseudorange
     rates corrected for the satellite clock drift (Groves eq. 9.141):
-    rate = los . (v_s - v) + c d(dt_r)/dt, with v_s rotated into the frame of reception."""
+    rate = los . (v_s - v) / f + c d(dt_r)/dt, with v_s rotated into the frame of reception and
+    f = ``light_time_factor`` (the exact light-time derivative; 1 - f is about 1e-5)."""
     ok = (mask.sum(axis=1) >= 4) & np.isfinite(pos_m).all(axis=1)
     rx = np.where(ok[:, None], pos_m, 0.0)
     rng, los = _geometry(sat_pos_m, rx)
     vs = rotate_to_reception_frame(sat_vel_m_s, rng / C_M_S)
-    y = np.where(mask, rate_m_s - np.einsum("nki,nki->nk", los, vs), 0.0)
-    h = np.concatenate([-los, np.ones(rng.shape + (1,))], axis=-1)
+    factor = light_time_factor(los, sat_pos_m, vs, rng / C_M_S)
+    y = np.where(mask, rate_m_s * factor - np.einsum("nki,nki->nk", los, vs), 0.0)
+    h = np.concatenate([-los, factor[..., None]], axis=-1)
     hw = h * np.where(mask, weight, 0.0)[..., None]
     x = _solve(np.einsum("nki,nkj->nij", hw, h), np.einsum("nki,nk->ni", hw, y), ok)
     x = np.where(ok[:, None], x, np.nan)
@@ -196,8 +198,8 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     w_rate = 1.0 / raw["pseudorange_rate_std"].to_numpy() ** 2
     mask, (pr_p, pos_p, vel_p, rate_p, w_pr_p, w_rate_p) = pack_epochs(
         epoch, n, pr, sat_pos, sat_vel, rate, w_pr, w_rate)
-    pos, _, ok = solve_position(pr_p, pos_p, w_pr_p, mask)
-    vel, _ = solve_velocity(rate_p, pos_p, vel_p, pos, w_rate_p, mask)
+    pos, clock, ok = solve_position(pr_p, pos_p, w_pr_p, mask)
+    vel, drift = solve_velocity(rate_p, pos_p, vel_p, pos, w_rate_p, mask)
     hdop, vdop = dilution_of_precision(pos_p, pos, mask)
     if smoothing_time_constant_s > 0 and n > 1:
         pos = smooth_positions(pos, vel, float(t[1] - t[0]), smoothing_time_constant_s)
@@ -211,5 +213,5 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
         "speed": np.hypot(v_ned[:, 0], v_ned[:, 1]),
         "course": np.mod(np.arctan2(v_ned[:, 1], v_ned[:, 0]), 2.0 * np.pi),
         "num_sats": mask.sum(axis=1), "hdop": hdop, "vdop": vdop,
-        "fix": np.where(ok, 2, 0),
+        "fix": np.where(ok, 2, 0), "clock_bias": clock, "clock_drift": drift,
     }, columns=list(col.GNSS_FIX))

@@ -8,8 +8,8 @@ first-order recursions run along the epoch axis by ``scipy.signal.lfilter``.
 
 Public functions
 ----------------
-rotate_to_reception_frame, signal_geometry, clock_process, gauss_markov, cn0_model,
-dll_sigma_m, fll_sigma_hz, multipath_sigma_m.
+rotate_to_reception_frame, light_time_factor, signal_geometry, clock_process, gauss_markov,
+cn0_model, dll_sigma_m, fll_sigma_hz, multipath_sigma_m.
 
 References
 ----------
@@ -43,6 +43,26 @@ def rotate_to_reception_frame(vec: np.ndarray, tau_s: np.ndarray) -> np.ndarray:
     return np.stack([cos_t * x + sin_t * y, -sin_t * x + cos_t * y, vec[..., 2]], axis=-1)
 
 
+def light_time_factor(los: np.ndarray, sat_pos_m: np.ndarray, sat_vel_rx_frame_m_s: np.ndarray,
+                      tau_s: np.ndarray) -> np.ndarray:
+    """The factor 1 - B / c relating the range rate to its first-order value:
+    d(range)/dt = los . (R v_s - v_r) / (1 - B / c), with
+    B = los . (omega_e R'(omega_e tau) r_s - R v_s), from differentiating
+    |R(omega_e tau) r_s(t - tau) - r_r(t)| with d(tau)/dt = (d range/dt) / c.
+
+    ``sat_pos_m`` is in the ECEF frame of transmission, ``sat_vel_rx_frame_m_s`` already rotated
+    into the frame of reception; shapes (..., 3), result (...).
+    """
+    theta = OMEGA_E_DOT_RAD_S * np.asarray(tau_s)
+    cos_t, sin_t = np.cos(theta), np.sin(theta)
+    x, y = sat_pos_m[..., 0], sat_pos_m[..., 1]
+    # d/dtheta of the rotation applied to r_s, times omega_e: the rate of the frame change
+    spin = OMEGA_E_DOT_RAD_S * np.stack([-sin_t * x + cos_t * y, -cos_t * x - sin_t * y,
+                                         np.zeros_like(x)], axis=-1)
+    b = np.einsum("...k,...k->...", los, spin - sat_vel_rx_frame_m_s)
+    return 1.0 - b / C_M_S
+
+
 def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np.ndarray,
                     rx_vel_m_s: np.ndarray) -> dict[str, np.ndarray]:
     """Transmit time, satellite state and geometric range of each signal received at t_rx.
@@ -64,7 +84,8 @@ def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np
         transmission; ``clock_s``, ``clock_drift_s_s`` (S): broadcast satellite clock;
         ``range`` (S, m): c tau, the geometric range including the Sagnac term;
         ``range_rate`` (S, m/s): its exact time derivative (with d tau/dt and the rotation's
-        own rate); ``los`` (S + (3,)): unit vector from antenna to satellite, ECEF of reception.
+        own rate); ``tau_rate`` (S): d tau / dt; ``los`` (S + (3,)): unit vector from antenna
+        to satellite, ECEF of reception; ``los_rate`` (S + (3,), 1/s): its time derivative.
     """
     t_rx = np.broadcast_to(np.asarray(t_rx_s, dtype=float), eph["toe_s"].shape)
     tau = np.full(t_rx.shape, 0.075)
@@ -77,16 +98,11 @@ def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np
     rng = np.linalg.norm(rel, axis=-1)
     los = rel / rng[..., None]
     vel_rx_frame = rotate_to_reception_frame(state["vel"], tau)
-    theta = OMEGA_E_DOT_RAD_S * tau
-    cos_t, sin_t = np.cos(theta), np.sin(theta)
-    # d/dtheta of the rotation applied to r_s, times omega_e: the frame's own rate
-    x, y = state["pos"][..., 0], state["pos"][..., 1]
-    spin = OMEGA_E_DOT_RAD_S * np.stack([-sin_t * x + cos_t * y, -cos_t * x - sin_t * y,
-                                         np.zeros_like(x)], axis=-1)
     a = np.einsum("...k,...k->...", los, vel_rx_frame - rx_vel_m_s[None, :, :])
-    b = np.einsum("...k,...k->...", los, spin - vel_rx_frame)
-    rate = a / (1.0 - b / C_M_S)  # d(range)/dt with d(tau)/dt = rate / c
-    return {"tau": rng / C_M_S, "pos": state["pos"], "vel": state["vel"],
+    rate = a / light_time_factor(los, state["pos"], vel_rx_frame, tau)
+    v_rel = vel_rx_frame - rx_vel_m_s[None, :, :]
+    los_rate = (v_rel - np.einsum("...k,...k->...", los, v_rel)[..., None] * los) / rng[..., None]
+    return {"tau": rng / C_M_S, "pos": state["pos"], "vel": state["vel"], "los_rate": los_rate,
             "clock_s": state["clock_s"], "clock_drift_s_s": state["clock_drift_s_s"],
             "range": rng, "range_rate": rate, "los": los, "tau_rate": rate / C_M_S}
 

@@ -6,7 +6,8 @@ its model class; the dataset generator builds every configured sensor from these
 
 from __future__ import annotations
 
+from simulator.sensors.gnss import GNSS_FIELD, Gnss
 from simulator.sensors.imu import IMU_FIELD, Imu
 
-SENSOR_FIELDS = {"imu": IMU_FIELD}
-SENSOR_MODELS = {"imu": Imu}
+SENSOR_FIELDS = {"imu": IMU_FIELD, "gnss": GNSS_FIELD}
+SENSOR_MODELS = {"imu": Imu, "gnss": Gnss}

@@ -1,0 +1,354 @@
+"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the GPS
+satellites in view, and the receiver's own fixes computed from them, so that a fix degrades
+exactly when and how the measurements do.
+
+Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
+``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac), ``elevation_mask``
+(deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
+(body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
+DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative, ``tropo_residual``
+zenith 1-sigma, ``sis_error`` 1-sigma signal-in-space range error, ``cn0_noise``), the tracking
+loop and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
+single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
+mass-market single-frequency receiver with a TCXO.
+
+Streams: ``gnss_raw`` (one row per tracked signal), ``gnss_fix`` (one row per epoch, fix = 0 and
+NaN position when fewer than 4 signals), ``gnss_nav`` (the broadcast elements used) and
+``truth_gnss`` (the true error terms of every signal above the horizon). Epoch times ``t`` are
+true GPS time since the scenario start; the receiver clock error is in the measurements.
+
+Public names
+------------
+GNSS_FIELD, OSCILLATORS, PRESETS, Gnss.
+
+References
+----------
+Oscillator h-parameters: Brown & Hwang 2012, Table 9.1. See ``simulator.gnss`` modules for the
+signal, error and fix models.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path as FilePath
+
+import numpy as np
+import pandas as pd
+
+from simulator import columns as col
+from simulator.earth import (
+    earth_rate_ned,
+    ecef_to_geodetic,
+    euler_to_dcm,
+    geodetic_to_ecef,
+    ned_to_ecef_matrix,
+    radii_of_curvature,
+)
+from simulator.environment.sky import canyon_visibility
+from simulator.gnss.atmosphere import klobuchar_delay, saastamoinen_delay
+from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
+from simulator.gnss.constellation import nominal_gps_navigation
+from simulator.gnss.ephemeris import ephemeris_arrays, gather, select_ephemeris
+from simulator.gnss.fix import receiver_fixes
+from simulator.gnss.navfiles import read_navigation
+from simulator.gnss.receiver import (
+    clock_process,
+    cn0_model,
+    dll_sigma_m,
+    fll_sigma_hz,
+    gauss_markov,
+    multipath_sigma_m,
+    signal_geometry,
+)
+from simulator.scenario.schema import Context, ListOf, Number, Path, Record, Text, Vector
+from simulator.sensors.base import sample_times
+from simulator.timebase import utc_to_gps
+from simulator.trajectory.kinematics import Kinematics
+
+# receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
+# crystal) and the 1-sigma spread of the clock state at switch-on
+OSCILLATORS: dict[str, dict[str, float]] = {
+    "tcxo": {"h0": 2e-19, "h_minus2": 2e-20, "bias_s": 1e-4, "drift_s_s": 5e-7},
+    "ocxo": {"h0": 8e-20, "h_minus2": 4e-23, "bias_s": 1e-4, "drift_s_s": 1e-8},
+    "ideal": {"h0": 0.0, "h_minus2": 0.0, "bias_s": 0.0, "drift_s_s": 0.0},
+}
+_ERROR_KEYS = ("clock", "tracking_noise", "multipath", "iono_residual", "tropo_residual",
+               "sis_error", "cn0_noise")
+PRESETS: dict[str, dict] = {
+    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
+                   "iono_residual": 0.2, "tropo_residual": 0.05, "sis_error": 0.5,
+                   "cn0_noise": 1.0},
+    "ideal": {"clock": "ideal", "tracking_noise": 0.0, "multipath": 0.0, "iono_residual": 0.0,
+              "tropo_residual": 0.0, "sis_error": 0.0, "cn0_noise": 0.0},
+}
+# broadcast ionosphere used with the nominal constellation: the coefficients of the IGS
+# broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
+DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
+DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
+SIS_CORRELATION_TIME_S = 3600.0  # broadcast orbit/clock errors change over an upload cycle
+IONO_CORRELATION_TIME_S = 1800.0  # residual of the Klobuchar model along one line of sight
+NLOS_CN0_LOSS_DEFAULT_DB = 10.0
+
+
+def _resolve(value: dict, path: Path, ctx: Context) -> dict:
+    if value["preset"] not in PRESETS:
+        return ctx.error(path + ("preset",), f"unknown GNSS preset {value['preset']!r}; known: "
+                                             f"{', '.join(sorted(PRESETS))}")
+    for key in _ERROR_KEYS:
+        if value[key] is None:
+            value[key] = PRESETS[value["preset"]][key]
+    if value["clock"] not in OSCILLATORS:
+        return ctx.error(path + ("clock",), f"unknown oscillator {value['clock']!r}; known: "
+                                            f"{', '.join(sorted(OSCILLATORS))}")
+    source = value["constellation"]
+    if source != "nominal-gps":
+        candidates = [FilePath(source)]
+        if ctx.file and not FilePath(source).is_absolute():
+            candidates.insert(0, FilePath(ctx.file).resolve().parent / source)
+        found = [c for c in candidates if c.is_file()]
+        if not found:
+            return ctx.error(path + ("constellation",),
+                             f"{source!r} is neither 'nominal-gps' nor an existing RINEX "
+                             "navigation or YUMA almanac file")
+        value["constellation"] = str(found[0].resolve())
+    if value["cn0_horizon"] > value["cn0_zenith"]:
+        return ctx.error(path + ("cn0_horizon",), "must not exceed cn0_zenith")
+    return value
+
+
+GNSS_FIELD = Record(
+    {
+        "preset": Text("automotive", doc="error preset: 'automotive' or 'ideal' (no errors)"),
+        "rate": Number("Hz", 1.0, gt=0, max=100),
+        "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1),
+        "constellation": Text("nominal-gps",
+                              doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
+        "elevation_mask": Number(angle=True, default=10.0, min=0, max=90),
+        "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
+        "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
+        "tracking_noise": Number("", None, min=0,
+                                 doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
+        "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
+        "multipath_correlation_time": Number("s", 5.0, min=0),
+        "iono_residual": Number("", None, min=0,
+                                doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
+        "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
+        "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
+        "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
+        "cn0_zenith": Number("", 47.0, doc="C/N0 of a satellite at zenith, dB-Hz"),
+        "cn0_horizon": Number("", 35.0, doc="C/N0 of a satellite at the horizon, dB-Hz"),
+        "cn0_threshold": Number("", 25.0, doc="tracking threshold, dB-Hz"),
+        "dll_bandwidth": Number("Hz", 0.5, gt=0),
+        "correlator_spacing": Number("", 0.5, gt=0, max=1, doc="early-late spacing, chips"),
+        "fll_bandwidth": Number("Hz", 2.0, gt=0),
+        "integration_time": Number("s", 0.02, gt=0, max=0.02),
+        "smoothing": Number("s", 0.0, min=0, doc="fix smoothing time constant (0 = none)"),
+    },
+    default=None,
+    post=_resolve,
+)
+
+
+class Gnss:
+    """A GPS L1 C/A receiver built from its resolved scenario block (``sensors.gnss``)."""
+
+    name = "gnss"
+
+    def __init__(self, config: dict):
+        self.config = config
+        self.rate_hz = float(config["rate"])
+        self.drawn: dict = {"preset": config["preset"], "constellation": config["constellation"]}
+
+    # -- inputs --------------------------------------------------------------------------------
+    def navigation(self, truth: Kinematics) -> pd.DataFrame:
+        """The navigation table used for the drive (nominal constellation or the named file)."""
+        week0, _ = utc_to_gps(truth.utc_start)
+        if self.config["constellation"] == "nominal-gps":
+            nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0)
+            nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
+            return nav
+        return read_navigation(self.config["constellation"], reference_week=week0)
+
+    def antenna(self, truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Antenna ECEF position and velocity, geodetic position, and heading at times t."""
+        k = truth.inertial(t)
+        lever = np.asarray(self.config["antenna_lever_arm"], dtype=float)
+        c_bn = euler_to_dcm(k["roll"], k["pitch"], k["yaw"])
+        c_ne = ned_to_ecef_matrix(k["lat"], k["lon"])
+        pos = geodetic_to_ecef(k["lat"], k["lon"], k["alt"])
+        pos = pos + np.einsum("nij,njk,k->ni", c_ne, c_bn, lever)
+        # body rate w.r.t. the Earth, w_eb^b = w_ib^b - C_n^b w_ie^n, turns the lever arm
+        w_eb = k["w_body"] - np.einsum("nji,nj->ni", c_bn, earth_rate_ned(k["lat"]))
+        v_ned = k["v_ned"] + np.einsum("nij,nj->ni", c_bn, np.cross(w_eb, lever))
+        vel = np.einsum("nij,nj->ni", c_ne, v_ned)
+        lat, lon, alt = ecef_to_geodetic(pos)
+        return {"pos": pos, "vel": vel, "v_ned": v_ned, "lat": lat, "lon": lon, "alt": alt,
+                "yaw": k["yaw"]}
+
+    def sky(self, truth: Kinematics, t: np.ndarray, az: np.ndarray, el: np.ndarray,
+            yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Line of sight, NLOS, NLOS extra path (m) and C/N0 loss (dB) per satellite and epoch
+        from the environment zones (``sky``: open, none, canyon)."""
+        los = np.ones(el.shape, dtype=bool)
+        nlos = np.zeros(el.shape, dtype=bool)
+        extra = np.zeros(el.shape)
+        loss = np.zeros(el.shape)
+        zones = (truth.environment or {}).get("zones", {}) or {}
+        names = truth.zone_at(t)
+        for name in set(names) - {""}:
+            zone = zones.get(name, {}) or {}
+            sky = zone.get("sky", "open")
+            here = names == name
+            if sky == "none":
+                los[:, here] = False
+            elif sky == "canyon":
+                z_los, z_nlos, z_extra = canyon_visibility(
+                    az[:, here], el[:, here], yaw[None, here], zone.get("building_height", 30.0),
+                    zone.get("street_width", 20.0))
+                los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
+                loss[:, here] = np.where(
+                    z_nlos, zone.get("nlos_attenuation", NLOS_CN0_LOSS_DEFAULT_DB), 0.0)
+        return los, nlos, extra, loss
+
+    # -- generation ----------------------------------------------------------------------------
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+        cfg = self.config
+        t = sample_times(truth.duration_s, self.rate_hz)
+        n_ep = len(t)
+        dt = 1.0 / self.rate_hz
+        week0, tow0 = utc_to_gps(truth.utc_start)
+        t_gps = tow0 + t
+        nav = self.navigation(truth)
+        eph = ephemeris_arrays(nav, week0)
+        max_age = 7 * 86400.0 if (nav["sqrt_a"] > 0).all() and (nav["iode"] == 0).all() \
+            else 4 * 3600.0
+        svs = np.unique(nav["sv"].to_numpy())
+        idx = select_ephemeris(eph, svs[:, None], t_gps[None, :], max_age_s=max_age)
+        ant = self.antenna(truth, t)
+        geo = signal_geometry(gather(eph, idx), t_gps, ant["pos"], ant["vel"])
+
+        c_ne = ned_to_ecef_matrix(ant["lat"], ant["lon"])
+        los_ned = np.einsum("eji,sej->sei", c_ne, geo["los"])
+        el = np.arcsin(np.clip(-los_ned[..., 2], -1.0, 1.0))
+        az = np.mod(np.arctan2(los_ned[..., 1], los_ned[..., 0]), 2.0 * np.pi)
+        # rate of the line of sight, for the rates of the broadcast atmosphere models
+        v_rel_ned = np.einsum("eji,sej->sei", c_ne, geo["los_rate"])
+        el_rate = -v_rel_ned[..., 2] / np.maximum(np.cos(el), 1e-9)
+        horiz = np.maximum(los_ned[..., 0] ** 2 + los_ned[..., 1] ** 2, 1e-18)
+        az_rate = (los_ned[..., 0] * v_rel_ned[..., 1] - los_ned[..., 1] * v_rel_ned[..., 0]) \
+            / horiz
+
+        alpha = nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA)
+        beta = nav.attrs.get("iono_beta", DEFAULT_IONO_BETA)
+        rn, re = radii_of_curvature(ant["lat"])
+        lat_rate = ant["v_ned"][:, 0] / (rn + ant["alt"])
+        lon_rate = ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"]))
+
+        def models(step_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+            lat = ant["lat"] + lat_rate * step_s
+            alt = ant["alt"] - ant["v_ned"][:, 2] * step_s
+            e = np.clip(el + el_rate * step_s, -np.pi / 2, np.pi / 2)
+            iono = klobuchar_delay(lat, ant["lon"] + lon_rate * step_s, az + az_rate * step_s,
+                                   e, t_gps + step_s, alpha, beta)
+            tropo = saastamoinen_delay(lat, alt, e)
+            zenith = saastamoinen_delay(lat, alt, np.pi / 2)
+            return iono, tropo, np.broadcast_to(zenith, tropo.shape)
+
+        iono_b, tropo_b, zenith_b = models(0.0)
+        half = 0.5
+        iono_hi, tropo_hi, zen_hi = models(half)
+        iono_lo, tropo_lo, zen_lo = models(-half)
+
+        have = idx >= 0
+        above_horizon = have & (el > 0)
+        above_mask = have & (el > np.radians(cfg["elevation_mask"]))
+        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
+        cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss \
+            + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+        tracked = above_mask & (los | nlos) & (cn0 >= cfg["cn0_threshold"])
+
+        # receiver clock
+        osc = OSCILLATORS[cfg["clock"]]
+        bias0 = osc["bias_s"] * rng.standard_normal()
+        drift0 = osc["drift_s_s"] * rng.standard_normal()
+        bias_s, drift_s_s = clock_process(n_ep, dt, osc["h0"], osc["h_minus2"], bias0, drift0,
+                                          rng)
+        self.drawn["clock"] = {"oscillator": cfg["clock"], "bias_s": bias0,
+                               "drift_s_s": drift0}
+
+        # correlated error processes and white tracking noise (satellites x epochs)
+        shape = el.shape
+        sis = cfg["sis_error"] * gauss_markov(rng, shape, SIS_CORRELATION_TIME_S, dt)
+        iono_ratio = 1.0 + cfg["iono_residual"] * gauss_markov(rng, shape,
+                                                               IONO_CORRELATION_TIME_S, dt)
+        zenith_error = cfg["tropo_residual"] * rng.standard_normal()
+        self.drawn["tropo_zenith_error_m"] = zenith_error
+        mp_sigma = multipath_sigma_m(el, cfg["multipath"])
+        mp = mp_sigma * gauss_markov(rng, shape, cfg["multipath_correlation_time"], dt)
+        code_sigma = cfg["tracking_noise"] * dll_sigma_m(
+            cn0, cfg["dll_bandwidth"], cfg["correlator_spacing"], cfg["integration_time"])
+        code_noise = code_sigma * rng.standard_normal(shape)
+        rate_sigma = cfg["tracking_noise"] * LAMBDA_L1_M * fll_sigma_hz(
+            cn0, cfg["fll_bandwidth"], cfg["integration_time"])
+        rate_noise = rate_sigma * rng.standard_normal(shape)
+
+        iono_true = iono_b * iono_ratio
+        tropo_true = tropo_b * (1.0 + zenith_error / zenith_b)
+        iono_true_rate = iono_ratio * (iono_hi - iono_lo) / (2 * half)
+        tropo_true_rate = ((tropo_hi * (1.0 + zenith_error / zen_hi))
+                           - (tropo_lo * (1.0 + zenith_error / zen_lo))) / (2 * half)
+        nlos_delay = np.where(nlos & ~los, extra, 0.0)
+        sat_clock = C_M_S * geo["clock_s"]
+        sat_drift = C_M_S * geo["clock_drift_s_s"]
+        rx_clock = C_M_S * bias_s[None, :]
+        rx_drift = C_M_S * drift_s_s[None, :]
+
+        pseudorange = (geo["range"] + rx_clock - sat_clock + iono_true + tropo_true + sis + mp
+                       + nlos_delay + code_noise)
+        rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
+                + tropo_true_rate - iono_true_rate + rate_noise)
+        pr_std = np.sqrt(code_sigma**2 + mp_sigma**2 + (cfg["iono_residual"] * iono_b) ** 2
+                         + (cfg["tropo_residual"] * tropo_b / zenith_b) ** 2
+                         + cfg["sis_error"] ** 2)
+        pr_std = np.maximum(pr_std, 0.1)  # floor of the reported uncertainty
+        rate_std = np.maximum(rate_sigma, 0.01)
+
+        def table(mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
+            m = mask.T  # epochs first, satellites in PRN order within an epoch
+            out = {"t": np.broadcast_to(t[:, None], m.shape)[m],
+                   "sv": np.broadcast_to(svs[None, :], m.shape)[m]}
+            for key, value in columns.items():
+                arr = np.broadcast_to(value, mask.shape + value.shape[2:]) \
+                    if value.ndim >= 2 else value
+                out[key] = np.swapaxes(arr, 0, 1)[m]
+            return pd.DataFrame(out)
+
+        raw = table(tracked, {
+            "pseudorange": pseudorange, "pseudorange_rate": rate,
+            "doppler": -rate / LAMBDA_L1_M, "cn0": cn0,
+            "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
+            "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
+            "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
+            "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": iono_b,
+            "tropo": tropo_b, "elevation": el, "azimuth": az,
+            "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
+        })[list(col.GNSS_RAW)]
+        truth_table = table(above_horizon, {
+            "tracked": tracked.astype(np.int8), "los": los.astype(np.int8),
+            "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
+            "range": geo["range"], "range_rate": geo["range_rate"],
+            "receiver_clock": rx_clock, "receiver_clock_drift": rx_drift,
+            "iono_true": iono_true, "tropo_true": tropo_true,
+            "iono_true_rate": iono_true_rate, "tropo_true_rate": tropo_true_rate,
+            "sis_error": sis, "multipath": mp, "nlos_delay": nlos_delay,
+            "code_noise": code_noise, "rate_noise": rate_noise,
+            "antenna_x": ant["pos"][None, :, 0], "antenna_y": ant["pos"][None, :, 1],
+            "antenna_z": ant["pos"][None, :, 2],
+        })[list(col.TRUTH_GNSS)]
+        used = np.unique(idx[idx >= 0])
+        out = {"gnss_nav": nav.iloc[used].reset_index(drop=True)[list(col.GNSS_NAV)],
+               "truth_gnss": truth_table}
+        if "raw" in cfg["outputs"]:
+            out["gnss_raw"] = raw
+        if "fix" in cfg["outputs"]:
+            out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"])
+        return out
