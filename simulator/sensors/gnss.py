@@ -6,7 +6,9 @@ Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``
 ``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac), ``elevation_mask``
 (deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
 (body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
-DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative, ``tropo_residual``
+DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative 1-sigma of the
+ionosphere the broadcast model misses (common to all signals, plus an independent part per
+signal of half that size), ``tropo_residual``
 zenith 1-sigma, ``sis_error`` 1-sigma signal-in-space range error, ``cn0_noise``), the tracking
 loop and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
 single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
@@ -85,7 +87,8 @@ PRESETS: dict[str, dict] = {
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
 SIS_CORRELATION_TIME_S = 3600.0  # broadcast orbit/clock errors change over an upload cycle
-IONO_CORRELATION_TIME_S = 1800.0  # residual of the Klobuchar model along one line of sight
+IONO_CORRELATION_TIME_S = 1800.0  # residual of the Klobuchar model
+IONO_OWN_SHARE = 0.5  # 1-sigma of the per-signal iono residual relative to the common one
 NLOS_CN0_LOSS_DEFAULT_DB = 10.0
 
 
@@ -278,8 +281,11 @@ class Gnss:
         # correlated error processes and white tracking noise (satellites x epochs)
         shape = el.shape
         sis = cfg["sis_error"] * gauss_markov(rng, shape, SIS_CORRELATION_TIME_S, dt)
-        iono_ratio = 1.0 + cfg["iono_residual"] * gauss_markov(rng, shape,
-                                                               IONO_CORRELATION_TIME_S, dt)
+        # the broadcast model misses mostly the vertical electron content (common to every line
+        # of sight) and, to half that extent, its spatial structure (independent per signal)
+        iono_common = gauss_markov(rng, (1, n_ep), IONO_CORRELATION_TIME_S, dt)
+        iono_own = gauss_markov(rng, shape, IONO_CORRELATION_TIME_S, dt)
+        iono_ratio = 1.0 + cfg["iono_residual"] * (iono_common + IONO_OWN_SHARE * iono_own)
         zenith_error = cfg["tropo_residual"] * rng.standard_normal()
         self.drawn["tropo_zenith_error_m"] = zenith_error
         mp_sigma = multipath_sigma_m(el, cfg["multipath"])
@@ -306,7 +312,8 @@ class Gnss:
                        + nlos_delay + code_noise)
         rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
                 + tropo_true_rate - iono_true_rate + rate_noise)
-        pr_std = np.sqrt(code_sigma**2 + mp_sigma**2 + (cfg["iono_residual"] * iono_b) ** 2
+        pr_std = np.sqrt(code_sigma**2 + mp_sigma**2
+                         + (1.0 + IONO_OWN_SHARE**2) * (cfg["iono_residual"] * iono_b) ** 2
                          + (cfg["tropo_residual"] * tropo_b / zenith_b) ** 2
                          + cfg["sis_error"] ** 2)
         pr_std = np.maximum(pr_std, 0.1)  # floor of the reported uncertainty
