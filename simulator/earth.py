@@ -12,8 +12,8 @@ Public functions
 ----------------
 radii_of_curvature, normal_gravity, gravity_ned, earth_rate_ned, transport_rate_ned,
 geodetic_to_ecef, ecef_to_geodetic, ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef_vector,
-euler_to_dcm, dcm_to_euler, euler_to_quat, quat_to_dcm, quat_to_euler, quat_multiply,
-rotvec_to_quat, wrap_angle, skew.
+euler_to_dcm, ned_to_body, ned_to_body_trig, dcm_to_euler, euler_to_quat, quat_to_dcm,
+quat_to_euler, quat_multiply, rotvec_to_quat, wrap_angle, skew.
 
 References
 ----------
@@ -178,6 +178,28 @@ def euler_to_dcm(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.nda
         ],
         axis=-2,
     )
+
+
+def ned_to_body(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray,
+                v_ned: np.ndarray) -> np.ndarray:
+    """Resolve NED vectors (n, 3) in the body frame: C_n^b v = (C_b^n)^T v (Groves eq. 2.22),
+    written out so no (n, 3, 3) matrix stack is built."""
+    return ned_to_body_trig(np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch),
+                            np.cos(yaw), np.sin(yaw), v_ned)
+
+
+def ned_to_body_trig(cr: np.ndarray, sr: np.ndarray, cp: np.ndarray, sp: np.ndarray,
+                     cy: np.ndarray, sy: np.ndarray, v_ned: np.ndarray) -> np.ndarray:
+    """``ned_to_body`` from the cosines and sines of roll, pitch and yaw."""
+    vn, ve, vd = v_ned[..., 0], v_ned[..., 1], v_ned[..., 2]
+    h = cy * vn + sy * ve  # north/east rotated into the heading frame
+    lateral = -sy * vn + cy * ve
+    vertical = sp * h + cp * vd
+    out = np.empty(np.broadcast_shapes(np.shape(cr), vn.shape) + (3,))
+    out[..., 0] = cp * h - sp * vd
+    out[..., 1] = cr * lateral + sr * vertical
+    out[..., 2] = -sr * lateral + cr * vertical
+    return out
 
 
 def dcm_to_euler(c_bn: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -16,8 +16,6 @@ from __future__ import annotations
 import functools
 import re
 
-import pint
-
 from simulator.earth import G0_M_S2
 
 
@@ -26,7 +24,9 @@ class UnitError(ValueError):
 
 
 @functools.cache
-def _registry() -> pint.UnitRegistry:
+def _registry():
+    import pint  # imported on first use: a scenario of plain SI numbers never pays for it
+
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
     ureg.define(f"gee = {G0_M_S2} * meter / second ** 2")
     ureg.define("ppb = 1e-9 = _ = parts_per_billion")
@@ -77,7 +77,7 @@ def to_si(value: str, si_unit: str) -> float:
         except Exception as exc:  # pint raises several unrelated exception types
             last_error = f"cannot read {value!r} as a quantity ({exc})"
             continue
-        if not isinstance(quantity, pint.Quantity):
+        if not isinstance(quantity, ureg.Quantity):
             quantity = ureg.Quantity(float(quantity))
         if quantity.dimensionality == target:
             return float(quantity.to(_rewrite(si_unit, False) or "dimensionless").magnitude)

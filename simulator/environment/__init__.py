@@ -5,7 +5,7 @@ The sky geometry of a canyon (line of sight, reflections) is in ``simulator.envi
 
 Public names
 ------------
-ENVIRONMENT_FIELD, ZONE_FIELD.
+ENVIRONMENT_FIELD, ZONE_FIELD, COVERED_ZONE_NAMES.
 """
 
 from __future__ import annotations
@@ -25,5 +25,8 @@ ZONE_FIELD = Record(
     },
     default={},
 )
+
+# zones a scenario uses without declaring them: these names have no sky, the others open sky
+COVERED_ZONE_NAMES = ("tunnel", "garage", "parking", "underground", "underpass")
 
 ENVIRONMENT_FIELD = Record({"zones": MapOf(ZONE_FIELD, {})}, default={})

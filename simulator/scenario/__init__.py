@@ -1,0 +1,76 @@
+"""Scenario files: reading, ``--set`` overrides, validation and resolution (defaults filled).
+
+Public names
+------------
+Scenario, load_scenario, validate_data.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from simulator.errors import InputError, Problem
+from simulator.scenario.schema import INVALID, Context
+from simulator.scenario.yamlio import apply_overrides, read_yaml
+
+
+@dataclass
+class Scenario:
+    """A validated scenario: ``data`` is the resolved scenario (defaults filled, SI values)."""
+
+    path: Path
+    data: dict
+    overrides: list[str]
+
+    @property
+    def name(self) -> str:
+        return self.data["name"]
+
+    @property
+    def seed(self) -> int:
+        return self.data["seed"]
+
+
+def validate_data(data: Any, file: str, lines: dict | None = None,
+                  overridden: set | None = None) -> dict:
+    """Validate scenario data; return the resolved scenario or raise InputError with every
+    problem found."""
+    from simulator.scenario.spec import SCENARIO_FIELD  # the spec imports every model's part
+
+    ctx = Context(file, lines, overridden)
+    resolved = SCENARIO_FIELD.check(copy.deepcopy(data), (), ctx)
+    if ctx.problems or resolved is INVALID:
+        raise InputError(ctx.problems)
+    return resolved
+
+
+def load_scenario(path: str | Path, overrides: list[str] | None = None,
+                  seed: int | None = None) -> Scenario:
+    """Read, override and validate a scenario file.
+
+    Parameters
+    ----------
+    path : path of the YAML file.
+    overrides : ``key.path=value`` strings (``--set``), applied before validation.
+    seed : replaces the scenario's seed when given (``--seed``).
+
+    Raises
+    ------
+    InputError
+        With every problem as ``file:line: key.path: message``.
+    """
+    path = Path(path)
+    data, lines = read_yaml(path)
+    if not isinstance(data, dict):
+        raise InputError([Problem(str(path), 1, "", "a scenario is a mapping of keys (name, "
+                                  f"start, trajectory, sensors, ...), not {data!r}")])
+    overrides = list(overrides or [])
+    if seed is not None:
+        overrides.append(f"seed={seed}")
+    data, touched = apply_overrides(data, overrides, str(path))
+    data.setdefault("name", path.stem.removesuffix(".scenario"))
+    resolved = validate_data(data, str(path), lines, touched)
+    return Scenario(path=path, data=resolved, overrides=overrides)

@@ -97,7 +97,9 @@ class Number(Field):
             try:
                 return to_si(value, self.unit)
             except UnitError as exc:
-                return ctx.error(path, str(exc))
+                if "dimension" in str(exc):
+                    return ctx.error(path, str(exc))
+                return ctx.error(path, f"expected a number{self._unit_hint()}; {exc}")
         return ctx.error(path, f"expected a number{self._unit_hint()}, got {value!r}")
 
     def _unit_hint(self) -> str:
@@ -235,7 +237,9 @@ class Record(Field):
                 ctx.error(path + (key,), _unknown_key(key, list(self.fields)))
                 failed = True
         for key, field in self.fields.items():
-            if key in value:
+            if key in value and value[key] is None and field.default is None:
+                got = None  # an optional value given explicitly as null
+            elif key in value:
                 got = field.check(value[key], path + (key,), ctx)
             else:
                 got = field.resolve_missing(path + (key,), ctx)
@@ -316,3 +320,27 @@ def _contains_invalid(value: Any) -> bool:
     if isinstance(value, list):
         return any(_contains_invalid(v) for v in value)
     return False
+
+
+class Tagged(Field):
+    """A mapping whose ``key`` (default ``kind``) picks the record that validates the rest."""
+
+    def __init__(self, variants: dict[str, Record], default: Any = REQUIRED, *,
+                 key: str = "kind", what: str = "kind", doc: str = ""):
+        super().__init__(default, doc)
+        self.variants, self.key, self.what = variants, key, what
+
+    def check(self, value: Any, path: Path, ctx: Context) -> Any:
+        if not isinstance(value, dict):
+            return ctx.error(path, f"expected a mapping with a {self.key!r} key, got {value!r}")
+        if self.key not in value:
+            return ctx.error(path + (self.key,), f"missing required key (one of: "
+                                                 f"{', '.join(self.variants)})")
+        kind = value[self.key]
+        if kind not in self.variants:
+            return ctx.error(path + (self.key,), f"unknown {self.what} {kind!r}; known: "
+                                                 f"{', '.join(self.variants) or 'none'}")
+        record = self.variants[kind]
+        body = {k: v for k, v in value.items() if k != self.key}
+        got = record.check(body, path, ctx)
+        return INVALID if got is INVALID else {self.key: kind, **got}

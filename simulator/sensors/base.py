@@ -19,6 +19,9 @@ from simulator.trajectory.kinematics import Kinematics
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(3)
 GL_NODES = 0.5 * (_GL_X + 1.0)
 GL_WEIGHTS = 0.5 * _GL_W
+# largest Simpson error accepted per interval before Gauss-Legendre takes over: 1e-12 rad and
+# 1e-11 m/s, so that a million samples cannot add up to a measurable drift
+SIMPSON_TOLERANCE = {"w_body": 1e-12, "f_body": 1e-11}
 
 
 class SensorModel(Protocol):
@@ -42,37 +45,53 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
                            keys: tuple[str, ...] = ("w_body", "f_body")) -> dict[str, np.ndarray]:
     """Integrals of truth vectors over each sample interval (t_end - dt, t_end].
 
-    Three-point Gauss-Legendre quadrature of the exact kinematics (exact for polynomials up to
-    degree 5): this is the anti-aliased increment an integrating IMU outputs.
+    This is the anti-aliased increment an integrating IMU outputs. On the truth's own grid,
+    Simpson's rule on the cached grid and midpoint evaluations is used where it is exact to
+    ``SIMPSON_TOLERANCE`` (its error dt^5/2880 f'''' estimated from the fourth difference of the
+    five neighbouring half-step values). Every other interval is integrated with three-point
+    Gauss-Legendre (exact for polynomials up to degree 5), split at the breakpoints of the
+    piecewise kinematics so each piece is smooth.
     """
-    n_nodes = len(GL_NODES)
+    t_end = np.asarray(t_end, dtype=float)
     lo, hi = t_end - dt, t_end
-    # intervals holding a breakpoint of the piecewise kinematics are split there, so every
-    # quadrature runs over a smooth stretch and stays exact
     breaks = truth.breakpoints()
     first = np.searchsorted(breaks, lo, side="right")
     last = np.searchsorted(breaks, hi, side="left")
-    split = np.flatnonzero(last > first)
-    starts, lengths, owner = [lo], [np.full(len(t_end), dt)], [np.arange(len(t_end))]
-    if len(split):
-        starts.pop(), lengths.pop(), owner.pop()
-        smooth = np.flatnonzero(last <= first)
-        starts.append(lo[smooth])
-        lengths.append(np.full(len(smooth), dt))
-        owner.append(smooth)
-        for i in split:
-            edges = np.concatenate([[lo[i]], breaks[first[i]:last[i]], [hi[i]]])
-            starts.append(edges[:-1])
-            lengths.append(np.diff(edges))
-            owner.append(np.full(len(edges) - 1, i))
+    out = {key: np.zeros((len(t_end), 3)) for key in keys}
+    gauss = np.ones(len(t_end), dtype=bool)
+
+    k_end = np.rint(t_end * truth.rate_hz).astype(int)
+    on_grid = (len(t_end) > 0 and abs(dt * truth.rate_hz - 1.0) < 1e-12
+               and np.allclose(k_end, t_end * truth.rate_hz, rtol=0, atol=1e-6)
+               and k_end.min() >= 1 and k_end.max() < len(truth.t_grid))
+    if on_grid:
+        grid, mid = truth.grid_inertial(), truth.grid_inertial(midpoints=True)
+        k = k_end
+        gauss = last > first
+        for key in keys:
+            g, m = grid[key], mid[key]
+            out[key] = dt / 6 * (g[k - 1] + 4 * m[k - 1] + g[k])
+            # half-step sequence g0 m0 g1 m1 ...: fourth difference centred on each interval
+            half = np.empty((2 * len(g) - 1, 3))
+            half[0::2], half[1::2] = g, m
+            d4 = np.zeros_like(half)
+            d4[2:-2] = half[:-4] - 4 * half[1:-3] + 6 * half[2:-2] - 4 * half[3:-1] + half[4:]
+            d4[:2], d4[-2:] = np.inf, np.inf
+            error = dt / 180 * np.max(np.abs(d4[2 * k - 1]), axis=1)
+            gauss |= error > SIMPSON_TOLERANCE[key]
+    starts, lengths, owner = [], [], []
+    for i in np.flatnonzero(gauss):
+        edges = np.concatenate([[lo[i]], breaks[first[i]:last[i]], [hi[i]]])
+        starts.append(edges[:-1])
+        lengths.append(np.diff(edges))
+        owner.append(np.full(len(edges) - 1, i))
+    if not starts:
+        return out
     start, length, idx = (np.concatenate(a) for a in (starts, lengths, owner))
     nodes = (start[:, None] + length[:, None] * GL_NODES[None, :]).ravel()
-    k = truth.inertial(nodes)
-    out = {}
+    values = truth.inertial(nodes)
     for key in keys:
-        values = k[key].reshape(len(start), n_nodes, -1)
-        pieces = length[:, None] * np.einsum("j,njk->nk", GL_WEIGHTS, values)
-        total = np.zeros((len(t_end), values.shape[-1]))
-        np.add.at(total, idx, pieces)
-        out[key] = total
+        v = values[key].reshape(len(start), len(GL_NODES), -1)
+        out[key][gauss] = 0.0
+        np.add.at(out[key], idx, length[:, None] * np.einsum("j,njk->nk", GL_WEIGHTS, v))
     return out

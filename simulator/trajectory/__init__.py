@@ -1,0 +1,31 @@
+"""Trajectory sources: each turns its ``trajectory`` block into a ``RoadProfile`` (road geometry
+along the distance travelled and the distance in time), from which ``kinematics`` computes the
+exact truth.
+
+``TRAJECTORY_KINDS`` maps each ``trajectory.kind`` to its schema record and ``PROFILE_BUILDERS``
+to the function ``(scenario, ctx) -> RoadProfile | None`` that builds it (reporting manoeuvres the
+vehicle cannot drive into ``ctx`` when one is given).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from simulator.scenario.schema import Context, ListOf, Number, Record
+from simulator.trajectory.segments import SEGMENT_FIELD, RoadProfile, build_road_profile
+
+_RATE = Number("Hz", None, gt=0, max=10000,
+               doc="base rate of the truth table (default: the IMU rate, or 100 Hz)")
+
+TRAJECTORY_KINDS: dict[str, Record] = {
+    "segments": Record({"segments": ListOf(SEGMENT_FIELD, min_len=1), "rate": _RATE}),
+}
+
+
+def _segments_profile(scenario: dict, ctx: Context | None) -> RoadProfile | None:
+    return build_road_profile(scenario["trajectory"]["segments"], scenario["limits"], ctx)
+
+
+PROFILE_BUILDERS: dict[str, Callable[[dict, Context | None], RoadProfile | None]] = {
+    "segments": _segments_profile,
+}

@@ -34,8 +34,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.interpolate import PPoly
-from scipy.optimize import brentq
 
 from simulator.earth import G0_M_S2
 from simulator.scenario.schema import (
@@ -46,6 +44,7 @@ from simulator.scenario.schema import (
     Record,
     Text,
 )
+from simulator.trajectory.piecewise import PiecewisePolynomial
 
 MAX_GRADE = 0.3  # steepest grade a car is allowed to drive (SPEC section 4)
 
@@ -113,11 +112,11 @@ class _TimePiece:
 class RoadProfile:
     """Road geometry along s and the travelled distance in time, as piecewise polynomials."""
 
-    distance_of_time: PPoly  # s(t), m
-    curvature: PPoly  # kappa(s), rad/m, + right
-    heading: PPoly  # psi(s) - psi0, rad
-    grade: PPoly  # gamma(s), rad
-    bank: PPoly  # road bank angle (s), rad
+    distance_of_time: PiecewisePolynomial  # s(t), m
+    curvature: PiecewisePolynomial  # kappa(s), rad/m, + right
+    heading: PiecewisePolynomial  # psi(s) - psi0, rad
+    grade: PiecewisePolynomial  # gamma(s), rad
+    bank: PiecewisePolynomial  # road bank angle (s), rad
     duration_s: float
     zones: list[tuple[float, float, str]] = field(default_factory=list)
 
@@ -229,6 +228,8 @@ def _helix(seg: dict, v: float, lim: dict) -> list[_PathPiece]:
 
     if abs(rise) < 1e-9:
         return build(0.0)
+    from scipy.optimize import brentq  # imported here: only helices and lane changes solve
+
     bound = np.arctan(1.0) * np.sign(rise)
     gamma = brentq(rise_error, 1e-9 * np.sign(rise), bound, xtol=1e-14)
     return build(gamma)
@@ -255,6 +256,8 @@ def _lane_change(offset: float, length: float) -> list[_PathPiece]:
 
     def shift(c: float) -> float:
         return float(0.5 * length * np.sum(w * np.sin(c * shape))) - offset
+
+    from scipy.optimize import brentq
 
     c = 0.0 if offset == 0 else brentq(shift, 0.0, np.sign(offset) * 0.8, xtol=1e-15)
     uu = np.polynomial.polynomial.Polynomial([0.0, 1.0 / length])
@@ -372,13 +375,13 @@ def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None =
     return _assemble(path_pieces, time_pieces, zones)
 
 
-def _ppoly(lengths: list[float], polys: list[np.ndarray]) -> PPoly:
+def _ppoly(lengths: list[float], polys: list[np.ndarray]) -> PiecewisePolynomial:
     degree = max(len(p) for p in polys)
     c = np.zeros((degree, len(polys)))
     for j, p in enumerate(polys):
         c[degree - len(p):, j] = p
     x = np.concatenate([[0.0], np.cumsum(lengths)])
-    return PPoly(c, x)
+    return PiecewisePolynomial(c, x)
 
 
 def _assemble(path_pieces: list[_PathPiece], time_pieces: list[_TimePiece],
@@ -404,7 +407,7 @@ def _assemble(path_pieces: list[_PathPiece], time_pieces: list[_TimePiece],
         a += p.jerk * tt
     breaks = np.concatenate([[0.0], np.cumsum([p.duration for p in time_pieces])])
     return RoadProfile(
-        distance_of_time=PPoly(c, breaks),
+        distance_of_time=PiecewisePolynomial(c, breaks),
         curvature=curvature,
         heading=curvature.antiderivative(),
         grade=grade,

@@ -1,0 +1,63 @@
+"""Benchmark: the whole `landnav generate` of a one-hour drive, truth and ideal IMU at 100 Hz.
+
+Run:  python benchmarks/bench_truth.py   (prints the figures recorded in BENCHMARKS.md)
+
+The drive repeats a city loop (turns, a hill, a lane change, a stop) until it lasts an hour;
+the timing covers the whole command line process (interpreter start, imports, scenario loading,
+kinematics, ideal IMU increments and Parquet writing), measured best of three.
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+HERE = Path(__file__).resolve().parent
+LOOP = [
+    {"accelerate": {"to_speed": 13.0, "accel": 1.5}},
+    {"straight": {"length": 400}},
+    {"turn": {"angle": 90, "radius": 30}},
+    {"slope": {"grade": 0.06, "length": 300}},
+    {"lane_change": {"offset": 3.5, "length": 60}},
+    {"turn": {"angle": 90, "radius": 30}},
+    {"straight": {"length": 400}},
+    {"turn": {"angle": 90, "radius": 30}},
+    {"slope": {"grade": -0.06, "length": 300}},
+    {"turn": {"angle": 90, "radius": 30}},
+    {"accelerate": {"to_speed": 0.0, "accel": 2.0}},
+    {"stop": {"duration": 15}},
+]
+
+
+def hour_scenario(path: Path) -> None:
+    data = yaml.safe_load((HERE / "hour_drive.yaml").read_text())
+    data["trajectory"]["segments"] = LOOP * 24  # about 3650 s
+    path.write_text(yaml.safe_dump(data))
+
+
+def main() -> None:
+    with tempfile.TemporaryDirectory() as tmp:
+        scenario = Path(tmp) / "hour.yaml"
+        hour_scenario(scenario)
+        times = []
+        for _ in range(3):
+            start = time.perf_counter()
+            subprocess.run([sys.executable, "-m", "simulator.cli", "generate", str(scenario),
+                            "-o", str(Path(tmp) / "out"), "--force"], check=True,
+                           capture_output=True)
+            times.append(time.perf_counter() - start)
+        manifest = yaml.safe_load((Path(tmp) / "out" / "manifest.json").read_text())
+        duration = manifest["duration"]
+        best = min(times)
+        print(f"drive {duration:.0f} s, imu rows {manifest['streams']['imu']['rows']}")
+        print(f"landnav generate (whole process): best {best:.2f} s of {times}")
+        print(f"real-time factor: {duration / best:.0f}x")
+
+
+if __name__ == "__main__":
+    main()

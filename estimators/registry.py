@@ -1,0 +1,83 @@
+"""Finding estimator classes by name: the built-ins, the ``landnav.estimators`` entry-point group
+of installed third-party packages, and ``module:Class`` strings.
+
+A third-party package registers an estimator in its ``pyproject.toml``::
+
+    [project.entry-points."landnav.estimators"]
+    my_filter = "my_package.filters:MyFilter"
+
+Public functions
+----------------
+get_estimator, list_estimators.
+"""
+
+from __future__ import annotations
+
+import importlib
+from importlib import metadata
+
+from estimators.base import Estimator, check_estimator_class
+from simulator.errors import InputError
+
+ENTRY_POINT_GROUP = "landnav.estimators"
+
+# name -> "module:Class"; imported on demand so listing names imports nothing
+BUILTINS = {
+    "gnss_only": "estimators.baselines:GnssOnly",
+    "dead_reckoning": "estimators.baselines:DeadReckoning",
+}
+
+
+def _entry_points() -> dict[str, metadata.EntryPoint]:
+    return {ep.name: ep for ep in metadata.entry_points(group=ENTRY_POINT_GROUP)}
+
+
+def list_estimators() -> list[str]:
+    """Names of the built-in and entry-point estimators (built-ins first, then sorted)."""
+    plugins = sorted(set(_entry_points()) - set(BUILTINS))
+    return [*BUILTINS, *plugins]
+
+
+def _import_target(target: str, what: str) -> type:
+    module_name, _, attr = target.partition(":")
+    if not module_name or not attr:
+        raise InputError(f"{what}: expected module:Class, got {target!r}")
+    try:
+        module = importlib.import_module(module_name)
+    except Exception as exc:  # a plug-in's own failure, reported as its message
+        raise InputError(f"{what}: cannot import module {module_name!r}: "
+                         f"{type(exc).__name__}: {exc}") from None
+    try:
+        return getattr(module, attr)
+    except AttributeError:
+        raise InputError(f"{what}: module {module_name!r} has no {attr!r}") from None
+
+
+def get_estimator(name: str) -> type[Estimator]:
+    """The estimator class of a registered name or a ``module:Class`` string.
+
+    Raises
+    ------
+    InputError
+        For an unknown name (listing the known ones), a plug-in that fails to import (its own
+        error message), or a class that does not satisfy the ``Estimator`` contract.
+    """
+    where = f"estimator {name!r}"
+    if name in BUILTINS:
+        cls = _import_target(BUILTINS[name], where)
+    elif ":" in name:
+        cls = _import_target(name, where)
+    else:
+        entry = _entry_points().get(name)
+        if entry is None:
+            raise InputError(f"unknown estimator {name!r}; known: "
+                             f"{', '.join(list_estimators())} (or give module:Class)")
+        try:
+            cls = entry.load()
+        except Exception as exc:  # a plug-in's own failure, reported as its message
+            raise InputError(f"{where} (entry point {entry.value}) fails to import: "
+                             f"{type(exc).__name__}: {exc}") from None
+    problems = check_estimator_class(cls, where)
+    if problems:
+        raise InputError(problems[0] if len(problems) == 1 else "; ".join(problems))
+    return cls

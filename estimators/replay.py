@@ -1,0 +1,302 @@
+"""Causal replay of a dataset into one estimator, and the solution file (SPEC sections 6-7).
+
+The replay reads only the streams the estimator ``needs`` and ``uses`` (never ``truth*`` or
+``events``), merges them by timestamp and hands the estimator one message at a time in time order.
+Messages with equal times come in the fixed stream order ``imu, odometer, baro, mag, gnss_fix,
+gnss_raw`` (then any other stream, alphabetically): the inertial step ending at ``t`` is taken
+before the measurements valid at ``t`` are applied. A ``gnss_raw`` message is one whole epoch.
+
+Solutions are asked for (``solution(T)``) at the ticks ``t0 + k / output_rate_hz`` from the first
+message time ``t0``, at every GNSS epoch and at the last message time, each once every message
+with time <= ``T`` has been handed; so an estimator that only gets 1 Hz fixes still reports at
+10 Hz (holding or predicting its state), and a row always follows each GNSS update.
+
+The framework reads the truth only to build the initial state: the truth at the estimator's
+first message time, perturbed by the entry's ``init`` errors (position and velocity in NED,
+roll/pitch/yaw added to the Euler angles, ``heading_error`` added to yaw).
+
+Public functions
+----------------
+run_estimator, initial_state, merge_streams, output_times, write_solution, read_solution.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from estimators.base import GNSS_STREAMS, Estimator, InitialState
+from estimators.registry import get_estimator
+from simulator import columns as col
+from simulator.dataset.io import Dataset, read_table, write_table
+from simulator.earth import (
+    ecef_to_geodetic,
+    geodetic_to_ecef,
+    ned_to_ecef_vector,
+    wrap_angle,
+)
+from simulator.errors import InputError, Problem
+from simulator.progress import progress
+
+STREAM_ORDER = ("imu", "odometer", "baro", "mag", "gnss_fix", "gnss_raw")
+
+
+def _stream_rank(name: str) -> tuple[int, str]:
+    return (STREAM_ORDER.index(name) if name in STREAM_ORDER else len(STREAM_ORDER), name)
+
+
+def _entry_fields(entry: Mapping[str, Any] | str) -> tuple[str, str, dict | None, dict | None]:
+    if isinstance(entry, str):
+        return entry, entry, None, None
+    name = entry["name"]
+    return name, entry.get("label") or name, entry.get("init"), entry.get("config")
+
+
+def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None
+                  ) -> InitialState:
+    """The truth at ``t0`` (linear interpolation, yaw unwrapped) perturbed by ``init`` errors.
+
+    Parameters
+    ----------
+    truth : DataFrame
+        The truth table (SPEC section 5): ``t, lat, lon`` (deg), ``alt, vn, ve, vd, roll, pitch,
+        yaw`` (SI).
+    t0 : float
+        Start time, s.
+    init : mapping or None
+        ``position_error`` [n, e, d] m, ``velocity_error`` [n, e, d] m/s, ``attitude_error``
+        [roll, pitch, yaw] deg, ``heading_error`` deg; each may be None.
+    """
+    t = truth["t"].to_numpy()
+
+    def at(name: str) -> float:
+        values = truth[name].to_numpy(dtype=float)
+        if name == "yaw":
+            values = np.unwrap(values)
+        return float(np.interp(t0, t, values))
+
+    lat, lon, alt = np.radians(at("lat")), np.radians(at("lon")), at("alt")
+    vel = np.array([at("vn"), at("ve"), at("vd")])
+    att = np.array([at("roll"), at("pitch"), at("yaw")])
+    init = init or {}
+    if init.get("position_error") is not None:
+        d_ned = np.asarray(init["position_error"], dtype=float)
+        ecef = geodetic_to_ecef(lat, lon, alt) + ned_to_ecef_vector(d_ned, lat, lon)
+        lat, lon, alt = (float(x) for x in ecef_to_geodetic(ecef))
+    if init.get("velocity_error") is not None:
+        vel = vel + np.asarray(init["velocity_error"], dtype=float)
+    if init.get("attitude_error") is not None:
+        att = att + np.radians(np.asarray(init["attitude_error"], dtype=float))
+    if init.get("heading_error") is not None:
+        att[2] += np.radians(float(init["heading_error"]))
+    att[2] = wrap_angle(att[2])
+    return InitialState(float(t0), np.array([lat, lon, alt]), vel, att)
+
+
+class _Stream:
+    """One stream as a float64 array, with the message times and how to index messages."""
+
+    def __init__(self, name: str, frame: pd.DataFrame, units: dict[str, str]):
+        numeric = [c for c in frame.columns if pd.api.types.is_numeric_dtype(frame[c])]
+        self.name = name
+        self.data = np.ascontiguousarray(frame[numeric].to_numpy(dtype=np.float64))
+        self.data.flags.writeable = False
+        self.columns = {c: i for i, c in enumerate(numeric)}
+        self.units = {c: units.get(c, "") for c in numeric}
+        t = self.data[:, self.columns["t"]]
+        if len(t) > 1 and np.any(np.diff(t) < 0):
+            raise InputError(f"stream {name!r}: time t decreases")
+        if name == "gnss_raw":  # one message per epoch: a 2-D block of its satellites
+            starts = np.flatnonzero(np.r_[True, np.diff(t) > 0])
+            bounds = np.r_[starts, len(t)]
+            self.times = t[starts]
+            self.messages: Any = [self.data[a:b]
+                                  for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
+        else:
+            self.times = t
+            self.messages = self.data
+
+
+def merge_streams(times: list[np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Merge per-stream message times into one time-ordered sequence.
+
+    Parameters
+    ----------
+    times : list of arrays
+        Message times of each stream, in the stream order used for ties.
+
+    Returns
+    -------
+    t : (n,) merged times; stream : (n,) index of each message's stream; index : (n,) the
+    message's position within its stream. Equal times keep the order of ``times``.
+    """
+    t = np.concatenate(times) if times else np.zeros(0)
+    stream = np.concatenate([np.full(len(x), i, dtype=np.int64) for i, x in enumerate(times)]
+                            ) if times else np.zeros(0, dtype=np.int64)
+    index = np.concatenate([np.arange(len(x)) for x in times]) if times else stream
+    order = np.argsort(t, kind="stable")
+    return t[order], stream[order], index[order]
+
+
+def output_times(t: np.ndarray, stream: np.ndarray, gnss: list[int], rate_hz: float
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """When to ask for a solution, and how many merged messages to hand before each ask.
+
+    Output instants are the grid ``t[0] + k / rate_hz`` up to the last message, every GNSS
+    epoch, and the last message time; a grid instant within 1 ns of a message time takes that
+    time exactly. Before asking at time ``T`` every message with time <= ``T`` is handed.
+
+    Returns
+    -------
+    times : (m,) output times, increasing; upto : (m,) number of messages handed before each.
+    """
+    if len(t) == 0:
+        return np.zeros(0), np.zeros(0, dtype=np.int64)
+    n_grid = int(np.floor((t[-1] - t[0]) * rate_hz + 1e-9)) + 1
+    grid = t[0] + np.arange(n_grid) / rate_hz
+    near = np.searchsorted(t, grid + 1e-9, side="right") - 1
+    grid = np.where(np.abs(t[near] - grid) <= 1e-9, t[near], grid)
+    times = np.unique(np.concatenate([grid, t[np.isin(stream, gnss)], t[-1:]]))
+    return times, np.searchsorted(t, times, side="right")
+
+
+def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_Stream]:
+    missing = [s for s in cls.needs if not dataset.has(s)]
+    if missing:
+        raise InputError([Problem(str(dataset.path), None, "", f"estimator {cls.name!r} "
+                                  f"({label}) needs the {s!r} stream, which the dataset does "
+                                  f"not have (it has: {', '.join(dataset.stream_names)})")
+                          for s in missing])
+    names = [s for s in dict.fromkeys((*cls.needs, *cls.uses)) if dataset.has(s)]
+    refused = [s for s in names if s in col.SCORING_ONLY]
+    if refused:
+        raise InputError(f"estimator {cls.name!r} asks for scoring-only stream(s) {refused}")
+    names.sort(key=_stream_rank)
+    return [_Stream(s, dataset.read(s), _units(dataset, s)) for s in names]
+
+
+def _units(dataset: Dataset, name: str) -> dict[str, str]:
+    """Column units of a stream; an IMU configured for increment output has rad and m/s
+    increments whatever its files say (the manifest's resolved scenario is authoritative)."""
+    units = dataset.units(name)
+    imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
+    if name == "imu" and imu.get("output") == "increment":
+        units.update({c: u for c, u in col.IMU_INCREMENT_UNITS.items() if c in units})
+    return units
+
+
+def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
+                  show_progress: bool = True) -> tuple[pd.DataFrame, dict]:
+    """Replay a dataset causally into one estimator.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        An opened dataset (``simulator.dataset.io.open_dataset``).
+    entry : str or mapping
+        A resolved scenario estimator entry: a name (registered or ``module:Class``), or a
+        mapping with ``name``, ``label``, ``init`` and ``config``.
+    show_progress : bool
+        Show a progress bar when stderr is a terminal.
+
+    Returns
+    -------
+    solution : DataFrame
+        ``t`` (strictly increasing) and the estimator's ``output_columns`` (SPEC section 7).
+    info : dict
+        ``label``, ``name``, ``runtime_s`` (wall time of the estimator run, s) and
+        ``realtime_factor`` (data duration / runtime).
+
+    Raises
+    ------
+    InputError
+        Unknown estimator, failing plug-in import, bad config, missing needed stream.
+    """
+    name, label, init, config = _entry_fields(entry)
+    cls = get_estimator(name)
+    streams = _load_streams(dataset, cls, label)
+    t, sid, idx = merge_streams([s.times for s in streams])
+    if len(t) == 0:
+        raise InputError([Problem(str(dataset.path), None, "", f"no messages for estimator "
+                                  f"{name!r} in streams {[s.name for s in streams]}")])
+    initial = None
+    if not cls.initialises_itself:
+        initial = initial_state(dataset.read("truth"), float(t[0]), init)
+    estimator = cls(config, initial, {s.name: s.columns for s in streams},
+                    {s.name: s.units for s in streams})
+    gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
+    out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
+    out = np.full((len(out_t), len(cls.output_columns)), np.nan)
+    kept = np.zeros(len(out_t), dtype=bool)
+
+    handlers = [getattr(estimator, f"on_{s.name}") for s in streams]
+    messages = [s.messages for s in streams]
+    t_list, sid_list, idx_list = t.tolist(), sid.tolist(), idx.tolist()
+    solution = estimator.solution
+    start = time.perf_counter()
+    k = 0
+    asks = zip(out_t.tolist(), upto.tolist(), strict=True)
+    for j, (t_out, n_before) in enumerate(progress(asks, label, show_progress, len(out_t))):
+        while k < n_before:
+            s = sid_list[k]
+            handlers[s](t_list[k], messages[s][idx_list[k]])
+            k += 1
+        row = solution(t_out)
+        if row is not None:
+            out[j] = row
+            kept[j] = True
+    runtime = time.perf_counter() - start
+
+    frame = pd.DataFrame(out[kept], columns=list(cls.output_columns))
+    frame.insert(0, "t", out_t[kept])
+    duration = float(t[-1] - t[0])
+    info = {"label": label, "name": name, "runtime_s": runtime,
+            "realtime_factor": duration / runtime if runtime > 0 else float("inf")}
+    return frame, info
+
+
+def _solution_problems(frame: pd.DataFrame) -> list[str]:
+    missing = [c for c in col.SOLUTION if c not in frame.columns]
+    if missing:
+        return [f"missing column(s) {', '.join(missing)} (a solution needs "
+                f"{', '.join(col.SOLUTION)})"]
+    t = frame["t"].to_numpy(dtype=float)
+    if np.any(~np.isfinite(t)):
+        return ["column t has missing or non-finite values"]
+    bad = np.flatnonzero(np.diff(t) <= 0)
+    if len(bad):
+        i = int(bad[0])
+        return [f"t is not increasing: row {i + 1} has t = {t[i + 1]:.6f} s after "
+                f"t = {t[i]:.6f} s"]
+    return []
+
+
+def write_solution(frame: pd.DataFrame, path: str | Path) -> None:
+    """Write a solution table as Parquet (SPEC section 7); extra columns get unit ""."""
+    problems = _solution_problems(frame)
+    if problems:
+        raise InputError([Problem(str(path), None, "", p) for p in problems])
+    units = {**col.SOLUTION, **col.SOLUTION_STD}
+    Path(path).parent.mkdir(parents=True, exist_ok=True)
+    write_table(frame, Path(path), {c: units.get(c, "") for c in frame.columns})
+
+
+def read_solution(path: str | Path) -> pd.DataFrame:
+    """Read a solution file written by landnav or any other program.
+
+    Raises
+    ------
+    InputError
+        Naming the file, when it is unreadable, lacks a required column or its ``t`` does not
+        increase.
+    """
+    frame = read_table(Path(path))
+    problems = _solution_problems(frame)
+    if problems:
+        raise InputError([Problem(str(path), None, "", p) for p in problems])
+    return frame

@@ -1,0 +1,57 @@
+"""The ``landnav`` command line (SPEC section 3). Each command lives in its own module under
+``simulator/commands/`` with ``add_parser(subparsers)`` and ``run(args) -> int``.
+
+Bad input ends with one clear message per problem on stderr and exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+from simulator.errors import InputError
+
+COMMANDS = ["validate", "generate", "score", "run"]
+
+DESCRIPTION = """\
+landnav: synthetic land-vehicle drives and navigation-sensor datasets, with estimator replay
+and truth-referenced scoring.
+
+A scenario (YAML) describes the drive, the sensors, the faults and the estimators to run.
+Typical use:
+
+  landnav validate scenarios/quickstart.yaml      check a scenario, list every problem
+  landnav generate scenarios/quickstart.yaml -o out/quick   write the dataset
+  landnav generate scenarios/garage.yaml -o out/g --set sensors.imu.rate=200 --seed 3
+
+Run `landnav COMMAND --help` for each command's options.
+"""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="landnav", description=DESCRIPTION,
+        formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
+    for name in COMMANDS:
+        importlib.import_module(f"simulator.commands.{name}").add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.run(args) or 0)
+    except InputError as exc:
+        for problem in exc.problems:
+            print(f"error: {problem}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":
+    sys.exit(main())

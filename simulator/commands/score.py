@@ -1,0 +1,84 @@
+"""``landnav score DATASET (--solution FILE... | -e NAME...)``: truth-referenced metrics of one
+or more solutions (SPEC section 8), optionally as JSON and as a markdown report with plots."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+from pathlib import Path
+
+import pandas as pd
+
+from estimators.replay import read_solution, run_estimator
+from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
+from simulator.errors import InputError, Problem
+from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
+from simulator.scoring.report import text_table, write_report
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "score", help="score solutions against a dataset's truth (table, JSON, report)",
+        description="Score navigation solutions against the truth of a dataset: horizontal, "
+                    "vertical, velocity and attitude errors, per-GNSS-outage drift, NEES when "
+                    "the solution has standard deviations (SPEC section 8). Solutions are files "
+                    "(--solution, labelled by file stem; written by any program, SPEC section 7)"
+                    " or registered estimators run here (-e, labelled by name). Prints a compact "
+                    "table; --json writes the scores keyed by label; --report writes report.md "
+                    "with plots into DIR (atomically; an existing DIR needs --force).")
+    p.add_argument("dataset", metavar="DATASET", help="dataset directory")
+    which = p.add_mutually_exclusive_group(required=True)
+    which.add_argument("--solution", nargs="+", action="extend", metavar="FILE",
+                       help="solution Parquet file(s)")
+    which.add_argument("-e", "--estimator", nargs="+", action="extend", metavar="NAME",
+                       help="registered estimator(s) to run over the dataset and score")
+    p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
+    p.add_argument("--report", metavar="DIR", help="write report.md and plots/ into DIR")
+    p.add_argument("--force", action="store_true", help="overwrite an existing report DIR")
+    p.set_defaults(run=run)
+
+
+def _from_files(paths: list[str]) -> dict[str, tuple[pd.DataFrame, None]]:
+    out: dict[str, tuple[pd.DataFrame, None]] = {}
+    for path in paths:
+        label = Path(path).stem
+        if label in out:
+            raise InputError([Problem(path, None, "", f"another solution file is also labelled "
+                                      f"{label!r} (labels are file stems); rename one")])
+        out[label] = (read_solution(path), None)
+    return out
+
+
+def _from_estimators(dataset: Dataset, names: list[str]) -> dict[str, tuple[pd.DataFrame, dict]]:
+    out: dict[str, tuple[pd.DataFrame, dict]] = {}
+    for name in dict.fromkeys(names):
+        frame, info = run_estimator(dataset, name)
+        out[info["label"]] = (frame, info)
+    return out
+
+
+def print_scores(ev: Evaluation) -> None:
+    """The compact table on stdout and the scoring warnings on stderr."""
+    for line in ev.warnings():
+        print(f"warning: {line}", file=sys.stderr)
+    print(text_table(ev.scores()))
+
+
+def run(args: argparse.Namespace) -> int:
+    dataset = open_dataset(args.dataset)
+    with contextlib.ExitStack() as stack:
+        report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force))
+                      if args.report else None)
+        solutions = (_from_files(args.solution) if args.solution
+                     else _from_estimators(dataset, args.estimator))
+        ev = score_solutions(dataset, solutions)
+        print_scores(ev)
+        if args.json:
+            write_scores(ev.scores(), Path(args.json))
+            print(f"wrote {args.json}")
+        if report_dir is not None:
+            write_report(report_dir, ev, f"Scores on {dataset.path.name}")
+    if args.report:
+        print(f"wrote {Path(args.report) / 'report.md'}")
+    return 0

@@ -1,0 +1,46 @@
+"""The events table (SPEC section 5, ``events.parquet``): every zone and fault actually applied,
+and every stretch without any GNSS measurement exactly once as ``gnss_outage``.
+
+Public functions
+----------------
+zone_events, gnss_outage_intervals, events_table.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from simulator import columns as col
+
+
+def zone_events(zones: list[tuple[float, float, str]]) -> list[dict]:
+    """One ``zone`` row per zone interval of the drive."""
+    return [{"t_start": a, "t_end": b, "kind": "zone", "detail": name} for a, b, name in zones]
+
+
+def gnss_outage_intervals(epoch_t: np.ndarray, has_measurement: np.ndarray,
+                          end_t: float) -> list[tuple[float, float]]:
+    """Maximal stretches of consecutive GNSS epochs without a single measurement.
+
+    An outage runs from its first empty epoch to the next epoch with measurements (or to the end
+    of the drive).
+    """
+    epoch_t = np.asarray(epoch_t, dtype=float)
+    empty = ~np.asarray(has_measurement, dtype=bool)
+    if not empty.any():
+        return []
+    edges = np.diff(np.concatenate([[0], empty.astype(int), [0]]))
+    starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
+    out = []
+    for a, b in zip(starts, stops, strict=True):
+        t_end = epoch_t[b] if b < len(epoch_t) else end_t
+        out.append((float(epoch_t[a]), float(t_end)))
+    return out
+
+
+def events_table(rows: list[dict]) -> pd.DataFrame:
+    """Events sorted by start time, with the SPEC columns."""
+    frame = pd.DataFrame(rows, columns=list(col.EVENTS))
+    frame = frame.astype({"t_start": float, "t_end": float, "kind": str, "detail": str})
+    return frame.sort_values(["t_start", "kind"], kind="stable").reset_index(drop=True)

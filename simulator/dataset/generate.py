@@ -1,0 +1,125 @@
+"""From a resolved scenario to a dataset: truth, sensors (each with its own random stream),
+events and manifest, written atomically.
+
+Public functions
+----------------
+build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
+"""
+
+from __future__ import annotations
+
+import platform
+import zlib
+from dataclasses import dataclass, field
+from importlib import metadata
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
+from simulator.dataset.io import atomic_output_dir, write_dataset
+from simulator.errors import InputError
+from simulator.progress import progress
+from simulator.scenario import Scenario
+from simulator.sensors import SENSOR_MODELS
+from simulator.timebase import parse_utc, utc_to_gps
+from simulator.trajectory import PROFILE_BUILDERS
+from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
+
+
+def build_truth(scenario: dict) -> Kinematics:
+    """The exact truth trajectory of a resolved scenario."""
+    traj = scenario["trajectory"]
+    try:
+        profile = PROFILE_BUILDERS[traj["kind"]](scenario, None)
+    except ValueError as exc:
+        raise InputError(str(exc)) from None
+    truth = kinematics_from_profile(profile, scenario["start"], traj["rate"],
+                                    scenario["limits"]["roll_gradient"])
+    truth.utc_start = parse_utc(scenario["start"]["utc"])
+    truth.gps_week, truth.gps_tow = utc_to_gps(truth.utc_start)
+    truth.environment = scenario["environment"]
+    return truth
+
+
+def sensor_rng(seed: int, name: str) -> np.random.Generator:
+    """The random stream of one sensor: a SeedSequence child keyed by the sensor's name, so adding
+    a sensor does not change the others (SPEC section 2)."""
+    return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(zlib.crc32(
+        name.encode()),)))
+
+
+@dataclass
+class Generated:
+    truth: Kinematics
+    streams: dict[str, pd.DataFrame]
+    drawn: dict[str, dict] = field(default_factory=dict)
+
+
+def generate_streams(scenario: dict, show_progress: bool = True) -> Generated:
+    """Truth table, every configured sensor's streams, and the events table."""
+    truth = build_truth(scenario)
+    streams: dict[str, pd.DataFrame] = {"truth": truth.table()}
+    drawn: dict[str, dict] = {}
+    sensors = {k: v for k, v in scenario["sensors"].items() if v is not None}
+    for name in progress(sensors, "sensors", show_progress):
+        model = SENSOR_MODELS[name](sensors[name])
+        streams.update(model.generate(truth, sensor_rng(scenario["seed"], name)))
+        drawn[name] = model.drawn
+    rows = zone_events(truth.profile.zones)
+    for t_start, t_end in _outages(streams, truth.duration_s):
+        rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
+    streams["events"] = events_table(rows)
+    return Generated(truth, streams, drawn)
+
+
+def _outages(streams: dict[str, pd.DataFrame], end_t: float) -> list[tuple[float, float]]:
+    if "gnss_fix" in streams:
+        fix = streams["gnss_fix"]
+        epochs = fix["t"].to_numpy()
+        if "gnss_raw" in streams:
+            has = np.isin(epochs, streams["gnss_raw"]["t"].to_numpy())
+        else:
+            has = fix["fix"].to_numpy() > 0
+        return gnss_outage_intervals(epochs, has, end_t)
+    return []
+
+
+def _versions() -> dict[str, str]:
+    out = {"python": platform.python_version()}
+    for pkg in ("landnav", "numpy", "scipy", "pandas", "pyarrow"):
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = "not installed"
+    return out
+
+
+def build_manifest(scenario: Scenario, generated: Generated) -> dict:
+    """The manifest (SPEC section 5) without its ``streams`` block."""
+    data = scenario.data
+    truth = generated.truth
+    return {
+        "scenario": data,
+        "seed": data["seed"],
+        "overrides": scenario.overrides,
+        "software": _versions(),
+        "gps_time_start": {"week": truth.gps_week, "tow": truth.gps_tow},
+        "utc_start": data["start"]["utc"],
+        "origin": {"lat": data["start"]["lat"], "lon": data["start"]["lon"],
+                   "alt": data["start"]["alt"]},
+        "duration": truth.duration_s,
+        "sensors": generated.drawn,
+    }
+
+
+def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
+                     show_progress: bool = True) -> Path:
+    """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
+    ``force``). Returns ``out_dir``."""
+    out_dir = Path(out_dir)
+    with atomic_output_dir(out_dir, force) as tmp:
+        generated = generate_streams(scenario.data, show_progress)
+        write_dataset(tmp, build_manifest(scenario, generated), generated.streams)
+    return out_dir

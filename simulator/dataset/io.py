@@ -1,0 +1,160 @@
+"""The dataset on disk (SPEC section 5): a directory with ``manifest.json`` and one Parquet file
+per stream, every column's unit in the Parquet field metadata.
+
+Writing is atomic: everything goes into a temporary sibling directory that is renamed into place
+when complete, so an interrupted or failed run never leaves a half-written dataset.
+
+Public names
+------------
+write_dataset, open_dataset, Dataset, write_table, read_table, atomic_output_dir.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from simulator import columns as col
+from simulator.errors import InputError, Problem
+
+
+def _units_for(name: str, frame: pd.DataFrame) -> dict[str, str]:
+    declared = dict(col.STREAMS.get(name, (None, {}))[1])
+    declared.update(frame.attrs.get("units", {}))
+    missing = [c for c in frame.columns if c not in declared]
+    if missing:
+        raise ValueError(f"stream {name!r}: no unit declared for column(s) {missing}; add them "
+                         "to simulator/columns.py or frame.attrs['units']")
+    return {c: declared[c] for c in frame.columns}
+
+
+def write_table(frame: pd.DataFrame, path: Path, units: dict[str, str]) -> None:
+    """Write one table as Parquet with each column's unit in its field metadata."""
+    table = pa.Table.from_pandas(frame, preserve_index=False)
+    fields = [f.with_metadata({"unit": units.get(f.name, "")}) for f in table.schema]
+    table = table.cast(pa.schema(fields, metadata={}))
+    # dictionary encoding only for text columns: on float columns it costs time and no space
+    text_columns = [f.name for f in table.schema if pa.types.is_string(f.type)
+                    or pa.types.is_large_string(f.type)]
+    pq.write_table(table, path, compression="zstd", compression_level=1,
+                   use_dictionary=text_columns)
+
+
+def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
+    """Read one Parquet table; raise InputError naming the file if it is missing or corrupt."""
+    try:
+        return pq.read_table(path, columns=columns).to_pandas()
+    except FileNotFoundError:
+        raise InputError([Problem(str(path), None, "", "file not found")]) from None
+    except (pa.ArrowException, OSError) as exc:
+        raise InputError([Problem(str(path), None, "", f"not a readable Parquet file: {exc}")]
+                         ) from None
+
+
+@contextlib.contextmanager
+def atomic_output_dir(out_dir: Path, force: bool) -> Iterator[Path]:
+    """Yield a temporary directory beside ``out_dir``; on success it replaces ``out_dir``.
+
+    Refuses an existing ``out_dir`` unless ``force``. On any error the temporary directory is
+    removed and ``out_dir`` is left as it was.
+    """
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not force:
+        raise InputError([Problem(str(out_dir), None, "",
+                                  "already exists; use --force to overwrite it")])
+    if out_dir.exists() and not out_dir.is_dir():
+        raise InputError([Problem(str(out_dir), None, "", "exists and is not a directory")])
+    out_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = out_dir.parent / f".{out_dir.name}.tmp-{os.getpid()}"
+    shutil.rmtree(tmp, ignore_errors=True)
+    tmp.mkdir()
+    try:
+        yield tmp
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    old = out_dir.parent / f".{out_dir.name}.old-{os.getpid()}"
+    if out_dir.exists():
+        out_dir.rename(old)
+    tmp.rename(out_dir)
+    shutil.rmtree(old, ignore_errors=True)
+
+
+def write_dataset(directory: Path, manifest: dict, streams: dict[str, pd.DataFrame]) -> None:
+    """Write streams and the manifest into ``directory`` (use inside ``atomic_output_dir``).
+
+    The manifest's ``streams`` block is filled here from the tables.
+    """
+    manifest = dict(manifest)
+    manifest["format"] = col.DATASET_FORMAT
+    manifest["streams"] = {}
+    for name, frame in streams.items():
+        file = col.STREAMS[name][0] if name in col.STREAMS else f"{name}.parquet"
+        write_table(frame, directory / file, _units_for(name, frame))
+        rate = None
+        if "t" in frame and len(frame) > 1 and name not in ("gnss_raw", "truth_gnss"):
+            rate = round(float((len(frame) - 1) / (frame["t"].iloc[-1] - frame["t"].iloc[0])), 6)
+        manifest["streams"][name] = {"file": file, "rows": len(frame), "rate_hz": rate}
+    text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
+    (directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
+
+
+class Dataset:
+    """A landnav dataset directory opened for reading."""
+
+    def __init__(self, path: Path, manifest: dict):
+        self.path = Path(path)
+        self.manifest = manifest
+
+    @property
+    def stream_names(self) -> list[str]:
+        return list(self.manifest["streams"])
+
+    def has(self, name: str) -> bool:
+        return name in self.manifest["streams"]
+
+    def read(self, name: str, columns: list[str] | None = None) -> pd.DataFrame:
+        """Read a stream by name (``imu``, ``gnss_fix``, ``truth``, ...)."""
+        if name not in self.manifest["streams"]:
+            raise InputError([Problem(str(self.path), None, "", f"the dataset has no {name!r} "
+                                      f"stream (it has: {', '.join(self.stream_names)})")])
+        return read_table(self.path / self.manifest["streams"][name]["file"], columns)
+
+    def units(self, name: str) -> dict[str, str]:
+        schema = pq.read_schema(self.path / self.manifest["streams"][name]["file"])
+        return {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in schema}
+
+
+def open_dataset(path: str | Path) -> Dataset:
+    """Open a dataset directory; raise InputError if it is not a landnav dataset."""
+    path = Path(path)
+    manifest_path = path / "manifest.json"
+    if not path.is_dir():
+        raise InputError([Problem(str(path), None, "", "no such dataset directory")])
+    if not manifest_path.is_file():
+        raise InputError([Problem(str(path), None, "", "not a landnav dataset (no manifest.json;"
+                                  " make one with `landnav generate SCENARIO -o DIR`)")])
+    try:
+        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        raise InputError([Problem(str(manifest_path), None, "", f"corrupt manifest: {exc}")]
+                         ) from None
+    if not isinstance(manifest, dict) or manifest.get("format") != col.DATASET_FORMAT:
+        raise InputError([Problem(str(manifest_path), None, "format",
+                                  f"not a {col.DATASET_FORMAT} manifest")])
+    streams = manifest.get("streams")
+    if not isinstance(streams, dict):
+        raise InputError([Problem(str(manifest_path), None, "streams", "missing or malformed")])
+    for name, entry in streams.items():
+        if not (path / entry.get("file", "")).is_file():
+            raise InputError([Problem(str(manifest_path), None, f"streams.{name}",
+                                      f"its file {entry.get('file')!r} is missing")])
+    return Dataset(path, manifest)

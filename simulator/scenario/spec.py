@@ -1,0 +1,107 @@
+"""The scenario file's schema (SPEC section 4), assembled from the parts each module owns, and the
+cross-section checks (drivability, rates) that need more than one section.
+
+Public names
+------------
+SCENARIO_FIELD, START_FIELD, ESTIMATOR_ENTRY_FIELD.
+"""
+
+from __future__ import annotations
+
+from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
+from simulator.faults import FAULT_FIELD
+from simulator.scenario.schema import (
+    Anything,
+    Context,
+    DateTime,
+    Either,
+    Integer,
+    ListOf,
+    Number,
+    Path,
+    Record,
+    Tagged,
+    Text,
+    Vector,
+)
+from simulator.sensors import SENSOR_FIELDS
+from simulator.trajectory import PROFILE_BUILDERS, TRAJECTORY_KINDS
+from simulator.trajectory.segments import LIMITS_FIELD
+
+START_FIELD = Record({
+    "utc": DateTime("2020-01-01T00:00:00Z", doc="UTC time of t = 0"),
+    "lat": Number(angle=True, min=-89.0, max=89.0, doc="latitude, deg"),
+    "lon": Number(angle=True, min=-180.0, max=180.0, doc="longitude, deg"),
+    "alt": Number("m", 0.0, min=-500.0, max=9000.0, doc="ellipsoidal height, m"),
+    "heading": Number(default=0.0, angle=True, min=-360.0, max=360.0,
+                      doc="initial heading from true north, deg"),
+})
+
+_INIT_FIELD = Record({
+    "position_error": Vector(3, Number("m"), None, doc="north, east, down, m"),
+    "velocity_error": Vector(3, Number("m/s"), None, doc="north, east, down, m/s"),
+    "attitude_error": Vector(3, Number(angle=True), None, doc="roll, pitch, yaw, deg"),
+    "heading_error": Number(default=None, angle=True, doc="deg (adds to attitude_error's yaw)"),
+}, default=None)
+
+ESTIMATOR_ENTRY_FIELD = Either(
+    Text(),
+    Record({
+        "name": Text(doc="registered name, or module:Class"),
+        "label": Text(None, doc="solution name (default: the estimator name)"),
+        "init": _INIT_FIELD,
+        "config": Anything(None, doc="the estimator's own options"),
+    }),
+)
+
+
+def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
+    traj = value["trajectory"]
+    imu = value["sensors"].get("imu")
+    if traj.get("rate") is None:
+        traj["rate"] = imu["rate"] if imu else 100.0
+    elif imu and traj["rate"] < imu["rate"]:
+        ctx.error(path + ("trajectory", "rate"),
+                  f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
+    PROFILE_BUILDERS[traj["kind"]](value, ctx)
+    labels: set[str] = set()
+    for i, entry in enumerate(value["estimators"]):
+        label = entry if isinstance(entry, str) else (entry["label"] or entry["name"])
+        if label in labels:
+            ctx.error(path + ("estimators", i), f"label {label!r} is used twice; give a label")
+        labels.add(label)
+    zones = value["environment"]["zones"]
+    used = _zones_used(value)
+    if used is not None:
+        for name in sorted(set(zones) - used):
+            ctx.error(path + ("environment", "zones", name), "no segment has this zone")
+        for name in sorted(used - set(zones)):
+            sky = "none" if name in COVERED_ZONE_NAMES else "open"
+            zones[name] = ZONE_FIELD.check({"sky": sky}, path + ("environment", "zones", name),
+                                           ctx)
+    return value
+
+
+def _zones_used(value: dict) -> set[str] | None:
+    """Zone names the segments carry (None for sources whose zones come from elsewhere)."""
+    traj = value["trajectory"]
+    if traj["kind"] != "segments":
+        return None
+    return {seg.get("zone") for item in traj["segments"] for seg in item.values()} - {None}
+
+
+SCENARIO_FIELD = Record(
+    {
+        "name": Text(None),
+        "description": Text(None),
+        "seed": Integer(0, min=0, max=2**63 - 1),
+        "start": START_FIELD,
+        "limits": LIMITS_FIELD,
+        "trajectory": Tagged(TRAJECTORY_KINDS, what="trajectory kind"),
+        "environment": ENVIRONMENT_FIELD,
+        "sensors": Record(SENSOR_FIELDS, default={}),
+        "faults": ListOf(FAULT_FIELD, []),
+        "estimators": ListOf(ESTIMATOR_ENTRY_FIELD, []),
+    },
+    post=_check_whole,
+)

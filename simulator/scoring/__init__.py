@@ -1,0 +1,9 @@
+"""Truth-referenced scoring of navigation solutions (SPEC section 8) and the report.
+
+Modules
+-------
+align     truth interpolated at the solution times; per-sample errors in local NED
+metrics   the scores of one solution (horizontal, vertical, velocity, attitude, outages, NEES)
+evaluate  several solutions on one dataset: read truth and events once, score, write JSON
+report    the markdown report with its plots (matplotlib, Agg)
+"""

@@ -1,0 +1,129 @@
+"""A solution against the truth: the truth at the solution times and the per-sample errors.
+
+The truth is interpolated at each solution time and never extrapolated (solution rows outside the
+truth's time span are dropped and counted):
+
+* position linearly in ECEF, which is the same as linear interpolation in any fixed local NED
+  frame (the two differ by a rotation and a translation);
+* velocity (NED) linearly, component by component;
+* roll, pitch and yaw linearly along the wrapped step between consecutive truth samples (the
+  truth angles are unwrapped, interpolated, and the error is wrapped), so a yaw crossing +-180 deg
+  interpolates through 180 deg, not through 0.
+
+Position errors are the ECEF difference (solution minus truth) resolved in the NED frame at the
+interpolated true position (C_e^n, Groves eq. 2.150); velocity errors are NED differences;
+attitude errors are wrapped Euler-angle differences (solution minus truth), rad. NaN in a solution
+row propagates to the errors it feeds; the metrics skip those rows.
+
+Public names
+------------
+SolutionErrors, solution_errors, local_ned, ERR_POS, ERR_VEL, ERR_ATT, ERR_H.
+
+References
+----------
+Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed.,
+2013, section 2.4.3 (local navigation frame) and eq. 2.150.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from simulator import columns as col
+from simulator.earth import ecef_to_ned, geodetic_to_ecef, ned_to_ecef_matrix, wrap_angle
+
+ERR_POS = ("err_n", "err_e", "err_d")  # position error, north/east/down, m
+ERR_H = "err_h"  # horizontal position error, m
+ERR_VEL = ("err_vn", "err_ve", "err_vd")  # velocity error, m/s
+ERR_ATT = ("err_roll", "err_pitch", "err_yaw")  # attitude error, rad, wrapped to [-pi, pi)
+
+# the solution's (and truth's) lat, lon, alt / vn, ve, vd / roll, pitch, yaw columns
+_POS, _VEL, _ATT = (tuple(col.SOLUTION)[i:i + 3] for i in (1, 4, 7))
+
+
+@dataclass
+class SolutionErrors:
+    """Per-sample errors of one solution.
+
+    Attributes
+    ----------
+    errors : DataFrame
+        One row per solution row inside the truth span: ``t`` (s), ``err_n, err_e, err_d`` (m),
+        ``err_h`` (m), ``err_vn, err_ve, err_vd`` (m/s), ``err_roll, err_pitch, err_yaw`` (rad),
+        and the solution's own ``std_*`` columns when it has them.
+    total_rows : int
+        Rows of the solution.
+    outside_truth : int
+        Rows dropped because their time lies outside the truth's time span.
+    """
+
+    errors: pd.DataFrame
+    total_rows: int
+    outside_truth: int
+
+
+def _ecef(frame: pd.DataFrame) -> np.ndarray:
+    return geodetic_to_ecef(np.radians(frame["lat"].to_numpy(float)),
+                            np.radians(frame["lon"].to_numpy(float)),
+                            frame["alt"].to_numpy(float))
+
+
+def local_ned(frame: pd.DataFrame, origin: tuple[float, float, float]) -> np.ndarray:
+    """Positions of a table with ``lat, lon`` (deg) and ``alt`` (m) in the NED frame of ``origin``.
+
+    Parameters
+    ----------
+    frame : DataFrame with n rows.
+    origin : (lat deg, lon deg, alt m) of the frame's origin.
+
+    Returns
+    -------
+    ndarray, shape (n, 3): north, east, down, m.
+    """
+    return ecef_to_ned(_ecef(frame), np.radians(origin[0]), np.radians(origin[1]), origin[2])
+
+
+def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErrors:
+    """Errors of a solution against the truth interpolated at the solution times.
+
+    Parameters
+    ----------
+    truth : DataFrame
+        ``truth.parquet`` (at least ``t, lat, lon, alt, vn, ve, vd, roll, pitch, yaw``), t
+        strictly increasing.
+    solution : DataFrame
+        A solution table (SPEC section 7), t increasing.
+
+    Returns
+    -------
+    SolutionErrors
+    """
+    t_truth = truth["t"].to_numpy(float)
+    t_all = solution["t"].to_numpy(float)
+    inside = (t_all >= t_truth[0]) & (t_all <= t_truth[-1])
+    sol = solution.loc[inside]
+    t = t_all[inside]
+
+    def interp(values: np.ndarray) -> np.ndarray:
+        return np.interp(t, t_truth, values)
+
+    truth_ecef = np.stack([interp(x) for x in _ecef(truth).T], axis=-1)
+    # the NED frame of the interpolated true position (lat/lon interpolated only for the rotation)
+    c_ne = ned_to_ecef_matrix(np.radians(interp(truth["lat"].to_numpy(float))),
+                              np.radians(interp(truth["lon"].to_numpy(float))))
+    err_pos = np.einsum("kji,kj->ki", c_ne, _ecef(sol) - truth_ecef)
+    out = {"t": t}
+    out.update(zip(ERR_POS, err_pos.T, strict=True))
+    out[ERR_H] = np.hypot(err_pos[:, 0], err_pos[:, 1])
+    for name, key in zip(ERR_VEL, _VEL, strict=True):
+        out[name] = sol[key].to_numpy(float) - interp(truth[key].to_numpy(float))
+    for name, key in zip(ERR_ATT, _ATT, strict=True):
+        true_angle = interp(np.unwrap(truth[key].to_numpy(float)))
+        out[name] = wrap_angle(sol[key].to_numpy(float) - true_angle)
+    for name in col.SOLUTION_STD:
+        if name in sol:
+            out[name] = sol[name].to_numpy(float)
+    return SolutionErrors(pd.DataFrame(out), len(solution), int((~inside).sum()))

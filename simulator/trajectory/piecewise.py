@@ -1,0 +1,75 @@
+"""Piecewise polynomials: the representation of every road profile (light, fast, and
+interchangeable with ``scipy.interpolate.PPoly``, whose ``c``/``x`` layout it shares).
+
+Public names
+------------
+PiecewisePolynomial.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+class PiecewisePolynomial:
+    """p(x) = sum_k c[k, i] (x - x[i])^(K-1-k) on [x[i], x[i+1]); extrapolates the end pieces.
+
+    Parameters
+    ----------
+    c : array, shape (K, m)
+        Coefficients, highest power first (the ``scipy.interpolate.PPoly`` convention).
+    x : array, shape (m + 1,)
+        Increasing breakpoints.
+    """
+
+    def __init__(self, c: np.ndarray, x: np.ndarray):
+        self.c = np.asarray(c, dtype=float)
+        self.x = np.asarray(x, dtype=float)
+
+    @classmethod
+    def from_ppoly(cls, ppoly) -> PiecewisePolynomial:
+        """Wrap a ``scipy.interpolate.PPoly`` (or anything with ``c`` and ``x``)."""
+        return cls(ppoly.c, ppoly.x)
+
+    def _index(self, x: np.ndarray) -> np.ndarray:
+        return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.c.shape[1] - 1)
+
+    def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,)) -> list[np.ndarray]:
+        """Values of the requested derivatives at x (one search for all of them)."""
+        x = np.asarray(x, dtype=float)
+        idx = self._index(x)
+        dx = x - self.x[idx]
+        out = []
+        for nu in orders:
+            c = self.derivative(nu).c if nu else self.c
+            acc = c[0, idx].copy()
+            for k in range(1, c.shape[0]):
+                acc *= dx
+                acc += c[k, idx]
+            out.append(acc)
+        return out
+
+    def __call__(self, x: np.ndarray, nu: int = 0) -> np.ndarray:
+        return self.evaluate(x, (nu,))[0]
+
+    def derivative(self, nu: int = 1) -> PiecewisePolynomial:
+        c = self.c
+        for _ in range(nu):
+            k = c.shape[0] - 1
+            if k == 0:
+                return PiecewisePolynomial(np.zeros((1, c.shape[1])), self.x)
+            c = c[:-1] * np.arange(k, 0, -1)[:, None]
+        return PiecewisePolynomial(c, self.x)
+
+    def antiderivative(self) -> PiecewisePolynomial:
+        """The continuous antiderivative that is zero at x[0]."""
+        k = self.c.shape[0]
+        c = np.zeros((k + 1, self.c.shape[1]))
+        c[:-1] = self.c / np.arange(k, 0, -1)[:, None]
+        widths = np.diff(self.x)
+        ends = np.zeros(self.c.shape[1])
+        for j in range(k):  # value of each piece's integral at its right end
+            ends = ends * widths + c[j]
+        ends *= widths
+        c[-1] = np.concatenate([[0.0], np.cumsum(ends)[:-1]])
+        return PiecewisePolynomial(c, self.x)

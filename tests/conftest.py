@@ -1,0 +1,73 @@
+"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, drive builders."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED = REPO.parent / "shared"
+
+
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--runslow", action="store_true", default=False,
+                     help="also run the full-length (slow) long-drive cases")
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if config.getoption("--runslow"):
+        return
+    skip = pytest.mark.skip(reason="slow long-drive case: run with --runslow")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture
+def shared_dir() -> Path:
+    """The shared reference-data folder beside the checkout (skips when absent)."""
+    if not (SHARED / "refdata").is_dir():
+        pytest.skip(f"reference data not available: {SHARED / 'refdata'} is absent "
+                    "(a user's clone has no ../shared; CI has it)")
+    return SHARED
+
+
+def scenario_data(segments: list[dict], **extra) -> dict:
+    """A resolved scenario for a segment drive (validated like a file)."""
+    from simulator.scenario import validate_data
+
+    data = {
+        "name": "test",
+        "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5, "lon": 127.0, "alt": 40.0,
+                  "heading": 30.0},
+        "trajectory": {"kind": "segments", "segments": segments},
+        "sensors": {"imu": {"preset": "ideal", "rate": 100}},
+    }
+    data.update(extra)
+    return validate_data(data, "test.yaml")
+
+
+def ten_minute_drive() -> list[dict]:
+    """A ten-minute drive with turns, slopes, a helix, a speed bump and a lane change."""
+    return [
+        {"stop": {"duration": 20}},
+        {"accelerate": {"to_speed": 12.0, "accel": 1.5}},
+        {"straight": {"length": 300}},
+        {"turn": {"angle": 90, "radius": 25}},
+        {"slope": {"grade": 0.08, "length": 200}},
+        {"speed_bump": {"height": 0.08, "length": 3.0}},
+        {"lane_change": {"offset": 3.5, "length": 60}},
+        {"turn": {"angle": -120, "radius": 40, "bank": 3.0}},
+        {"straight": {"length": 1000}},
+        {"turn": {"angle": 45, "radius": 60, "speed": 10.0}},
+        {"straight": {"length": 1000}},
+        {"accelerate": {"to_speed": 4.0, "accel": 1.0}},
+        {"helix": {"turns": 3, "radius": 11, "rise": -9.0, "direction": "right"}},
+        {"straight": {"length": 200, "speed": 8.0}},
+        {"slope": {"grade": -0.1, "length": 150}},
+        {"turn": {"angle": -45, "radius": 60}},
+        {"straight": {"length": 1400}},
+        {"accelerate": {"to_speed": 0.0, "accel": 2.0}},
+        {"stop": {"duration": 20}},
+    ]

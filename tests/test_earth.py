@@ -1,0 +1,121 @@
+"""The Earth model and frame helpers against published values and an independent library."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from scipy.spatial.transform import Rotation
+
+from simulator import earth
+
+
+def test_normal_gravity_published_surface_values():
+    # TR8350.2 eq. 4-1 defines gamma at the equator and pole; 45 deg and 30 deg values are the
+    # ones printed in independent public test suites (refdata tables README).
+    lat = np.radians([0.0, 30.0, 45.0, 90.0])
+    expected = [9.7803253359, 9.793247269215307, 9.80619776937, 9.8321849378]
+    np.testing.assert_allclose(earth.normal_gravity(lat, 0.0), expected, atol=2e-10)
+
+
+def test_normal_gravity_free_air_gradient():
+    # The normal free-air gradient is about -0.3086 mGal/m (Heiskanen & Moritz 1967, eq. 2-124)
+    lat = np.radians(45.0)
+    gradient = (earth.normal_gravity(lat, 100.0) - earth.normal_gravity(lat, 0.0)) / 100.0
+    assert gradient == pytest.approx(-3.086e-6, rel=2e-3)
+
+
+def test_normal_gravity_table(shared_dir):
+    table = pd.read_csv(shared_dir / "refdata/tables/wgs84_normal_gravity.csv", comment="#")
+    got = earth.normal_gravity(np.radians(table.lat_deg.to_numpy()), table.h_m.to_numpy())
+    np.testing.assert_allclose(got, table.gamma_m_s2, atol=1e-9)
+
+
+def test_radii_of_curvature_closed_forms():
+    rn, re = earth.radii_of_curvature(np.radians([0.0, 90.0]))
+    assert re[0] == pytest.approx(earth.A_M)
+    assert rn[0] == pytest.approx(earth.A_M * (1 - earth.E2))
+    # at the pole both radii equal a^2 / b
+    assert rn[1] == pytest.approx(earth.A_M**2 / earth.B_M)
+    assert re[1] == pytest.approx(earth.A_M**2 / earth.B_M)
+
+
+def test_meridian_radius_against_meridian_arc():
+    # independent check: a short meridian arc length computed from the ellipse directly
+    lat0, lat1 = np.radians(45.0), np.radians(45.001)
+    lats = np.linspace(lat0, lat1, 20001)
+    x, z = (earth.geodetic_to_ecef(lats, 0.0, 0.0)[:, i] for i in (0, 2))
+    arc = np.sum(np.hypot(np.diff(x), np.diff(z)))
+    rn, _ = earth.radii_of_curvature(np.radians(45.0005))
+    assert rn * (lat1 - lat0) == pytest.approx(arc, rel=1e-9)
+
+
+def test_ecef_pairs(shared_dir):
+    # the source column holds commas, so only the six numeric columns are read
+    table = pd.read_csv(shared_dir / "refdata/tables/ecef_geodetic_pairs.csv", comment="#",
+                        usecols=range(6), engine="python")
+    assert len(table) == 9
+    xyz = earth.geodetic_to_ecef(np.radians(table.lat_deg), np.radians(table.lon_deg),
+                                 table.h_m.to_numpy())
+    np.testing.assert_allclose(xyz, table[["x_m", "y_m", "z_m"]], atol=1e-3)
+    lat, lon, h = earth.ecef_to_geodetic(table[["x_m", "y_m", "z_m"]].to_numpy())
+    np.testing.assert_allclose(np.degrees(lat), table.lat_deg, atol=1e-7)
+    np.testing.assert_allclose(h, table.h_m, atol=1e-3)
+
+
+def test_ecef_published_pair():
+    # pymap3d's test_geodetic: (42, -82, 200 m) <-> (660675.2518247, -4700948.68316, 4245737.66222)
+    xyz = earth.geodetic_to_ecef(np.radians(42.0), np.radians(-82.0), 200.0)
+    np.testing.assert_allclose(xyz, [660675.2518247, -4700948.68316, 4245737.66222],
+                               atol=1e-4)
+
+
+def test_ned_frame_published_enu_example():
+    # RTKLIB t_coord.c utest3: at 35 N 140 E the ECEF vector (0.3, 0.4, 0.5) has ENU
+    # (-0.499254, 0.393916, 0.309152)
+    c_ne = earth.ned_to_ecef_matrix(np.radians(35.0), np.radians(140.0))
+    ned = c_ne.T @ np.array([0.3, 0.4, 0.5])
+    np.testing.assert_allclose([ned[1], ned[0], -ned[2]], [-0.499254, 0.393916, 0.309152],
+                               atol=1e-6)
+
+
+def test_earth_and_transport_rates():
+    lat = np.radians(37.0)
+    w = earth.earth_rate_ned(lat)[0]
+    assert np.linalg.norm(w) == pytest.approx(earth.OMEGA_E_RAD_S)
+    assert w[2] == pytest.approx(-earth.OMEGA_E_RAD_S * np.sin(lat))
+    # moving east at v along a parallel turns the frame about the north axis at v / (R_E + h)
+    _, re = earth.radii_of_curvature(lat)
+    w_en = earth.transport_rate_ned(lat, 100.0, np.array([0.0, 20.0, 0.0]))[0]
+    assert w_en[0] == pytest.approx(20.0 / (re + 100.0))
+    assert w_en[1] == 0.0
+
+
+@pytest.mark.parametrize("angles", [(0.1, -0.2, 2.5), (-1.0, 0.7, -3.0), (0.0, 0.0, 0.3)])
+def test_attitude_helpers_against_scipy(angles):
+    roll, pitch, yaw = angles
+    reference = Rotation.from_euler("ZYX", [yaw, pitch, roll]).as_matrix()
+    np.testing.assert_allclose(earth.euler_to_dcm(roll, pitch, yaw), reference, atol=1e-14)
+    q = earth.euler_to_quat(roll, pitch, yaw)
+    np.testing.assert_allclose(earth.quat_to_dcm(q), reference, atol=1e-14)
+    np.testing.assert_allclose(earth.quat_to_euler(q), angles, atol=1e-12)
+    rotvec = np.array([0.3, -0.2, 0.5])
+    q2 = earth.rotvec_to_quat(rotvec)
+    np.testing.assert_allclose(earth.quat_to_dcm(q2), Rotation.from_rotvec(rotvec).as_matrix(),
+                               atol=1e-14)
+    combined = earth.quat_to_dcm(earth.quat_multiply(q, q2))
+    np.testing.assert_allclose(combined, reference @ Rotation.from_rotvec(rotvec).as_matrix(),
+                               atol=1e-14)
+
+
+def test_wrap_angle():
+    np.testing.assert_allclose(earth.wrap_angle(np.array([3 * np.pi / 2, -3 * np.pi / 2, 0.1])),
+                               [-np.pi / 2, np.pi / 2, 0.1])
+
+
+def test_ned_to_body_is_the_transposed_dcm():
+    rng = np.random.default_rng(3)
+    roll, pitch, yaw = rng.uniform(-3, 3, (3, 50))
+    v = rng.normal(size=(50, 3))
+    expected = np.einsum("nji,nj->ni", earth.euler_to_dcm(roll, pitch, yaw), v)
+    np.testing.assert_allclose(earth.ned_to_body(roll, pitch, yaw, v), expected, atol=1e-14)
