@@ -12,7 +12,7 @@ import sys
 
 from simulator.errors import InputError
 
-COMMANDS = ["validate", "generate", "score", "run"]
+COMMANDS = ["validate", "generate", "score", "run", "export"]
 
 DESCRIPTION = """\
 landnav: synthetic land-vehicle drives and navigation-sensor datasets, with estimator replay

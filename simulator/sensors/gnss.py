@@ -240,8 +240,9 @@ class Gnss:
         az_rate = (los_ned[..., 0] * v_rel_ned[..., 1] - los_ned[..., 1] * v_rel_ned[..., 0]) \
             / horiz
 
-        alpha = nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA)
-        beta = nav.attrs.get("iono_beta", DEFAULT_IONO_BETA)
+        alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
+        beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
+        self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
         rn, re = radii_of_curvature(ant["lat"])
         lat_rate = ant["v_ned"][:, 0] / (rn + ant["alt"])
         lon_rate = ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"]))
