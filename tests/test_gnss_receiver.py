@@ -10,7 +10,7 @@ from gnss_helpers import drive, receiver
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import saastamoinen_delay
 from simulator.gnss.constants import LAMBDA_L1_M
-from simulator.gnss.fix import pack_epochs, solve_position
+from simulator.gnss.fix import pack_epochs, receiver_fixes, solve_position
 from simulator.gnss.receiver import dll_sigma_m, multipath_sigma_m
 from simulator.sensors.gnss import IONO_OWN_SHARE
 
@@ -204,3 +204,42 @@ def test_canyon_has_fewer_satellites_and_worse_dop(heading):
     assert (m.loc[m["nlos"] == 0, "nlos_delay"] == 0).all()
     assert (m.loc[m["nlos"] == 1, "cn0"] < m.loc[m["nlos"] == 1, "elevation"].pipe(
         lambda e: 35.0 + 12.0 * np.sin(e))).all()
+
+
+def test_three_satellites_give_a_2d_fix_and_two_give_none():
+    truth = drive([{"stop": {"duration": 60}}], rate_hz=1.0)
+    out = receiver(preset="ideal").generate(truth, np.random.default_rng(9))
+    raw = out["gnss_raw"]
+    rank = raw.groupby("t").cumcount()
+    t = raw["t"]
+    keep = (rank < np.where((t >= 20) & (t < 30), 3, np.where((t >= 40) & (t < 45), 2, 99)))
+    fix = receiver_fixes(out["gnss_fix"]["t"].to_numpy(), raw[keep])
+    kind = fix["fix"].to_numpy()
+    tt = fix["t"].to_numpy()
+    assert (kind[(tt >= 20) & (tt < 30)] == 1).all()
+    assert (kind[(tt >= 40) & (tt < 45)] == 0).all()
+    assert (kind[(tt < 20) | ((tt >= 30) & (tt < 40)) | (tt >= 45)] == 2).all()
+    assert fix.loc[kind == 1, "vdop"].isna().all() and (fix.loc[kind == 1, "hdop"] > 0).all()
+    # the vehicle stands still, so holding the last height is exact: the 2D fix is too
+    k = truth.inertial(tt)
+    two_d = kind == 1
+    assert np.abs(fix["lat"][two_d] - np.degrees(k["lat"][two_d])).max() < 1e-8
+    assert np.abs(fix["lon"][two_d] - np.degrees(k["lon"][two_d])).max() < 1e-8
+    assert fix.loc[kind == 0, ["lat", "lon", "alt", "vn"]].isna().all().all()
+
+
+def test_smoothed_fixes_are_quieter_and_follow_the_motion():
+    static = drive([{"stop": {"duration": 300}}], rate_hz=1.0)
+    raw_fix = receiver().generate(static, np.random.default_rng(10))["gnss_fix"]
+    smooth = receiver(smoothing=20.0).generate(static, np.random.default_rng(10))["gnss_fix"]
+    jitter = [np.std(np.diff(f["lat"].to_numpy())) for f in (raw_fix, smooth)]
+    assert jitter[1] < 0.5 * jitter[0]
+    moving = drive(DRIVE)
+    ideal = receiver(preset="ideal", smoothing=5.0).generate(moving, np.random.default_rng(1))
+    fix = ideal["gnss_fix"]
+    k = moving.inertial(fix["t"].to_numpy())
+    c = ned_to_ecef_matrix(k["lat"][0], k["lon"][0])
+    err = (geodetic_to_ecef(np.radians(fix["lat"]), np.radians(fix["lon"]), fix["alt"])
+           - geodetic_to_ecef(k["lat"], k["lon"], k["alt"])) @ c
+    # velocity aiding leaves no lag; what remains is the trapezoidal step's error at 1 Hz
+    assert np.abs(err).max() < 0.3

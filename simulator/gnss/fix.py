@@ -1,7 +1,8 @@
 """The receiver's own navigation solution from its raw measurements: weighted least-squares
 position and clock bias from pseudoranges, velocity and clock drift from pseudorange rates,
-dilutions of precision, fix type, speed and course; optionally the smoothed (filtered) output
-of low-cost receivers.
+dilutions of precision, fix type (3D with four or more satellites; 2D with three, the height
+held at the last 3D fix's; none otherwise), speed and course; optionally the smoothed
+(filtered) output of low-cost receivers.
 
 All epochs are solved at once: measurements are packed into (epoch, slot) arrays with a mask,
 and a fixed number of Gauss-Newton iterations runs as batched 4 x 4 linear algebra.
@@ -69,12 +70,23 @@ def _solve(normal: np.ndarray, rhs: np.ndarray, ok: np.ndarray) -> np.ndarray:
     return np.linalg.solve(normal, rhs[..., None])[..., 0]
 
 
+def _up_ecef(pos_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Ellipsoidal height and the unit up vector (ellipsoid normal) in ECEF at positions."""
+    lat, lon, alt = ecef_to_geodetic(pos_m)
+    up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+    return alt, up
+
+
 def solve_position(pr_m: np.ndarray, sat_pos_m: np.ndarray, weight: np.ndarray,
-                   mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+                   mask: np.ndarray, height_m: np.ndarray | None = None,
+                   start_m: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Weighted least-squares antenna position and receiver clock from corrected pseudoranges.
 
     Model (Groves eq. 9.126 with 8.36): pr = |R(omega_e tau) r_s - r| + c dt_r, tau = range / c,
-    with r_s at transmission in the ECEF frame of transmission.
+    with r_s at transmission in the ECEF frame of transmission. Where ``height_m`` is given
+    (finite) the ellipsoidal height is held at that value by one more equation, so three
+    satellites give a 2D fix (Kaplan & Hegarty section 11.2.2, altitude hold).
 
     Parameters
     ----------
@@ -84,25 +96,37 @@ def solve_position(pr_m: np.ndarray, sat_pos_m: np.ndarray, weight: np.ndarray,
     weight : ndarray, shape (n, k)
         1 / sigma^2 of each pseudorange (0 where masked).
     mask : ndarray of bool, shape (n, k)
+    height_m : ndarray, shape (n,), optional
+        Height to hold (NaN: none), m.
+    start_m : ndarray, shape (n, 3), optional
+        Starting positions (default: the Earth's centre; needed where a height is held).
 
     Returns
     -------
-    pos_m : ndarray, shape (n, 3) (NaN where fewer than 4 satellites)
+    pos_m : ndarray, shape (n, 3) (NaN where not solvable)
     clock_m : ndarray, shape (n,), c dt_r
-    ok : ndarray of bool, shape (n,), at least 4 satellites
+    ok : ndarray of bool, shape (n,): at least 4 equations
     """
     n = pr_m.shape[0]
-    ok = mask.sum(axis=1) >= 4
+    held = np.zeros(n, dtype=bool) if height_m is None else np.isfinite(height_m)
+    ok = mask.sum(axis=1) + held >= 4
     w = np.where(mask, weight, 0.0)
     x = np.zeros((n, 4))
+    if start_m is not None:
+        x[:, :3] = np.where(np.isfinite(start_m), start_m, 0.0)
     for _ in range(_GAUSS_NEWTON_ITERATIONS):
-        geo = _geometry(sat_pos_m, x[:, :3])
-        rng, los = geo
+        rng, los = _geometry(sat_pos_m, x[:, :3])
         h = np.concatenate([-los, np.ones(rng.shape + (1,))], axis=-1)
         resid = np.where(mask, pr_m - rng - x[:, 3:4], 0.0)
         hw = h * w[..., None]
         normal = np.einsum("nki,nkj->nij", hw, h)
-        dx = _solve(normal, np.einsum("nki,nk->ni", hw, resid), ok)
+        rhs = np.einsum("nki,nk->ni", hw, resid)
+        if held.any():
+            alt, up = _up_ecef(x[held, :3])
+            row = np.concatenate([up, np.zeros((len(up), 1))], axis=1)
+            normal[held] += row[:, :, None] * row[:, None, :]
+            rhs[held] += row * (height_m[held] - alt)[:, None]
+        dx = _solve(normal, rhs, ok)
         x = x + np.where(ok[:, None], dx, 0.0)
     pos = np.where(ok[:, None], x[:, :3], np.nan)
     return pos, np.where(ok, x[:, 3], np.nan), ok
@@ -118,13 +142,15 @@ def _geometry(sat_pos_m: np.ndarray, rx_m: np.ndarray) -> tuple[np.ndarray, np.n
 
 
 def solve_velocity(rate_m_s: np.ndarray, sat_pos_m: np.ndarray, sat_vel_m_s: np.ndarray,
-                   pos_m: np.ndarray, weight: np.ndarray, mask: np.ndarray
-                   ) -> tuple[np.ndarray, np.ndarray]:
+                   pos_m: np.ndarray, weight: np.ndarray, mask: np.ndarray,
+                   held: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Weighted least-squares ECEF velocity and clock drift (c d(dt_r)/dt, m/s) from pseudorange
     rates corrected for the satellite clock drift (Groves eq. 9.141):
     rate = los . (v_s - v) / f + c d(dt_r)/dt, with v_s rotated into the frame of reception and
-    f = ``light_time_factor`` (the exact light-time derivative; 1 - f is about 1e-5)."""
-    ok = (mask.sum(axis=1) >= 4) & np.isfinite(pos_m).all(axis=1)
+    f = ``light_time_factor`` (the exact light-time derivative; 1 - f is about 1e-5).
+    Epochs flagged ``held`` (2D fixes) add the equation "no vertical velocity"."""
+    held = np.zeros(len(pos_m), dtype=bool) if held is None else held
+    ok = (mask.sum(axis=1) + held >= 4) & np.isfinite(pos_m).all(axis=1)
     rx = np.where(ok[:, None], pos_m, 0.0)
     rng, los = _geometry(sat_pos_m, rx)
     vs = rotate_to_reception_frame(sat_vel_m_s, rng / C_M_S)
@@ -132,15 +158,25 @@ def solve_velocity(rate_m_s: np.ndarray, sat_pos_m: np.ndarray, sat_vel_m_s: np.
     y = np.where(mask, rate_m_s * factor - np.einsum("nki,nki->nk", los, vs), 0.0)
     h = np.concatenate([-los, factor[..., None]], axis=-1)
     hw = h * np.where(mask, weight, 0.0)[..., None]
-    x = _solve(np.einsum("nki,nkj->nij", hw, h), np.einsum("nki,nk->ni", hw, y), ok)
+    normal = np.einsum("nki,nkj->nij", hw, h)
+    held = held & ok
+    if held.any():
+        _, up = _up_ecef(rx[held])
+        row = np.concatenate([up, np.zeros((len(up), 1))], axis=1)
+        normal[held] += row[:, :, None] * row[:, None, :]
+    x = _solve(normal, np.einsum("nki,nk->ni", hw, y), ok)
     x = np.where(ok[:, None], x, np.nan)
     return x[:, :3], x[:, 3]
 
 
-def dilution_of_precision(sat_pos_m: np.ndarray, pos_m: np.ndarray, mask: np.ndarray
-                          ) -> tuple[np.ndarray, np.ndarray]:
-    """HDOP and VDOP from the unweighted geometry matrix in local NED (Groves eq. 9.91)."""
-    ok = (mask.sum(axis=1) >= 4) & np.isfinite(pos_m).all(axis=1)
+def dilution_of_precision(sat_pos_m: np.ndarray, pos_m: np.ndarray, mask: np.ndarray,
+                          held: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """HDOP and VDOP from the unweighted geometry matrix in local NED (Groves eq. 9.91).
+
+    For 2D fixes (``held``) the held height enters as one more unit row on the down axis, and
+    VDOP is NaN (there is no vertical solution)."""
+    held = np.zeros(len(pos_m), dtype=bool) if held is None else held
+    ok = (mask.sum(axis=1) + held >= 4) & np.isfinite(pos_m).all(axis=1)
     rx = np.where(ok[:, None], pos_m, np.array([1.0, 0.0, 0.0]) * 6.4e6)
     _, los = _geometry(sat_pos_m, rx)
     lat, lon, _ = ecef_to_geodetic(rx)
@@ -148,26 +184,29 @@ def dilution_of_precision(sat_pos_m: np.ndarray, pos_m: np.ndarray, mask: np.nda
     los_ned = np.einsum("nji,nkj->nki", c_ne, los)
     h = np.concatenate([-los_ned, np.ones(mask.shape + (1,))], axis=-1) * mask[..., None]
     normal = np.einsum("nki,nkj->nij", h, h)
+    normal[:, 2, 2] += held
     normal = np.where(ok[:, None, None], normal, np.eye(4))
     g = np.linalg.inv(normal)
     hdop = np.sqrt(g[:, 0, 0] + g[:, 1, 1])
     vdop = np.sqrt(g[:, 2, 2])
-    return np.where(ok, hdop, np.nan), np.where(ok, vdop, np.nan)
+    return np.where(ok, hdop, np.nan), np.where(ok & ~held, vdop, np.nan)
 
 
 def smooth_positions(pos_m: np.ndarray, vel_m_s: np.ndarray, dt_s: float,
                      time_constant_s: float) -> np.ndarray:
     """Velocity-aided first-order smoothing of fixes, as low-cost receivers filter their output:
-    p_k = p_{k-1} + v_k dt + alpha (z_k - p_{k-1} - v_k dt), alpha = dt / (time_constant + dt);
-    the filter restarts after every epoch without a fix."""
+    p_k = q_k + alpha (z_k - q_k) with the prediction q_k = p_{k-1} + (v_{k-1} + v_k) dt / 2
+    (trapezoidal, so a turn or an acceleration does not make the output lag) and
+    alpha = dt / (time_constant + dt); the filter restarts after every epoch without a fix."""
     alpha = dt_s / (time_constant_s + dt_s)
     out = np.full_like(pos_m, np.nan)
     valid = np.isfinite(pos_m).all(axis=1) & np.isfinite(vel_m_s).all(axis=1)
     edges = np.flatnonzero(np.diff(np.concatenate([[0], valid.astype(int), [0]])))
     for start, stop in zip(edges[::2], edges[1::2], strict=True):  # one pass per fix stretch
         z = pos_m[start:stop]
-        step = vel_m_s[start:stop] * dt_s
-        # p_k - (1 - alpha) p_{k-1} = alpha z_k + (1 - alpha) v_k dt, started at the first fix
+        v = vel_m_s[start:stop]
+        step = np.concatenate([np.zeros((1, 3)), 0.5 * (v[1:] + v[:-1]) * dt_s])
+        # p_k - (1 - alpha) p_{k-1} = alpha z_k + (1 - alpha) step_k, started at the first fix
         drive = alpha * z + (1.0 - alpha) * step
         drive[0] = z[0]
         out[start:stop] = lfilter([1.0], [1.0, alpha - 1.0], drive, axis=0)
@@ -199,8 +238,21 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     mask, (pr_p, pos_p, vel_p, rate_p, w_pr_p, w_rate_p) = pack_epochs(
         epoch, n, pr, sat_pos, sat_vel, rate, w_pr, w_rate)
     pos, clock, ok = solve_position(pr_p, pos_p, w_pr_p, mask)
-    vel, drift = solve_velocity(rate_p, pos_p, vel_p, pos, w_rate_p, mask)
-    hdop, vdop = dilution_of_precision(pos_p, pos, mask)
+    # 2D fixes: three satellites, the height held at the last 3D fix's (causal)
+    last = pd.DataFrame(np.where(ok[:, None], pos, np.nan)).ffill().to_numpy()
+    last_alt = np.full(n, np.nan)
+    known = np.isfinite(last).all(axis=1)
+    last_alt[known] = ecef_to_geodetic(last[known])[2]
+    held = (mask.sum(axis=1) == 3) & known
+    if held.any():
+        pos2, clock2, ok2 = solve_position(pr_p[held], pos_p[held], w_pr_p[held], mask[held],
+                                           last_alt[held], last[held])
+        pos[held], clock[held] = pos2, clock2
+        held[held] = ok2
+    vel, drift = solve_velocity(rate_p, pos_p, vel_p, pos, w_rate_p, mask, held)
+    hdop, vdop = dilution_of_precision(pos_p, pos, mask, held)
+    fix_type = np.where(ok, 2, np.where(held, 1, 0))
+    ok = fix_type > 0
     if smoothing_time_constant_s > 0 and n > 1:
         pos = smooth_positions(pos, vel, float(t[1] - t[0]), smoothing_time_constant_s)
     lat, lon, alt = ecef_to_geodetic(np.where(ok[:, None], pos, [6.4e6, 0.0, 0.0]))
@@ -213,5 +265,5 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
         "speed": np.hypot(v_ned[:, 0], v_ned[:, 1]),
         "course": np.mod(np.arctan2(v_ned[:, 1], v_ned[:, 0]), 2.0 * np.pi),
         "num_sats": mask.sum(axis=1), "hdop": hdop, "vdop": vdop,
-        "fix": np.where(ok, 2, 0), "clock_bias": clock, "clock_drift": drift,
+        "fix": fix_type, "clock_bias": clock, "clock_drift": drift,
     }, columns=list(col.GNSS_FIX))
