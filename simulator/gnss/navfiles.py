@@ -1,8 +1,9 @@
 """Navigation-file readers: RINEX 2 and 3 GPS navigation messages and YUMA almanacs, each turned
 into the one navigation table (columns ``simulator.columns.GNSS_NAV``, one row per ephemeris).
 
-The table's ``attrs`` carry the broadcast ionosphere coefficients when the file has them:
-``iono_alpha`` (s, s/sc, s/sc^2, s/sc^3) and ``iono_beta`` (s, ...), IS-GPS-200 20.3.3.5.1.7.
+The table's ``attrs`` carry ``kind`` (``ephemeris`` or ``almanac``) and the broadcast ionosphere
+coefficients when the file has them: ``iono_alpha`` (s, s/sc, s/sc^2, s/sc^3) and ``iono_beta``
+(s, ...), IS-GPS-200 20.3.3.5.1.7.
 
 Numbers are read with a regular expression rather than fixed columns, so files that separate
 their fields by blanks instead of keeping the RINEX 2 columns (e.g. Stanford's ``sugl0010.20n``)
@@ -73,7 +74,7 @@ def _record(sv: int, epoch: dt.datetime, values: list[float]) -> dict:
 
 
 def _header(lines: list[str]) -> tuple[float, dict, int]:
-    version, attrs = 2.0, {}
+    version, attrs = 2.0, {"kind": "ephemeris"}
     for i, line in enumerate(lines):
         label = line[60:].strip()
         if label == "RINEX VERSION / TYPE":
@@ -174,7 +175,7 @@ def read_yuma(path: str | Path, reference_week: int | None = None) -> pd.DataFra
         full.update(rec)
         full.update(week=week, toc=rec["toe"], sv=int(rec["sv"]), health=int(rec["health"]))
         out.append(full)
-    return _table(out, {})
+    return _table(out, {"kind": "almanac"})
 
 
 def read_navigation(path: str | Path, reference_week: int | None = None) -> pd.DataFrame:

@@ -46,6 +46,7 @@ from simulator.earth import (
     radii_of_curvature,
 )
 from simulator.environment.sky import canyon_visibility
+from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import klobuchar_delay, saastamoinen_delay
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.constellation import nominal_gps_navigation
@@ -212,6 +213,19 @@ class Gnss:
                     z_nlos, zone.get("nlos_attenuation", NLOS_CN0_LOSS_DEFAULT_DB), 0.0)
         return los, nlos, extra, loss
 
+    def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
+                        max_age_s: float) -> None:
+        """A navigation file that does not cover the drive is an input error, not a silent
+        outage: at least four satellites need an ephemeris at every epoch."""
+        short = (idx >= 0).sum(axis=0) < 4
+        if short.any():
+            raise InputError([Problem(
+                self.config["constellation"], None, "sensors.gnss.constellation",
+                f"fewer than four satellites have an ephemeris within {max_age_s / 3600:g} h "
+                f"of the drive from t = {t[short][0]:g} s (the drive starts "
+                f"{truth.utc_start:%Y-%m-%d %H:%M:%S} UTC); use a navigation file of that "
+                "day or 'nominal-gps'")])
+
     # -- generation ----------------------------------------------------------------------------
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         cfg = self.config
@@ -222,10 +236,11 @@ class Gnss:
         t_gps = tow0 + t
         nav = self.navigation(truth)
         eph = ephemeris_arrays(nav, week0)
-        max_age = 7 * 86400.0 if (nav["sqrt_a"] > 0).all() and (nav["iode"] == 0).all() \
-            else 4 * 3600.0
+        # an almanac describes the orbits for days (coarsely); an ephemeris for its fit interval
+        max_age = 7 * 86400.0 if nav.attrs.get("kind") == "almanac" else 4 * 3600.0
         svs = np.unique(nav["sv"].to_numpy())
         idx = select_ephemeris(eph, svs[:, None], t_gps[None, :], max_age_s=max_age)
+        self._check_coverage(idx, t, truth, max_age)
         ant = self.antenna(truth, t)
         geo = signal_geometry(gather(eph, idx), t_gps, ant["pos"], ant["vel"])
 
