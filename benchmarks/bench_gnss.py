@@ -2,9 +2,9 @@
 
 Run:  python benchmarks/bench_gnss.py   (prints the figures recorded in BENCHMARKS.md, "GNSS")
 
-The receiver (automotive preset, every error on) drives the city loop of
-``bench_truth.py`` (21 rounds, about one hour) on 2010-07-01 with the IGS broadcast ephemeris brdc1820.10n of that day
-(31 healthy satellites; ``shared/refdata/gnss/igs_2010-07-01_rtklib``). The timing covers
+The receiver (automotive preset, every error on) drives the city loop of ``bench_truth.py``
+(21 rounds, about one hour) on 2010-07-01 with the IGS broadcast ephemeris brdc1820.10n of that
+day (31 healthy satellites; ``shared/refdata/gnss/igs_2010-07-01_rtklib``). The timing covers
 ``Gnss.generate`` only (navigation file reading, ephemeris selection and evaluation with the
 transmit-time iteration for all 31 satellites x 3601 epochs, atmosphere, error processes, the
 environment, the raw table and the WLS fixes), best of three; the truth trajectory is built once
