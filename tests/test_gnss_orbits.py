@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 
 from simulator.earth import ecef_to_geodetic
-from simulator.gnss.atmosphere import klobuchar_delay, saastamoinen_delay
+from simulator.gnss.atmosphere import klobuchar_delay, niell_mapping, saastamoinen_delay
 from simulator.gnss.constants import C_M_S, SECONDS_PER_WEEK
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
 from simulator.gnss.navfiles import read_navigation, read_rinex_nav, read_yuma
@@ -155,3 +155,14 @@ def test_loose_rinex_and_yuma_against_each_other():
                        - satellite_state(gather(e_alm, i_alm[ok]), ts[ok])["pos"], axis=1)
     assert ok.sum() > 2000
     assert 300.0 < np.median(d) < 2500.0 and d.max() < 6000.0
+
+
+def test_niell_mapping_against_rtklib_table():
+    cases = _table("niell_mapping_rtklib_utest.csv")
+    stamps = pd.to_datetime(cases["gps_epoch"])
+    doy = np.array([(s - pd.Timestamp(s.year, 1, 1)).total_seconds() / 86400.0 + 1.0
+                    for s in stamps])
+    m_h, m_w = niell_mapping(np.radians(cases["lat_deg"]), cases["h_m"],
+                             np.radians(cases["el_deg"]), doy)
+    np.testing.assert_allclose(m_h, cases["mapf_dry"], rtol=0, atol=1e-8)
+    np.testing.assert_allclose(m_w, cases["mapf_wet"], rtol=0, atol=1e-8)

@@ -8,7 +8,7 @@ import pytest
 from gnss_helpers import drive, receiver
 
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
-from simulator.gnss.atmosphere import saastamoinen_delay
+from simulator.gnss.atmosphere import saastamoinen_zenith
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.fix import pack_epochs, receiver_fixes, solve_position
 from simulator.gnss.receiver import dll_sigma_m, multipath_sigma_m
@@ -131,7 +131,7 @@ def _budget_run(seed: int):
     own = (code**2 + multipath_sigma_m(el, cfg["multipath"]) ** 2 + cfg["sis_error"] ** 2
            + (IONO_OWN_SHARE * cfg["iono_residual"] * raw["iono"].to_numpy()) ** 2)
     iono_common = cfg["iono_residual"] * raw["iono"].to_numpy()
-    zenith = saastamoinen_delay(k["lat"][0], k["alt"][0], np.pi / 2)
+    zenith = np.add(*saastamoinen_zenith(k["lat"][0], k["alt"][0]))
     tropo_common = cfg["tropo_residual"] * raw["tropo"].to_numpy() / zenith
     u = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)], axis=1)
     epoch = np.searchsorted(fix["t"].to_numpy(), raw["t"].to_numpy())

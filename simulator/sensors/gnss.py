@@ -31,6 +31,7 @@ signal, error and fix models.
 
 from __future__ import annotations
 
+import datetime as dt
 from pathlib import Path as FilePath
 
 import numpy as np
@@ -47,7 +48,7 @@ from simulator.earth import (
 )
 from simulator.environment.sky import canyon_visibility
 from simulator.errors import InputError, Problem
-from simulator.gnss.atmosphere import klobuchar_delay, saastamoinen_delay
+from simulator.gnss.atmosphere import klobuchar_delay, saastamoinen_zenith, tropo_delay
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.constellation import nominal_gps_navigation
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, select_ephemeris
@@ -231,7 +232,7 @@ class Gnss:
         cfg = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
         n_ep = len(t)
-        dt = 1.0 / self.rate_hz
+        dt_s = 1.0 / self.rate_hz
         week0, tow0 = utc_to_gps(truth.utc_start)
         t_gps = tow0 + t
         nav = self.navigation(truth)
@@ -262,14 +263,17 @@ class Gnss:
         lat_rate = ant["v_ned"][:, 0] / (rn + ant["alt"])
         lon_rate = ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"]))
 
+        new_year = dt.datetime(truth.utc_start.year, 1, 1)
+        day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0
+
         def models(step_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
             lat = ant["lat"] + lat_rate * step_s
             alt = ant["alt"] - ant["v_ned"][:, 2] * step_s
             e = np.clip(el + el_rate * step_s, -np.pi / 2, np.pi / 2)
             iono = klobuchar_delay(lat, ant["lon"] + lon_rate * step_s, az + az_rate * step_s,
                                    e, t_gps + step_s, alpha, beta)
-            tropo = saastamoinen_delay(lat, alt, e)
-            zenith = saastamoinen_delay(lat, alt, np.pi / 2)
+            tropo = tropo_delay(lat, alt, e, day_of_year + (t + step_s) / 86400.0)
+            zenith = np.add(*saastamoinen_zenith(lat, alt))
             return iono, tropo, np.broadcast_to(zenith, tropo.shape)
 
         iono_b, tropo_b, zenith_b = models(0.0)
@@ -289,23 +293,23 @@ class Gnss:
         osc = OSCILLATORS[cfg["clock"]]
         bias0 = osc["bias_s"] * rng.standard_normal()
         drift0 = osc["drift_s_s"] * rng.standard_normal()
-        bias_s, drift_s_s = clock_process(n_ep, dt, osc["h0"], osc["h_minus2"], bias0, drift0,
+        bias_s, drift_s_s = clock_process(n_ep, dt_s, osc["h0"], osc["h_minus2"], bias0, drift0,
                                           rng)
         self.drawn["clock"] = {"oscillator": cfg["clock"], "bias_s": bias0,
                                "drift_s_s": drift0}
 
         # correlated error processes and white tracking noise (satellites x epochs)
         shape = el.shape
-        sis = cfg["sis_error"] * gauss_markov(rng, shape, SIS_CORRELATION_TIME_S, dt)
+        sis = cfg["sis_error"] * gauss_markov(rng, shape, SIS_CORRELATION_TIME_S, dt_s)
         # the broadcast model misses mostly the vertical electron content (common to every line
         # of sight) and, to half that extent, its spatial structure (independent per signal)
-        iono_common = gauss_markov(rng, (1, n_ep), IONO_CORRELATION_TIME_S, dt)
-        iono_own = gauss_markov(rng, shape, IONO_CORRELATION_TIME_S, dt)
+        iono_common = gauss_markov(rng, (1, n_ep), IONO_CORRELATION_TIME_S, dt_s)
+        iono_own = gauss_markov(rng, shape, IONO_CORRELATION_TIME_S, dt_s)
         iono_ratio = 1.0 + cfg["iono_residual"] * (iono_common + IONO_OWN_SHARE * iono_own)
         zenith_error = cfg["tropo_residual"] * rng.standard_normal()
         self.drawn["tropo_zenith_error_m"] = zenith_error
         mp_sigma = multipath_sigma_m(el, cfg["multipath"])
-        mp = mp_sigma * gauss_markov(rng, shape, cfg["multipath_correlation_time"], dt)
+        mp = mp_sigma * gauss_markov(rng, shape, cfg["multipath_correlation_time"], dt_s)
         code_sigma = cfg["tracking_noise"] * dll_sigma_m(
             cn0, cfg["dll_bandwidth"], cfg["correlator_spacing"], cfg["integration_time"])
         code_noise = code_sigma * rng.standard_normal(shape)
