@@ -93,11 +93,12 @@ def test_satellite_states_against_google_gsdc2022():
     pos_ref = raw[[f"SvPosition{a}EcefMeters" for a in "XYZ"]].to_numpy()
     vel_ref = raw[[f"SvVelocity{a}EcefMetersPerSecond" for a in "XYZ"]].to_numpy()
     assert len(raw) >= 40
-    assert np.abs(state["pos"] - pos_ref).max() < 0.01
-    assert np.abs(state["vel"] - vel_ref).max() < 0.01
-    assert np.abs(C_M_S * state["clock_s"] - raw["SvClockBiasMeters"]).max() < 0.01
+    # issue 5 asks for centimetres; measured: 0.9 mm, 0.8 mm/s, 0.6 um, 1e-10 m/s
+    assert np.abs(state["pos"] - pos_ref).max() < 0.005
+    assert np.abs(state["vel"] - vel_ref).max() < 0.005
+    assert np.abs(C_M_S * state["clock_s"] - raw["SvClockBiasMeters"]).max() < 0.001
     assert np.abs(C_M_S * state["clock_drift_s_s"] - raw["SvClockDriftMetersPerSecond"]
-                  ).max() < 0.001
+                  ).max() < 1e-6
 
 
 def test_klobuchar_against_google_gsdc2022():
@@ -108,7 +109,7 @@ def test_klobuchar_against_google_gsdc2022():
     iono = klobuchar_delay(lat, lon, np.radians(raw["SvAzimuthDegrees"].to_numpy()),
                            np.radians(raw["SvElevationDegrees"].to_numpy()), tow,
                            nav.attrs["iono_alpha"], nav.attrs["iono_beta"])
-    assert np.abs(iono - raw["IonosphericDelayMeters"].to_numpy()).max() < 0.01
+    assert np.abs(iono - raw["IonosphericDelayMeters"].to_numpy()).max() < 0.001  # 0.07 mm
 
 
 def _table(name: str) -> pd.DataFrame:
