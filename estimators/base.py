@@ -33,6 +33,7 @@ check_estimator_class.
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar
@@ -130,7 +131,7 @@ def resolve_config(cls: type[Estimator], config: Mapping[str, Any] | None) -> di
     problems = config_problems(cls, config)
     if problems:
         raise InputError([Problem("config", None, "", p) for p in problems])
-    return {**cls.defaults, **(config or {})}
+    return copy.deepcopy({**cls.defaults, **(config or {})})
 
 
 def _kind(value: Any) -> str | None:
@@ -161,6 +162,8 @@ def check_estimator_class(cls: Any, where: str) -> list[str]:
     for stream in (*cls.needs, *cls.uses):
         if not callable(getattr(cls, f"on_{stream}", None)):
             problems.append(f"{where} takes the {stream!r} stream but has no on_{stream} method")
+    if cls.solution is Estimator.solution:
+        problems.append(f"{where} has no solution(t) method")
     missing = [c for c in NAV_COLUMNS if c not in cls.output_columns]
     if missing:
         problems.append(f"{where}: output_columns lacks {', '.join(missing)}")

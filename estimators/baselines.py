@@ -7,9 +7,9 @@
   section 6.3 (odometry, heading-and-distance form); the 2-D DR of Cho & Choi 2006,
   eqs. 24a-b and 24e, with the odometer giving the speed): the yaw integrates the z gyro,
   compensated for the Earth rate and the transport rate (Groves eqs. 5.41, 5.44) as seen by a
-  level vehicle; the distance between odometer samples comes from their speeds interpolated
-  linearly in time, laid along the yaw history of the IMU samples. The height is held at its
-  initial value, roll and pitch are reported as zero.
+  level vehicle (refreshed at each odometer sample); the distance between odometer samples
+  comes from their speeds interpolated linearly in time, laid along the yaw history of the IMU
+  samples. The height is held at its initial value, roll and pitch are reported as zero.
 
 Public classes
 --------------
@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from estimators.base import Estimator
-from simulator.earth import OMEGA_E_RAD_S, radii_of_curvature, wrap_angle
+from simulator.earth import earth_rate_ned, radii_of_curvature, transport_rate_ned, wrap_angle
 
 
 class GnssOnly(Estimator):
@@ -76,16 +76,17 @@ class DeadReckoning(Estimator):
         self._t_odo: float | None = None
         # integrals since the last odometer sample of the unit heading vector, A = int u dt, and
         # of its time-weighted version, B = int u (t - t_odo) dt, north and east
-        self._a = np.zeros(2)
-        self._b = np.zeros(2)
+        self._a_n = self._a_e = self._b_n = self._b_e = 0.0
+        self._update_frame()
+
+    def _update_frame(self) -> None:
+        """Radii and the down component of the NED frame's rotation w.r.t. inertial space
+        (Earth plus transport rate), refreshed at each odometer sample: they change slowly."""
         rn, re = radii_of_curvature(self._lat)
         self._rn, self._re = float(rn), float(re)
-
-    def _level_frame_rate(self) -> float:
-        """Down component of the NED frame's rotation rate w.r.t. inertial space, rad/s."""
-        ve = self._speed * math.sin(self._yaw)
-        return -OMEGA_E_RAD_S * math.sin(self._lat) - ve * math.tan(self._lat) / (
-            self._re + self._alt)
+        v_ned = self._speed * np.array([math.cos(self._yaw), math.sin(self._yaw), 0.0])
+        w_in = earth_rate_ned(self._lat) + transport_rate_ned(self._lat, self._alt, v_ned)
+        self._frame_rate_d = float(w_in[0, 2]) if self.config["earth_rate"] else 0.0
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         dt = t - self._t_imu
@@ -98,39 +99,38 @@ class DeadReckoning(Estimator):
             self._rate_prev = rate
         if dt <= 0:
             return
-        if self.config["earth_rate"]:
-            dpsi -= self._level_frame_rate() * dt
+        dpsi -= self._frame_rate_d * dt
         yaw_mid = self._yaw + 0.5 * dpsi
         self._yaw += dpsi
-        u = np.array([math.cos(yaw_mid), math.sin(yaw_mid)])
+        c, s = math.cos(yaw_mid) * dt, math.sin(yaw_mid) * dt
         t_ref = self._t_odo if self._t_odo is not None else self._t_imu
-        self._a += u * dt
-        self._b += u * (0.5 * (self._t_imu + t) - t_ref) * dt
+        lag = 0.5 * (self._t_imu + t) - t_ref
+        self._a_n += c
+        self._a_e += s
+        self._b_n += c * lag
+        self._b_e += s * lag
         self._t_imu = t
 
     def _move(self, d_north: float, d_east: float) -> None:
         self._lat += d_north / (self._rn + self._alt)
         self._lon += d_east / ((self._re + self._alt) * math.cos(self._lat))
-        rn, re = radii_of_curvature(self._lat)
-        self._rn, self._re = float(rn), float(re)
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         speed = float(row[self._speed_col])
-        if self._t_odo is None:  # before the first sample the initial speed was held
-            self._move(*(self._speed * self._a))
-        else:
-            span = t - self._t_odo
-            slope = (speed - self._speed) / span if span > 0 else 0.0
-            self._move(*(self._speed * self._a + slope * self._b))
-        self._a[:] = 0.0
-        self._b[:] = 0.0
+        slope = 0.0  # before the first sample the initial speed was held
+        if self._t_odo is not None and t > self._t_odo:
+            slope = (speed - self._speed) / (t - self._t_odo)
+        self._move(self._speed * self._a_n + slope * self._b_n,
+                   self._speed * self._a_e + slope * self._b_e)
+        self._a_n = self._a_e = self._b_n = self._b_e = 0.0
         self._speed = speed
         self._t_odo = t
+        self._update_frame()
 
     def solution(self, t: float) -> list[float]:
-        d_north, d_east = self._speed * self._a  # held speed since the last odometer sample
-        lat = self._lat + d_north / (self._rn + self._alt)
-        lon = self._lon + d_east / ((self._re + self._alt) * math.cos(lat))
+        # the speed is held since the last odometer sample
+        lat = self._lat + self._speed * self._a_n / (self._rn + self._alt)
+        lon = self._lon + self._speed * self._a_e / ((self._re + self._alt) * math.cos(lat))
         return [math.degrees(lat), math.degrees(lon), self._alt,
                 self._speed * math.cos(self._yaw), self._speed * math.sin(self._yaw), 0.0,
                 0.0, 0.0, float(wrap_angle(self._yaw))]

@@ -8,15 +8,17 @@ A third-party package registers an estimator in its ``pyproject.toml``::
 
 Public functions
 ----------------
-get_estimator, list_estimators.
+get_estimator, list_estimators, entry_problems.
 """
 
 from __future__ import annotations
 
 import importlib
+from collections.abc import Mapping
 from importlib import metadata
+from typing import Any
 
-from estimators.base import Estimator, check_estimator_class
+from estimators.base import Estimator, check_estimator_class, config_problems
 from simulator.errors import InputError
 
 ENTRY_POINT_GROUP = "landnav.estimators"
@@ -81,3 +83,15 @@ def get_estimator(name: str) -> type[Estimator]:
     if problems:
         raise InputError(problems[0] if len(problems) == 1 else "; ".join(problems))
     return cls
+
+
+def entry_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:
+    """Problems of a resolved scenario estimator entry, as (key, message) pairs: the name must
+    resolve to an estimator class and the config must fit its defaults."""
+    name = entry if isinstance(entry, str) else entry["name"]
+    try:
+        cls = get_estimator(name)
+    except InputError as exc:
+        return [("name", p.message) for p in exc.problems]
+    config = None if isinstance(entry, str) else entry.get("config")
+    return [("config", message) for message in config_problems(cls, config)]

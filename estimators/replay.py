@@ -22,6 +22,7 @@ run_estimator, initial_state, merge_streams, output_times, write_solution, read_
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Mapping
 from pathlib import Path
@@ -101,16 +102,18 @@ def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None
 class _Stream:
     """One stream as a float64 array, with the message times and how to index messages."""
 
-    def __init__(self, name: str, frame: pd.DataFrame, units: dict[str, str]):
+    def __init__(self, name: str, frame: pd.DataFrame, units: dict[str, str], where: Path):
         numeric = [c for c in frame.columns if pd.api.types.is_numeric_dtype(frame[c])]
+        if "t" not in numeric:
+            raise InputError([Problem(str(where), None, name, "no numeric time column t")])
         self.name = name
         self.data = np.ascontiguousarray(frame[numeric].to_numpy(dtype=np.float64))
         self.data.flags.writeable = False
         self.columns = {c: i for i, c in enumerate(numeric)}
         self.units = {c: units.get(c, "") for c in numeric}
         t = self.data[:, self.columns["t"]]
-        if len(t) > 1 and np.any(np.diff(t) < 0):
-            raise InputError(f"stream {name!r}: time t decreases")
+        if not np.all(np.diff(t) >= 0):
+            raise InputError([Problem(str(where), None, name, "time t decreases or is missing")])
         if name == "gnss_raw":  # one message per epoch: a 2-D block of its satellites
             starts = np.flatnonzero(np.r_[True, np.diff(t) > 0])
             bounds = np.r_[starts, len(t)]
@@ -173,11 +176,8 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
                                   f"not have (it has: {', '.join(dataset.stream_names)})")
                           for s in missing])
     names = [s for s in dict.fromkeys((*cls.needs, *cls.uses)) if dataset.has(s)]
-    refused = [s for s in names if s in col.SCORING_ONLY]
-    if refused:
-        raise InputError(f"estimator {cls.name!r} asks for scoring-only stream(s) {refused}")
-    names.sort(key=_stream_rank)
-    return [_Stream(s, dataset.read(s), _units(dataset, s)) for s in names]
+    names.sort(key=_stream_rank)  # scoring-only streams were refused by get_estimator
+    return [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
 
 
 def _units(dataset: Dataset, name: str) -> dict[str, str]:
@@ -226,6 +226,10 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                   f"{name!r} in streams {[s.name for s in streams]}")])
     initial = None
     if not cls.initialises_itself:
+        if not dataset.has("truth"):
+            raise InputError([Problem(str(dataset.path), None, "", f"estimator {name!r} starts "
+                                      "from the true state, and the dataset has no truth "
+                                      "stream; use an estimator that initialises itself")])
         initial = initial_state(dataset.read("truth"), float(t[0]), init)
     estimator = cls(config, initial, {s.name: s.columns for s in streams},
                     {s.name: s.units for s in streams})
@@ -248,7 +252,12 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
             k += 1
         row = solution(t_out)
         if row is not None:
-            out[j] = row
+            try:
+                out[j] = row
+            except ValueError:
+                raise ValueError(f"estimator {name!r} returned {len(row)} values at t = "
+                                 f"{t_out} s; its output_columns has {out.shape[1]}: "
+                                 f"{', '.join(cls.output_columns)}") from None
             kept[j] = True
     runtime = time.perf_counter() - start
 
@@ -277,13 +286,20 @@ def _solution_problems(frame: pd.DataFrame) -> list[str]:
 
 
 def write_solution(frame: pd.DataFrame, path: str | Path) -> None:
-    """Write a solution table as Parquet (SPEC section 7); extra columns get unit ""."""
+    """Write a solution table as Parquet (SPEC section 7), atomically; extra columns get unit
+    ""."""
     problems = _solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     units = {**col.SOLUTION, **col.SOLUTION_STD}
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    write_table(frame, Path(path), {c: units.get(c, "") for c in frame.columns})
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"  # never a half-written file
+    try:
+        write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns})
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def read_solution(path: str | Path) -> pd.DataFrame:

@@ -10,9 +10,8 @@ import argparse
 import importlib
 import sys
 
+from simulator.commands import SUMMARIES
 from simulator.errors import InputError
-
-COMMANDS = ["validate", "generate", "score", "run", "export"]
 
 DESCRIPTION = """\
 landnav: synthetic land-vehicle drives and navigation-sensor datasets, with estimator replay
@@ -29,18 +28,24 @@ Run `landnav COMMAND --help` for each command's options.
 """
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The parser; only ``command``'s module is imported (all of them when None)."""
     parser = argparse.ArgumentParser(
         prog="landnav", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
-    for name in COMMANDS:
-        importlib.import_module(f"simulator.commands.{name}").add_parser(sub)
+    for name, summary in SUMMARIES.items():
+        if command in (None, name):
+            importlib.import_module(f"simulator.commands.{name}").add_parser(sub)
+        else:
+            sub.add_parser(name, help=summary)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else argv
+    command = next((a for a in argv if not a.startswith("-")), None)
+    parser = build_parser(command if command in SUMMARIES else None)
     args = parser.parse_args(argv)
     try:
         return int(args.run(args) or 0)

@@ -48,9 +48,9 @@ def radii_of_curvature(lat_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Groves eqs. 2.105 and 2.106: R_N = a (1 - e^2) / (1 - e^2 sin^2 L)^1.5 and
     R_E = a / sqrt(1 - e^2 sin^2 L).
     """
-    s2 = np.sin(lat_rad) ** 2
-    den = 1.0 - E2 * s2
-    return A_M * (1.0 - E2) / den**1.5, A_M / np.sqrt(den)
+    s = np.sin(lat_rad)
+    re = A_M / np.sqrt(1.0 - E2 * s * s)
+    return re * re * re * (1.0 - E2) / (A_M * A_M), re
 
 
 def normal_gravity(lat_rad: np.ndarray, alt_m: np.ndarray) -> np.ndarray:

@@ -42,22 +42,6 @@ class Recorder(Estimator):
                 *self.initial.attitude]
 
 
-class Silent(Estimator):
-    """Does nothing with the IMU, odometer, baro and GNSS fixes it is handed (benchmarks)."""
-
-    name = "silent"
-    needs = ("imu",)
-    uses = ("odometer", "baro", "gnss_fix")
-
-    def on_imu(self, t, row):
-        pass
-
-    on_odometer = on_baro = on_gnss_fix = on_imu
-
-    def solution(self, t):
-        return (0.0,) * 9
-
-
 class Peeker(Estimator):
     """Asks for the truth: must be refused."""
 
@@ -65,4 +49,21 @@ class Peeker(Estimator):
     needs = ("truth",)
 
     def on_truth(self, t, row):
+        pass
+
+
+class Miscounted(Recorder):
+    """Returns fewer values than its output columns: a plug-in bug reported clearly."""
+
+    def solution(self, t):
+        return [0.0, 0.0, 0.0]
+
+
+class Mute(Estimator):
+    """Takes the IMU but never reports: refused, it has no solution method."""
+
+    name = "mute"
+    needs = ("imu",)
+
+    def on_imu(self, t, row):
         pass

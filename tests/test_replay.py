@@ -167,3 +167,39 @@ def test_read_solution_rejects_bad_files(tmp_path):
     frame.assign(t=[0.0, 1.0, 2.0]).drop(columns="yaw").to_parquet(no_yaw)
     with pytest.raises(InputError, match=r"no_yaw.parquet: missing column\(s\) yaw"):
         read_solution(no_yaw)
+
+
+def test_wrong_number_of_solution_values_names_the_columns(dataset):
+    with pytest.raises(ValueError, match=r"returned 3 values at t = .* output_columns has 9"):
+        run_estimator(dataset, "tests.recording:Miscounted", show_progress=False)
+
+
+def test_dataset_without_truth_only_runs_self_initialising_estimators(tmp_path, dataset):
+    with atomic_output_dir(tmp_path / "no_truth", force=False) as tmp:
+        write_dataset(tmp, {}, {"imu": dataset.read("imu"), "gnss_fix": dataset.read("gnss_fix")})
+    no_truth = open_dataset(tmp_path / "no_truth")
+    with pytest.raises(InputError, match="starts from the true state.*no truth stream"):
+        run_estimator(no_truth, "tests.recording:Recorder", show_progress=False)
+    frame, _ = run_estimator(no_truth, "gnss_only", show_progress=False)
+    assert len(frame) > 0
+
+
+def test_stream_with_decreasing_time_is_refused(tmp_path, dataset):
+    imu = dataset.read("imu").iloc[:50]
+    imu.loc[10, "t"] = 100.0
+    with atomic_output_dir(tmp_path / "bad", force=False) as tmp:
+        write_dataset(tmp, {}, {"imu": imu, "truth": dataset.read("truth")})
+    with pytest.raises(InputError, match=r"bad: imu: time t decreases"):
+        run_estimator(open_dataset(tmp_path / "bad"), "tests.recording:Recorder",
+                      show_progress=False)
+
+
+def test_replay_benchmark_dataset_runs(tmp_path):
+    """The benchmark's synthetic streams (here 72 s of them) replay into its do-nothing
+    estimator: 10 Hz output from the first to the last message."""
+    from benchmarks.bench_replay import make_dataset
+    make_dataset(tmp_path, hours=0.02)
+    frame, info = run_estimator(open_dataset(tmp_path), "benchmarks.bench_replay:DoNothing",
+                                show_progress=False)
+    assert len(frame) == 721 and frame["t"].iloc[-1] == 72.0
+    assert info["realtime_factor"] > 1.0

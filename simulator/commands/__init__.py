@@ -1,1 +1,15 @@
-"""One module per ``landnav`` command: ``add_parser(subparsers)`` and ``run(args) -> int``."""
+"""One module per ``landnav`` command: ``add_parser(subparsers)`` and ``run(args) -> int``.
+
+``SUMMARIES`` gives each command's one-line help, so ``landnav --help`` lists every command
+without importing any (a command's module, and what it needs, is imported only when it runs).
+"""
+
+SUMMARIES = {
+    "validate": "check scenario files; print every problem as file:line: key: message",
+    "generate": "write the dataset of a scenario (truth, sensor streams, events)",
+    "estimators": "list the registered estimators (name, streams it needs, paper)",
+    "estimate": "run one estimator causally over a dataset, write its solution",
+    "score": "score solutions against a dataset's truth (table, JSON, report)",
+    "run": "generate, run the scenario's estimators, score, write the report",
+    "export": "write a dataset's GNSS streams as RINEX 3.04 and NMEA 0183",
+}

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from simulator.commands import SUMMARIES
 from simulator.dataset.io import open_dataset
 from simulator.earth import geodetic_to_ecef
 from simulator.errors import InputError, Problem
@@ -19,7 +20,7 @@ from simulator.timebase import gps_to_utc, leap_seconds
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "export", help="write a dataset's GNSS streams as RINEX 3.04 and NMEA 0183",
+        "export", help=SUMMARIES["export"],
         description="Export the GNSS streams of a dataset: --rinex DIR writes a RINEX 3.04 "
                     "observation file (C1C, D1C, S1C from gnss_raw) and a navigation file (the "
                     "broadcast elements of gnss_nav) into DIR; --nmea FILE writes GGA, RMC, VTG, "

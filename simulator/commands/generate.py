@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import time
 
+from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
 from simulator.dataset.generate import generate_dataset
 from simulator.scenario import load_scenario
@@ -12,7 +13,7 @@ from simulator.scenario import load_scenario
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "generate", help="write the dataset of a scenario (truth, sensor streams, events)",
+        "generate", help=SUMMARIES["generate"],
         description="Generate the dataset of a scenario: the exact truth trajectory, every "
                     "configured sensor's stream and the events table, as Parquet files with a "
                     "manifest.json (SPEC section 5). The directory is written under a temporary "

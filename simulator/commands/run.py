@@ -9,6 +9,7 @@ import argparse
 from pathlib import Path
 
 from estimators.replay import run_estimator, write_solution
+from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
 from simulator.commands.score import print_scores
 from simulator.dataset.generate import generate_dataset
@@ -24,7 +25,7 @@ NO_ESTIMATOR = ("No estimator was named in the scenario (its `estimators:` list 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "run", help="generate, run the scenario's estimators, score, write the report",
+        "run", help=SUMMARIES["run"],
         description="The main job: generate the scenario's dataset into DIR/dataset/, run every "
                     "estimator the scenario names over it (causally), write their solutions to "
                     "DIR/solutions/LABEL.parquet, the scores to DIR/scores.json (keyed by label)"

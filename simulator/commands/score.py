@@ -11,6 +11,7 @@ from pathlib import Path
 import pandas as pd
 
 from estimators.replay import read_solution, run_estimator
+from simulator.commands import SUMMARIES
 from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
 from simulator.errors import InputError, Problem
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
@@ -19,7 +20,7 @@ from simulator.scoring.report import text_table, write_report
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "score", help="score solutions against a dataset's truth (table, JSON, report)",
+        "score", help=SUMMARIES["score"],
         description="Score navigation solutions against the truth of a dataset: horizontal, "
                     "vertical, velocity and attitude errors, per-GNSS-outage drift, NEES when "
                     "the solution has standard deviations (SPEC section 8). Solutions are files "

@@ -5,13 +5,14 @@ from __future__ import annotations
 import argparse
 import sys
 
+from simulator.commands import SUMMARIES
 from simulator.errors import InputError
 from simulator.scenario import load_scenario
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "validate", help="check scenario files; print every problem as file:line: key: message",
+        "validate", help=SUMMARIES["validate"],
         description="Check scenario files against the schema (keys, types, units, ranges) and "
                     "the physics limits (lateral acceleration, grade). Every problem of every "
                     "file is printed as `file:line: key.path: message`. Exit code 0 when all "

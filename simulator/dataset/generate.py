@@ -20,6 +20,7 @@ import pandas as pd
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
 from simulator.dataset.io import atomic_output_dir, write_dataset
 from simulator.errors import InputError
+from simulator.faults.apply import apply_faults
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
@@ -67,7 +68,7 @@ def generate_streams(scenario: dict, show_progress: bool = True) -> Generated:
         model = SENSOR_MODELS[name](sensors[name])
         streams.update(model.generate(truth, sensor_rng(scenario["seed"], name)))
         drawn[name] = model.drawn
-    rows = zone_events(truth.profile.zones)
+    rows = zone_events(truth.profile.zones) + apply_faults(streams, scenario, truth)
     for t_start, t_end in _outages(streams, truth.duration_s):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
     streams["events"] = events_table(rows)

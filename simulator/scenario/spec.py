@@ -8,8 +8,9 @@ SCENARIO_FIELD, START_FIELD, ESTIMATOR_ENTRY_FIELD.
 
 from __future__ import annotations
 
+from estimators.registry import entry_problems
 from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
-from simulator.faults import FAULT_FIELD
+from simulator.faults import FAULT_FIELD, check_faults
 from simulator.scenario.schema import (
     Anything,
     Context,
@@ -63,13 +64,18 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     elif imu and traj["rate"] < imu["rate"]:
         ctx.error(path + ("trajectory", "rate"),
                   f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
-    PROFILE_BUILDERS[traj["kind"]](value, ctx)
+    profile = PROFILE_BUILDERS[traj["kind"]](value, ctx)
+    if profile is not None:
+        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones})
     labels: set[str] = set()
     for i, entry in enumerate(value["estimators"]):
         label = entry if isinstance(entry, str) else (entry["label"] or entry["name"])
         if label in labels:
             ctx.error(path + ("estimators", i), f"label {label!r} is used twice; give a label")
         labels.add(label)
+        for key, message in entry_problems(entry):
+            where = path + ("estimators", i) + (() if isinstance(entry, str) else (key,))
+            ctx.error(where, message)
     zones = value["environment"]["zones"]
     used = _zones_used(value)
     if used is not None:

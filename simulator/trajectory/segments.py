@@ -228,10 +228,8 @@ def _helix(seg: dict, v: float, lim: dict) -> list[_PathPiece]:
 
     if abs(rise) < 1e-9:
         return build(0.0)
-    from scipy.optimize import brentq  # imported here: only helices and lane changes solve
-
     bound = np.arctan(1.0) * np.sign(rise)
-    gamma = brentq(rise_error, 1e-9 * np.sign(rise), bound, xtol=1e-14)
+    gamma = _bisect(rise_error, 1e-9 * np.sign(rise), bound)
     return build(gamma)
 
 
@@ -240,6 +238,24 @@ def _rise_of(piece: _PathPiece) -> float:
     x, w = np.polynomial.legendre.leggauss(8)
     s = 0.5 * piece.length * (x + 1)
     return float(0.5 * piece.length * np.sum(w * np.sin(np.polyval(piece.grade, s))))
+
+
+def _bisect(f, a: float, b: float) -> float:
+    """Root of f on [a, b] (f(a), f(b) of opposite signs) to machine precision by bisection
+    (a scenario solves a handful of these; scipy.optimize would cost more to import)."""
+    fa = f(a)
+    if fa * f(b) > 0:
+        raise ValueError("the manoeuvre cannot be built with these parameters")
+    for _ in range(200):
+        m = 0.5 * (a + b)
+        if m in (a, b):
+            break
+        fm = f(m)
+        if (fm < 0) == (fa < 0):
+            a, fa = m, fm
+        else:
+            b = m
+    return 0.5 * (a + b)
 
 
 def _speed_bump(height: float, length: float) -> list[_PathPiece]:
@@ -257,9 +273,7 @@ def _lane_change(offset: float, length: float) -> list[_PathPiece]:
     def shift(c: float) -> float:
         return float(0.5 * length * np.sum(w * np.sin(c * shape))) - offset
 
-    from scipy.optimize import brentq
-
-    c = 0.0 if offset == 0 else brentq(shift, 0.0, np.sign(offset) * 0.8, xtol=1e-15)
+    c = 0.0 if offset == 0 else _bisect(shift, 0.0, np.sign(offset) * 0.8)
     uu = np.polynomial.polynomial.Polynomial([0.0, 1.0 / length])
     kappa = 420.0 * c / length * uu**2 * (1 - uu) ** 2 * (1 - 2 * uu)
     return [_PathPiece(length, kappa.coef[::-1], _ZERO, _ZERO)]

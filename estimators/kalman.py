@@ -1,0 +1,114 @@
+"""The Kalman filter's linear algebra, the one home for every estimator: prediction, the
+Joseph-form measurement update, and the closed- or open-loop handling of an error state.
+
+* ``predict``: x <- Phi x, P <- Phi P Phi^T + Q_d (Groves 2013, section 3.2.2, steps 1-2).
+* ``update``: K = P H^T (H P H^T + R)^-1, x <- x + K nu, P <- (I - K H) P (I - K H)^T + K R K^T,
+  the Joseph form, which keeps P symmetric and positive semi-definite for any gain (Groves
+  section 3.2.2, steps 4-7, with the Joseph covariance update of Brown & Hwang, *Introduction
+  to Random Signals and Applied Kalman Filtering*, 4th ed., section 4.2).
+* ``ErrorState``: the estimate of errors of a nominal (total-state) solution. Errors are defined
+  as estimate minus truth, and a measurement enters as dz = h(nominal) - z ~ H dx + noise. In
+  closed loop (Groves section 14.1.1) the estimated errors are fed back into the nominal solution
+  after each update and the error estimate is reset to zero, so it need not be propagated; in
+  open loop the nominal solution is never corrected, the error estimate is propagated with the
+  transition matrix and subtracted from the nominal solution only for output.
+
+``predict`` and ``update`` are plain numpy: with 15 states a prediction takes about 12 us and an
+update about 50 us, so an hour of 100 Hz predictions costs about 4 s (900 times real time);
+numba would save little of that and cost every process 20 s of compilation.
+
+Public names
+------------
+predict, update, ErrorState.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+
+def predict(x: np.ndarray, p: np.ndarray, phi: np.ndarray,
+            q_d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Time update of a linear(ised) discrete system.
+
+    Parameters
+    ----------
+    x : (n,) state estimate.
+    p : (n, n) its covariance.
+    phi : (n, n) transition matrix over the step.
+    q_d : (n, n) discrete process-noise covariance of the step.
+
+    Returns
+    -------
+    x : (n,) predicted state; p : (n, n) predicted covariance (symmetrised).
+    """
+    p_new = phi @ p @ phi.T + q_d
+    return phi @ x, 0.5 * (p_new + p_new.T)
+
+
+def update(x: np.ndarray, p: np.ndarray, innovation: np.ndarray, h: np.ndarray,
+           r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Measurement update in Joseph form.
+
+    Parameters
+    ----------
+    x : (n,) state estimate; p : (n, n) its covariance.
+    innovation : (m,) measurement minus its prediction, nu = z - H x (linear case).
+    h : (m, n) measurement matrix.
+    r : (m, m) measurement-noise covariance.
+
+    Returns
+    -------
+    x : (n,) updated state; p : (n, n) updated covariance; s : (m, m) innovation covariance
+    H P H^T + R (for gating: nu^T S^-1 nu is chi-square with m degrees of freedom).
+    """
+    h = np.atleast_2d(h)
+    r = np.atleast_2d(r)
+    s = h @ p @ h.T + r
+    s = 0.5 * (s + s.T)
+    k = np.linalg.solve(s, h @ p).T  # P H^T S^-1 with S and P symmetric
+    a = np.eye(p.shape[0]) - k @ h
+    p_new = a @ p @ a.T + k @ r @ k.T
+    return x + k @ innovation, 0.5 * (p_new + p_new.T), s
+
+
+class ErrorState:
+    """Error estimate and covariance of a nominal solution, in closed or open loop.
+
+    Parameters
+    ----------
+    p0 : (n, n) initial error covariance (the initial error estimate is zero).
+    closed_loop : bool
+        True: call ``feedback()`` after each update and remove the returned errors from the
+        nominal solution. False: never correct the nominal solution; output nominal minus
+        ``estimate``.
+    """
+
+    def __init__(self, p0: np.ndarray, closed_loop: bool = True):
+        self.p = np.array(p0, dtype=float)
+        self.x = np.zeros(self.p.shape[0])
+        self.closed_loop = closed_loop
+
+    @property
+    def estimate(self) -> np.ndarray:
+        """The current error estimate (estimate minus truth), shape (n,)."""
+        return self.x
+
+    def predict(self, phi: np.ndarray, q_d: np.ndarray) -> None:
+        """Propagate the covariance (and in open loop the error estimate) over one step."""
+        self.x, self.p = predict(self.x, self.p, phi, q_d)
+
+    def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Update with dz = h(nominal) - z (shape (m,)); returns the innovation covariance."""
+        h = np.atleast_2d(np.asarray(h, dtype=float))
+        self.x, self.p, s = update(self.x, self.p, np.asarray(dz, float) - h @ self.x, h, r)
+        return s
+
+    def feedback(self) -> np.ndarray:
+        """Closed loop: the estimated errors to remove from the nominal solution; the error
+        estimate is reset to zero (its covariance is unchanged)."""
+        if not self.closed_loop:
+            raise RuntimeError("feedback() is for closed-loop error states; in open loop "
+                               "subtract `estimate` from the nominal solution for output")
+        dx, self.x = self.x, np.zeros_like(self.x)
+        return dx

@@ -1,0 +1,62 @@
+"""The navigation error-state convention shared by every error-state filter and measurement
+model, and the corrections that go with it.
+
+Errors are estimate minus truth, as in the NED-frame INS error states of Groves 2013
+(chapter 14):
+
+* dr : (3,) position error resolved in NED, m: north and east arc lengths and down;
+* dv : (3,) NED velocity error, m/s;
+* psi : (3,) attitude error, rad, a small rotation of the NED frame:
+  C_b^n(estimate) = exp([psi x]) C_b^n(true) ~ (I + [psi x]) C_b^n(true), so
+  q(estimate) = q(psi) * q(true).
+
+The 9-vector dx = [dr, dv, psi] is the navigation block of an error state; ``correct`` removes
+estimated errors from a solution (closed-loop feedback, or open-loop output) and ``perturb``
+adds them (initial errors, tests).
+
+Public names
+------------
+NAV_ERROR_STATES, perturb, correct.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from simulator.earth import quat_multiply, radii_of_curvature, rotvec_to_quat
+
+NAV_ERROR_STATES = ("dr_n", "dr_e", "dr_d", "dv_n", "dv_e", "dv_d", "psi_n", "psi_e", "psi_d")
+
+
+def _shift(pos: np.ndarray, d_ned: np.ndarray) -> np.ndarray:
+    lat, lon, h = pos
+    rn, re = radii_of_curvature(lat)
+    return np.array([lat + d_ned[0] / (rn + h), lon + d_ned[1] / ((re + h) * np.cos(lat)),
+                     h - d_ned[2]])
+
+
+def perturb(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dx: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A solution with errors ``dx`` added.
+
+    Parameters
+    ----------
+    q : (4,) body-to-NED quaternion (scalar first); v : (3,) NED velocity, m/s;
+    pos : (3,) latitude (rad), longitude (rad), height (m); dx : (9,) [dr, dv, psi].
+
+    Returns
+    -------
+    q, v, pos of the erroneous solution.
+    """
+    dx = np.asarray(dx, dtype=float)
+    q_new = quat_multiply(rotvec_to_quat(dx[6:9]), q)
+    return q_new, np.asarray(v, float) + dx[3:6], _shift(np.asarray(pos, float), dx[0:3])
+
+
+def correct(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dx: np.ndarray
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """A solution with estimated errors ``dx`` removed (the inverse of ``perturb`` to first
+    order in the position's curvature; exact for velocity and attitude)."""
+    dx = np.asarray(dx, dtype=float)
+    q_new = quat_multiply(rotvec_to_quat(-dx[6:9]), q)
+    return q_new, np.asarray(v, float) - dx[3:6], _shift(np.asarray(pos, float), -dx[0:3])

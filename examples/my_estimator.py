@@ -1,0 +1,83 @@
+"""A third-party estimator, the worked example of docs/estimator_plugins.md (not part of landnav).
+
+A loosely coupled odometer/gyro/GNSS extended Kalman filter in a local level plane: the state is
+north and east position (m, from the start) and yaw (rad); it is predicted with the odometer
+speed and the z gyro at the IMU rate and updated with each GNSS position fix. Compare the 2-D
+DR/GPS filters of Cho & Choi 2006 (eqs. 24a-b, 24e) and Park et al. 2019.
+
+Run it with ``landnav estimate DATASET -e examples.my_estimator:MyEstimator -o sol.parquet``
+from a directory where ``examples`` is importable.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from estimators.base import NAV_COLUMNS, Estimator
+from estimators.kalman import predict, update
+from simulator.earth import radii_of_curvature
+
+
+class MyEstimator(Estimator):
+    name = "my_estimator"
+    needs = ("imu", "odometer")
+    uses = ("gnss_fix",)
+    paper = "example: 3-state DR/GNSS EKF after Cho & Choi 2006"
+    defaults = {
+        "gnss_sigma": 3.0,  # GNSS horizontal position noise, m (1-sigma)
+        "speed_sigma": 0.1,  # odometer speed noise, m/s
+        "gyro_psd": 1e-3,  # z-gyro white noise, rad/s/sqrt(Hz)
+        "yaw_sigma0": 0.05,  # initial yaw uncertainty, rad
+    }
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw")
+
+    def setup(self) -> None:
+        lat0, lon0, self.alt = self.initial.position
+        self.lat0, self.lon0 = lat0, lon0
+        rn, re = radii_of_curvature(lat0)
+        self.m_per_rad = np.array([rn + self.alt, (re + self.alt) * math.cos(lat0)])
+        self.x = np.array([0.0, 0.0, self.initial.attitude[2]])  # north, east, yaw
+        self.p = np.diag([0.0, 0.0, self.config["yaw_sigma0"] ** 2])
+        self.speed = float(np.hypot(*self.initial.velocity[:2]))
+        self.t = self.initial.t
+        self.gz = self.columns["imu"]["gyro_z"]
+        self.increments = self.units["imu"]["gyro_z"] == "rad"
+        self.v = self.columns["odometer"]["speed"]
+        if "gnss_fix" in self.columns:
+            g = self.columns["gnss_fix"]
+            self.fix, self.lat, self.lon = g["fix"], g["lat"], g["lon"]
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        dt, self.t = t - self.t, t
+        if dt <= 0:
+            return
+        dpsi = row[self.gz] if self.increments else row[self.gz] * dt
+        yaw = self.x[2] + 0.5 * dpsi
+        c, s = math.cos(yaw), math.sin(yaw)
+        f = np.array([[1.0, 0.0, -self.speed * s * dt],
+                      [0.0, 1.0, self.speed * c * dt],
+                      [0.0, 0.0, 1.0]])
+        q = np.diag([(self.config["speed_sigma"] * dt) ** 2] * 2
+                    + [self.config["gyro_psd"] ** 2 * dt])
+        _, self.p = predict(self.x, self.p, f, q)
+        self.x = self.x + np.array([self.speed * c * dt, self.speed * s * dt, dpsi])
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        self.speed = float(row[self.v])
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        if row[self.fix] <= 0:
+            return
+        z = (np.radians([row[self.lat], row[self.lon]]) - [self.lat0, self.lon0]) * self.m_per_rad
+        h = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
+        r = np.eye(2) * self.config["gnss_sigma"] ** 2
+        self.x, self.p, _ = update(self.x, self.p, z - h @ self.x, h, r)
+
+    def solution(self, t: float) -> list[float]:
+        lat, lon = np.degrees(np.array([self.lat0, self.lon0]) + self.x[:2] / self.m_per_rad)
+        yaw = self.x[2]
+        std = np.sqrt(np.diag(self.p))
+        return [lat, lon, self.alt, self.speed * math.cos(yaw), self.speed * math.sin(yaw), 0.0,
+                0.0, 0.0, math.atan2(math.sin(yaw), math.cos(yaw)), std[0], std[1], std[2]]

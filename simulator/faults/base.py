@@ -1,0 +1,65 @@
+"""What a fault kind is: its parameters (schema) and a transformation of the streams over its
+intervals. Faults draw randomness only from their own streams, so everything outside their
+intervals stays byte-identical to the clean dataset.
+
+Public names
+------------
+FaultKind, FaultContext, FAULT_REGISTRY, in_intervals, register.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from simulator.faults.triggers import TRIGGER_FIELDS
+from simulator.scenario.schema import Field, Record
+
+
+@dataclass
+class FaultContext:
+    """What a fault may look at besides the streams: the drive, the resolved sensor blocks and
+    the fault's own random stream."""
+
+    truth: object  # simulator.trajectory.kinematics.Kinematics
+    sensors: dict
+    rng: np.random.Generator
+
+
+# apply(streams, intervals, params, context) changes streams in place
+Apply = Callable[[dict[str, pd.DataFrame], list[tuple[float, float]], dict, FaultContext],
+                 None]
+
+
+@dataclass(frozen=True)
+class FaultKind:
+    name: str
+    record: Record
+    apply: Apply
+    streams: tuple[str, ...]  # streams it acts on (one of them must exist)
+    doc: str
+
+
+FAULT_REGISTRY: dict[str, FaultKind] = {}
+
+
+def register(name: str, params: dict[str, Field], streams: tuple[str, ...], doc: str
+             ) -> Callable[[Apply], Apply]:
+    """Decorator registering a fault kind's parameters and its ``apply`` function."""
+    def wrap(apply: Apply) -> Apply:
+        FAULT_REGISTRY[name] = FaultKind(name, Record({**TRIGGER_FIELDS, **params}), apply,
+                                         streams, doc)
+        return apply
+    return wrap
+
+
+def in_intervals(t: np.ndarray, intervals: list[tuple[float, float]]) -> np.ndarray:
+    """Boolean mask of the times inside any of the half-open intervals [start, end)."""
+    t = np.asarray(t, dtype=float)
+    mask = np.zeros(t.shape, dtype=bool)
+    for start, end in intervals:
+        mask |= (t >= start) & (t < end)
+    return mask

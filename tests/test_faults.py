@@ -1,0 +1,224 @@
+"""Faults: triggers, validation, and each kind's effect present inside its interval and absent
+outside (faulted against clean streams of the same seed)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from conftest import scenario_data
+
+from simulator.dataset.generate import build_truth, generate_streams
+from simulator.errors import InputError
+from simulator.faults.base import FAULT_REGISTRY, FaultContext
+from simulator.faults.triggers import fault_intervals
+
+DRIVE = [
+    {"stop": {"duration": 10}},
+    {"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+    {"straight": {"length": 300}},
+    {"straight": {"length": 200, "zone": "tunnel"}},
+    {"straight": {"length": 1500}},
+]
+
+
+@pytest.fixture(scope="module")
+def truth():
+    return build_truth(scenario_data(DRIVE))
+
+
+def _fault(kind: str, **fields) -> dict:
+    """A resolved fault entry (validated through the scenario schema)."""
+    data = scenario_data(DRIVE, faults=[{"kind": kind, **fields}])
+    return data["faults"][0]
+
+
+def test_start_zone_and_distance_triggers(truth):
+    rng = np.random.default_rng(0)
+    assert fault_intervals(_fault("imu_bias_step", start=20, duration=5), truth, rng) == [
+        (20.0, 25.0)]
+    (zone,) = fault_intervals(_fault("imu_bias_step", zone="tunnel"), truth, rng)
+    # stop 10 s; 0 -> 10 m/s at 1 m/s^2 with jerk 1.5 m/s^3 takes 10 + 1/1.5 s; 300 m at 10 m/s
+    accelerate = 10.0 + 1.0 / 1.5
+    assert zone == pytest.approx((10 + accelerate + 30, 10 + accelerate + 50))
+    (a, b), = fault_intervals(_fault("imu_bias_step", distance=[100, 200]), truth, rng)
+    s = truth.profile.distance_of_time(np.array([a, b]))
+    assert s == pytest.approx([100, 200], abs=0.11)
+
+
+def test_random_trigger_matches_rate_and_distribution():
+    long_drive = [{"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+                  {"straight": {"length": 10.0 * 40 * 3600}}]  # 40 hours
+    data = scenario_data(long_drive, faults=[{
+        "kind": "imu_bias_step", "random": {"rate": "6 /h", "duration": {
+            "distribution": "exponential", "mean": 20.0}}}],
+        sensors={"imu": {"preset": "ideal", "rate": 1}})
+    truth = build_truth(data)
+    intervals = fault_intervals(data["faults"][0], truth, np.random.default_rng(7))
+    hours = truth.duration_s / 3600
+    count = len(intervals)
+    # Poisson count: 240 expected, standard deviation sqrt(240) = 15.5
+    assert abs(count - 6 * hours) < 4 * np.sqrt(6 * hours)
+    lengths = np.array([b - a for a, b in intervals])
+    assert lengths.mean() == pytest.approx(20.0, rel=4 / np.sqrt(count))
+    # exponential: the standard deviation equals the mean
+    assert lengths.std() == pytest.approx(20.0, rel=0.2)
+    starts = np.array([a for a, _ in intervals])
+    assert np.all(np.diff(starts) > 0)
+
+
+@pytest.mark.parametrize("fault, key, words", [
+    ({"kind": "volcano", "start": 1, "duration": 1}, "faults.0.kind", "unknown fault kind"),
+    ({"kind": "baro_jump", "start": 1, "duration": 1, "delta_pa": 30}, "faults.0.kind",
+     "no configured"),
+    ({"kind": "imu_bias_step", "start": 1, "duration": "3 m"}, "faults.0.duration",
+     "dimension"),
+    ({"kind": "imu_bias_step", "start": 200, "duration": 100}, "faults.0.duration",
+     "ends after the drive"),
+    ({"kind": "imu_bias_step", "zone": "garage"}, "faults.0.zone", "no stretch"),
+    ({"kind": "imu_bias_step", "start": 1}, "faults.0.duration", "needs a duration"),
+    ({"kind": "imu_bias_step", "start": 1, "duration": 1, "zone": "tunnel"}, "faults.0",
+     "exactly one trigger"),
+    ({"kind": "gnss_latency", "start": 1, "duration": 1}, "faults.0.latency",
+     "missing required key"),
+])
+def test_fault_validation(fault, key, words):
+    with pytest.raises(InputError) as exc:
+        scenario_data(DRIVE, faults=[fault])
+    text = str(exc.value)
+    assert f"{key}:" in text and words in text
+
+
+def _apply(kind: str, streams: dict, intervals, truth, sensors=None, **params):
+    fault = FAULT_REGISTRY[kind]
+    context = FaultContext(truth, sensors or {}, np.random.default_rng(1))
+    fault.apply(streams, intervals, params, context)
+    return streams
+
+
+def _stream(rate: float, duration: float, **columns) -> pd.DataFrame:
+    t = np.arange(0, duration, 1 / rate)
+    return pd.DataFrame({"t": t, **{k: f(t) for k, f in columns.items()}})
+
+
+def _inside(t, a, b):
+    return (t >= a) & (t < b)
+
+
+def test_baro_jump_steps_and_recovers(truth):
+    clean = _stream(20, 100, pressure=lambda t: 101325.0 - 0.1 * t)
+    faulted = _apply("baro_jump", {"baro": clean.copy()}, [(30.0, 50.0)], truth,
+                     delta_pa=30.0, recovery=5.0)["baro"]
+    diff = faulted.pressure - clean.pressure
+    t = clean.t
+    assert np.all(diff[~_inside(t, 30, 50)] == 0.0)
+    assert np.allclose(diff[_inside(t, 30, 45)], 30.0)
+    assert 0 < diff[_inside(t, 47.5, 47.6)].iloc[0] < 30.0
+
+
+def test_odometer_slip_and_scale_change(truth):
+    clean = _stream(10, 100, speed=lambda t: np.full_like(t, 10.0))
+    slip = _apply("odometer_slip", {"odometer": clean.copy()}, [(20.0, 30.0)], truth,
+                  slip=-1.0)["odometer"]
+    assert np.all(slip.speed[_inside(clean.t, 20, 30)] == 0.0)
+    assert np.all(slip.speed[~_inside(clean.t, 20, 30)] == 10.0)
+    tyre = _apply("odometer_scale_change", {"odometer": clean.copy()}, [(50.0, 100.0)], truth,
+                  scale_change=0.03)["odometer"]
+    assert np.allclose(tyre.speed[_inside(clean.t, 50, 100)], 10.3)
+    assert np.all(tyre.speed[~_inside(clean.t, 50, 100)] == 10.0)
+
+
+def test_imu_bias_step_on_rates_and_increments(truth):
+    zeros = {a: np.zeros_like for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y",
+                                         "accel_z")}
+    clean = _stream(100, 10, **zeros)
+    sensors = {"imu": {"rate": 100.0, "output": "increment"}}
+    out = _apply("imu_bias_step", {"imu": clean.copy()}, [(2.0, 4.0)], truth, sensors,
+                 axes=["gyro_z", "accel_x"], gyro=1e-3, accel=0.05)["imu"]
+    inside = _inside(clean.t, 2, 4)
+    assert np.allclose(out.gyro_z[inside], 1e-5) and np.allclose(out.accel_x[inside], 5e-4)
+    assert np.all(out.gyro_z[~inside] == 0) and np.all(out.gyro_x == 0)
+
+
+def test_saturation_burst_clips(truth):
+    clean = _stream(200, 10, accel_z=lambda t: np.full_like(t, -9.8))
+    out = _apply("imu_saturation_burst", {"imu": clean.copy()}, [(5.0, 5.5)], truth,
+                 {"imu": {"rate": 200.0, "output": "rate"}}, axes=["accel_z"],
+                 gyro_amplitude=0.0, accel_amplitude=40.0, frequency=30.0, gyro_range=None,
+                 accel_range=16.0)["imu"]
+    inside = _inside(clean.t, 5, 5.5)
+    assert out.accel_z[inside].min() == pytest.approx(-16.0)
+    assert out.accel_z[inside].max() == pytest.approx(16.0)
+    assert np.all(out.accel_z[~inside] == -9.8)
+
+
+def test_dropout_and_jitter(truth):
+    clean = _stream(10, 30, speed=np.ones_like)
+    out = _apply("sensor_dropout", {"odometer": clean.copy()}, [(10.0, 12.0)], truth,
+                 stream="odometer")["odometer"]
+    assert len(out) == len(clean) - 20
+    assert not np.any(_inside(out.t, 10, 12))
+    jittered = _apply("timestamp_jitter", {"odometer": clean.copy()}, [(10.0, 20.0)], truth,
+                      stream="odometer", sigma=0.01)["odometer"]
+    moved = jittered.t - clean.t
+    assert np.all(moved[~_inside(clean.t, 10, 20)] == 0.0)
+    assert 0.005 < moved[_inside(clean.t, 10, 20)].std() < 0.02
+    assert np.all(np.diff(jittered.t) > 0)
+
+
+def _fixes(truth):
+    t = np.arange(0.0, 60.0, 1.0)
+    table = truth.table(t)
+    return pd.DataFrame({"t": t, "lat": table.lat, "lon": table.lon, "alt": table.alt,
+                         "vn": table.vn, "ve": table.ve, "vd": table.vd, "speed": table.speed,
+                         "course": table.yaw, "num_sats": 8, "hdop": 1.0, "vdop": 1.5,
+                         "fix": 2})
+
+
+def test_gnss_outage_latency_jump_and_rate_drop(truth):
+    clean = _fixes(truth)
+    raw = pd.DataFrame({"t": np.repeat(clean.t, 5), "sv": np.tile(np.arange(1, 6), 60)})
+    out = _apply("gnss_outage", {"gnss_fix": clean.copy(), "gnss_raw": raw.copy()},
+                 [(10.0, 20.0)], truth)
+    inside = _inside(clean.t, 10, 20)
+    assert np.all(out["gnss_fix"].fix[inside] == 0) and out["gnss_fix"].lat[inside].isna().all()
+    pd.testing.assert_frame_equal(out["gnss_fix"][~inside], clean[~inside], check_dtype=False)
+    assert not np.any(_inside(out["gnss_raw"].t, 10, 20)) and len(out["gnss_raw"]) == 250
+
+    late = _apply("gnss_latency", {"gnss_fix": clean.copy()}, [(30.0, 40.0)], truth,
+                  latency=2.0)["gnss_fix"]
+    inside = _inside(clean.t, 30, 40)
+    assert np.allclose(late.lat[inside], clean.lat.shift(2)[inside])
+    pd.testing.assert_frame_equal(late[~inside], clean[~inside])
+
+    jump = _apply("gnss_fix_jump", {"gnss_fix": clean.copy()}, [(40.0, 50.0)], truth,
+                  offset=[30.0, -20.0, 5.0])["gnss_fix"]
+    inside = _inside(clean.t, 40, 50)
+    from simulator import earth
+    ned = earth.ecef_to_ned(
+        earth.geodetic_to_ecef(np.radians(jump.lat[inside]), np.radians(jump.lon[inside]),
+                               jump.alt[inside].to_numpy()),
+        np.radians(clean.lat[inside].iloc[0]), np.radians(clean.lon[inside].iloc[0]),
+        clean.alt[inside].iloc[0])
+    assert ned[0] == pytest.approx([30.0, -20.0, 5.0], abs=1e-3)
+    pd.testing.assert_frame_equal(jump[~inside], clean[~inside])
+
+    slow = _apply("gnss_rate_drop", {"gnss_fix": clean.copy()}, [(10.0, 30.0)], truth,
+                  rate=0.2)["gnss_fix"]
+    assert list(slow.t[_inside(slow.t, 10, 30)]) == [10.0, 15.0, 20.0, 25.0]
+    assert len(slow) == 60 - 16
+
+
+def test_faulted_dataset_identical_outside_the_interval():
+    clean = generate_streams(scenario_data(DRIVE), show_progress=False).streams
+    faulted = generate_streams(scenario_data(DRIVE, faults=[
+        {"kind": "imu_bias_step", "start": 40, "duration": 10, "gyro": "100 deg/h"},
+        {"kind": "timestamp_jitter", "stream": "imu", "start": 60, "duration": 5,
+         "sigma": 0.001}]), show_progress=False).streams
+    t = clean["imu"].t.to_numpy()
+    outside = ~(_inside(t, 40, 50) | _inside(t, 60, 65))
+    pd.testing.assert_frame_equal(faulted["imu"][outside], clean["imu"][outside])
+    assert not faulted["imu"].equals(clean["imu"])
+    events = faulted["events"]
+    assert list(events.kind) == ["imu_bias_step", "zone", "timestamp_jitter"]
+    assert events.t_start.iloc[0] == 40.0 and events.t_end.iloc[0] == 50.0
