@@ -9,6 +9,7 @@ weather in the troposphere model, as the refdata README computed them."""
 from __future__ import annotations
 
 import datetime as dt
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -60,7 +61,7 @@ def residuals(obs: pd.DataFrame, nav: pd.DataFrame, rx: np.ndarray,
     rate = np.einsum("ni,ni->n", los, vs) / light_time_factor(los, state["pos"], vs,
                                                                rng / C_M_S)
     out = pd.DataFrame({
-        "tow": tow, "sv": sv, "elevation": el,
+        "tow": tow, "sv": sv, "elevation": el, "cn0": obs["cn0"].to_numpy(),
         "pr_res": pr - (rng - C_M_S * state["clock_s"] + iono + tropo),
         "dop_res": obs["doppler"].to_numpy()
         + (rate - C_M_S * state["clock_drift_s_s"]) / LAMBDA_L1_M,
@@ -81,13 +82,15 @@ def _nav() -> pd.DataFrame:
 
 def _real_observations() -> pd.DataFrame:
     georinex = pytest.importorskip("georinex", reason="georinex (test extra) reads the RINEX obs")
-    ds = georinex.load(FOLDER / "arlm200a.15o", meas=["P1", "D1"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        ds = georinex.load(FOLDER / "arlm200a.15o", meas=["P1", "D1", "S1"])
     frame = ds.to_dataframe().reset_index().dropna(subset=["P1", "D1"])
     frame = frame[(frame["P1"] > 0) & frame["sv"].str.startswith("G")]
     tow = (frame["time"] - pd.Timestamp(1980, 1, 6)).dt.total_seconds() - WEEK * SECONDS_PER_WEEK
     return pd.DataFrame({"tow": tow.to_numpy(), "sv": frame["sv"].str[1:].astype(int).to_numpy(),
                          "pseudorange": frame["P1"].to_numpy(),
-                         "doppler": frame["D1"].to_numpy()})
+                         "doppler": frame["D1"].to_numpy(), "cn0": frame["S1"].to_numpy()})
 
 
 def _simulated(preset: str) -> pd.DataFrame:
@@ -101,7 +104,7 @@ def _simulated(preset: str) -> pd.DataFrame:
     raw = gnss.generate(truth, np.random.default_rng(2015))["gnss_raw"]
     return pd.DataFrame({"tow": raw["t"].to_numpy(), "sv": raw["sv"].to_numpy(),
                          "pseudorange": raw["pseudorange"].to_numpy(),
-                         "doppler": raw["doppler"].to_numpy()})
+                         "doppler": raw["doppler"].to_numpy(), "cn0": raw["cn0"].to_numpy()})
 
 
 def test_static_residuals_beside_the_real_arl1_receiver():
@@ -130,3 +133,17 @@ def test_static_residuals_beside_the_real_arl1_receiver():
     # a mass-market receiver is noisier than a monitor station, but of the same order
     assert 0.8 < figures["simulated automotive"][0] / figures["real ARL1"][0] < 2.5
     assert 0.5 < figures["simulated automotive"][1] / figures["real ARL1"][1] < 2.5
+
+
+def test_cn0_against_elevation_beside_the_real_arl1_receiver():
+    """The C/N0 model's elevation shape was fitted to these data: mean C/N0 per elevation band
+    of the simulated receiver within 1.5 dB of the real one's (S1)."""
+    nav = _nav()
+    bands = [10, 20, 30, 45, 60, 90]
+    means = {}
+    for name, obs in (("real", _real_observations()), ("sim", _simulated("automotive"))):
+        r = residuals(obs, nav, ARL1_XYZ)
+        band = pd.cut(np.degrees(r["elevation"]), bands)
+        means[name] = r.groupby(band, observed=False)["cn0"].mean()
+    print(pd.DataFrame(means))
+    assert np.abs(means["real"] - means["sim"]).max() < 1.5

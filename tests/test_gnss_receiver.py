@@ -11,7 +11,7 @@ from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matr
 from simulator.gnss.atmosphere import saastamoinen_zenith
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.fix import pack_epochs, receiver_fixes, solve_position
-from simulator.gnss.receiver import dll_sigma_m, multipath_sigma_m
+from simulator.gnss.receiver import cn0_model, dll_sigma_m, multipath_sigma_m
 from simulator.sensors.gnss import IONO_OWN_SHARE
 
 DRIVE = [{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
@@ -202,8 +202,10 @@ def test_canyon_has_fewer_satellites_and_worse_dop(heading):
     m = _truth_by_row(b["gnss_raw"], b["truth_gnss"])
     assert (m.loc[m["nlos"] == 1, "nlos_delay"] > 0).all()
     assert (m.loc[m["nlos"] == 0, "nlos_delay"] == 0).all()
-    assert (m.loc[m["nlos"] == 1, "cn0"] < m.loc[m["nlos"] == 1, "elevation"].pipe(
-        lambda e: 35.0 + 12.0 * np.sin(e))).all()
+    nlos = m[m["nlos"] == 1]
+    cfg = gnss.config
+    np.testing.assert_allclose(nlos["cn0"], cn0_model(nlos["elevation"], cfg["cn0_zenith"],
+                                                      cfg["cn0_horizon"]) - 10.0)
 
 
 def test_three_satellites_give_a_2d_fix_and_two_give_none():
