@@ -10,9 +10,9 @@ from gnss_helpers import drive, receiver
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import saastamoinen_zenith
 from simulator.gnss.constants import LAMBDA_L1_M
+from simulator.gnss.errors import IONO_OWN_SHARE
 from simulator.gnss.fix import pack_epochs, receiver_fixes, solve_position
 from simulator.gnss.receiver import cn0_model, dll_sigma_m, multipath_sigma_m
-from simulator.sensors.gnss import IONO_OWN_SHARE
 
 DRIVE = [{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
          {"turn": {"angle": 90, "radius": 50}}, {"straight": {"length": 200}}]

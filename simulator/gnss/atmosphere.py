@@ -4,7 +4,7 @@ ionosphere and the Saastamoinen troposphere with the Niell mapping functions.
 Public functions
 ----------------
 klobuchar_delay, default_weather, water_vapour_pressure, saastamoinen_zenith,
-saastamoinen_delay, niell_mapping, tropo_delay.
+saastamoinen_delay, niell_mapping, tropo_delay, broadcast_delays.
 
 References
 ----------
@@ -168,3 +168,39 @@ def tropo_delay(lat_rad: np.ndarray, alt_m: np.ndarray, elevation_rad: np.ndarra
     hydro, wet = saastamoinen_zenith(lat_rad, alt_m, humidity, weather)
     m_h, m_w = niell_mapping(lat_rad, alt_m, elevation_rad, day_of_year)
     return hydro * m_h + wet * m_w
+
+
+def broadcast_delays(lat_rad: np.ndarray, lon_rad: np.ndarray, alt_m: np.ndarray,
+                     azimuth_rad: np.ndarray, elevation_rad: np.ndarray, gps_tow_s: np.ndarray,
+                     day_of_year: np.ndarray, alpha: np.ndarray, beta: np.ndarray,
+                     rates: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
+    """The delays a single-frequency receiver applies, and their time derivatives.
+
+    ``iono``: Klobuchar (``klobuchar_delay``); ``tropo``: ``tropo_delay`` (standard atmosphere);
+    ``zenith``: the zenith troposphere of the same model (broadcast to the slant's shape).
+    With ``rates`` (d/dt of ``lat``, ``lon``, ``alt``, ``azimuth``, ``elevation``, per second)
+    also ``iono_rate`` and ``tropo_rate`` (m/s), by central differences over +-0.5 s along
+    those rates (the models are smooth; the step error is below 1e-6 m/s). Receiver arrays have
+    shape (n_epoch,), satellite arrays (n_sat, n_epoch).
+    """
+    def at(step_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        r = rates or {}
+        lat = lat_rad + r.get("lat", 0.0) * step_s
+        alt = alt_m + r.get("alt", 0.0) * step_s
+        el = np.clip(elevation_rad + r.get("elevation", 0.0) * step_s, -np.pi / 2, np.pi / 2)
+        iono = klobuchar_delay(lat, lon_rad + r.get("lon", 0.0) * step_s,
+                               azimuth_rad + r.get("azimuth", 0.0) * step_s, el,
+                               gps_tow_s + step_s, alpha, beta)
+        tropo = tropo_delay(lat, alt, el, day_of_year + step_s / SECONDS_PER_DAY)
+        zenith = np.broadcast_to(np.add(*saastamoinen_zenith(lat, alt)), tropo.shape)
+        return iono, tropo, zenith
+
+    iono, tropo, zenith = at(0.0)
+    out = {"iono": iono, "tropo": tropo, "zenith": zenith}
+    if rates is not None:
+        half = 0.5
+        iono_hi, tropo_hi, _ = at(half)
+        iono_lo, tropo_lo, _ = at(-half)
+        out["iono_rate"] = (iono_hi - iono_lo) / (2.0 * half)
+        out["tropo_rate"] = (tropo_hi - tropo_lo) / (2.0 * half)
+    return out

@@ -8,8 +8,8 @@ first-order recursions run along the epoch axis by ``scipy.signal.lfilter``.
 
 Public functions
 ----------------
-rotate_to_reception_frame, light_time_factor, signal_geometry, clock_process, gauss_markov,
-cn0_model, dll_sigma_m, fll_sigma_hz, multipath_sigma_m.
+rotate_to_reception_frame, light_time_factor, signal_geometry, look_angles, clock_process,
+gauss_markov, cn0_model, dll_sigma_m, fll_sigma_hz, multipath_sigma_m.
 
 References
 ----------
@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.signal import lfilter
 
+from simulator.earth import ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S, CHIP_L1CA_M, OMEGA_E_DOT_RAD_S
 from simulator.gnss.ephemeris import satellite_state
 
@@ -105,6 +106,36 @@ def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np
     return {"tau": rng / C_M_S, "pos": state["pos"], "vel": state["vel"], "los_rate": los_rate,
             "clock_s": state["clock_s"], "clock_drift_s_s": state["clock_drift_s_s"],
             "range": rng, "range_rate": rate, "los": los, "tau_rate": rate / C_M_S}
+
+
+def look_angles(los: np.ndarray, los_rate: np.ndarray, lat_rad: np.ndarray, lon_rad: np.ndarray
+                ) -> dict[str, np.ndarray]:
+    """Elevation and azimuth (from north, clockwise; in [0, 2 pi)) of unit lines of sight, and
+    their rates.
+
+    Parameters
+    ----------
+    los, los_rate : ndarray, shape (n_sat, n_epoch, 3)
+        Unit line of sight (ECEF) and its time derivative (1/s).
+    lat_rad, lon_rad : ndarray, shape (n_epoch,)
+        Receiver position.
+
+    Returns
+    -------
+    dict with ``elevation``, ``azimuth`` (rad) and ``elevation_rate``, ``azimuth_rate``
+    (rad/s), each (n_sat, n_epoch).
+    """
+    c_ne = ned_to_ecef_matrix(lat_rad, lon_rad)
+    u = np.einsum("eji,sej->sei", c_ne, los)
+    du = np.einsum("eji,sej->sei", c_ne, los_rate)
+    el = np.arcsin(np.clip(-u[..., 2], -1.0, 1.0))
+    horizontal = np.maximum(u[..., 0] ** 2 + u[..., 1] ** 2, 1e-18)
+    return {
+        "elevation": el,
+        "azimuth": np.mod(np.arctan2(u[..., 1], u[..., 0]), 2.0 * np.pi),
+        "elevation_rate": -du[..., 2] / np.maximum(np.cos(el), 1e-9),
+        "azimuth_rate": (u[..., 0] * du[..., 1] - u[..., 1] * du[..., 0]) / horizontal,
+    }
 
 
 def clock_process(n: int, dt_s: float, h0: float, h_minus2: float, bias0_s: float,

@@ -21,7 +21,7 @@ true GPS time since the scenario start; the receiver clock error is in the measu
 
 Public names
 ------------
-GNSS_FIELD, OSCILLATORS, PRESETS, Gnss.
+GNSS_FIELD, PRESETS, Gnss.
 
 References
 ----------
@@ -48,33 +48,24 @@ from simulator.earth import (
 )
 from simulator.environment.sky import canyon_visibility
 from simulator.errors import InputError, Problem
-from simulator.gnss.atmosphere import klobuchar_delay, saastamoinen_zenith, tropo_delay
+from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.constellation import nominal_gps_navigation
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, select_ephemeris
+from simulator.gnss.errors import (
+    OSCILLATORS,
+    draw_error_terms,
+    draw_receiver_clock,
+    pseudorange_sigma,
+)
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
-from simulator.gnss.receiver import (
-    clock_process,
-    cn0_model,
-    dll_sigma_m,
-    fll_sigma_hz,
-    gauss_markov,
-    multipath_sigma_m,
-    signal_geometry,
-)
+from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
 from simulator.scenario.schema import Context, ListOf, Number, Path, Record, Text, Vector
 from simulator.sensors.base import sample_times
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.kinematics import Kinematics
 
-# receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
-# crystal) and the 1-sigma spread of the clock state at switch-on
-OSCILLATORS: dict[str, dict[str, float]] = {
-    "tcxo": {"h0": 2e-19, "h_minus2": 2e-20, "bias_s": 1e-4, "drift_s_s": 5e-7},
-    "ocxo": {"h0": 8e-20, "h_minus2": 4e-23, "bias_s": 1e-4, "drift_s_s": 1e-8},
-    "ideal": {"h0": 0.0, "h_minus2": 0.0, "bias_s": 0.0, "drift_s_s": 0.0},
-}
 _ERROR_KEYS = ("clock", "tracking_noise", "multipath", "iono_residual", "tropo_residual",
                "sis_error", "cn0_noise")
 PRESETS: dict[str, dict] = {
@@ -88,9 +79,6 @@ PRESETS: dict[str, dict] = {
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
-SIS_CORRELATION_TIME_S = 3600.0  # broadcast orbit/clock errors change over an upload cycle
-IONO_CORRELATION_TIME_S = 1800.0  # residual of the Klobuchar model
-IONO_OWN_SHARE = 0.5  # 1-sigma of the per-signal iono residual relative to the common one
 NLOS_CN0_LOSS_DEFAULT_DB = 10.0
 
 
@@ -231,143 +219,83 @@ class Gnss:
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         cfg = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
-        n_ep = len(t)
         dt_s = 1.0 / self.rate_hz
         week0, tow0 = utc_to_gps(truth.utc_start)
-        t_gps = tow0 + t
         nav = self.navigation(truth)
         eph = ephemeris_arrays(nav, week0)
         # an almanac describes the orbits for days (coarsely); an ephemeris for its fit interval
         max_age = 7 * 86400.0 if nav.attrs.get("kind") == "almanac" else 4 * 3600.0
         svs = np.unique(nav["sv"].to_numpy())
-        idx = select_ephemeris(eph, svs[:, None], t_gps[None, :], max_age_s=max_age)
+        idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age)
         self._check_coverage(idx, t, truth, max_age)
+
+        # geometry: antenna, signal flight, look angles (satellites x epochs)
         ant = self.antenna(truth, t)
-        geo = signal_geometry(gather(eph, idx), t_gps, ant["pos"], ant["vel"])
-
-        c_ne = ned_to_ecef_matrix(ant["lat"], ant["lon"])
-        los_ned = np.einsum("eji,sej->sei", c_ne, geo["los"])
-        el = np.arcsin(np.clip(-los_ned[..., 2], -1.0, 1.0))
-        az = np.mod(np.arctan2(los_ned[..., 1], los_ned[..., 0]), 2.0 * np.pi)
-        # rate of the line of sight, for the rates of the broadcast atmosphere models
-        v_rel_ned = np.einsum("eji,sej->sei", c_ne, geo["los_rate"])
-        el_rate = -v_rel_ned[..., 2] / np.maximum(np.cos(el), 1e-9)
-        horiz = np.maximum(los_ned[..., 0] ** 2 + los_ned[..., 1] ** 2, 1e-18)
-        az_rate = (los_ned[..., 0] * v_rel_ned[..., 1] - los_ned[..., 1] * v_rel_ned[..., 0]) \
-            / horiz
-
+        geo = signal_geometry(gather(eph, idx), tow0 + t, ant["pos"], ant["vel"])
+        look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
+        el, az = look["elevation"], look["azimuth"]
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
-        rn, re = radii_of_curvature(ant["lat"])
-        lat_rate = ant["v_ned"][:, 0] / (rn + ant["alt"])
-        lon_rate = ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"]))
-
         new_year = dt.datetime(truth.utc_start.year, 1, 1)
-        day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0
+        day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
+        rn, re = radii_of_curvature(ant["lat"])
+        model = broadcast_delays(
+            ant["lat"], ant["lon"], ant["alt"], az, el, tow0 + t, day_of_year, alpha, beta,
+            rates={"lat": ant["v_ned"][:, 0] / (rn + ant["alt"]),
+                   "lon": ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"])),
+                   "alt": -ant["v_ned"][:, 2], "azimuth": look["azimuth_rate"],
+                   "elevation": look["elevation_rate"]})
 
-        def models(step_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-            lat = ant["lat"] + lat_rate * step_s
-            alt = ant["alt"] - ant["v_ned"][:, 2] * step_s
-            e = np.clip(el + el_rate * step_s, -np.pi / 2, np.pi / 2)
-            iono = klobuchar_delay(lat, ant["lon"] + lon_rate * step_s, az + az_rate * step_s,
-                                   e, t_gps + step_s, alpha, beta)
-            tropo = tropo_delay(lat, alt, e, day_of_year + (t + step_s) / 86400.0)
-            zenith = np.add(*saastamoinen_zenith(lat, alt))
-            return iono, tropo, np.broadcast_to(zenith, tropo.shape)
-
-        iono_b, tropo_b, zenith_b = models(0.0)
-        half = 0.5
-        iono_hi, tropo_hi, zen_hi = models(half)
-        iono_lo, tropo_lo, zen_lo = models(-half)
-
-        have = idx >= 0
-        above_horizon = have & (el > 0)
-        above_mask = have & (el > np.radians(cfg["elevation_mask"]))
+        # what the receiver tracks
         los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
         cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss \
             + cfg["cn0_noise"] * rng.standard_normal(el.shape)
-        tracked = above_mask & (los | nlos) & (cn0 >= cfg["cn0_threshold"])
+        have = idx >= 0
+        tracked = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos) \
+            & (cn0 >= cfg["cn0_threshold"])
 
-        # receiver clock
-        osc = OSCILLATORS[cfg["clock"]]
-        bias0 = osc["bias_s"] * rng.standard_normal()
-        drift0 = osc["drift_s_s"] * rng.standard_normal()
-        bias_s, drift_s_s = clock_process(n_ep, dt_s, osc["h0"], osc["h_minus2"], bias0, drift0,
-                                          rng)
-        self.drawn["clock"] = {"oscillator": cfg["clock"], "bias_s": bias0,
-                               "drift_s_s": drift0}
-
-        # correlated error processes and white tracking noise (satellites x epochs)
-        shape = el.shape
-        sis = cfg["sis_error"] * gauss_markov(rng, shape, SIS_CORRELATION_TIME_S, dt_s)
-        # the broadcast model misses mostly the vertical electron content (common to every line
-        # of sight) and, to half that extent, its spatial structure (independent per signal)
-        iono_common = gauss_markov(rng, (1, n_ep), IONO_CORRELATION_TIME_S, dt_s)
-        iono_own = gauss_markov(rng, shape, IONO_CORRELATION_TIME_S, dt_s)
-        iono_ratio = 1.0 + cfg["iono_residual"] * (iono_common + IONO_OWN_SHARE * iono_own)
-        zenith_error = cfg["tropo_residual"] * rng.standard_normal()
-        self.drawn["tropo_zenith_error_m"] = zenith_error
-        mp_sigma = multipath_sigma_m(el, cfg["multipath"])
-        mp = mp_sigma * gauss_markov(rng, shape, cfg["multipath_correlation_time"], dt_s)
-        code_sigma = cfg["tracking_noise"] * dll_sigma_m(
-            cn0, cfg["dll_bandwidth"], cfg["correlator_spacing"], cfg["integration_time"])
-        code_noise = code_sigma * rng.standard_normal(shape)
-        rate_sigma = cfg["tracking_noise"] * LAMBDA_L1_M * fll_sigma_hz(
-            cn0, cfg["fll_bandwidth"], cfg["integration_time"])
-        rate_noise = rate_sigma * rng.standard_normal(shape)
-
-        iono_true = iono_b * iono_ratio
-        tropo_true = tropo_b * (1.0 + zenith_error / zenith_b)
-        iono_true_rate = iono_ratio * (iono_hi - iono_lo) / (2 * half)
-        tropo_true_rate = ((tropo_hi * (1.0 + zenith_error / zen_hi))
-                           - (tropo_lo * (1.0 + zenith_error / zen_lo))) / (2 * half)
+        # errors and measurements
+        bias_s, drift_s_s, self.drawn["clock"] = draw_receiver_clock(rng, cfg["clock"], len(t),
+                                                                      dt_s)
+        err = draw_error_terms(rng, cfg, el, cn0, dt_s)
+        self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
+        mapping = model["tropo"] / model["zenith"]
+        iono_true = model["iono"] * err["iono_ratio"]
+        tropo_true = model["tropo"] + err["tropo_zenith"] * mapping
+        iono_true_rate = model["iono_rate"] * err["iono_ratio"]
+        tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
         nlos_delay = np.where(nlos & ~los, extra, 0.0)
         sat_clock = C_M_S * geo["clock_s"]
         sat_drift = C_M_S * geo["clock_drift_s_s"]
         rx_clock = C_M_S * bias_s[None, :]
         rx_drift = C_M_S * drift_s_s[None, :]
-
-        pseudorange = (geo["range"] + rx_clock - sat_clock + iono_true + tropo_true + sis + mp
-                       + nlos_delay + code_noise)
+        pseudorange = (geo["range"] + rx_clock - sat_clock + iono_true + tropo_true
+                       + err["sis"] + err["multipath"] + nlos_delay + err["code_noise"])
         rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
-                + tropo_true_rate - iono_true_rate + rate_noise)
-        pr_std = np.sqrt(code_sigma**2 + mp_sigma**2
-                         + (1.0 + IONO_OWN_SHARE**2) * (cfg["iono_residual"] * iono_b) ** 2
-                         + (cfg["tropo_residual"] * tropo_b / zenith_b) ** 2
-                         + cfg["sis_error"] ** 2)
-        pr_std = np.maximum(pr_std, 0.1)  # floor of the reported uncertainty
-        rate_std = np.maximum(rate_sigma, 0.01)
+                + tropo_true_rate - iono_true_rate + err["rate_noise"])
+        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping)
 
-        def table(mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
-            m = mask.T  # epochs first, satellites in PRN order within an epoch
-            out = {"t": np.broadcast_to(t[:, None], m.shape)[m],
-                   "sv": np.broadcast_to(svs[None, :], m.shape)[m]}
-            for key, value in columns.items():
-                arr = np.broadcast_to(value, mask.shape + value.shape[2:]) \
-                    if value.ndim >= 2 else value
-                out[key] = np.swapaxes(arr, 0, 1)[m]
-            return pd.DataFrame(out)
-
+        table = _RowTable(t, svs)
         raw = table(tracked, {
             "pseudorange": pseudorange, "pseudorange_rate": rate,
             "doppler": -rate / LAMBDA_L1_M, "cn0": cn0,
             "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
             "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
             "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
-            "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": iono_b,
-            "tropo": tropo_b, "elevation": el, "azimuth": az,
+            "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": model["iono"],
+            "tropo": model["tropo"], "elevation": el, "azimuth": az,
             "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
         })[list(col.GNSS_RAW)]
-        truth_table = table(above_horizon, {
+        truth_table = table(have & (el > 0), {
             "tracked": tracked.astype(np.int8), "los": los.astype(np.int8),
             "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
             "range": geo["range"], "range_rate": geo["range_rate"],
             "receiver_clock": rx_clock, "receiver_clock_drift": rx_drift,
             "iono_true": iono_true, "tropo_true": tropo_true,
             "iono_true_rate": iono_true_rate, "tropo_true_rate": tropo_true_rate,
-            "sis_error": sis, "multipath": mp, "nlos_delay": nlos_delay,
-            "code_noise": code_noise, "rate_noise": rate_noise,
+            "sis_error": err["sis"], "multipath": err["multipath"], "nlos_delay": nlos_delay,
+            "code_noise": err["code_noise"], "rate_noise": err["rate_noise"],
             "antenna_x": ant["pos"][None, :, 0], "antenna_y": ant["pos"][None, :, 1],
             "antenna_z": ant["pos"][None, :, 2],
         })[list(col.TRUTH_GNSS)]
@@ -379,3 +307,19 @@ class Gnss:
         if "fix" in cfg["outputs"]:
             out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"])
         return out
+
+
+class _RowTable:
+    """Flattens (satellite, epoch) arrays into stream rows: epochs first, satellites in PRN
+    order within an epoch, only where a mask is set."""
+
+    def __init__(self, t: np.ndarray, svs: np.ndarray):
+        self.t, self.svs = t, svs
+
+    def __call__(self, mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
+        m = mask.T
+        out = {"t": np.broadcast_to(self.t[:, None], m.shape)[m],
+               "sv": np.broadcast_to(self.svs[None, :], m.shape)[m]}
+        for key, value in columns.items():
+            out[key] = np.swapaxes(np.broadcast_to(value, mask.shape), 0, 1)[m]
+        return pd.DataFrame(out)
