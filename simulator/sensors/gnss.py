@@ -51,7 +51,7 @@ from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.constellation import nominal_gps_navigation
-from simulator.gnss.ephemeris import ephemeris_arrays, gather, select_ephemeris
+from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
 from simulator.gnss.errors import (
     OSCILLATORS,
     draw_error_terms,
@@ -229,23 +229,15 @@ class Gnss:
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age)
         self._check_coverage(idx, t, truth, max_age)
 
-        # geometry: antenna, signal flight, look angles (satellites x epochs)
+        # geometry: antenna, signal flight, look angles, broadcast delays (satellites x epochs)
         ant = self.antenna(truth, t)
-        geo = signal_geometry(gather(eph, idx), tow0 + t, ant["pos"], ant["vel"])
-        look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
-        el, az = look["elevation"], look["azimuth"]
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
         new_year = dt.datetime(truth.utc_start.year, 1, 1)
         day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
-        rn, re = radii_of_curvature(ant["lat"])
-        model = broadcast_delays(
-            ant["lat"], ant["lon"], ant["alt"], az, el, tow0 + t, day_of_year, alpha, beta,
-            rates={"lat": ant["v_ned"][:, 0] / (rn + ant["alt"]),
-                   "lon": ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"])),
-                   "alt": -ant["v_ned"][:, 2], "azimuth": look["azimuth_rate"],
-                   "elevation": look["elevation_rate"]})
+        geo = model = _signals_in_chunks(eph, idx, tow0 + t, ant, day_of_year, alpha, beta)
+        el, az = geo["elevation"], geo["azimuth"]
 
         # what the receiver tracks
         los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
@@ -307,6 +299,71 @@ class Gnss:
         if "fix" in cfg["outputs"]:
             out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"])
         return out
+
+
+CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives
+COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
+BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
+# what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
+_KEPT = ("pos", "vel", "clock_s", "clock_drift_s_s", "range", "range_rate", "tau_rate",
+         "elevation", "azimuth", "iono", "tropo", "zenith", "iono_rate", "tropo_rate")
+
+
+def _signals(eph: dict[str, np.ndarray], t_gps: np.ndarray, ant: dict[str, np.ndarray],
+             day_of_year: np.ndarray, alpha: list[float], beta: list[float]
+             ) -> dict[str, np.ndarray]:
+    """Signal geometry, look angles and broadcast delays (with rates) of gathered ephemerides
+    (n_sat, n_epoch) received by the antenna ``ant`` (arrays over the same n_epoch)."""
+    geo = signal_geometry(eph, t_gps, ant["pos"], ant["vel"])
+    look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
+    rn, re = radii_of_curvature(ant["lat"])
+    model = broadcast_delays(
+        ant["lat"], ant["lon"], ant["alt"], look["azimuth"], look["elevation"], t_gps,
+        day_of_year, alpha, beta,
+        rates={"lat": ant["v_ned"][:, 0] / (rn + ant["alt"]),
+               "lon": ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"])),
+               "alt": -ant["v_ned"][:, 2], "azimuth": look["azimuth_rate"],
+               "elevation": look["elevation_rate"]})
+    return {**geo, **look, **model}
+
+
+def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
+                         ant: dict[str, np.ndarray]) -> np.ndarray:
+    """Satellites (rows of idx) that may rise above the horizon during these epochs: their
+    elevation, sampled every ``COARSE_STEP_S`` without the light-time correction, exceeds
+    ``BELOW_HORIZON_MARGIN_RAD`` somewhere."""
+    n = len(t_gps)
+    step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
+    cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
+    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
+    lat, lon = ant["lat"][cols], ant["lon"][cols]
+    up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+    rel = pos - ant["pos"][None, cols]
+    sin_el = np.einsum("sek,ek->se", rel, up) / np.linalg.norm(rel, axis=-1)
+    return np.flatnonzero((sin_el > np.sin(BELOW_HORIZON_MARGIN_RAD)).any(axis=1)
+                          & (idx >= 0).any(axis=1))
+
+
+def _signals_in_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
+                       ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
+                       beta: list[float]) -> dict[str, np.ndarray]:
+    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time and only
+    for the satellites that may be above the horizon in each chunk; the others keep elevation
+    -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
+    n_sat, n_ep = idx.shape
+    first = {k: v[:1] for k, v in ant.items()}
+    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
+    fill = {"elevation": -np.pi / 2, "zenith": 1.0}
+    out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
+    for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
+        cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
+        ant_c = {k: v[cols] for k, v in ant.items()}
+        rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
+        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
+                        alpha, beta)
+        for key in _KEPT:
+            out[key][rows, cols] = part[key]
+    return out
 
 
 class _RowTable:
