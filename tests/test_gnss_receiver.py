@@ -4,6 +4,7 @@ consistency, the error budget, and the environment (tunnel, canyon)."""
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 from gnss_helpers import drive, receiver
 
@@ -245,3 +246,27 @@ def test_smoothed_fixes_are_quieter_and_follow_the_motion():
            - geodetic_to_ecef(k["lat"], k["lon"], k["alt"])) @ c
     # velocity aiding leaves no lag; what remains is the trapezoidal step's error at 1 Hz
     assert np.abs(err).max() < 0.3
+
+
+def test_chunked_evaluation_with_horizon_screen_changes_nothing(monkeypatch):
+    """Evaluating the signals in chunks of epochs, only for the satellites the coarse screen
+    lets through, gives the same streams as evaluating every satellite at once."""
+    import simulator.sensors.gnss as gnss_module
+
+    truth = drive([{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
+                   {"straight": {"length": 3000}}], rate_hz=1.0)
+    chunked = receiver().generate(truth, np.random.default_rng(11))
+    monkeypatch.setattr(gnss_module, "CHUNK_EPOCHS", 10**9)
+    monkeypatch.setattr(gnss_module, "BELOW_HORIZON_MARGIN_RAD", -np.pi)
+    whole = receiver().generate(truth, np.random.default_rng(11))
+    for name in ("gnss_raw", "gnss_fix", "truth_gnss"):
+        pd.testing.assert_frame_equal(chunked[name], whole[name], rtol=1e-12)
+    assert len(chunked["gnss_raw"]) > 1000
+
+
+@pytest.fixture(autouse=True)
+def _small_chunks(monkeypatch):
+    """Every test here runs with short chunks, so chunk boundaries are crossed."""
+    import simulator.sensors.gnss as gnss_module
+
+    monkeypatch.setattr(gnss_module, "CHUNK_EPOCHS", 97)
