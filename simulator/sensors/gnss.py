@@ -8,16 +8,17 @@ Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``
 (body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
 DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative 1-sigma of the
 ionosphere the broadcast model misses (common to all signals, plus an independent part per
-signal of half that size), ``tropo_residual``
-zenith 1-sigma, ``sis_error`` 1-sigma signal-in-space range error, ``cn0_noise``), the tracking
-loop and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
+signal of half that size), ``tropo_residual`` zenith 1-sigma, ``sis_error`` 1-sigma
+signal-in-space range error, ``cn0_noise``; see ``simulator.gnss.errors``), the tracking-loop
+and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
 single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
 mass-market single-frequency receiver with a TCXO.
 
-Streams: ``gnss_raw`` (one row per tracked signal), ``gnss_fix`` (one row per epoch, fix = 0 and
-NaN position when fewer than 4 signals), ``gnss_nav`` (the broadcast elements used) and
-``truth_gnss`` (the true error terms of every signal above the horizon). Epoch times ``t`` are
-true GPS time since the scenario start; the receiver clock error is in the measurements.
+Streams: ``gnss_raw`` (one row per tracked signal), ``gnss_fix`` (one row per epoch: 3D fix
+from four signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
+elements used) and ``truth_gnss`` (the true error terms of every signal above the horizon).
+Epoch times ``t`` are true GPS time since the scenario start; the receiver clock error is in
+the measurements.
 
 Public names
 ------------
