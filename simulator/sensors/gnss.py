@@ -47,6 +47,7 @@ from simulator.earth import (
     ned_to_ecef_matrix,
     radii_of_curvature,
 )
+from simulator.environment import ZONE_FIELD
 from simulator.environment.sky import canyon_visibility
 from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import broadcast_delays
@@ -80,7 +81,8 @@ PRESETS: dict[str, dict] = {
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
-NLOS_CN0_LOSS_DEFAULT_DB = 10.0
+# a zone the environment block does not describe, or describes in part: the schema's defaults
+_ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
 
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
@@ -188,19 +190,17 @@ class Gnss:
         loss = np.zeros(el.shape)
         zones = (truth.environment or {}).get("zones", {}) or {}
         names = truth.zone_at(t)
-        for name in set(names) - {""}:
-            zone = zones.get(name, {}) or {}
-            sky = zone.get("sky", "open")
+        for name in sorted(set(names) - {""}):  # one pass per zone
+            zone = {**_ZONE_DEFAULTS, **(zones.get(name) or {})}
             here = names == name
-            if sky == "none":
+            if zone["sky"] == "none":
                 los[:, here] = False
-            elif sky == "canyon":
+            elif zone["sky"] == "canyon":
                 z_los, z_nlos, z_extra = canyon_visibility(
-                    az[:, here], el[:, here], yaw[None, here], zone.get("building_height", 30.0),
-                    zone.get("street_width", 20.0))
+                    az[:, here], el[:, here], yaw[None, here], zone["building_height"],
+                    zone["street_width"])
                 los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
-                loss[:, here] = np.where(
-                    z_nlos, zone.get("nlos_attenuation", NLOS_CN0_LOSS_DEFAULT_DB), 0.0)
+                loss[:, here] = np.where(z_nlos, zone["nlos_attenuation"], 0.0)
         return los, nlos, extra, loss
 
     def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
