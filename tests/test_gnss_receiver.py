@@ -8,6 +8,7 @@ import pandas as pd
 import pytest
 from gnss_helpers import drive, receiver
 
+from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import saastamoinen_zenith
 from simulator.gnss.constants import LAMBDA_L1_M
@@ -270,3 +271,13 @@ def _small_chunks(monkeypatch):
     import simulator.sensors.gnss as gnss_module
 
     monkeypatch.setattr(gnss_module, "CHUNK_EPOCHS", 97)
+
+
+def test_a_drive_entirely_without_sky_gives_empty_raw_and_no_fix():
+    truth = drive([{"stop": {"duration": 20, "zone": "garage"}},
+                   {"stop": {"duration": 1, "zone": "garage"}}],
+                  zones={"garage": {"sky": "none"}}, rate_hz=1.0)
+    out = receiver().generate(truth, np.random.default_rng(12))
+    assert len(out["gnss_raw"]) == 0 and list(out["gnss_raw"].columns) == list(col.GNSS_RAW)
+    assert (out["gnss_fix"]["fix"] == 0).all() and out["gnss_fix"]["lat"].isna().all()
+    assert len(out["truth_gnss"]) > 0 and (out["truth_gnss"]["tracked"] == 0).all()
