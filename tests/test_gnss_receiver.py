@@ -274,10 +274,15 @@ def _small_chunks(monkeypatch):
 
 
 def test_a_drive_entirely_without_sky_gives_empty_raw_and_no_fix():
-    truth = drive([{"stop": {"duration": 20, "zone": "garage"}},
-                   {"stop": {"duration": 1, "zone": "garage"}}],
+    truth = drive([{"stop": {"duration": 20, "zone": "garage"}}],
                   zones={"garage": {"sky": "none"}}, rate_hz=1.0)
     out = receiver().generate(truth, np.random.default_rng(12))
-    assert len(out["gnss_raw"]) == 0 and list(out["gnss_raw"].columns) == list(col.GNSS_RAW)
-    assert (out["gnss_fix"]["fix"] == 0).all() and out["gnss_fix"]["lat"].isna().all()
-    assert len(out["truth_gnss"]) > 0 and (out["truth_gnss"]["tracked"] == 0).all()
+    raw, fix = out["gnss_raw"], out["gnss_fix"]
+    # zones cover [start, end): only the epoch at the very end of the drive is outside
+    inside = fix["t"] < truth.duration_s
+    assert (raw["t"] == truth.duration_s).all() and list(raw.columns) == list(col.GNSS_RAW)
+    assert (fix.loc[inside, "fix"] == 0).all() and fix.loc[inside, "lat"].isna().all()
+    assert len(out["truth_gnss"]) > 0
+    assert (out["truth_gnss"].query(f"t < {truth.duration_s}")["tracked"] == 0).all()
+    empty = receiver_fixes(fix["t"].to_numpy(), raw.iloc[0:0])
+    assert (empty["fix"] == 0).all() and empty["lat"].isna().all()
