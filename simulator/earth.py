@@ -11,9 +11,9 @@ and longitude are in radians inside this module unless a name ends in ``_deg``.
 Public functions
 ----------------
 radii_of_curvature, normal_gravity, gravity_ned, earth_rate_ned, transport_rate_ned,
-geodetic_to_ecef, ecef_to_geodetic, ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef_vector,
-euler_to_dcm, ned_to_body, ned_to_body_trig, dcm_to_euler, euler_to_quat, quat_to_dcm,
-quat_to_euler, quat_multiply, rotvec_to_quat, wrap_angle, skew.
+geodetic_to_ecef, ecef_to_geodetic, ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef,
+ned_to_ecef_vector, euler_to_dcm, ned_to_body, ned_to_body_trig, dcm_to_euler, euler_to_quat,
+quat_to_dcm, quat_to_euler, quat_multiply, rotvec_to_quat, wrap_angle, skew.
 
 References
 ----------
@@ -138,6 +138,14 @@ def ecef_to_ned(
     ref = geodetic_to_ecef(lat0_rad, lon0_rad, alt0_m)
     c_ne = ned_to_ecef_matrix(lat0_rad, lon0_rad)
     return (np.asarray(xyz_m) - ref) @ c_ne
+
+
+def ned_to_ecef(ned_m: np.ndarray, lat0_rad: float, lon0_rad: float, alt0_m: float) -> np.ndarray:
+    """Local NED coordinates about a reference point (n, 3), m, to ECEF points (n, 3), m
+    (the inverse of ``ecef_to_ned``)."""
+    ref = geodetic_to_ecef(lat0_rad, lon0_rad, alt0_m)
+    c_ne = ned_to_ecef_matrix(lat0_rad, lon0_rad)
+    return ref + np.asarray(ned_m) @ c_ne.T
 
 
 def ned_to_ecef_vector(v_ned: np.ndarray, lat_rad: np.ndarray, lon_rad: np.ndarray) -> np.ndarray:

@@ -1,7 +1,7 @@
 """Receiver error processes against their defining statistics: the two-state clock against the
 Allan variance of its h-parameters (computed by allantools, an independent implementation), the
-Gauss-Markov generator against its variance and autocorrelation, the tracking-noise formulas
-against their limiting forms, and the canyon geometry against hand-solvable cases."""
+tracking-noise formulas against their limiting forms, and the canyon geometry against
+hand-solvable cases."""
 
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ import pytest
 
 from simulator.environment.sky import canyon_visibility
 from simulator.gnss.constants import CHIP_L1CA_M
-from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, gauss_markov
+from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz
 
 
 @pytest.mark.parametrize("h0, h_minus2", [(2e-19, 2e-20), (8e-20, 4e-23)])
@@ -25,15 +25,6 @@ def test_clock_allan_variance_matches_h_parameters(h0, h_minus2):
     got_taus, adev, _, _ = allantools.oadev(bias, rate=1.0, data_type="phase", taus=taus)
     expected = np.sqrt(h0 / (2 * got_taus) + 2 * np.pi**2 / 3 * h_minus2 * got_taus)
     np.testing.assert_allclose(adev, expected, rtol=0.1)
-
-
-def test_gauss_markov_variance_and_correlation():
-    x = gauss_markov(np.random.default_rng(12), (400, 2000), tau_s=10.0, dt_s=1.0)
-    assert abs(x.var() - 1.0) < 0.03
-    assert abs(x[:, 0].var() - 1.0) < 0.2  # stationary from the first sample
-    lag = 10
-    rho = np.mean(x[:, :-lag] * x[:, lag:])
-    assert abs(rho - np.exp(-1.0)) < 0.03
 
 
 def test_tracking_noise_limits():

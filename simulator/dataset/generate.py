@@ -36,7 +36,8 @@ def build_truth(scenario: dict) -> Kinematics:
         profile = PROFILE_BUILDERS[traj["kind"]](scenario, None)
     except ValueError as exc:
         raise InputError(str(exc)) from None
-    truth = kinematics_from_profile(profile, scenario["start"], traj["rate"],
+    start = {**scenario["start"], **(profile.start or {})}
+    truth = kinematics_from_profile(profile, start, traj["rate"],
                                     scenario["limits"]["roll_gradient"])
     truth.utc_start = parse_utc(scenario["start"]["utc"])
     truth.gps_week, truth.gps_tow = utc_to_gps(truth.utc_start)
@@ -108,8 +109,8 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
         "software": _versions(),
         "gps_time_start": {"week": truth.gps_week, "tow": truth.gps_tow},
         "utc_start": data["start"]["utc"],
-        "origin": {"lat": data["start"]["lat"], "lon": data["start"]["lon"],
-                   "alt": data["start"]["alt"]},
+        "origin": {"lat": truth.origin.lat_deg, "lon": truth.origin.lon_deg,
+                   "alt": truth.origin.alt_m},
         "duration": truth.duration_s,
         "sensors": generated.drawn,
     }

@@ -2,8 +2,9 @@
 signal-in-space error, ionosphere and troposphere residuals, multipath, code and carrier
 tracking noise) for satellites x epochs, and the 1-sigma the receiver reports for weighting.
 
-The processes themselves (Gauss-Markov, two-state clock, DLL/FLL jitter, multipath shape) are in
-``simulator.gnss.receiver``; this module sets how large each is and how they are shared.
+The processes themselves are in ``simulator.sensors.noise`` (Gauss-Markov) and
+``simulator.gnss.receiver`` (two-state clock, DLL/FLL jitter, multipath shape); this module sets
+how large each is and how they are shared.
 
 Public names
 ------------
@@ -23,13 +24,8 @@ from __future__ import annotations
 import numpy as np
 
 from simulator.gnss.constants import LAMBDA_L1_M
-from simulator.gnss.receiver import (
-    clock_process,
-    dll_sigma_m,
-    fll_sigma_hz,
-    gauss_markov,
-    multipath_sigma_m,
-)
+from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
+from simulator.sensors.noise import gauss_markov
 
 # receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
 # crystal) and the 1-sigma spread of the clock state at switch-on
@@ -77,16 +73,19 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
     ``rate_sigma`` (m/s).
     """
     shape = elevation_rad.shape
-    n_ep = shape[1]
+    n_sat, n_ep = shape
     scale = cfg["tracking_noise"]
-    out = {"sis": cfg["sis_error"] * gauss_markov(rng, shape, SIS_CORRELATION_TIME_S, dt_s)}
-    common = gauss_markov(rng, (1, n_ep), IONO_CORRELATION_TIME_S, dt_s)
-    own = gauss_markov(rng, shape, IONO_CORRELATION_TIME_S, dt_s)
+
+    def unit_gm(rows: int, tau_s: float) -> np.ndarray:  # (rows, n_ep), unit variance
+        return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
+
+    out = {"sis": cfg["sis_error"] * unit_gm(n_sat, SIS_CORRELATION_TIME_S)}
+    common = unit_gm(1, IONO_CORRELATION_TIME_S)
+    own = unit_gm(n_sat, IONO_CORRELATION_TIME_S)
     out["iono_ratio"] = 1.0 + cfg["iono_residual"] * (common + IONO_OWN_SHARE * own)
     out["tropo_zenith"] = cfg["tropo_residual"] * rng.standard_normal()
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
-    out["multipath"] = out["multipath_sigma"] * gauss_markov(
-        rng, shape, cfg["multipath_correlation_time"], dt_s)
+    out["multipath"] = out["multipath_sigma"] * unit_gm(n_sat, cfg["multipath_correlation_time"])
     out["code_sigma"] = scale * dll_sigma_m(cn0_dbhz, cfg["dll_bandwidth"],
                                             cfg["correlator_spacing"], cfg["integration_time"])
     out["code_noise"] = out["code_sigma"] * rng.standard_normal(shape)

@@ -23,12 +23,12 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
-from scipy.signal import lfilter
 
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
+from simulator.sensors.noise import ar1_filter
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
 
@@ -209,7 +209,7 @@ def smooth_positions(pos_m: np.ndarray, vel_m_s: np.ndarray, dt_s: float,
         # p_k - (1 - alpha) p_{k-1} = alpha z_k + (1 - alpha) step_k, started at the first fix
         drive = alpha * z + (1.0 - alpha) * step
         drive[0] = z[0]
-        out[start:stop] = lfilter([1.0], [1.0, alpha - 1.0], drive, axis=0)
+        out[start:stop] = ar1_filter(drive, 1.0 - alpha)
     return out
 
 

@@ -3,13 +3,13 @@ the Earth-rotation (Sagnac) correction, their exact rates, the receiver clock, C
 frequency tracking noise, and the correlated error processes (multipath, atmospheric residuals,
 signal-in-space error).
 
-Every function works on whole arrays (satellites x epochs); the correlated processes are
-first-order recursions run along the epoch axis by ``scipy.signal.lfilter``.
+Every function works on whole arrays (satellites x epochs). The correlated (Gauss-Markov)
+processes come from ``simulator.sensors.noise``, the one home of sensor noise processes.
 
 Public functions
 ----------------
 rotate_to_reception_frame, light_time_factor, signal_geometry, look_angles, clock_process,
-gauss_markov, cn0_model, dll_sigma_m, fll_sigma_hz, multipath_sigma_m.
+cn0_model, dll_sigma_m, fll_sigma_hz, multipath_sigma_m.
 
 References
 ----------
@@ -26,7 +26,6 @@ RTCA DO-229D, section J.2.4 (elevation dependence of multipath: 0.13 + 0.53 exp(
 from __future__ import annotations
 
 import numpy as np
-from scipy.signal import lfilter
 
 from simulator.earth import ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S, CHIP_L1CA_M, OMEGA_E_DOT_RAD_S
@@ -154,22 +153,6 @@ def clock_process(n: int, dt_s: float, h0: float, h_minus2: float, bias0_s: floa
     drift = drift0_s_s + np.concatenate([[0.0], np.cumsum(w[:, 1])])
     bias = bias0_s + np.concatenate([[0.0], np.cumsum(drift[:-1] * dt_s + w[:, 0])])
     return bias, drift
-
-
-def gauss_markov(rng: np.random.Generator, shape: tuple[int, int], tau_s: float,
-                 dt_s: float) -> np.ndarray:
-    """Unit-variance stationary first-order Gauss-Markov processes along the last axis:
-    x_k = a x_{k-1} + sqrt(1 - a^2) w_k, a = exp(-dt / tau), started in the stationary law."""
-    white = rng.standard_normal(shape)
-    if tau_s <= 0:
-        return white
-    a = np.exp(-dt_s / tau_s)
-    gain = np.sqrt(1.0 - a**2)
-    zi = white[..., :1]  # x_0 = w_0: the stationary start
-    scaled = gain * white
-    scaled[..., 0] = 0.0
-    out, _ = lfilter([1.0], [1.0, -a], scaled, axis=-1, zi=zi)
-    return out
 
 
 CN0_ELEVATION_SCALE_DEG = 17.0  # e-folding elevation of the C/N0 loss towards the horizon

@@ -81,6 +81,9 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     if used is not None:
         for name in sorted(set(zones) - used):
             ctx.error(path + ("environment", "zones", name), "no segment has this zone")
+    elif profile is not None:  # zones from a network or a log: the drive may miss a declared one
+        used = {name for _, _, name in profile.zones}
+    if used is not None:
         for name in sorted(used - set(zones)):
             sky = "none" if name in COVERED_ZONE_NAMES else "open"
             zones[name] = ZONE_FIELD.check({"sky": sky}, path + ("environment", "zones", name),

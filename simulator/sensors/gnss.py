@@ -124,7 +124,7 @@ GNSS_FIELD = Record(
         "tracking_noise": Number("", None, min=0,
                                  doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
         "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
-        "multipath_correlation_time": Number("s", 5.0, min=0),
+        "multipath_correlation_time": Number("s", 5.0, gt=0),
         "iono_residual": Number("", None, min=0,
                                 doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
         "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),

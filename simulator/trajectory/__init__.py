@@ -12,13 +12,17 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from simulator.scenario.schema import Context, ListOf, Number, Record
+from simulator.trajectory.recorded import RECORDED_FIELD, build_recorded_profile
 from simulator.trajectory.segments import SEGMENT_FIELD, RoadProfile, build_road_profile
+from simulator.trajectory.sumo import SUMO_FIELD, build_sumo_profile
 
 _RATE = Number("Hz", None, gt=0, max=10000,
                doc="base rate of the truth table (default: the IMU rate, or 100 Hz)")
 
 TRAJECTORY_KINDS: dict[str, Record] = {
     "segments": Record({"segments": ListOf(SEGMENT_FIELD, min_len=1), "rate": _RATE}),
+    "sumo": SUMO_FIELD,
+    "recorded": RECORDED_FIELD,
 }
 
 
@@ -28,4 +32,6 @@ def _segments_profile(scenario: dict, ctx: Context | None) -> RoadProfile | None
 
 PROFILE_BUILDERS: dict[str, Callable[[dict, Context | None], RoadProfile | None]] = {
     "segments": _segments_profile,
+    "sumo": build_sumo_profile,
+    "recorded": build_recorded_profile,
 }

@@ -119,6 +119,9 @@ class RoadProfile:
     bank: PiecewisePolynomial  # road bank angle (s), rad
     duration_s: float
     zones: list[tuple[float, float, str]] = field(default_factory=list)
+    # where the drive starts, for sources that fix it (a SUMO network, a recorded drive):
+    # {lat, lon (deg), alt (m), heading (deg)}, replacing the scenario's start; None: use it
+    start: dict | None = None
 
 
 _ZERO = np.zeros(1)
