@@ -63,13 +63,12 @@ from simulator.gnss.errors import (
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
 from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
-from simulator.scenario.schema import Context, ListOf, Number, Path, Record, Text, Vector
+from simulator.scenario.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
 from simulator.sensors.base import sample_times
+from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.kinematics import Kinematics
 
-_ERROR_KEYS = ("clock", "tracking_noise", "multipath", "iono_residual", "tropo_residual",
-               "sis_error", "cn0_noise")
 PRESETS: dict[str, dict] = {
     "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
                    "iono_residual": 0.2, "tropo_residual": 0.05, "sis_error": 0.5,
@@ -85,13 +84,26 @@ DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
 _ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
 
 
+# the error levels a preset sets (a key the scenario gives overrides the preset's value)
+_ERROR_FIELDS = {
+    "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
+    "tracking_noise": Number("", None, min=0,
+                             doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
+    "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
+    "iono_residual": Number("", None, min=0,
+                            doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
+    "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
+    "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
+    "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
+}
+
+
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
-    if value["preset"] not in PRESETS:
-        return ctx.error(path + ("preset",), f"unknown GNSS preset {value['preset']!r}; known: "
-                                             f"{', '.join(sorted(PRESETS))}")
-    for key in _ERROR_KEYS:
-        if value[key] is None:
-            value[key] = PRESETS[value["preset"]][key]
+    if not known_preset(value["preset"], PRESETS, "GNSS", path, ctx):
+        return INVALID
+    value = fill_from_preset(value, PRESETS[value["preset"]], _ERROR_FIELDS, path, ctx, {})
+    if value is INVALID:
+        return INVALID
     if value["clock"] not in OSCILLATORS:
         return ctx.error(path + ("clock",), f"unknown oscillator {value['clock']!r}; known: "
                                             f"{', '.join(sorted(OSCILLATORS))}")
@@ -119,17 +131,9 @@ GNSS_FIELD = Record(
         "constellation": Text("nominal-gps",
                               doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
         "elevation_mask": Number(angle=True, default=10.0, min=0, max=90),
-        "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
         "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
-        "tracking_noise": Number("", None, min=0,
-                                 doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
-        "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
+        **_ERROR_FIELDS,
         "multipath_correlation_time": Number("s", 5.0, gt=0),
-        "iono_residual": Number("", None, min=0,
-                                doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
-        "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
-        "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
-        "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
         "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
         "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
         "cn0_threshold": Number("", 25.0, doc="tracking threshold, dB-Hz"),
