@@ -299,8 +299,9 @@ class Gnss:
         used = np.unique(idx[idx >= 0])
         out = {"gnss_nav": nav.iloc[used].reset_index(drop=True)[list(col.GNSS_NAV)],
                "truth_gnss": truth_table}
-        if "raw" in cfg["outputs"]:
-            out["gnss_raw"] = raw
+        # the raw stream always comes out here: faults act on the measurements and the fixes
+        # are recomputed from them; the generator drops it if the scenario did not ask for it
+        out["gnss_raw"] = raw
         if "fix" in cfg["outputs"]:
             out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"])
         return out
