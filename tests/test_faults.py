@@ -228,8 +228,9 @@ GNSS = {"imu": {"preset": "ideal", "rate": 100},
         "gnss": {"preset": "automotive", "rate": 1, "outputs": ["fix", "raw"]}}
 
 
-def _gnss_streams(faults):
-    data = scenario_data(DRIVE, sensors=GNSS, faults=faults)
+def _gnss_streams(faults, **gnss):
+    sensors = {**GNSS, "gnss": {**GNSS["gnss"], **gnss}}
+    data = scenario_data(DRIVE, sensors=sensors, faults=faults)
     return generate_streams(data, show_progress=False).streams
 
 
@@ -257,6 +258,12 @@ def test_satellite_limit_keeps_the_highest(clean_gnss):
     assert set(raw[raw.t == 110.0].sv) == set(epoch.sv)
     fix = faulted["gnss_fix"]
     assert set(fix.fix[_inside(fix.t, 100, 130)]) == {1}  # 2-D fixes with held height
+    # the receiver's DOP mask (20): three high satellites with a poor geometry give no fix
+    masked = _gnss_streams([{"kind": "gnss_satellite_limit", "start": 100, "duration": 30,
+                             "count": 3}], dop_mask=1.0)["gnss_fix"]
+    inside = _inside(masked.t, 100, 130)
+    assert (masked.fix[inside] == 0).all() and masked.lat[inside].isna().all()
+    assert (fix.hdop[fix.fix > 0] <= 20.0).all()
     assert (faulted["truth_gnss"].tracked[_inside(faulted["truth_gnss"].t, 100, 130)] == 0).any()
     outages = faulted["events"][faulted["events"].kind == "gnss_outage"]
     assert not _inside(outages.t_start, 100, 130).any()  # measurements remain: no outage

@@ -107,8 +107,9 @@ def _refix(streams, intervals, context) -> None:
     # solved from the start, so the receiver's history (the height a 2-D fix holds, the
     # smoothing state) is that of the real receiver; only the intervals' rows are written
     upto = t <= t[mask].max()
-    smoothing = (context.sensors.get("gnss") or {}).get("smoothing", 0.0)
-    new = receiver_fixes(t[upto], raw.loc[raw["t"].to_numpy() <= t[mask].max()], smoothing)
+    gnss = context.sensors.get("gnss") or {}
+    new = receiver_fixes(t[upto], raw.loc[raw["t"].to_numpy() <= t[mask].max()],
+                         gnss.get("smoothing", 0.0), gnss.get("dop_mask", np.inf))
     fix.loc[mask, list(new.columns)] = new.to_numpy()[mask[upto]]
 
 

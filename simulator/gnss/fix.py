@@ -213,8 +213,8 @@ def smooth_positions(pos_m: np.ndarray, vel_m_s: np.ndarray, dt_s: float,
     return out
 
 
-def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: float = 0.0
-                   ) -> pd.DataFrame:
+def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: float = 0.0,
+                   dop_mask: float = np.inf) -> pd.DataFrame:
     """The fix stream (``simulator.columns.GNSS_FIX``) at epochs t from the raw measurements.
 
     Parameters
@@ -225,6 +225,9 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
         Rows of ``gnss_raw`` (with ``pseudorange_std`` and ``pseudorange_rate_std``).
     smoothing_time_constant_s : float
         0 for raw single-epoch fixes, else the time constant of ``smooth_positions``.
+    dop_mask : float
+        Largest HDOP a fix is given with, as receivers' DOP masks do (a receiver with three
+        satellites near the zenith reports no fix rather than one hundreds of metres off).
     """
     n = len(t)
     raw = raw.sort_values(["t", "sv"], kind="stable")
@@ -252,6 +255,7 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     vel, drift = solve_velocity(rate_p, pos_p, vel_p, pos, w_rate_p, mask, held)
     hdop, vdop = dilution_of_precision(pos_p, pos, mask, held)
     fix_type = np.where(ok, 2, np.where(held, 1, 0))
+    fix_type[~(hdop <= dop_mask)] = 0
     ok = fix_type > 0
     if smoothing_time_constant_s > 0 and n > 1:
         pos = smooth_positions(pos, vel, float(t[1] - t[0]), smoothing_time_constant_s)

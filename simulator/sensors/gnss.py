@@ -142,6 +142,7 @@ GNSS_FIELD = Record(
         "fll_bandwidth": Number("Hz", 0.5, gt=0, doc="carrier (frequency) loop noise bandwidth"),
         "integration_time": Number("s", 0.02, gt=0, max=0.02),
         "smoothing": Number("s", 0.0, min=0, doc="fix smoothing time constant (0 = none)"),
+        "dop_mask": Number("", 20.0, gt=0, doc="no fix when the HDOP is above this"),
     },
     default=None,
     post=_resolve,
@@ -303,7 +304,7 @@ class Gnss:
         # are recomputed from them; the generator drops it if the scenario did not ask for it
         out["gnss_raw"] = raw
         if "fix" in cfg["outputs"]:
-            out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"])
+            out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"], cfg["dop_mask"])
         return out
 
 
