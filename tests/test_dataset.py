@@ -36,9 +36,10 @@ def test_layout_and_manifest(dataset):
     assert m["scenario"]["sensors"]["imu"]["output"] == "increment"
     assert m["gps_time_start"] == {"week": 2312, "tow": pytest.approx(3 * 86400 + 3 * 3600 + 18)}
     assert m["origin"] == {"lat": 37.5665, "lon": 126.978, "alt": 40.0}
-    assert set(m["streams"]) == {"truth", "imu", "events"}
+    assert set(m["streams"]) == {"truth", "imu", "odometer", "baro", "gnss_fix", "gnss_raw",
+                                 "gnss_nav", "truth_gnss", "events"}
     assert m["streams"]["imu"]["rate_hz"] == pytest.approx(100.0)
-    assert m["sensors"]["imu"]["preset"] == "ideal"
+    assert m["sensors"]["imu"]["preset"] == "bosch-smi130"
     truth = ds.read("truth")
     assert list(truth.columns) == list(col.TRUTH)
     assert m["streams"]["truth"]["rows"] == len(truth)
@@ -56,7 +57,9 @@ def test_same_seed_gives_identical_files(dataset, tmp_path):
     again = tmp_path / "again"
     assert main(["generate", str(QUICK), "-o", str(again), "--seed", "5",
                  "--set", "sensors.imu.output=increment"]) == 0
-    for name in ("truth.parquet", "imu.parquet", "events.parquet", "manifest.json"):
+    for name in ("truth.parquet", "imu.parquet", "odometer.parquet", "baro.parquet",
+                 "gnss_fix.parquet", "gnss_raw.parquet", "truth_gnss.parquet", "events.parquet",
+                 "manifest.json"):
         assert (again / name).read_bytes() == (dataset / name).read_bytes(), name
 
 

@@ -158,5 +158,6 @@ def test_generated_dataset_round_trip(tmp_path, capsys):
     imu = open_dataset(data).read("imu").to_numpy(dtype=float)
     seen = np.array([row for stream, _, row in Recorder.last.seen if stream == "imu"])
     np.testing.assert_array_equal(seen, imu)
-    assert set(Recorder.last.columns) == {"imu"}
+    # every stream an estimator may see, never the truth, truth_gnss, gnss_nav or events
+    assert set(Recorder.last.columns) == {"imu", "odometer", "baro", "gnss_fix", "gnss_raw"}
     assert len(read_solution(out)) == len(Recorder.last.asked)
