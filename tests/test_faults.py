@@ -303,3 +303,56 @@ def test_multipath_moves_the_fix(clean_gnss):
     moved = np.hypot(faulted["gnss_fix"].lat - clean_gnss["gnss_fix"].lat,
                      faulted["gnss_fix"].lon - clean_gnss["gnss_fix"].lon) * 111e3
     assert moved[_inside(faulted["gnss_fix"].t, 100, 140)].max() > 5.0
+
+
+ALL_SENSORS = {"imu": {"preset": "automotive", "rate": 100},
+               "odometer": {"preset": "abs-wheel-speed"}, "baro": {"preset": "bosch-bmp280"},
+               "mag": {"preset": "automotive"},
+               "gnss": {"preset": "automotive", "rate": 1, "outputs": ["fix", "raw"]}}
+EVERY_KIND = [
+    ("gnss_outage", {}, ["gnss_fix", "gnss_raw", "truth_gnss"]),
+    ("gnss_satellite_limit", {"count": 2}, ["gnss_fix", "gnss_raw", "truth_gnss"]),
+    ("gnss_multipath", {"sigma": 30.0}, ["gnss_fix", "gnss_raw", "truth_gnss"]),
+    ("gnss_fix_jump", {"offset": [20.0, 0.0, 0.0]}, ["gnss_fix"]),
+    ("gnss_latency", {"latency": 2.0}, ["gnss_fix"]),
+    ("gnss_rate_drop", {"rate": 0.2}, ["gnss_fix", "gnss_raw", "truth_gnss"]),
+    ("baro_jump", {"delta_pa": 30.0}, ["baro"]),
+    ("odometer_slip", {"slip": 0.3}, ["odometer"]),
+    ("odometer_scale_change", {"scale_change": "2 %"}, ["odometer"]),
+    ("imu_bias_step", {"gyro": "0.5 deg/s"}, ["imu"]),
+    ("imu_saturation_burst", {"accel_amplitude": 60.0}, ["imu"]),
+    ("sensor_dropout", {"stream": "mag"}, ["mag"]),
+    ("timestamp_jitter", {"stream": "odometer", "sigma": 0.01}, ["odometer"]),
+]
+
+
+@pytest.fixture(scope="module")
+def clean_all():
+    return generate_streams(scenario_data(DRIVE, sensors=ALL_SENSORS),
+                            show_progress=False).streams
+
+
+def test_every_kind_is_covered():
+    assert {kind for kind, _, _ in EVERY_KIND} == set(FAULT_REGISTRY)
+
+
+@pytest.mark.parametrize("kind, params, touched", EVERY_KIND, ids=[k[0] for k in EVERY_KIND])
+def test_fault_acts_only_inside_its_interval(clean_all, kind, params, touched):
+    """Faulted against clean dataset of the same seed: the touched streams differ inside the
+    interval and are identical outside it; every other stream is identical."""
+    a, b = 95.0, 125.0
+    faulted = generate_streams(scenario_data(DRIVE, sensors=ALL_SENSORS, faults=[
+        {"kind": kind, "start": a, "duration": b - a, **params}]), show_progress=False).streams
+    for name, clean in clean_all.items():
+        if name == "events":
+            continue
+        if name not in touched:
+            pd.testing.assert_frame_equal(faulted[name], clean, obj=name)
+            continue
+        _same_outside(faulted, clean_all, name, a, b)
+        inside_f = faulted[name][_inside(faulted[name].t, a, b)].reset_index(drop=True)
+        inside_c = clean[_inside(clean.t, a, b)].reset_index(drop=True)
+        assert not inside_f.equals(inside_c), f"{kind} left {name} unchanged"
+    events = faulted["events"]
+    rows = events[(events.kind == kind) & (events.t_start == a)]
+    assert len(rows) == 1 and rows.t_end.iloc[0] == b  # the outage row, or the fault's own
