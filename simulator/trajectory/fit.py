@@ -43,9 +43,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import sparse
-from scipy.interpolate import Akima1DInterpolator, BSpline, PPoly, make_interp_spline
-from scipy.sparse.linalg import spsolve
 
 from simulator.earth import (
     ecef_to_geodetic,
@@ -141,6 +138,8 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
     ValueError
         When the samples are not increasing in time or the vehicle never moves.
     """
+    from scipy.interpolate import Akima1DInterpolator, make_interp_spline  # see module doc
+
     t = np.asarray(t, dtype=float)
     enu = np.asarray(enu, dtype=float)
     if len(t) < 2 or np.any(np.diff(t) <= 0):
@@ -213,6 +212,8 @@ def zone_intervals(t: np.ndarray, zone: np.ndarray) -> list[tuple[float, float, 
 
 def _piecewise(spline) -> PiecewisePolynomial:
     """A B-spline as a piecewise polynomial without its zero-width end intervals."""
+    from scipy.interpolate import PPoly
+
     pp = PPoly.from_spline(spline)
     keep = np.diff(pp.x) > 0
     return PiecewisePolynomial(pp.c[:, keep], np.concatenate([pp.x[:-1][keep], pp.x[-1:]]))
@@ -223,6 +224,10 @@ def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: np.ndarray):
     knots ``spacing`` (n,) metres apart locally and a ``_PENALTY`` on the third differences of
     the coefficients (Eilers and Marx 1996, eq. 8), which damps the ringing a plain least-squares
     fit shows next to a kink."""
+    from scipy import sparse
+    from scipy.interpolate import BSpline
+    from scipy.sparse.linalg import spsolve
+
     k = 5
     count = np.concatenate([[0.0], np.cumsum(np.diff(u) / spacing[1:])])
     n_int = max(1, int(round(count[-1])))
@@ -253,6 +258,8 @@ def _smoothed_distance(t: np.ndarray, s: np.ndarray, w: float) -> PiecewisePolyn
 
     S is extended linearly beyond both ends with its first and last slopes.
     """
+    from scipy.interpolate import PPoly
+
     slope0 = (s[1] - s[0]) / (t[1] - t[0])
     slope1 = (s[-1] - s[-2]) / (t[-1] - t[-2])
     tx = np.concatenate([[t[0] - 2 * w], t, [t[-1] + 2 * w]])
