@@ -11,4 +11,5 @@ SUMMARIES = {
     "estimate": "run one estimator causally over a dataset, write its solution",
     "score": "score solutions against a dataset's truth (table, JSON, report)",
     "run": "generate, run the scenario's estimators, score, write the report",
+    "campaign": "Monte Carlo over seeds and sweeps, locally or on Dask; resumable",
 }
