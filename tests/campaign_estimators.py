@@ -1,4 +1,5 @@
-"""Test estimators for campaigns: one that always fails, one that logs every run it makes."""
+"""Test estimators for campaigns: one that fails, one that kills its worker process, one that
+logs every run it makes."""
 
 from __future__ import annotations
 
@@ -16,6 +17,15 @@ class Fails(HoldStart):
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         raise RuntimeError(f"deliberate failure at t = {t}")
+
+
+class Crashes(HoldStart):
+    """Ends its process at once, as a crash in compiled code would."""
+
+    name = "crashes"
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        os._exit(3)
 
 
 class Counting(HoldStart):

@@ -187,6 +187,21 @@ def test_a_failing_estimator_is_recorded_and_the_others_go_on(tmp_path, capsys):
     assert _group(summary, "fails")["scores"]["horizontal.rms"]["count"] == 0
     assert "deliberate failure" in (out / "report.md").read_text()
     assert "2 ok, 2 failed" in capsys.readouterr().out
+    args = ["campaign", str(scenario), "--runs", "2", "--workers", "2", "-o", str(out)]
+    assert main(args) == 0  # a failed run is done ...
+    assert "(0 run(s) computed now, 2 already done)" in capsys.readouterr().out
+    assert main([*args, "--retry-failed"]) == 0  # ... unless asked to retry it
+    assert "(2 run(s) computed now, 0 already done)" in capsys.readouterr().out
+
+
+def test_a_dying_worker_process_fails_its_run_and_a_new_pool_goes_on(tmp_path):
+    crashes = {"name": "tests.campaign_estimators:Crashes", "label": "crashes"}
+    out = tmp_path / "crash"
+    assert main(["campaign", str(_scenario(tmp_path, [HOLD, crashes])), "--runs", "2",
+                 "--workers", "1", "-o", str(out)]) == 0
+    runs = _runs(out)
+    assert runs["run_id"].tolist() == [0, 0, 1, 1] and (runs["status"] == "failed").all()
+    assert runs["error"].str.contains("BrokenProcessPool").all()
 
 
 def test_resume_computes_only_the_missing_runs(tmp_path, capsys, monkeypatch):

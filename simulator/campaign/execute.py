@@ -4,7 +4,9 @@ flight so that an interrupted campaign has little work under way.
 
 Local processes come from a ``forkserver`` whose preloaded worker module is forked for each
 process (fast start, and no fork of a parent that runs threads). On Ctrl-C they receive the
-interrupt too and abandon their run; nothing of an unfinished run is recorded.
+interrupt too and abandon their run; nothing of an unfinished run is recorded. A worker process
+that dies (a crash inside an estimator's compiled code, the out-of-memory killer) fails the runs
+that were under way in the pool, and a new pool takes the next runs.
 
 Public functions
 ----------------
@@ -25,6 +27,30 @@ T = TypeVar("T")
 _WORKER_MODULE = "simulator.campaign.worker"  # preloaded by the forkserver
 
 
+class _RenewingPool(cf.Executor):
+    """A local process pool that is replaced by a new one when a worker process has died."""
+
+    def __init__(self, workers: int):
+        self.workers = workers
+        self.context = multiprocessing.get_context("forkserver")
+        self.context.set_forkserver_preload([_WORKER_MODULE])
+        self.pool = self._new()
+
+    def _new(self) -> cf.ProcessPoolExecutor:
+        return cf.ProcessPoolExecutor(self.workers, mp_context=self.context)
+
+    def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> cf.Future:
+        try:
+            return self.pool.submit(fn, *args, **kwargs)
+        except cf.BrokenExecutor:
+            self.pool.shutdown(wait=False)
+            self.pool = self._new()
+            return self.pool.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        self.pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
 @contextlib.contextmanager
 def open_executor(workers: int, scheduler: str | None, timeout_s: float
                   ) -> Iterator[tuple[cf.Executor, int]]:
@@ -42,9 +68,7 @@ def open_executor(workers: int, scheduler: str | None, timeout_s: float
         When the scheduler does not answer within ``timeout_s``.
     """
     if scheduler is None:
-        context = multiprocessing.get_context("forkserver")
-        context.set_forkserver_preload([_WORKER_MODULE])
-        with cf.ProcessPoolExecutor(workers, mp_context=context) as executor:
+        with _RenewingPool(workers) as executor:
             yield executor, workers
         return
     from distributed import Client

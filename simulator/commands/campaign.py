@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 from pathlib import Path
 
 from simulator.commands import SUMMARIES
@@ -71,6 +72,12 @@ def _check_counts(args: argparse.Namespace) -> int:
     return args.workers or os.cpu_count() or 1
 
 
+def _stop(signum: int, frame: object) -> None:
+    """SIGTERM ends the campaign like Ctrl-C: the runs under way are abandoned, the folder
+    resumes."""
+    raise KeyboardInterrupt
+
+
 def run(args: argparse.Namespace) -> int:
     from simulator.campaign.campaign import CampaignOptions, run_campaign
     from simulator.campaign.plan import plan_campaign
@@ -82,7 +89,11 @@ def run(args: argparse.Namespace) -> int:
         scheduler_timeout_s=args.scheduler_timeout, force=args.force,
         keep_datasets=args.keep_datasets, retry_failed=args.retry_failed)
     out = Path(args.output)
-    result = run_campaign(plan, out, options)
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
+        result = run_campaign(plan, out, options)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
     n_runs = len(result.runs) // max(1, len(plan.labels))
     print(f"campaign {plan.base.name}: {n_runs} run(s) x {len(plan.labels)} estimator(s): "
           f"{result.ok} ok, {result.failed} failed ({result.computed} run(s) computed now, "
