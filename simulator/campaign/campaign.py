@@ -79,7 +79,8 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
     out = Path(out)
     fingerprint, record = plan.fingerprint(), plan.record()
     check_campaign_dir(out, record, fingerprint, options.force)
-    tasks = plan.tasks(options.runs, out / DATASETS if options.keep_datasets else None)
+    tasks = plan.tasks(options.runs,
+                       out.resolve() / DATASETS if options.keep_datasets else None)
     with open_executor(options.workers, options.scheduler, options.scheduler_timeout_s) as (
             executor, in_flight):
         init_campaign_dir(out, record, fingerprint, options.force)

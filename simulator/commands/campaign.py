@@ -34,8 +34,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="local worker processes (default: the CPU count)")
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on the Dask cluster of this scheduler (tcp://host:port) instead of "
-                        "local processes; its workers must import landnav and read SCENARIO's "
-                        "files")
+                        "local processes; its workers need landnav, any module:Class estimator "
+                        "and the files the scenario refers to")
     p.add_argument("--scheduler-timeout", type=float, default=10.0, metavar="SECONDS",
                    help="how long to try to reach the scheduler (default 10)")
     p.add_argument("--sweep", action="append", default=[], metavar="KEY.PATH=V1,V2,...",
