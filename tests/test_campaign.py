@@ -168,7 +168,7 @@ def test_sweeps_give_columns_and_per_value_summaries(tmp_path, capsys):
     assert grid["sensors.imu.rate"].tolist() == [25] * 3 + [50] * 3
     assert grid["trajectory.segments.2.straight.duration"].tolist() == [1, 2, 3] * 2
     assert len(_summary(out2)["groups"]) == 6
-    assert "6 run(s) x 1 estimator(s): 6 ok, 0 failed" in capsys.readouterr().out
+    assert "6 run(s) x 1 estimator(s): 6 result(s) ok, 0 failed" in capsys.readouterr().out
 
 
 def test_a_failing_estimator_is_recorded_and_the_others_go_on(tmp_path, capsys):
@@ -186,7 +186,7 @@ def test_a_failing_estimator_is_recorded_and_the_others_go_on(tmp_path, capsys):
     assert _group(summary, "fails")["failed"] == 2 and _group(summary, "hold")["failed"] == 0
     assert _group(summary, "fails")["scores"]["horizontal.rms"]["count"] == 0
     assert "deliberate failure" in (out / "report.md").read_text()
-    assert "2 ok, 2 failed" in capsys.readouterr().out
+    assert "2 result(s) ok, 2 failed" in capsys.readouterr().out
     args = ["campaign", str(scenario), "--runs", "2", "--workers", "2", "-o", str(out)]
     assert main(args) == 0  # a failed run is done ...
     assert "(0 run(s) computed now, 2 already done)" in capsys.readouterr().out
@@ -267,7 +267,11 @@ def test_flatten_scores_means_over_outages():
 
 @pytest.mark.parametrize("extra, message", [
     (["--sweep", "sensors.imu.rat=1,2"], "sensors.imu.rat: unknown key"),
-    (["--sweep", "sensors.imu.rate=50,-1"], "sweep value '-1'"),
+    (["--sweep", "sensors.imu.rate=50,-1"], "--sweep: sensors.imu.rate: -1 must be greater"),
+    (["--set", "trajectory.segments.2={turn: {angle: 90, radius: 30}}",
+      "--sweep", "trajectory.segments.2.turn.radius=30,1"],
+     "--sweep: trajectory.segments.2.turn: the turn asks for 25.00 m/s^2"),
+    (["--sweep", "estimators.0.label=a,b"], "may not change the estimators"),
     (["--sweep", "sensors.imu.rate"], "expected KEY.PATH=V1,V2"),
     (["--sweep", "sensors.imu.rate=50,,60"], "empty value"),
     (["--sweep", "seed=1,2"], "the seeds are not swept"),

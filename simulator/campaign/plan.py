@@ -192,16 +192,18 @@ def _column_values(sweep: Sweep) -> list[Any]:
 
 def _validate(path: Path, overrides: list[str], seed: int | None, swept: dict[str, str]
               ) -> Scenario:
-    """Load a sweep point; its problems on a swept key name ``--sweep`` and the value."""
+    """Load a sweep point. Its problems name the sweep point (the scenario without it is
+    valid), and those on a swept key come from ``--sweep``, not ``--set``."""
     try:
         return load_scenario(path, overrides, seed)
     except InputError as exc:
+        where = ", ".join(f"{k}={v}" for k, v in swept.items())
         problems = []
         for p in exc.problems:
-            key = next((k for k in swept if p.key_path == k or p.key_path.startswith(k + ".")),
-                       None)
-            problems.append(p if key is None else dataclasses.replace(
-                p, line="--sweep", message=f"{p.message} (sweep value {swept[key]!r})"))
+            on_key = any(p.key_path == k or p.key_path.startswith(k + ".")
+                         or k.startswith(p.key_path + ".") for k in swept)
+            problems.append(dataclasses.replace(
+                p, line="--sweep" if on_key else p.line, message=f"{p.message} (--sweep {where})"))
         raise InputError(problems) from None
 
 
@@ -220,7 +222,8 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
     ------
     InputError
         Every problem found: a bad scenario, a malformed sweep, a key swept twice or also
-        given with ``--set``, an invalid sweep value, a scenario without estimators.
+        given with ``--set``, an invalid sweep value, a sweep that changes the estimator labels,
+        a scenario without estimators.
     """
     path = Path(path)
     base = load_scenario(path, overrides, seed)
@@ -248,4 +251,8 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
         values = {s.key: col[j] for s, col, j in zip(sweeps, columns, choice, strict=True)}
         points.append(SweepPoint(index, assignments, values))
         scenarios.append(_validate(path, [*overrides, *assignments], seed, swept))
+        if entry_labels(scenarios[-1].data["estimators"]) != entry_labels(
+                base.data["estimators"]):
+            raise InputError([Problem(str(path), "--sweep", ", ".join(swept), "a sweep may not "
+                                      "change the estimators or their labels")])
     return CampaignPlan(base, sweeps, tuple(points), tuple(scenarios))

@@ -96,7 +96,8 @@ def run(args: argparse.Namespace) -> int:
         signal.signal(signal.SIGTERM, previous)
     n_runs = len(result.runs) // max(1, len(plan.labels))
     print(f"campaign {plan.base.name}: {n_runs} run(s) x {len(plan.labels)} estimator(s): "
-          f"{result.ok} ok, {result.failed} failed ({result.computed} run(s) computed now, "
+          f"{result.ok} result(s) ok, {result.failed} failed "
+          f"({result.computed} run(s) computed now, "
           f"{result.skipped} already done); results in {out}/ (runs.parquet, summary.json, "
           "report.md)")
     return 0
