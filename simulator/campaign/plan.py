@@ -11,7 +11,7 @@ the same random draws (common random numbers) and a difference between them is n
 
 Public names
 ------------
-Sweep, SweepPoint, CampaignPlan, RunTask, entry_labels, parse_sweep, plan_campaign.
+PLAN_FORMAT, Sweep, SweepPoint, CampaignPlan, RunTask, entry_labels, parse_sweep, plan_campaign.
 """
 
 from __future__ import annotations

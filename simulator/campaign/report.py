@@ -13,6 +13,7 @@ write_campaign_report.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -32,8 +33,9 @@ _PLOTTED = [("horizontal.rms", "horizontal RMS (m)", "horizontal_rms"),
 
 
 def _group_name(group: dict) -> str:
-    sweep = ", ".join(f"{k}={v}" for k, v in group["sweep"].items())
-    return f"{group['label']} ({sweep})" if sweep else group["label"]
+    """A box's tick: the label, and under it the sweep values (the axis names the keys)."""
+    values = ", ".join(str(v) for v in group["sweep"].values())
+    return f"{group['label']}\n{values}" if values else group["label"]
 
 
 def _has(summary: dict, column: str) -> bool:
@@ -65,7 +67,7 @@ def _failure_lines(runs: pd.DataFrame, keys: list[str]) -> list[str]:
             *markdown_table(["run", "seed", *keys, "label", "error"], rows)]
 
 
-def _replace(path: Path, write) -> None:
+def _replace(path: Path, write: Callable[[Path], object]) -> None:
     tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
     try:
         write(tmp)
@@ -88,8 +90,9 @@ def _box_plot(runs: pd.DataFrame, summary: dict, column: str, title: str, path: 
     ax.boxplot(data, showfliers=False)
     for i, values in enumerate(data, start=1):  # every run as a point over its box
         ax.plot(np.full(values.size, i), values, "o", ms=3, alpha=0.5, color="tab:blue")
-    ax.set_xticks(range(1, len(names) + 1), names, rotation=20, ha="right", fontsize="small")
-    ax.set(ylabel=title, title=f"{title} over the runs")
+    ax.set_xticks(range(1, len(names) + 1), names, fontsize="small")
+    ax.set(xlabel=", ".join(["estimator", *summary["sweep"]]), ylabel=title,
+           title=f"{title} over the runs")
     ax.grid(axis="y", alpha=0.3)
     _replace(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
