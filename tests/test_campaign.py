@@ -9,10 +9,12 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 import yaml
 
-from simulator.campaign.worker import flatten_scores
+from simulator.campaign.plan import plan_campaign
+from simulator.campaign.worker import execute_run, flatten_scores
 from simulator.cli import main
 
 HOLD = {"name": "tests.scoring_helpers:HoldStart", "label": "hold"}
@@ -93,6 +95,10 @@ def test_local_campaign_rows_seeds_and_summary(local):
         assert stats["mean"] == pytest.approx(values.mean())
         assert stats["median"] == pytest.approx(np.median(values))
         assert min(values) <= stats["p95"] <= max(values) and stats["count"] == 3
+    units = {f.name: f.metadata[b"unit"].decode()
+             for f in pq.read_schema(out / "runs.parquet")}
+    assert (units["horizontal.rms"], units["attitude.yaw_rms"], units["velocity.rms"],
+            units["runtime.seconds"], units["outages.count"]) == ("m", "deg", "m/s", "s", "")
     report = (out / "report.md").read_text()
     assert "| hold |" in report and "| shifted |" in report and "No run failed." in report
     assert (out / "plots" / "horizontal_rms.png").stat().st_size > 1000
@@ -247,6 +253,17 @@ def test_resume_computes_only_the_missing_runs(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(campaign_module, "write_part", real)
     assert main([*args, "--runs", "3"]) == 0
     assert _runs(out)["run_id"].tolist() == [0, 1, 2]
+
+
+def test_a_run_whose_dataset_fails_fails_every_estimator(tmp_path):
+    plan = plan_campaign(_scenario(tmp_path, [HOLD, SHIFTED]), [], 7, [])
+    (task,) = plan.tasks(1)
+    task.scenario.data["trajectory"]["kind"] = "teleport"  # past validation: fails in the run
+    rows = execute_run(task)
+    assert [(r["run_id"], r["seed"], r["label"], r["status"]) for r in rows] == [
+        (0, 7, "hold", "failed"), (0, 7, "shifted", "failed")]
+    assert all("KeyError: 'teleport'" in r["error"] for r in rows)
+    assert not any(k.startswith("horizontal.") for r in rows for k in r)
 
 
 def test_flatten_scores_means_over_outages():

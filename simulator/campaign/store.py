@@ -23,7 +23,7 @@ import pandas as pd
 import pyarrow.parquet as pq
 
 from simulator.campaign.plan import PLAN_FORMAT
-from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED
+from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, score_unit
 from simulator.dataset.io import read_table, write_table
 from simulator.errors import InputError, Problem
 
@@ -104,10 +104,11 @@ def done_parts(out: Path, retry_failed: bool = False) -> set[str]:
 
 
 def write_frame(frame: pd.DataFrame, path: Path) -> None:
-    """Write a table as Parquet under a temporary name, then rename it into place."""
+    """Write a runs table as Parquet (each score's unit in its field metadata) under a
+    temporary name, then rename it into place."""
     tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
     try:
-        write_table(frame, tmp, {})
+        write_table(frame, tmp, {c: score_unit(c) for c in frame.columns})
         os.replace(tmp, path)
     finally:
         tmp.unlink(missing_ok=True)

@@ -8,7 +8,7 @@ each per-outage score over the run's outages and ``outages.count``.
 
 Public names
 ------------
-STATUS_OK, STATUS_FAILED, RUN_COLUMNS, flatten_scores, execute_run, failed_rows.
+STATUS_OK, STATUS_FAILED, RUN_COLUMNS, flatten_scores, score_unit, execute_run, failed_rows.
 """
 
 from __future__ import annotations
@@ -30,6 +30,11 @@ STATUS_OK = "ok"
 STATUS_FAILED = "failed"
 RUN_COLUMNS = ("run_id", "seed", "label", "status")  # the leading columns of runs.parquet
 _SKIPPED = {"rows", "nees.expected", "outages.start"}  # bookkeeping, not performance
+# unit of a flattened score column, by column or else by group (SPEC section 8)
+_UNITS = {"horizontal": "m", "vertical": "m", "velocity": "m/s", "attitude": "deg",
+          "runtime.seconds": "s", "outages.duration": "s", "outages.distance": "m",
+          "outages.max_horizontal": "m", "outages.end_horizontal": "m",
+          "outages.end_percent": "%"}
 
 
 def _number(x: Any) -> float:
@@ -59,6 +64,11 @@ def flatten_scores(scores: dict) -> dict[str, float]:
                 values = values[np.isfinite(values)]
                 out[f"{group}.{key}"] = float(values.mean()) if values.size else float("nan")
     return out
+
+
+def score_unit(column: str) -> str:
+    """The unit of a flattened score column (``""`` for counts, ratios and other columns)."""
+    return _UNITS.get(column, _UNITS.get(column.partition(".")[0], ""))
 
 
 def _row(task: RunTask, label: str, status: str, scores: dict[str, float] | None = None,
