@@ -305,6 +305,16 @@ def test_bad_input_exits_2_with_one_message(tmp_path, capsys, extra, message):
     assert not out.exists()
 
 
+def test_a_folder_that_is_not_a_campaign_is_never_replaced(tmp_path, capsys):
+    out = tmp_path / "precious"
+    out.mkdir()
+    (out / "thesis.tex").write_text("years of work")
+    argv = ["campaign", str(_scenario(tmp_path, [HOLD])), "--runs", "1", "-o", str(out)]
+    assert main(argv) == 2 and main([*argv, "--force"]) == 2
+    assert "not a landnav campaign folder" in capsys.readouterr().err
+    assert [p.name for p in out.iterdir()] == ["thesis.tex"]
+
+
 def test_a_scheduler_that_does_not_answer_exits_2(tmp_path, capsys):
     out = tmp_path / "out"
     address = f"tcp://127.0.0.1:{_closed_port()}"

@@ -46,24 +46,25 @@ def _stored(out: Path) -> dict | None:
 def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -> None:
     """Refuse an output folder this campaign cannot use (writes nothing).
 
-    Without ``force``, ``out`` must be absent, empty, or a campaign folder of the same
-    fingerprint (then the campaign resumes).
+    ``out`` must be absent, empty, or a campaign folder: of the same fingerprint (then the
+    campaign resumes) or, with ``force``, of any (then it starts over). A folder that is not a
+    campaign is never replaced, even with ``force``.
 
     Raises
     ------
     InputError
         ``out`` is a file, a folder that is not a campaign, or a campaign of another plan
-        (naming what differs).
+        without ``force`` (naming what differs).
     """
     if out.exists() and not out.is_dir():
         raise InputError([Problem(str(out), None, "", "exists and is not a directory")])
-    if force or not out.exists() or not any(out.iterdir()):
+    if not out.exists() or not any(out.iterdir()):
         return
     stored = _stored(out)
     if stored is None or stored.get("format") != PLAN_FORMAT:
         raise InputError([Problem(str(out), None, "", "exists and is not a landnav campaign "
-                                  "folder; choose another -o DIR or use --force to replace it")])
-    if stored.get("fingerprint") != fingerprint:
+                                  "folder (no campaign.json); choose another -o DIR")])
+    if stored.get("fingerprint") != fingerprint and not force:
         differs = [k for k in ("scenario", "base_seed", "overrides", "sweep", "labels")
                    if stored.get(k) != record.get(k)] or ["the resolved scenario content"]
         raise InputError([Problem(str(out), None, "", "holds a campaign of another scenario or"

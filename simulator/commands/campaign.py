@@ -42,7 +42,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="also vary a scenario value (the key paths of --set); repeat for the "
                         "cartesian product. Run i has the same seed at every sweep point.")
     p.add_argument("--force", action="store_true",
-                   help="start over: replace DIR even if it holds another campaign")
+                   help="start over: replace the campaign in DIR even if it is another one "
+                        "(a folder that is not a campaign is never replaced)")
     p.add_argument("--keep-datasets", action="store_true",
                    help="keep each run's dataset in DIR/datasets/ (deleted after scoring "
                         "otherwise)")
