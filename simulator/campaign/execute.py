@@ -3,7 +3,8 @@ address. Both are driven as ``concurrent.futures`` executors, with a bounded num
 flight so that an interrupted campaign has little work under way.
 
 Local processes come from a ``forkserver`` whose preloaded worker module is forked for each
-process (fast start, and no fork of a parent that runs threads). On Ctrl-C they receive the
+process (fast start, and no fork of a parent that runs threads; ``spawn`` where there is no
+forkserver). On Ctrl-C they receive the
 interrupt too and abandon their run; nothing of an unfinished run is recorded. A worker process
 that dies (a crash inside an estimator's compiled code, the out-of-memory killer) fails the runs
 that were under way in the pool, and a new pool takes the next runs.
@@ -32,8 +33,11 @@ class _RenewingPool(cf.Executor):
 
     def __init__(self, workers: int):
         self.workers = workers
-        self.context = multiprocessing.get_context("forkserver")
-        self.context.set_forkserver_preload([_WORKER_MODULE])
+        if "forkserver" in multiprocessing.get_all_start_methods():
+            self.context = multiprocessing.get_context("forkserver")
+            self.context.set_forkserver_preload([_WORKER_MODULE])
+        else:  # Windows
+            self.context = multiprocessing.get_context("spawn")
         self.pool = self._new()
 
     def _new(self) -> cf.ProcessPoolExecutor:
