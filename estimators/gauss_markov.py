@@ -20,7 +20,6 @@ gauss_markov_continuous, gauss_markov_discrete, van_loan.
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import expm
 
 
 def gauss_markov_continuous(tau: np.ndarray, sigma: np.ndarray
@@ -74,6 +73,8 @@ def van_loan(f: np.ndarray, gqg: np.ndarray, dt: float) -> tuple[np.ndarray, np.
     phi : (n, n) exp(F dt); q_d : (n, n) integral over the step of
     exp(F s) G Q G^T exp(F s)^T ds (symmetrised).
     """
+    from scipy.linalg import expm  # imported here: dataset generation uses only the closed form
+
     f = np.asarray(f, dtype=float)
     n = f.shape[0]
     m = np.zeros((2 * n, 2 * n))

@@ -32,6 +32,8 @@ GNSS_FIX = {
     "t": "s", "lat": "deg", "lon": "deg", "alt": "m",
     "vn": "m/s", "ve": "m/s", "vd": "m/s", "speed": "m/s", "course": "rad",
     "num_sats": "1", "hdop": "1", "vdop": "1", "fix": "1",
+    # the receiver's clock solution: c dt_r and c d(dt_r)/dt
+    "clock_bias": "m", "clock_drift": "m/s",
 }
 
 GNSS_RAW = {
@@ -40,6 +42,32 @@ GNSS_RAW = {
     "sat_vx": "m/s", "sat_vy": "m/s", "sat_vz": "m/s",
     "sat_clock": "m", "sat_clock_drift": "m/s", "iono": "m", "tropo": "m",
     "elevation": "rad", "azimuth": "rad",
+    # the receiver's own 1-sigma estimates (as Android's ...UncertaintyMeters), for weighting
+    "pseudorange_std": "m", "pseudorange_rate_std": "m/s",
+}
+
+# the true error terms of every signal above the horizon (tracked or not), so that
+# pseudorange = range + receiver_clock - sat_clock + iono_true + tropo_true + sis_error
+#               + multipath + nlos_delay + code_noise
+# pseudorange_rate = range_rate + receiver_clock_drift - sat_clock_drift (1 - range_rate / c)
+#               + tropo_true_rate - iono_true_rate + rate_noise
+TRUTH_GNSS = {
+    "t": "s", "sv": "1", "tracked": "1", "los": "1", "nlos": "1",
+    "elevation": "rad", "azimuth": "rad", "range": "m", "range_rate": "m/s",
+    "receiver_clock": "m", "receiver_clock_drift": "m/s",
+    "iono_true": "m", "tropo_true": "m", "iono_true_rate": "m/s", "tropo_true_rate": "m/s",
+    "sis_error": "m", "multipath": "m", "nlos_delay": "m", "code_noise": "m",
+    "rate_noise": "m/s", "antenna_x": "m", "antenna_y": "m", "antenna_z": "m",
+}
+
+# broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of GPS week
+# ``week`` (toc may fall just outside [0, 604800) when the clock epoch is in the adjacent week)
+GNSS_NAV = {
+    "sv": "1", "week": "1", "toe": "s", "toc": "s",
+    "af0": "s", "af1": "s/s", "af2": "s/s^2", "tgd": "s", "iode": "1", "health": "1",
+    "sqrt_a": "m^0.5", "e": "1", "i0": "rad", "omega0": "rad", "omega": "rad", "m0": "rad",
+    "delta_n": "rad/s", "omega_dot": "rad/s", "idot": "rad/s",
+    "cuc": "rad", "cus": "rad", "crc": "m", "crs": "m", "cic": "rad", "cis": "rad",
 }
 
 BARO = {"t": "s", "pressure": "Pa", "altitude": "m"}
@@ -63,10 +91,10 @@ STREAMS = {
     "odometer": ("odometer.parquet", ODOMETER),
     "gnss_fix": ("gnss_fix.parquet", GNSS_FIX),
     "gnss_raw": ("gnss_raw.parquet", GNSS_RAW),
-    "gnss_nav": ("gnss_nav.parquet", {}),
+    "gnss_nav": ("gnss_nav.parquet", GNSS_NAV),
     "baro": ("baro.parquet", BARO),
     "mag": ("mag.parquet", MAG),
     "events": ("events.parquet", EVENTS),
-    "truth_gnss": ("truth_gnss.parquet", {}),
+    "truth_gnss": ("truth_gnss.parquet", TRUTH_GNSS),
 }
 SCORING_ONLY = ("truth", "truth_gnss", "events")

@@ -6,9 +6,14 @@ as datasheets print it: ``"0.02 deg/s/sqrt(Hz)"``, ``"70 mg"``, ``"10 deg/h"``, 
 ``(X)**0.5``, and where an acceleration is expected ``g``/``mg``/``ug`` mean standard gravity
 (9.80665 m/s^2), not grams.
 
-Public functions
-----------------
-to_si, UnitError.
+Named parameter sets written in code (sensor presets) use the factors below instead of strings,
+so that a scenario naming a preset does not load pint (about a second): ``0.02 * DEG_S_RT_HZ``
+reads like the datasheet's "0.02 deg/s/sqrt(Hz)".
+
+Public names
+------------
+to_si, UnitError; DEG, DEG_S, DEG_H, DEG_RT_H, DEG_S_RT_HZ, DEG_S2_RT_HZ, MILLI_G, MICRO_G,
+MILLI_G_RT_HZ, MILLI_G_S_RT_HZ, M_S_RT_H, PERCENT, PPM, PERCENT_RT_H, HPA, MICRO_T, MILLI.
 """
 
 from __future__ import annotations
@@ -17,6 +22,25 @@ import functools
 import re
 
 from simulator.earth import G0_M_S2
+
+# datasheet units as SI factors (value * factor = SI value)
+DEG = 0.017453292519943295  # degree, rad
+DEG_S = DEG  # deg/s, rad/s
+DEG_H = DEG / 3600.0  # deg/h, rad/s
+DEG_RT_H = DEG / 60.0  # deg/sqrt(h) (angle random walk), rad/s/sqrt(Hz)
+DEG_S_RT_HZ = DEG  # deg/s/sqrt(Hz), rad/s/sqrt(Hz)
+DEG_S2_RT_HZ = DEG  # deg/s^2/sqrt(Hz) (rate random walk), rad/s^2/sqrt(Hz)
+MILLI_G = 1e-3 * G0_M_S2  # mg, m/s^2
+MICRO_G = 1e-6 * G0_M_S2  # ug, m/s^2
+MILLI_G_RT_HZ = MILLI_G  # mg/sqrt(Hz), m/s^2/sqrt(Hz)
+MILLI_G_S_RT_HZ = MILLI_G  # mg/s/sqrt(Hz) (acceleration random walk), m/s^3/sqrt(Hz)
+M_S_RT_H = 1.0 / 60.0  # m/s/sqrt(h) (velocity random walk), m/s^2/sqrt(Hz)
+PERCENT = 1e-2  # %, dimensionless
+PPM = 1e-6  # ppm, dimensionless
+PERCENT_RT_H = PERCENT / 60.0  # %/sqrt(h), 1/sqrt(s)
+HPA = 100.0  # hPa, Pa
+MICRO_T = 1e-6  # uT, T
+MILLI = 1e-3  # the prefix m (mrad, ms)
 
 
 class UnitError(ValueError):

@@ -222,3 +222,84 @@ def test_faulted_dataset_identical_outside_the_interval():
     events = faulted["events"]
     assert list(events.kind) == ["imu_bias_step", "zone", "timestamp_jitter"]
     assert events.t_start.iloc[0] == 40.0 and events.t_end.iloc[0] == 50.0
+
+
+GNSS = {"imu": {"preset": "ideal", "rate": 100},
+        "gnss": {"preset": "automotive", "rate": 1, "outputs": ["fix", "raw"]}}
+
+
+def _gnss_streams(faults, **gnss):
+    sensors = {**GNSS, "gnss": {**GNSS["gnss"], **gnss}}
+    data = scenario_data(DRIVE, sensors=sensors, faults=faults)
+    return generate_streams(data, show_progress=False).streams
+
+
+@pytest.fixture(scope="module")
+def clean_gnss():
+    return _gnss_streams([])
+
+
+def _same_outside(faulted, clean, name, a, b):
+    f, c = faulted[name], clean[name]
+    pd.testing.assert_frame_equal(f[~_inside(f.t, a, b)].reset_index(drop=True),
+                                  c[~_inside(c.t, a, b)].reset_index(drop=True))
+
+
+def test_satellite_limit_keeps_the_highest(clean_gnss):
+    faulted = _gnss_streams([{"kind": "gnss_satellite_limit", "start": 100, "duration": 30,
+                              "count": 3}])
+    for name in ("gnss_raw", "gnss_fix", "truth_gnss", "imu"):
+        _same_outside(faulted, clean_gnss, name, 100, 130)
+    raw, clean_raw = faulted["gnss_raw"], clean_gnss["gnss_raw"]
+    inside = _inside(raw.t, 100, 130)
+    assert raw[inside].groupby("t").size().max() == 3
+    # the three kept are the three highest of the clean epoch
+    epoch = clean_raw[clean_raw.t == 110.0].nlargest(3, "elevation")
+    assert set(raw[raw.t == 110.0].sv) == set(epoch.sv)
+    fix = faulted["gnss_fix"]
+    assert set(fix.fix[_inside(fix.t, 100, 130)]) == {1}  # 2-D fixes with held height
+    # the receiver's DOP mask (20): three high satellites with a poor geometry give no fix
+    masked = _gnss_streams([{"kind": "gnss_satellite_limit", "start": 100, "duration": 30,
+                             "count": 3}], dop_mask=1.0)["gnss_fix"]
+    inside = _inside(masked.t, 100, 130)
+    assert (masked.fix[inside] == 0).all() and masked.lat[inside].isna().all()
+    assert (fix.hdop[fix.fix > 0] <= 20.0).all()
+    assert (faulted["truth_gnss"].tracked[_inside(faulted["truth_gnss"].t, 100, 130)] == 0).any()
+    outages = faulted["events"][faulted["events"].kind == "gnss_outage"]
+    assert not _inside(outages.t_start, 100, 130).any()  # measurements remain: no outage
+
+
+def test_satellite_limit_zero_is_an_outage(clean_gnss):
+    faulted = _gnss_streams([{"kind": "gnss_satellite_limit", "start": 100, "duration": 30,
+                              "count": 0}])
+    fix = faulted["gnss_fix"]
+    assert (fix.fix[_inside(fix.t, 100, 130)] == 0).all()
+    outages = faulted["events"][faulted["events"].kind == "gnss_outage"]
+    spans = list(zip(outages.t_start, outages.t_end, strict=True))
+    assert (100.0, 130.0) in spans and len(spans) == 2  # and the tunnel's
+
+
+def test_outage_fault_and_tunnel_each_appear_once(clean_gnss):
+    tunnel = [(a, b) for a, b, name in build_truth(scenario_data(DRIVE)).profile.zones]
+    assert len(tunnel) == 1
+    faulted = _gnss_streams([{"kind": "gnss_outage", "start": 120, "duration": 60}])
+    outages = faulted["events"][faulted["events"].kind == "gnss_outage"]
+    assert len(outages) == 2
+    assert outages.t_start.iloc[1] == 120.0 and outages.t_end.iloc[1] == 180.0
+    # the tunnel has no sky: its outage comes from the measurements themselves
+    assert outages.t_start.iloc[0] == pytest.approx(np.ceil(tunnel[0][0]))
+    _same_outside(faulted, clean_gnss, "gnss_fix", 120, 180)
+
+
+def test_multipath_moves_the_fix(clean_gnss):
+    faulted = _gnss_streams([{"kind": "gnss_multipath", "start": 100, "duration": 40,
+                              "satellites": 2, "sigma": 40.0}])
+    for name in ("gnss_raw", "gnss_fix", "truth_gnss"):
+        _same_outside(faulted, clean_gnss, name, 100, 140)
+    raw, clean_raw = faulted["gnss_raw"], clean_gnss["gnss_raw"]
+    changed = raw.pseudorange.to_numpy() != clean_raw.pseudorange.to_numpy()
+    assert raw.sv[changed].nunique() == 2 and _inside(raw.t[changed], 100, 140).all()
+    assert np.abs(raw.pseudorange - clean_raw.pseudorange)[changed].std() > 10.0
+    moved = np.hypot(faulted["gnss_fix"].lat - clean_gnss["gnss_fix"].lat,
+                     faulted["gnss_fix"].lon - clean_gnss["gnss_fix"].lon) * 111e3
+    assert moved[_inside(faulted["gnss_fix"].t, 100, 140)].max() > 5.0

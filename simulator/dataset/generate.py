@@ -72,6 +72,9 @@ def generate_streams(scenario: dict, show_progress: bool = True) -> Generated:
     rows = zone_events(truth.profile.zones) + apply_faults(streams, scenario, truth)
     for t_start, t_end in _outages(streams, truth.duration_s):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
+    gnss = sensors.get("gnss")
+    if gnss is not None and "raw" not in gnss["outputs"]:
+        streams.pop("gnss_raw", None)  # kept until here for the faults and the outage table
     streams["events"] = events_table(rows)
     return Generated(truth, streams, drawn)
 

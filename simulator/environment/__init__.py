@@ -1,6 +1,8 @@
 """The environment the drive happens in: named zones (tunnel, garage, urban canyon) and what each
 does to the sky, signals and fields.
 
+The sky geometry of a canyon (line of sight, reflections) is in ``simulator.environment.sky``.
+
 Public names
 ------------
 ENVIRONMENT_FIELD, ZONE_FIELD, COVERED_ZONE_NAMES.
@@ -17,6 +19,9 @@ ZONE_FIELD = Record(
                         "urban canyon"),
         "building_height": Number("m", 30.0, min=0, doc="canyon: height of the buildings"),
         "street_width": Number("m", 20.0, gt=0, doc="canyon: width between the facades"),
+        "nlos_attenuation": Number("", 10.0, min=0,
+                                   doc="canyon: C/N0 loss of a signal received only by "
+                                       "reflection, dB"),
     },
     default={},
 )

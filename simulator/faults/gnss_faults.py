@@ -1,17 +1,22 @@
 """Faults of the GNSS receiver's outputs.
 
-Kinds here: ``gnss_outage`` (no measurement, no fix), ``gnss_fix_jump`` (a position step in the
-fixes, as in the downtown data of Park et al. 2019), ``gnss_latency`` (fixes reported late),
-``gnss_rate_drop`` (the receiver outputs fewer epochs).
+Kinds here: ``gnss_outage`` (no measurement, no fix), ``gnss_satellite_limit`` (only a few
+satellites left, the lowest lost first), ``gnss_multipath`` (large correlated pseudorange errors
+on the lowest satellites), ``gnss_fix_jump`` (a position step in the fixes, as in the downtown
+data of Park et al. 2019), ``gnss_latency`` (fixes reported late), ``gnss_rate_drop`` (the
+receiver outputs fewer epochs). Faults on the measurements recompute the fixes inside their
+intervals from the faulted measurements, so a fix degrades exactly as the measurements do.
 """
 
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 
 from simulator.earth import radii_of_curvature
 from simulator.faults.base import in_intervals, register
-from simulator.scenario.schema import Number, Vector
+from simulator.scenario.schema import Integer, ListOf, Number, Vector
+from simulator.sensors.noise import gauss_markov
 
 # fix columns that describe the solution (blanked when there is none, delayed by latency)
 FIX_SOLUTION = ("lat", "lon", "alt", "vn", "ve", "vd", "speed", "course", "hdop", "vdop")
@@ -85,3 +90,84 @@ def _gnss_rate_drop(streams, intervals, params, context) -> None:
             phase = (t - start) / period
             drop |= inside & (np.abs(phase - np.round(phase)) > 1e-6)
         streams[name] = frame.loc[~drop].reset_index(drop=True)
+
+
+def _refix(streams, intervals, context) -> None:
+    """Recompute the receiver's fixes inside the intervals from the (faulted) measurements, as
+    the receiver itself would; fixes outside are untouched."""
+    from simulator.gnss.fix import receiver_fixes  # the GNSS package imports the scenario spec
+
+    if "gnss_fix" not in streams:
+        return
+    fix, raw = streams["gnss_fix"], streams["gnss_raw"]
+    t = fix["t"].to_numpy()
+    mask = in_intervals(t, intervals)
+    if not mask.any():
+        return
+    # solved from the start, so the receiver's history (the height a 2-D fix holds, the
+    # smoothing state) is that of the real receiver; only the intervals' rows are written
+    upto = t <= t[mask].max()
+    gnss = context.sensors.get("gnss") or {}
+    new = receiver_fixes(t[upto], raw.loc[raw["t"].to_numpy() <= t[mask].max()],
+                         gnss.get("smoothing", 0.0), gnss.get("dop_mask", np.inf))
+    fix.loc[mask, list(new.columns)] = new.to_numpy()[mask[upto]]
+
+
+def _set_tracked(streams, rows_dropped) -> None:
+    """Mark dropped measurements as not tracked in the truth table."""
+    if "truth_gnss" not in streams or rows_dropped.empty:
+        return
+    truth = streams["truth_gnss"]
+    key = truth.set_index(["t", "sv"]).index
+    dropped = rows_dropped.set_index(["t", "sv"]).index
+    truth.loc[key.isin(dropped), "tracked"] = 0
+
+
+@register("gnss_satellite_limit", {
+    "count": Integer(min=0, doc="satellites kept; the lowest are lost first"),
+    "keep": ListOf(Integer(min=1), None, doc="or: the PRNs kept (the others are lost)"),
+}, ("gnss_fix", "gnss_raw"), "only a few satellites left (partial outage, Karamat et al. 2015)")
+def _gnss_satellite_limit(streams, intervals, params, context) -> None:
+    raw = streams["gnss_raw"]
+    inside = in_intervals(raw["t"].to_numpy(), intervals)
+    if params["keep"] is not None:
+        lost = inside & ~raw["sv"].isin(params["keep"]).to_numpy()
+    else:
+        rank = raw.groupby("t")["elevation"].rank(ascending=False, method="first").to_numpy()
+        lost = inside & (rank > params["count"])
+    _set_tracked(streams, raw.loc[lost, ["t", "sv"]])
+    streams["gnss_raw"] = raw.loc[~lost].reset_index(drop=True)
+    _refix(streams, intervals, context)
+
+
+@register("gnss_multipath", {
+    "satellites": Integer(2, min=1, doc="how many satellites (the lowest at the start)"),
+    "sigma": Number("m", 30.0, gt=0, doc="standard deviation of the multipath error"),
+    "correlation_time": Number("s", 5.0, gt=0, doc="its Gauss-Markov correlation time"),
+}, ("gnss_fix", "gnss_raw"), "haywire multipath: large correlated pseudorange errors")
+def _gnss_multipath(streams, intervals, params, context) -> None:
+    raw = streams["gnss_raw"]
+    t = raw["t"].to_numpy()
+    epochs = np.unique(t)
+    dt_s = float(np.min(np.diff(epochs))) if len(epochs) > 1 else 1.0
+    error = np.zeros(len(raw))
+    for start, end in intervals:
+        inside = (t >= start) & (t < end)
+        if not inside.any():
+            continue
+        first = t[inside].min()
+        at_start = raw.loc[inside & (t == first)].sort_values("elevation", kind="stable")
+        for sv in at_start["sv"].to_numpy()[:params["satellites"]]:
+            rows = np.flatnonzero(inside & (raw["sv"].to_numpy() == sv))
+            steps = np.rint((t[rows] - first) / dt_s).astype(int)
+            series = gauss_markov(steps.max() + 1, dt_s, np.array([params["sigma"]]),
+                                  params["correlation_time"], context.rng)[:, 0]
+            error[rows] = series[steps]
+    raw["pseudorange"] = raw["pseudorange"].to_numpy() + error
+    if "truth_gnss" in streams:
+        truth = streams["truth_gnss"]
+        extra = pd.Series(error, index=pd.MultiIndex.from_arrays([t, raw["sv"].to_numpy()]))
+        key = pd.MultiIndex.from_arrays([truth["t"].to_numpy(), truth["sv"].to_numpy()])
+        truth["multipath"] = truth["multipath"].to_numpy() + extra.reindex(key).fillna(
+            0.0).to_numpy()
+    _refix(streams, intervals, context)

@@ -293,10 +293,10 @@ class OneKey(Field):
 
 
 class Either(Field):
-    """A value that is a plain name (``Text``) or a mapping (``Record``)."""
+    """A value that is a plain name (``Text``) or a structured value (``Record``, ``ListOf``)."""
 
-    def __init__(self, name: Text, record: Record, doc: str = ""):
-        super().__init__(REQUIRED, doc)
+    def __init__(self, name: Text, record: Field, default: Any = REQUIRED, doc: str = ""):
+        super().__init__(default, doc)
         self.name, self.record = name, record
 
     def check(self, value: Any, path: Path, ctx: Context) -> Any:

@@ -6,7 +6,13 @@ its model class; the dataset generator builds every configured sensor from these
 
 from __future__ import annotations
 
+from simulator.sensors.baro import BARO_FIELD, Barometer
+from simulator.sensors.gnss import GNSS_FIELD, Gnss
 from simulator.sensors.imu import IMU_FIELD, Imu
+from simulator.sensors.mag import MAG_FIELD, Magnetometer
+from simulator.sensors.odometer import ODOMETER_FIELD, Odometer
 
-SENSOR_FIELDS = {"imu": IMU_FIELD}
-SENSOR_MODELS = {"imu": Imu}
+SENSOR_FIELDS = {"imu": IMU_FIELD, "odometer": ODOMETER_FIELD, "gnss": GNSS_FIELD,
+                 "baro": BARO_FIELD, "mag": MAG_FIELD}
+SENSOR_MODELS = {"imu": Imu, "odometer": Odometer, "gnss": Gnss, "baro": Barometer,
+                 "mag": Magnetometer}

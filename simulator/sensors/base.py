@@ -3,7 +3,7 @@ that turns the exact trajectory and a random generator into stream tables.
 
 Public names
 ------------
-SensorModel, sample_times, integrate_over_samples.
+SensorModel, sample_times, grid_index, integrate_over_samples.
 """
 
 from __future__ import annotations
@@ -41,6 +41,16 @@ def sample_times(duration_s: float, rate_hz: float, first: int = 0) -> np.ndarra
     return np.arange(first, n + 1) / rate_hz
 
 
+def grid_index(truth: Kinematics, t: np.ndarray) -> np.ndarray | None:
+    """Indices k with t = t_grid[k] when every time lies on the truth's base grid, else None
+    (then ``truth.grid_inertial()`` holds the truth at t, already evaluated)."""
+    k = np.rint(np.asarray(t, dtype=float) * truth.rate_hz).astype(int)
+    if (len(k) == 0 or not np.allclose(k, t * truth.rate_hz, rtol=0, atol=1e-6)
+            or k.min() < 0 or k.max() >= len(truth.t_grid)):
+        return None
+    return k
+
+
 def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
                            keys: tuple[str, ...] = ("w_body", "f_body")) -> dict[str, np.ndarray]:
     """Integrals of truth vectors over each sample interval (t_end - dt, t_end].
@@ -60,10 +70,9 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
     out = {key: np.zeros((len(t_end), 3)) for key in keys}
     gauss = np.ones(len(t_end), dtype=bool)
 
-    k_end = np.rint(t_end * truth.rate_hz).astype(int)
-    on_grid = (len(t_end) > 0 and abs(dt * truth.rate_hz - 1.0) < 1e-12
-               and np.allclose(k_end, t_end * truth.rate_hz, rtol=0, atol=1e-6)
-               and k_end.min() >= 1 and k_end.max() < len(truth.t_grid))
+    k_end = grid_index(truth, t_end)
+    on_grid = (k_end is not None and abs(dt * truth.rate_hz - 1.0) < 1e-12
+               and k_end.min() >= 1)
     if on_grid:
         grid, mid = truth.grid_inertial(), truth.grid_inertial(midpoints=True)
         k = k_end
@@ -79,13 +88,16 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
             d4[:2], d4[-2:] = np.inf, np.inf
             error = dt / 180 * np.max(np.abs(d4[2 * k - 1]), axis=1)
             gauss |= error > SIMPSON_TOLERANCE[key]
-    starts, lengths, owner = [], [], []
-    for i in np.flatnonzero(gauss):
+    # intervals without a breakpoint in one vectorised piece; only those holding breakpoints
+    # (a few per manoeuvre) are split one by one
+    smooth = np.flatnonzero(gauss & (last <= first))
+    starts, lengths, owner = [lo[smooth]], [np.full(len(smooth), dt)], [smooth]
+    for i in np.flatnonzero(gauss & (last > first)):
         edges = np.concatenate([[lo[i]], breaks[first[i]:last[i]], [hi[i]]])
         starts.append(edges[:-1])
         lengths.append(np.diff(edges))
         owner.append(np.full(len(edges) - 1, i))
-    if not starts:
+    if not gauss.any():
         return out
     start, length, idx = (np.concatenate(a) for a in (starts, lengths, owner))
     nodes = (start[:, None] + length[:, None] * GL_NODES[None, :]).ravel()

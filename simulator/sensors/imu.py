@@ -1,23 +1,79 @@
-"""Inertial measurement unit: samples the exact body rate and specific force as rates or as
-increments integrated over each sample interval.
+"""Inertial measurement unit: the exact body rate and specific force with a per-axis MEMS error
+model, sampled as rates or as increments integrated over each sample interval.
 
-The ``ideal`` preset turns every error term off: its rate output is the truth sampled at the IMU
-rate and its increment output is the exact integral over each interval (Gauss-Legendre on the
-analytic kinematics), which is what the strapdown closure test integrates.
+Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the sensor frame::
+
+    y = x + (S + M) x + b0 + b_in(t) + b_rw(t) + k_T dT(t) + G f  (gyro only) + n
+
+* ``x``: the true rate (w_ib, rad/s) or specific force (m/s^2) at the unit, rotated by the
+  ``mounting`` (roll, pitch, yaw of the unit in the vehicle, degrees): x_s = C_v^s x_v, with the
+  lever-arm terms dw/dt x r + w x (w x r) added to the specific force (Groves eq. 6.43 rearranged;
+  dw/dt a central difference, step 1 ms, of the analytic body rate), plus the engine and road
+  ``vibration`` of the unit on its mount (``simulator.sensors.vibration``), in the sensor frame.
+* ``S + M``: diagonal scale-factor errors and off-diagonal misalignment / cross-axis coupling,
+  each drawn once per run, N(0, ``scale_factor``^2) and N(0, ``misalignment``^2).
+* ``b0``: turn-on bias, N(0, ``bias``^2) per axis.
+* ``b_in``: in-run bias instability B. With ``bias_correlation_time`` tau_c: a first-order
+  Gauss-Markov process whose Allan-deviation peak (at 1.89 tau_c) is 0.664 B, i.e. its stationary
+  std is 0.664 B / 0.6174; without: a flicker process (sum of Gauss-Markov processes, see
+  ``simulator.sensors.noise``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
+  discretised exactly, so their statistics do not depend on the rate.
+* ``b_rw``: rate / acceleration random walk of density ``random_walk`` (rad/s^2/sqrt(Hz),
+  m/s^3/sqrt(Hz)), starting at zero, plus a rate ramp R t (IEEE Std 952 "rate ramp", Allan
+  deviation R tau / sqrt(2)) of magnitude ``ramp`` (rad/s^2, m/s^3) and a drawn sign.
+* ``k_T dT``: bias change with temperature; k_T per axis is drawn N(0, ``temperature_coefficient``
+  ^2) and dT(t) = offset + warmup (1 - exp(-t / warmup_time)) is the unit's temperature profile
+  (``temperature`` block, kelvin from the calibration temperature); the scale factor changes too,
+  by s_T dT with s_T drawn N(0, ``scale_factor_temperature_coefficient``^2) (1/K).
+* ``G f``: gyro g-sensitivity, a 3 x 3 matrix with elements N(0, ``g_sensitivity``^2),
+  rad/s per m/s^2.
+* ``n``: white noise of density N: sigma = N sqrt(rate) on rate output and N sqrt(dt) on the
+  increment (IEEE Std 952 angle / velocity random walk).
+
+Then the sensor's internal first-order low-pass of corner ``bandwidth`` (Hz; none when unset),
+saturation at +-``range`` and quantisation to ``resolution``. Increment output (``output:
+increment``) integrates the truth exactly over each interval (anti-aliased, Gauss-Legendre on the
+analytic kinematics); its error terms are the rate terms times dt, its saturation limit is
+range x dt and its quantum resolution x dt, with the rounding remainder carried to the next
+sample as integrating IMUs do (so the summed increments are exact to one quantum).
+``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t (for
+increments: the interval ends move by e, to first order in e). On increment output the lever-arm
+term integrates to dw x r + the integral of w x (w x r) (Simpson on the truth grid, else
+three-point Gauss-Legendre).
+
+Every parameter of a group is one number for all three axes or a list of three (x, y, z).
+Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 mrad" accepted).
+``axes`` lists the channels the unit has, or names a reduced unit of the seeds: ``riss3d``
+(Karamat 2015: vertical gyro, forward and lateral accelerometers), ``drm1`` (Cho 2006: two
+accelerometers and a yaw gyro) and ``drm2`` (Cho 2006: forward accelerometer, pitch and yaw gyros).
+The drawn values (turn-on biases, scale factors, misalignment and g-sensitivity matrices,
+temperature coefficients) are in ``drawn``. The ``ideal`` preset turns every error off: its rate
+output is the truth sampled at the IMU rate and its increment output the exact integral.
 
 Public names
 ------------
-IMU_FIELD, Imu.
+IMU_FIELD, REDUCED_UNITS, Imu.
+
+References
+----------
+Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed.,
+2013, section 4.4 (eqs. 4.16-4.17). IEEE Std 952-1997, Annex C.
 """
 
 from __future__ import annotations
+
+from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from simulator import columns as col
+from simulator.earth import euler_to_dcm
 from simulator.scenario.schema import (
+    INVALID,
     Context,
+    Either,
+    Field,
     ListOf,
     Number,
     Path,
@@ -25,31 +81,135 @@ from simulator.scenario.schema import (
     Text,
     Vector,
 )
-from simulator.sensors.base import integrate_over_samples, sample_times
+from simulator.sensors.base import (
+    GL_NODES,
+    GL_WEIGHTS,
+    grid_index,
+    integrate_over_samples,
+    sample_times,
+)
+from simulator.sensors.imu_presets import IMU_PRESETS
+from simulator.sensors.noise import (
+    FLICKER_ADEV_FACTOR,
+    GM_ADEV_PEAK,
+    ar1_filter,
+    flicker,
+    gauss_markov,
+    random_walk,
+    white,
+)
+from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.vibration import VIBRATION_FIELD, vibration
 from simulator.trajectory.kinematics import Kinematics
 
-PRESETS: dict[str, dict] = {"ideal": {}}
+REDUCED_UNITS = {
+    "full": list(col.IMU_AXES),
+    "riss3d": ["gyro_z", "accel_x", "accel_y"],
+    "drm1": ["gyro_z", "accel_x", "accel_y"],
+    "drm2": ["gyro_y", "gyro_z", "accel_x"],
+}
+_LEVER_ARM_STEP_S = 1e-3  # central-difference step for the angular acceleration, s
+
+
+class AxisNumber(Field):
+    """One number for all three axes, or a list of three (x, y, z), in ``unit``."""
+
+    def __init__(self, unit: str, default: Any = None, **limits: float):
+        super().__init__(default)
+        self.number = Number(unit, **limits)
+        self.vector = Vector(3, self.number)
+
+    def check(self, value: Any, path: Path, ctx: Context) -> Any:
+        if isinstance(value, (list, tuple)):
+            return self.vector.check(value, path, ctx)
+        return self.number.check(value, path, ctx)
+
+
+def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Field]:
+    fields: dict[str, Field] = {
+        "bias": AxisNumber(unit, min=0),
+        "bias_instability": AxisNumber(unit, min=0),
+        "bias_correlation_time": Number("s", None, gt=0),
+        "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
+        "random_walk": AxisNumber(random_walk_unit, min=0),
+        "ramp": AxisNumber(f"{unit}/s", min=0),
+        "scale_factor": AxisNumber("", min=0),
+        "misalignment": AxisNumber("rad", min=0),
+        "range": AxisNumber(unit, gt=0),
+        "resolution": AxisNumber(unit, min=0),
+        "temperature_coefficient": AxisNumber(f"{unit}/K", min=0),
+        "scale_factor_temperature_coefficient": AxisNumber("1/K", min=0),
+        "bandwidth": AxisNumber("Hz", gt=0),
+    }
+    if gyro:
+        fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0)
+    return fields
+
+
+_GROUPS = {
+    "gyro": _group_fields("rad/s", "rad/s^2/sqrt(Hz)", gyro=True),
+    "accel": _group_fields("m/s^2", "m/s^3/sqrt(Hz)", gyro=False),
+}
+# keys whose absence means "no such term" rather than zero
+_UNSET_IS_NONE = {"bias_correlation_time": None, "range": None, "bandwidth": None}
 
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
-    if value["preset"] not in PRESETS:
-        ctx.error(path + ("preset",), f"unknown IMU preset {value['preset']!r}; known: "
-                                      f"{', '.join(sorted(PRESETS))}")
-    return value
+    """Merge the preset into the resolved block (explicit values win) and expand ``axes``."""
+    if not known_preset(value["preset"], IMU_PRESETS, "IMU", path, ctx):
+        return INVALID
+    preset = IMU_PRESETS[value["preset"]]
+    out = fill_from_preset(value, preset, {"rate": IMU_FIELD.fields["rate"],
+                                           "output": IMU_FIELD.fields["output"]},
+                           path, ctx, {"rate": 100.0, "output": "rate"})
+    if out is INVALID:
+        return INVALID
+    for group, fields in _GROUPS.items():
+        out[group] = fill_from_preset(value[group] or {}, preset.get(group, {}), fields,
+                                      path + (group,), ctx, _UNSET_IS_NONE)
+        if out[group] is INVALID:
+            return INVALID
+    axes = value["axes"]
+    out["axes"] = list(REDUCED_UNITS[axes]) if isinstance(axes, str) else axes
+    failed = False
+    for group in _GROUPS:
+        limit, res = out[group]["range"], out[group]["resolution"]
+        if limit is not None and np.any(np.asarray(res) >= np.asarray(limit)):
+            ctx.error(path + (group, "resolution"), "must be smaller than range")
+            failed = True
+    return INVALID if failed else out
 
 
 IMU_FIELD = Record(
     {
         "preset": Text("ideal", doc="named parameter set; 'ideal' turns every error off"),
-        "rate": Number("Hz", 100.0, gt=0, max=10000),
-        "output": Text("rate", choices=["rate", "increment"]),
-        "axes": ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1),
-        "lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
-        "mounting": Vector(3, Number(angle=True), [0.0, 0.0, 0.0]),
+        "rate": Number("Hz", None, gt=0, max=10000, doc="sample rate (default: the preset's, "
+                                                        "else 100 Hz)"),
+        "output": Text(None, choices=["rate", "increment"]),
+        "axes": Either(Text(choices=list(REDUCED_UNITS)),
+                       ListOf(Text(choices=list(col.IMU_AXES)), min_len=1), default="full",
+                       doc="channels of the unit, or a reduced unit: " + ", ".join(REDUCED_UNITS)),
+        "lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
+                            doc="position of the unit from the vehicle reference point, FRD"),
+        "mounting": Vector(3, Number(angle=True), [0.0, 0.0, 0.0],
+                           doc="roll, pitch, yaw of the unit in the vehicle"),
+        "timestamp_jitter": Number("s", 0.0, min=0, doc="1-sigma sampling-time error"),
+        "temperature": Record({
+            "offset": Number("K", 0.0, doc="temperature at t = 0 minus calibration temperature"),
+            "warmup": Number("K", 0.0, doc="temperature rise during the warm-up"),
+            "warmup_time": Number("s", 600.0, gt=0, doc="time constant of the warm-up"),
+        }, default={}),
+        "vibration": VIBRATION_FIELD,
+        "gyro": Record(_GROUPS["gyro"], default=None),
+        "accel": Record(_GROUPS["accel"], default=None),
     },
     default=None,
     post=_resolve,
 )
+
+
+def _per_axis(value: float | list[float] | None) -> np.ndarray:
+    return np.broadcast_to(np.asarray(0.0 if value is None else value, dtype=float), (3,))
 
 
 class Imu:
@@ -58,21 +218,177 @@ class Imu:
     name = "imu"
 
     def __init__(self, config: dict):
-        self.config = config
-        self.rate_hz = float(config["rate"])
-        self.drawn: dict = {"preset": config["preset"]}
+        # a partial block (as built in code rather than read from a scenario) is completed by the
+        # schema; a resolved block passes through unchanged
+        ctx = Context("sensors.imu")
+        self.config = IMU_FIELD.check(config, ("sensors", "imu"), ctx)
+        if ctx.problems:
+            raise ValueError("; ".join(str(p) for p in ctx.problems))
+        self.rate_hz = float(self.config["rate"])
+        self.increment = self.config["output"] == "increment"
+        self.drawn: dict = {"preset": self.config["preset"]}
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    # -- truth at the unit ------------------------------------------------------------------
+    def _true_values(self, truth: Kinematics, t: np.ndarray,
+                     rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """True rate and specific force (or their increments) at the unit, sensor frame."""
         dt = 1.0 / self.rate_hz
-        if self.config["output"] == "increment":
-            t = sample_times(truth.duration_s, self.rate_hz, first=1)
+        jitter = float(self.config["timestamp_jitter"])
+        lever = np.asarray(self.config["lever_arm"], dtype=float)
+        if self.increment:
             k = integrate_over_samples(truth, t, dt)
+            w, f = k["w_body"], k["f_body"]
+            if jitter > 0 or lever.any():
+                ends = _truth_at(truth, np.concatenate([[t[0] - dt], t]))
+            if jitter > 0:
+                # interval (t - dt + e0, t + e1]: to first order in e, the exact increment plus
+                # x(t) e1 - x(t - dt) e0
+                e = jitter * rng.standard_normal(len(t) + 1)[:, None]
+                w = w + ends["w_body"][1:] * e[1:] - ends["w_body"][:-1] * e[:-1]
+                f = f + ends["f_body"][1:] * e[1:] - ends["f_body"][:-1] * e[:-1]
+            if lever.any():
+                dw = np.diff(ends["w_body"], axis=0)
+                f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
         else:
-            t = sample_times(truth.duration_s, self.rate_hz)
-            k = truth.inertial(t)
-        values = np.concatenate([k["w_body"], k["f_body"]], axis=1)
+            t_true = t + jitter * rng.standard_normal(len(t)) if jitter > 0 else t
+            k = _truth_at(truth, t_true)
+            w, f = k["w_body"], k["f_body"]
+            if lever.any():
+                h = _LEVER_ARM_STEP_S
+                dw = (truth.inertial(t_true + h)["w_body"]
+                      - truth.inertial(t_true - h)["w_body"]) / (2 * h)
+                f = f + np.cross(dw, lever) + np.cross(w, np.cross(w, lever))
+        mount = self.config["mounting"]
+        if any(mount):
+            c_sv = euler_to_dcm(*np.radians(mount)).T
+            w, f = w @ c_sv.T, f @ c_sv.T
+        return w, f
+
+    # -- errors -----------------------------------------------------------------------------
+    def _errors(self, group: str, x: np.ndarray, t: np.ndarray, f_true: np.ndarray,
+                rng: np.random.Generator) -> np.ndarray:
+        """Apply the group's error model to the true values x (n, 3); returns the output."""
+        p = self.config[group]
+        n = len(t)
+        dt = 1.0 / self.rate_hz
+        scale = dt if self.increment else 1.0  # rate terms -> increment terms
+        bias0 = _per_axis(p["bias"]) * rng.standard_normal(3)
+        sf = _per_axis(p["scale_factor"]) * rng.standard_normal(3)
+        mis = _per_axis(p["misalignment"])[:, None] * rng.standard_normal((3, 3))
+        np.fill_diagonal(mis, 0.0)
+        k_temp = _per_axis(p["temperature_coefficient"]) * rng.standard_normal(3)
+        k_sf_temp = _per_axis(p["scale_factor_temperature_coefficient"]) * rng.standard_normal(3)
+        drawn = {"bias": bias0.tolist(), "scale_factor": sf.tolist(),
+                 "misalignment": mis.tolist(), "temperature_coefficient": k_temp.tolist(),
+                 "scale_factor_temperature_coefficient": k_sf_temp.tolist()}
+        y = x + x @ (np.diag(sf) + mis).T
+        temp = self.config["temperature"]
+        d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
+        if k_sf_temp.any():
+            y += x * (d_temp[:, None] * k_sf_temp)
+        bias = np.broadcast_to(bias0, (n, 3)).copy()
+        instability = _per_axis(p["bias_instability"])
+        if instability.any():
+            if p["bias_correlation_time"]:
+                sigma = FLICKER_ADEV_FACTOR * instability / GM_ADEV_PEAK
+                bias += gauss_markov(n, dt, sigma, p["bias_correlation_time"], rng)
+            else:
+                bias += flicker(n, dt, instability, rng)
+        walk = _per_axis(p["random_walk"])
+        if walk.any():
+            bias += random_walk(n, dt, walk, rng)
+        ramp = _per_axis(p["ramp"]) * rng.choice([-1.0, 1.0], size=3) + 0.0  # no -0.0
+        drawn["ramp"] = ramp.tolist()
+        if ramp.any():
+            bias += t[:, None] * ramp
+        if k_temp.any():
+            bias += d_temp[:, None] * k_temp
+        y = y + bias * scale
+        if group == "gyro":
+            g_matrix = float(p["g_sensitivity"]) * rng.standard_normal((3, 3))
+            drawn["g_sensitivity"] = g_matrix.tolist()
+            if g_matrix.any():
+                y = y + f_true @ g_matrix.T
+        density = _per_axis(p["noise_density"])
+        if density.any():
+            y = y + white(n, dt, density, rng, increment=self.increment)
+        if p["bandwidth"] is not None:
+            y = _low_pass(y, _per_axis(p["bandwidth"]), dt)
+        if p["range"] is not None:
+            limit = _per_axis(p["range"]) * scale
+            y = np.clip(y, -limit, limit)
+        quantum = _per_axis(p["resolution"]) * scale
+        if quantum.any():
+            q = np.where(quantum > 0, quantum, 1.0)
+            if self.increment:
+                counts = np.round(np.cumsum(y, axis=0) / q)
+                stepped = np.diff(counts, axis=0, prepend=0.0) * q
+            else:
+                stepped = np.round(y / q) * q
+            y = np.where(quantum > 0, stepped, y)
+        self.drawn[group] = drawn
+        return y
+
+    def generate(self, truth: Kinematics,
+                 rng: np.random.Generator | None) -> dict[str, pd.DataFrame]:
+        """The ``imu`` stream. ``rng`` may be None only for a unit without random terms (the
+        ideal unit): a fresh generator then makes the (zero-size) draws."""
+        rng = rng if rng is not None else np.random.default_rng()
+        t = sample_times(truth.duration_s, self.rate_hz, first=1 if self.increment else 0)
+        w, f = self._true_values(truth, t, rng)
+        vib = self.config["vibration"]
+        if any(vib[k] > 0 for k in ("engine_accel", "engine_gyro", "road_accel", "road_gyro")):
+            dt = 1.0 / self.rate_hz
+            t_speed = t - dt / 2 if self.increment else t
+            speed = np.maximum(truth.profile.distance_of_time(np.clip(t_speed, 0, None), 1), 0)
+            # its own child stream: switching vibration on leaves every other draw unchanged
+            dw, df = vibration(t, speed, dt, vib, self.increment, rng.spawn(1)[0])
+            w, f = w + dw, f + df
+        gyro = self._errors("gyro", w, t, f, rng)
+        accel = self._errors("accel", f, t, f, rng)
+        values = np.concatenate([gyro, accel], axis=1)
         table = {"t": t}
         for i, axis in enumerate(col.IMU_AXES):
             if axis in self.config["axes"]:
                 table[axis] = values[:, i]
         return {"imu": pd.DataFrame(table)}
+
+
+def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarray:
+    """First-order low-pass y[k] = a y[k-1] + (1 - a) x[k], a = exp(-2 pi f_c dt), per column,
+    started in steady state on the first sample (the sensor's internal digital filter)."""
+    out = np.empty_like(y)
+    for j, f_c in enumerate(bandwidth_hz):
+        a = np.exp(-2 * np.pi * f_c * dt_s)
+        u = (1 - a) * y[:, j]
+        u[0] = y[0, j]  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]
+        out[:, j] = ar1_filter(u, a)
+    return out
+
+
+def _truth_at(truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
+    """``truth.inertial(t)``, from the truth's cached grid evaluation when t lies on its grid."""
+    k = grid_index(truth, t)
+    if k is None:
+        return truth.inertial(t)
+    grid = truth.grid_inertial()
+    return {key: grid[key][k] for key in ("w_body", "f_body")}
+
+
+def _centripetal_increment(truth: Kinematics, t_end: np.ndarray, dt_s: float,
+                           lever_arm: np.ndarray) -> np.ndarray:
+    """Integral of w x (w x r) over each interval (t - dt, t]: Simpson's rule on the truth's
+    cached grid and midpoint values when the intervals are its grid intervals, three-point
+    Gauss-Legendre otherwise."""
+    k = grid_index(truth, t_end)
+    if k is not None and abs(dt_s * truth.rate_hz - 1.0) < 1e-12 and k.min() >= 1:
+        grid = truth.grid_inertial()["w_body"]
+        mid = truth.grid_inertial(midpoints=True)["w_body"]
+        w = np.stack([grid[k - 1], mid[k - 1], grid[k]], axis=1)
+        weights = np.array([1.0, 4.0, 1.0]) / 6.0
+    else:
+        nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
+        w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
+        weights = GL_WEIGHTS
+    centripetal = np.cross(w, np.cross(w, lever_arm))
+    return dt_s * np.einsum("j,njk->nk", weights, centripetal)

@@ -234,11 +234,16 @@ class Kinematics:
         return self._breaks
 
     def zone_at(self, t: np.ndarray) -> np.ndarray:
-        """Zone name at times t ('' outside every zone); later zones win where they overlap."""
+        """Zone name at times t ('' outside every zone); later zones win where they overlap.
+
+        Zones are [start, end), except that a zone reaching the end of the drive also holds
+        its last instant (a drive that ends in a garage ends without sky).
+        """
         t = np.atleast_1d(t)
         out = np.full(t.shape, "", dtype=object)
         for start, end, name in self.profile.zones:
-            out[(t >= start) & (t < end)] = name
+            last = end >= self.duration_s - 1e-9
+            out[(t >= start) & ((t < end) | (last & (t <= end)))] = name
         return out
 
     def table(self, t: np.ndarray | None = None) -> pd.DataFrame:

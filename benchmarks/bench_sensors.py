@@ -1,0 +1,91 @@
+"""Benchmark: sensor generation for a one-hour drive, automotive IMU at 100 Hz with every error
+term on, odometer, barometer and magnetometer.
+
+Run:  PYTHONPATH=. python benchmarks/bench_sensors.py   (prints the figures in BENCHMARKS.md)
+
+Two figures, each the best of three:
+
+* in process: each sensor model's ``generate`` on the already built truth (the cost of the
+  sensor models themselves);
+* the whole ``landnav generate`` process (interpreter start, imports, scenario loading,
+  kinematics, every sensor, Parquet writing), as in ``bench_truth.py``.
+
+The drive is ``bench_truth.py``'s city loop repeated to an hour.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+from bench_truth import LOOP
+
+from simulator.dataset.generate import build_truth, sensor_rng
+from simulator.scenario import validate_data
+from simulator.sensors import SENSOR_MODELS
+
+HERE = Path(__file__).resolve().parent
+# plain SI numbers: a unit string anywhere in a scenario loads pint, about 1 s once
+SENSORS = {
+    "imu": {"preset": "automotive", "rate": 100, "output": "increment",
+            "lever_arm": [0.8, 0.2, -0.3], "mounting": [0.5, -0.3, 1.0],
+            "timestamp_jitter": 2e-5, "temperature": {"offset": 2.0, "warmup": 8.0},
+            "gyro": {"bandwidth": 40.0, "ramp": 1e-8},
+            "accel": {"bandwidth": 40.0, "ramp": 1e-6}},
+    "odometer": {"preset": "abs-wheel-speed"},
+    "baro": {"preset": "bosch-bmp280", "drift": -50.0 / 3600.0},
+    "mag": {"preset": "automotive"},
+}
+
+
+def hour_data() -> dict:
+    data = yaml.safe_load((HERE / "hour_drive.yaml").read_text())
+    data["trajectory"]["segments"] = LOOP * 24  # about 3650 s
+    data["sensors"] = SENSORS
+    return data
+
+
+def best_of_three(run) -> float:
+    times = []
+    for _ in range(3):
+        start = time.perf_counter()
+        run()
+        times.append(time.perf_counter() - start)
+    return min(times)
+
+
+def main() -> None:
+    data = hour_data()
+    scenario = validate_data(data, "hour.yaml")
+    truth = build_truth(scenario)
+    total = 0.0
+    for name, block in scenario["sensors"].items():
+        if block is None:
+            continue
+        model = SENSOR_MODELS[name](block)
+        best = best_of_three(lambda model=model, name=name:
+                             model.generate(truth, sensor_rng(scenario["seed"], name)))
+        total += best
+        print(f"{name:9s} generate: {best:.3f} s")
+    print(f"all sensors, in process: {total:.3f} s for a {truth.duration_s:.0f} s drive "
+          f"({truth.duration_s / total:.0f}x real time)")
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "hour.yaml"
+        path.write_text(yaml.safe_dump(data))
+        out = Path(tmp) / "out"
+        best = best_of_three(lambda: subprocess.run(
+            [sys.executable, "-m", "simulator.cli", "generate", str(path), "-o", str(out),
+             "--force"], check=True, capture_output=True))
+        rows = json.loads((out / "manifest.json").read_text())["streams"]
+        print(f"landnav generate (whole process): {best:.2f} s "
+              f"({truth.duration_s / best:.0f}x real time); rows: "
+              + ", ".join(f"{k} {v['rows']}" for k, v in rows.items()))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,389 @@
+"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the GPS
+satellites in view, and the receiver's own fixes computed from them, so that a fix degrades
+exactly when and how the measurements do.
+
+Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
+``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac), ``elevation_mask``
+(deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
+(body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
+DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative 1-sigma of the
+ionosphere the broadcast model misses (common to all signals, plus an independent part per
+signal of half that size), ``tropo_residual`` zenith 1-sigma, ``sis_error`` 1-sigma
+signal-in-space range error, ``cn0_noise``; see ``simulator.gnss.errors``), the tracking-loop
+and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
+single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
+mass-market single-frequency receiver with a TCXO.
+
+Streams: ``gnss_raw`` (one row per tracked signal), ``gnss_fix`` (one row per epoch: 3D fix
+from four signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
+elements used) and ``truth_gnss`` (the true error terms of every signal above the horizon).
+Epoch times ``t`` are true GPS time since the scenario start; the receiver clock error is in
+the measurements.
+
+Public names
+------------
+GNSS_FIELD, PRESETS, Gnss.
+
+References
+----------
+Oscillator h-parameters: Brown & Hwang 2012, Table 9.1. See ``simulator.gnss`` modules for the
+signal, error and fix models.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from pathlib import Path as FilePath
+
+import numpy as np
+import pandas as pd
+
+from simulator import columns as col
+from simulator.earth import (
+    earth_rate_ned,
+    ecef_to_geodetic,
+    euler_to_dcm,
+    geodetic_to_ecef,
+    ned_to_ecef_matrix,
+    radii_of_curvature,
+)
+from simulator.environment import ZONE_FIELD
+from simulator.environment.sky import canyon_visibility
+from simulator.errors import InputError, Problem
+from simulator.gnss.atmosphere import broadcast_delays
+from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
+from simulator.gnss.constellation import nominal_gps_navigation
+from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
+from simulator.gnss.errors import (
+    OSCILLATORS,
+    draw_error_terms,
+    draw_receiver_clock,
+    pseudorange_sigma,
+)
+from simulator.gnss.fix import receiver_fixes
+from simulator.gnss.navfiles import read_navigation
+from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
+from simulator.scenario.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
+from simulator.sensors.base import sample_times
+from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.timebase import utc_to_gps
+from simulator.trajectory.kinematics import Kinematics
+
+PRESETS: dict[str, dict] = {
+    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
+                   "iono_residual": 0.2, "tropo_residual": 0.05, "sis_error": 0.5,
+                   "cn0_noise": 1.0},
+    "ideal": {"clock": "ideal", "tracking_noise": 0.0, "multipath": 0.0, "iono_residual": 0.0,
+              "tropo_residual": 0.0, "sis_error": 0.0, "cn0_noise": 0.0},
+}
+# broadcast ionosphere used with the nominal constellation: the coefficients of the IGS
+# broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
+DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
+DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
+# a zone the environment block does not describe, or describes in part: the schema's defaults
+_ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
+
+
+# the error levels a preset sets (a key the scenario gives overrides the preset's value)
+_ERROR_FIELDS = {
+    "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
+    "tracking_noise": Number("", None, min=0,
+                             doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
+    "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
+    "iono_residual": Number("", None, min=0,
+                            doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
+    "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
+    "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
+    "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
+}
+
+
+def _resolve(value: dict, path: Path, ctx: Context) -> dict:
+    if not known_preset(value["preset"], PRESETS, "GNSS", path, ctx):
+        return INVALID
+    value = fill_from_preset(value, PRESETS[value["preset"]], _ERROR_FIELDS, path, ctx, {})
+    if value is INVALID:
+        return INVALID
+    if value["clock"] not in OSCILLATORS:
+        return ctx.error(path + ("clock",), f"unknown oscillator {value['clock']!r}; known: "
+                                            f"{', '.join(sorted(OSCILLATORS))}")
+    source = value["constellation"]
+    if source != "nominal-gps":
+        candidates = [FilePath(source)]
+        if ctx.file and not FilePath(source).is_absolute():
+            candidates.insert(0, FilePath(ctx.file).resolve().parent / source)
+        found = [c for c in candidates if c.is_file()]
+        if not found:
+            return ctx.error(path + ("constellation",),
+                             f"{source!r} is neither 'nominal-gps' nor an existing RINEX "
+                             "navigation or YUMA almanac file")
+        value["constellation"] = str(found[0].resolve())
+    if value["cn0_horizon"] > value["cn0_zenith"]:
+        return ctx.error(path + ("cn0_horizon",), "must not exceed cn0_zenith")
+    return value
+
+
+GNSS_FIELD = Record(
+    {
+        "preset": Text("automotive", doc="error preset: 'automotive' or 'ideal' (no errors)"),
+        "rate": Number("Hz", 1.0, gt=0, max=100),
+        "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1),
+        "constellation": Text("nominal-gps",
+                              doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
+        "elevation_mask": Number(angle=True, default=10.0, min=0, max=90),
+        "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
+        **_ERROR_FIELDS,
+        "multipath_correlation_time": Number("s", 5.0, gt=0),
+        "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
+        "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
+        "cn0_threshold": Number("", 25.0, doc="tracking threshold, dB-Hz"),
+        "dll_bandwidth": Number("Hz", 0.5, gt=0),
+        "correlator_spacing": Number("", 0.5, gt=0, max=1, doc="early-late spacing, chips"),
+        "fll_bandwidth": Number("Hz", 0.5, gt=0, doc="carrier (frequency) loop noise bandwidth"),
+        "integration_time": Number("s", 0.02, gt=0, max=0.02),
+        "smoothing": Number("s", 0.0, min=0, doc="fix smoothing time constant (0 = none)"),
+        "dop_mask": Number("", 20.0, gt=0, doc="no fix when the HDOP is above this"),
+    },
+    default=None,
+    post=_resolve,
+)
+
+
+class Gnss:
+    """A GPS L1 C/A receiver built from its resolved scenario block (``sensors.gnss``)."""
+
+    name = "gnss"
+
+    def __init__(self, config: dict):
+        self.config = config
+        self.rate_hz = float(config["rate"])
+        self.drawn: dict = {"preset": config["preset"], "constellation": config["constellation"]}
+
+    # -- inputs --------------------------------------------------------------------------------
+    def navigation(self, truth: Kinematics) -> pd.DataFrame:
+        """The navigation table used for the drive (nominal constellation or the named file)."""
+        week0, _ = utc_to_gps(truth.utc_start)
+        if self.config["constellation"] == "nominal-gps":
+            nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0)
+            nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
+            return nav
+        return read_navigation(self.config["constellation"], reference_week=week0)
+
+    def antenna(self, truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Antenna ECEF position and velocity, geodetic position, and heading at times t."""
+        k = truth.inertial(t)
+        lever = np.asarray(self.config["antenna_lever_arm"], dtype=float)
+        c_bn = euler_to_dcm(k["roll"], k["pitch"], k["yaw"])
+        c_ne = ned_to_ecef_matrix(k["lat"], k["lon"])
+        pos = geodetic_to_ecef(k["lat"], k["lon"], k["alt"])
+        pos = pos + np.einsum("nij,njk,k->ni", c_ne, c_bn, lever)
+        # body rate w.r.t. the Earth, w_eb^b = w_ib^b - C_n^b w_ie^n, turns the lever arm
+        w_eb = k["w_body"] - np.einsum("nji,nj->ni", c_bn, earth_rate_ned(k["lat"]))
+        v_ned = k["v_ned"] + np.einsum("nij,nj->ni", c_bn, np.cross(w_eb, lever))
+        vel = np.einsum("nij,nj->ni", c_ne, v_ned)
+        lat, lon, alt = ecef_to_geodetic(pos)
+        return {"pos": pos, "vel": vel, "v_ned": v_ned, "lat": lat, "lon": lon, "alt": alt,
+                "yaw": k["yaw"]}
+
+    def sky(self, truth: Kinematics, t: np.ndarray, az: np.ndarray, el: np.ndarray,
+            yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Line of sight, NLOS, NLOS extra path (m) and C/N0 loss (dB) per satellite and epoch
+        from the environment zones (``sky``: open, none, canyon)."""
+        los = np.ones(el.shape, dtype=bool)
+        nlos = np.zeros(el.shape, dtype=bool)
+        extra = np.zeros(el.shape)
+        loss = np.zeros(el.shape)
+        zones = (truth.environment or {}).get("zones", {}) or {}
+        names = truth.zone_at(t)
+        for name in sorted(set(names) - {""}):  # one pass per zone
+            zone = {**_ZONE_DEFAULTS, **(zones.get(name) or {})}
+            here = names == name
+            if zone["sky"] == "none":
+                los[:, here] = False
+            elif zone["sky"] == "canyon":
+                z_los, z_nlos, z_extra = canyon_visibility(
+                    az[:, here], el[:, here], yaw[None, here], zone["building_height"],
+                    zone["street_width"])
+                los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
+                loss[:, here] = np.where(z_nlos, zone["nlos_attenuation"], 0.0)
+        return los, nlos, extra, loss
+
+    def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
+                        max_age_s: float) -> None:
+        """A navigation file that does not cover the drive is an input error, not a silent
+        outage: at least four satellites need an ephemeris at every epoch."""
+        short = (idx >= 0).sum(axis=0) < 4
+        if short.any():
+            raise InputError([Problem(
+                self.config["constellation"], None, "sensors.gnss.constellation",
+                f"fewer than four satellites have an ephemeris within {max_age_s / 3600:g} h "
+                f"of the drive from t = {t[short][0]:g} s (the drive starts "
+                f"{truth.utc_start:%Y-%m-%d %H:%M:%S} UTC); use a navigation file of that "
+                "day or 'nominal-gps'")])
+
+    # -- generation ----------------------------------------------------------------------------
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+        cfg = self.config
+        t = sample_times(truth.duration_s, self.rate_hz)
+        dt_s = 1.0 / self.rate_hz
+        week0, tow0 = utc_to_gps(truth.utc_start)
+        nav = self.navigation(truth)
+        eph = ephemeris_arrays(nav, week0)
+        # an almanac describes the orbits for days (coarsely); an ephemeris for its fit interval
+        max_age = 7 * 86400.0 if nav.attrs.get("kind") == "almanac" else 4 * 3600.0
+        svs = np.unique(nav["sv"].to_numpy())
+        idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age)
+        self._check_coverage(idx, t, truth, max_age)
+
+        # geometry: antenna, signal flight, look angles, broadcast delays (satellites x epochs)
+        ant = self.antenna(truth, t)
+        alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
+        beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
+        self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
+        new_year = dt.datetime(truth.utc_start.year, 1, 1)
+        day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
+        geo = model = _signals_in_chunks(eph, idx, tow0 + t, ant, day_of_year, alpha, beta)
+        el, az = geo["elevation"], geo["azimuth"]
+
+        # what the receiver tracks
+        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
+        cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss \
+            + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+        have = idx >= 0
+        tracked = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos) \
+            & (cn0 >= cfg["cn0_threshold"])
+
+        # errors and measurements
+        bias_s, drift_s_s, self.drawn["clock"] = draw_receiver_clock(rng, cfg["clock"], len(t),
+                                                                      dt_s)
+        err = draw_error_terms(rng, cfg, el, cn0, dt_s)
+        self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
+        mapping = model["tropo"] / model["zenith"]
+        iono_true = model["iono"] * err["iono_ratio"]
+        tropo_true = model["tropo"] + err["tropo_zenith"] * mapping
+        iono_true_rate = model["iono_rate"] * err["iono_ratio"]
+        tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
+        nlos_delay = np.where(nlos & ~los, extra, 0.0)
+        sat_clock = C_M_S * geo["clock_s"]
+        sat_drift = C_M_S * geo["clock_drift_s_s"]
+        rx_clock = C_M_S * bias_s[None, :]
+        rx_drift = C_M_S * drift_s_s[None, :]
+        pseudorange = (geo["range"] + rx_clock - sat_clock + iono_true + tropo_true
+                       + err["sis"] + err["multipath"] + nlos_delay + err["code_noise"])
+        rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
+                + tropo_true_rate - iono_true_rate + err["rate_noise"])
+        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping)
+
+        table = _RowTable(t, svs)
+        raw = table(tracked, {
+            "pseudorange": pseudorange, "pseudorange_rate": rate,
+            "doppler": -rate / LAMBDA_L1_M, "cn0": cn0,
+            "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
+            "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
+            "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
+            "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": model["iono"],
+            "tropo": model["tropo"], "elevation": el, "azimuth": az,
+            "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
+        })[list(col.GNSS_RAW)]
+        truth_table = table(have & (el > 0), {
+            "tracked": tracked.astype(np.int8), "los": los.astype(np.int8),
+            "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
+            "range": geo["range"], "range_rate": geo["range_rate"],
+            "receiver_clock": rx_clock, "receiver_clock_drift": rx_drift,
+            "iono_true": iono_true, "tropo_true": tropo_true,
+            "iono_true_rate": iono_true_rate, "tropo_true_rate": tropo_true_rate,
+            "sis_error": err["sis"], "multipath": err["multipath"], "nlos_delay": nlos_delay,
+            "code_noise": err["code_noise"], "rate_noise": err["rate_noise"],
+            "antenna_x": ant["pos"][None, :, 0], "antenna_y": ant["pos"][None, :, 1],
+            "antenna_z": ant["pos"][None, :, 2],
+        })[list(col.TRUTH_GNSS)]
+        used = np.unique(idx[idx >= 0])
+        out = {"gnss_nav": nav.iloc[used].reset_index(drop=True)[list(col.GNSS_NAV)],
+               "truth_gnss": truth_table}
+        # the raw stream always comes out here: faults act on the measurements and the fixes
+        # are recomputed from them; the generator drops it if the scenario did not ask for it
+        out["gnss_raw"] = raw
+        if "fix" in cfg["outputs"]:
+            out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"], cfg["dop_mask"])
+        return out
+
+
+CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives
+COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
+BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
+# what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
+_KEPT = ("pos", "vel", "clock_s", "clock_drift_s_s", "range", "range_rate", "tau_rate",
+         "elevation", "azimuth", "iono", "tropo", "zenith", "iono_rate", "tropo_rate")
+
+
+def _signals(eph: dict[str, np.ndarray], t_gps: np.ndarray, ant: dict[str, np.ndarray],
+             day_of_year: np.ndarray, alpha: list[float], beta: list[float]
+             ) -> dict[str, np.ndarray]:
+    """Signal geometry, look angles and broadcast delays (with rates) of gathered ephemerides
+    (n_sat, n_epoch) received by the antenna ``ant`` (arrays over the same n_epoch)."""
+    geo = signal_geometry(eph, t_gps, ant["pos"], ant["vel"])
+    look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
+    rn, re = radii_of_curvature(ant["lat"])
+    model = broadcast_delays(
+        ant["lat"], ant["lon"], ant["alt"], look["azimuth"], look["elevation"], t_gps,
+        day_of_year, alpha, beta,
+        rates={"lat": ant["v_ned"][:, 0] / (rn + ant["alt"]),
+               "lon": ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"])),
+               "alt": -ant["v_ned"][:, 2], "azimuth": look["azimuth_rate"],
+               "elevation": look["elevation_rate"]})
+    return {**geo, **look, **model}
+
+
+def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
+                         ant: dict[str, np.ndarray]) -> np.ndarray:
+    """Satellites (rows of idx) that may rise above the horizon during these epochs: their
+    elevation, sampled every ``COARSE_STEP_S`` without the light-time correction, exceeds
+    ``BELOW_HORIZON_MARGIN_RAD`` somewhere."""
+    n = len(t_gps)
+    step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
+    cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
+    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
+    lat, lon = ant["lat"][cols], ant["lon"][cols]
+    up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+    rel = pos - ant["pos"][None, cols]
+    sin_el = np.einsum("sek,ek->se", rel, up) / np.linalg.norm(rel, axis=-1)
+    return np.flatnonzero((sin_el > np.sin(BELOW_HORIZON_MARGIN_RAD)).any(axis=1)
+                          & (idx >= 0).any(axis=1))
+
+
+def _signals_in_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
+                       ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
+                       beta: list[float]) -> dict[str, np.ndarray]:
+    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time and only
+    for the satellites that may be above the horizon in each chunk; the others keep elevation
+    -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
+    n_sat, n_ep = idx.shape
+    first = {k: v[:1] for k, v in ant.items()}
+    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
+    fill = {"elevation": -np.pi / 2, "zenith": 1.0}
+    out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
+    for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
+        cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
+        ant_c = {k: v[cols] for k, v in ant.items()}
+        rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
+        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
+                        alpha, beta)
+        for key in _KEPT:
+            out[key][rows, cols] = part[key]
+    return out
+
+
+class _RowTable:
+    """Flattens (satellite, epoch) arrays into stream rows: epochs first, satellites in PRN
+    order within an epoch, only where a mask is set."""
+
+    def __init__(self, t: np.ndarray, svs: np.ndarray):
+        self.t, self.svs = t, svs
+
+    def __call__(self, mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
+        m = mask.T
+        out = {"t": np.broadcast_to(self.t[:, None], m.shape)[m],
+               "sv": np.broadcast_to(self.svs[None, :], m.shape)[m]}
+        for key, value in columns.items():
+            out[key] = np.swapaxes(np.broadcast_to(value, mask.shape), 0, 1)[m]
+        return pd.DataFrame(out)

@@ -1,0 +1,202 @@
+"""Random error processes of sensors, generated vectorised and discretised exactly, and their
+analytic Allan variances.
+
+Every process here is defined in continuous time and sampled exactly at the sample times, so its
+statistics do not depend on the sample rate (a first-order Gauss-Markov process is the exact
+AR(1) recursion, run vectorised by recursive doubling in ``ar1_filter``; scipy is not imported,
+so that generating a dataset stays quick to start).
+
+Conventions (IEEE Std 952-1997, Annex C): a white rate noise of density N (unit/sqrt(Hz)) has
+Allan variance N^2 / tau; a rate random walk of density K (unit/s/sqrt(Hz)) has K^2 tau / 3; a
+flicker ("bias instability") noise with two-sided power spectral density B^2 / (2 pi f) has the flat
+Allan deviation sqrt(2 ln 2 / pi) B = 0.664 B.
+
+Public names
+------------
+FLICKER_ADEV_FACTOR, GM_ADEV_PEAK, GM_ADEV_PEAK_TAU, FLICKER_TAUS_S,
+ar1_filter, white, random_walk, gauss_markov, flicker, gauss_markov_avar, flicker_avar,
+adev_model.
+
+References
+----------
+IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for Single-Axis
+Interferometric Fiber Optic Gyros*, Annex C (Allan variance of the noise terms).
+Gelb, *Applied Optimal Estimation*, 1974, Table 3.8-1 (exact discrete first-order Markov process).
+Keshner, "1/f noise", Proc. IEEE 70(3), 1982 (1/f spectrum as a sum of Lorentzians with
+log-uniform time constants).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from estimators.gauss_markov import gauss_markov_discrete
+
+# Allan deviation floor of flicker noise per unit bias instability, sqrt(2 ln 2 / pi) (IEEE 952)
+FLICKER_ADEV_FACTOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
+
+# time constants of the Gauss-Markov processes whose sum makes the flicker floor: two per decade
+# from 0.1 s to 1e5 s, fixed (not tied to the sample rate, so the process is rate independent);
+# the floor is flat within 1 % from about 1 s to 1e4 s
+FLICKER_TAUS_S = 10.0 ** (np.arange(-2, 11) / 2.0)
+_FLICKER_RATIO = 10.0 ** 0.5  # ratio of consecutive time constants
+# a flicker component slower than this many samples per correlation time is generated exactly on
+# a coarser grid of this many points per correlation time and interpolated linearly (the part of
+# its variance the interpolation misses is about 1 / (2 x 64), under 1 %)
+_POINTS_PER_TAU = 64
+
+
+def _gm_avar_unit(x: np.ndarray) -> np.ndarray:
+    """Allan variance of a unit-variance Gauss-Markov process at tau = x * correlation time."""
+    x = np.asarray(x, dtype=float)
+    small = x < 1e-4
+    xs = np.where(small, 1.0, x)
+    full = (2 * xs - 3 + 4 * np.exp(-xs) - np.exp(-2 * xs)) / xs**2
+    return np.where(small, 2.0 * x / 3.0, full)
+
+
+_X = np.linspace(1.0, 3.0, 200_001)  # search grid for the peak, step 1e-5 correlation times
+# Allan deviation peak of a unit-variance Gauss-Markov process and where it sits (in correlation
+# times): about 0.6174 at 1.893 tau_c
+GM_ADEV_PEAK = float(np.sqrt(_gm_avar_unit(_X).max()))
+GM_ADEV_PEAK_TAU = float(_X[np.argmax(_gm_avar_unit(_X))])
+
+
+def ar1_filter(u: np.ndarray, phi: float) -> np.ndarray:
+    """x[k] = phi x[k-1] + u[k] along axis 0, x[-1] = 0 (the first-order recursion of an exact
+    Gauss-Markov discretisation), by recursive doubling: after the pass with shift s each x[k]
+    holds the sum over the last 2 s inputs, so log2(n) vectorised passes replace the loop.
+    Stops early once phi^s underflows (the older inputs no longer count)."""
+    x = np.array(u, dtype=float)
+    power, shift = phi, 1
+    while shift < len(x) and power > 0.0:
+        x[shift:] += power * x[:-shift]
+        power, shift = power * power, shift * 2
+    return x
+
+
+def white(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generator,
+          increment: bool = False) -> np.ndarray:
+    """Samples of white noise of two-sided density ``density`` (per axis, shape (m,)).
+
+    Rate output: sigma = N / sqrt(dt); increment output (the noise integrated over each
+    interval): sigma = N * sqrt(dt). Returns shape (n, m).
+    """
+    density = np.atleast_1d(np.asarray(density, dtype=float))
+    scale = np.sqrt(dt_s) if increment else 1.0 / np.sqrt(dt_s)
+    return rng.standard_normal((n, density.size)) * (density * scale)
+
+
+def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Random walk b(k dt) = K * W(k dt) sampled exactly, b(0) = 0; K per axis (unit/s/sqrt(Hz)).
+
+    Allan variance K^2 tau / 3 (IEEE Std 952, Annex C). Returns shape (n, m).
+    """
+    density = np.atleast_1d(np.asarray(density, dtype=float))
+    steps = rng.standard_normal((n, density.size)) * (density * np.sqrt(dt_s))
+    steps[0] = 0.0
+    return np.cumsum(steps, axis=0)
+
+
+def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float,
+                 rng: np.random.Generator) -> np.ndarray:
+    """Stationary first-order Gauss-Markov process, exact discretisation (Gelb 1974, Table 3.8-1).
+
+    x[k+1] = exp(-dt/tau) x[k] + sigma sqrt(1 - exp(-2 dt/tau)) w[k], x[0] ~ N(0, sigma^2).
+
+    Parameters
+    ----------
+    n : number of samples.
+    dt_s : sample interval, s.
+    sigma : stationary standard deviation per axis, shape (m,).
+    tau_s : correlation time, s.
+
+    Returns
+    -------
+    ndarray, shape (n, m)
+    """
+    sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
+    phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
+    drive = rng.standard_normal((n, sigma.size)) * np.sqrt(q_unit)
+    drive[0] = rng.standard_normal(sigma.size)
+    return ar1_filter(drive, phi) * sigma
+
+
+def flicker(n: int, dt_s: float, instability: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Flicker (1/f) bias with the flat Allan floor 0.664 B, as a sum of Gauss-Markov processes.
+
+    Lorentzians with log-uniformly spaced time constants (``FLICKER_TAUS_S``, ratio r between
+    neighbours) each of variance B^2 ln(r) / pi sum to the two-sided spectrum B^2 / (2 pi f)
+    between 1 / (2 pi tau_max) and 1 / (2 pi tau_min) (Keshner 1982). Components with more than
+    128 samples per correlation time run exactly on a grid of tau / 64 and are interpolated.
+
+    Parameters
+    ----------
+    n : number of samples.
+    dt_s : sample interval, s.
+    instability : bias instability B per axis, shape (m,).
+
+    Returns
+    -------
+    ndarray, shape (n, m)
+    """
+    instability = np.atleast_1d(np.asarray(instability, dtype=float))
+    sigma = instability * np.sqrt(np.log(_FLICKER_RATIO) / np.pi)
+    total = np.zeros((n, instability.size))
+    t = np.arange(n) * dt_s
+    # slow components, slowest first, each on its own grid of tau / 64; the running sum is carried
+    # down to each finer grid, and to the sample times once at the end
+    grid, slow = None, None
+    for tau in sorted(FLICKER_TAUS_S, reverse=True):
+        step = tau / _POINTS_PER_TAU
+        if step < 2 * dt_s:
+            total += gauss_markov(n, dt_s, sigma, tau, rng)
+            continue
+        fine = np.arange(int(np.ceil(t[-1] / step)) + 2) * step
+        part = gauss_markov(len(fine), step, sigma, tau, rng)
+        if slow is not None:
+            part += _interp_columns(fine, grid, slow)
+        grid, slow = fine, part
+    if slow is not None:
+        total += _interp_columns(t, grid, slow)
+    return total
+
+
+def _interp_columns(x: np.ndarray, xp: np.ndarray, fp: np.ndarray) -> np.ndarray:
+    """Linear interpolation of each column of fp (len(xp), m) at x."""
+    return np.stack([np.interp(x, xp, fp[:, j]) for j in range(fp.shape[1])], axis=1)
+
+
+def gauss_markov_avar(tau_s: np.ndarray, sigma: float, corr_time_s: float) -> np.ndarray:
+    """Allan variance of a Gauss-Markov process of std ``sigma`` and correlation time tau_c.
+
+    AVAR(T) = sigma^2 (tau_c / T)^2 (2 T / tau_c - 3 + 4 exp(-T / tau_c) - exp(-2 T / tau_c)).
+    """
+    return sigma**2 * _gm_avar_unit(np.asarray(tau_s, dtype=float) / corr_time_s)
+
+
+def flicker_avar(tau_s: np.ndarray, instability: float) -> np.ndarray:
+    """Allan variance of the sum-of-Gauss-Markov flicker process made by ``flicker``."""
+    sigma = instability * np.sqrt(np.log(_FLICKER_RATIO) / np.pi)
+    return sum(gauss_markov_avar(tau_s, sigma, tau) for tau in FLICKER_TAUS_S)
+
+
+def adev_model(tau_s: np.ndarray, noise_density: float = 0.0, bias_instability: float = 0.0,
+               random_walk_density: float = 0.0, ramp: float = 0.0,
+               correlation_time_s: float | None = None) -> np.ndarray:
+    """Allan deviation of white noise + bias instability + random walk + rate ramp
+    (IEEE Std 952, Annex C: N^2 / tau, K^2 tau / 3, R^2 tau^2 / 2).
+
+    The bias instability B is a Gauss-Markov process whose Allan peak is 0.664 B when a
+    correlation time is given, and the flicker sum of ``flicker`` otherwise.
+    """
+    tau_s = np.asarray(tau_s, dtype=float)
+    avar = (noise_density**2 / tau_s + random_walk_density**2 * tau_s / 3.0
+            + ramp**2 * tau_s**2 / 2.0)
+    if bias_instability > 0:
+        if correlation_time_s:
+            sigma = FLICKER_ADEV_FACTOR * bias_instability / GM_ADEV_PEAK
+            avar = avar + gauss_markov_avar(tau_s, sigma, correlation_time_s)
+        else:
+            avar = avar + flicker_avar(tau_s, bias_instability)
+    return np.sqrt(avar)

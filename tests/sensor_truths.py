@@ -1,0 +1,39 @@
+"""Small exact trajectories for the sensor tests (built without the scenario loader)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from simulator.scenario.schema import Context
+from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
+from simulator.trajectory.segments import LIMITS_FIELD, SEGMENT_FIELD, build_road_profile
+
+SHARED = Path(__file__).resolve().parents[2] / "shared"
+
+DRIVE = [
+    {"stop": {"duration": 10}}, {"accelerate": {"to_speed": 12, "accel": 1.5}},
+    {"straight": {"length": 300}}, {"turn": {"angle": 90, "radius": 40}},
+    {"slope": {"grade": 0.06, "length": 200}}, {"accelerate": {"to_speed": 0, "accel": 2.0}},
+    {"stop": {"duration": 5}},
+]
+
+
+def truth_from_segments(segments: list[dict], rate_hz: float = 100.0,
+                        start: dict | None = None) -> Kinematics:
+    ctx = Context("test")
+    limits = LIMITS_FIELD.check({}, ("limits",), ctx)
+    segs = [SEGMENT_FIELD.check(s, ("segments", i), ctx) for i, s in enumerate(segments)]
+    profile = build_road_profile(segs, limits, ctx)
+    assert not ctx.problems, ctx.problems
+    start = start or {"lat": 37.0, "lon": 127.0, "alt": 40.0, "heading": 30.0}
+    return kinematics_from_profile(profile, start, rate_hz, limits["roll_gradient"])
+
+
+def static_truth(duration_s: float) -> Kinematics:
+    """A vehicle standing still for ``duration_s`` (base grid 1 Hz: only the IMU samples it)."""
+    return truth_from_segments([{"stop": {"duration": duration_s}}], rate_hz=1.0)
+
+
+def drive_truth() -> Kinematics:
+    """A short drive with a stop, acceleration, straight, turn, slope and braking to a stop."""
+    return truth_from_segments(DRIVE)

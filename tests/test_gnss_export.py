@@ -1,0 +1,105 @@
+"""``landnav export``: RINEX 3.04 observation and navigation files read back with georinex
+(an independent reader) give the dataset's values; NMEA sentences parse with pynmeagps with
+valid checksums and carry the fixes."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from simulator.cli import main
+from simulator.dataset.io import open_dataset
+from simulator.gnss.navfiles import read_rinex_nav
+from simulator.gnss.nmea import nmea_checksum
+
+SCENARIO = {
+    "name": "export-test",
+    "seed": 5,
+    "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5665, "lon": 126.978, "alt": 40.0,
+              "heading": 90.0},
+    "trajectory": {"kind": "segments", "segments": [
+        {"stop": {"duration": 5}}, {"accelerate": {"to_speed": 10.0, "accel": 2.0}},
+        {"straight": {"length": 100, "zone": "tunnel"}}, {"straight": {"length": 100}}]},
+    "environment": {"zones": {"tunnel": {"sky": "none"}}},
+    "sensors": {"imu": {"preset": "ideal", "rate": 10}, "gnss": {"rate": 1}},
+}
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory):
+    root = tmp_path_factory.mktemp("export")
+    (root / "s.yaml").write_text(yaml.safe_dump(SCENARIO))
+    assert main(["generate", str(root / "s.yaml"), "-o", str(root / "ds")]) == 0
+    assert main(["export", str(root / "ds"), "--rinex", str(root / "rinex"),
+                 "--nmea", str(root / "out.nmea")]) == 0
+    return root, open_dataset(root / "ds")
+
+
+def test_rinex_observations_read_back_with_georinex(exported):
+    georinex = pytest.importorskip("georinex")
+    root, ds = exported
+    raw = ds.read("gnss_raw")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        obs = georinex.load(root / "rinex" / "ds.obs")
+    frame = obs.to_dataframe().reset_index().dropna(subset=["C1C"])
+    t0 = pd.Timestamp("2024-05-01T03:00:00") + pd.Timedelta(seconds=18)  # GPS = UTC + 18 s
+    frame["t"] = (frame["time"] - t0).dt.total_seconds()
+    frame["sv"] = frame["sv"].str[1:].astype(int)
+    merged = raw.merge(frame, on=["t", "sv"], how="outer", indicator=True)
+    assert (merged["_merge"] == "both").all() and len(merged) == len(raw) > 100
+    # identical to the file format's resolution (F14.3)
+    for ours, theirs in (("pseudorange", "C1C"), ("doppler", "D1C"), ("cn0", "S1C")):
+        assert np.abs(merged[ours] - merged[theirs]).max() <= 0.0005 + 1e-9
+
+
+def test_rinex_navigation_reads_back_with_georinex_and_our_reader(exported):
+    georinex = pytest.importorskip("georinex")
+    root, ds = exported
+    nav = ds.read("gnss_nav").sort_values("sv").reset_index(drop=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        theirs = georinex.load(root / "rinex" / "ds.nav").to_dataframe().reset_index()
+    theirs = theirs.dropna(subset=["sqrtA"]).sort_values("sv").reset_index(drop=True)
+    assert len(theirs) == len(nav)
+    pairs = {"af0": "SVclockBias", "af1": "SVclockDrift", "m0": "M0", "e": "Eccentricity",
+             "sqrt_a": "sqrtA", "toe": "Toe", "omega0": "Omega0", "i0": "Io",
+             "omega": "omega", "omega_dot": "OmegaDot", "week": "GPSWeek", "tgd": "TGD"}
+    for ours, name in pairs.items():
+        np.testing.assert_allclose(theirs[name], nav[ours], rtol=1e-12, atol=1e-300)
+    back = read_rinex_nav(root / "rinex" / "ds.nav").sort_values("sv").reset_index(drop=True)
+    pd.testing.assert_frame_equal(back[nav.columns], nav, check_dtype=False, rtol=1e-12)
+    iono = ds.manifest["sensors"]["gnss"]["broadcast_iono"]
+    np.testing.assert_allclose(back.attrs["iono_alpha"], iono["alpha"], rtol=1e-4)
+    np.testing.assert_allclose(back.attrs["iono_beta"], iono["beta"], rtol=1e-4)
+
+
+def test_nmea_sentences_parse_with_valid_checksums(exported):
+    pynmeagps = pytest.importorskip("pynmeagps")
+    root, ds = exported
+    fix = ds.read("gnss_fix")
+    lines = (root / "out.nmea").read_bytes().decode("ascii").split("\r\n")[:-1]
+    parsed = [pynmeagps.NMEAReader.parse(line, validate=pynmeagps.VALCKSUM) for line in lines]
+    kinds = pd.Series([p.msgID for p in parsed])
+    assert set(kinds) == {"GGA", "RMC", "VTG", "GSA", "GSV"}
+    assert (kinds == "GGA").sum() == len(fix)
+    for line in lines:
+        body, cs = line[1:].split("*")
+        assert cs == nmea_checksum(body)
+    gga = [p for p in parsed if p.msgID == "GGA"]
+    rmc = [p for p in parsed if p.msgID == "RMC"]
+    with_fix = fix["fix"].to_numpy() == 2
+    assert with_fix.any() and (~with_fix).any()  # the tunnel gives epochs without a fix
+    lat = np.array([g.lat if g.quality else np.nan for g in gga], dtype=float)
+    lon = np.array([g.lon if g.quality else np.nan for g in gga], dtype=float)
+    np.testing.assert_allclose(lat[with_fix], fix["lat"][with_fix], atol=2e-8)
+    np.testing.assert_allclose(lon[with_fix], fix["lon"][with_fix], atol=2e-8)
+    assert [g.quality for g in gga] == [1 if f else 0 for f in with_fix]
+    assert [g.numSV for g in gga] == fix["num_sats"].tolist()
+    assert [r.status for r in rmc] == ["A" if f else "V" for f in with_fix]
+    speed = np.array([r.spd if r.spd != "" else np.nan for r in rmc], dtype=float)
+    np.testing.assert_allclose(speed[with_fix] * 1852 / 3600, fix["speed"][with_fix], atol=1e-3)

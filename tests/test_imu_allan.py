@@ -1,0 +1,198 @@
+"""IMU noise statistics checked with allantools (an independent Allan-deviation implementation):
+noise density at tau = 1 s, the bias-instability floor 0.664 B (IEEE Std 952-1997), the
+Gauss-Markov bias at two rates, and the presets fitted to real units against the real curves."""
+
+from __future__ import annotations
+
+import allantools
+import numpy as np
+import pytest
+from sensor_truths import SHARED, static_truth
+
+from simulator import columns as col
+from simulator.scenario.schema import Context
+from simulator.sensors.imu import IMU_FIELD, Imu
+from simulator.sensors.noise import (
+    FLICKER_ADEV_FACTOR,
+    GM_ADEV_PEAK_TAU,
+    gauss_markov,
+    gauss_markov_avar,
+)
+
+REAL = SHARED / "refdata" / "allan" / "imu_utils_real_imus"
+IMU_UTILS_DEG_H = 57.3 * 3600.0  # imu_utils writes gyro ADEV in deg/h with this factor
+GROUPS = {"gyro": col.IMU_AXES[:3], "accel": col.IMU_AXES[3:]}
+
+
+@pytest.fixture(scope="module")
+def hour():
+    return static_truth(3600.0)
+
+
+def static_record(truth, block: dict, seed: int = 5) -> tuple[dict, np.ndarray, float]:
+    ctx = Context("test")
+    cfg = IMU_FIELD.check(block, ("imu",), ctx)
+    assert not ctx.problems, ctx.problems
+    out = Imu(cfg).generate(truth, np.random.default_rng(seed))["imu"]
+    rate = cfg["rate"]
+    values = out[list(col.IMU_AXES)].to_numpy()
+    if cfg["output"] == "increment":
+        values = values * rate  # increments -> mean rates over each interval
+    return cfg, values, rate
+
+
+def adev(series: np.ndarray, rate: float, taus: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    t, dev, _, _ = allantools.oadev(series, rate=rate, data_type="freq", taus=taus)
+    return t, dev
+
+
+@pytest.mark.parametrize("preset", ["automotive", "consumer"])
+@pytest.mark.parametrize("rate, output", [(20.0, "rate"), (100.0, "increment")])
+def test_noise_density_and_flicker_floor(hour, preset, rate, output):
+    cfg, values, rate = static_record(hour, {"preset": preset, "rate": rate, "output": output})
+    # floor read up to a hundredth of the record, where a one-hour flicker curve is known to
+    # about 10 %
+    taus = np.concatenate([[0.2], np.logspace(0, np.log10(36), 15)])
+    for g, (group, axes) in enumerate(GROUPS.items()):
+        density = cfg[group]["noise_density"]
+        floor = FLICKER_ADEV_FACTOR * cfg[group]["bias_instability"]
+        for i in range(3):
+            t, dev = adev(values[:, 3 * g + i], rate, taus)
+            assert t[0] == pytest.approx(0.2) and t[1] == pytest.approx(1.0, rel=0.05)
+            # white noise: the slope -1/2 line sigma(tau) = N / sqrt(tau) read at tau = 1 s
+            # (IEEE Std 952, Annex C), through its value at 0.2 s where the floor adds < 2 %
+            assert dev[0] * np.sqrt(t[0]) == pytest.approx(density, rel=0.10), axes[i]
+            # ... and the curve itself at 1 s, where the floor adds its share
+            assert dev[1] == pytest.approx(np.hypot(density, floor), rel=0.10), axes[i]
+            # bias instability: the flat floor of the curve is 0.664 B
+            assert dev[1:].min() == pytest.approx(floor, rel=0.30), axes[i]
+
+
+@pytest.mark.parametrize("rate", [20.0, 200.0])
+def test_gauss_markov_bias_peak(hour, rate):
+    tau_c = 40.0
+    cfg, values, rate = static_record(
+        hour, {"preset": "automotive", "rate": rate,
+               "gyro": {"bias_correlation_time": tau_c, "random_walk": 0.0},
+               "accel": {"bias_correlation_time": tau_c, "random_walk": 0.0}})
+    taus = np.logspace(0, np.log10(900), 30)
+    for g, group in enumerate(GROUPS):
+        peak = FLICKER_ADEV_FACTOR * cfg[group]["bias_instability"]
+        for i in range(3):
+            t, dev = adev(values[:, 3 * g + i], rate, taus)
+            at_peak = np.argmin(np.abs(t - GM_ADEV_PEAK_TAU * tau_c))
+            assert dev[at_peak] == pytest.approx(peak, rel=0.30)
+            # past the peak the Gauss-Markov bias averages down again: no flat floor
+            assert dev[-1] < dev[at_peak]
+
+
+def test_gauss_markov_same_variance_and_correlation_time_at_20_and_200_hz():
+    tau_c, sigma, duration = 2.0, 0.3, 40.0
+    rng = np.random.default_rng(8)
+    found = {}
+    for rate in (20.0, 200.0):
+        n = int(duration * rate)
+        x = gauss_markov(n, 1.0 / rate, np.full(400, sigma), tau_c, rng)
+        var = np.mean(x**2)
+        lag = int(round(tau_c * rate))
+        rho = np.mean(x[:-lag] * x[lag:]) / var
+        found[rate] = (var, -tau_c / np.log(rho))
+        assert var == pytest.approx(sigma**2, rel=0.05)
+        assert found[rate][1] == pytest.approx(tau_c, rel=0.08)
+    assert found[20.0][0] == pytest.approx(found[200.0][0], rel=0.07)
+    assert found[20.0][1] == pytest.approx(found[200.0][1], rel=0.10)
+
+
+def test_gauss_markov_allan_formula_against_allantools():
+    rate, tau_c, sigma = 10.0, 5.0, 1.0
+    x = gauss_markov(200_000, 1.0 / rate, np.array([sigma]), tau_c, np.random.default_rng(2))
+    taus = np.array([0.5, 2.0, 9.46, 30.0, 100.0])
+    t, dev = adev(x[:, 0], rate, taus)
+    np.testing.assert_allclose(dev, np.sqrt(gauss_markov_avar(t, sigma, tau_c)), rtol=0.08)
+    # the commonly quoted peak at 1.89 correlation times (IEEE Std 952-1997, Annex C, Markov noise)
+    assert GM_ADEV_PEAK_TAU == pytest.approx(1.89, abs=0.01)
+
+
+def real_curve(device: str, group: str, axis: str) -> tuple[np.ndarray, np.ndarray]:
+    tau = np.loadtxt(REAL / f"data_{device}_{group}_t.txt")
+    dev = np.loadtxt(REAL / f"data_{device}_{group}_{axis}.txt")
+    return tau, dev / IMU_UTILS_DEG_H if group == "gyr" else dev
+
+
+REAL_UNITS = [(preset, device, group, axis)
+              for preset, device in (("bosch-bmi160", "BMI160"), ("adis16448", "16448"))
+              for group in ("gyr", "acc") for axis in "xyz"]
+# the ADIS16448 y accelerometer has a bump between 2 s and 200 s that white noise + flicker +
+# random walk + ramp cannot follow: the best fit (tools/fit_imu_presets.py) is 28 % off
+KNOWN_MISFIT = {("adis16448", "acc", "y")}
+
+
+def compare_with_real(preset: str, device: str, duration_s: float, tau_max_s: float,
+                      seeds: list[int]) -> dict:
+    if not REAL.is_dir():
+        pytest.skip(f"real IMU Allan curves not found at {REAL} (shared/refdata is missing)")
+    tau0 = real_curve(device, "gyr", "x")[0][0]
+    truth = static_truth(duration_s)
+    avar = {}
+    for seed in seeds:
+        _, values, rate = static_record(truth, {"preset": preset, "rate": 1.0 / tau0}, seed)
+        for j, name in enumerate(col.IMU_AXES):
+            group = "gyr" if name.startswith("gyro") else "acc"
+            tau, _ = real_curve(device, group, name[-1])
+            _, dev = adev(values[:, j], rate, tau[tau <= tau_max_s])
+            avar[(group, name[-1])] = avar.get((group, name[-1]), 0.0) + dev**2 / len(seeds)
+    return {key: np.sqrt(v) for key, v in avar.items()}
+
+
+def check_real(preset, device, group, axis, simulated, tau_max_s):
+    tau, real = real_curve(device, group, axis)
+    use = tau <= tau_max_s
+    ratio = simulated[(group, axis)] / real[use]
+    worst = np.argmax(np.abs(ratio - 1))
+    assert np.abs(ratio - 1).max() <= 0.25, (
+        f"{preset} {group} {axis}: {ratio[worst] - 1:+.0%} at tau {tau[use][worst]:.3g} s")
+
+
+_CACHE: dict = {}
+
+
+def _real_params() -> list:
+    params = []
+    for preset, device, group, axis in REAL_UNITS:
+        marks = ([pytest.mark.xfail(strict=True, reason="bump not in the noise model")]
+                 if (preset, group, axis) in KNOWN_MISFIT else [])
+        params.append(pytest.param(preset, device, group, axis, marks=marks))
+    return params
+
+
+@pytest.mark.parametrize("preset, device, group, axis", _real_params())
+def test_fitted_presets_follow_real_curves(preset, device, group, axis):
+    # a 40 min record; tau up to 40 s, where its Allan deviation is known to about 10 %
+    if preset not in _CACHE:
+        _CACHE[preset] = compare_with_real(preset, device, 2400.0, 40.0, [1])
+    check_real(preset, device, group, axis, _CACHE[preset], 40.0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("preset, device", [("bosch-bmi160", "BMI160"),
+                                            ("adis16448", "16448")])
+def test_fitted_presets_follow_real_curves_long(preset, device):
+    # records as long as the real ones (twice the longest real tau), Allan variance averaged
+    # over four runs, compared up to a tenth of the record
+    duration = 2.0 * real_curve(device, "gyr", "x")[0][-1]
+    simulated = compare_with_real(preset, device, duration, duration / 10, [1, 2, 3, 4])
+    for group in ("gyr", "acc"):
+        for axis in "xyz":
+            if (preset, group, axis) not in KNOWN_MISFIT:
+                check_real(preset, device, group, axis, simulated, duration / 10)
+
+
+@pytest.mark.parametrize("phi", [0.0, 0.3, 0.905, 0.999999])
+def test_ar1_filter_matches_scipy_lfilter(phi):
+    from scipy.signal import lfilter
+
+    from simulator.sensors.noise import ar1_filter
+
+    u = np.random.default_rng(3).standard_normal((50_000, 3))
+    np.testing.assert_allclose(ar1_filter(u, phi), lfilter([1.0], [1.0, -phi], u, axis=0),
+                               rtol=1e-9, atol=1e-9)
