@@ -121,6 +121,33 @@ def test_campaign_scores_equal_those_of_landnav_run(local, tmp_path):
         runs.loc[runs["label"] == "hold", "horizontal.rms"].iloc[0])
 
 
+def test_gnss_outage_scores_are_means_over_the_runs_outages(tmp_path):
+    scenario = _scenario(tmp_path, ["gnss_only"])
+    data = yaml.safe_load(scenario.read_text())
+    data["trajectory"]["segments"][2] = {"straight": {"duration": 30}}
+    data["sensors"]["gnss"] = {"preset": "automotive", "rate": 1, "outputs": ["fix"]}
+    data["faults"] = [{"kind": "gnss_outage", "start": 8, "duration": 6},
+                      {"kind": "gnss_outage", "start": 20, "duration": 8}]
+    scenario.write_text(yaml.safe_dump(data))
+    out = tmp_path / "gnss"
+    assert main(["campaign", str(scenario), "--runs", "2", "--workers", "1", "-o",
+                 str(out)]) == 0
+    runs = _runs(out)
+    assert (runs["status"] == "ok").all()
+    # the seed draws the GNSS noise: the two runs differ
+    assert runs["horizontal.rms"].iloc[0] != pytest.approx(runs["horizontal.rms"].iloc[1])
+    assert main(["run", str(scenario), "--seed", "4", "-o", str(tmp_path / "r")]) == 0
+    expected = json.loads((tmp_path / "r" / "scores.json").read_text())["gnss_only"]
+    row = runs[runs["seed"] == 4].iloc[0]
+    assert row["horizontal.rms"] == pytest.approx(expected["horizontal"]["rms"], rel=1e-12)
+    outages = expected["outages"]
+    assert row["outages.count"] == len(outages) == 2
+    for key in ("max_horizontal", "end_horizontal", "end_percent", "duration", "distance"):
+        assert row[f"outages.{key}"] == pytest.approx(np.mean([o[key] for o in outages]),
+                                                      rel=1e-12)
+    assert (out / "plots" / "outage_end.png").is_file()
+
+
 @pytest.fixture(scope="module")
 def cluster():
     distributed = pytest.importorskip("distributed")
