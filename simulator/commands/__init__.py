@@ -11,5 +11,6 @@ SUMMARIES = {
     "estimate": "run one estimator causally over a dataset, write its solution",
     "score": "score solutions against a dataset's truth (table, JSON, report)",
     "run": "generate, run the scenario's estimators, score, write the report",
+    "campaign": "Monte Carlo over seeds and sweeps, locally or on Dask; resumable",
     "export": "write a dataset's GNSS streams as RINEX 3.04 and NMEA 0183",
 }

@@ -11,7 +11,7 @@ Numbers are printed with three decimals; a missing value prints as ``-``.
 
 Public functions
 ----------------
-write_report, text_table, format_number.
+write_report, text_table, format_number, markdown_table.
 """
 
 from __future__ import annotations
@@ -70,7 +70,8 @@ def _value(scores: dict, group: str, key: str) -> float | None:
     return (scores.get(group) or {}).get(key)
 
 
-def _markdown_table(header: list[str], rows: list[list[str]]) -> list[str]:
+def markdown_table(header: list[str], rows: list[list[str]]) -> list[str]:
+    """The lines of a markdown table with ``header`` and ``rows`` of cell texts."""
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     return lines + ["| " + " | ".join(row) + " |" for row in rows]
 
@@ -168,7 +169,7 @@ def _metrics_lines(scores: dict[str, dict]) -> list[str]:
     rows = [[title, *(format_number(_value(s, g, k)) for s in scores.values())]
             for g, k, title in _TABLE_ROWS
             if any(_value(s, g, k) is not None for s in scores.values())]
-    return _markdown_table(["metric", *scores], rows)
+    return markdown_table(["metric", *scores], rows)
 
 
 def _outage_lines(scores: dict[str, dict], outages: list[tuple[float, float]]) -> list[str]:
@@ -186,7 +187,7 @@ def _outage_lines(scores: dict[str, dict], outages: list[tuple[float, float]]) -
             row += [format_number(o[k]) for k in ("max_horizontal", "end_horizontal",
                                                    "end_percent")]
         rows.append(row)
-    return _markdown_table(header, rows)
+    return markdown_table(header, rows)
 
 
 def write_report(directory: Path, ev: Evaluation, title: str, note: str | None = None) -> Path:

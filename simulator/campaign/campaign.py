@@ -1,0 +1,105 @@
+"""A whole campaign from its validated plan: check the folder, reach the executor, run what is
+not done yet (recording each run as it finishes), then merge the rows into ``runs.parquet`` and
+write ``summary.json`` and ``report.md``.
+
+Public names
+------------
+CampaignOptions, CampaignResult, run_campaign.
+"""
+
+from __future__ import annotations
+
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from simulator.campaign.execute import completed, open_executor
+from simulator.campaign.plan import CampaignPlan
+from simulator.campaign.report import write_campaign_report
+from simulator.campaign.store import (
+    RUNS_FILE,
+    check_campaign_dir,
+    done_parts,
+    init_campaign_dir,
+    merge_parts,
+    write_frame,
+    write_part,
+)
+from simulator.campaign.summary import summarise
+from simulator.campaign.worker import STATUS_OK, execute_run, failed_rows
+from simulator.progress import progress
+from simulator.scoring.evaluate import write_scores
+
+SUMMARY_FILE = "summary.json"
+DATASETS = "datasets"  # sub-folder of the kept datasets (--keep-datasets)
+
+
+@dataclass(frozen=True)
+class CampaignOptions:
+    """How to run a campaign (none of these changes its results)."""
+
+    runs: int
+    workers: int
+    scheduler: str | None = None
+    scheduler_timeout_s: float = 10.0
+    force: bool = False
+    keep_datasets: bool = False
+    retry_failed: bool = False
+    show_progress: bool = True
+
+
+@dataclass(frozen=True)
+class CampaignResult:
+    """What a campaign did: the merged rows and how many runs were computed now."""
+
+    runs: pd.DataFrame
+    computed: int
+    skipped: int
+
+    @property
+    def ok(self) -> int:
+        return int((self.runs["status"] == STATUS_OK).sum())
+
+    @property
+    def failed(self) -> int:
+        return len(self.runs) - self.ok
+
+
+def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> CampaignResult:
+    """Run (or resume) a campaign into ``out``.
+
+    Raises
+    ------
+    InputError
+        ``out`` cannot be used (another campaign without ``force``), or the scheduler does not
+        answer; nothing is written then.
+    """
+    out = Path(out)
+    fingerprint, record = plan.fingerprint(), plan.record()
+    check_campaign_dir(out, record, fingerprint, options.force)
+    tasks = plan.tasks(options.runs,
+                       out.resolve() / DATASETS if options.keep_datasets else None)
+    with open_executor(options.workers, options.scheduler, options.scheduler_timeout_s) as (
+            executor, in_flight):
+        init_campaign_dir(out, record, fingerprint, options.force)
+        done = done_parts(out, options.retry_failed)
+        todo = [t for t in tasks if t.part not in done]
+        finished = completed(executor, in_flight, execute_run, todo)
+        for task, future in progress(finished, "runs", options.show_progress, len(todo)):
+            try:
+                rows = future.result()
+            except Exception as exc:  # the run never returned: its worker died or was lost
+                rows = failed_rows(task, "".join(traceback.format_exception(exc)))
+            write_part(out, task.part, rows)
+    runs = merge_parts(out, [t.part for t in tasks], plan.sweep_keys)
+    write_frame(runs, out / RUNS_FILE)
+    header = {"scenario": plan.base.name, "runs": options.runs, "base_seed": plan.base.seed,
+              "sweep": plan.sweep_values(),
+              "labels": plan.labels, "fingerprint": fingerprint}
+    summary = summarise(runs, plan.labels, [p.values for p in plan.points], header)
+    write_scores(summary, out / SUMMARY_FILE)
+    write_campaign_report(out, runs, summary)
+    return CampaignResult(runs, len(todo), len(tasks) - len(todo))
+

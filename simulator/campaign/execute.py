@@ -1,0 +1,116 @@
+"""Where campaign runs execute: local worker processes, or a Dask cluster given by its scheduler
+address. Both are driven as ``concurrent.futures`` executors, with a bounded number of runs in
+flight so that an interrupted campaign has little work under way.
+
+Local processes come from a ``forkserver`` whose preloaded worker module is forked for each
+process (fast start, and no fork of a parent that runs threads; ``spawn`` where there is no
+forkserver). On Ctrl-C they receive the
+interrupt too and abandon their run; nothing of an unfinished run is recorded. A worker process
+that dies (a crash inside an estimator's compiled code, the out-of-memory killer) fails the runs
+that were under way in the pool, and a new pool takes the next runs.
+
+Public functions
+----------------
+open_executor, completed.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures as cf
+import contextlib
+import multiprocessing
+from collections.abc import Callable, Iterable, Iterator
+from typing import Any, TypeVar
+
+from simulator.errors import InputError, Problem
+
+T = TypeVar("T")
+_WORKER_MODULE = "simulator.campaign.worker"  # preloaded by the forkserver
+
+
+class _RenewingPool(cf.Executor):
+    """A local process pool that is replaced by a new one when a worker process has died."""
+
+    def __init__(self, workers: int):
+        self.workers = workers
+        if "forkserver" in multiprocessing.get_all_start_methods():
+            self.context = multiprocessing.get_context("forkserver")
+            self.context.set_forkserver_preload([_WORKER_MODULE])
+        else:  # Windows
+            self.context = multiprocessing.get_context("spawn")
+        self.pool = self._new()
+
+    def _new(self) -> cf.ProcessPoolExecutor:
+        return cf.ProcessPoolExecutor(self.workers, mp_context=self.context)
+
+    def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> cf.Future:
+        try:
+            return self.pool.submit(fn, *args, **kwargs)
+        except cf.BrokenExecutor:
+            self.pool.shutdown(wait=False)
+            self.pool = self._new()
+            return self.pool.submit(fn, *args, **kwargs)
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        self.pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
+@contextlib.contextmanager
+def open_executor(workers: int, scheduler: str | None, timeout_s: float
+                  ) -> Iterator[tuple[cf.Executor, int]]:
+    """An executor and how many runs to keep in flight on it.
+
+    Parameters
+    ----------
+    workers : number of local worker processes (ignored with ``scheduler``).
+    scheduler : address of a Dask scheduler (``tcp://host:port``), or None for local processes.
+    timeout_s : how long to try to reach the scheduler, s.
+
+    Raises
+    ------
+    InputError
+        When the scheduler does not answer within ``timeout_s``.
+    """
+    if scheduler is None:
+        with _RenewingPool(workers) as executor:
+            yield executor, workers
+        return
+    from distributed import Client
+
+    try:
+        client = Client(scheduler, timeout=timeout_s, set_as_default=False)
+    except (OSError, ValueError, TypeError) as exc:
+        raise InputError([Problem("--scheduler", None, scheduler, f"no Dask scheduler answers "
+                                  f"within {timeout_s:g} s ({exc})")]) from None
+    try:
+        slots = max(1, sum(client.nthreads().values()))
+        yield client.get_executor(pure=False), 2 * slots
+    finally:
+        client.close()
+
+
+def completed(executor: cf.Executor, in_flight: int, fn: Callable[[T], Any], tasks: Iterable[T]
+              ) -> Iterator[tuple[T, cf.Future]]:
+    """Submit ``fn(task)`` for every task, at most ``in_flight`` at a time; yield each task
+    with its finished future, in the order they finish. Closing the iterator (or an exception
+    in the caller) cancels the runs under way."""
+    pending = iter(tasks)
+    running: dict[cf.Future, T] = {}
+
+    def fill() -> None:
+        while len(running) < in_flight:
+            task = next(pending, None)
+            if task is None:
+                return
+            running[executor.submit(fn, task)] = task
+
+    try:
+        fill()
+        while running:
+            done, _ = cf.wait(running, return_when=cf.FIRST_COMPLETED)
+            for future in done:
+                yield running.pop(future), future
+            fill()
+    finally:
+        for future in running:
+            future.cancel()

@@ -1,0 +1,131 @@
+"""The campaign folder on disk, which is also the state that lets a campaign resume.
+
+``DIR/campaign.json`` records the plan and its fingerprint; ``DIR/parts/PART.parquet`` holds
+the rows of one finished run, written under a temporary name and renamed when complete, so an
+interrupted campaign leaves only whole runs; ``DIR/runs.parquet`` is every requested run's rows
+merged at the end (written the same way). A rerun with the same plan skips the runs whose part
+exists; a different plan is refused unless ``force``, which starts over.
+
+Public names
+------------
+CAMPAIGN_FILE, PARTS, RUNS_FILE, check_campaign_dir, init_campaign_dir, done_parts,
+write_part, merge_parts, write_frame.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pyarrow.parquet as pq
+
+from simulator.campaign.plan import PLAN_FORMAT
+from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, score_unit
+from simulator.dataset.io import read_table, write_table
+from simulator.errors import InputError, Problem
+
+CAMPAIGN_FILE = "campaign.json"
+PARTS = "parts"  # sub-folder with one Parquet file per finished run
+RUNS_FILE = "runs.parquet"
+
+
+def _stored(out: Path) -> dict | None:
+    path = out / CAMPAIGN_FILE
+    if not path.is_file():
+        return None
+    try:
+        stored = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return stored if isinstance(stored, dict) else {}
+
+
+def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -> None:
+    """Refuse an output folder this campaign cannot use (writes nothing).
+
+    ``out`` must be absent, empty, or a campaign folder: of the same fingerprint (then the
+    campaign resumes) or, with ``force``, of any (then it starts over). A folder that is not a
+    campaign is never replaced, even with ``force``.
+
+    Raises
+    ------
+    InputError
+        ``out`` is a file, a folder that is not a campaign, or a campaign of another plan
+        without ``force`` (naming what differs).
+    """
+    if out.exists() and not out.is_dir():
+        raise InputError([Problem(str(out), None, "", "exists and is not a directory")])
+    if not out.exists() or not any(out.iterdir()):
+        return
+    stored = _stored(out)
+    if stored is None or stored.get("format") != PLAN_FORMAT:
+        raise InputError([Problem(str(out), None, "", "exists and is not a landnav campaign "
+                                  "folder (no campaign.json); choose another -o DIR")])
+    if stored.get("fingerprint") != fingerprint and not force:
+        differs = [k for k in ("scenario", "base_seed", "overrides", "sweep", "labels")
+                   if stored.get(k) != record.get(k)] or ["the resolved scenario content"]
+        raise InputError([Problem(str(out), None, "", "holds a campaign of another scenario or"
+                                  f" options (differs in: {', '.join(differs)}); rerun the same"
+                                  " command to resume it, or use --force to start over")])
+
+
+def init_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -> None:
+    """Create (or, with ``force``, recreate) the folder and write ``campaign.json``."""
+    if force and out.exists():
+        shutil.rmtree(out)
+    (out / PARTS).mkdir(parents=True, exist_ok=True)
+    if _stored(out) is None:
+        text = json.dumps({"format": PLAN_FORMAT, "fingerprint": fingerprint, **record},
+                          indent=2, default=str)
+        tmp = out / f".{CAMPAIGN_FILE}.tmp-{os.getpid()}"
+        tmp.write_text(text + "\n", encoding="utf-8")
+        os.replace(tmp, out / CAMPAIGN_FILE)
+
+
+def _part_path(out: Path, part: str) -> Path:
+    return out / PARTS / f"{part}.parquet"
+
+
+def done_parts(out: Path, retry_failed: bool = False) -> set[str]:
+    """The runs already finished (part names); with ``retry_failed`` a run with a failed row
+    counts as not done."""
+    done = set()
+    for path in (out / PARTS).glob("*.parquet"):
+        if path.name.startswith("."):
+            continue
+        if retry_failed:
+            status = pq.read_table(path, columns=["status"]).column("status").to_pylist()
+            if STATUS_FAILED in status:
+                continue
+        done.add(path.stem)
+    return done
+
+
+def write_frame(frame: pd.DataFrame, path: Path) -> None:
+    """Write a runs table as Parquet (each score's unit in its field metadata) under a
+    temporary name, then rename it into place."""
+    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
+    try:
+        write_table(frame, tmp, {c: score_unit(c) for c in frame.columns})
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
+
+
+def write_part(out: Path, part: str, rows: list[dict]) -> None:
+    """Record one finished run's rows."""
+    write_frame(pd.DataFrame(rows), _part_path(out, part))
+
+
+def merge_parts(out: Path, parts: list[str], sweep_keys: list[str]) -> pd.DataFrame:
+    """The rows of ``parts`` (in that order) with the columns ``run_id, seed, label, status``,
+    the sweep columns, the scores and ``error``."""
+    frames = [read_table(_part_path(out, p)) for p in parts]
+    runs = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(
+        columns=[*RUN_COLUMNS, *sweep_keys, "error"])
+    lead = [*RUN_COLUMNS, *sweep_keys]
+    scores = [c for c in runs.columns if c not in lead and c != "error"]
+    return runs[[*lead, *scores, "error"]]

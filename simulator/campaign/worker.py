@@ -1,0 +1,119 @@
+"""One campaign run, as a worker process executes it: generate the dataset, run every estimator
+of the scenario, score each solution (SPEC section 8) and return one flat row per estimator.
+
+Any exception inside the run is caught and recorded: a failed dataset fails every estimator's
+row, a failed estimator (or its scoring) fails its own row; the row's ``error`` holds the
+traceback. The scores are flattened into ``group.key`` columns; ``outages`` becomes the mean of
+each per-outage score over the run's outages and ``outages.count``.
+
+Public names
+------------
+STATUS_OK, STATUS_FAILED, RUN_COLUMNS, flatten_scores, score_unit, execute_run, failed_rows.
+"""
+
+from __future__ import annotations
+
+import tempfile
+import traceback
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from estimators.replay import run_estimator
+from simulator.campaign.plan import RunTask, entry_labels
+from simulator.dataset.generate import generate_dataset
+from simulator.dataset.io import open_dataset
+from simulator.scoring.evaluate import score_solutions
+
+STATUS_OK = "ok"
+STATUS_FAILED = "failed"
+RUN_COLUMNS = ("run_id", "seed", "label", "status")  # the leading columns of runs.parquet
+_SKIPPED = {"rows", "nees.expected", "outages.start"}  # bookkeeping, not performance
+# unit of a flattened score column, by column or else by group (SPEC section 8)
+_UNITS = {"horizontal": "m", "vertical": "m", "velocity": "m/s", "attitude": "deg",
+          "runtime.seconds": "s", "outages.duration": "s", "outages.distance": "m",
+          "outages.max_horizontal": "m", "outages.end_horizontal": "m",
+          "outages.end_percent": "%"}
+
+
+def _number(x: Any) -> float:
+    return float("nan") if x is None else float(x)
+
+
+def flatten_scores(scores: dict) -> dict[str, float]:
+    """Scores of one solution (SPEC section 8) as ``{"horizontal.rms": value, ...}``.
+
+    Missing values are NaN. The ``outages`` list becomes ``outages.count`` and, for each
+    per-outage score, its mean over the outages that have it (NaN when none has).
+    """
+    out: dict[str, float] = {}
+    for group, value in scores.items():
+        if group in _SKIPPED:
+            continue
+        if isinstance(value, dict):
+            out.update({f"{group}.{k}": _number(v) for k, v in value.items()
+                        if f"{group}.{k}" not in _SKIPPED})
+        elif isinstance(value, list):
+            out[f"{group}.count"] = float(len(value))
+            keys = dict.fromkeys(k for entry in value for k in entry)
+            for key in keys:
+                if f"{group}.{key}" in _SKIPPED:
+                    continue
+                values = np.array([_number(e.get(key)) for e in value])
+                values = values[np.isfinite(values)]
+                out[f"{group}.{key}"] = float(values.mean()) if values.size else float("nan")
+    return out
+
+
+def score_unit(column: str) -> str:
+    """The unit of a flattened score column (``""`` for counts, ratios and other columns)."""
+    return _UNITS.get(column, _UNITS.get(column.partition(".")[0], ""))
+
+
+def _row(task: RunTask, label: str, status: str, scores: dict[str, float] | None = None,
+         error: str = "") -> dict[str, Any]:
+    return {"run_id": task.run_id, "seed": task.seed, "label": label, "status": status,
+            **task.point.values, **(scores or {}), "error": error}
+
+
+def failed_rows(task: RunTask, error: str) -> list[dict[str, Any]]:
+    """The rows of a run that failed as a whole (every label failed with ``error``)."""
+    return [_row(task, label, STATUS_FAILED, error=error)
+            for label in entry_labels(task.scenario.data["estimators"])]
+
+
+def _score_all(task: RunTask, dataset_dir: Path) -> list[dict[str, Any]]:
+    labels = entry_labels(task.scenario.data["estimators"])
+    try:
+        dataset = open_dataset(generate_dataset(task.scenario, dataset_dir, force=True,
+                                                show_progress=False))
+    except Exception:
+        return failed_rows(task, traceback.format_exc())
+    rows = []
+    for label, entry in zip(labels, task.scenario.data["estimators"], strict=True):
+        try:
+            frame, info = run_estimator(dataset, entry, show_progress=False)
+            scores = score_solutions(dataset, {label: (frame, info)}).scores()[label]
+            rows.append(_row(task, label, STATUS_OK, flatten_scores(scores)))
+        except Exception:
+            rows.append(_row(task, label, STATUS_FAILED, error=traceback.format_exc()))
+    return rows
+
+
+def execute_run(task: RunTask) -> list[dict[str, Any]]:
+    """Run one campaign run; never raises for a failure inside the run.
+
+    Parameters
+    ----------
+    task : the run (its scenario already carries the run's seed and sweep values).
+
+    Returns
+    -------
+    One row per label: ``run_id, seed, label, status``, the sweep columns, the flattened scores
+    (none when failed) and ``error`` (the traceback, or "").
+    """
+    if task.keep is not None:
+        return _score_all(task, Path(task.keep))
+    with tempfile.TemporaryDirectory(prefix="landnav-run-") as tmp:
+        return _score_all(task, Path(tmp) / "dataset")

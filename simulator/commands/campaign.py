@@ -1,0 +1,104 @@
+"""``landnav campaign SCENARIO --runs N -o DIR``: Monte Carlo over seeds (and sweep points) of
+the scenario's estimators, in local processes or on a Dask cluster; resumable (SPEC section 3).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+from pathlib import Path
+
+from simulator.commands import SUMMARIES
+from simulator.commands.options import add_scenario_options
+from simulator.errors import InputError, Problem
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "campaign", help=SUMMARIES["campaign"],
+        description="Monte Carlo campaign: for run i = 0..N-1 (seed BASE + i) and every sweep "
+                    "point, generate the dataset in a temporary folder, run every estimator the "
+                    "scenario names and score it. Writes DIR/runs.parquet (one row per run and "
+                    "estimator: run_id, seed, label, status, the swept keys, the flattened "
+                    "scores, error), DIR/summary.json (mean, median, p95 of each score and the "
+                    "failure count per label and sweep point) and DIR/report.md with plots. "
+                    "Each finished run is recorded in DIR/parts/ at once: rerunning the same "
+                    "command (or with a larger --runs) resumes, computing only what is missing. "
+                    "A failing run is recorded as failed with its traceback and the campaign "
+                    "goes on.")
+    p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
+    p.add_argument("--runs", type=int, required=True, metavar="N", help="number of seeds")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="campaign directory")
+    p.add_argument("--workers", type=int, default=None, metavar="K",
+                   help="local worker processes (default: the CPU count)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on the Dask cluster of this scheduler (tcp://host:port) instead of "
+                        "local processes; its workers need landnav, any module:Class estimator "
+                        "and the files the scenario refers to")
+    p.add_argument("--scheduler-timeout", type=float, default=10.0, metavar="SECONDS",
+                   help="how long to try to reach the scheduler (default 10)")
+    p.add_argument("--sweep", action="append", default=[], metavar="KEY.PATH=V1,V2,...",
+                   help="also vary a scenario value (the key paths of --set); repeat for the "
+                        "cartesian product. Run i has the same seed at every sweep point.")
+    p.add_argument("--force", action="store_true",
+                   help="start over: replace the campaign in DIR even if it is another one "
+                        "(a folder that is not a campaign is never replaced)")
+    p.add_argument("--keep-datasets", action="store_true",
+                   help="keep each run's dataset in DIR/datasets/ (deleted after scoring "
+                        "otherwise)")
+    p.add_argument("--retry-failed", action="store_true",
+                   help="when resuming, compute the failed runs again")
+    add_scenario_options(p)
+    p.set_defaults(run=run)
+
+
+def _check_counts(args: argparse.Namespace) -> int:
+    """The number of local workers; refuses N < 1, K < 1 and --workers with --scheduler."""
+    problems = []
+    if args.runs < 1:
+        problems.append(Problem("landnav campaign", None, "--runs",
+                                f"must be at least 1, got {args.runs}"))
+    if args.workers is not None and args.scheduler:
+        problems.append(Problem("landnav campaign", None, "--workers", "a Dask cluster has its "
+                                "own workers: give --workers or --scheduler, not both"))
+    elif args.workers is not None and args.workers < 1:
+        problems.append(Problem("landnav campaign", None, "--workers",
+                                f"must be at least 1, got {args.workers}"))
+    if args.scheduler_timeout <= 0:
+        problems.append(Problem("landnav campaign", None, "--scheduler-timeout",
+                                f"must be positive, got {args.scheduler_timeout}"))
+    if problems:
+        raise InputError(problems)
+    return args.workers or os.cpu_count() or 1
+
+
+def _stop(signum: int, frame: object) -> None:
+    """SIGTERM ends the campaign like Ctrl-C: the runs under way are abandoned, the folder
+    resumes."""
+    raise KeyboardInterrupt
+
+
+def run(args: argparse.Namespace) -> int:
+    from simulator.campaign.campaign import CampaignOptions, run_campaign
+    from simulator.campaign.plan import plan_campaign
+
+    workers = _check_counts(args)
+    plan = plan_campaign(args.scenario, args.overrides, args.seed, args.sweep)
+    options = CampaignOptions(
+        runs=args.runs, workers=workers, scheduler=args.scheduler,
+        scheduler_timeout_s=args.scheduler_timeout, force=args.force,
+        keep_datasets=args.keep_datasets, retry_failed=args.retry_failed)
+    out = Path(args.output)
+    previous = signal.signal(signal.SIGTERM, _stop)
+    try:
+        result = run_campaign(plan, out, options)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+    n_runs = len(result.runs) // max(1, len(plan.labels))
+    print(f"campaign {plan.base.name}: {n_runs} run(s) x {len(plan.labels)} estimator(s): "
+          f"{result.ok} result(s) ok, {result.failed} failed "
+          f"({result.computed} run(s) computed now, "
+          f"{result.skipped} already done); results in {out}/ (runs.parquet, summary.json, "
+          "report.md)")
+    return 0

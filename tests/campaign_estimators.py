@@ -1,0 +1,39 @@
+"""Test estimators for campaigns: one that fails, one that kills its worker process, one that
+logs every run it makes."""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from tests.scoring_helpers import HoldStart
+
+
+class Fails(HoldStart):
+    """Raises on its first IMU message: a failing estimator inside a campaign worker."""
+
+    name = "fails"
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        raise RuntimeError(f"deliberate failure at t = {t}")
+
+
+class Crashes(HoldStart):
+    """Ends its process at once, as a crash in compiled code would."""
+
+    name = "crashes"
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        os._exit(3)
+
+
+class Counting(HoldStart):
+    """Holds its initial state and appends one line per run to the file ``config["log"]``."""
+
+    name = "counting"
+    defaults = {"log": ""}
+
+    def setup(self) -> None:
+        with open(self.config["log"], "a", encoding="utf-8") as log:
+            log.write(f"{os.getpid()}\n")
