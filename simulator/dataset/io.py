@@ -16,6 +16,7 @@ import json
 import os
 import shutil
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pandas as pd
@@ -96,9 +97,14 @@ def write_dataset(directory: Path, manifest: dict, streams: dict[str, pd.DataFra
     manifest = dict(manifest)
     manifest["format"] = col.DATASET_FORMAT
     manifest["streams"] = {}
+    files = {name: col.STREAMS[name][0] if name in col.STREAMS else f"{name}.parquet"
+             for name in streams}
+    # Parquet encoding and compression release the GIL: the files are written side by side
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        list(pool.map(lambda name: write_table(streams[name], directory / files[name],
+                                               _units_for(name, streams[name])), streams))
     for name, frame in streams.items():
-        file = col.STREAMS[name][0] if name in col.STREAMS else f"{name}.parquet"
-        write_table(frame, directory / file, _units_for(name, frame))
+        file = files[name]
         rate = None
         if "t" in frame and len(frame) > 1 and name not in ("gnss_raw", "truth_gnss"):
             rate = round(float((len(frame) - 1) / (frame["t"].iloc[-1] - frame["t"].iloc[0])), 6)
