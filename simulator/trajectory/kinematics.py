@@ -21,6 +21,7 @@ Kinematics, kinematics_from_profile.
 from __future__ import annotations
 
 import datetime as dt
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -120,8 +121,7 @@ class Kinematics:
             t = np.append(t, self.duration_s)
         dt = np.diff(t)
         n = len(self.t_grid)
-        node_motion = self._motion(t)
-        mid_motion = self._motion(t[:-1] + dt / 2)
+        node_motion, mid_motion = _in_two_threads(self._motion, t, t[:-1] + dt / 2)
         # kept for the grid evaluations of ``grid_inertial``
         self._motion_cache = {"grid": _take(node_motion, n), "mid": _take(mid_motion, n - 1)}
         node, mid = node_motion["v_ned"], mid_motion["v_ned"]
@@ -212,8 +212,13 @@ class Kinematics:
         truth table and the sensors sampling at the base rate share one evaluation."""
         key = "mid" if midpoints else "grid"
         if key not in self._cache:
-            t = self.t_grid[:-1] + 0.5 / self.rate_hz if midpoints else self.t_grid
-            self._cache[key] = self.inertial(t, self._motion_cache.pop(key))
+            # both are evaluated together, on two threads (numpy releases the GIL)
+            mid_t = self.t_grid[:-1] + 0.5 / self.rate_hz
+            grid, mid = _in_two_threads(
+                lambda t, m: self.inertial(t, m),
+                (self.t_grid, self._motion_cache.pop("grid")),
+                (mid_t, self._motion_cache.pop("mid")), star=True)
+            self._cache.update(grid=grid, mid=mid)
         return self._cache[key]
 
     def breakpoints(self) -> np.ndarray:
@@ -261,6 +266,16 @@ class Kinematics:
             "speed": k["speed"], "distance": k["distance"],
             "zone": self.zone_at(k["t"]).astype(str),
         }, columns=list(col.TRUTH))
+
+
+def _in_two_threads(function, first, second, star: bool = False):
+    """``function`` of two arguments (tuples with ``star``) evaluated on two threads."""
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        if star:
+            futures = [pool.submit(function, *first), pool.submit(function, *second)]
+        else:
+            futures = [pool.submit(function, first), pool.submit(function, second)]
+        return futures[0].result(), futures[1].result()
 
 
 def _take(arrays: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
