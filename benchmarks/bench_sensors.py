@@ -15,6 +15,7 @@ The drive is ``bench_truth.py``'s city loop repeated to an hour.
 
 from __future__ import annotations
 
+import argparse
 import json
 import subprocess
 import sys
@@ -59,7 +60,32 @@ def best_of_three(run) -> float:
     return min(times)
 
 
+def time_gnss_ins_sim(checkout: Path) -> float:
+    """Real-time factor of gnss-ins-sim (a checkout of Aceinna/gnss-ins-sim, which is not on
+    PyPI) generating its 966 s ``long_drive`` at 100 Hz with its ``mid-accuracy`` IMU error
+    model, in a fresh process: the comparison issue 4 asks for, measured in the same run."""
+    code = f"""
+import sys, time
+sys.path.insert(0, {str(checkout)!r})
+from gnss_ins_sim.sim import imu_model, ins_sim
+motion = {str(checkout / "demo_motion_def_files" / "motion_def-long_drive.csv")!r}
+imu = imu_model.IMU(accuracy="mid-accuracy", axis=6, gps=False)
+sim = ins_sim.Sim([100.0, None, None], motion, ref_frame=0, imu=imu, mode=None, env=None,
+                  algorithm=None)
+start = time.perf_counter()
+sim.run(1)
+print(len(sim.dmgr.get_data_all("time").data) / 100.0 / (time.perf_counter() - start))
+"""
+    result = subprocess.run([sys.executable, "-c", code], check=True, capture_output=True,
+                            text=True)
+    return float(result.stdout.split()[-1])
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--gnss-ins-sim", type=Path, metavar="CHECKOUT",
+                        help="a checkout of Aceinna/gnss-ins-sim to time in the same run")
+    args = parser.parse_args()
     data = hour_data()
     scenario = validate_data(data, "hour.yaml")
     truth = build_truth(scenario)
@@ -85,6 +111,10 @@ def main() -> None:
         print(f"landnav generate (whole process): {best:.2f} s "
               f"({truth.duration_s / best:.0f}x real time); rows: "
               + ", ".join(f"{k} {v['rows']}" for k, v in rows.items()))
+    if args.gnss_ins_sim is not None:
+        factor = time_gnss_ins_sim(args.gnss_ins_sim)
+        print(f"gnss-ins-sim long_drive: {factor:.0f}x real time; landnav generate is "
+              f"{truth.duration_s / best / factor:.1f} times faster")
 
 
 if __name__ == "__main__":
