@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
@@ -63,12 +63,17 @@ class InitialState:
         NED velocity, m/s.
     attitude : ndarray, shape (3,)
         Roll, pitch, yaw (rad), ZYX Euler angles of the FRD body frame in NED.
+    sensor_errors : dict
+        Priors of sensor-error states, ``{sensor: {parameter: value}}`` (the scenario's
+        ``init.sensor_errors``: the drawn true values with ``truth``, the given values with a
+        mapping; empty when not given, and the estimator starts from its own defaults).
     """
 
     t: float
     position: np.ndarray
     velocity: np.ndarray
     attitude: np.ndarray
+    sensor_errors: dict = field(default_factory=dict)
 
     @property
     def quaternion(self) -> np.ndarray:

@@ -58,8 +58,8 @@ def _entry_fields(entry: Mapping[str, Any] | str) -> tuple[str, str, dict | None
     return name, entry.get("label") or name, entry.get("init"), entry.get("config")
 
 
-def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None
-                  ) -> InitialState:
+def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None,
+                  drawn_sensor_errors: Mapping[str, Any] | None = None) -> InitialState:
     """The truth at ``t0`` (linear interpolation, yaw unwrapped) perturbed by ``init`` errors.
 
     Parameters
@@ -71,7 +71,11 @@ def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None
         Start time, s.
     init : mapping or None
         ``position_error`` [n, e, d] m, ``velocity_error`` [n, e, d] m/s, ``attitude_error``
-        [roll, pitch, yaw] deg, ``heading_error`` deg; each may be None.
+        [roll, pitch, yaw] deg, ``heading_error`` deg, ``sensor_errors`` ('truth' or a
+        mapping); each may be None.
+    drawn_sensor_errors : mapping or None
+        The dataset's true sensor errors (the manifest's ``sensors`` block), handed on when
+        ``sensor_errors`` is 'truth'.
     """
     t = truth["t"].to_numpy()
 
@@ -96,7 +100,10 @@ def initial_state(truth: pd.DataFrame, t0: float, init: Mapping[str, Any] | None
     if init.get("heading_error") is not None:
         att[2] += np.radians(float(init["heading_error"]))
     att[2] = wrap_angle(att[2])
-    return InitialState(float(t0), np.array([lat, lon, alt]), vel, att)
+    priors = init.get("sensor_errors")
+    if priors == "truth":
+        priors = drawn_sensor_errors
+    return InitialState(float(t0), np.array([lat, lon, alt]), vel, att, dict(priors or {}))
 
 
 class _Stream:
@@ -230,7 +237,8 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
             raise InputError([Problem(str(dataset.path), None, "", f"estimator {name!r} starts "
                                       "from the true state, and the dataset has no truth "
                                       "stream; use an estimator that initialises itself")])
-        initial = initial_state(dataset.read("truth"), float(t[0]), init)
+        initial = initial_state(dataset.read("truth"), float(t[0]), init,
+                                dataset.manifest.get("sensors"))
     estimator = cls(config, initial, {s.name: s.columns for s in streams},
                     {s.name: s.units for s in streams})
     gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]

@@ -203,3 +203,25 @@ def test_replay_benchmark_dataset_runs(tmp_path):
                                 show_progress=False)
     assert len(frame) == 721 and frame["t"].iloc[-1] == 72.0
     assert info["realtime_factor"] > 1.0
+
+
+def test_sensor_error_priors_reach_the_initial_state():
+    from conftest import scenario_data
+
+    from estimators.replay import initial_state
+    from simulator.dataset.generate import build_truth
+    from simulator.errors import InputError
+
+    segments = [{"accelerate": {"to_speed": 5.0, "accel": 1.0}}, {"straight": {"length": 20}}]
+    truth = build_truth(scenario_data(segments)).table()
+    drawn = {"odometer": {"scale_factor": 1.013}}
+    state = initial_state(truth, 1.0, {"sensor_errors": "truth"}, drawn)
+    assert state.sensor_errors == drawn
+    given = {"odometer": {"scale_factor": 1.0}}
+    assert initial_state(truth, 1.0, {"sensor_errors": given}, drawn).sensor_errors == given
+    assert initial_state(truth, 1.0, None, drawn).sensor_errors == {}
+    entry = {"name": "gnss_only", "init": {"sensor_errors": "truth"}}
+    scenario_data(segments, estimators=[entry])
+    with pytest.raises(InputError, match="sensor_errors"):
+        scenario_data(segments, estimators=[{"name": "gnss_only",
+                                             "init": {"sensor_errors": "exact"}}])

@@ -18,6 +18,7 @@ from simulator.scenario.schema import (
     Either,
     Integer,
     ListOf,
+    MapOf,
     Number,
     Path,
     Record,
@@ -43,6 +44,10 @@ _INIT_FIELD = Record({
     "velocity_error": Vector(3, Number("m/s"), None, doc="north, east, down, m/s"),
     "attitude_error": Vector(3, Number(angle=True), None, doc="roll, pitch, yaw, deg"),
     "heading_error": Number(default=None, angle=True, doc="deg (adds to attitude_error's yaw)"),
+    "sensor_errors": Either(
+        Text(choices=["truth"]), MapOf(Anything(None)), None,
+        doc="priors of the sensor-error states: 'truth' hands the drawn true values (the "
+            "manifest's sensors block), a mapping {sensor: {parameter: value}} hands those"),
 }, default=None)
 
 ESTIMATOR_ENTRY_FIELD = Either(
