@@ -61,7 +61,8 @@ NOMINAL_SLOTS: dict[str, tuple[float, float]] = {
     "F4": (212.847, 135.346),
 }
 # expandable slot: {location: (RAAN deg, argument of latitude deg)} at the same epoch, fore
-# first (SPS PS 2008 Table 3.4-2)
+# first (SPS PS 2008 Table 3.4-2, as also transcribed in github.com/Cfrazzle/SRCL_FFNAV
+# GPS_Simulator/FFNAV_RunGPS.m; checked against the 2020 edition's Table 3.2-2 in the tests)
 EXPANDABLE_SLOTS: dict[str, dict[str, tuple[float, float]]] = {
     "B1": {"B1F": (332.847, 94.916), "B1A": (332.847, 66.356)},
     "D2": {"D2F": (92.847, 282.676), "D2A": (92.847, 257.976)},
