@@ -49,10 +49,28 @@ def test_registered_and_defaults_filled_from_the_preset():
     ({"multipath": "3 s"}, "sensors.gnss.multipath"),
     ({"cn0_horizon": 50}, "sensors.gnss.cn0_horizon: must not exceed cn0_zenith"),
     ({"rate": 1, "antena_lever_arm": [0, 0, 0]}, "sensors.gnss.antena_lever_arm"),
+    ({"expanded_slots": ["B2"]}, "sensors.gnss.expanded_slots.0: 'B2' is not one of: B1, D2, F2"),
+    ({"expanded_slots": ["B1", "B1"]}, "sensors.gnss.expanded_slots: names a slot more than once"),
+    ({"constellation": __file__, "expanded_slots": ["B1"]},
+     "sensors.gnss.expanded_slots: only applies to constellation 'nominal-gps'"),
 ])
 def test_bad_configuration_is_reported_with_its_key(config, fragment):
     problems = _problems(config)
     assert any(fragment in p for p in problems), problems
+
+
+def test_expanded_slots_add_their_aft_satellites_to_the_receiver():
+    truth = drive([{"stop": {"duration": 600}}], rate_hz=1.0)
+    rng = np.random.default_rng(3)
+    base = receiver(preset="ideal").generate(truth, rng)
+    full = receiver(preset="ideal", expanded_slots=["B1", "D2", "F2"]).generate(truth, rng)
+    assert set(base["gnss_nav"]["sv"]) == set(range(1, 25))
+    assert set(full["gnss_nav"]["sv"]) == set(range(1, 28))
+    n_base, n_full = base["gnss_fix"]["num_sats"], full["gnss_fix"]["num_sats"]
+    assert (n_full >= n_base).all() and n_full.sum() > n_base.sum()
+    assert (full["gnss_fix"]["fix"] == 2).all()
+    k = truth.inertial(full["gnss_fix"]["t"].to_numpy())
+    assert np.abs(full["gnss_fix"]["alt"] - k["alt"]).max() < 0.01
 
 
 def test_yuma_almanac_as_constellation():

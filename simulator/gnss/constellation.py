@@ -1,5 +1,6 @@
-"""The nominal GPS constellation: the 24 baseline slots of the GPS SPS Performance Standard as
-broadcast Keplerian elements (a navigation table), for any date.
+"""The nominal GPS constellation: the 24 baseline slots of the GPS SPS Performance Standard,
+optionally with expandable slots split into their fore/aft pairs, as broadcast Keplerian elements
+(a navigation table), for any date.
 
 The Performance Standard defines each slot by its right ascension of the ascending node (RAAN)
 and argument of latitude at the epoch 1993-07-01 00:00 UT, when the Greenwich hour angle was
@@ -10,20 +11,32 @@ each node regresses by (omega_e - Omega_dot) and the argument of latitude advanc
 revolutions per repeat period. This keeps the sky of a given place at a given sidereal time as
 the real constellation does, which a plain two-body propagation over 30 years would not.
 
+The "Expandable 24" configuration (flown since 2011) splits the expandable slots B1, D2 and F2
+each into a fore (F) and an aft (A) location in the same plane, ahead of and behind the baseline
+slot, giving 27 slots. ``expanded`` chooses which of them are split. PRNs: 1-24 are the baseline
+slots A1 ... F4 in order; an expanded slot's fore location keeps its slot's PRN (B1F 5, D2F 14,
+F2F 22) and its aft location takes a PRN of its own (B1A 25, D2A 26, F2A 27), whatever else is
+expanded.
+
 Public names
 ------------
-NOMINAL_SLOTS, nominal_gps_navigation.
+NOMINAL_SLOTS, EXPANDABLE_SLOTS, AFT_PRN, nominal_slots, nominal_gps_navigation.
 
 References
 ----------
-GPS SPS Performance Standard, 5th ed. (2020), Table 3.2-1 (baseline 24-slot constellation, slot
-locations as of the epoch); 4th ed. (2008) Table 3.4-1 and 3rd ed. (2001) Table A-2-1 (nominal
-constellation plan: e = 0, i = 55 deg, A = 26 559.7 km, RAAN rate -4.4874e-7 deg/s).
+GPS SPS Performance Standard, 4th ed. (2008), Table 3.4-1 (baseline 24-slot constellation, slot
+locations as of the epoch; the same values as the 3rd ed. (2001) Table 3-1) and Table 3.4-2
+(expandable 24-slot constellation definition); 3rd ed. (2001) Table A-2-1 (nominal constellation
+plan: e = 0, i = 55 deg, A = 26 559.7 km, RAAN rate -4.4874e-7 deg/s). The 5th ed. (2020) Tables
+3.2-1 and 3.2-2 restate the same slots at 2016-12-31 23:59:43 UTC (Greenwich hour angle
+100.765 deg): every RAAN +16.003 deg and argument of latitude -28.586 deg from the values here,
+the same ground-track equatorial crossings (see tests/test_gnss_constellation.py).
 """
 
 from __future__ import annotations
 
 import datetime as dt
+from collections.abc import Iterable
 
 import numpy as np
 import pandas as pd
@@ -32,7 +45,7 @@ from simulator import columns as col
 from simulator.gnss.constants import MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, SECONDS_PER_WEEK
 from simulator.timebase import GPS_EPOCH, utc_to_gps
 
-# slot: (RAAN deg, argument of latitude deg) at the reference epoch (SPS PS 2020 Table 3.2-1)
+# slot: (RAAN deg, argument of latitude deg) at the reference epoch (SPS PS 2008 Table 3.4-1)
 NOMINAL_SLOTS: dict[str, tuple[float, float]] = {
     "A1": (272.847, 268.126), "A2": (272.847, 161.786), "A3": (272.847, 11.676),
     "A4": (272.847, 41.806),
@@ -47,6 +60,15 @@ NOMINAL_SLOTS: dict[str, tuple[float, float]] = {
     "F1": (212.847, 238.886), "F2": (212.847, 345.226), "F3": (212.847, 105.206),
     "F4": (212.847, 135.346),
 }
+# expandable slot: {location: (RAAN deg, argument of latitude deg)} at the same epoch, fore
+# first (SPS PS 2008 Table 3.4-2, as also transcribed in github.com/Cfrazzle/SRCL_FFNAV
+# GPS_Simulator/FFNAV_RunGPS.m; checked against the 2020 edition's Table 3.2-2 in the tests)
+EXPANDABLE_SLOTS: dict[str, dict[str, tuple[float, float]]] = {
+    "B1": {"B1F": (332.847, 94.916), "B1A": (332.847, 66.356)},
+    "D2": {"D2F": (92.847, 282.676), "D2A": (92.847, 257.976)},
+    "F2": {"F2F": (212.847, 0.456), "F2A": (212.847, 334.016)},
+}
+AFT_PRN = {"B1A": 25, "D2A": 26, "F2A": 27}  # PRNs of the aft locations (fore keeps the slot's)
 SLOT_EPOCH_UTC = dt.datetime(1993, 7, 1)  # reference epoch of the slot table, UT
 GHA_EPOCH_RAD = np.radians((18 + 36 / 60 + 14.4 / 3600) * 15.0)  # Greenwich hour angle then
 INCLINATION_RAD = np.radians(55.0)  # nominal inclination
@@ -57,27 +79,57 @@ REPEAT_PERIOD_S = 2.0 * np.pi / (OMEGA_E_DOT_RAD_S - RAAN_RATE_RAD_S)
 MEAN_MOTION_RAD_S = 4.0 * np.pi / REPEAT_PERIOD_S
 
 
-def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
-                           interval_s: float = 7200.0) -> pd.DataFrame:
-    """Broadcast-style elements of the 24 nominal slots, one record per slot every
-    ``interval_s`` from the last even interval before ``utc`` over ``span_s``.
+def nominal_slots(expanded: Iterable[str] = ()) -> pd.DataFrame:
+    """The slot table of the nominal constellation with the ``expanded`` slots (any of
+    ``EXPANDABLE_SLOTS``: B1, D2, F2) replaced by their fore/aft pairs.
 
-    PRNs 1-24 are assigned to slots A1 ... F4 in order. Orbits are circular (e = 0, so the
-    relativistic clock term is zero), satellite clocks are perfect (af0 = af1 = af2 = T_GD = 0)
-    and every record is healthy.
+    Returns
+    -------
+    pandas.DataFrame
+        One row per satellite, in PRN order: ``prn``, ``slot`` (A1 ... F4, B1F, B1A, ...),
+        ``raan_deg`` and ``arg_lat_deg`` at the reference epoch ``SLOT_EPOCH_UTC``.
+    """
+    expanded = list(expanded)
+    unknown = sorted(set(expanded) - set(EXPANDABLE_SLOTS))
+    if unknown:
+        raise ValueError(f"not expandable slot(s) {', '.join(unknown)}; the expandable slots "
+                         f"are {', '.join(EXPANDABLE_SLOTS)}")
+    rows = []
+    for prn, (slot, location) in enumerate(NOMINAL_SLOTS.items(), start=1):
+        if slot not in expanded:
+            rows.append((prn, slot, *location))
+            continue
+        (fore, fore_loc), (aft, aft_loc) = EXPANDABLE_SLOTS[slot].items()
+        rows += [(prn, fore, *fore_loc), (AFT_PRN[aft], aft, *aft_loc)]
+    table = pd.DataFrame(rows, columns=["prn", "slot", "raan_deg", "arg_lat_deg"])
+    return table.sort_values("prn", ignore_index=True)
+
+
+def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
+                           interval_s: float = 7200.0,
+                           expanded: Iterable[str] = ()) -> pd.DataFrame:
+    """Broadcast-style elements of the nominal slots (``nominal_slots(expanded)``), one record
+    per satellite every ``interval_s`` from the last even interval before ``utc`` over
+    ``span_s``.
+
+    PRNs are those of ``nominal_slots`` (1-24 for slots A1 ... F4 in order; 25-27 for the aft
+    locations of expanded slots). Orbits are circular (e = 0, so the relativistic clock term is
+    zero), satellite clocks are perfect (af0 = af1 = af2 = T_GD = 0) and every record is
+    healthy.
 
     Returns
     -------
     pandas.DataFrame
         The navigation table (``simulator.columns.GNSS_NAV``).
     """
+    slots = nominal_slots(expanded)
     week, tow = utc_to_gps(utc)
     first = np.floor(tow / interval_s) * interval_s
     toe_abs = week * SECONDS_PER_WEEK + first + np.arange(0.0, span_s + interval_s, interval_s)
     epoch_gps = (SLOT_EPOCH_UTC - GPS_EPOCH).total_seconds() + 9.0  # GPS - UTC = 9 s then
     since = toe_abs - epoch_gps
-    raan0, arg_lat0 = (np.radians(np.array(v)) for v in zip(*NOMINAL_SLOTS.values(),
-                                                                strict=True))
+    raan0 = np.radians(slots["raan_deg"].to_numpy())
+    arg_lat0 = np.radians(slots["arg_lat_deg"].to_numpy())
     # Earth-fixed longitude of the node and argument of latitude at each toe
     node_lon = (raan0[:, None] - GHA_EPOCH_RAD
                 - (OMEGA_E_DOT_RAD_S - RAAN_RATE_RAD_S) * since[None, :])
@@ -86,7 +138,7 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     toe = toe_abs - toe_week * SECONDS_PER_WEEK
     n_slot, n_toe = node_lon.shape
     nav = pd.DataFrame(0.0, index=range(n_slot * n_toe), columns=list(col.GNSS_NAV))
-    nav["sv"] = np.repeat(np.arange(1, n_slot + 1), n_toe)
+    nav["sv"] = np.repeat(slots["prn"].to_numpy(), n_toe)
     nav["week"] = np.tile(toe_week, n_slot).astype(int)
     nav["toe"] = nav["toc"] = np.tile(toe, n_slot)
     nav["iode"] = np.tile(np.arange(n_toe) % 256, n_slot)

@@ -3,7 +3,9 @@ satellites in view, and the receiver's own fixes computed from them, so that a f
 exactly when and how the measurements do.
 
 Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
-``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac), ``elevation_mask``
+``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac),
+``expanded_slots`` (which expandable slots of ``nominal-gps`` are split into their fore/aft pairs:
+any of ``B1``, ``D2``, ``F2``; all three give the 27-slot constellation), ``elevation_mask``
 (deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
 (body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
 DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative 1-sigma of the
@@ -52,7 +54,7 @@ from simulator.environment.sky import canyon_visibility
 from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
-from simulator.gnss.constellation import nominal_gps_navigation
+from simulator.gnss.constellation import EXPANDABLE_SLOTS, nominal_gps_navigation
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
 from simulator.gnss.errors import (
     OSCILLATORS,
@@ -108,6 +110,12 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
         return ctx.error(path + ("clock",), f"unknown oscillator {value['clock']!r}; known: "
                                             f"{', '.join(sorted(OSCILLATORS))}")
     source = value["constellation"]
+    expanded = value["expanded_slots"]
+    if expanded and source != "nominal-gps":
+        return ctx.error(path + ("expanded_slots",), "only applies to constellation "
+                                                     "'nominal-gps'")
+    if len(set(expanded)) < len(expanded):
+        return ctx.error(path + ("expanded_slots",), "names a slot more than once")
     if source != "nominal-gps":
         candidates = [FilePath(source)]
         if ctx.file and not FilePath(source).is_absolute():
@@ -130,6 +138,9 @@ GNSS_FIELD = Record(
         "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1),
         "constellation": Text("nominal-gps",
                               doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
+        "expanded_slots": ListOf(Text(choices=list(EXPANDABLE_SLOTS)), [],
+                                 doc="expandable slots of 'nominal-gps' split into their fore/aft "
+                                     "pairs (SPS PS 2008 Table 3.4-2); [B1, D2, F2] = 27 slots"),
         "elevation_mask": Number(angle=True, default=10.0, min=0, max=90),
         "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
         **_ERROR_FIELDS,
@@ -164,7 +175,8 @@ class Gnss:
         """The navigation table used for the drive (nominal constellation or the named file)."""
         week0, _ = utc_to_gps(truth.utc_start)
         if self.config["constellation"] == "nominal-gps":
-            nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0)
+            nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0,
+                                         expanded=self.config["expanded_slots"])
             nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
             return nav
         return read_navigation(self.config["constellation"], reference_week=week0)
