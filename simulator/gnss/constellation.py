@@ -8,8 +8,11 @@ and argument of latitude at the epoch 1993-07-01 00:00 UT, when the Greenwich ho
 constellation is maintained on a repeating ground track (two revolutions per sidereal day), so
 the slots are propagated to a date with that repeat condition: the Earth-fixed longitude of
 each node regresses by (omega_e - Omega_dot) and the argument of latitude advances by exactly two
-revolutions per repeat period. This keeps the sky of a given place at a given sidereal time as
-the real constellation does, which a plain two-body propagation over 30 years would not.
+revolutions per repeat period, which keeps the slots on their ground tracks (a plain two-body
+propagation over decades would not). It is the nominal pattern, not the real sky: the real
+constellation drifts along and across its tracks (the real 2020-01-01 almanac has its planes
+about 14 deg of node longitude, about an hour of sidereal time, away from the propagated 1993
+slots), so a scenario that must reproduce a real sky names a real almanac or navigation file.
 
 The "Expandable 24" configuration (flown since 2011) splits the expandable slots B1, D2 and F2
 each into a fore (F) and an aft (A) location in the same plane, ahead of and behind the baseline
