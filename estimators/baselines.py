@@ -2,14 +2,17 @@
 
 * ``gnss_only`` holds the last GNSS fix: position and velocity of the fix, yaw from its course
   over ground (held while the speed is below ``min_course_speed``), roll and pitch zero. It
-  initialises itself and reports nothing before the first fix.
+  initialises itself and reports nothing before the first fix. While the car reverses the
+  course points backwards, so this yaw is off by 180 deg: the floor cannot tell.
 * ``dead_reckoning`` is two-dimensional odometer/gyro dead reckoning with no GNSS (Groves 2013,
   section 6.3 (odometry, heading-and-distance form); the 2-D DR of Cho & Choi 2006,
   eqs. 24a-b and 24e, with the odometer giving the speed): the yaw integrates the z gyro,
   compensated for the Earth rate and the transport rate (Groves eqs. 5.41, 5.44) as seen by a
   level vehicle (refreshed at each odometer sample); the distance between odometer samples
   comes from their speeds interpolated linearly in time, laid along the yaw history of the IMU
-  samples. The height is held at its initial value, roll and pitch are reported as zero.
+  samples. The odometer speed is signed (negative while reversing), so a reversing car moves
+  back along its heading. The height is held at its initial value, roll and pitch are reported
+  as zero.
 
 Public classes
 --------------
@@ -67,7 +70,9 @@ class DeadReckoning(Estimator):
         init = self.initial
         self._lat, self._lon, self._alt = (float(x) for x in init.position)
         self._yaw = float(init.attitude[2])
-        self._speed = float(math.hypot(init.velocity[0], init.velocity[1]))
+        # signed speed along the heading (the odometer's convention: negative while reversing)
+        self._speed = float(init.velocity[0] * math.cos(self._yaw)
+                            + init.velocity[1] * math.sin(self._yaw))
         self._gz = self.columns["imu"]["gyro_z"]
         self._increments = self.units["imu"].get("gyro_z") == "rad"
         self._speed_col = self.columns["odometer"]["speed"]

@@ -3,16 +3,20 @@ counted in encoder ticks, reported late by a fixed latency.
 
 Model (the multiplicative odometer error of Park et al. 2019, eq. 22: u_odo = s (1 + ds) v):
 
-* measured distance D(t_k) = sum_j sf(t_j) (s(t_j) - s(t_j-1)), with s the true travelled distance
-  at t - ``latency`` and sf(t) = ``scale_factor`` + ``scale_drift`` W(t) a random walk (W a unit
+* measured distance D(t_k) = sum_j sf(t_j) (x(t_j) - x(t_j-1)), with x the true signed distance
+  along the body x axis (``RoadProfile.net_distance``: it decreases while reversing) at
+  t - ``latency`` and sf(t) = ``scale_factor`` + ``scale_drift`` W(t) a random walk (W a unit
   Wiener process, so the 1-sigma change after T seconds is scale_drift sqrt(T));
 * with ``ticks_per_meter`` > 0: ticks(t_k) = floor(D(t_k) ticks_per_meter + u), u ~ U[0, 1) the
   unknown phase of the encoder at t = 0; the ``ticks`` column counts the ticks of each interval
   and ``speed`` = ticks / (ticks_per_meter dt), the mean speed over the interval;
-* without ticks: ``speed`` = sf(t) v(t - latency), the instantaneous speed.
+* without ticks: ``speed`` = sf(t) d v(t - latency), the instantaneous signed speed.
 
-At standstill no distance accrues, so the speed is exactly zero. The speed is non-negative (the
-trajectories drive forward only).
+Reverse: the sensor is a wheel-speed sensor whose direction comes from the transmission (the
+gear selected), so ``speed`` is signed, negative while reversing, and the tick counter is an
+up/down counter: ``ticks`` of an interval are negative while reversing, and summing them gives
+the net displacement along the path, not the distance travelled. At standstill no distance
+accrues, so the speed is exactly zero (+0.0, never -0.0).
 
 Public names
 ------------
@@ -84,7 +88,7 @@ class Odometer:
         dt = 1.0 / self.rate_hz
         t = sample_times(truth.duration_s, self.rate_hz)
         t_true = np.clip(t - c["latency"], 0.0, truth.duration_s)
-        distance = truth.profile.distance_of_time(t_true)
+        distance = truth.profile.net_distance(t_true)
         scale = c["scale_factor"] + random_walk(len(t), dt, c["scale_drift"], rng)[:, 0]
         measured = np.cumsum(scale * np.diff(distance, prepend=distance[0]))
         self.drawn.update(scale_factor=float(scale[0]), scale_factor_end=float(scale[-1]))
@@ -98,5 +102,5 @@ class Odometer:
             self.drawn["tick_phase"] = phase
         else:
             speed = np.maximum(truth.profile.distance_of_time(t_true, 1), 0.0)
-            table["speed"] = scale * speed
+            table["speed"] = scale * truth.profile.direction_at(t_true) * speed + 0.0
         return {"odometer": pd.DataFrame(table)}

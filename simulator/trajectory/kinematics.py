@@ -5,8 +5,12 @@ by differencing samples:
 
 * attitude: yaw = road heading psi(s), pitch = road grade angle gamma(s), roll = road bank minus a
   body roll proportional to the lateral acceleration (``limits.roll_gradient``);
-* NED velocity v (cos g cos psi, cos g sin psi, -sin g), along the body x axis (no side slip), and
-  its exact time derivative;
+* NED velocity d v (cos g cos psi, cos g sin psi, -sin g), along the body x axis (no side slip),
+  and its exact time derivative; v = ds/dt >= 0 is the speed along the path and d = +1 forward,
+  -1 reversing (``RoadProfile.direction``, constant between standstills), so a reversing car
+  moves along -x body while its attitude, a function of s, stays continuous. The yaw rate is
+  kappa v (psi is a function of s, whichever way the car rolls), the lateral acceleration
+  d kappa v^2; the truth ``speed`` is the signed speed d v along body x;
 * geodetic position by integrating the NED velocity (Groves eq. 5.56) with Simpson's rule on the
   base grid, then cubic Hermite interpolation (with the exact derivatives) between grid points;
 * specific force f^n = dv/dt - g^n + (w_en + 2 w_ie) x v (Groves eq. 5.54 rearranged) with WGS-84
@@ -87,6 +91,7 @@ class Kinematics:
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration_s)
         s, v, a = p.distance_of_time.evaluate(t, (0, 1, 2))
         v = np.maximum(v, 0.0)
+        d = p.direction_at(t)  # +1 forward, -1 reversing: switches only where v = a = 0
         kappa, dkappa = p.curvature.evaluate(s, (0, 1))
         gamma, dgamma = p.grade.evaluate(s, (0, 1))
         bank, dbank = p.bank.evaluate(s, (0, 1))
@@ -94,18 +99,21 @@ class Kinematics:
         cg, sg, cp, sp = np.cos(gamma), np.sin(gamma), np.cos(psi), np.sin(psi)
         yaw_rate = kappa * v
         pitch_rate = dgamma * v
-        roll = bank - self.roll_gradient * v**2 * kappa
-        roll_rate = dbank * v - self.roll_gradient * (2 * v * a * kappa + v**3 * dkappa)
+        # body roll against the lateral acceleration d kappa v^2 (and its exact rate, d constant)
+        roll = bank - self.roll_gradient * d * v**2 * kappa
+        roll_rate = dbank * v - self.roll_gradient * d * (2 * v * a * kappa + v**3 * dkappa)
+        dv, da = d * v, d * a  # signed speed and acceleration along body x
         v_ned = np.empty(t.shape + (3,))
-        v_ned[:, 0] = v * cg * cp
-        v_ned[:, 1] = v * cg * sp
-        v_ned[:, 2] = -v * sg
-        # d/dt of v u(psi, gamma): a u + v (du/dpsi psi' + du/dgamma gamma')
+        v_ned[:, 0] = dv * cg * cp
+        v_ned[:, 1] = dv * cg * sp
+        v_ned[:, 2] = -dv * sg
+        # d/dt of d v u(psi, gamma): d (a u + v (du/dpsi psi' + du/dgamma gamma'))
         a_ned = np.empty_like(v_ned)
-        a_ned[:, 0] = a * cg * cp - v * (cg * sp * yaw_rate + sg * cp * pitch_rate)
-        a_ned[:, 1] = a * cg * sp + v * (cg * cp * yaw_rate - sg * sp * pitch_rate)
-        a_ned[:, 2] = -a * sg - v * cg * pitch_rate
-        return dict(s=s, v=v, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
+        a_ned[:, 0] = da * cg * cp - dv * (cg * sp * yaw_rate + sg * cp * pitch_rate)
+        a_ned[:, 1] = da * cg * sp + dv * (cg * cp * yaw_rate - sg * sp * pitch_rate)
+        a_ned[:, 2] = -da * sg - dv * cg * pitch_rate
+        # + 0.0: a reversing car at rest reads 0.0, not -0.0
+        return dict(s=s, v=dv + 0.0, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
                     pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
                     cos_pitch=cg, sin_pitch=sg, cos_yaw=cp, sin_yaw=sp)
 
@@ -286,7 +294,10 @@ def _as_fast(profile: RoadProfile) -> RoadProfile:
     """The profile with every curve a ``PiecewisePolynomial`` (sources may give scipy PPoly)."""
     fields = ("distance_of_time", "curvature", "heading", "grade", "bank")
     converted = {f: PiecewisePolynomial.from_ppoly(getattr(profile, f)) for f in fields}
-    return RoadProfile(**converted, duration_s=profile.duration_s, zones=profile.zones)
+    direction = (None if profile.direction is None
+                 else PiecewisePolynomial.from_ppoly(profile.direction))
+    return RoadProfile(**converted, duration_s=profile.duration_s, zones=profile.zones,
+                       direction=direction)
 
 
 def kinematics_from_profile(profile: RoadProfile, start: dict, rate_hz: float,

@@ -31,13 +31,14 @@ class PiecewisePolynomial:
         """Wrap a ``scipy.interpolate.PPoly`` (or anything with ``c`` and ``x``)."""
         return cls(ppoly.c, ppoly.x)
 
-    def _index(self, x: np.ndarray) -> np.ndarray:
+    def piece_index(self, x: np.ndarray) -> np.ndarray:
+        """Index of the piece holding each x (pieces are [x[i], x[i+1]); ends extrapolate)."""
         return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.c.shape[1] - 1)
 
     def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,)) -> list[np.ndarray]:
         """Values of the requested derivatives at x (one search for all of them)."""
         x = np.asarray(x, dtype=float)
-        idx = self._index(x)
+        idx = self.piece_index(x)
         dx = x - self.x[idx]
         out = []
         for nu in orders:

@@ -21,12 +21,26 @@ Geometry choices (a navigation researcher would expect them; they are documented
 * ``lane_change`` deflects the heading by c 140 u^3 (1-u)^3 with c solved so the lateral shift is
   ``offset`` exactly (heading and curvature continuous).
 * ``accelerate`` changes speed with a trapezoidal acceleration (jerk ``limits.jerk``); a segment
-  that says ``speed`` while the vehicle moves at another speed, and a ``stop`` reached while
-  moving, are preceded by such a change at ``limits.accel``.
+  that says ``speed`` while the vehicle moves at another speed, and a ``stop`` or ``reverse``
+  reached while moving, are preceded by such a change at ``limits.accel``.
+* ``reverse`` backs the car up from standstill over ``length`` m of path, up to ``speed`` and
+  back to standstill (jerk-limited, ``limits.accel``; a lower peak when ``length`` is too short
+  to reach ``speed``). With ``angle`` the path starts with a clothoid - arc - clothoid curve as in
+  ``turn`` (at ``radius``, then straight back for the rest of ``length``; without ``radius``,
+  the curve fills the whole ``length``). The sign of ``angle`` is the steering direction, as
+  for ``turn``: + steers right, so the rear swings right and the body heading changes by
+  -``angle``.
+
+Reversing is a direction sign d(t) = -1 on the time pieces of a ``reverse`` (``RoadProfile.
+direction``; it switches only at standstill). s, the distance travelled, keeps increasing; the
+road curves (heading psi(s), grade, bank) stay functions of s, so the body attitude is continuous,
+and the velocity is d v along the body x axis (see ``kinematics``). The direction lives in time,
+not in s, so that a switch falls exactly on the instant the speed profile reaches zero, whatever
+the rounding of s(t) there.
 
 Public names
 ------------
-SEGMENT_FIELD, LIMITS_FIELD, RoadProfile, build_road_profile.
+SEGMENT_FIELD, LIMITS_FIELD, REVERSE_SPEED, RoadProfile, build_road_profile.
 """
 
 from __future__ import annotations
@@ -65,6 +79,7 @@ LIMITS_FIELD = Record(
 )
 
 _speed = Number("m/s", None, min=0)
+REVERSE_SPEED = 2.0  # default peak speed of a ``reverse``, m/s (a parking manoeuvre)
 SEGMENT_FIELD = OneKey(
     {
         "stop": Record({"duration": Number("s", gt=0)}),
@@ -84,6 +99,15 @@ SEGMENT_FIELD = OneKey(
                               "length": Number("m", gt=0)}),
         "lane_change": Record({"offset": Number("m"), "length": Number("m", gt=0),
                                "speed": _speed}),
+        "reverse": Record({"length": Number("m", gt=0, doc="distance backed up along the path"),
+                           "angle": Number(default=0.0, angle=True,
+                                           doc="steering direction and heading change: + "
+                                               "steers right, the rear swings right, the "
+                                               "heading changes by -angle"),
+                           "radius": Number("m", None, gt=0,
+                                            doc="arc radius; default: the curve fills length"),
+                           "speed": Number("m/s", REVERSE_SPEED, gt=0,
+                                           doc="peak reverse speed (magnitude)")}),
     },
     shared={"zone": Text(None)},
     what="segment",
@@ -102,10 +126,11 @@ class _PathPiece:
 
 @dataclass
 class _TimePiece:
-    """A stretch of time with constant jerk."""
+    """A stretch of time with constant jerk, driven forward (direction +1) or reversing (-1)."""
 
     duration: float
     jerk: float
+    direction: float = 1.0
 
 
 @dataclass
@@ -122,6 +147,29 @@ class RoadProfile:
     # where the drive starts, for sources that fix it (a SUMO network, a recorded drive):
     # {lat, lon (deg), alt (m), heading (deg)}, replacing the scenario's start; None: use it
     start: dict | None = None
+    # d(t): +1 driving forward, -1 reversing, piecewise constant in time, switching only at
+    # standstill; None: forward throughout (SUMO and recorded drives)
+    direction: PiecewisePolynomial | None = None
+
+    def direction_at(self, t: np.ndarray) -> np.ndarray | float:
+        """d(t), +1 forward and -1 reversing, at times t (the scalar 1.0 if never reversing)."""
+        if self.direction is None:
+            return 1.0
+        return self.direction(t)
+
+    def net_distance(self, t: np.ndarray) -> np.ndarray:
+        """Signed distance along the body x axis since the start, int_0^t d v dt (m): what a
+        wheel odometer with the gear direction counts. Exact: s(t) is re-based at each switch
+        of d (the switch times are breaks of d, and the drive stands still at each)."""
+        s = self.distance_of_time(t)
+        if self.direction is None:
+            return s
+        x = self.direction.x
+        d = self.direction.c[0]
+        s_breaks = self.distance_of_time(x)
+        base = np.concatenate([[0.0], np.cumsum(d * np.diff(s_breaks))])
+        i = self.direction.piece_index(np.asarray(t, dtype=float))
+        return base[i] + d[i] * (s - s_breaks[i])
 
 
 _ZERO = np.zeros(1)
@@ -291,6 +339,58 @@ def _lateral_accel_problem(kind: str, v: float, radius: float, lim: dict) -> str
     return None
 
 
+def _curve_length(theta: float, kappa0: float, v: float, lim: dict) -> float:
+    return sum(p.length for p in _clothoid_turn(theta, kappa0, v, lim, 0.0))
+
+
+def _reverse(seg: dict, lim: dict) -> tuple[list[_PathPiece], list[_TimePiece]] | str:
+    """Path and time pieces of a ``reverse`` from standstill (time pieces with direction -1),
+    or a sentence saying why the car cannot drive it.
+
+    Speed: 0 -> peak -> 0 with the jerk-limited change of ``_speed_change`` at
+    ``limits.accel``; the peak is ``speed``, or the speed whose up and down ramps alone cover
+    ``length``. Path: the ``turn`` curve (``_clothoid_turn``) of heading change -``angle`` at
+    ``radius`` (or at the radius that makes the curve exactly ``length`` long: the curve's
+    length falls monotonically with its curvature), then straight for the rest.
+    """
+    length = seg["length"]
+
+    def ramps(v: float) -> float:
+        return 2 * _distance_of(_speed_change(0.0, v, lim["accel"], lim["jerk"]), 0.0)
+
+    v = seg["speed"]
+    if ramps(v) > length:
+        v = _bisect(lambda vp: ramps(vp) - length, 1e-12, v)
+    up = _speed_change(0.0, v, lim["accel"], lim["jerk"])
+    cruise = max(length - ramps(v), 0.0) / v
+    timing = [_TimePiece(p.duration, p.jerk, -1.0) for p in up]
+    timing.append(_TimePiece(cruise, 0.0, -1.0))
+    timing += [_TimePiece(p.duration, p.jerk, -1.0)
+               for p in _speed_change(v, 0.0, lim["accel"], lim["jerk"])]
+
+    pieces: list[_PathPiece] = []
+    theta = -np.radians(seg["angle"])  # + steers right: the rear swings right, the nose left
+    if theta != 0.0:
+        if seg["radius"] is None:
+            k0 = _bisect(lambda k: _curve_length(theta, k, v, lim) - length,
+                         abs(theta) / length, 2 * abs(theta) / length)
+        else:
+            k0 = 1.0 / seg["radius"]
+        problem = _lateral_accel_problem("reverse", v, 1.0 / k0, lim)
+        if problem:
+            return problem
+        pieces = _clothoid_turn(theta, k0, v, lim, 0.0)
+        curve = sum(p.length for p in pieces)
+        if curve > length * (1 + 1e-9):
+            return (f"a curve of {seg['angle']:g} deg at a radius of {1 / k0:g} m needs "
+                    f"{curve:.2f} m of path, more than length = {length:g} m; lengthen it, "
+                    "or leave out radius")
+    rest = length - sum(p.length for p in pieces)
+    if rest > 1e-9:
+        pieces.append(_PathPiece(rest, _ZERO, _ZERO, _ZERO))
+    return pieces, timing
+
+
 def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None = None,
                        path: Path = ("trajectory", "segments")) -> RoadProfile | None:
     """Turn validated segments into a ``RoadProfile``.
@@ -328,13 +428,21 @@ def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None =
         (kind, seg), = item.items()
         t_start = t + 0.0
         n_time = len(time_pieces)
-        if seg.get("speed") is not None:
+        if seg.get("speed") is not None and kind != "reverse":
             change_speed(seg["speed"], limits["accel"])
         if kind == "stop":
             change_speed(0.0, limits["accel"])
             time_pieces.append(_TimePiece(seg["duration"], 0.0))
         elif kind == "accelerate":
             change_speed(seg["to_speed"], seg["accel"])
+        elif kind == "reverse":
+            change_speed(0.0, limits["accel"])
+            built = _reverse(seg, limits)
+            if isinstance(built, str):
+                fail(i, kind, built)
+                continue
+            path_pieces.extend(built[0])
+            time_pieces.extend(built[1])
         else:
             if v <= 0.0:
                 fail(i, kind, f"the vehicle is standing still here; a {kind} needs speed "
@@ -423,6 +531,8 @@ def _assemble(path_pieces: list[_PathPiece], time_pieces: list[_TimePiece],
         v += a * tt + p.jerk * tt**2 / 2
         a += p.jerk * tt
     breaks = np.concatenate([[0.0], np.cumsum([p.duration for p in time_pieces])])
+    signs = np.array([p.direction for p in time_pieces])
+    direction = PiecewisePolynomial(signs[None, :], breaks) if (signs < 0).any() else None
     return RoadProfile(
         distance_of_time=PiecewisePolynomial(c, breaks),
         curvature=curvature,
@@ -431,5 +541,6 @@ def _assemble(path_pieces: list[_PathPiece], time_pieces: list[_TimePiece],
         bank=bank,
         duration_s=float(breaks[-1]),
         zones=zones,
+        direction=direction,
     )
 
