@@ -70,6 +70,9 @@ def test_every_preset_resolves():
     ({"gyro": {"bias": [1.0, 2.0]}}, "expected a list of 3"),
     ({"axes": ["gyro_q"]}, "is not one of"),
     ({"accel": {"g_sensitivity": 1.0}}, "unknown key"),
+    ({"accel": {"gauss_markov_sigma": [0.0, 1e-3, 0.0]}}, "gauss_markov_correlation_time"),
+    ({"gyro": {"gauss_markov_sigma": 1e-4, "gauss_markov_correlation_time": [5.0, 0.0, 5.0]}},
+     "must be above 0 on every axis whose gauss_markov_sigma is"),
 ])
 def test_bad_input_named(block, message):
     found = problems(block)

@@ -3,7 +3,7 @@ model, sampled as rates or as increments integrated over each sample interval.
 
 Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the sensor frame::
 
-    y = x + (S + M) x + b0 + b_in(t) + b_rw(t) + k_T dT(t) + G f  (gyro only) + n
+    y = x + (S + M) x + b0 + b_in(t) + b_gm(t) + b_rw(t) + k_T dT(t) + G f  (gyro only) + n
 
 * ``x``: the true rate (w_ib, rad/s) or specific force (m/s^2) at the unit, rotated by the
   ``mounting`` (roll, pitch, yaw of the unit in the vehicle, degrees): x_s = C_v^s x_v, with the
@@ -18,6 +18,16 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
   std is 0.664 B / 0.6174; without: a flicker process (sum of Gauss-Markov processes, see
   ``simulator.sensors.noise``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
   discretised exactly, so their statistics do not depend on the rate.
+* ``b_gm``: a correlated bias besides ``b_in``, so that an axis can have both the flicker floor
+  and an exponentially correlated bias, as real MEMS units do (the ADIS16448 y accelerometer's
+  Allan curve rises from 2 s to a plateau at 100-300 s above its flicker floor): a first-order
+  Gauss-Markov process of stationary std ``gauss_markov_sigma`` and correlation time
+  ``gauss_markov_correlation_time`` T_c, both per axis (sigma 0, the default, is off), discretised
+  exactly. Its Allan variance is IEEE Std 952's Markov noise
+  (``simulator.sensors.noise.gauss_markov_avar``), peaking at 0.617 sigma at 1.89 T_c.
+  El-Sheimy et al. (IEEE Trans. Instrum. Meas. 57(1), 2008) list this correlated noise among the
+  error terms of MEMS inertial sensors; it is commonly attributed to temperature variation inside
+  the unit.
 * ``b_rw``: rate / acceleration random walk of density ``random_walk`` (rad/s^2/sqrt(Hz),
   m/s^3/sqrt(Hz)), starting at zero, plus a rate ramp R t (IEEE Std 952 "rate ramp", Allan
   deviation R tau / sqrt(2)) of magnitude ``ramp`` (rad/s^2, m/s^3) and a drawn sign.
@@ -130,6 +140,8 @@ def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Fie
         "bias": AxisNumber(unit, min=0),
         "bias_instability": AxisNumber(unit, min=0),
         "bias_correlation_time": Number("s", None, gt=0),
+        "gauss_markov_sigma": AxisNumber(unit, min=0),
+        "gauss_markov_correlation_time": AxisNumber("s", min=0),
         "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
         "random_walk": AxisNumber(random_walk_unit, min=0),
         "ramp": AxisNumber(f"{unit}/s", min=0),
@@ -176,6 +188,11 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
         limit, res = out[group]["range"], out[group]["resolution"]
         if limit is not None and np.any(np.asarray(res) >= np.asarray(limit)):
             ctx.error(path + (group, "resolution"), "must be smaller than range")
+            failed = True
+        markov = _per_axis(out[group]["gauss_markov_sigma"])
+        if np.any((markov > 0) & (_per_axis(out[group]["gauss_markov_correlation_time"]) <= 0)):
+            ctx.error(path + (group, "gauss_markov_correlation_time"),
+                      "must be above 0 on every axis whose gauss_markov_sigma is")
             failed = True
     return INVALID if failed else out
 
@@ -294,6 +311,10 @@ class Imu:
                 bias += gauss_markov(n, dt, sigma, p["bias_correlation_time"], rng)
             else:
                 bias += flicker(n, dt, instability, rng)
+        markov = _per_axis(p["gauss_markov_sigma"])
+        if markov.any():
+            corr_time = np.where(markov > 0, _per_axis(p["gauss_markov_correlation_time"]), 1.0)
+            bias += gauss_markov(n, dt, markov, corr_time, rng)
         walk = _per_axis(p["random_walk"])
         if walk.any():
             bias += random_walk(n, dt, walk, rng)

@@ -9,7 +9,11 @@ so that generating a dataset stays quick to start).
 Conventions (IEEE Std 952-1997, Annex C): a white rate noise of density N (unit/sqrt(Hz)) has
 Allan variance N^2 / tau; a rate random walk of density K (unit/s/sqrt(Hz)) has K^2 tau / 3; a
 flicker ("bias instability") noise with two-sided power spectral density B^2 / (2 pi f) has the flat
-Allan deviation sqrt(2 ln 2 / pi) B = 0.664 B.
+Allan deviation sqrt(2 ln 2 / pi) B = 0.664 B; an exponentially correlated ("Markov") noise of
+stationary std sigma and correlation time T_c has Allan variance
+sigma^2 (T_c / tau)^2 (2 tau / T_c - 3 + 4 exp(-tau / T_c) - exp(-2 tau / T_c)) (IEEE Std 952,
+Annex C, Markov noise, with sigma^2 = q_c^2 T_c / 2), rising as sqrt(tau) well below T_c, peaking at
+0.617 sigma at 1.89 T_c and falling as 1 / sqrt(tau) beyond.
 
 Public names
 ------------
@@ -62,14 +66,15 @@ GM_ADEV_PEAK = float(np.sqrt(_gm_avar_unit(_X).max()))
 GM_ADEV_PEAK_TAU = float(_X[np.argmax(_gm_avar_unit(_X))])
 
 
-def ar1_filter(u: np.ndarray, phi: float) -> np.ndarray:
+def ar1_filter(u: np.ndarray, phi: float | np.ndarray) -> np.ndarray:
     """x[k] = phi x[k-1] + u[k] along axis 0, x[-1] = 0 (the first-order recursion of an exact
     Gauss-Markov discretisation), by recursive doubling: after the pass with shift s each x[k]
     holds the sum over the last 2 s inputs, so log2(n) vectorised passes replace the loop.
-    Stops early once phi^s underflows (the older inputs no longer count)."""
+    ``phi`` is one factor, or one per column of a 2-D ``u`` (shape (m,)). Stops early once every
+    phi^s underflows (the older inputs no longer count)."""
     x = np.array(u, dtype=float)
-    power, shift = phi, 1
-    while shift < len(x) and power > 0.0:
+    power, shift = np.asarray(phi, dtype=float), 1
+    while shift < len(x) and np.any(power > 0.0):
         x[shift:] += power * x[:-shift]
         power, shift = power * power, shift * 2
     return x
@@ -98,7 +103,7 @@ def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generat
     return np.cumsum(steps, axis=0)
 
 
-def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float,
+def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarray,
                  rng: np.random.Generator) -> np.ndarray:
     """Stationary first-order Gauss-Markov process, exact discretisation (Gelb 1974, Table 3.8-1).
 
@@ -109,7 +114,7 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float,
     n : number of samples.
     dt_s : sample interval, s.
     sigma : stationary standard deviation per axis, shape (m,).
-    tau_s : correlation time, s.
+    tau_s : correlation time, s: one for all axes or one per axis, shape (m,).
 
     Returns
     -------
@@ -183,12 +188,16 @@ def flicker_avar(tau_s: np.ndarray, instability: float) -> np.ndarray:
 
 def adev_model(tau_s: np.ndarray, noise_density: float = 0.0, bias_instability: float = 0.0,
                random_walk_density: float = 0.0, ramp: float = 0.0,
-               correlation_time_s: float | None = None) -> np.ndarray:
+               correlation_time_s: float | None = None, markov_sigma: float = 0.0,
+               markov_time_s: float | None = None) -> np.ndarray:
     """Allan deviation of white noise + bias instability + random walk + rate ramp
-    (IEEE Std 952, Annex C: N^2 / tau, K^2 tau / 3, R^2 tau^2 / 2).
+    (IEEE Std 952, Annex C: N^2 / tau, K^2 tau / 3, R^2 tau^2 / 2) + an optional exponentially
+    correlated (Markov) bias of std ``markov_sigma`` and correlation time ``markov_time_s``
+    (``gauss_markov_avar``).
 
     The bias instability B is a Gauss-Markov process whose Allan peak is 0.664 B when a
-    correlation time is given, and the flicker sum of ``flicker`` otherwise.
+    correlation time is given, and the flicker sum of ``flicker`` otherwise. The Markov bias is a
+    separate process, added to either (the terms are independent, so their variances add).
     """
     tau_s = np.asarray(tau_s, dtype=float)
     avar = (noise_density**2 / tau_s + random_walk_density**2 * tau_s / 3.0
@@ -199,4 +208,6 @@ def adev_model(tau_s: np.ndarray, noise_density: float = 0.0, bias_instability: 
             avar = avar + gauss_markov_avar(tau_s, sigma, correlation_time_s)
         else:
             avar = avar + flicker_avar(tau_s, bias_instability)
+    if markov_sigma > 0:
+        avar = avar + gauss_markov_avar(tau_s, markov_sigma, markov_time_s)
     return np.sqrt(avar)
