@@ -64,7 +64,10 @@ class DeadReckoning(Estimator):
     name = "dead_reckoning"
     needs = ("imu", "odometer")
     paper = "Groves 2013 section 6.3; Cho & Choi 2006 eqs. 24a-b, 24e (2-D DR)"
-    defaults = {"earth_rate": True}  # compensate the Earth and transport rates in the yaw rate
+    # earth_rate: compensate the Earth and transport rates in the yaw rate; standstill: while the
+    # odometer reads exactly zero, hold the heading and learn the yaw-gyro bias as the mean of
+    # its readings (a zero angular rate update, Groves 2013 section 15.3.3), removed once moving
+    defaults = {"earth_rate": True, "standstill": True}
 
     def setup(self) -> None:
         init = self.initial
@@ -77,6 +80,8 @@ class DeadReckoning(Estimator):
         self._increments = self.units["imu"].get("gyro_z") == "rad"
         self._speed_col = self.columns["odometer"]["speed"]
         self._t_imu = init.t
+        self._bias = 0.0  # yaw-gyro bias learned at standstill, rad/s
+        self._still_sum = self._still_time = 0.0
         self._rate_prev: float | None = None
         self._t_odo: float | None = None
         # integrals since the last odometer sample of the unit heading vector, A = int u dt, and
@@ -105,6 +110,12 @@ class DeadReckoning(Estimator):
         if dt <= 0:
             return
         dpsi -= self._frame_rate_d * dt
+        if self.config["standstill"] and self._t_odo is not None and self._speed == 0.0:
+            self._still_sum += dpsi
+            self._still_time += dt
+            self._t_imu = t
+            return
+        dpsi -= self._bias * dt
         yaw_mid = self._yaw + 0.5 * dpsi
         self._yaw += dpsi
         c, s = math.cos(yaw_mid) * dt, math.sin(yaw_mid) * dt
@@ -122,6 +133,10 @@ class DeadReckoning(Estimator):
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         speed = float(row[self._speed_col])
+        if speed != 0.0 and self._still_time > 1.0:  # leaving a standstill of over a second
+            self._bias = self._still_sum / self._still_time
+        if speed != 0.0:
+            self._still_sum = self._still_time = 0.0
         slope = 0.0  # before the first sample the initial speed was held
         if self._t_odo is not None and t > self._t_odo:
             slope = (speed - self._speed) / (t - self._t_odo)

@@ -56,7 +56,7 @@ def test_dead_reckoning_without_earth_rate_drifts_as_predicted(tmp_path):
     data = _flat(0.0, "rate")
     ds = open_dataset(write_synthetic(tmp_path / "ds", data, streams=("imu", "odometer")))
     entry = {"name": "dead_reckoning", "label": None, "init": None,
-             "config": {"earth_rate": False}}
+             "config": {"earth_rate": False, "standstill": False}}
     solution, _ = run_estimator(ds, entry, show_progress=False)
     truth = ds.read("truth")
     t = solution["t"].to_numpy()
@@ -97,3 +97,37 @@ def test_gnss_only_reproduces_the_fixes(tmp_path):
     moving = fixes["speed"].to_numpy()[latest] >= 1.0
     np.testing.assert_allclose(solution["yaw"].to_numpy()[moving],
                                fixes["course"].to_numpy()[latest][moving], atol=1e-12)
+
+
+def test_dead_reckoning_learns_the_gyro_bias_at_standstill(tmp_path):
+    """A constant yaw-gyro bias: without the standstill calibration the heading drifts by
+    bias x time; with it, the bias learned during the first stop is removed (Groves 2013
+    section 15.3.3)."""
+    from simulator.dataset.generate import generate_dataset
+    from simulator.scenario import Scenario
+    from tests.conftest import scenario_data
+
+    segments = [{"stop": {"duration": 20}}, {"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+                {"straight": {"length": 1000}}, {"turn": {"angle": 90, "radius": 50}},
+                {"straight": {"length": 500}}]
+    bias = 0.2  # deg/s
+    data = scenario_data(segments, sensors={"imu": {"preset": "ideal", "rate": 100},
+                                            "odometer": {"preset": "ideal", "rate": 10}})
+    out = tmp_path / "ds"
+    generate_dataset(Scenario(tmp_path / "s.yaml", data, []), out, show_progress=False)
+    ds = open_dataset(out)
+    imu = ds.read("imu")  # the ideal gyro with a known constant bias added
+    imu["gyro_z"] = imu["gyro_z"] + np.radians(bias)
+    imu.to_parquet(out / ds.manifest["streams"]["imu"]["file"])
+    finals = {}
+    for standstill in (False, True):
+        entry = {"name": "dead_reckoning", "label": "dr", "init": None,
+                 "config": {"standstill": standstill}}
+        solution, _ = run_estimator(ds, entry, show_progress=False)
+        truth = ds.read("truth")
+        yaw_error = np.degrees(np.angle(np.exp(1j * (
+            solution.yaw.to_numpy() - np.interp(solution.t, truth.t, np.unwrap(truth.yaw))))))
+        finals[standstill] = yaw_error[-1]
+    moving_time = float(ds.manifest["duration"]) - 20.0
+    assert finals[False] == pytest.approx(bias * (moving_time + 20.0), rel=0.02)
+    assert abs(finals[True]) < 0.01 * bias * moving_time
