@@ -34,9 +34,9 @@ import numpy as np
 import pandas as pd
 
 from simulator.environment.atmosphere import P0_PA, pressure_altitude_m, pressure_pa
-from simulator.scenario.schema import INVALID, Context, Number, Path, Record, Text, Vector
+from simulator.scenario.schema import Context, Number, Path, Vector
 from simulator.sensors.base import sample_times
-from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import HPA
 
@@ -58,33 +58,20 @@ _FIELDS = {
 _DEFAULTS = {"rate": 10.0, "sea_level_pressure": P0_PA, "range": None}
 
 
-def _resolve(value: dict, path: Path, ctx: Context) -> dict:
-    if not known_preset(value["preset"], BARO_PRESETS, "barometer", path, ctx):
-        return INVALID
-    out = fill_from_preset(value, BARO_PRESETS[value["preset"]], _FIELDS, path, ctx, _DEFAULTS)
-    if out is not INVALID and out["range"] is not None and out["range"][0] >= out["range"][1]:
-        ctx.error(path + ("range",), "the lowest pressure must be below the highest")
-        return INVALID
+def _check_range(out: dict, path: Path, ctx: Context) -> dict:
+    if out["range"] is not None and out["range"][0] >= out["range"][1]:
+        return ctx.error(path + ("range",), "the lowest pressure must be below the highest")
     return out
 
 
-BARO_FIELD = Record(
-    {"preset": Text("ideal", doc="named parameter set; 'ideal' is the exact pressure"),
-     **_FIELDS},
-    default=None,
-    post=_resolve,
-)
+BARO_FIELD = preset_sensor_field("barometer", BARO_PRESETS, _FIELDS, _DEFAULTS,
+                                 "is the exact pressure", _check_range)
 
 
-class Barometer:
+class Barometer(PresetSensor):
     """A barometer built from its resolved scenario block (``sensors.baro``)."""
 
     name = "baro"
-
-    def __init__(self, config: dict):
-        self.config = config
-        self.rate_hz = float(config["rate"])
-        self.drawn: dict = {"preset": config["preset"]}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         c = self.config

@@ -67,7 +67,7 @@ from simulator.gnss.navfiles import read_navigation
 from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
 from simulator.scenario.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
 from simulator.sensors.base import sample_times
-from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.presets import PresetSensor, fill_from_preset, known_preset
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.kinematics import Kinematics
 
@@ -160,15 +160,14 @@ GNSS_FIELD = Record(
 )
 
 
-class Gnss:
+class Gnss(PresetSensor):
     """A GPS L1 C/A receiver built from its resolved scenario block (``sensors.gnss``)."""
 
     name = "gnss"
 
     def __init__(self, config: dict):
-        self.config = config
-        self.rate_hz = float(config["rate"])
-        self.drawn: dict = {"preset": config["preset"], "constellation": config["constellation"]}
+        super().__init__(config)
+        self.drawn["constellation"] = config["constellation"]
 
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:

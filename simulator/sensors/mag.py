@@ -35,10 +35,10 @@ import numpy as np
 import pandas as pd
 
 from simulator.earth import euler_to_dcm
-from simulator.scenario.schema import INVALID, Context, Number, Path, Record, Text
+from simulator.scenario.schema import Number
 from simulator.sensors.base import sample_times
 from simulator.sensors.noise import gauss_markov
-from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MICRO_T
 
@@ -63,18 +63,8 @@ _FIELDS = {
 _DEFAULTS = {"rate": 10.0, "disturbance_time": 2.0}
 
 
-def _resolve(value: dict, path: Path, ctx: Context) -> dict:
-    if not known_preset(value["preset"], MAG_PRESETS, "magnetometer", path, ctx):
-        return INVALID
-    return fill_from_preset(value, MAG_PRESETS[value["preset"]], _FIELDS, path, ctx, _DEFAULTS)
-
-
-MAG_FIELD = Record(
-    {"preset": Text("ideal", doc="named parameter set; 'ideal' is the exact IGRF field"),
-     **_FIELDS},
-    default=None,
-    post=_resolve,
-)
+MAG_FIELD = preset_sensor_field("magnetometer", MAG_PRESETS, _FIELDS, _DEFAULTS,
+                                "is the exact IGRF field")
 
 
 def earth_field_ned(lat_deg: np.ndarray, lon_deg: np.ndarray, alt_m: np.ndarray,
@@ -87,15 +77,10 @@ def earth_field_ned(lat_deg: np.ndarray, lon_deg: np.ndarray, alt_m: np.ndarray,
     return np.stack([np.ravel(north), np.ravel(east), -np.ravel(up)], axis=-1) * NT_TO_T
 
 
-class Magnetometer:
+class Magnetometer(PresetSensor):
     """A magnetometer built from its resolved scenario block (``sensors.mag``)."""
 
     name = "mag"
-
-    def __init__(self, config: dict):
-        self.config = config
-        self.rate_hz = float(config["rate"])
-        self.drawn: dict = {"preset": config["preset"]}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         c = self.config

@@ -33,10 +33,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from simulator.scenario.schema import INVALID, Context, Number, Path, Record, Text
+from simulator.scenario.schema import Number
 from simulator.sensors.base import sample_times
 from simulator.sensors.noise import random_walk
-from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MILLI, PERCENT_RT_H
 
@@ -59,29 +59,14 @@ _FIELDS = {
 _DEFAULTS = {"rate": 10.0, "scale_factor": 1.0}
 
 
-def _resolve(value: dict, path: Path, ctx: Context) -> dict:
-    if not known_preset(value["preset"], ODOMETER_PRESETS, "odometer", path, ctx):
-        return INVALID
-    return fill_from_preset(value, ODOMETER_PRESETS[value["preset"]], _FIELDS, path, ctx,
-                            _DEFAULTS)
+ODOMETER_FIELD = preset_sensor_field("odometer", ODOMETER_PRESETS, _FIELDS, _DEFAULTS,
+                                     "is the true speed")
 
 
-ODOMETER_FIELD = Record(
-    {"preset": Text("ideal", doc="named parameter set; 'ideal' is the true speed"), **_FIELDS},
-    default=None,
-    post=_resolve,
-)
-
-
-class Odometer:
+class Odometer(PresetSensor):
     """An odometer built from its resolved scenario block (``sensors.odometer``)."""
 
     name = "odometer"
-
-    def __init__(self, config: dict):
-        self.config = config
-        self.rate_hz = float(config["rate"])
-        self.drawn: dict = {"preset": config["preset"]}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         c = self.config

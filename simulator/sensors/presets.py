@@ -3,14 +3,15 @@ the keys a user left out, so the resolved scenario shows every value the sensor 
 
 Public functions
 ----------------
-known_preset, fill_from_preset.
+known_preset, fill_from_preset, preset_sensor_field; class PresetSensor.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Any
 
-from simulator.scenario.schema import INVALID, Context, Field, Path
+from simulator.scenario.schema import INVALID, Context, Field, Path, Record, Text
 
 
 def known_preset(name: str, presets: dict[str, dict], what: str, path: Path,
@@ -41,3 +42,35 @@ def fill_from_preset(given: dict, preset: dict, fields: dict[str, Field], path: 
             if out[key] is INVALID:
                 return INVALID
     return out
+
+
+def preset_sensor_field(what: str, presets: dict[str, dict], fields: dict[str, Field],
+                        defaults: dict[str, Any], ideal_doc: str,
+                        check: Callable[[dict, Path, Context], Any] | None = None) -> Record:
+    """The scenario block of a sensor configured by ``preset`` plus single-key overrides.
+
+    ``check(resolved, path, ctx)`` runs after the preset filled the block (cross-key checks);
+    it returns the block, or INVALID after reporting a problem.
+    """
+    def resolve(value: dict, path: Path, ctx: Context) -> Any:
+        if not known_preset(value["preset"], presets, what, path, ctx):
+            return INVALID
+        out = fill_from_preset(value, presets[value["preset"]], fields, path, ctx, defaults)
+        if out is INVALID or check is None:
+            return out
+        return check(out, path, ctx)
+
+    return Record({"preset": Text("ideal", doc=f"named parameter set; 'ideal' {ideal_doc}"),
+                   **fields}, default=None, post=resolve)
+
+
+class PresetSensor:
+    """Base of the sensors built from a resolved preset block: keeps the block, the rate, and
+    the ``drawn`` record of the true error values (starting with the preset's name)."""
+
+    name = ""
+
+    def __init__(self, config: dict):
+        self.config = config
+        self.rate_hz = float(config["rate"])
+        self.drawn: dict = {"preset": config["preset"]}
