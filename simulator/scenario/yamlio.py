@@ -53,7 +53,8 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
         raise InputError([Problem(file, None, "", "file not found")]) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError([Problem(file, None, "", f"cannot read the file: {exc}")]) from None
-    loader = yaml.SafeLoader(text)
+    # libyaml's parser when PyYAML has it (several times faster), the pure-Python one otherwise
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)(text)
     try:
         node = loader.get_single_node()
         lines: dict[tuple, int] = {}
