@@ -14,14 +14,16 @@ import numpy as np
 import pandas as pd
 
 from simulator.trajectory.kinematics import Kinematics
+from simulator.trajectory.quadrature import (
+    GL_NODES,
+    GL_WEIGHTS,
+    cubic_interval_integrals,
+    cubic_rule_error,
+)
 
-# Gauss-Legendre nodes and weights on [0, 1]: exact for polynomials up to degree 5
-_GL_X, _GL_W = np.polynomial.legendre.leggauss(3)
-GL_NODES = 0.5 * (_GL_X + 1.0)
-GL_WEIGHTS = 0.5 * _GL_W
-# largest Simpson error accepted per interval before Gauss-Legendre takes over: 1e-12 rad and
-# 1e-11 m/s, so that a million samples cannot add up to a measurable drift
-SIMPSON_TOLERANCE = {"w_body": 1e-12, "f_body": 1e-11}
+# largest error of the cubic rule accepted per interval before Gauss-Legendre takes over:
+# 1e-12 rad and 1e-11 m/s, so that a million samples cannot add up to a measurable drift
+CUBIC_RULE_TOLERANCE = {"w_body": 1e-12, "f_body": 1e-11}
 
 
 class SensorModel(Protocol):
@@ -55,12 +57,11 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
                            keys: tuple[str, ...] = ("w_body", "f_body")) -> dict[str, np.ndarray]:
     """Integrals of truth vectors over each sample interval (t_end - dt, t_end].
 
-    This is the anti-aliased increment an integrating IMU outputs. On the truth's own grid,
-    Simpson's rule on the cached grid and midpoint evaluations is used where it is exact to
-    ``SIMPSON_TOLERANCE`` (its error dt^5/2880 f'''' estimated from the fourth difference of the
-    five neighbouring half-step values). Every other interval is integrated with three-point
-    Gauss-Legendre (exact for polynomials up to degree 5), split at the breakpoints of the
-    piecewise kinematics so each piece is smooth.
+    This is the anti-aliased increment an integrating IMU outputs. On the truth's own grid, the
+    cubic rule on the cached grid samples (``simulator.trajectory.quadrature``) is used where its
+    estimated error is within ``CUBIC_RULE_TOLERANCE``. Every other interval is integrated with
+    three-point Gauss-Legendre (exact for polynomials up to degree 5) on the analytic
+    kinematics, split at the breakpoints of the piecewise kinematics so each piece is smooth.
     """
     t_end = np.asarray(t_end, dtype=float)
     lo, hi = t_end - dt, t_end
@@ -73,21 +74,14 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
     k_end = grid_index(truth, t_end)
     on_grid = (k_end is not None and abs(dt * truth.rate_hz - 1.0) < 1e-12
                and k_end.min() >= 1)
-    if on_grid:
-        grid, mid = truth.grid_inertial(), truth.grid_inertial(midpoints=True)
-        k = k_end
+    if on_grid and len(truth.t_grid) >= 5:
+        grid = truth.grid_inertial()
         gauss = last > first
+        interval = k_end - 1  # the grid interval [t_k-1, t_k] each sample covers
         for key in keys:
-            g, m = grid[key], mid[key]
-            out[key] = dt / 6 * (g[k - 1] + 4 * m[k - 1] + g[k])
-            # half-step sequence g0 m0 g1 m1 ...: fourth difference centred on each interval
-            half = np.empty((2 * len(g) - 1, 3))
-            half[0::2], half[1::2] = g, m
-            d4 = np.zeros_like(half)
-            d4[2:-2] = half[:-4] - 4 * half[1:-3] + 6 * half[2:-2] - 4 * half[3:-1] + half[4:]
-            d4[:2], d4[-2:] = np.inf, np.inf
-            error = dt / 180 * np.max(np.abs(d4[2 * k - 1]), axis=1)
-            gauss |= error > SIMPSON_TOLERANCE[key]
+            out[key] = cubic_interval_integrals(grid[key], dt)[interval]
+            error = np.max(cubic_rule_error(grid[key], dt)[interval], axis=1)
+            gauss |= error > CUBIC_RULE_TOLERANCE[key]
     # intervals without a breakpoint in one vectorised piece; only those holding breakpoints
     # (a few per manoeuvre) are split one by one
     smooth = np.flatnonzero(gauss & (last <= first))

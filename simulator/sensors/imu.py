@@ -91,13 +91,7 @@ from simulator.scenario.schema import (
     Text,
     Vector,
 )
-from simulator.sensors.base import (
-    GL_NODES,
-    GL_WEIGHTS,
-    grid_index,
-    integrate_over_samples,
-    sample_times,
-)
+from simulator.sensors.base import grid_index, integrate_over_samples, sample_times
 from simulator.sensors.imu_presets import IMU_PRESETS
 from simulator.sensors.noise import (
     FLICKER_ADEV_FACTOR,
@@ -111,6 +105,7 @@ from simulator.sensors.noise import (
 from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.sensors.vibration import VIBRATION_FIELD, vibration
 from simulator.trajectory.kinematics import Kinematics
+from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
 
 REDUCED_UNITS = {
     "full": list(col.IMU_AXES),
@@ -398,18 +393,16 @@ def _truth_at(truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
 
 def _centripetal_increment(truth: Kinematics, t_end: np.ndarray, dt_s: float,
                            lever_arm: np.ndarray) -> np.ndarray:
-    """Integral of w x (w x r) over each interval (t - dt, t]: Simpson's rule on the truth's
-    cached grid and midpoint values when the intervals are its grid intervals, three-point
-    Gauss-Legendre otherwise."""
+    """Integral of w x (w x r) over each interval (t - dt, t]: the cubic rule on the truth's
+    cached grid when the intervals are its grid intervals, three-point Gauss-Legendre
+    otherwise."""
     k = grid_index(truth, t_end)
-    if k is not None and abs(dt_s * truth.rate_hz - 1.0) < 1e-12 and k.min() >= 1:
-        grid = truth.grid_inertial()["w_body"]
-        mid = truth.grid_inertial(midpoints=True)["w_body"]
-        w = np.stack([grid[k - 1], mid[k - 1], grid[k]], axis=1)
-        weights = np.array([1.0, 4.0, 1.0]) / 6.0
-    else:
-        nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
-        w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
-        weights = GL_WEIGHTS
+    if (k is not None and abs(dt_s * truth.rate_hz - 1.0) < 1e-12 and k.min() >= 1
+            and len(truth.t_grid) >= 4):
+        w = truth.grid_inertial()["w_body"]
+        centripetal = np.cross(w, np.cross(w, lever_arm))
+        return cubic_interval_integrals(centripetal, dt_s)[k - 1]
+    nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
+    w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
     centripetal = np.cross(w, np.cross(w, lever_arm))
-    return dt_s * np.einsum("j,njk->nk", weights, centripetal)
+    return dt_s * np.einsum("j,njk->nk", GL_WEIGHTS, centripetal)

@@ -25,7 +25,6 @@ Kinematics, kinematics_from_profile.
 from __future__ import annotations
 
 import datetime as dt
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,6 +40,7 @@ from simulator.earth import (
 from simulator.earth import ned_to_body_trig as ned_to_body
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.piecewise import PiecewisePolynomial
+from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
 from simulator.trajectory.segments import RoadProfile
 
 
@@ -70,6 +70,9 @@ class Kinematics:
     def __init__(self, profile: RoadProfile, origin: Origin, rate_hz: float,
                  roll_gradient: float):
         self.profile = _as_fast(profile)
+        curves = (self.profile.curvature, self.profile.grade, self.profile.bank,
+                  self.profile.heading)
+        self._shared_breaks = all(np.array_equal(c.x, curves[0].x) for c in curves)
         self.origin = origin
         self.rate_hz = float(rate_hz)
         self.roll_gradient = float(roll_gradient)
@@ -92,10 +95,12 @@ class Kinematics:
         s, v, a = p.distance_of_time.evaluate(t, (0, 1, 2))
         v = np.maximum(v, 0.0)
         d = p.direction_at(t)  # +1 forward, -1 reversing: switches only where v = a = 0
-        kappa, dkappa = p.curvature.evaluate(s, (0, 1))
-        gamma, dgamma = p.grade.evaluate(s, (0, 1))
-        bank, dbank = p.bank.evaluate(s, (0, 1))
-        psi = np.radians(self.origin.heading_deg) + p.heading(s)
+        # the road curves of a parametric drive share their breakpoints: one search serves all
+        idx = p.curvature.piece_index(s) if self._shared_breaks else None
+        kappa, dkappa = p.curvature.evaluate(s, (0, 1), idx)
+        gamma, dgamma = p.grade.evaluate(s, (0, 1), idx)
+        bank, dbank = p.bank.evaluate(s, (0, 1), idx)
+        psi = np.radians(self.origin.heading_deg) + p.heading.evaluate(s, (0,), idx)[0]
         cg, sg, cp, sp = np.cos(gamma), np.sin(gamma), np.cos(psi), np.sin(psi)
         yaw_rate = kappa * v
         pitch_rate = dgamma * v
@@ -119,42 +124,59 @@ class Kinematics:
 
     # -- position ---------------------------------------------------------------------------
     def _integrate_position(self) -> None:
-        """Geodetic position on the grid: Simpson's rule on dlat/dt, dlon/dt, dh/dt.
-
-        The integration grid is the base grid plus the drive's end time, so positions are
-        exact up to the last instant of the drive.
+        """Geodetic position on the grid: dlat/dt, dlon/dt, dh/dt (Groves eq. 5.56) integrated
+        interval by interval with the cubic rule on the grid samples (``quadrature``), and with
+        three-point Gauss-Legendre on the analytic velocity where the grid is too short for it
+        and over the last, partial interval up to the drive's end.
         """
         t = self.t_grid
-        if t[-1] < self.duration_s - 1e-9:
+        h = 1.0 / self.rate_hz
+        motion = self._motion(t)
+        self._motion_cache = {"grid": motion}  # reused by ``grid_inertial``
+        v = motion["v_ned"]
+        if t[-1] < self.duration_s - 1e-9:  # the drive ends between two grid points
             t = np.append(t, self.duration_s)
-        dt = np.diff(t)
-        n = len(self.t_grid)
-        node_motion, mid_motion = _in_two_threads(self._motion, t, t[:-1] + dt / 2)
-        # kept for the grid evaluations of ``grid_inertial``
-        self._motion_cache = {"grid": _take(node_motion, n), "mid": _take(mid_motion, n - 1)}
-        node, mid = node_motion["v_ned"], mid_motion["v_ned"]
+            v = np.vstack([v, self._motion(t[-1:])["v_ned"]])
         lat0, lon0 = np.radians(self.origin.lat_deg), np.radians(self.origin.lon_deg)
 
-        def simpson(f_node: np.ndarray, f_mid: np.ndarray) -> np.ndarray:
-            steps = dt / 6 * (f_node[:-1] + 4 * f_mid + f_node[1:])
+        def integrate(rate_of) -> np.ndarray:
+            """Cumulative integral of rate_of(times, v_ned, index) over the nodes."""
+            values = rate_of(t, v, np.arange(len(t)))
+            n_uniform = len(self.t_grid)
+            steps = np.empty(len(t) - 1)
+            if n_uniform >= 4:
+                steps[:n_uniform - 1] = cubic_interval_integrals(values[:n_uniform], h)
+                first_gauss = n_uniform - 1
+            else:
+                first_gauss = 0
+            if first_gauss < len(t) - 1:
+                a, b = t[first_gauss:-1], t[first_gauss + 1:]
+                nodes = (a[:, None] + (b - a)[:, None] * GL_NODES[None, :]).ravel()
+                owner = np.repeat(np.arange(first_gauss, len(t) - 1), len(GL_NODES))
+                at_nodes = rate_of(nodes, self._motion(nodes)["v_ned"], owner)
+                steps[first_gauss:] = (b - a) * (at_nodes.reshape(-1, len(GL_NODES))
+                                                 @ GL_WEIGHTS)
             return np.concatenate([[0.0], np.cumsum(steps)])
 
-        alt = self.origin.alt_m + simpson(-node[:, 2], -mid[:, 2])
-        alt_mid = 0.5 * (alt[:-1] + alt[1:]) + dt / 8 * (node[1:, 2] - node[:-1, 2])
+        alt = self.origin.alt_m + integrate(lambda tt, vv, i: -vv[:, 2])
         lat = np.full_like(t, lat0)
-        for _ in range(3):  # fixed point on the weak dependence of the radii on latitude
-            lat_mid = 0.5 * (lat[:-1] + lat[1:])
-            rn_node, _ = radii_of_curvature(lat)
-            rn_mid, _ = radii_of_curvature(lat_mid)
-            lat = lat0 + simpson(node[:, 0] / (rn_node + alt), mid[:, 0] / (rn_mid + alt_mid))
-        lat_mid = 0.5 * (lat[:-1] + lat[1:])
-        _, re_node = radii_of_curvature(lat)
-        _, re_mid = radii_of_curvature(lat_mid)
-        lon = lon0 + simpson(node[:, 1] / ((re_node + alt) * np.cos(lat)),
-                             mid[:, 1] / ((re_mid + alt_mid) * np.cos(lat_mid)))
+
+        def between(nodes_value: np.ndarray, tt: np.ndarray, i: np.ndarray) -> np.ndarray:
+            # node values at the nodes; linear between them (the radii vary slowly)
+            j = np.minimum(i, len(t) - 2)
+            u = (tt - t[j]) / (t[j + 1] - t[j])
+            return nodes_value[j] + u * (nodes_value[j + 1] - nodes_value[j])
+
+        for _ in range(2):  # fixed point on the weak dependence of the radii on latitude
+            lat_prev = lat
+            lat = lat0 + integrate(lambda tt, vv, i, lat_prev=lat_prev: vv[:, 0] / (
+                radii_of_curvature(between(lat_prev, tt, i))[0] + between(alt, tt, i)))
+        lon = lon0 + integrate(lambda tt, vv, i: vv[:, 1] / (
+            (radii_of_curvature(between(lat, tt, i))[1] + between(alt, tt, i))
+            * np.cos(between(lat, tt, i))))
         rn, re = radii_of_curvature(lat)
-        rates = np.stack([node[:, 0] / (rn + alt), node[:, 1] / ((re + alt) * np.cos(lat)),
-                          -node[:, 2]], axis=-1)
+        rates = np.stack([v[:, 0] / (rn + alt), v[:, 1] / ((re + alt) * np.cos(lat)), -v[:, 2]],
+                         axis=-1)
         self._t_int = t
         self._pos_values = np.stack([lat, lon, alt], axis=-1)
         self._pos_rates = rates
@@ -178,7 +200,8 @@ class Kinematics:
                 + (u3 - u2) * h * self._pos_rates[i + 1])
 
     # -- the truth columns ------------------------------------------------------------------
-    def inertial(self, t: np.ndarray, motion: dict | None = None) -> dict[str, np.ndarray]:
+    def inertial(self, t: np.ndarray, motion: dict | None = None,
+                 position: np.ndarray | None = None) -> dict[str, np.ndarray]:
         """Everything at times t: position, velocity, attitude, w_ib^b and f_ib^b (FRD).
 
         f^n = dv/dt - g^n + (w_en + 2 w_ie) x v (Groves eq. 5.54) and
@@ -186,7 +209,7 @@ class Kinematics:
         """
         t = np.atleast_1d(np.asarray(t, dtype=float))
         m = self._motion(t) if motion is None else motion
-        pos = self.position(t)
+        pos = self.position(t) if position is None else position
         lat, alt = pos[:, 0], pos[:, 2]
         v = m["v_ned"]
         rn, re = radii_of_curvature(lat)
@@ -215,19 +238,14 @@ class Kinematics:
                     pitch=m["pitch"], yaw=m["yaw"], w_body=w_body, f_body=f_body, speed=m["v"],
                     distance=m["s"])
 
-    def grid_inertial(self, midpoints: bool = False) -> dict[str, np.ndarray]:
-        """``inertial`` on the base grid (or at the midpoints of its intervals), cached: the
-        truth table and the sensors sampling at the base rate share one evaluation."""
-        key = "mid" if midpoints else "grid"
-        if key not in self._cache:
-            # both are evaluated together, on two threads (numpy releases the GIL)
-            mid_t = self.t_grid[:-1] + 0.5 / self.rate_hz
-            grid, mid = _in_two_threads(
-                lambda t, m: self.inertial(t, m),
-                (self.t_grid, self._motion_cache.pop("grid")),
-                (mid_t, self._motion_cache.pop("mid")), star=True)
-            self._cache.update(grid=grid, mid=mid)
-        return self._cache[key]
+    def grid_inertial(self) -> dict[str, np.ndarray]:
+        """``inertial`` on the base grid, cached: the truth table and the sensors sampling at
+        the base rate share one evaluation."""
+        if "grid" not in self._cache:
+            n = len(self.t_grid)  # the grid's positions are the integration's own nodes
+            self._cache["grid"] = self.inertial(self.t_grid, self._motion_cache.pop("grid"),
+                                                self._pos_values[:n])
+        return self._cache["grid"]
 
     def breakpoints(self) -> np.ndarray:
         """Times where the piecewise kinematics switch polynomial pieces (rates may kink there).
@@ -274,20 +292,6 @@ class Kinematics:
             "speed": k["speed"], "distance": k["distance"],
             "zone": self.zone_at(k["t"]).astype(str),
         }, columns=list(col.TRUTH))
-
-
-def _in_two_threads(function, first, second, star: bool = False):
-    """``function`` of two arguments (tuples with ``star``) evaluated on two threads."""
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        if star:
-            futures = [pool.submit(function, *first), pool.submit(function, *second)]
-        else:
-            futures = [pool.submit(function, first), pool.submit(function, second)]
-        return futures[0].result(), futures[1].result()
-
-
-def _take(arrays: dict[str, np.ndarray], n: int) -> dict[str, np.ndarray]:
-    return {k: v[:n] for k, v in arrays.items()}
 
 
 def _as_fast(profile: RoadProfile) -> RoadProfile:

@@ -35,20 +35,29 @@ class PiecewisePolynomial:
         """Index of the piece holding each x (pieces are [x[i], x[i+1]); ends extrapolate)."""
         return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.c.shape[1] - 1)
 
-    def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,)) -> list[np.ndarray]:
-        """Values of the requested derivatives at x (one search for all of them)."""
+    def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,),
+                 index: np.ndarray | None = None) -> list[np.ndarray]:
+        """Values of the requested derivatives at x (one search for all of them; ``index``
+        from ``piece_index`` skips it, for curves that share these breakpoints)."""
         x = np.asarray(x, dtype=float)
-        idx = self.piece_index(x)
+        idx = self.piece_index(x) if index is None else index
         dx = x - self.x[idx]
         out = []
         for nu in orders:
-            c = self.derivative(nu).c if nu else self.c
+            c = self._coefficients(nu)
             acc = c[0, idx].copy()
             for k in range(1, c.shape[0]):
                 acc *= dx
                 acc += c[k, idx]
             out.append(acc)
         return out
+
+    def _coefficients(self, nu: int) -> np.ndarray:
+        """Coefficients of the nu-th derivative, computed once."""
+        cache = self.__dict__.setdefault("_derivatives", {0: self.c})
+        if nu not in cache:
+            cache[nu] = self.derivative(nu).c
+        return cache[nu]
 
     def __call__(self, x: np.ndarray, nu: int = 0) -> np.ndarray:
         return self.evaluate(x, (nu,))[0]
