@@ -20,6 +20,7 @@ from simulator.sensors.noise import (
     gauss_markov,
     gauss_markov_avar,
 )
+from simulator.tables import as_frame
 
 REAL = SHARED / "refdata" / "allan" / "imu_utils_real_imus"
 IMU_UTILS_DEG_H = 57.3 * 3600.0  # imu_utils writes gyro ADEV in deg/h with this factor
@@ -35,7 +36,7 @@ def static_record(truth, block: dict, seed: int = 5) -> tuple[dict, np.ndarray, 
     ctx = Context("test")
     cfg = IMU_FIELD.check(block, ("imu",), ctx)
     assert not ctx.problems, ctx.problems
-    out = Imu(cfg).generate(truth, np.random.default_rng(seed))["imu"]
+    out = as_frame(Imu(cfg).generate(truth, np.random.default_rng(seed))["imu"])
     rate = cfg["rate"]
     values = out[list(col.IMU_AXES)].to_numpy()
     if cfg["output"] == "increment":
