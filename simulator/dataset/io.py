@@ -73,8 +73,9 @@ def _text_column(values: np.ndarray) -> pa.Array:
     """A text column (None as null) as ``large_string``, run by run: the columns written this
     way (truth zone, event kinds) hold long runs of one value."""
     n = len(values)
-    starts = np.flatnonzero(np.concatenate([[True], values[1:] != values[:-1]])) if n else \
-        np.zeros(0, dtype=int)
+    changes = np.ones(n, dtype=bool)
+    changes[1:] = values[1:] != values[:-1]
+    starts = np.flatnonzero(changes)
     runs = np.diff(np.append(starts, n))
     run_values = [values[i] for i in starts]
     valid = np.array([v is not None and v == v for v in run_values], dtype=bool)  # v != v: NaN
