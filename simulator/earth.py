@@ -24,8 +24,9 @@ Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Sys
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
-import pymap3d
 
 A_M = 6378137.0  # WGS-84 semi-major axis, m (TR8350.2 Table 3.1)
 F = 1.0 / 298.257223563  # WGS-84 flattening (TR8350.2 Table 3.1)
@@ -39,7 +40,15 @@ SOMIGLIANA_K = 0.00193185265241  # Somigliana constant k = b*gp/(a*ge) - 1 (TR83
 M_RATIO = 0.00344978650684  # m = w^2 a^2 b / GM (TR8350.2 eq. 4-3)
 G0_M_S2 = 9.80665  # standard gravity g_0, m/s^2 (unit conversions of "mg", "g")
 
-_WGS84 = pymap3d.Ellipsoid.from_name("wgs84")
+
+
+@functools.cache
+def _pymap3d():
+    """pymap3d and its WGS-84 ellipsoid, imported on first use: about 10 ms of a start (it loads
+    dateutil), which the generation of a drive without ECEF conversions does not need."""
+    import pymap3d
+
+    return pymap3d, pymap3d.Ellipsoid.from_name("wgs84")
 
 
 def radii_of_curvature(lat_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -101,7 +110,8 @@ def transport_rate_ned(lat_rad: np.ndarray, alt_m: np.ndarray, v_ned: np.ndarray
 
 def geodetic_to_ecef(lat_rad: np.ndarray, lon_rad: np.ndarray, alt_m: np.ndarray) -> np.ndarray:
     """Geodetic (rad, rad, m) to ECEF, shape (n, 3), m (pymap3d.geodetic2ecef, WGS-84)."""
-    x, y, z = pymap3d.geodetic2ecef(lat_rad, lon_rad, alt_m, ell=_WGS84, deg=False)
+    pymap3d, wgs84 = _pymap3d()
+    x, y, z = pymap3d.geodetic2ecef(lat_rad, lon_rad, alt_m, ell=wgs84, deg=False)
     return np.stack(np.broadcast_arrays(x, y, z), axis=-1)
 
 
@@ -111,8 +121,9 @@ def ecef_to_geodetic(xyz_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     Uses pymap3d.ecef2geodetic (WGS-84).
     """
     xyz = np.asarray(xyz_m, dtype=float)
+    pymap3d, wgs84 = _pymap3d()
     lat, lon, alt = pymap3d.ecef2geodetic(
-        xyz[..., 0], xyz[..., 1], xyz[..., 2], ell=_WGS84, deg=False
+        xyz[..., 0], xyz[..., 1], xyz[..., 2], ell=wgs84, deg=False
     )
     return np.asarray(lat), np.asarray(lon), np.asarray(alt)
 

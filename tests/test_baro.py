@@ -18,6 +18,7 @@ from simulator.environment.atmosphere import (
 from simulator.scenario.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.baro import BARO_FIELD, Barometer
+from simulator.tables import as_frame
 
 TABLES = SHARED / "refdata" / "tables"
 
@@ -66,7 +67,7 @@ def test_registered():
 
 def test_ideal_barometer_altitude_is_truth():
     truth = drive_truth()
-    out = make({}).generate(truth, np.random.default_rng(1))["baro"]
+    out = as_frame(make({}).generate(truth, np.random.default_rng(1))["baro"])
     np.testing.assert_allclose(out["altitude"], truth.position(out["t"])[:, 2], atol=1e-6)
 
 
@@ -74,7 +75,7 @@ def test_bmp280_noise_bias_resolution():
     # Park et al. 2019, Table 2: 1.3 Pa RMS noise at 20 Hz
     baro = make({"preset": "bosch-bmp280"})
     truth = static_truth(600.0)
-    out = baro.generate(truth, np.random.default_rng(4))["baro"]
+    out = as_frame(baro.generate(truth, np.random.default_rng(4))["baro"])
     assert len(out) == 600 * 20 + 1
     expected = pressure_pa(truth.position(out["t"])[:, 2]) + baro.drawn["bias"]
     residual = out["pressure"].to_numpy() - expected
@@ -86,13 +87,14 @@ def test_bmp280_noise_bias_resolution():
 
 def test_weather_drift_and_range():
     truth = static_truth(3600.0)
-    out = make({"drift": "-1 hPa/h", "rate": 1}).generate(truth, np.random.default_rng(5))["baro"]
+    out = as_frame(make({"drift": "-1 hPa/h", "rate": 1}).generate(truth,
+                                                                   np.random.default_rng(5))["baro"])
     p = out["pressure"].to_numpy()
     p0 = pressure_pa(truth.position([0.0])[0, 2])
     # the whole column scales with the sea-level pressure
     assert p[-1] - p[0] == pytest.approx(-100.0 * p0 / 101325.0, rel=1e-9)
-    clipped = make({"range": ["300 hPa", "1000 hPa"]}).generate(
-        truth, np.random.default_rng(5))["baro"]
+    clipped = as_frame(make({"range": ["300 hPa", "1000 hPa"]}).generate(
+        truth, np.random.default_rng(5))["baro"])
     assert clipped["pressure"].max() == 100000.0
 
 

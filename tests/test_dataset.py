@@ -4,16 +4,24 @@ regeneration, atomic writes, refusal to overwrite."""
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
 import pyarrow.parquet as pq
 import pytest
+import yaml
 
 from simulator import columns as col
 from simulator.cli import main
-from simulator.dataset.io import open_dataset
+from simulator.dataset.events import events_table
+from simulator.dataset.generate import generate_streams
+from simulator.dataset.io import open_dataset, read_table, write_table
 from simulator.errors import InputError
+from simulator.scenario import validate_data
+from simulator.tables import as_frame
 
 REPO = Path(__file__).resolve().parents[1]
 QUICK = REPO / "scenarios" / "quickstart.yaml"
@@ -107,3 +115,51 @@ def test_corrupt_stream_file(dataset, tmp_path):
     (copy / "imu.parquet").write_bytes(b"not parquet at all")
     with pytest.raises(InputError, match="imu.parquet"):
         open_dataset(copy).read("imu")
+
+
+def _no_gnss_scenario(path: Path) -> Path:
+    """The quick-start drive (tunnel and estimators included) with an IMU, odometer, barometer
+    and magnetometer and no GNSS."""
+    data = yaml.safe_load(QUICK.read_text())
+    data["sensors"] = {"imu": {"preset": "automotive", "rate": 100, "output": "increment"},
+                       "odometer": {"preset": "abs-wheel-speed"},
+                       "baro": {"preset": "bosch-bmp280"}, "mag": {"preset": "automotive"}}
+    path.write_text(yaml.safe_dump(data))
+    return path
+
+
+def test_generate_without_gnss_and_faults_does_not_import_pandas(tmp_path):
+    """Importing pandas is a third of the whole generation of an hour's drive: a scenario
+    without GNSS and faults is generated without it, and reads back as before."""
+    scenario, out = _no_gnss_scenario(tmp_path / "s.yaml"), tmp_path / "out"
+    code = ("import sys\nfrom simulator.cli import main\n"
+            f"assert main(['generate', {str(scenario)!r}, '-o', {str(out)!r}]) == 0\n"
+            "print(sorted(m for m in sys.modules if m.split('.')[0] == 'pandas'))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)}, check=True)
+    assert result.stdout.splitlines()[-1] == "[]"
+    ds = open_dataset(out)
+    assert set(ds.stream_names) == {"truth", "imu", "odometer", "baro", "mag", "events"}
+    assert list(ds.read("truth").columns) == list(col.TRUTH)
+    assert set(ds.read("truth")["zone"]) == {"", "tunnel"}
+    assert ds.read("odometer")["ticks"].dtype == np.int64
+    assert list(ds.read("events")["kind"]) == ["zone"]
+
+
+def test_column_tables_and_dataframes_write_the_same_files(tmp_path):
+    """The writer gives the same bytes for a stream whether it is a column table or the
+    DataFrame of it (text, integers, NaN as null, empty tables)."""
+    data = yaml.safe_load(_no_gnss_scenario(tmp_path / "s.yaml").read_text())
+    tables = generate_streams(validate_data(data, "s.yaml"), False, frames=False).streams
+    tables["nan"] = {"t": np.array([0.0, 1.0, 2.0]), "x": np.array([1.0, np.nan, 3.0])}
+    tables["empty"] = events_table([])
+    units = {"nan": {"t": "s", "x": "m"}, "empty": col.EVENTS}
+    for name, table in tables.items():
+        assert isinstance(table, dict)
+        unit = units[name] if name in units else col.STREAMS[name][1]
+        write_table(table, tmp_path / f"{name}-columns.parquet", unit)
+        write_table(as_frame(table), tmp_path / f"{name}-frame.parquet", unit)
+        assert ((tmp_path / f"{name}-columns.parquet").read_bytes()
+                == (tmp_path / f"{name}-frame.parquet").read_bytes()), name
+    assert read_table(tmp_path / "nan-columns.parquet")["x"].isna().tolist() == [False, True,
+                                                                                  False]

@@ -14,6 +14,7 @@ from simulator.scenario.schema import Context
 from simulator.sensors import SENSOR_FIELDS, SENSOR_MODELS
 from simulator.sensors.imu import IMU_FIELD, REDUCED_UNITS, Imu
 from simulator.sensors.imu_presets import IMU_PRESETS
+from simulator.tables import as_frame
 
 
 def resolve(block: dict) -> dict:
@@ -36,7 +37,7 @@ def truth():
 
 def run(truth, block: dict, seed: int = 3):
     imu = Imu(resolve(block))
-    return imu.generate(truth, np.random.default_rng(seed))["imu"], imu
+    return as_frame(imu.generate(truth, np.random.default_rng(seed))["imu"]), imu
 
 
 def test_registered():

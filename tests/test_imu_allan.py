@@ -15,11 +15,14 @@ from simulator.scenario.schema import Context
 from simulator.sensors.imu import IMU_FIELD, Imu
 from simulator.sensors.noise import (
     FLICKER_ADEV_FACTOR,
+    GM_ADEV_PEAK,
     GM_ADEV_PEAK_TAU,
     adev_model,
     gauss_markov,
     gauss_markov_avar,
+    gm_adev_peak,
 )
+from simulator.tables import as_frame
 
 REAL = SHARED / "refdata" / "allan" / "imu_utils_real_imus"
 IMU_UTILS_DEG_H = 57.3 * 3600.0  # imu_utils writes gyro ADEV in deg/h with this factor
@@ -35,7 +38,7 @@ def static_record(truth, block: dict, seed: int = 5) -> tuple[dict, np.ndarray, 
     ctx = Context("test")
     cfg = IMU_FIELD.check(block, ("imu",), ctx)
     assert not ctx.problems, ctx.problems
-    out = Imu(cfg).generate(truth, np.random.default_rng(seed))["imu"]
+    out = as_frame(Imu(cfg).generate(truth, np.random.default_rng(seed))["imu"])
     rate = cfg["rate"]
     values = out[list(col.IMU_AXES)].to_numpy()
     if cfg["output"] == "increment":
@@ -113,6 +116,10 @@ def test_gauss_markov_allan_formula_against_allantools():
     np.testing.assert_allclose(dev, np.sqrt(gauss_markov_avar(t, sigma, tau_c)), rtol=0.08)
     # the commonly quoted peak at 1.89 correlation times (IEEE Std 952-1997, Annex C, Markov noise)
     assert GM_ADEV_PEAK_TAU == pytest.approx(1.89, abs=0.01)
+
+
+def test_gauss_markov_peak_constants_are_the_grid_search():
+    assert gm_adev_peak() == (GM_ADEV_PEAK, GM_ADEV_PEAK_TAU)
 
 
 @pytest.mark.parametrize("rate, output", [(20.0, "rate"), (200.0, "increment")])

@@ -12,6 +12,7 @@ from estimators.strapdown import rates_to_increments, run_strapdown
 from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.sensors.imu import Imu
+from simulator.tables import as_frame
 
 
 @pytest.fixture(scope="module")
@@ -65,7 +66,7 @@ def test_strapdown_closure_ideal_increments(drive):
     bounds asserted here are far stricter than the issue's."""
     imu = Imu({"preset": "ideal", "rate": 100.0, "output": "increment",
                "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
-    err = _closure(drive, imu.generate(drive, None)["imu"], increments=True)
+    err = _closure(drive, as_frame(imu.generate(drive, None)["imu"]), increments=True)
     assert err["horizontal"] < 0.1
     assert err["vertical"] < 0.1
     assert err["yaw_deg"] < 1e-4
@@ -76,7 +77,7 @@ def test_strapdown_closure_ideal_increments(drive):
 def test_rate_output_samples_the_truth_exactly(drive):
     imu = Imu({"preset": "ideal", "rate": 50.0, "output": "rate",
                "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
-    table = imu.generate(drive, None)["imu"]
+    table = as_frame(imu.generate(drive, None)["imu"])
     ref = drive.table(table.t.to_numpy())
     np.testing.assert_array_equal(table[["gyro_x", "gyro_y", "gyro_z"]].to_numpy(),
                                   ref[["wx", "wy", "wz"]].to_numpy())
@@ -90,7 +91,7 @@ def test_strapdown_closure_ideal_rates_smooth_drive():
     truth = build_truth(scenario_data(segments))
     imu = Imu({"preset": "ideal", "rate": 100.0, "output": "rate",
                "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
-    err = _closure(truth, imu.generate(truth, None)["imu"], increments=False)
+    err = _closure(truth, as_frame(imu.generate(truth, None)["imu"]), increments=False)
     assert err["horizontal"] < 1.0
     assert err["yaw_deg"] < 0.01
 

@@ -9,9 +9,11 @@ import numpy as np
 import pytest
 from sensor_truths import truth_from_segments
 
+from simulator.environment.igrf import igrf_ned
 from simulator.scenario.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.mag import MAG_FIELD, Magnetometer
+from simulator.tables import as_frame
 
 # NOAA NCEI geomagnetic calculator, IGRF, 2020-01-01, 5 km above the WGS-84 ellipsoid, as in
 # ppigrf's test data (klaundal/ppigrf test/data/2020-01-01/b_{n,e,z}.csv): north, east, down, nT
@@ -39,7 +41,7 @@ def test_registered():
 
 @pytest.mark.parametrize("lat, lon, ncei", NCEI)
 def test_igrf_magnitude_and_inclination(lat, lon, ncei):
-    out = make({}).generate(standing(lat, lon), np.random.default_rng(0))["mag"]
+    out = as_frame(make({}).generate(standing(lat, lon), np.random.default_rng(0))["mag"])
     b = out[["mag_x", "mag_y", "mag_z"]].to_numpy()[0] * 1e9
     ref = np.array(ncei)
     # IGRF-14 (ppigrf) against the IGRF-13-era calculator: agreement to about 10 nT
@@ -51,9 +53,10 @@ def test_igrf_magnitude_and_inclination(lat, lon, ncei):
 
 
 def test_heading_rotates_the_horizontal_field():
-    east = make({}).generate(standing(37.0, 127.0, heading=90.0),
-                             np.random.default_rng(0))["mag"].iloc[0]
-    north = make({}).generate(standing(37.0, 127.0), np.random.default_rng(0))["mag"].iloc[0]
+    east = as_frame(make({}).generate(standing(37.0, 127.0, heading=90.0),
+                                      np.random.default_rng(0))["mag"]).iloc[0]
+    north = as_frame(make({}).generate(standing(37.0, 127.0),
+                                       np.random.default_rng(0))["mag"]).iloc[0]
     # facing east, the body x axis sees the east component, the y axis minus the north one
     assert east["mag_x"] == pytest.approx(north["mag_y"], rel=1e-9)
     assert east["mag_y"] == pytest.approx(-north["mag_x"], rel=1e-9)
@@ -61,9 +64,9 @@ def test_heading_rotates_the_horizontal_field():
 
 def test_hard_and_soft_iron():
     truth = standing(37.0, 127.0)
-    ideal = make({}).generate(truth, np.random.default_rng(0))["mag"]
+    ideal = as_frame(make({}).generate(truth, np.random.default_rng(0))["mag"])
     mag = make({"hard_iron": "5 uT", "soft_iron": 0.02})
-    out = mag.generate(truth, np.random.default_rng(0))["mag"]
+    out = as_frame(mag.generate(truth, np.random.default_rng(0))["mag"])
     cols = ["mag_x", "mag_y", "mag_z"]
     soft = np.array(mag.drawn["soft_iron"])
     expected = ideal[cols].to_numpy() @ (np.eye(3) + soft).T + np.array(mag.drawn["hard_iron"])
@@ -76,11 +79,26 @@ def test_disturbance_only_in_covered_zones():
         {"straight": {"length": 300, "zone": "tunnel"}}, {"straight": {"length": 200}}])
     truth.environment = {"zones": {"tunnel": {"sky": "none"}}}
     block = {"disturbance": "20 uT"}
-    ideal = make({}).generate(truth, np.random.default_rng(0))["mag"]
-    out = make(block).generate(truth, np.random.default_rng(0))["mag"]
+    ideal = as_frame(make({}).generate(truth, np.random.default_rng(0))["mag"])
+    out = as_frame(make(block).generate(truth, np.random.default_rng(0))["mag"])
     diff = np.linalg.norm((out[["mag_x", "mag_y", "mag_z"]] - ideal[["mag_x", "mag_y", "mag_z"]])
                           .to_numpy(), axis=1)
     inside = truth.zone_at(out["t"].to_numpy()) == "tunnel"
     assert inside.sum() > 100
     assert np.all(diff[~inside] == 0.0)
     assert np.sqrt(np.mean(diff[inside] ** 2)) == pytest.approx(20e-6 * np.sqrt(3), rel=0.4)
+
+
+def test_igrf_synthesis_is_ppigrf():
+    """``simulator.environment.igrf`` evaluates ppigrf's own model without importing pandas:
+    the same field as ``ppigrf.igrf`` everywhere and at any date of the model."""
+    ppigrf = pytest.importorskip("ppigrf")
+    rng = np.random.default_rng(1)
+    lat, lon = rng.uniform(-89.0, 89.0, 300), rng.uniform(-180.0, 180.0, 300)
+    h_km = rng.uniform(-0.5, 10.0, 300)
+    for date in (dt.datetime(2024, 5, 1, 3), dt.datetime(2020, 1, 1),
+                 dt.datetime(1987, 7, 3, 12, 34, 56)):
+        ours = igrf_ned(lat, lon, h_km, date)
+        theirs = ppigrf.igrf(lon, lat, h_km, date)
+        for a, b in zip(ours, theirs, strict=True):
+            np.testing.assert_allclose(a, np.ravel(b), rtol=1e-12, atol=1e-9)

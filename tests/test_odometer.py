@@ -10,6 +10,7 @@ from sensor_truths import drive_truth
 from simulator.scenario.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.odometer import ODOMETER_FIELD, Odometer
+from simulator.tables import as_frame
 
 
 def make(block: dict) -> Odometer:
@@ -31,7 +32,7 @@ def test_registered():
 @pytest.mark.parametrize("scale, tpm, rate", [(1.02, 20.0, 10.0), (0.97, 47.3, 50.0)])
 def test_distance_is_scaled_truth_within_one_tick(truth, scale, tpm, rate):
     odo = make({"rate": rate, "scale_factor": scale, "ticks_per_meter": tpm})
-    out = odo.generate(truth, np.random.default_rng(1))["odometer"]
+    out = as_frame(odo.generate(truth, np.random.default_rng(1))["odometer"])
     wheel = np.sum(out["speed"].to_numpy() / rate)
     true = truth.profile.distance_of_time(out["t"].iloc[-1])
     assert abs(wheel - scale * true) <= 1.0 / tpm + 1e-9
@@ -41,7 +42,7 @@ def test_distance_is_scaled_truth_within_one_tick(truth, scale, tpm, rate):
 
 def test_exact_zero_at_standstill(truth):
     for block in ({"preset": "abs-wheel-speed"}, {"scale_factor": 1.05}):
-        out = make(block).generate(truth, np.random.default_rng(2))["odometer"]
+        out = as_frame(make(block).generate(truth, np.random.default_rng(2))["odometer"])
         t = out["t"].to_numpy()
         still = truth.profile.distance_of_time(np.clip(t - 0.5, 0, None)) == \
             truth.profile.distance_of_time(np.minimum(t + 0.5, truth.duration_s))
@@ -51,8 +52,8 @@ def test_exact_zero_at_standstill(truth):
 
 
 def test_latency_delays_the_speed(truth):
-    out = make({"scale_factor": 1.0, "latency": 0.3, "rate": 20}).generate(
-        truth, np.random.default_rng(3))["odometer"]
+    out = as_frame(make({"scale_factor": 1.0, "latency": 0.3, "rate": 20}).generate(
+        truth, np.random.default_rng(3))["odometer"])
     t = out["t"].to_numpy()
     late = truth.inertial(np.clip(t - 0.3, 0, None))["speed"]
     np.testing.assert_allclose(out["speed"], late, atol=1e-9)

@@ -18,6 +18,7 @@ from simulator.cli import main
 from simulator.dataset.generate import build_truth
 from simulator.dataset.io import open_dataset
 from simulator.sensors.imu import Imu
+from simulator.tables import as_frame
 from tests.synthetic import scenario, write_synthetic
 
 REVERSES = {"r1": 20.0, "r2": 15.0, "r3": 12.0, "r4": 4.0}
@@ -68,7 +69,7 @@ def _ned(truth, t: np.ndarray, t0: float) -> np.ndarray:
 def test_strapdown_closure_with_reversing(truth):
     """The same bounds as the forward ten-minute drive (tests/test_kinematics.py): an
     independent NED strapdown of the ideal IMU closes on the truth through four reverses."""
-    err = _closure(truth, Imu(IDEAL_IMU).generate(truth, None)["imu"], increments=True)
+    err = _closure(truth, as_frame(Imu(IDEAL_IMU).generate(truth, None)["imu"]), increments=True)
     assert err["horizontal"] < 0.1
     assert err["vertical"] < 0.1
     assert err["yaw_deg"] < 1e-4
@@ -135,7 +136,7 @@ def test_velocity_along_minus_body_x_while_reversing(truth):
     {"rate": 50.0, "scale_factor": 0.97},
 ])
 def test_odometer_is_signed_and_sums_to_net_displacement(truth, block):
-    out = make_odometer(block).generate(truth, np.random.default_rng(1))["odometer"]
+    out = as_frame(make_odometer(block).generate(truth, np.random.default_rng(1))["odometer"])
     speed = out["speed"].to_numpy()
     # net displacement along the path: distance travelled minus twice what was backed up
     travelled = truth.table(np.array([truth.duration_s])).distance.iloc[0]

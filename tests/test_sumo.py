@@ -18,6 +18,7 @@ from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.scenario import load_scenario
 from simulator.sensors.imu import Imu
+from simulator.tables import as_frame
 from simulator.trajectory.sumo import place_drive, run_sumo
 from simulator.trajectory.sumo_network import prepare_network
 
@@ -78,7 +79,7 @@ def test_strapdown_closure_on_sumo_drive(hilly_city):
     truth, _, _ = hilly_city
     imu = Imu({"preset": "ideal", "rate": 100.0, "output": "increment",
                "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
-    table = imu.generate(truth, None)["imu"]
+    table = as_frame(imu.generate(truth, None)["imu"])
     t = np.concatenate([[0.0], table.t.to_numpy()])
     ref = truth.table(t)
     first = ref.iloc[0]

@@ -10,6 +10,7 @@ from sensor_truths import static_truth, truth_from_segments
 from simulator import columns as col
 from simulator.scenario.schema import Context
 from simulator.sensors.imu import IMU_FIELD, Imu
+from simulator.tables import as_frame
 
 
 def run(truth, block: dict, seed: int = 1):
@@ -17,7 +18,7 @@ def run(truth, block: dict, seed: int = 1):
     cfg = IMU_FIELD.check(block, ("sensors", "imu"), ctx)
     assert not ctx.problems, ctx.problems
     imu = Imu(cfg)
-    return imu.generate(truth, np.random.default_rng(seed))["imu"], imu
+    return as_frame(imu.generate(truth, np.random.default_rng(seed))["imu"]), imu
 
 
 @pytest.fixture(scope="module")

@@ -9,9 +9,11 @@ zone_events, gnss_outage_intervals, events_table.
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
+from simulator.tables import ColumnTable
+
+_EVENT_TYPES = {"t_start": float, "t_end": float, "kind": str, "detail": str}
 
 
 def zone_events(zones: list[tuple[float, float, str]]) -> list[dict]:
@@ -39,8 +41,9 @@ def gnss_outage_intervals(epoch_t: np.ndarray, has_measurement: np.ndarray,
     return out
 
 
-def events_table(rows: list[dict]) -> pd.DataFrame:
-    """Events sorted by start time, with the SPEC columns."""
-    frame = pd.DataFrame(rows, columns=list(col.EVENTS))
-    frame = frame.astype({"t_start": float, "t_end": float, "kind": str, "detail": str})
-    return frame.sort_values(["t_start", "kind"], kind="stable").reset_index(drop=True)
+def events_table(rows: list[dict]) -> ColumnTable:
+    """Events sorted by start time, then kind (rows that tie keep their order), as a column
+    table with the SPEC columns."""
+    rows = sorted(rows, key=lambda r: (float(r["t_start"]), str(r["kind"])))
+    return {name: np.array([_EVENT_TYPES[name](r[name]) for r in rows], dtype=_EVENT_TYPES[name])
+            for name in col.EVENTS}

@@ -1,6 +1,13 @@
 """From a resolved scenario to a dataset: truth, sensors (each with its own random stream),
 events and manifest, written atomically.
 
+The streams are column tables (``simulator.tables``) wherever no pandas code touches them: the
+truth, the IMU, odometer, barometer and magnetometer, and the events. The GNSS streams, and the
+streams a fault acts on, are DataFrames; the writer takes either. ``generate_streams`` returns
+every stream as a DataFrame unless asked for the tables as they are (``frames=False``, what
+``generate_dataset`` does), so a scenario without GNSS and faults is generated without importing
+pandas.
+
 Public functions
 ----------------
 build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
@@ -15,7 +22,6 @@ from importlib import metadata
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
 from simulator.dataset.io import atomic_output_dir, write_dataset
@@ -24,6 +30,7 @@ from simulator.faults.apply import apply_faults
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
+from simulator.tables import Table, as_frames, column
 from simulator.timebase import parse_utc, utc_to_gps
 from simulator.trajectory import PROFILE_BUILDERS
 from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
@@ -55,14 +62,19 @@ def sensor_rng(seed: int, name: str) -> np.random.Generator:
 @dataclass
 class Generated:
     truth: Kinematics
-    streams: dict[str, pd.DataFrame]
+    streams: dict[str, Table]  # DataFrames unless generate_streams(frames=False)
     drawn: dict[str, dict] = field(default_factory=dict)
 
 
-def generate_streams(scenario: dict, show_progress: bool = True) -> Generated:
-    """Truth table, every configured sensor's streams, and the events table."""
+def generate_streams(scenario: dict, show_progress: bool = True,
+                     frames: bool = True) -> Generated:
+    """Truth table, every configured sensor's streams, and the events table.
+
+    With ``frames`` (the default) every stream is a DataFrame; without, the tables stay as the
+    sensors and faults left them (column tables or DataFrames), which is all the writer needs.
+    """
     truth = build_truth(scenario)
-    streams: dict[str, pd.DataFrame] = {"truth": truth.table()}
+    streams: dict[str, Table] = {"truth": truth.columns()}
     drawn: dict[str, dict] = {}
     sensors = {k: v for k, v in scenario["sensors"].items() if v is not None}
     for name in progress(sensors, "sensors", show_progress):
@@ -76,17 +88,17 @@ def generate_streams(scenario: dict, show_progress: bool = True) -> Generated:
     if gnss is not None and "raw" not in gnss["outputs"]:
         streams.pop("gnss_raw", None)  # kept until here for the faults and the outage table
     streams["events"] = events_table(rows)
-    return Generated(truth, streams, drawn)
+    return Generated(truth, as_frames(streams) if frames else streams, drawn)
 
 
-def _outages(streams: dict[str, pd.DataFrame], end_t: float) -> list[tuple[float, float]]:
+def _outages(streams: dict[str, Table], end_t: float) -> list[tuple[float, float]]:
     if "gnss_fix" in streams:
         fix = streams["gnss_fix"]
-        epochs = fix["t"].to_numpy()
+        epochs = column(fix, "t")
         if "gnss_raw" in streams:
-            has = np.isin(epochs, streams["gnss_raw"]["t"].to_numpy())
+            has = np.isin(epochs, column(streams["gnss_raw"], "t"))
         else:
-            has = fix["fix"].to_numpy() > 0
+            has = column(fix, "fix") > 0
         return gnss_outage_intervals(epochs, has, end_t)
     return []
 
@@ -125,6 +137,6 @@ def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
     ``force``). Returns ``out_dir``."""
     out_dir = Path(out_dir)
     with atomic_output_dir(out_dir, force) as tmp:
-        generated = generate_streams(scenario.data, show_progress)
+        generated = generate_streams(scenario.data, show_progress, frames=False)
         write_dataset(tmp, build_manifest(scenario, generated), generated.streams)
     return out_dir

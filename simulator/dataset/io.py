@@ -1,6 +1,11 @@
 """The dataset on disk (SPEC section 5): a directory with ``manifest.json`` and one Parquet file
 per stream, every column's unit in the Parquet field metadata.
 
+Streams are written from column tables (``simulator.tables``) or DataFrames, to the same Parquet
+schema either way: float and integer columns as they are, NaN as null (pandas' convention), text
+columns as ``large_string`` (what pandas' ``str`` dtype writes), no schema-level metadata. Writing
+imports pandas only for a DataFrame; reading returns DataFrames.
+
 Writing is atomic: everything goes into a temporary sibling directory that is renamed into place
 when complete, so an interrupted or failed run never leaves a half-written dataset.
 
@@ -18,30 +23,91 @@ import shutil
 from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import pandas as pd
+import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from simulator import columns as col
 from simulator.errors import InputError, Problem
+from simulator.tables import Table, column, n_rows
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
-def _units_for(name: str, frame: pd.DataFrame) -> dict[str, str]:
+def _units_for(name: str, table: Table) -> dict[str, str]:
     declared = dict(col.STREAMS.get(name, (None, {}))[1])
-    declared.update(frame.attrs.get("units", {}))
-    missing = [c for c in frame.columns if c not in declared]
+    declared.update(getattr(table, "attrs", {}).get("units", {}))
+    names = list(table)
+    missing = [c for c in names if c not in declared]
     if missing:
         raise ValueError(f"stream {name!r}: no unit declared for column(s) {missing}; add them "
                          "to simulator/columns.py or frame.attrs['units']")
-    return {c: declared[c] for c in frame.columns}
+    return {c: declared[c] for c in names}
 
 
-def write_table(frame: pd.DataFrame, path: Path, units: dict[str, str]) -> None:
-    """Write one table as Parquet with each column's unit in its field metadata."""
-    table = pa.Table.from_pandas(frame, preserve_index=False)
-    fields = [f.with_metadata({"unit": units.get(f.name, "")}) for f in table.schema]
-    table = table.cast(pa.schema(fields, metadata={}))
+def _arrow_column(values: np.ndarray) -> pa.Array:
+    """One column of a column table as an Arrow array, built from its buffers: ``pyarrow.array``
+    would import pandas (it checks every argument for pandas types). NaN becomes null, as in
+    ``pyarrow.Table.from_pandas``; text becomes ``large_string``."""
+    values = np.asarray(values)
+    if values.dtype.kind in "UO":
+        return _text_column(values)
+    if values.dtype.kind == "b":
+        bits = np.packbits(values, bitorder="little")
+        return pa.Array.from_buffers(pa.bool_(), len(values), [None, pa.py_buffer(bits)])
+    values = np.ascontiguousarray(values, dtype=values.dtype.newbyteorder("="))
+    validity, null_count = None, 0
+    if values.dtype.kind == "f":
+        nan = np.isnan(values)
+        null_count = int(np.count_nonzero(nan))
+        if null_count:
+            validity = pa.py_buffer(np.packbits(~nan, bitorder="little"))
+    return pa.Array.from_buffers(pa.from_numpy_dtype(values.dtype), len(values),
+                                 [validity, pa.py_buffer(values)], null_count=null_count)
+
+
+def _text_column(values: np.ndarray) -> pa.Array:
+    """A text column (None as null) as ``large_string``, run by run: the columns written this
+    way (truth zone, event kinds) hold long runs of one value."""
+    n = len(values)
+    changes = np.ones(n, dtype=bool)
+    changes[1:] = values[1:] != values[:-1]
+    starts = np.flatnonzero(changes)
+    runs = np.diff(np.append(starts, n))
+    run_values = [values[i] for i in starts]
+    valid = np.array([v is not None and v == v for v in run_values], dtype=bool)  # v != v: NaN
+    encoded = [str(v).encode() if ok else b"" for v, ok in zip(run_values, valid, strict=True)]
+    row_bytes = np.repeat(np.array([len(e) for e in encoded], dtype=np.int64), runs)
+    offsets = np.concatenate([[0], np.cumsum(row_bytes)]).astype(np.int64)
+    data = b"".join(e * int(r) for e, r in zip(encoded, runs, strict=True))
+    validity, null_count = None, int(runs[~valid].sum())
+    if null_count:
+        validity = pa.py_buffer(np.packbits(np.repeat(valid, runs), bitorder="little"))
+    return pa.Array.from_buffers(pa.large_string(), n, [validity, pa.py_buffer(offsets),
+                                                        pa.py_buffer(data)],
+                                 null_count=null_count)
+
+
+def _arrow_table(table: Table, units: dict[str, str]) -> pa.Table:
+    """The Arrow table of a column table or DataFrame, each field with its unit and no
+    schema-level metadata (no ``pandas`` key)."""
+    if isinstance(table, dict):
+        names, arrays = list(table), [_arrow_column(v) for v in table.values()]
+    else:
+        converted = pa.Table.from_pandas(table, preserve_index=False)
+        names, arrays = converted.column_names, converted.columns
+    schema = pa.schema([pa.field(name, array.type).with_metadata({"unit": units.get(name, "")})
+                        for name, array in zip(names, arrays, strict=True)], metadata={})
+    return pa.Table.from_arrays(arrays, schema=schema)
+
+
+def write_table(frame: Table, path: Path, units: dict[str, str]) -> None:
+    """Write one table (a column table or a DataFrame) as Parquet with each column's unit in its
+    field metadata."""
+    table = _arrow_table(frame, units)
     # dictionary encoding only for text columns: on float columns it costs time and no space
     text_columns = [f.name for f in table.schema if pa.types.is_string(f.type)
                     or pa.types.is_large_string(f.type)]
@@ -89,8 +155,9 @@ def atomic_output_dir(out_dir: Path, force: bool) -> Iterator[Path]:
     shutil.rmtree(old, ignore_errors=True)
 
 
-def write_dataset(directory: Path, manifest: dict, streams: dict[str, pd.DataFrame]) -> None:
-    """Write streams and the manifest into ``directory`` (use inside ``atomic_output_dir``).
+def write_dataset(directory: Path, manifest: dict, streams: dict[str, Table]) -> None:
+    """Write streams (column tables or DataFrames) and the manifest into ``directory`` (use
+    inside ``atomic_output_dir``).
 
     The manifest's ``streams`` block is filled here from the tables.
     """
@@ -103,12 +170,14 @@ def write_dataset(directory: Path, manifest: dict, streams: dict[str, pd.DataFra
     with ThreadPoolExecutor(max_workers=2) as pool:
         list(pool.map(lambda name: write_table(streams[name], directory / files[name],
                                                _units_for(name, streams[name])), streams))
-    for name, frame in streams.items():
+    for name, table in streams.items():
         file = files[name]
+        rows = n_rows(table)
         rate = None
-        if "t" in frame and len(frame) > 1 and name not in ("gnss_raw", "truth_gnss"):
-            rate = round(float((len(frame) - 1) / (frame["t"].iloc[-1] - frame["t"].iloc[0])), 6)
-        manifest["streams"][name] = {"file": file, "rows": len(frame), "rate_hz": rate}
+        if "t" in table and rows > 1 and name not in ("gnss_raw", "truth_gnss"):
+            t = column(table, "t")
+            rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
+        manifest["streams"][name] = {"file": file, "rows": rows, "rate_hz": rate}
     text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
     (directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
 

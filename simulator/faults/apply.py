@@ -12,10 +12,10 @@ import json
 import zlib
 
 import numpy as np
-import pandas as pd
 
 from simulator.faults.base import FAULT_REGISTRY, FaultContext
 from simulator.faults.triggers import TRIGGER_FIELDS, fault_intervals
+from simulator.tables import Table, as_frame
 
 
 def fault_rng(seed: int, index: int, kind: str) -> np.random.Generator:
@@ -25,8 +25,11 @@ def fault_rng(seed: int, index: int, kind: str) -> np.random.Generator:
     return np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(1, key)))
 
 
-def apply_faults(streams: dict[str, pd.DataFrame], scenario: dict, truth) -> list[dict]:
+def apply_faults(streams: dict[str, Table], scenario: dict, truth) -> list[dict]:
     """Apply every fault of a resolved scenario in order (in place); return their events rows.
+
+    Each stream a fault acts on is turned into a DataFrame first (``simulator.tables``), so
+    pandas is imported only when a fault applies.
 
     ``gnss_outage`` faults add no row of their own: the events table lists every stretch without
     any GNSS measurement exactly once, whatever caused it.
@@ -40,6 +43,9 @@ def apply_faults(streams: dict[str, pd.DataFrame], scenario: dict, truth) -> lis
         context = FaultContext(truth=truth, sensors=scenario["sensors"], rng=rng)
         if not intervals or not any(name in streams for name in kind.streams):
             continue
+        for name in kind.streams:  # faults are written with pandas
+            if name in streams:
+                streams[name] = as_frame(streams[name])
         kind.apply(streams, intervals, params, context)
         if fault["kind"] != "gnss_outage":
             detail = json.dumps({"fault": index, **params}, sort_keys=True)

@@ -11,12 +11,15 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from simulator.faults.triggers import TRIGGER_FIELDS
 from simulator.scenario.schema import Field, Record
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass
@@ -29,8 +32,9 @@ class FaultContext:
     rng: np.random.Generator
 
 
-# apply(streams, intervals, params, context) changes streams in place
-Apply = Callable[[dict[str, pd.DataFrame], list[tuple[float, float]], dict, FaultContext],
+# apply(streams, intervals, params, context) changes streams in place; the streams it acts on
+# are DataFrames (``apply_faults`` converts column tables before calling it)
+Apply = Callable[["dict[str, pd.DataFrame]", list[tuple[float, float]], dict, FaultContext],
                  None]
 
 

@@ -11,7 +11,6 @@ intervals from the faulted measurements, so a fix degrades exactly as the measur
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from simulator.earth import radii_of_curvature
 from simulator.faults.base import in_intervals, register
@@ -146,6 +145,8 @@ def _gnss_satellite_limit(streams, intervals, params, context) -> None:
     "correlation_time": Number("s", 5.0, gt=0, doc="its Gauss-Markov correlation time"),
 }, ("gnss_fix", "gnss_raw"), "haywire multipath: large correlated pseudorange errors")
 def _gnss_multipath(streams, intervals, params, context) -> None:
+    import pandas as pd
+
     raw = streams["gnss_raw"]
     t = raw["t"].to_numpy()
     epochs = np.unique(t)

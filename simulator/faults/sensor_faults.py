@@ -6,12 +6,16 @@ Kinds: ``imu_bias_step``, ``imu_saturation_burst``, ``odometer_slip``,
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.faults.base import in_intervals, register
 from simulator.scenario.schema import ListOf, Number, Text
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 _AXES = ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1)
 

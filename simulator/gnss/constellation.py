@@ -40,13 +40,16 @@ from __future__ import annotations
 
 import datetime as dt
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.gnss.constants import MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, SECONDS_PER_WEEK
 from simulator.timebase import GPS_EPOCH, utc_to_gps
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 # slot: (RAAN deg, argument of latitude deg) at the reference epoch (SPS PS 2008 Table 3.4-1)
 NOMINAL_SLOTS: dict[str, tuple[float, float]] = {
@@ -92,6 +95,8 @@ def nominal_slots(expanded: Iterable[str] = ()) -> pd.DataFrame:
         One row per satellite, in PRN order: ``prn``, ``slot`` (A1 ... F4, B1F, B1A, ...),
         ``raan_deg`` and ``arg_lat_deg`` at the reference epoch ``SLOT_EPOCH_UTC``.
     """
+    import pandas as pd
+
     expanded = list(expanded)
     unknown = sorted(set(expanded) - set(EXPANDABLE_SLOTS))
     if unknown:
@@ -125,6 +130,8 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     pandas.DataFrame
         The navigation table (``simulator.columns.GNSS_NAV``).
     """
+    import pandas as pd
+
     slots = nominal_slots(expanded)
     week, tow = utc_to_gps(utc)
     first = np.floor(tow / interval_s) * interval_s

@@ -20,8 +20,9 @@ GPS Solutions 8(3), 2004.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from simulator.gnss.constants import (
     F_REL_S_SQRTM,
@@ -29,6 +30,9 @@ from simulator.gnss.constants import (
     OMEGA_E_DOT_RAD_S,
     SECONDS_PER_WEEK,
 )
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 _KEPLER_ITERATIONS = 8  # Newton steps on Kepler's equation: below 1e-15 rad for e < 0.1
 

@@ -21,14 +21,18 @@ Kaplan & Hegarty 2017, section 11.2.1 (weighted least squares).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
 from simulator.sensors.noise import ar1_filter
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
 
@@ -229,6 +233,8 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
         Largest HDOP a fix is given with, as receivers' DOP masks do (a receiver with three
         satellites near the zenith reports no fix rather than one hundreds of metres off).
     """
+    import pandas as pd
+
     n = len(t)
     raw = raw.sort_values(["t", "sv"], kind="stable")
     epoch = np.searchsorted(t, raw["t"].to_numpy())

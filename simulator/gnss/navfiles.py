@@ -25,11 +25,13 @@ from __future__ import annotations
 import datetime as dt
 import re
 from pathlib import Path
-
-import pandas as pd
+from typing import TYPE_CHECKING
 
 from simulator import columns as col
 from simulator.timebase import GPS_EPOCH, SECONDS_PER_WEEK
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 _NUMBER = re.compile(r"[+-]?(?:\d+\.\d*|\.\d+|\d+)(?:[DdEe][+-]?\d+)?")
 
@@ -57,6 +59,8 @@ def _gps_seconds(epoch: dt.datetime) -> float:
 
 
 def _table(rows: list[dict], attrs: dict) -> pd.DataFrame:
+    import pandas as pd
+
     nav = pd.DataFrame(rows, columns=list(col.GNSS_NAV))
     nav = nav.astype({"sv": int, "week": int, "iode": int, "health": int})
     nav = nav.sort_values(["sv", "week", "toe"], kind="stable").reset_index(drop=True)

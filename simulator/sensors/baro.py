@@ -31,12 +31,12 @@ ICAO Doc 7488/3, *Manual of the ICAO Standard Atmosphere*, 1993. Park et al., IE
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from simulator.environment.atmosphere import P0_PA, pressure_altitude_m, pressure_pa
 from simulator.scenario.schema import Context, Number, Path, Vector
 from simulator.sensors.base import sample_times
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
+from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import HPA
 
@@ -73,7 +73,7 @@ class Barometer(PresetSensor):
 
     name = "baro"
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
         altitude = truth.position(t)[:, 2]
@@ -87,5 +87,5 @@ class Barometer(PresetSensor):
             pressure = np.round(pressure / c["resolution"]) * c["resolution"]
         self.drawn.update(bias=float(bias), sea_level_pressure_start=float(sea_level[0]),
                           sea_level_pressure_end=float(sea_level[-1]))
-        return {"baro": pd.DataFrame({"t": t, "pressure": pressure,
-                                      "altitude": pressure_altitude_m(pressure)})}
+        return {"baro": {"t": t, "pressure": pressure,
+                         "altitude": pressure_altitude_m(pressure)}}

@@ -1,5 +1,7 @@
 """What every sensor model is: a small object built from validated parameters, with one method
-that turns the exact trajectory and a random generator into stream tables.
+that turns the exact trajectory and a random generator into stream tables (column tables of
+``simulator.tables``, or DataFrames for a model written with pandas, such as the GNSS receiver;
+``simulator.tables.as_frame`` turns either into a DataFrame).
 
 Public names
 ------------
@@ -11,8 +13,8 @@ from __future__ import annotations
 from typing import Protocol
 
 import numpy as np
-import pandas as pd
 
+from simulator.tables import Table
 from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import (
     GL_NODES,
@@ -33,7 +35,7 @@ class SensorModel(Protocol):
     name: str
     drawn: dict
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, Table]:
         ...
 
 

@@ -36,9 +36,9 @@ from __future__ import annotations
 
 import datetime as dt
 from pathlib import Path as FilePath
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import (
@@ -70,6 +70,9 @@ from simulator.sensors.base import sample_times
 from simulator.sensors.presets import PresetSensor, fill_from_preset, known_preset
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.kinematics import Kinematics
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 PRESETS: dict[str, dict] = {
     "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
@@ -392,6 +395,8 @@ class _RowTable:
         self.t, self.svs = t, svs
 
     def __call__(self, mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
+        import pandas as pd
+
         m = mask.T
         out = {"t": np.broadcast_to(self.t[:, None], m.shape)[m],
                "sv": np.broadcast_to(self.svs[None, :], m.shape)[m]}

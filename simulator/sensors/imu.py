@@ -75,7 +75,6 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import euler_to_dcm
@@ -104,6 +103,7 @@ from simulator.sensors.noise import (
 )
 from simulator.sensors.presets import fill_from_preset, known_preset
 from simulator.sensors.vibration import VIBRATION_FIELD, vibration
+from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
 
@@ -346,7 +346,7 @@ class Imu:
         return y
 
     def generate(self, truth: Kinematics,
-                 rng: np.random.Generator | None) -> dict[str, pd.DataFrame]:
+                 rng: np.random.Generator | None) -> dict[str, ColumnTable]:
         """The ``imu`` stream. ``rng`` may be None only for a unit without random terms (the
         ideal unit): a fresh generator then makes the (zero-size) draws."""
         rng = rng if rng is not None else np.random.default_rng()
@@ -367,7 +367,7 @@ class Imu:
         for i, axis in enumerate(col.IMU_AXES):
             if axis in self.config["axes"]:
                 table[axis] = values[:, i]
-        return {"imu": pd.DataFrame(table)}
+        return {"imu": table}
 
 
 def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarray:

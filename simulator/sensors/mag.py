@@ -1,4 +1,5 @@
-"""Magnetometer: the Earth's main field from the IGRF (through ``ppigrf``) in the body frame, with
+"""Magnetometer: the Earth's main field from the IGRF (``ppigrf``'s model, evaluated by
+``simulator.environment.igrf`` without its pandas import) in the body frame, with
 hard- and soft-iron distortion, white noise, and field disturbances inside covered zones.
 
 Model (the usual compass-calibration model, e.g. Gebre-Egziabher et al. 2006, eq. 4)::
@@ -32,13 +33,14 @@ from __future__ import annotations
 import datetime as dt
 
 import numpy as np
-import pandas as pd
 
 from simulator.earth import euler_to_dcm
+from simulator.environment.igrf import igrf_ned
 from simulator.scenario.schema import Number
 from simulator.sensors.base import sample_times
 from simulator.sensors.noise import gauss_markov
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
+from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MICRO_T
 
@@ -70,11 +72,9 @@ MAG_FIELD = preset_sensor_field("magnetometer", MAG_PRESETS, _FIELDS, _DEFAULTS,
 def earth_field_ned(lat_deg: np.ndarray, lon_deg: np.ndarray, alt_m: np.ndarray,
                     date: dt.datetime) -> np.ndarray:
     """IGRF main field (north, east, down), tesla, shape (n, 3), at geodetic positions."""
-    import ppigrf  # imported here: it costs most of a second, and only this sensor needs it
-
-    east, north, up = ppigrf.igrf(np.asarray(lon_deg, float), np.asarray(lat_deg, float),
-                                  np.asarray(alt_m, float) / 1000.0, date)
-    return np.stack([np.ravel(north), np.ravel(east), -np.ravel(up)], axis=-1) * NT_TO_T
+    east, north, up = igrf_ned(np.asarray(lat_deg, float), np.asarray(lon_deg, float),
+                               np.asarray(alt_m, float) / 1000.0, date)
+    return np.stack([north, east, -up], axis=-1) * NT_TO_T
 
 
 class Magnetometer(PresetSensor):
@@ -82,7 +82,7 @@ class Magnetometer(PresetSensor):
 
     name = "mag"
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
         k = truth.inertial(t)
@@ -105,5 +105,4 @@ class Magnetometer(PresetSensor):
             m = m + d * disturbed[:, None]
         m = m + c["noise"] * rng.standard_normal((len(t), 3))
         self.drawn.update(hard_iron=hard.tolist(), soft_iron=soft.tolist())
-        return {"mag": pd.DataFrame({"t": t, "mag_x": m[:, 0], "mag_y": m[:, 1],
-                                     "mag_z": m[:, 2]})}
+        return {"mag": {"t": t, "mag_x": m[:, 0], "mag_y": m[:, 1], "mag_z": m[:, 2]}}

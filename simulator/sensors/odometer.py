@@ -31,12 +31,12 @@ Outages", IEEE Access 7, 2019, eq. 22 (odometer scale factor).
 from __future__ import annotations
 
 import numpy as np
-import pandas as pd
 
 from simulator.scenario.schema import Number
 from simulator.sensors.base import sample_times
 from simulator.sensors.noise import random_walk
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
+from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MILLI, PERCENT_RT_H
 
@@ -68,7 +68,7 @@ class Odometer(PresetSensor):
 
     name = "odometer"
 
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config
         dt = 1.0 / self.rate_hz
         t = sample_times(truth.duration_s, self.rate_hz)
@@ -88,4 +88,4 @@ class Odometer(PresetSensor):
         else:
             speed = np.maximum(truth.profile.distance_of_time(t_true, 1), 0.0)
             table["speed"] = scale * truth.profile.direction_at(t_true) * speed + 0.0
-        return {"odometer": pd.DataFrame(table)}
+        return {"odometer": table}

@@ -17,6 +17,9 @@ by differencing samples:
   normal gravity, and body rate w_ib^b = w_nb^b + C_n^b (w_ie^n + w_en^n), where w_nb^b comes
   from the exact Euler-angle rates (Groves eq. 2.56 inverted).
 
+The truth table is ``Kinematics.columns`` (a column table of ``simulator.tables``, what the
+dataset writer takes, without pandas) or ``Kinematics.table`` (the same as a DataFrame).
+
 Public names
 ------------
 Kinematics, kinematics_from_profile.
@@ -26,9 +29,9 @@ from __future__ import annotations
 
 import datetime as dt
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import (
@@ -38,10 +41,14 @@ from simulator.earth import (
     wrap_angle,
 )
 from simulator.earth import ned_to_body_trig as ned_to_body
+from simulator.tables import ColumnTable
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.piecewise import PiecewisePolynomial
 from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
 from simulator.trajectory.segments import RoadProfile
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 
 @dataclass
@@ -278,9 +285,16 @@ class Kinematics:
         return out
 
     def table(self, t: np.ndarray | None = None) -> pd.DataFrame:
-        """The truth table (SPEC section 5 ``truth.parquet`` columns) at times t (default: grid)."""
+        """The truth table (SPEC section 5 ``truth.parquet`` columns) at times t (default: grid),
+        as a DataFrame (imports pandas)."""
+        import pandas as pd
+
+        return pd.DataFrame(self.columns(t), columns=list(col.TRUTH))
+
+    def columns(self, t: np.ndarray | None = None) -> ColumnTable:
+        """The truth table as a column table (``simulator.tables``): ``table`` without pandas."""
         k = self.grid_inertial() if t is None else self.inertial(t)
-        return pd.DataFrame({
+        return {
             "t": k["t"],
             "lat": np.degrees(k["lat"]),
             "lon": np.degrees(k["lon"]),
@@ -291,7 +305,7 @@ class Kinematics:
             "fx": k["f_body"][:, 0], "fy": k["f_body"][:, 1], "fz": k["f_body"][:, 2],
             "speed": k["speed"], "distance": k["distance"],
             "zone": self.zone_at(k["t"]).astype(str),
-        }, columns=list(col.TRUTH))
+        }
 
 
 def _as_fast(profile: RoadProfile) -> RoadProfile:

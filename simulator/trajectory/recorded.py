@@ -32,9 +32,9 @@ RECORDED_FIELD, LogError, read_log, build_recorded_profile.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from simulator.scenario.schema import Context, Number, Record, Text
 from simulator.trajectory.fit import (
@@ -45,6 +45,9 @@ from simulator.trajectory.fit import (
     zone_intervals,
 )
 from simulator.trajectory.segments import RoadProfile
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 REQUIRED_COLUMNS = ("t", "lat", "lon", "alt")
 _BANK_KNOTS_M = 10.0  # smallest knot spacing of the bank fitted to a logged roll, m
@@ -83,6 +86,8 @@ def read_log(path: Path) -> pd.DataFrame:
     LogError
         Missing or unreadable file, missing columns, too few rows, times not increasing.
     """
+    import pandas as pd
+
     if not path.is_file():
         raise LogError(("file",), f"log file not found: {path}")
     try:
