@@ -9,7 +9,6 @@ import numpy as np
 import pytest
 from sensor_truths import truth_from_segments
 
-from simulator.environment.igrf import igrf_ned
 from simulator.scenario.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.mag import MAG_FIELD, Magnetometer
@@ -87,18 +86,3 @@ def test_disturbance_only_in_covered_zones():
     assert inside.sum() > 100
     assert np.all(diff[~inside] == 0.0)
     assert np.sqrt(np.mean(diff[inside] ** 2)) == pytest.approx(20e-6 * np.sqrt(3), rel=0.4)
-
-
-def test_igrf_synthesis_is_ppigrf():
-    """``simulator.environment.igrf`` evaluates ppigrf's own model without importing pandas:
-    the same field as ``ppigrf.igrf`` everywhere and at any date of the model."""
-    ppigrf = pytest.importorskip("ppigrf")
-    rng = np.random.default_rng(1)
-    lat, lon = rng.uniform(-89.0, 89.0, 300), rng.uniform(-180.0, 180.0, 300)
-    h_km = rng.uniform(-0.5, 10.0, 300)
-    for date in (dt.datetime(2024, 5, 1, 3), dt.datetime(2020, 1, 1),
-                 dt.datetime(1987, 7, 3, 12, 34, 56)):
-        ours = igrf_ned(lat, lon, h_km, date)
-        theirs = ppigrf.igrf(lon, lat, h_km, date)
-        for a, b in zip(ours, theirs, strict=True):
-            np.testing.assert_allclose(a, np.ravel(b), rtol=1e-12, atol=1e-9)

@@ -2,8 +2,8 @@
 does to the sky, signals and fields.
 
 The sky geometry of a canyon (line of sight, reflections) is in ``simulator.environment.sky``.
-The standard atmosphere is in ``simulator.environment.atmosphere``, the geomagnetic main field
-(IGRF) in ``simulator.environment.igrf``.
+The standard atmosphere is in ``simulator.environment.atmosphere``; the geomagnetic main field
+comes from the IGRF through ``ppigrf`` (``simulator.sensors.mag``).
 
 Public names
 ------------

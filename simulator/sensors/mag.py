@@ -1,5 +1,4 @@
-"""Magnetometer: the Earth's main field from the IGRF (``ppigrf``'s model, evaluated by
-``simulator.environment.igrf`` without its pandas import) in the body frame, with
+"""Magnetometer: the Earth's main field from the IGRF (through ``ppigrf``) in the body frame, with
 hard- and soft-iron distortion, white noise, and field disturbances inside covered zones.
 
 Model (the usual compass-calibration model, e.g. Gebre-Egziabher et al. 2006, eq. 4)::
@@ -35,7 +34,6 @@ import datetime as dt
 import numpy as np
 
 from simulator.earth import euler_to_dcm
-from simulator.environment.igrf import igrf_ned
 from simulator.scenario.schema import Number
 from simulator.sensors.base import sample_times
 from simulator.sensors.noise import gauss_markov
@@ -72,9 +70,13 @@ MAG_FIELD = preset_sensor_field("magnetometer", MAG_PRESETS, _FIELDS, _DEFAULTS,
 def earth_field_ned(lat_deg: np.ndarray, lon_deg: np.ndarray, alt_m: np.ndarray,
                     date: dt.datetime) -> np.ndarray:
     """IGRF main field (north, east, down), tesla, shape (n, 3), at geodetic positions."""
-    east, north, up = igrf_ned(np.asarray(lat_deg, float), np.asarray(lon_deg, float),
-                               np.asarray(alt_m, float) / 1000.0, date)
-    return np.stack([north, east, -up], axis=-1) * NT_TO_T
+    # imported here: ppigrf (and the pandas it loads) cost a quarter of a second, and only
+    # this sensor needs them
+    import ppigrf
+
+    east, north, up = ppigrf.igrf(np.asarray(lon_deg, float), np.asarray(lat_deg, float),
+                                  np.asarray(alt_m, float) / 1000.0, date)
+    return np.stack([np.ravel(north), np.ravel(east), -np.ravel(up)], axis=-1) * NT_TO_T
 
 
 class Magnetometer(PresetSensor):
