@@ -108,11 +108,15 @@ def write_table(frame: Table, path: Path, units: dict[str, str]) -> None:
     """Write one table (a column table or a DataFrame) as Parquet with each column's unit in its
     field metadata."""
     table = _arrow_table(frame, units)
-    # dictionary encoding only for text columns: on float columns it costs time and no space
+    # dictionary encoding for text columns only (on floats it costs time and saves nothing);
+    # floats byte-stream-split before zstd: smooth time series then compress about twice as
+    # well, and faster; no column statistics (nothing here filters row groups by them)
     text_columns = [f.name for f in table.schema if pa.types.is_string(f.type)
                     or pa.types.is_large_string(f.type)]
+    float_columns = [f.name for f in table.schema if pa.types.is_floating(f.type)]
     pq.write_table(table, path, compression="zstd", compression_level=1,
-                   use_dictionary=text_columns)
+                   use_dictionary=text_columns, use_byte_stream_split=float_columns,
+                   write_statistics=False)
 
 
 def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
