@@ -48,8 +48,8 @@ range x dt and its quantum resolution x dt, with the rounding remainder carried 
 sample as integrating IMUs do (so the summed increments are exact to one quantum).
 ``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t (for
 increments: the interval ends move by e, to first order in e). On increment output the lever-arm
-term integrates to dw x r + the integral of w x (w x r) (Simpson on the truth grid, else
-three-point Gauss-Legendre).
+term integrates to dw x r + the integral of w x (w x r) (the cubic rule on the truth grid,
+else three-point Gauss-Legendre).
 
 Every parameter of a group is one number for all three axes or a list of three (x, y, z).
 Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 mrad" accepted).

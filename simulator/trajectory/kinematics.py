@@ -11,8 +11,9 @@ by differencing samples:
   moves along -x body while its attitude, a function of s, stays continuous. The yaw rate is
   kappa v (psi is a function of s, whichever way the car rolls), the lateral acceleration
   d kappa v^2; the truth ``speed`` is the signed speed d v along body x;
-* geodetic position by integrating the NED velocity (Groves eq. 5.56) with Simpson's rule on the
-  base grid, then cubic Hermite interpolation (with the exact derivatives) between grid points;
+* geodetic position by integrating the NED velocity (Groves eq. 5.56) with the cubic rule on the
+  base grid's samples (``quadrature``), then cubic Hermite interpolation (with the exact
+  derivatives) between grid points;
 * specific force f^n = dv/dt - g^n + (w_en + 2 w_ie) x v (Groves eq. 5.54 rearranged) with WGS-84
   normal gravity, and body rate w_ib^b = w_nb^b + C_n^b (w_ie^n + w_en^n), where w_nb^b comes
   from the exact Euler-angle rates (Groves eq. 2.56 inverted).
