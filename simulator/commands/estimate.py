@@ -9,6 +9,7 @@ import yaml
 
 from estimators.registry import entry_problems
 from estimators.replay import run_estimator, write_solution
+from simulator.commands import SUMMARIES
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 from simulator.scenario.schema import INVALID, Context
@@ -17,7 +18,7 @@ from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "estimate", help="run one estimator causally over a dataset, write its solution",
+        "estimate", help=SUMMARIES["estimate"],
         description="Replay a dataset into one estimator, message by message in time order "
                     "(the estimator never sees the truth), and write its solution as Parquet "
                     "(SPEC section 7). The estimator starts from the truth at its first "

@@ -5,12 +5,13 @@ from __future__ import annotations
 import argparse
 
 from estimators.registry import get_estimator, list_estimators
+from simulator.commands import SUMMARIES
 from simulator.errors import InputError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
-        "estimators", help="list the registered estimators (name, streams it needs, paper)",
+        "estimators", help=SUMMARIES["estimators"],
         description="List the built-in estimators and those installed through the "
                     "landnav.estimators entry-point group: name, the streams each needs (and "
                     "takes if present), and the paper it follows. Any estimator class can also "

@@ -135,13 +135,6 @@ IMU_PRESETS: dict[str, dict] = {
         "accel": {"bias": 30 * MILLI_G, "scale_factor": 1 * PERCENT,
                   "noise_density": 0.15 * M_S_RT_H, "range": 2 * G0_M_S2},
     },
-    "crossbow-dmu300cc": {
-        "rate": 10.0,
-        "gyro": {"bias": 2 * DEG_S, "scale_factor": 1 * PERCENT, "noise_density": 2.25 * DEG_RT_H,
-                 "range": 100 * DEG_S},
-        "accel": {"bias": 30 * MILLI_G, "scale_factor": 1 * PERCENT,
-                  "noise_density": 0.15 * M_S_RT_H, "range": 2 * G0_M_S2},
-    },
     "honeywell-hg1700": {
         "rate": 100.0,
         "gyro": {"bias": 1 * DEG_H, "scale_factor": 150 * PPM,
@@ -189,3 +182,5 @@ IMU_PRESETS: dict[str, dict] = {
                   "bandwidth": [65.5, 57.4, 62.3]},
     },
 }
+# the same Crossbow 300CC-family sensors as the IMU300CC, sampled at Cho & Choi's 10 Hz
+IMU_PRESETS["crossbow-dmu300cc"] = {**IMU_PRESETS["crossbow-imu300cc"], "rate": 10.0}
