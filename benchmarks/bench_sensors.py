@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 import yaml
-from bench_truth import LOOP
+from bench_truth import HOUR_SEGMENTS
 
 from simulator.dataset.generate import build_truth, sensor_rng
 from simulator.scenario import validate_data
@@ -46,7 +46,7 @@ SENSORS = {
 
 def hour_data() -> dict:
     data = yaml.safe_load((HERE / "hour_drive.yaml").read_text())
-    data["trajectory"]["segments"] = LOOP * 24  # about 3650 s
+    data["trajectory"]["segments"] = HOUR_SEGMENTS
     data["sensors"] = SENSORS
     return data
 

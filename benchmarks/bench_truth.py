@@ -35,9 +35,13 @@ LOOP = [
 ]
 
 
+# twenty loops (3476.14 s) and a stop to make the hour
+HOUR_SEGMENTS = LOOP * 20 + [{"stop": {"duration": 123.86}}]
+
+
 def hour_scenario(path: Path) -> None:
     data = yaml.safe_load((HERE / "hour_drive.yaml").read_text())
-    data["trajectory"]["segments"] = LOOP * 24  # about 3650 s
+    data["trajectory"]["segments"] = HOUR_SEGMENTS
     path.write_text(yaml.safe_dump(data))
 
 

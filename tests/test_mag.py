@@ -1,5 +1,5 @@
-"""Magnetometer: the IGRF field at two places against the NOAA NCEI calculator values that
-ppigrf's own test suite uses; hard and soft iron; disturbances only inside covered zones."""
+"""Magnetometer: the WMM field at two places and two epochs against the test values NOAA NCEI
+publishes with each WMM release; hard and soft iron; disturbances only inside covered zones."""
 
 from __future__ import annotations
 
@@ -11,13 +11,25 @@ from sensor_truths import truth_from_segments
 
 from simulator.scenario.schema import Context
 from simulator.sensors import SENSOR_MODELS
-from simulator.sensors.mag import MAG_FIELD, Magnetometer
+from simulator.sensors.mag import (
+    MAG_FIELD,
+    Magnetometer,
+    decimal_year,
+    earth_field_ned,
+    wmm_release,
+)
 from simulator.tables import as_frame
 
-# NOAA NCEI geomagnetic calculator, IGRF, 2020-01-01, 5 km above the WGS-84 ellipsoid, as in
-# ppigrf's test data (klaundal/ppigrf test/data/2020-01-01/b_{n,e,z}.csv): north, east, down, nT
-NCEI = [(37.0, 127.0, (29683.9, -4408.0, 40976.6)),
-        (-34.0, 151.0, (23981.7, 5357.9, -51441.4))]
+# Published WMM test values (NOAA NCEI, "WMM2020 test values" and "WMM2025 test values", the
+# tables distributed with each release; also in pygeomag's test/test_values): date, height above
+# the ellipsoid (km), latitude, longitude (deg); X north, Y east, Z down (nT); inclination (deg)
+WMM_TEST_VALUES = [
+    (dt.datetime(2020, 1, 1), 65.0, 43.0, 93.0, (24375.3, 303.2, 49691.4), 63.87),
+    (dt.datetime(2020, 1, 1), 51.0, -33.0, 109.0, (21556.3, -2183.2, -52676.0), -67.64),
+    (dt.datetime(2025, 1, 1), 65.0, 43.0, 93.0, (24299.852822, 210.517066, 50037.923998), 64.10),
+    (dt.datetime(2025, 1, 1), 51.0, -33.0, 109.0, (21737.778822, -2090.274098, -52710.003920),
+     -67.50),
+]
 
 
 def make(block: dict) -> Magnetometer:
@@ -27,10 +39,11 @@ def make(block: dict) -> Magnetometer:
     return Magnetometer(cfg)
 
 
-def standing(lat: float, lon: float, heading: float = 0.0, alt: float = 5000.0):
+def standing(lat: float, lon: float, heading: float = 0.0, alt: float = 5000.0,
+             date: dt.datetime = dt.datetime(2020, 1, 1)):
     truth = truth_from_segments([{"stop": {"duration": 5}}], rate_hz=1.0,
                                 start={"lat": lat, "lon": lon, "alt": alt, "heading": heading})
-    truth.utc_start = dt.datetime(2020, 1, 1)
+    truth.utc_start = date
     return truth
 
 
@@ -38,17 +51,37 @@ def test_registered():
     assert SENSOR_MODELS["mag"] is Magnetometer
 
 
-@pytest.mark.parametrize("lat, lon, ncei", NCEI)
-def test_igrf_magnitude_and_inclination(lat, lon, ncei):
-    out = as_frame(make({}).generate(standing(lat, lon), np.random.default_rng(0))["mag"])
+@pytest.mark.parametrize("date, height_km, lat, lon, xyz, inclination", WMM_TEST_VALUES)
+def test_wmm_field_magnitude_and_inclination(date, height_km, lat, lon, xyz, inclination):
+    mag = make({})
+    truth = standing(lat, lon, alt=height_km * 1000.0, date=date)
+    out = as_frame(mag.generate(truth, np.random.default_rng(0))["mag"])
     b = out[["mag_x", "mag_y", "mag_z"]].to_numpy()[0] * 1e9
-    ref = np.array(ncei)
-    # IGRF-14 (ppigrf) against the IGRF-13-era calculator: agreement to about 10 nT
-    assert np.linalg.norm(b) == pytest.approx(np.linalg.norm(ref), abs=15.0)
-    inclination = np.degrees(np.arctan2(b[2], np.hypot(b[0], b[1])))
-    ref_inclination = np.degrees(np.arctan2(ref[2], np.hypot(ref[0], ref[1])))
-    assert inclination == pytest.approx(ref_inclination, abs=0.02)
-    np.testing.assert_allclose(b, ref, atol=15.0)
+    ref = np.array(xyz)
+    # the tables give 0.1 nT (2020) or more digits (2025) and inclinations to 0.01 deg
+    np.testing.assert_allclose(b, ref, atol=0.15)
+    assert np.linalg.norm(b) == pytest.approx(np.linalg.norm(ref), abs=0.15)
+    assert np.degrees(np.arctan2(b[2], np.hypot(b[0], b[1]))) == pytest.approx(inclination,
+                                                                              abs=0.006)
+    assert mag.drawn["field_model"] == f"WMM_{date.year}"
+
+
+def test_release_by_date_and_extrapolation_outside_the_life_spans():
+    assert wmm_release(2012.3) == "WMM_2010"
+    assert wmm_release(2019.99) == "WMM_2015v2"
+    assert wmm_release(2024.33) == "WMM_2020"
+    assert wmm_release(2031.0) == "WMM_2025"
+    assert wmm_release(2006.0) == "WMM_2010"
+    assert decimal_year(dt.datetime(2020, 7, 2)) == pytest.approx(2020.5, abs=1e-12)
+    # 2006 (Cho et al.'s experiment): WMM2010 carried back four years, the field still the
+    # Earth's (25-65 uT) and within a few hundred nT of the 2010 one
+    early, release = earth_field_ned(np.array([37.0]), np.array([127.0]), np.array([0.0]),
+                                     dt.datetime(2006, 1, 1))
+    at_epoch, _ = earth_field_ned(np.array([37.0]), np.array([127.0]), np.array([0.0]),
+                                  dt.datetime(2010, 1, 1))
+    assert release == "WMM_2010"
+    assert 25e-6 < np.linalg.norm(early) < 65e-6
+    assert np.linalg.norm(early - at_epoch) < 500e-9
 
 
 def test_heading_rotates_the_horizontal_field():

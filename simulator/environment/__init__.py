@@ -3,7 +3,7 @@ does to the sky, signals and fields.
 
 The sky geometry of a canyon (line of sight, reflections) is in ``simulator.environment.sky``.
 The standard atmosphere is in ``simulator.environment.atmosphere``; the geomagnetic main field
-comes from the IGRF through ``ppigrf`` (``simulator.sensors.mag``).
+comes from the World Magnetic Model through ``pygeomag`` (``simulator.sensors.mag``).
 
 Public names
 ------------

@@ -1,13 +1,16 @@
-"""Magnetometer: the Earth's main field from the IGRF (through ``ppigrf``) in the body frame, with
-hard- and soft-iron distortion, white noise, and field disturbances inside covered zones.
+"""Magnetometer: the Earth's main field from the World Magnetic Model (through ``pygeomag``) in
+the body frame, with hard- and soft-iron distortion, white noise, and field disturbances inside
+covered zones.
 
 Model (the usual compass-calibration model, e.g. Gebre-Egziabher et al. 2006, eq. 4)::
 
     m = (I + S) C_n^b B^n(lat, lon, h, date) + b_hi + d(t) + n
 
-* B^n: IGRF main field (north, east, down) at the truth position and the drive's start date,
+* B^n: WMM main field (north, east, down) at the truth position and the drive's start date,
   evaluated every ``_FIELD_STEP_S`` seconds and interpolated (the field changes by a few nT per
-  kilometre);
+  kilometre); the model is the WMM release whose five-year life span holds the date (WMM2010,
+  WMM2015v2, WMM2020, WMM2025); before 2010 or from 2030 the nearest release is extrapolated
+  with its secular variation, and the manifest names the release used (``field_model``);
 * S: soft iron, a 3 x 3 matrix with elements N(0, ``soft_iron``^2); b_hi: hard iron, N(0,
   ``hard_iron``^2) per axis; both drawn once per run, body frame;
 * d(t): inside zones whose sky is ``none`` (tunnels, garages: steel and cables), a first-order
@@ -17,12 +20,13 @@ Model (the usual compass-calibration model, e.g. Gebre-Egziabher et al. 2006, eq
 
 Public names
 ------------
-MAG_FIELD, MAG_PRESETS, Magnetometer, earth_field_ned.
+MAG_FIELD, MAG_PRESETS, WMM_RELEASES, Magnetometer, wmm_release, earth_field_ned.
 
 References
 ----------
-Alken et al., "International Geomagnetic Reference Field: the thirteenth generation", Earth
-Planets Space 73, 49 (2021); IGRF-14 coefficients as shipped with ``ppigrf``.
+Chulliat et al., *The US/UK World Magnetic Model for 2020-2025*, NOAA NCEI, 2020, and
+*for 2025-2030*, 2025 (the models and their test values); coefficients as shipped with
+``pygeomag`` (a Python port of the WMM reference C code).
 Gebre-Egziabher, Elkaim, Powell & Parkinson, "Calibration of strapdown magnetometers in
 magnetic field domain", J. Aerosp. Eng. 19(2), 2006.
 """
@@ -43,7 +47,7 @@ from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MICRO_T
 
 NT_TO_T = 1e-9
-_FIELD_STEP_S = 10.0  # spacing of the IGRF evaluations along the drive, s
+_FIELD_STEP_S = 10.0  # spacing of the WMM evaluations along the drive, s
 
 MAG_PRESETS: dict[str, dict] = {
     "ideal": {},
@@ -64,19 +68,49 @@ _DEFAULTS = {"rate": 10.0, "disturbance_time": 2.0}
 
 
 MAG_FIELD = preset_sensor_field("magnetometer", MAG_PRESETS, _FIELDS, _DEFAULTS,
-                                "is the exact IGRF field")
+                                "is the exact WMM field")
+
+
+# WMM releases shipped with pygeomag: (first decimal year of the life span, coefficient file)
+WMM_RELEASES = ((2010.0, "WMM_2010"), (2015.0, "WMM_2015v2"), (2020.0, "WMM_2020"),
+                (2025.0, "WMM_2025"))
+_WMM_LIFE_SPAN_YEARS = 5.0
+
+
+def wmm_release(decimal_year: float) -> str:
+    """The WMM release for a date: the one whose life span holds it, else the nearest."""
+    chosen = WMM_RELEASES[0][1]
+    for first_year, name in WMM_RELEASES:
+        if decimal_year >= first_year:
+            chosen = name
+    return chosen
+
+
+def decimal_year(date: dt.datetime) -> float:
+    """Date as a decimal year (the time argument of the WMM), to the second."""
+    start = dt.datetime(date.year, 1, 1, tzinfo=date.tzinfo)
+    length = dt.datetime(date.year + 1, 1, 1, tzinfo=date.tzinfo) - start
+    return date.year + (date - start) / length
 
 
 def earth_field_ned(lat_deg: np.ndarray, lon_deg: np.ndarray, alt_m: np.ndarray,
-                    date: dt.datetime) -> np.ndarray:
-    """IGRF main field (north, east, down), tesla, shape (n, 3), at geodetic positions."""
-    # imported here: ppigrf (and the pandas it loads) cost a quarter of a second, and only
-    # this sensor needs them
-    import ppigrf
+                    date: dt.datetime) -> tuple[np.ndarray, str]:
+    """WMM main field (north, east, down), tesla, shape (n, 3), at geodetic positions (height
+    above the WGS-84 ellipsoid), and the name of the WMM release used. One model evaluation per
+    position: call it on a coarse set of points and interpolate."""
+    from pygeomag import GeoMag  # pure Python, a few milliseconds; only this sensor needs it
 
-    east, north, up = ppigrf.igrf(np.asarray(lon_deg, float), np.asarray(lat_deg, float),
-                                  np.asarray(alt_m, float) / 1000.0, date)
-    return np.stack([np.ravel(north), np.ravel(east), -np.ravel(up)], axis=-1) * NT_TO_T
+    year = decimal_year(date)
+    release = wmm_release(year)
+    model = GeoMag(coefficients_file=f"wmm/{release}.COF")
+    outside = not (WMM_RELEASES[0][0] <= year < WMM_RELEASES[-1][0] + _WMM_LIFE_SPAN_YEARS)
+    field = np.empty((np.size(lat_deg), 3))
+    for i, (lat, lon, alt) in enumerate(zip(np.ravel(lat_deg), np.ravel(lon_deg),
+                                            np.ravel(alt_m), strict=True)):
+        result = model.calculate(glat=float(lat), glon=float(lon), alt=float(alt) / 1000.0,
+                                 time=year, allow_date_outside_lifespan=outside)
+        field[i] = result.x, result.y, result.z
+    return field * NT_TO_T, release
 
 
 class Magnetometer(PresetSensor):
@@ -90,8 +124,8 @@ class Magnetometer(PresetSensor):
         k = truth.inertial(t)
         coarse = np.unique(np.append(np.arange(0.0, t[-1], _FIELD_STEP_S), t[-1]))
         pos = truth.position(coarse)
-        field = earth_field_ned(np.degrees(pos[:, 0]), np.degrees(pos[:, 1]), pos[:, 2],
-                                truth.utc_start)
+        field, release = earth_field_ned(np.degrees(pos[:, 0]), np.degrees(pos[:, 1]),
+                                         pos[:, 2], truth.utc_start)
         b_ned = np.stack([np.interp(t, coarse, field[:, j]) for j in range(3)], axis=-1)
         c_bn = euler_to_dcm(k["roll"], k["pitch"], k["yaw"])
         b_body = np.einsum("nji,nj->ni", c_bn, b_ned)
@@ -106,5 +140,5 @@ class Magnetometer(PresetSensor):
                              c["disturbance_time"], rng)
             m = m + d * disturbed[:, None]
         m = m + c["noise"] * rng.standard_normal((len(t), 3))
-        self.drawn.update(hard_iron=hard.tolist(), soft_iron=soft.tolist())
+        self.drawn.update(field_model=release, hard_iron=hard.tolist(), soft_iron=soft.tolist())
         return {"mag": {"t": t, "mag_x": m[:, 0], "mag_y": m[:, 1], "mag_z": m[:, 2]}}
