@@ -87,12 +87,15 @@ def test_force_replaces_and_leaves_no_temporaries(tmp_path):
 
 
 def test_failed_generation_leaves_nothing(tmp_path, monkeypatch):
+    """A write that fails (here every Parquet file, the truth written early in a worker thread
+    included) leaves no output directory and no temporary one."""
     from simulator.dataset import generate as gen
+    from simulator.dataset import io
 
     def boom(*args, **kwargs):
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(gen, "write_dataset", boom)
+    monkeypatch.setattr(io, "write_table", boom)
     with pytest.raises(RuntimeError):
         gen.generate_dataset(__import__("simulator.scenario", fromlist=["x"]).load_scenario(
             QUICK), tmp_path / "ds")

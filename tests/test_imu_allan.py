@@ -81,14 +81,25 @@ def test_gauss_markov_bias_peak(hour, rate):
                "gyro": {"bias_correlation_time": tau_c, "random_walk": 0.0},
                "accel": {"bias_correlation_time": tau_c, "random_walk": 0.0}})
     taus = np.logspace(0, np.log10(900), 30)
+    ratios = []
     for g, group in enumerate(GROUPS):
-        peak = FLICKER_ADEV_FACTOR * cfg[group]["bias_instability"]
+        p = cfg[group]
+        assert p["random_walk"] == 0.0 and p["ramp"] == 0.0
         for i in range(3):
             t, dev = adev(values[:, 3 * g + i], rate, taus)
             at_peak = np.argmin(np.abs(t - GM_ADEV_PEAK_TAU * tau_c))
-            assert dev[at_peak] == pytest.approx(peak, rel=0.30)
+            # the Gauss-Markov peak 0.664 B with the white noise's share at that tau
+            expected = adev_model(t[at_peak], noise_density=p["noise_density"],
+                                  bias_instability=p["bias_instability"],
+                                  correlation_time_s=tau_c)
+            ratios.append(dev[at_peak] / expected)
+            # one axis of a one-hour record reads its peak (76 s) to about 12 % (1-sigma,
+            # measured over eight seeds): a gross check per axis at 3.5 sigma ...
+            assert ratios[-1] == pytest.approx(1.0, abs=0.45)
             # past the peak the Gauss-Markov bias averages down again: no flat floor
             assert dev[-1] < dev[at_peak]
+    # ... and the six axes together (about 5 %) within the issue's 30 %, and tighter
+    assert np.mean(ratios) == pytest.approx(1.0, rel=0.15)
 
 
 def test_gauss_markov_same_variance_and_correlation_time_at_20_and_200_hz():
@@ -229,7 +240,7 @@ def test_fitted_presets_follow_real_curves_long(preset, device):
             check_real(preset, device, group, axis, simulated, duration / 10)
 
 
-@pytest.mark.parametrize("phi", [0.0, 0.3, 0.905, 0.999999])
+@pytest.mark.parametrize("phi", [0.0, 1e-100, 0.3, 0.905, 0.999999, 1.0])
 def test_ar1_filter_matches_scipy_lfilter(phi):
     from scipy.signal import lfilter
 
@@ -249,3 +260,21 @@ def test_ar1_filter_one_factor_per_column_matches_scipy_lfilter():
     u = np.random.default_rng(4).standard_normal((50_000, 3))
     expected = np.stack([lfilter([1.0], [1.0, -f], u[:, j]) for j, f in enumerate(phi)], axis=1)
     np.testing.assert_allclose(ar1_filter(u, phi), expected, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [1, 2, 7, 1000, 4099])
+def test_ar1_filter_short_and_one_dimensional_inputs_match_scipy_lfilter(n):
+    """Blocks that do not divide the length, a single block, and 1-D input."""
+    from scipy.signal import lfilter
+
+    from simulator.sensors.noise import ar1_filter
+
+    u = np.random.default_rng(n).standard_normal(n)
+    for phi in (0.5, 0.99, 0.99999):
+        np.testing.assert_allclose(ar1_filter(u, phi), lfilter([1.0], [1.0, -phi], u),
+                                   rtol=1e-9, atol=1e-9)
+    mixed = np.array([0.5, 0.99, 1.0])
+    u3 = np.random.default_rng(n + 1).standard_normal((n, 3))
+    expected = np.stack([lfilter([1.0], [1.0, -f], u3[:, j]) for j, f in enumerate(mixed)],
+                        axis=1)
+    np.testing.assert_allclose(ar1_filter(u3, mixed), expected, rtol=1e-9, atol=1e-9)

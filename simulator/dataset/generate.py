@@ -10,13 +10,15 @@ pandas.
 
 Public functions
 ----------------
-build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
+build_profile, build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
 """
 
 from __future__ import annotations
 
 import platform
 import zlib
+from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from importlib import metadata
 from pathlib import Path
@@ -24,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
-from simulator.dataset.io import atomic_output_dir, write_dataset
+from simulator.dataset.io import DatasetWriter, atomic_output_dir
 from simulator.errors import InputError
 from simulator.faults.apply import apply_faults
 from simulator.progress import progress
@@ -34,17 +36,23 @@ from simulator.tables import Table, as_frames, column
 from simulator.timebase import parse_utc, utc_to_gps
 from simulator.trajectory import PROFILE_BUILDERS
 from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
+from simulator.trajectory.segments import RoadProfile
 
 
-def build_truth(scenario: dict) -> Kinematics:
-    """The exact truth trajectory of a resolved scenario."""
-    traj = scenario["trajectory"]
+def build_profile(scenario: dict) -> tuple[RoadProfile, dict]:
+    """The road and speed profile of a resolved scenario, and its resolved ``start`` block (a
+    source may set the start itself). Fixes the drive's duration before any kinematics."""
     try:
-        profile = PROFILE_BUILDERS[traj["kind"]](scenario, None)
+        profile = PROFILE_BUILDERS[scenario["trajectory"]["kind"]](scenario, None)
     except ValueError as exc:
         raise InputError(str(exc)) from None
-    start = {**scenario["start"], **(profile.start or {})}
-    truth = kinematics_from_profile(profile, start, traj["rate"],
+    return profile, {**scenario["start"], **(profile.start or {})}
+
+
+def build_truth(scenario: dict, built: tuple[RoadProfile, dict] | None = None) -> Kinematics:
+    """The exact truth trajectory of a resolved scenario (of its ``build_profile`` when given)."""
+    profile, start = built if built is not None else build_profile(scenario)
+    truth = kinematics_from_profile(profile, start, scenario["trajectory"]["rate"],
                                     scenario["limits"]["roll_gradient"])
     truth.utc_start = parse_utc(scenario["start"]["utc"])
     truth.gps_week, truth.gps_tow = utc_to_gps(truth.utc_start)
@@ -66,21 +74,37 @@ class Generated:
     drawn: dict[str, dict] = field(default_factory=dict)
 
 
-def generate_streams(scenario: dict, show_progress: bool = True,
-                     frames: bool = True) -> Generated:
+def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = True,
+                     on_truth: Callable[[Table], None] | None = None) -> Generated:
     """Truth table, every configured sensor's streams, and the events table.
 
     With ``frames`` (the default) every stream is a DataFrame; without, the tables stay as the
     sensors and faults left them (column tables or DataFrames), which is all the writer needs.
+    ``on_truth`` receives the truth table as soon as it exists (faults never change it), so that
+    it can be written while the sensors run.
+
+    A sensor with a ``prepare(duration_s, rng)`` step (the IMU: its bias processes and noise
+    need no trajectory) runs it in a worker thread while the truth is built; numpy releases the
+    interpreter lock in its array work, so on two cores the two overlap. The draws are the same
+    as without the thread: each sensor owns its random stream.
     """
-    truth = build_truth(scenario)
-    streams: dict[str, Table] = {"truth": truth.columns()}
-    drawn: dict[str, dict] = {}
+    profile, start = build_profile(scenario)
     sensors = {k: v for k, v in scenario["sensors"].items() if v is not None}
-    for name in progress(sensors, "sensors", show_progress):
-        model = SENSOR_MODELS[name](sensors[name])
-        streams.update(model.generate(truth, sensor_rng(scenario["seed"], name)))
-        drawn[name] = model.drawn
+    models = {name: SENSOR_MODELS[name](block) for name, block in sensors.items()}
+    rngs = {name: sensor_rng(scenario["seed"], name) for name in models}
+    with ThreadPoolExecutor(max_workers=1) as pool:
+        prepared = [pool.submit(model.prepare, profile.duration_s, rngs[name])
+                    for name, model in models.items() if hasattr(model, "prepare")]
+        truth = build_truth(scenario, (profile, start))
+        streams: dict[str, Table] = {"truth": truth.columns()}
+        if on_truth is not None:
+            on_truth(streams["truth"])
+        for job in prepared:
+            job.result()
+    drawn: dict[str, dict] = {}
+    for name in progress(models, "sensors", show_progress):
+        streams.update(models[name].generate(truth, rngs[name]))
+        drawn[name] = models[name].drawn
     rows = zone_events(truth.profile.zones) + apply_faults(streams, scenario, truth)
     for t_start, t_end in _outages(streams, truth.duration_s):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
@@ -134,9 +158,10 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
 def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
                      show_progress: bool = True) -> Path:
     """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
-    ``force``). Returns ``out_dir``."""
+    ``force``). Returns ``out_dir``. The truth file is written while the sensors run."""
     out_dir = Path(out_dir)
-    with atomic_output_dir(out_dir, force) as tmp:
-        generated = generate_streams(scenario.data, show_progress, frames=False)
-        write_dataset(tmp, build_manifest(scenario, generated), generated.streams)
+    with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp) as writer:
+        generated = generate_streams(scenario.data, show_progress, frames=False,
+                                     on_truth=lambda table: writer.write("truth", table))
+        writer.finish(build_manifest(scenario, generated), generated.streams)
     return out_dir

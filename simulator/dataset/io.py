@@ -11,7 +11,7 @@ when complete, so an interrupted or failed run never leaves a half-written datas
 
 Public names
 ------------
-write_dataset, open_dataset, Dataset, write_table, read_table, atomic_output_dir.
+DatasetWriter, write_dataset, open_dataset, Dataset, write_table, read_table, atomic_output_dir.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ import json
 import os
 import shutil
 from collections.abc import Iterator
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -159,31 +159,63 @@ def atomic_output_dir(out_dir: Path, force: bool) -> Iterator[Path]:
     shutil.rmtree(old, ignore_errors=True)
 
 
+class DatasetWriter:
+    """Writes a dataset's streams into ``directory`` (inside ``atomic_output_dir``), each as soon
+    as it is handed over, two at a time (Parquet encoding and compression release the GIL, so
+    the files are written side by side, and beside the work that makes the next streams).
+
+    ``write(name, table)`` starts one stream; ``finish(manifest, streams)`` writes those not yet
+    started, waits for all and writes the manifest, its ``streams`` block filled from the
+    tables. Used as a context manager, which waits for (or, after an error, drops) what is
+    still being written.
+    """
+
+    def __init__(self, directory: Path):
+        self.directory = Path(directory)
+        self._pool = ThreadPoolExecutor(max_workers=2)
+        self._jobs: dict[str, Future] = {}
+
+    def __enter__(self) -> DatasetWriter:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        self._pool.shutdown(wait=True, cancel_futures=exc_info[0] is not None)
+
+    @staticmethod
+    def file_name(name: str) -> str:
+        return col.STREAMS[name][0] if name in col.STREAMS else f"{name}.parquet"
+
+    def write(self, name: str, table: Table) -> None:
+        self._jobs[name] = self._pool.submit(write_table, table,
+                                             self.directory / self.file_name(name),
+                                             _units_for(name, table))
+
+    def finish(self, manifest: dict, streams: dict[str, Table]) -> None:
+        manifest = dict(manifest)
+        manifest["format"] = col.DATASET_FORMAT
+        manifest["streams"] = {}
+        for name, table in streams.items():
+            if name not in self._jobs:
+                self.write(name, table)
+        for job in self._jobs.values():
+            job.result()
+        for name, table in streams.items():
+            rows = n_rows(table)
+            rate = None
+            if "t" in table and rows > 1 and name not in ("gnss_raw", "truth_gnss"):
+                t = column(table, "t")
+                rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
+            manifest["streams"][name] = {"file": self.file_name(name), "rows": rows,
+                                         "rate_hz": rate}
+        text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
+        (self.directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
+
+
 def write_dataset(directory: Path, manifest: dict, streams: dict[str, Table]) -> None:
     """Write streams (column tables or DataFrames) and the manifest into ``directory`` (use
-    inside ``atomic_output_dir``).
-
-    The manifest's ``streams`` block is filled here from the tables.
-    """
-    manifest = dict(manifest)
-    manifest["format"] = col.DATASET_FORMAT
-    manifest["streams"] = {}
-    files = {name: col.STREAMS[name][0] if name in col.STREAMS else f"{name}.parquet"
-             for name in streams}
-    # Parquet encoding and compression release the GIL: the files are written side by side
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        list(pool.map(lambda name: write_table(streams[name], directory / files[name],
-                                               _units_for(name, streams[name])), streams))
-    for name, table in streams.items():
-        file = files[name]
-        rows = n_rows(table)
-        rate = None
-        if "t" in table and rows > 1 and name not in ("gnss_raw", "truth_gnss"):
-            t = column(table, "t")
-            rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
-        manifest["streams"][name] = {"file": file, "rows": rows, "rate_hz": rate}
-    text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
-    (directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
+    inside ``atomic_output_dir``); the manifest's ``streams`` block is filled from the tables."""
+    with DatasetWriter(directory) as writer:
+        writer.finish(manifest, streams)
 
 
 class Dataset:

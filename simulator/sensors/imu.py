@@ -72,6 +72,7 @@ Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Sys
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -102,7 +103,7 @@ from simulator.sensors.noise import (
     white,
 )
 from simulator.sensors.presets import fill_from_preset, known_preset
-from simulator.sensors.vibration import VIBRATION_FIELD, vibration
+from simulator.sensors.vibration import VIBRATION_FIELD, draw_vibration, vibration_at_speed
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
@@ -239,47 +240,37 @@ class Imu:
         self.rate_hz = float(self.config["rate"])
         self.increment = self.config["output"] == "increment"
         self.drawn: dict = {"preset": self.config["preset"]}
+        self._prepared: _Draws | None = None
 
-    # -- truth at the unit ------------------------------------------------------------------
-    def _true_values(self, truth: Kinematics, t: np.ndarray,
-                     rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """True rate and specific force (or their increments) at the unit, sensor frame."""
+    # -- the random part, drawn before the truth exists ---------------------------------------
+    def prepare(self, duration_s: float, rng: np.random.Generator | None) -> None:
+        """Draw every random term that does not depend on the trajectory: each group's constants,
+        bias processes and white noise, the timestamp jitter and the vibration noise.
+
+        Needs only the drive's duration, so the dataset generator runs it in a worker thread
+        while the truth is built; ``generate`` runs it itself when it has not been run. ``rng``
+        is split into one stream per part (timing, vibration, gyro, accel), so switching one
+        term on leaves the draws of the others unchanged.
+        """
+        rng = rng if rng is not None else np.random.default_rng()
+        timing, shaking, *groups = rng.spawn(4)
+        t = sample_times(duration_s, self.rate_hz, first=1 if self.increment else 0)
         dt = 1.0 / self.rate_hz
         jitter = float(self.config["timestamp_jitter"])
-        lever = np.asarray(self.config["lever_arm"], dtype=float)
-        if self.increment:
-            k = integrate_over_samples(truth, t, dt)
-            w, f = k["w_body"], k["f_body"]
-            if jitter > 0 or lever.any():
-                ends = _truth_at(truth, np.concatenate([[t[0] - dt], t]))
-            if jitter > 0:
-                # interval (t - dt + e0, t + e1]: to first order in e, the exact increment plus
-                # x(t) e1 - x(t - dt) e0
-                e = jitter * rng.standard_normal(len(t) + 1)[:, None]
-                w = w + ends["w_body"][1:] * e[1:] - ends["w_body"][:-1] * e[:-1]
-                f = f + ends["f_body"][1:] * e[1:] - ends["f_body"][:-1] * e[:-1]
-            if lever.any():
-                dw = np.diff(ends["w_body"], axis=0)
-                f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
-        else:
-            t_true = t + jitter * rng.standard_normal(len(t)) if jitter > 0 else t
-            k = _truth_at(truth, t_true)
-            w, f = k["w_body"], k["f_body"]
-            if lever.any():
-                h = _LEVER_ARM_STEP_S
-                dw = (truth.inertial(t_true + h)["w_body"]
-                      - truth.inertial(t_true - h)["w_body"]) / (2 * h)
-                f = f + np.cross(dw, lever) + np.cross(w, np.cross(w, lever))
-        mount = self.config["mounting"]
-        if any(mount):
-            c_sv = euler_to_dcm(*np.radians(mount)).T
-            w, f = w @ c_sv.T, f @ c_sv.T
-        return w, f
+        # increments: the interval ends t - dt and t move; rates: the sampling instant moves
+        size = len(t) + 1 if self.increment else len(t)
+        time_error = jitter * timing.standard_normal(size) if jitter > 0 else None
+        vib = self.config["vibration"]
+        shake = None
+        if any(vib[k] > 0 for k in ("engine_accel", "engine_gyro", "road_accel", "road_gyro")):
+            shake = draw_vibration(t, dt, vib, self.increment, shaking)
+        self._prepared = _Draws(duration_s, t, time_error, shake,
+                                {group: self._draw_group(group, t, stream)
+                                 for group, stream in zip(("gyro", "accel"), groups,
+                                                          strict=True)})
 
-    # -- errors -----------------------------------------------------------------------------
-    def _errors(self, group: str, x: np.ndarray, t: np.ndarray, f_true: np.ndarray,
-                rng: np.random.Generator) -> np.ndarray:
-        """Apply the group's error model to the true values x (n, 3); returns the output."""
+    def _draw_group(self, group: str, t: np.ndarray, rng: np.random.Generator) -> _GroupDraws:
+        """One group's drawn constants and its additive error b(t) x (1 or dt) + n (white)."""
         p = self.config[group]
         n = len(t)
         dt = 1.0 / self.rate_hz
@@ -290,14 +281,17 @@ class Imu:
         np.fill_diagonal(mis, 0.0)
         k_temp = _per_axis(p["temperature_coefficient"]) * rng.standard_normal(3)
         k_sf_temp = _per_axis(p["scale_factor_temperature_coefficient"]) * rng.standard_normal(3)
+        ramp = _per_axis(p["ramp"]) * rng.choice([-1.0, 1.0], size=3) + 0.0  # no -0.0
+        g_matrix = (float(p["g_sensitivity"]) * rng.standard_normal((3, 3))
+                    if group == "gyro" else None)
         drawn = {"bias": bias0.tolist(), "scale_factor": sf.tolist(),
                  "misalignment": mis.tolist(), "temperature_coefficient": k_temp.tolist(),
-                 "scale_factor_temperature_coefficient": k_sf_temp.tolist()}
-        y = x + x @ (np.diag(sf) + mis).T
+                 "scale_factor_temperature_coefficient": k_sf_temp.tolist(),
+                 "ramp": ramp.tolist()}
+        if g_matrix is not None:
+            drawn["g_sensitivity"] = g_matrix.tolist()
         temp = self.config["temperature"]
         d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
-        if k_sf_temp.any():
-            y += x * (d_temp[:, None] * k_sf_temp)
         bias = np.broadcast_to(bias0, (n, 3)).copy()
         instability = _per_axis(p["bias_instability"])
         if instability.any():
@@ -313,23 +307,68 @@ class Imu:
         walk = _per_axis(p["random_walk"])
         if walk.any():
             bias += random_walk(n, dt, walk, rng)
-        ramp = _per_axis(p["ramp"]) * rng.choice([-1.0, 1.0], size=3) + 0.0  # no -0.0
-        drawn["ramp"] = ramp.tolist()
         if ramp.any():
             bias += t[:, None] * ramp
         if k_temp.any():
             bias += d_temp[:, None] * k_temp
-        y = y + bias * scale
-        if group == "gyro":
-            g_matrix = float(p["g_sensitivity"]) * rng.standard_normal((3, 3))
-            drawn["g_sensitivity"] = g_matrix.tolist()
-            if g_matrix.any():
-                y = y + f_true @ g_matrix.T
+        additive = bias * scale if self.increment else bias
         density = _per_axis(p["noise_density"])
         if density.any():
-            y = y + white(n, dt, density, rng, increment=self.increment)
+            additive += white(n, dt, density, rng, increment=self.increment)
+        return _GroupDraws(drawn, np.eye(3) + np.diag(sf) + mis,
+                           d_temp[:, None] * k_sf_temp if k_sf_temp.any() else None,
+                           additive, g_matrix if g_matrix is not None and g_matrix.any() else None)
+
+    # -- truth at the unit ------------------------------------------------------------------
+    def _true_values(self, truth: Kinematics, t: np.ndarray,
+                     time_error: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:
+        """True rate and specific force (or their increments) at the unit, sensor frame."""
+        dt = 1.0 / self.rate_hz
+        lever = np.asarray(self.config["lever_arm"], dtype=float)
+        if self.increment:
+            k = integrate_over_samples(truth, t, dt)
+            w, f = k["w_body"], k["f_body"]
+            if time_error is not None or lever.any():
+                ends = _truth_at(truth, np.concatenate([[t[0] - dt], t]))
+            if time_error is not None:
+                # interval (t - dt + e0, t + e1]: to first order in e, the exact increment plus
+                # x(t) e1 - x(t - dt) e0
+                e = time_error[:, None]
+                w = w + ends["w_body"][1:] * e[1:] - ends["w_body"][:-1] * e[:-1]
+                f = f + ends["f_body"][1:] * e[1:] - ends["f_body"][:-1] * e[:-1]
+            if lever.any():
+                dw = np.diff(ends["w_body"], axis=0)
+                f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
+        else:
+            t_true = t + time_error if time_error is not None else t
+            k = _truth_at(truth, t_true)
+            w, f = k["w_body"], k["f_body"]
+            if lever.any():
+                h = _LEVER_ARM_STEP_S
+                dw = (truth.inertial(t_true + h)["w_body"]
+                      - truth.inertial(t_true - h)["w_body"]) / (2 * h)
+                f = f + np.cross(dw, lever) + np.cross(w, np.cross(w, lever))
+        mount = self.config["mounting"]
+        if any(mount):
+            c_sv = euler_to_dcm(*np.radians(mount)).T
+            w, f = w @ c_sv.T, f @ c_sv.T
+        return w, f
+
+    # -- errors -----------------------------------------------------------------------------
+    def _apply_errors(self, group: str, x: np.ndarray, f_true: np.ndarray,
+                      draws: _GroupDraws) -> np.ndarray:
+        """The group's output for the true values x (n, 3): scale factor, misalignment,
+        g-sensitivity, the drawn additive errors, then low-pass, saturation and quantisation."""
+        p = self.config[group]
+        scale = 1.0 / self.rate_hz if self.increment else 1.0
+        y = x @ draws.gain.T
+        if draws.sf_temperature is not None:
+            y += x * draws.sf_temperature
+        y += draws.additive
+        if draws.g_matrix is not None:
+            y += f_true @ draws.g_matrix.T
         if p["bandwidth"] is not None:
-            y = _low_pass(y, _per_axis(p["bandwidth"]), dt)
+            y = _low_pass(y, _per_axis(p["bandwidth"]), 1.0 / self.rate_hz)
         if p["range"] is not None:
             limit = _per_axis(p["range"]) * scale
             y = np.clip(y, -limit, limit)
@@ -342,44 +381,66 @@ class Imu:
             else:
                 stepped = np.round(y / q) * q
             y = np.where(quantum > 0, stepped, y)
-        self.drawn[group] = drawn
+        self.drawn[group] = draws.drawn
         return y
 
     def generate(self, truth: Kinematics,
                  rng: np.random.Generator | None) -> dict[str, ColumnTable]:
         """The ``imu`` stream. ``rng`` may be None only for a unit without random terms (the
-        ideal unit): a fresh generator then makes the (zero-size) draws."""
-        rng = rng if rng is not None else np.random.default_rng()
-        t = sample_times(truth.duration_s, self.rate_hz, first=1 if self.increment else 0)
-        w, f = self._true_values(truth, t, rng)
-        vib = self.config["vibration"]
-        if any(vib[k] > 0 for k in ("engine_accel", "engine_gyro", "road_accel", "road_gyro")):
+        ideal unit): a fresh generator then makes the (zero-size) draws. Uses the draws of an
+        earlier ``prepare`` for the same duration, else draws them now."""
+        if self._prepared is None or self._prepared.duration_s != truth.duration_s:
+            self.prepare(truth.duration_s, rng)
+        draws, self._prepared = self._prepared, None
+        t = draws.t
+        w, f = self._true_values(truth, t, draws.time_error)
+        if draws.vibration is not None:
             dt = 1.0 / self.rate_hz
             t_speed = t - dt / 2 if self.increment else t
             speed = np.maximum(truth.profile.distance_of_time(np.clip(t_speed, 0, None), 1), 0)
-            # its own child stream: switching vibration on leaves every other draw unchanged
-            dw, df = vibration(t, speed, dt, vib, self.increment, rng.spawn(1)[0])
+            dw, df = vibration_at_speed(draws.vibration, speed, dt, self.config["vibration"],
+                                        self.increment)
             w, f = w + dw, f + df
-        gyro = self._errors("gyro", w, t, f, rng)
-        accel = self._errors("accel", f, t, f, rng)
-        values = np.concatenate([gyro, accel], axis=1)
+        gyro = self._apply_errors("gyro", w, f, draws.groups["gyro"])
+        accel = self._apply_errors("accel", f, f, draws.groups["accel"])
         table = {"t": t}
         for i, axis in enumerate(col.IMU_AXES):
             if axis in self.config["axes"]:
-                table[axis] = values[:, i]
+                table[axis] = (gyro if i < 3 else accel)[:, i % 3]
         return {"imu": table}
+
+
+@dataclass
+class _GroupDraws:
+    """One group's random terms: the ``drawn`` record, I + S + M, the temperature change of the
+    scale factor per sample (or None), the additive errors (n, 3) and the g-sensitivity matrix
+    (or None)."""
+
+    drawn: dict
+    gain: np.ndarray
+    sf_temperature: np.ndarray | None
+    additive: np.ndarray
+    g_matrix: np.ndarray | None
+
+
+@dataclass
+class _Draws:
+    """What ``Imu.prepare`` drew for a drive of ``duration_s``."""
+
+    duration_s: float
+    t: np.ndarray
+    time_error: np.ndarray | None
+    vibration: tuple[np.ndarray, np.ndarray] | None
+    groups: dict[str, _GroupDraws]
 
 
 def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarray:
     """First-order low-pass y[k] = a y[k-1] + (1 - a) x[k], a = exp(-2 pi f_c dt), per column,
     started in steady state on the first sample (the sensor's internal digital filter)."""
-    out = np.empty_like(y)
-    for j, f_c in enumerate(bandwidth_hz):
-        a = np.exp(-2 * np.pi * f_c * dt_s)
-        u = (1 - a) * y[:, j]
-        u[0] = y[0, j]  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]
-        out[:, j] = ar1_filter(u, a)
-    return out
+    a = np.exp(-2 * np.pi * np.asarray(bandwidth_hz, dtype=float) * dt_s)
+    u = (1 - a) * y
+    u[0] = y[0]  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]
+    return ar1_filter(u, a)
 
 
 def _truth_at(truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:

@@ -47,7 +47,7 @@ from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MICRO_T
 
 NT_TO_T = 1e-9
-_FIELD_STEP_S = 10.0  # spacing of the WMM evaluations along the drive, s
+_FIELD_STEP_S = 30.0  # spacing of the WMM evaluations along the drive, s
 
 MAG_PRESETS: dict[str, dict] = {
     "ideal": {},

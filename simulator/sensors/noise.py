@@ -3,8 +3,8 @@ analytic Allan variances.
 
 Every process here is defined in continuous time and sampled exactly at the sample times, so its
 statistics do not depend on the sample rate (a first-order Gauss-Markov process is the exact
-AR(1) recursion, run vectorised by recursive doubling in ``ar1_filter``; scipy is not imported,
-so that generating a dataset stays quick to start).
+AR(1) recursion, run vectorised in blocks in ``ar1_filter``; scipy is not imported, so that
+generating a dataset stays quick to start).
 
 Conventions (IEEE Std 952-1997, Annex C): a white rate noise of density N (unit/sqrt(Hz)) has
 Allan variance N^2 / tau; a rate random walk of density K (unit/s/sqrt(Hz)) has K^2 tau / 3; a
@@ -74,18 +74,55 @@ def gm_adev_peak() -> tuple[float, float]:
     return float(np.sqrt(avar.max())), float(x[np.argmax(avar)])
 
 
+# largest exponent |ln phi| k used inside one block of ``ar1_filter`` (e^300 = 2e130: the scaled
+# inputs stay far from overflow)
+_AR1_BLOCK_LOG_RANGE = 300.0
+
+
 def ar1_filter(u: np.ndarray, phi: float | np.ndarray) -> np.ndarray:
     """x[k] = phi x[k-1] + u[k] along axis 0, x[-1] = 0 (the first-order recursion of an exact
-    Gauss-Markov discretisation), by recursive doubling: after the pass with shift s each x[k]
-    holds the sum over the last 2 s inputs, so log2(n) vectorised passes replace the loop.
-    ``phi`` is one factor, or one per column of a 2-D ``u`` (shape (m,)). Stops early once every
-    phi^s underflows (the older inputs no longer count)."""
+    Gauss-Markov discretisation), vectorised without a loop over the samples.
+
+    ``phi`` (0 <= phi <= 1) is one factor, or one per column of a 2-D ``u`` (shape (m,)). Blocks
+    of L samples are solved in closed form, x[j] = phi^j cumsum(phi^-i u[i]) (L chosen so that
+    phi^-L stays below e^300 for every column; the rounding error stays that of the recursion,
+    since each partial sum is scaled back by phi^j), then the state at the end of each block is
+    carried into the next by the same recursion on the block ends (factor phi^L) and added with
+    the factors phi^(j+1). About five passes over the data whatever phi; a factor too small for
+    blocks of two (phi < e^-150) falls back to recursive doubling, which then stops after a few
+    passes once phi^(2^p) underflows.
+    """
     x = np.array(u, dtype=float)
-    power, shift = np.asarray(phi, dtype=float), 1
-    while shift < len(x) and np.any(power > 0.0):
-        x[shift:] += power * x[:-shift]
-        power, shift = power * power, shift * 2
-    return x
+    flat = x.ndim == 1
+    if flat:
+        x = x[:, None]
+    n, m = x.shape
+    phi = np.broadcast_to(np.asarray(phi, dtype=float), (m,))
+    if n == 0:
+        return x[:, 0] if flat else x
+    with np.errstate(divide="ignore"):
+        decay = -np.log(phi)  # |ln phi| per column, inf for phi = 0
+    fastest = float(decay.max())
+    length = n if fastest <= _AR1_BLOCK_LOG_RANGE / n else int(_AR1_BLOCK_LOG_RANGE / fastest)
+    if length < 2:
+        power, shift = phi.copy(), 1
+        while shift < n and np.any(power > 0.0):
+            x[shift:] += power * x[:-shift]
+            power, shift = power * power, shift * 2
+        return x[:, 0] if flat else x
+    blocks = -(-n // length)
+    if blocks * length != n:
+        x = np.concatenate([x, np.zeros((blocks * length - n, m))])
+    xb = x.reshape(blocks, length, m)
+    j = np.arange(length)[:, None]
+    xb *= np.exp(j * decay)
+    np.cumsum(xb, axis=1, out=xb)
+    xb *= np.exp(-j * decay)
+    if blocks > 1:
+        carry = ar1_filter(xb[:-1, -1, :], np.exp(-length * decay))
+        xb[1:] += carry[:, None, :] * np.exp(-(j + 1) * decay)
+    x = x[:n]
+    return x[:, 0] if flat else x
 
 
 def white(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generator,
@@ -155,23 +192,27 @@ def flicker(n: int, dt_s: float, instability: np.ndarray, rng: np.random.Generat
     """
     instability = np.atleast_1d(np.asarray(instability, dtype=float))
     sigma = instability * np.sqrt(np.log(_FLICKER_RATIO) / np.pi)
-    total = np.zeros((n, instability.size))
-    t = np.arange(n) * dt_s
+    m = instability.size
+    slowest_first = sorted(FLICKER_TAUS_S, reverse=True)
+    fast = [tau for tau in slowest_first if tau / _POINTS_PER_TAU < 2 * dt_s]
+    if fast:  # the components run at the sample rate: one recursion, a column per term and axis
+        terms = gauss_markov(n, dt_s, np.tile(sigma, len(fast)), np.repeat(fast, m), rng)
+        total = terms.reshape(n, len(fast), m).sum(axis=1)
+    else:
+        total = np.zeros((n, m))
     # slow components, slowest first, each on its own grid of tau / 64; the running sum is carried
     # down to each finer grid, and to the sample times once at the end
+    t_end = (n - 1) * dt_s
     grid, slow = None, None
-    for tau in sorted(FLICKER_TAUS_S, reverse=True):
+    for tau in slowest_first[:len(slowest_first) - len(fast)]:
         step = tau / _POINTS_PER_TAU
-        if step < 2 * dt_s:
-            total += gauss_markov(n, dt_s, sigma, tau, rng)
-            continue
-        fine = np.arange(int(np.ceil(t[-1] / step)) + 2) * step
+        fine = np.arange(int(np.ceil(t_end / step)) + 2) * step
         part = gauss_markov(len(fine), step, sigma, tau, rng)
         if slow is not None:
             part += _interp_columns(fine, grid, slow)
         grid, slow = fine, part
     if slow is not None:
-        total += _interp_columns(t, grid, slow)
+        total += _interp_columns(np.arange(n) * dt_s, grid, slow)
     return total
 
 

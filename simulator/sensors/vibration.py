@@ -12,7 +12,7 @@ to what the IMU senses, not to the truth trajectory.
 
 Public names
 ------------
-VIBRATION_FIELD, vibration.
+VIBRATION_FIELD, draw_vibration, vibration_at_speed.
 """
 
 from __future__ import annotations
@@ -71,31 +71,31 @@ def _road(n: int, rms: float, band_hz: list[float], dt_s: float,
     return np.fft.irfft(spectrum, n, axis=0) * (rms / np.sqrt(fraction))
 
 
-def vibration(t: np.ndarray, speed: np.ndarray, dt_s: float, config: dict, increment: bool,
-              rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """Angular-rate and specific-force vibration (or their increments), body frame.
+def draw_vibration(t: np.ndarray, dt_s: float, config: dict, increment: bool,
+                   rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """The random part of the vibration, which needs no trajectory: per group (gyro, accel) the
+    engine term plus the road term at ``road_speed``, stacked as shape (2, n, 3) each.
 
-    Parameters
-    ----------
-    t : sample times, s, shape (n,) (interval ends for increments).
-    speed : vehicle speed at the samples, m/s, shape (n,).
-    dt_s : sample interval, s.
-    config : the resolved ``vibration`` block.
-
-    Returns
-    -------
-    gyro, accel : ndarray, shape (n, 3) each
+    ``vibration_at_speed`` scales the road term by the speed once the truth is known.
     """
     c = config
-    scale = dt_s if increment else 1.0
-    road = (speed / c["road_speed"])[:, None] * scale
     out = []
     for engine_rms, road_rms in ((c["engine_gyro"], c["road_gyro"]),
                                  (c["engine_accel"], c["road_accel"])):
-        total = np.zeros((len(t), 3))
+        parts = np.zeros((2, len(t), 3))
         if engine_rms > 0:
-            total += _engine(t, engine_rms, c["engine_frequency"], dt_s, increment, rng)
+            parts[0] = _engine(t, engine_rms, c["engine_frequency"], dt_s, increment, rng)
         if road_rms > 0:
-            total += _road(len(t), road_rms, c["road_band"], dt_s, rng) * road
-        out.append(total)
+            parts[1] = _road(len(t), road_rms, c["road_band"], dt_s, rng)
+        out.append(parts)
     return out[0], out[1]
+
+
+def vibration_at_speed(drawn: tuple[np.ndarray, np.ndarray], speed: np.ndarray, dt_s: float,
+                       config: dict, increment: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Angular-rate and specific-force vibration (or their increments), body frame, shape (n, 3)
+    each: the engine term plus the road term scaled by speed / ``road_speed`` (``drawn`` from
+    ``draw_vibration``; ``speed`` at the samples, m/s, shape (n,))."""
+    scale = dt_s if increment else 1.0
+    road = (speed / config["road_speed"])[:, None] * scale
+    return tuple(parts[0] + parts[1] * road for parts in drawn)
