@@ -29,6 +29,7 @@ from simulator.dataset.events import events_table, gnss_outage_intervals, zone_e
 from simulator.dataset.io import DatasetWriter, atomic_output_dir
 from simulator.errors import InputError
 from simulator.faults.apply import apply_faults
+from simulator.faults.base import FAULT_REGISTRY
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
@@ -60,6 +61,10 @@ def build_truth(scenario: dict, built: tuple[RoadProfile, dict] | None = None) -
     return truth
 
 
+# worker threads for the sensors (the dataset writer has its own two)
+_SENSOR_WORKERS = 2
+
+
 def sensor_rng(seed: int, name: str) -> np.random.Generator:
     """The random stream of one sensor: a SeedSequence child keyed by the sensor's name, so adding
     a sensor does not change the others (SPEC section 2)."""
@@ -75,42 +80,56 @@ class Generated:
 
 
 def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = True,
-                     on_truth: Callable[[Table], None] | None = None) -> Generated:
+                     on_final: Callable[[str, Table], None] | None = None) -> Generated:
     """Truth table, every configured sensor's streams, and the events table.
 
     With ``frames`` (the default) every stream is a DataFrame; without, the tables stay as the
     sensors and faults left them (column tables or DataFrames), which is all the writer needs.
-    ``on_truth`` receives the truth table as soon as it exists (faults never change it), so that
-    it can be written while the sensors run.
+    ``on_final(name, table)`` receives each stream no fault will change (the truth always) as
+    soon as it exists, so that it can be written while the other streams are made.
 
-    A sensor with a ``prepare(duration_s, rng)`` step (the IMU: its bias processes and noise
-    need no trajectory) runs it in a worker thread while the truth is built; numpy releases the
-    interpreter lock in its array work, so on two cores the two overlap. The draws are the same
-    as without the thread: each sensor owns its random stream.
+    A sensor with a ``prepare(duration_s, rng, pool)`` step (the IMU: its bias processes and
+    noise need no trajectory) draws in worker threads while the truth is built, and the sensors
+    then run side by side in worker threads; numpy releases the interpreter lock in its array
+    work, so they overlap on several cores. The draws are the same as without the threads: each
+    sensor owns its random stream.
     """
     profile, start = build_profile(scenario)
     sensors = {k: v for k, v in scenario["sensors"].items() if v is not None}
     models = {name: SENSOR_MODELS[name](block) for name, block in sensors.items()}
     rngs = {name: sensor_rng(scenario["seed"], name) for name in models}
-    with ThreadPoolExecutor(max_workers=1) as pool:
-        prepared = [pool.submit(model.prepare, profile.duration_s, rngs[name])
-                    for name, model in models.items() if hasattr(model, "prepare")]
-        truth = build_truth(scenario, (profile, start))
-        streams: dict[str, Table] = {"truth": truth.columns()}
-        if on_truth is not None:
-            on_truth(streams["truth"])
-        for job in prepared:
-            job.result()
     drawn: dict[str, dict] = {}
-    for name in progress(models, "sensors", show_progress):
-        streams.update(models[name].generate(truth, rngs[name]))
-        drawn[name] = models[name].drawn
+    with ThreadPoolExecutor(max_workers=_SENSOR_WORKERS) as pool:
+        for name, model in models.items():
+            if hasattr(model, "prepare"):  # its parts go to the pool, ahead of the sensors
+                model.prepare(profile.duration_s, rngs[name], pool)
+        truth = build_truth(scenario, (profile, start))
+        streams: dict[str, Table] = {"truth": truth.columns()}  # caches the grid evaluation
+        # streams still to change: those a fault acts on, and raw GNSS kept only for the faults
+        # and the outage table unless asked for
+        gnss = sensors.get("gnss")
+        unsettled = {name for fault in scenario["faults"]
+                     for name in FAULT_REGISTRY[fault["kind"]].streams}
+        if gnss is not None and "raw" not in gnss["outputs"]:
+            unsettled.add("gnss_raw")
+        if on_final is not None:
+            on_final("truth", streams["truth"])
+        # the sensors only read the truth (its grid evaluation is cached above); a job waits
+        # only for jobs submitted before it, so two workers cannot wait on each other
+        jobs = {name: pool.submit(model.generate, truth, rngs[name])
+                for name, model in models.items()}
+        for name in progress(models, "sensors", show_progress):
+            made = jobs[name].result()
+            streams.update(made)
+            drawn[name] = models[name].drawn
+            for stream, table in made.items():
+                if on_final is not None and stream not in unsettled:
+                    on_final(stream, table)
     rows = zone_events(truth.profile.zones) + apply_faults(streams, scenario, truth)
     for t_start, t_end in _outages(streams, truth.duration_s):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
-    gnss = sensors.get("gnss")
     if gnss is not None and "raw" not in gnss["outputs"]:
-        streams.pop("gnss_raw", None)  # kept until here for the faults and the outage table
+        streams.pop("gnss_raw", None)
     streams["events"] = events_table(rows)
     return Generated(truth, as_frames(streams) if frames else streams, drawn)
 
@@ -158,10 +177,11 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
 def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
                      show_progress: bool = True) -> Path:
     """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
-    ``force``). Returns ``out_dir``. The truth file is written while the sensors run."""
+    ``force``). Returns ``out_dir``. Each stream no fault changes is written while the others are
+    made."""
     out_dir = Path(out_dir)
     with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp) as writer:
         generated = generate_streams(scenario.data, show_progress, frames=False,
-                                     on_truth=lambda table: writer.write("truth", table))
+                                     on_final=writer.write)
         writer.finish(build_manifest(scenario, generated), generated.streams)
     return out_dir

@@ -197,8 +197,10 @@ class DatasetWriter:
         for name, table in streams.items():
             if name not in self._jobs:
                 self.write(name, table)
-        for job in self._jobs.values():
+        for name, job in self._jobs.items():
             job.result()
+            if name not in streams:  # handed over, then left out of the dataset
+                (self.directory / self.file_name(name)).unlink()
         for name, table in streams.items():
             rows = n_rows(table)
             rate = None

@@ -72,6 +72,8 @@ Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Sys
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from concurrent.futures import Executor, Future
 from dataclasses import dataclass
 from typing import Any
 
@@ -243,19 +245,22 @@ class Imu:
         self._prepared: _Draws | None = None
 
     # -- the random part, drawn before the truth exists ---------------------------------------
-    def prepare(self, duration_s: float, rng: np.random.Generator | None) -> None:
+    def prepare(self, duration_s: float, rng: np.random.Generator | None,
+                pool: Executor | None = None) -> None:
         """Draw every random term that does not depend on the trajectory: each group's constants,
         bias processes and white noise, the timestamp jitter and the vibration noise.
 
-        Needs only the drive's duration, so the dataset generator runs it in a worker thread
-        while the truth is built; ``generate`` runs it itself when it has not been run. ``rng``
-        is split into one stream per part (timing, vibration, gyro, accel), so switching one
-        term on leaves the draws of the others unchanged.
+        Needs only the drive's duration, so the dataset generator calls it before the truth is
+        built, with its ``pool``: the groups and the vibration are then drawn in worker threads
+        while the truth is computed. ``generate`` calls it itself when it has not been called.
+        ``rng`` is split into one stream per part (timing, vibration, gyro, accel), so the draws
+        do not depend on the threads, and switching one term on leaves the others unchanged.
         """
         rng = rng if rng is not None else np.random.default_rng()
         timing, shaking, *groups = rng.spawn(4)
         t = sample_times(duration_s, self.rate_hz, first=1 if self.increment else 0)
         dt = 1.0 / self.rate_hz
+        run = pool.submit if pool is not None else _run_now
         jitter = float(self.config["timestamp_jitter"])
         # increments: the interval ends t - dt and t move; rates: the sampling instant moves
         size = len(t) + 1 if self.increment else len(t)
@@ -263,9 +268,9 @@ class Imu:
         vib = self.config["vibration"]
         shake = None
         if any(vib[k] > 0 for k in ("engine_accel", "engine_gyro", "road_accel", "road_gyro")):
-            shake = draw_vibration(t, dt, vib, self.increment, shaking)
+            shake = run(draw_vibration, t, dt, vib, self.increment, shaking)
         self._prepared = _Draws(duration_s, t, time_error, shake,
-                                {group: self._draw_group(group, t, stream)
+                                {group: run(self._draw_group, group, t, stream)
                                  for group, stream in zip(("gyro", "accel"), groups,
                                                           strict=True)})
 
@@ -398,11 +403,11 @@ class Imu:
             dt = 1.0 / self.rate_hz
             t_speed = t - dt / 2 if self.increment else t
             speed = np.maximum(truth.profile.distance_of_time(np.clip(t_speed, 0, None), 1), 0)
-            dw, df = vibration_at_speed(draws.vibration, speed, dt, self.config["vibration"],
-                                        self.increment)
+            dw, df = vibration_at_speed(draws.vibration.result(), speed, dt,
+                                        self.config["vibration"], self.increment)
             w, f = w + dw, f + df
-        gyro = self._apply_errors("gyro", w, f, draws.groups["gyro"])
-        accel = self._apply_errors("accel", f, f, draws.groups["accel"])
+        gyro = self._apply_errors("gyro", w, f, draws.groups["gyro"].result())
+        accel = self._apply_errors("accel", f, f, draws.groups["accel"].result())
         table = {"t": t}
         for i, axis in enumerate(col.IMU_AXES):
             if axis in self.config["axes"]:
@@ -425,13 +430,21 @@ class _GroupDraws:
 
 @dataclass
 class _Draws:
-    """What ``Imu.prepare`` drew for a drive of ``duration_s``."""
+    """What ``Imu.prepare`` drew for a drive of ``duration_s``: the vibration and the groups as
+    futures (done at once without a pool)."""
 
     duration_s: float
     t: np.ndarray
     time_error: np.ndarray | None
-    vibration: tuple[np.ndarray, np.ndarray] | None
-    groups: dict[str, _GroupDraws]
+    vibration: Future | None
+    groups: dict[str, Future]
+
+
+def _run_now(function: Callable, *args: Any) -> Future:
+    """``function(*args)`` run now, as a finished future (``prepare`` without a pool)."""
+    done: Future = Future()
+    done.set_result(function(*args))
+    return done
 
 
 def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarray:
