@@ -273,17 +273,20 @@ class Kinematics:
         return self._breaks
 
     def zone_at(self, t: np.ndarray) -> np.ndarray:
-        """Zone name at times t ('' outside every zone); later zones win where they overlap.
+        """Zone name at times t ('' outside every zone), a string array; later zones win where
+        they overlap.
 
         Zones are [start, end), except that a zone reaching the end of the drive also holds
-        its last instant (a drive that ends in a garage ends without sky).
+        its last instant (a drive that ends in a garage ends without sky). Each time gets the
+        number of its zone (0: none), and the names are looked up once from those numbers.
         """
         t = np.atleast_1d(t)
-        out = np.full(t.shape, "", dtype=object)
-        for start, end, name in self.profile.zones:
+        zones = self.profile.zones
+        zone_number = np.zeros(t.shape, dtype=np.intp)
+        for number, (start, end, _) in enumerate(zones, start=1):
             last = end >= self.duration_s - 1e-9
-            out[(t >= start) & ((t < end) | (last & (t <= end)))] = name
-        return out
+            zone_number[(t >= start) & ((t < end) | (last & (t <= end)))] = number
+        return np.array(["", *(name for _, _, name in zones)]).take(zone_number)
 
     def table(self, t: np.ndarray | None = None) -> pd.DataFrame:
         """The truth table (SPEC section 5 ``truth.parquet`` columns) at times t (default: grid),
@@ -305,7 +308,7 @@ class Kinematics:
             "wx": k["w_body"][:, 0], "wy": k["w_body"][:, 1], "wz": k["w_body"][:, 2],
             "fx": k["f_body"][:, 0], "fy": k["f_body"][:, 1], "fz": k["f_body"][:, 2],
             "speed": k["speed"], "distance": k["distance"],
-            "zone": self.zone_at(k["t"]).astype(str),
+            "zone": self.zone_at(k["t"]),
         }
 
 
