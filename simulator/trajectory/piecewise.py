@@ -38,17 +38,21 @@ class PiecewisePolynomial:
     def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,),
                  index: np.ndarray | None = None) -> list[np.ndarray]:
         """Values of the requested derivatives at x (one search for all of them; ``index``
-        from ``piece_index`` skips it, for curves that share these breakpoints)."""
+        from ``piece_index`` skips it, for curves that share these breakpoints).
+
+        Horner's scheme in place, the coefficients of each sample's piece gathered with
+        ``take`` (much cheaper than fancy indexing of the 2-D coefficient array).
+        """
         x = np.asarray(x, dtype=float)
         idx = self.piece_index(x) if index is None else index
-        dx = x - self.x[idx]
+        dx = x - self.x.take(idx)
         out = []
         for nu in orders:
             c = self._coefficients(nu)
-            acc = c[0, idx].copy()
-            for k in range(1, c.shape[0]):
+            acc = c[0].take(idx)
+            for row in c[1:]:
                 acc *= dx
-                acc += c[k, idx]
+                acc += row.take(idx)
             out.append(acc)
         return out
 
