@@ -191,9 +191,29 @@ def skew(v: np.ndarray) -> np.ndarray:
     )
 
 
+# 2 pi as the sum of three doubles (Cody and Waite), the first two with 33 significant bits, so
+# that k times each of them is exact for whole turns |k| < 2^20
+_TWO_PI_PARTS = (float.fromhex("0x1.921fb544p+2"), float.fromhex("0x1.0b4611a6p-32"),
+                 float.fromhex("0x1.3198a2e037073p-67"))
+
+
 def wrap_angle(angle_rad: np.ndarray) -> np.ndarray:
-    """Wrap angles to [-pi, pi)."""
-    return (np.asarray(angle_rad) + np.pi) % (2.0 * np.pi) - np.pi
+    """Wrap angles to [-pi, pi).
+
+    a - 2 pi k with k = round(a / 2 pi) the whole turns, 2 pi k subtracted in three exact parts
+    (Cody-Waite argument reduction): as accurate as the angle itself, without the rounding of
+    a + pi, and several times cheaper than a floating-point remainder. (Sines and cosines of
+    the wrapped angle are also cheaper than those of a large one.)
+    """
+    a = np.atleast_1d(np.asarray(angle_rad, dtype=float))
+    turns = np.rint(a * (1.0 / (2.0 * np.pi)))
+    wrapped = a - turns * _TWO_PI_PARTS[0]
+    for part in _TWO_PI_PARTS[1:]:
+        wrapped -= turns * part
+    # a rounding may leave a result a hair outside [-pi, pi): fold it back
+    wrapped[wrapped >= np.pi] -= 2.0 * np.pi
+    wrapped[wrapped < -np.pi] += 2.0 * np.pi
+    return wrapped.reshape(np.shape(angle_rad))[()]
 
 
 def euler_to_dcm(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.ndarray:

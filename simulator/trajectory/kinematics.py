@@ -114,7 +114,8 @@ class Kinematics:
         bank, dbank = p.bank.evaluate(s, (0, 1), idx)
         psi = p.heading.evaluate(s, (0,), idx)[0]
         psi += np.radians(self.origin.heading_deg)
-        cg, sg, cp, sp = np.cos(gamma), np.sin(gamma), np.cos(psi), np.sin(psi)
+        yaw = wrap_angle(psi)  # the same angle, whose cosine and sine are cheaper
+        cg, sg, cp, sp = np.cos(gamma), np.sin(gamma), np.cos(yaw), np.sin(yaw)
         yaw_rate = kappa * v
         pitch_rate = dgamma * v
         # body roll against the lateral acceleration d kappa v^2 (and its exact rate, d constant)

@@ -32,8 +32,18 @@ class PiecewisePolynomial:
         return cls(ppoly.c, ppoly.x)
 
     def piece_index(self, x: np.ndarray) -> np.ndarray:
-        """Index of the piece holding each x (pieces are [x[i], x[i+1]); ends extrapolate)."""
-        return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.c.shape[1] - 1)
+        """Index of the piece holding each x (pieces are [x[i], x[i+1]); ends extrapolate).
+
+        For many increasing x (a time grid, the distance along it) the pieces' starts are
+        looked up in x instead (one search per piece rather than one per x), with the same
+        result.
+        """
+        x = np.asarray(x, dtype=float)
+        m = self.c.shape[1]
+        if x.ndim == 1 and len(x) > 8 * m and (x[1:] >= x[:-1]).all():
+            first = np.searchsorted(x, self.x[1:m], side="left")  # first x in pieces 1 ... m-1
+            return np.repeat(np.arange(m), np.diff(first, prepend=0, append=len(x)))
+        return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, m - 1)
 
     def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,),
                  index: np.ndarray | None = None) -> list[np.ndarray]:
