@@ -250,15 +250,15 @@ def ned_to_body_components(cr: np.ndarray, sr: np.ndarray, cp: np.ndarray, sp: n
                            cy: np.ndarray, sy: np.ndarray, vn: np.ndarray, ve: np.ndarray,
                            vd: np.ndarray) -> np.ndarray:
     """``ned_to_body_trig`` of the vectors given by their north, east and down components (no
-    (n, 3) array of them need be built); returns shape (..., 3)."""
+    (n, 3) array of them need be built); returns shape (..., 3), each component contiguous."""
     h = cy * vn + sy * ve  # north/east rotated into the heading frame
-    lateral = -sy * vn + cy * ve
+    lateral = cy * ve - sy * vn
     vertical = sp * h + cp * vd
-    out = np.empty(np.broadcast_shapes(np.shape(cr), np.shape(vn)) + (3,))
-    out[..., 0] = cp * h - sp * vd
-    out[..., 1] = cr * lateral + sr * vertical
-    out[..., 2] = -sr * lateral + cr * vertical
-    return out
+    out = np.empty((3,) + np.broadcast_shapes(np.shape(cr), np.shape(vn)))
+    out[0] = cp * h - sp * vd
+    out[1] = cr * lateral + sr * vertical
+    out[2] = cr * vertical - sr * lateral
+    return np.moveaxis(out, 0, -1)
 
 
 def dcm_to_euler(c_bn: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

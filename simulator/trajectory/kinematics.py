@@ -124,22 +124,23 @@ class Kinematics:
         roll = bank - roll_per_accel * v2 * kappa
         roll_rate = dbank * v - roll_per_accel * (2 * v * a * kappa + v2 * v * dkappa)
         dv, da = d * v, d * a  # signed speed and acceleration along body x
-        # the velocity is d v u with the unit vector u = (cg cp, cg sp, -sg) along the road
+        # the velocity is d v u with the unit vector u = (cg cp, cg sp, -sg) along the road;
+        # stored component by component (shape (3, n)), handed out transposed as (n, 3)
         u_n, u_e = cg * cp, cg * sp
-        v_ned = np.empty(t.shape + (3,))
-        np.multiply(dv, u_n, out=v_ned[:, 0])
-        np.multiply(dv, u_e, out=v_ned[:, 1])
-        np.multiply(dv, sg, out=v_ned[:, 2])
-        np.negative(v_ned[:, 2], out=v_ned[:, 2])
+        v_ned = np.empty((3,) + t.shape)
+        np.multiply(dv, u_n, out=v_ned[0])
+        np.multiply(dv, u_e, out=v_ned[1])
+        np.multiply(dv, sg, out=v_ned[2])
+        np.negative(v_ned[2], out=v_ned[2])
         # d/dt of d v u(psi, gamma): d (a u + v (du/dpsi psi' + du/dgamma gamma'))
         sg_pitch_rate = sg * pitch_rate
         a_ned = np.empty_like(v_ned)
-        a_ned[:, 0] = da * u_n - dv * (u_e * yaw_rate + cp * sg_pitch_rate)
-        a_ned[:, 1] = da * u_e + dv * (u_n * yaw_rate - sp * sg_pitch_rate)
-        a_ned[:, 2] = -da * sg - dv * cg * pitch_rate
+        a_ned[0] = da * u_n - dv * (u_e * yaw_rate + cp * sg_pitch_rate)
+        a_ned[1] = da * u_e + dv * (u_n * yaw_rate - sp * sg_pitch_rate)
+        a_ned[2] = -da * sg - dv * cg * pitch_rate
         # + 0.0: a reversing car at rest reads 0.0, not -0.0
         return dict(s=s, v=dv + 0.0, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
-                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
+                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned.T, a_ned=a_ned.T,
                     cos_pitch=cg, sin_pitch=sg, cos_yaw=cp, sin_yaw=sp)
 
     # -- position ---------------------------------------------------------------------------
@@ -157,11 +158,11 @@ class Kinematics:
         """
         h = 1.0 / self.rate_hz
         n_grid = len(self.t_grid)
-        grid_motion = self._motion(self.t_grid)
-        t, v = self.t_grid, grid_motion["v_ned"]
-        if t[-1] < self.duration_s - 1e-9:  # the drive ends between two grid points
+        t = self.t_grid  # the integration nodes: the grid, and the drive's end if off the grid
+        if t[-1] < self.duration_s - 1e-9:
             t = np.append(t, self.duration_s)
-            v = np.vstack([v, self._motion(t[-1:])["v_ned"]])
+        motion = self._motion(t)
+        v = motion["v_ned"]
         # intervals [t_k, t_k+1] for k >= first_gauss: Gauss-Legendre on the analytic velocity
         first_gauss = n_grid - 1 if n_grid >= 4 else 0
         owner = np.repeat(np.arange(first_gauss, len(t) - 1), len(GL_NODES))
@@ -212,7 +213,7 @@ class Kinematics:
         self._lla = (lat, lon, alt)
         self._lla_rates = (v[:, 0] / (rn + alt), lon_rate, -v[:, 2])
         # for ``grid_inertial``: the grid's positions are the integration's own nodes
-        self._grid_motion = grid_motion
+        self._grid_motion = {key: values[:n_grid] for key, values in motion.items()}
         self._grid_place = dict(lat=lat[:n_grid], lon=lon[:n_grid], alt=alt[:n_grid],
                                 sin_lat=sin_lat[:n_grid], cos_lat=cos_lat[:n_grid],
                                 rn=rn[:n_grid], re=re[:n_grid])
@@ -225,10 +226,10 @@ class Kinematics:
         """
         nodes = self._t_int
         t = np.clip(np.atleast_1d(np.asarray(t, float)), 0.0, nodes[-1])
-        out = np.empty(t.shape + (3,))
+        out = np.empty((3,) + t.shape)  # component by component, handed out as (n, 3)
         if len(nodes) == 1:
-            out[:] = [values[0] for values in self._lla]
-            return out
+            out[:] = [[values[0]] for values in self._lla]
+            return out.T
         i = np.clip(np.searchsorted(nodes, t, side="right") - 1, 0, len(nodes) - 2)
         start = nodes.take(i)
         h = nodes.take(i + 1) - start
@@ -239,9 +240,9 @@ class Kinematics:
         value_start, value_end = 2 * u3 - 3 * u2 + 1, -2 * u3 + 3 * u2
         rate_start, rate_end = (u3 - 2 * u2 + u) * h, (u3 - u2) * h
         for column, (values, rates) in enumerate(zip(self._lla, self._lla_rates, strict=True)):
-            out[:, column] = (value_start * values.take(i) + rate_start * rates.take(i)
-                              + value_end * values.take(i + 1) + rate_end * rates.take(i + 1))
-        return out
+            out[column] = (value_start * values.take(i) + rate_start * rates.take(i)
+                           + value_end * values.take(i + 1) + rate_end * rates.take(i + 1))
+        return out.T
 
     # -- the truth columns ------------------------------------------------------------------
     def inertial(self, t: np.ndarray) -> dict[str, np.ndarray]:
