@@ -10,10 +10,11 @@ and longitude are in radians inside this module unless a name ends in ``_deg``.
 
 Public functions
 ----------------
-radii_of_curvature, normal_gravity, gravity_ned, earth_rate_ned, transport_rate_ned,
-geodetic_to_ecef, ecef_to_geodetic, ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef,
-ned_to_ecef_vector, euler_to_dcm, ned_to_body, ned_to_body_trig, dcm_to_euler, euler_to_quat,
-quat_to_dcm, quat_to_euler, quat_multiply, rotvec_to_quat, wrap_angle, skew.
+radii_of_curvature, radii_of_curvature_from_sin, normal_gravity, normal_gravity_from_sin,
+gravity_ned, earth_rate_ned, transport_rate_ned, geodetic_to_ecef, ecef_to_geodetic,
+ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef, ned_to_ecef_vector, euler_to_dcm, ned_to_body,
+ned_to_body_trig, ned_to_body_components, dcm_to_euler, euler_to_quat, quat_to_dcm, quat_to_euler,
+quat_multiply, rotvec_to_quat, wrap_angle, skew.
 
 References
 ----------
@@ -57,8 +58,13 @@ def radii_of_curvature(lat_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Groves eqs. 2.105 and 2.106: R_N = a (1 - e^2) / (1 - e^2 sin^2 L)^1.5 and
     R_E = a / sqrt(1 - e^2 sin^2 L).
     """
-    s = np.sin(lat_rad)
-    re = A_M / np.sqrt(1.0 - E2 * s * s)
+    return radii_of_curvature_from_sin(np.sin(lat_rad))
+
+
+def radii_of_curvature_from_sin(sin_lat: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``radii_of_curvature`` from the sine of the latitude (Groves eqs. 2.105 and 2.106), for
+    callers that already have it."""
+    re = A_M / np.sqrt(1.0 - E2 * sin_lat * sin_lat)
     return re * re * re * (1.0 - E2) / (A_M * A_M), re
 
 
@@ -69,7 +75,13 @@ def normal_gravity(lat_rad: np.ndarray, alt_m: np.ndarray) -> np.ndarray:
     (TR8350.2 eq. 4-3). Normal gravity includes the centrifugal acceleration of the Earth's
     rotation, so it is what an accelerometer at rest measures (with opposite sign).
     """
-    s2 = np.sin(lat_rad) ** 2
+    return normal_gravity_from_sin(np.sin(lat_rad), alt_m)
+
+
+def normal_gravity_from_sin(sin_lat: np.ndarray, alt_m: np.ndarray) -> np.ndarray:
+    """``normal_gravity`` from the sine of the latitude (TR8350.2 eqs. 4-1 and 4-3), for callers
+    that already have it."""
+    s2 = sin_lat * sin_lat
     gamma0 = GAMMA_E_M_S2 * (1.0 + SOMIGLIANA_K * s2) / np.sqrt(1.0 - E2 * s2)
     h = np.asarray(alt_m, dtype=float)
     return gamma0 * (
@@ -179,9 +191,29 @@ def skew(v: np.ndarray) -> np.ndarray:
     )
 
 
+# 2 pi as the sum of three doubles (Cody and Waite), the first two with 33 significant bits, so
+# that k times each of them is exact for whole turns |k| < 2^20
+_TWO_PI_PARTS = (float.fromhex("0x1.921fb544p+2"), float.fromhex("0x1.0b4611a6p-32"),
+                 float.fromhex("0x1.3198a2e037073p-67"))
+
+
 def wrap_angle(angle_rad: np.ndarray) -> np.ndarray:
-    """Wrap angles to [-pi, pi)."""
-    return (np.asarray(angle_rad) + np.pi) % (2.0 * np.pi) - np.pi
+    """Wrap angles to [-pi, pi).
+
+    a - 2 pi k with k = round(a / 2 pi) the whole turns, 2 pi k subtracted in three exact parts
+    (Cody-Waite argument reduction): as accurate as the angle itself, without the rounding of
+    a + pi, and several times cheaper than a floating-point remainder. (Sines and cosines of
+    the wrapped angle are also cheaper than those of a large one.)
+    """
+    a = np.atleast_1d(np.asarray(angle_rad, dtype=float))
+    turns = np.rint(a * (1.0 / (2.0 * np.pi)))
+    wrapped = a - turns * _TWO_PI_PARTS[0]
+    for part in _TWO_PI_PARTS[1:]:
+        wrapped -= turns * part
+    # a rounding may leave a result a hair outside [-pi, pi): fold it back
+    wrapped[wrapped >= np.pi] -= 2.0 * np.pi
+    wrapped[wrapped < -np.pi] += 2.0 * np.pi
+    return wrapped.reshape(np.shape(angle_rad))[()]
 
 
 def euler_to_dcm(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.ndarray:
@@ -210,15 +242,23 @@ def ned_to_body(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray,
 def ned_to_body_trig(cr: np.ndarray, sr: np.ndarray, cp: np.ndarray, sp: np.ndarray,
                      cy: np.ndarray, sy: np.ndarray, v_ned: np.ndarray) -> np.ndarray:
     """``ned_to_body`` from the cosines and sines of roll, pitch and yaw."""
-    vn, ve, vd = v_ned[..., 0], v_ned[..., 1], v_ned[..., 2]
+    return ned_to_body_components(cr, sr, cp, sp, cy, sy,
+                                  v_ned[..., 0], v_ned[..., 1], v_ned[..., 2])
+
+
+def ned_to_body_components(cr: np.ndarray, sr: np.ndarray, cp: np.ndarray, sp: np.ndarray,
+                           cy: np.ndarray, sy: np.ndarray, vn: np.ndarray, ve: np.ndarray,
+                           vd: np.ndarray) -> np.ndarray:
+    """``ned_to_body_trig`` of the vectors given by their north, east and down components (no
+    (n, 3) array of them need be built); returns shape (..., 3), each component contiguous."""
     h = cy * vn + sy * ve  # north/east rotated into the heading frame
-    lateral = -sy * vn + cy * ve
+    lateral = cy * ve - sy * vn
     vertical = sp * h + cp * vd
-    out = np.empty(np.broadcast_shapes(np.shape(cr), vn.shape) + (3,))
-    out[..., 0] = cp * h - sp * vd
-    out[..., 1] = cr * lateral + sr * vertical
-    out[..., 2] = -sr * lateral + cr * vertical
-    return out
+    out = np.empty((3,) + np.broadcast_shapes(np.shape(cr), np.shape(vn)))
+    out[0] = cp * h - sp * vd
+    out[1] = cr * lateral + sr * vertical
+    out[2] = cr * vertical - sr * lateral
+    return np.moveaxis(out, 0, -1)
 
 
 def dcm_to_euler(c_bn: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -37,11 +37,12 @@ import numpy as np
 from simulator import columns as col
 from simulator.earth import (
     OMEGA_E_RAD_S,
-    normal_gravity,
+    ned_to_body_components,
+    normal_gravity_from_sin,
     radii_of_curvature,
+    radii_of_curvature_from_sin,
     wrap_angle,
 )
-from simulator.earth import ned_to_body_trig as ned_to_body
 from simulator.tables import ColumnTable
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.piecewise import PiecewisePolynomial
@@ -98,36 +99,48 @@ class Kinematics:
 
     # -- along-road quantities --------------------------------------------------------------
     def _motion(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Along-road quantities at times t: distance, signed speed, attitude and Euler-angle
+        rates, the NED velocity and its exact time derivative, and the cosines and sines of
+        pitch and yaw (which ``inertial`` reuses)."""
         p = self.profile
         t = np.clip(np.asarray(t, dtype=float), 0.0, self.duration_s)
         s, v, a = p.distance_of_time.evaluate(t, (0, 1, 2))
-        v = np.maximum(v, 0.0)
+        np.maximum(v, 0.0, out=v)
         d = p.direction_at(t)  # +1 forward, -1 reversing: switches only where v = a = 0
         # the road curves of a parametric drive share their breakpoints: one search serves all
         idx = p.curvature.piece_index(s) if self._shared_breaks else None
         kappa, dkappa = p.curvature.evaluate(s, (0, 1), idx)
         gamma, dgamma = p.grade.evaluate(s, (0, 1), idx)
         bank, dbank = p.bank.evaluate(s, (0, 1), idx)
-        psi = np.radians(self.origin.heading_deg) + p.heading.evaluate(s, (0,), idx)[0]
-        cg, sg, cp, sp = np.cos(gamma), np.sin(gamma), np.cos(psi), np.sin(psi)
+        psi = p.heading.evaluate(s, (0,), idx)[0]
+        psi += np.radians(self.origin.heading_deg)
+        yaw = wrap_angle(psi)  # the same angle, whose cosine and sine are cheaper
+        cg, sg, cp, sp = np.cos(gamma), np.sin(gamma), np.cos(yaw), np.sin(yaw)
         yaw_rate = kappa * v
         pitch_rate = dgamma * v
         # body roll against the lateral acceleration d kappa v^2 (and its exact rate, d constant)
-        roll = bank - self.roll_gradient * d * v**2 * kappa
-        roll_rate = dbank * v - self.roll_gradient * d * (2 * v * a * kappa + v**3 * dkappa)
+        roll_per_accel = self.roll_gradient * d
+        v2 = v * v
+        roll = bank - roll_per_accel * v2 * kappa
+        roll_rate = dbank * v - roll_per_accel * (2 * v * a * kappa + v2 * v * dkappa)
         dv, da = d * v, d * a  # signed speed and acceleration along body x
-        v_ned = np.empty(t.shape + (3,))
-        v_ned[:, 0] = dv * cg * cp
-        v_ned[:, 1] = dv * cg * sp
-        v_ned[:, 2] = -dv * sg
+        # the velocity is d v u with the unit vector u = (cg cp, cg sp, -sg) along the road;
+        # stored component by component (shape (3, n)), handed out transposed as (n, 3)
+        u_n, u_e = cg * cp, cg * sp
+        v_ned = np.empty((3,) + t.shape)
+        np.multiply(dv, u_n, out=v_ned[0])
+        np.multiply(dv, u_e, out=v_ned[1])
+        np.multiply(dv, sg, out=v_ned[2])
+        np.negative(v_ned[2], out=v_ned[2])
         # d/dt of d v u(psi, gamma): d (a u + v (du/dpsi psi' + du/dgamma gamma'))
+        sg_pitch_rate = sg * pitch_rate
         a_ned = np.empty_like(v_ned)
-        a_ned[:, 0] = da * cg * cp - dv * (cg * sp * yaw_rate + sg * cp * pitch_rate)
-        a_ned[:, 1] = da * cg * sp + dv * (cg * cp * yaw_rate - sg * sp * pitch_rate)
-        a_ned[:, 2] = -da * sg - dv * cg * pitch_rate
+        a_ned[0] = da * u_n - dv * (u_e * yaw_rate + cp * sg_pitch_rate)
+        a_ned[1] = da * u_e + dv * (u_n * yaw_rate - sp * sg_pitch_rate)
+        a_ned[2] = -da * sg - dv * cg * pitch_rate
         # + 0.0: a reversing car at rest reads 0.0, not -0.0
         return dict(s=s, v=dv + 0.0, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
-                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
+                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned.T, a_ned=a_ned.T,
                     cos_pitch=cg, sin_pitch=sg, cos_yaw=cp, sin_yaw=sp)
 
     # -- position ---------------------------------------------------------------------------
@@ -136,58 +149,74 @@ class Kinematics:
         interval by interval with the cubic rule on the grid samples (``quadrature``), and with
         three-point Gauss-Legendre on the analytic velocity where the grid is too short for it
         and over the last, partial interval up to the drive's end.
+
+        Altitude first, then latitude by two fixed-point passes on the weak dependence of R_N on
+        latitude (R_N at the start latitude, then at the first pass's latitude), then longitude.
+        At the Gauss-Legendre nodes, latitude and altitude are interpolated linearly between the
+        integration nodes (the radii vary slowly). The motion on the grid, and the sine, cosine
+        and radii of the grid latitudes, are kept for ``grid_inertial``.
         """
-        t = self.t_grid
         h = 1.0 / self.rate_hz
-        motion = self._motion(t)
-        self._motion_cache = {"grid": motion}  # reused by ``grid_inertial``
-        v = motion["v_ned"]
-        if t[-1] < self.duration_s - 1e-9:  # the drive ends between two grid points
+        n_grid = len(self.t_grid)
+        t = self.t_grid  # the integration nodes: the grid, and the drive's end if off the grid
+        if t[-1] < self.duration_s - 1e-9:
             t = np.append(t, self.duration_s)
-            v = np.vstack([v, self._motion(t[-1:])["v_ned"]])
-        lat0, lon0 = np.radians(self.origin.lat_deg), np.radians(self.origin.lon_deg)
+        motion = self._motion(t)
+        v = motion["v_ned"]
+        # intervals [t_k, t_k+1] for k >= first_gauss: Gauss-Legendre on the analytic velocity
+        first_gauss = n_grid - 1 if n_grid >= 4 else 0
+        owner = np.repeat(np.arange(first_gauss, len(t) - 1), len(GL_NODES))
+        gauss_t = t[owner] + (t[owner + 1] - t[owner]) * np.tile(GL_NODES, len(t) - 1
+                                                                  - first_gauss)
+        gauss_v = self._motion(gauss_t)["v_ned"] if len(gauss_t) else np.empty((0, 3))
+        gauss_u = (gauss_t - t[owner]) / (t[owner + 1] - t[owner])
 
-        def integrate(rate_of) -> np.ndarray:
-            """Cumulative integral of rate_of(times, v_ned, index) over the nodes."""
-            values = rate_of(t, v, np.arange(len(t)))
-            n_uniform = len(self.t_grid)
+        def at_gauss(node_values: np.ndarray) -> np.ndarray:
+            """Values at the nodes interpolated linearly to the Gauss-Legendre nodes."""
+            left = node_values[owner]
+            return left + gauss_u * (node_values[owner + 1] - left)
+
+        def integrate(rate_at_nodes: np.ndarray, rate_at_gauss: np.ndarray) -> np.ndarray:
+            """Cumulative integral over the nodes (0 at the first) of a rate given at the
+            nodes and at the Gauss-Legendre nodes."""
             steps = np.empty(len(t) - 1)
-            if n_uniform >= 4:
-                steps[:n_uniform - 1] = cubic_interval_integrals(values[:n_uniform], h)
-                first_gauss = n_uniform - 1
-            else:
-                first_gauss = 0
-            if first_gauss < len(t) - 1:
-                a, b = t[first_gauss:-1], t[first_gauss + 1:]
-                nodes = (a[:, None] + (b - a)[:, None] * GL_NODES[None, :]).ravel()
-                owner = np.repeat(np.arange(first_gauss, len(t) - 1), len(GL_NODES))
-                at_nodes = rate_of(nodes, self._motion(nodes)["v_ned"], owner)
-                steps[first_gauss:] = (b - a) * (at_nodes.reshape(-1, len(GL_NODES))
-                                                 @ GL_WEIGHTS)
-            return np.concatenate([[0.0], np.cumsum(steps)])
+            if first_gauss:
+                steps[:first_gauss] = cubic_interval_integrals(rate_at_nodes[:n_grid], h)
+            if len(gauss_t):
+                widths = t[first_gauss + 1:] - t[first_gauss:-1]
+                steps[first_gauss:] = widths * (rate_at_gauss.reshape(-1, len(GL_NODES))
+                                                @ GL_WEIGHTS)
+            total = np.empty(len(t))
+            total[0] = 0.0
+            np.cumsum(steps, out=total[1:])
+            return total
 
-        alt = self.origin.alt_m + integrate(lambda tt, vv, i: -vv[:, 2])
-        lat = np.full_like(t, lat0)
-
-        def between(nodes_value: np.ndarray, tt: np.ndarray, i: np.ndarray) -> np.ndarray:
-            # node values at the nodes; linear between them (the radii vary slowly)
-            j = np.minimum(i, len(t) - 2)
-            u = (tt - t[j]) / (t[j + 1] - t[j])
-            return nodes_value[j] + u * (nodes_value[j + 1] - nodes_value[j])
-
-        for _ in range(2):  # fixed point on the weak dependence of the radii on latitude
-            lat_prev = lat
-            lat = lat0 + integrate(lambda tt, vv, i, lat_prev=lat_prev: vv[:, 0] / (
-                radii_of_curvature(between(lat_prev, tt, i))[0] + between(alt, tt, i)))
-        lon = lon0 + integrate(lambda tt, vv, i: vv[:, 1] / (
-            (radii_of_curvature(between(lat, tt, i))[1] + between(alt, tt, i))
-            * np.cos(between(lat, tt, i))))
-        rn, re = radii_of_curvature(lat)
-        rates = np.stack([v[:, 0] / (rn + alt), v[:, 1] / ((re + alt) * np.cos(lat)), -v[:, 2]],
-                         axis=-1)
+        lat0, lon0 = np.radians(self.origin.lat_deg), np.radians(self.origin.lon_deg)
+        alt = integrate(-v[:, 2], -gauss_v[:, 2])
+        alt += self.origin.alt_m
+        alt_gauss = at_gauss(alt)
+        rn_start = radii_of_curvature(lat0)[0]
+        lat = integrate(v[:, 0] / (rn_start + alt), gauss_v[:, 0] / (rn_start + alt_gauss))
+        lat += lat0
+        rn_gauss = radii_of_curvature(at_gauss(lat))[0]
+        lat = integrate(v[:, 0] / (radii_of_curvature(lat)[0] + alt),
+                        gauss_v[:, 0] / (rn_gauss + alt_gauss))
+        lat += lat0
+        sin_lat, cos_lat = np.sin(lat), np.cos(lat)
+        rn, re = radii_of_curvature_from_sin(sin_lat)
+        lat_gauss = at_gauss(lat)
+        lon_rate = v[:, 1] / ((re + alt) * cos_lat)
+        lon = integrate(lon_rate, gauss_v[:, 1] / ((radii_of_curvature(lat_gauss)[1] + alt_gauss)
+                                                   * np.cos(lat_gauss)))
+        lon += lon0
         self._t_int = t
-        self._pos_values = np.stack([lat, lon, alt], axis=-1)
-        self._pos_rates = rates
+        self._lla = (lat, lon, alt)
+        self._lla_rates = (v[:, 0] / (rn + alt), lon_rate, -v[:, 2])
+        # for ``grid_inertial``: the grid's positions are the integration's own nodes
+        self._grid_motion = {key: values[:n_grid] for key, values in motion.items()}
+        self._grid_place = dict(lat=lat[:n_grid], lon=lon[:n_grid], alt=alt[:n_grid],
+                                sin_lat=sin_lat[:n_grid], cos_lat=cos_lat[:n_grid],
+                                rn=rn[:n_grid], re=re[:n_grid])
 
     def position(self, t: np.ndarray) -> np.ndarray:
         """Latitude (rad), longitude (rad), altitude (m) at times t, shape (n, 3).
@@ -195,64 +224,80 @@ class Kinematics:
         Cubic Hermite interpolation between integration nodes with the exact rates, so the
         interpolation error is O(dt^4) (far below a millimetre at the base rate).
         """
-        t = np.clip(np.atleast_1d(np.asarray(t, float)), 0.0, self._t_int[-1])
-        if len(self._t_int) == 1:
-            return np.repeat(self._pos_values, len(t), axis=0)
-        i = np.clip(np.searchsorted(self._t_int, t, side="right") - 1, 0, len(self._t_int) - 2)
-        h = (self._t_int[i + 1] - self._t_int[i])[:, None]
-        u = ((t - self._t_int[i]) / h[:, 0])[:, None]
-        u2, u3 = u * u, u * u * u
-        return ((2 * u3 - 3 * u2 + 1) * self._pos_values[i]
-                + (u3 - 2 * u2 + u) * h * self._pos_rates[i]
-                + (-2 * u3 + 3 * u2) * self._pos_values[i + 1]
-                + (u3 - u2) * h * self._pos_rates[i + 1])
+        nodes = self._t_int
+        t = np.clip(np.atleast_1d(np.asarray(t, float)), 0.0, nodes[-1])
+        out = np.empty((3,) + t.shape)  # component by component, handed out as (n, 3)
+        if len(nodes) == 1:
+            out[:] = [[values[0]] for values in self._lla]
+            return out.T
+        i = np.clip(np.searchsorted(nodes, t, side="right") - 1, 0, len(nodes) - 2)
+        start = nodes.take(i)
+        h = nodes.take(i + 1) - start
+        u = (t - start) / h
+        u2 = u * u
+        u3 = u2 * u
+        # the cubic Hermite basis: values at the ends, and rates at the ends (times h)
+        value_start, value_end = 2 * u3 - 3 * u2 + 1, -2 * u3 + 3 * u2
+        rate_start, rate_end = (u3 - 2 * u2 + u) * h, (u3 - u2) * h
+        for column, (values, rates) in enumerate(zip(self._lla, self._lla_rates, strict=True)):
+            out[column] = (value_start * values.take(i) + rate_start * rates.take(i)
+                           + value_end * values.take(i + 1) + rate_end * rates.take(i + 1))
+        return out.T
 
     # -- the truth columns ------------------------------------------------------------------
-    def inertial(self, t: np.ndarray, motion: dict | None = None,
-                 position: np.ndarray | None = None) -> dict[str, np.ndarray]:
-        """Everything at times t: position, velocity, attitude, w_ib^b and f_ib^b (FRD).
+    def inertial(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Everything at times t: position, velocity, attitude, w_ib^b and f_ib^b (FRD)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        pos = self.position(t)
+        lat = pos[:, 0]
+        sin_lat, cos_lat = np.sin(lat), np.cos(lat)
+        rn, re = radii_of_curvature_from_sin(sin_lat)
+        place = dict(lat=lat, lon=pos[:, 1], alt=pos[:, 2], sin_lat=sin_lat, cos_lat=cos_lat,
+                     rn=rn, re=re)
+        return self._inertial(t, self._motion(t), place)
+
+    def _inertial(self, t: np.ndarray, m: dict[str, np.ndarray],
+                  place: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """``inertial`` from the motion at t and the place: latitude, longitude, altitude, the
+        sine and cosine of latitude and the radii of curvature R_N, R_E there.
 
         f^n = dv/dt - g^n + (w_en + 2 w_ie) x v (Groves eq. 5.54) and
         w_ib^b = w_nb^b + C_n^b (w_ie + w_en), written component-wise for speed.
         """
-        t = np.atleast_1d(np.asarray(t, dtype=float))
-        m = self._motion(t) if motion is None else motion
-        pos = self.position(t) if position is None else position
-        lat, alt = pos[:, 0], pos[:, 2]
         v = m["v_ned"]
-        rn, re = radii_of_curvature(lat)
-        cos_lat, sin_lat = np.cos(lat), np.sin(lat)
+        vn, ve, vd = v[:, 0], v[:, 1], v[:, 2]
+        alt, sin_lat, cos_lat = place["alt"], place["sin_lat"], place["cos_lat"]
         # Earth rate (Groves eq. 5.41) and transport rate (eq. 5.44) in NED
-        rate_n = v[:, 1] / (re + alt)
-        rate_e = -v[:, 0] / (rn + alt)
+        rate_n = ve / (place["re"] + alt)
+        rate_e = -vn / (place["rn"] + alt)
         rate_d = -rate_n * sin_lat / cos_lat
         ie_n, ie_d = OMEGA_E_RAD_S * cos_lat, -OMEGA_E_RAD_S * sin_lat
-        w_in = np.stack([ie_n + rate_n, rate_e, ie_d + rate_d], axis=-1)
         cn, ce, cd = 2 * ie_n + rate_n, rate_e, 2 * ie_d + rate_d  # w_en + 2 w_ie
-        f_ned = m["a_ned"].copy()
-        f_ned[:, 0] += ce * v[:, 2] - cd * v[:, 1]
-        f_ned[:, 1] += cd * v[:, 0] - cn * v[:, 2]
-        f_ned[:, 2] += cn * v[:, 1] - ce * v[:, 0] - normal_gravity(lat, alt)
+        a = m["a_ned"]
+        f_n = a[:, 0] + (ce * vd - cd * ve)
+        f_e = a[:, 1] + (cd * vn - cn * vd)
+        f_d = a[:, 2] + (cn * ve - ce * vn - normal_gravity_from_sin(sin_lat, alt))
         roll = m["roll"]
         sr, cr = np.sin(roll), np.cos(roll)
         sp, cp = m["sin_pitch"], m["cos_pitch"]
         trig = (cr, sr, cp, sp, m["cos_yaw"], m["sin_yaw"])
-        f_body = ned_to_body(*trig, f_ned)
-        w_body = ned_to_body(*trig, w_in)
+        f_body = ned_to_body_components(*trig, f_n, f_e, f_d)
+        w_body = ned_to_body_components(*trig, ie_n + rate_n, rate_e, ie_d + rate_d)  # w_in
         w_body[:, 0] += m["roll_rate"] - m["yaw_rate"] * sp
         w_body[:, 1] += m["pitch_rate"] * cr + m["yaw_rate"] * cp * sr
         w_body[:, 2] += -m["pitch_rate"] * sr + m["yaw_rate"] * cp * cr
-        return dict(t=t, lat=lat, lon=pos[:, 1], alt=alt, v_ned=v, roll=roll,
+        return dict(t=t, lat=place["lat"], lon=place["lon"], alt=alt, v_ned=v, roll=roll,
                     pitch=m["pitch"], yaw=m["yaw"], w_body=w_body, f_body=f_body, speed=m["v"],
                     distance=m["s"])
 
     def grid_inertial(self) -> dict[str, np.ndarray]:
         """``inertial`` on the base grid, cached: the truth table and the sensors sampling at
-        the base rate share one evaluation."""
+        the base rate share one evaluation, which reuses the motion and the latitude terms the
+        position integration computed on the grid."""
         if "grid" not in self._cache:
-            n = len(self.t_grid)  # the grid's positions are the integration's own nodes
-            self._cache["grid"] = self.inertial(self.t_grid, self._motion_cache.pop("grid"),
-                                                self._pos_values[:n])
+            self._cache["grid"] = self._inertial(self.t_grid, self._grid_motion,
+                                                 self._grid_place)
+            del self._grid_motion, self._grid_place
         return self._cache["grid"]
 
     def breakpoints(self) -> np.ndarray:
@@ -273,17 +318,20 @@ class Kinematics:
         return self._breaks
 
     def zone_at(self, t: np.ndarray) -> np.ndarray:
-        """Zone name at times t ('' outside every zone); later zones win where they overlap.
+        """Zone name at times t ('' outside every zone), a string array; later zones win where
+        they overlap.
 
         Zones are [start, end), except that a zone reaching the end of the drive also holds
-        its last instant (a drive that ends in a garage ends without sky).
+        its last instant (a drive that ends in a garage ends without sky). Each time gets the
+        number of its zone (0: none), and the names are looked up once from those numbers.
         """
         t = np.atleast_1d(t)
-        out = np.full(t.shape, "", dtype=object)
-        for start, end, name in self.profile.zones:
+        zones = self.profile.zones
+        zone_number = np.zeros(t.shape, dtype=np.intp)
+        for number, (start, end, _) in enumerate(zones, start=1):
             last = end >= self.duration_s - 1e-9
-            out[(t >= start) & ((t < end) | (last & (t <= end)))] = name
-        return out
+            zone_number[(t >= start) & ((t < end) | (last & (t <= end)))] = number
+        return np.array(["", *(name for _, _, name in zones)]).take(zone_number)
 
     def table(self, t: np.ndarray | None = None) -> pd.DataFrame:
         """The truth table (SPEC section 5 ``truth.parquet`` columns) at times t (default: grid),
@@ -305,7 +353,7 @@ class Kinematics:
             "wx": k["w_body"][:, 0], "wy": k["w_body"][:, 1], "wz": k["w_body"][:, 2],
             "fx": k["f_body"][:, 0], "fy": k["f_body"][:, 1], "fz": k["f_body"][:, 2],
             "speed": k["speed"], "distance": k["distance"],
-            "zone": self.zone_at(k["t"]).astype(str),
+            "zone": self.zone_at(k["t"]),
         }
 
 

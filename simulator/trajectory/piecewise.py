@@ -32,23 +32,37 @@ class PiecewisePolynomial:
         return cls(ppoly.c, ppoly.x)
 
     def piece_index(self, x: np.ndarray) -> np.ndarray:
-        """Index of the piece holding each x (pieces are [x[i], x[i+1]); ends extrapolate)."""
-        return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, self.c.shape[1] - 1)
+        """Index of the piece holding each x (pieces are [x[i], x[i+1]); ends extrapolate).
+
+        For many increasing x (a time grid, the distance along it) the pieces' starts are
+        looked up in x instead (one search per piece rather than one per x), with the same
+        result.
+        """
+        x = np.asarray(x, dtype=float)
+        m = self.c.shape[1]
+        if x.ndim == 1 and len(x) > 8 * m and (x[1:] >= x[:-1]).all():
+            first = np.searchsorted(x, self.x[1:m], side="left")  # first x in pieces 1 ... m-1
+            return np.repeat(np.arange(m), np.diff(first, prepend=0, append=len(x)))
+        return np.clip(np.searchsorted(self.x, x, side="right") - 1, 0, m - 1)
 
     def evaluate(self, x: np.ndarray, orders: tuple[int, ...] = (0,),
                  index: np.ndarray | None = None) -> list[np.ndarray]:
         """Values of the requested derivatives at x (one search for all of them; ``index``
-        from ``piece_index`` skips it, for curves that share these breakpoints)."""
+        from ``piece_index`` skips it, for curves that share these breakpoints).
+
+        Horner's scheme in place, the coefficients of each sample's piece gathered with
+        ``take`` (much cheaper than fancy indexing of the 2-D coefficient array).
+        """
         x = np.asarray(x, dtype=float)
         idx = self.piece_index(x) if index is None else index
-        dx = x - self.x[idx]
+        dx = x - self.x.take(idx)
         out = []
         for nu in orders:
             c = self._coefficients(nu)
-            acc = c[0, idx].copy()
-            for k in range(1, c.shape[0]):
+            acc = c[0].take(idx)
+            for row in c[1:]:
                 acc *= dx
-                acc += c[k, idx]
+                acc += row.take(idx)
             out.append(acc)
         return out
 

@@ -28,7 +28,12 @@ def cubic_interval_integrals(f: np.ndarray, h: float) -> np.ndarray:
     """Integrals of the samples ``f`` (shape (n, ...), n >= 4) over the n - 1 intervals."""
     f = np.asarray(f, dtype=float)
     out = np.empty((len(f) - 1,) + f.shape[1:])
-    out[1:-1] = h / 24 * (-f[:-3] + 13 * f[1:-2] + 13 * f[2:-1] - f[3:])
+    inner = out[1:-1]  # h/24 (13 (f_k + f_k+1) - f_k-1 - f_k+2), in place
+    np.add(f[1:-2], f[2:-1], out=inner)
+    inner *= 13.0
+    inner -= f[:-3]
+    inner -= f[3:]
+    inner *= h / 24
     out[0] = h / 24 * (9 * f[0] + 19 * f[1] - 5 * f[2] + f[3])
     out[-1] = h / 24 * (f[-4] - 5 * f[-3] + 19 * f[-2] + 9 * f[-1])
     return out

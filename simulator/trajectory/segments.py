@@ -45,6 +45,7 @@ SEGMENT_FIELD, LIMITS_FIELD, REVERSE_SPEED, RoadProfile, build_road_profile.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -284,11 +285,13 @@ def _helix(seg: dict, v: float, lim: dict) -> list[_PathPiece]:
     return build(gamma)
 
 
+_RISE_GL_X, _RISE_GL_W = np.polynomial.legendre.leggauss(8)
+
+
 def _rise_of(piece: _PathPiece) -> float:
     """Height gained over a piece: integral of sin(gamma(s)) ds (Gauss-Legendre, 8 nodes)."""
-    x, w = np.polynomial.legendre.leggauss(8)
-    s = 0.5 * piece.length * (x + 1)
-    return float(0.5 * piece.length * np.sum(w * np.sin(np.polyval(piece.grade, s))))
+    s = 0.5 * piece.length * (_RISE_GL_X + 1)
+    return float(0.5 * piece.length * np.sum(_RISE_GL_W * np.sin(np.polyval(piece.grade, s))))
 
 
 def _bisect(f, a: float, b: float) -> float:
@@ -316,18 +319,28 @@ def _speed_bump(height: float, length: float) -> list[_PathPiece]:
     return [_PathPiece(length, _ZERO, dz.coef[::-1], _ZERO)]
 
 
-def _lane_change(offset: float, length: float) -> list[_PathPiece]:
-    x, w = np.polynomial.legendre.leggauss(16)
-    u = 0.5 * (x + 1)
-    shape = 140.0 * u**3 * (1 - u) ** 3  # integrates to 1 over [0, 1]
+# 16-point Gauss-Legendre on [0, 1] and the heading deflection's shape 140 u^3 (1-u)^3 there
+_LANE_GL_X, _LANE_GL_W = np.polynomial.legendre.leggauss(16)
+_LANE_U = 0.5 * (_LANE_GL_X + 1)
+_LANE_SHAPE = 140.0 * _LANE_U**3 * (1 - _LANE_U) ** 3  # integrates to 1 over [0, 1]
 
+
+def _lane_change(offset: float, length: float) -> list[_PathPiece]:
+    return [_PathPiece(length, _lane_change_curvature(offset, length), _ZERO, _ZERO)]
+
+
+@functools.cache
+def _lane_change_curvature(offset: float, length: float) -> np.ndarray:
+    """Curvature coefficients of a lane change (heading c 140 u^3 (1-u)^3, c solved for the
+    lateral shift), read-only; cached, since a drive repeats its manoeuvres."""
     def shift(c: float) -> float:
-        return float(0.5 * length * np.sum(w * np.sin(c * shape))) - offset
+        return float(0.5 * length * np.sum(_LANE_GL_W * np.sin(c * _LANE_SHAPE))) - offset
 
     c = 0.0 if offset == 0 else _bisect(shift, 0.0, np.sign(offset) * 0.8)
     uu = np.polynomial.polynomial.Polynomial([0.0, 1.0 / length])
-    kappa = 420.0 * c / length * uu**2 * (1 - uu) ** 2 * (1 - 2 * uu)
-    return [_PathPiece(length, kappa.coef[::-1], _ZERO, _ZERO)]
+    kappa = (420.0 * c / length * uu**2 * (1 - uu) ** 2 * (1 - 2 * uu)).coef[::-1]
+    kappa.flags.writeable = False
+    return kappa
 
 
 def _lateral_accel_problem(kind: str, v: float, radius: float, lim: dict) -> str | None:
