@@ -22,18 +22,24 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-import yaml
-from bench_truth import HOUR_SEGMENTS, time_generate
+from simulator.cli import BLAS_THREADS
 
-from simulator.dataset.generate import build_truth, sensor_rng
-from simulator.scenario import validate_data
-from simulator.sensors import SENSOR_MODELS
+# the in-process figures with the BLAS threads the command line uses (set before numpy loads)
+os.environ.update({k: os.environ.get(k, v) for k, v in BLAS_THREADS.items()})
+
+import yaml  # noqa: E402
+from bench_truth import HOUR_SEGMENTS, time_generate  # noqa: E402
+
+from simulator.dataset.generate import build_truth, sensor_rng  # noqa: E402
+from simulator.scenario import validate_data  # noqa: E402
+from simulator.sensors import SENSOR_MODELS  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 # plain SI numbers: a unit string anywhere in a scenario loads pint, about 1 s once

@@ -48,13 +48,19 @@ VIBRATION_FIELD = Record(
 
 def _engine(t: np.ndarray, rms: float, freq_hz: float, dt_s: float, increment: bool,
             rng: np.random.Generator) -> np.ndarray:
+    """A sine of amplitude rms sqrt(2) and a drawn phase per axis, or its integral over each
+    interval (t - dt, t]: (2 A / w) sin(w dt / 2) sin(w (t - dt / 2) + phase). Written as
+    sin(theta) cos(phase) + cos(theta) sin(phase), so two sines serve the three axes."""
     phase = rng.uniform(0.0, 2 * np.pi, 3)
-    arg = 2 * np.pi * freq_hz * t[:, None] + phase
+    w = 2 * np.pi * freq_hz
     amplitude = rms * np.sqrt(2.0)
     if increment:
-        w = 2 * np.pi * freq_hz
-        return amplitude / w * (np.cos(arg - w * dt_s) - np.cos(arg))
-    return amplitude * np.sin(arg)
+        theta = w * (t - dt_s / 2)
+        amplitude = 2 * amplitude / w * np.sin(w * dt_s / 2)
+    else:
+        theta = w * t
+    return (np.sin(theta)[:, None] * (amplitude * np.cos(phase))
+            + np.cos(theta)[:, None] * (amplitude * np.sin(phase)))
 
 
 def _road(n: int, rms: float, band_hz: list[float], dt_s: float,
