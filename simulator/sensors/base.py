@@ -5,7 +5,7 @@ that turns the exact trajectory and a random generator into stream tables (colum
 
 Public names
 ------------
-SensorModel, sample_times, grid_index, integrate_over_samples.
+SensorModel, sample_times, grid_index, grid_rows, truth_at, integrate_over_samples.
 """
 
 from __future__ import annotations
@@ -48,11 +48,31 @@ def sample_times(duration_s: float, rate_hz: float, first: int = 0) -> np.ndarra
 def grid_index(truth: Kinematics, t: np.ndarray) -> np.ndarray | None:
     """Indices k with t = t_grid[k] when every time lies on the truth's base grid, else None
     (then ``truth.grid_inertial()`` holds the truth at t, already evaluated)."""
-    k = np.rint(np.asarray(t, dtype=float) * truth.rate_hz).astype(int)
-    if (len(k) == 0 or not np.allclose(k, t * truth.rate_hz, rtol=0, atol=1e-6)
-            or k.min() < 0 or k.max() >= len(truth.t_grid)):
+    x = np.asarray(t, dtype=float) * truth.rate_hz
+    k = np.rint(x)
+    if len(k) == 0 or np.abs(k - x).max() > 1e-6 or k.min() < 0 or k.max() >= len(truth.t_grid):
         return None
+    return k.astype(np.intp)
+
+
+def grid_rows(k: np.ndarray) -> slice | np.ndarray:
+    """``k`` as a slice when it is a run of consecutive indices (rows are then a view, not a
+    gathered copy), else ``k`` itself."""
+    if len(k) and k[-1] - k[0] == len(k) - 1 and (np.diff(k) == 1).all():
+        return slice(int(k[0]), int(k[-1]) + 1)
     return k
+
+
+def truth_at(truth: Kinematics, t: np.ndarray,
+             keys: tuple[str, ...] = ("w_body", "f_body")) -> dict[str, np.ndarray]:
+    """``truth.inertial(t)`` (the ``keys`` of it), taken from the truth's cached grid evaluation
+    when every time lies on its grid (sensors sampling at the base rate or a divisor of it)."""
+    k = grid_index(truth, t)
+    if k is None:
+        values = truth.inertial(t)
+        return {key: values[key] for key in keys}
+    grid, rows = truth.grid_inertial(), grid_rows(k)
+    return {key: grid[key][rows] for key in keys}
 
 
 def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
@@ -79,11 +99,10 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
     if on_grid and len(truth.t_grid) >= 5:
         grid = truth.grid_inertial()
         gauss = last > first
-        interval = k_end - 1  # the grid interval [t_k-1, t_k] each sample covers
+        interval = grid_rows(k_end - 1)  # the grid interval [t_k-1, t_k] of each sample
         for key in keys:
             out[key] = cubic_interval_integrals(grid[key], dt)[interval]
-            error = np.max(cubic_rule_error(grid[key], dt)[interval], axis=1)
-            gauss |= error > CUBIC_RULE_TOLERANCE[key]
+            gauss |= cubic_rule_error(grid[key], dt)[interval] > CUBIC_RULE_TOLERANCE[key]
     # intervals without a breakpoint in one vectorised piece; only those holding breakpoints
     # (a few per manoeuvre) are split one by one
     smooth = np.flatnonzero(gauss & (last <= first))

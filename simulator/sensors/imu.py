@@ -93,7 +93,13 @@ from simulator.scenario.schema import (
     Text,
     Vector,
 )
-from simulator.sensors.base import grid_index, integrate_over_samples, sample_times
+from simulator.sensors.base import (
+    grid_index,
+    grid_rows,
+    integrate_over_samples,
+    sample_times,
+    truth_at,
+)
 from simulator.sensors.imu_presets import IMU_PRESETS
 from simulator.sensors.noise import (
     FLICKER_ADEV_FACTOR,
@@ -279,7 +285,6 @@ class Imu:
         p = self.config[group]
         n = len(t)
         dt = 1.0 / self.rate_hz
-        scale = dt if self.increment else 1.0  # rate terms -> increment terms
         bias0 = _per_axis(p["bias"]) * rng.standard_normal(3)
         sf = _per_axis(p["scale_factor"]) * rng.standard_normal(3)
         mis = _per_axis(p["misalignment"])[:, None] * rng.standard_normal((3, 3))
@@ -297,26 +302,32 @@ class Imu:
             drawn["g_sensitivity"] = g_matrix.tolist()
         temp = self.config["temperature"]
         d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
-        bias = np.broadcast_to(bias0, (n, 3)).copy()
+        processes = []  # the random processes of the bias, each (n, 3)
         instability = _per_axis(p["bias_instability"])
         if instability.any():
             if p["bias_correlation_time"]:
                 sigma = FLICKER_ADEV_FACTOR * instability / GM_ADEV_PEAK
-                bias += gauss_markov(n, dt, sigma, p["bias_correlation_time"], rng)
+                processes.append(gauss_markov(n, dt, sigma, p["bias_correlation_time"], rng))
             else:
-                bias += flicker(n, dt, instability, rng)
+                processes.append(flicker(n, dt, instability, rng))
         markov = _per_axis(p["gauss_markov_sigma"])
         if markov.any():
             corr_time = np.where(markov > 0, _per_axis(p["gauss_markov_correlation_time"]), 1.0)
-            bias += gauss_markov(n, dt, markov, corr_time, rng)
+            processes.append(gauss_markov(n, dt, markov, corr_time, rng))
         walk = _per_axis(p["random_walk"])
         if walk.any():
-            bias += random_walk(n, dt, walk, rng)
+            processes.append(random_walk(n, dt, walk, rng))
+        # summed in place into the first process (the additions are the only full passes)
+        additive = processes[0] if processes else np.zeros((n, 3))
+        for process in processes[1:]:
+            additive += process
+        additive += bias0
         if ramp.any():
-            bias += t[:, None] * ramp
+            additive += np.multiply.outer(t, ramp)
         if k_temp.any():
-            bias += d_temp[:, None] * k_temp
-        additive = bias * scale if self.increment else bias
+            additive += np.multiply.outer(d_temp, k_temp)
+        if self.increment:
+            additive *= dt  # rate terms -> increment terms
         density = _per_axis(p["noise_density"])
         if density.any():
             additive += white(n, dt, density, rng, increment=self.increment)
@@ -334,7 +345,7 @@ class Imu:
             k = integrate_over_samples(truth, t, dt)
             w, f = k["w_body"], k["f_body"]
             if time_error is not None or lever.any():
-                ends = _truth_at(truth, np.concatenate([[t[0] - dt], t]))
+                ends = truth_at(truth, np.concatenate([[t[0] - dt], t]))
             if time_error is not None:
                 # interval (t - dt + e0, t + e1]: to first order in e, the exact increment plus
                 # x(t) e1 - x(t - dt) e0
@@ -346,13 +357,13 @@ class Imu:
                 f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
         else:
             t_true = t + time_error if time_error is not None else t
-            k = _truth_at(truth, t_true)
+            k = truth_at(truth, t_true)
             w, f = k["w_body"], k["f_body"]
             if lever.any():
                 h = _LEVER_ARM_STEP_S
                 dw = (truth.inertial(t_true + h)["w_body"]
                       - truth.inertial(t_true - h)["w_body"]) / (2 * h)
-                f = f + np.cross(dw, lever) + np.cross(w, np.cross(w, lever))
+                f = f + np.cross(dw, lever) + _centripetal(w, lever)
         mount = self.config["mounting"]
         if any(mount):
             c_sv = euler_to_dcm(*np.radians(mount)).T
@@ -456,13 +467,9 @@ def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarra
     return ar1_filter(u, a)
 
 
-def _truth_at(truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
-    """``truth.inertial(t)``, from the truth's cached grid evaluation when t lies on its grid."""
-    k = grid_index(truth, t)
-    if k is None:
-        return truth.inertial(t)
-    grid = truth.grid_inertial()
-    return {key: grid[key][k] for key in ("w_body", "f_body")}
+def _centripetal(w: np.ndarray, lever_arm: np.ndarray) -> np.ndarray:
+    """w x (w x r) = w (w . r) - r |w|^2, rows of w (n, 3)."""
+    return (w @ lever_arm)[:, None] * w - np.einsum("ij,ij->i", w, w)[:, None] * lever_arm
 
 
 def _centripetal_increment(truth: Kinematics, t_end: np.ndarray, dt_s: float,
@@ -473,10 +480,9 @@ def _centripetal_increment(truth: Kinematics, t_end: np.ndarray, dt_s: float,
     k = grid_index(truth, t_end)
     if (k is not None and abs(dt_s * truth.rate_hz - 1.0) < 1e-12 and k.min() >= 1
             and len(truth.t_grid) >= 4):
-        w = truth.grid_inertial()["w_body"]
-        centripetal = np.cross(w, np.cross(w, lever_arm))
-        return cubic_interval_integrals(centripetal, dt_s)[k - 1]
+        centripetal = _centripetal(truth.grid_inertial()["w_body"], lever_arm)
+        return cubic_interval_integrals(centripetal, dt_s)[grid_rows(k - 1)]
     nodes = (t_end - dt_s)[:, None] + dt_s * GL_NODES[None, :]
-    w = truth.inertial(nodes.ravel())["w_body"].reshape(len(t_end), len(GL_NODES), 3)
-    centripetal = np.cross(w, np.cross(w, lever_arm))
-    return dt_s * np.einsum("j,njk->nk", GL_WEIGHTS, centripetal)
+    centripetal = _centripetal(truth.inertial(nodes.ravel())["w_body"], lever_arm)
+    return dt_s * np.einsum("j,njk->nk", GL_WEIGHTS,
+                            centripetal.reshape(len(t_end), len(GL_NODES), 3))

@@ -39,7 +39,7 @@ import numpy as np
 
 from simulator.earth import euler_to_dcm
 from simulator.scenario.schema import Number
-from simulator.sensors.base import sample_times
+from simulator.sensors.base import sample_times, truth_at
 from simulator.sensors.noise import gauss_markov
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.tables import ColumnTable
@@ -121,7 +121,7 @@ class Magnetometer(PresetSensor):
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
-        k = truth.inertial(t)
+        k = truth_at(truth, t, ("roll", "pitch", "yaw"))
         coarse = np.unique(np.append(np.arange(0.0, t[-1], _FIELD_STEP_S), t[-1]))
         pos = truth.position(coarse)
         field, release = earth_field_ned(np.degrees(pos[:, 0]), np.degrees(pos[:, 1]),

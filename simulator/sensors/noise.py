@@ -79,7 +79,7 @@ def gm_adev_peak() -> tuple[float, float]:
 _AR1_BLOCK_LOG_RANGE = 300.0
 
 
-def ar1_filter(u: np.ndarray, phi: float | np.ndarray) -> np.ndarray:
+def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False) -> np.ndarray:
     """x[k] = phi x[k-1] + u[k] along axis 0, x[-1] = 0 (the first-order recursion of an exact
     Gauss-Markov discretisation), vectorised without a loop over the samples.
 
@@ -90,9 +90,10 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray) -> np.ndarray:
     carried into the next by the same recursion on the block ends (factor phi^L) and added with
     the factors phi^(j+1). About five passes over the data whatever phi; a factor too small for
     blocks of two (phi < e^-150) falls back to recursive doubling, which then stops after a few
-    passes once phi^(2^p) underflows.
+    passes once phi^(2^p) underflows. With ``overwrite`` a float array ``u`` is filtered in
+    place (no copy).
     """
-    x = np.array(u, dtype=float)
+    x = u if overwrite and u.dtype == float else np.array(u, dtype=float)
     flat = x.ndim == 1
     if flat:
         x = x[:, None]
@@ -167,9 +168,12 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     """
     sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
     phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
-    drive = rng.standard_normal((n, sigma.size)) * np.sqrt(q_unit)
+    drive = rng.standard_normal((n, sigma.size))
+    drive *= np.sqrt(q_unit)
     drive[0] = rng.standard_normal(sigma.size)
-    return ar1_filter(drive, phi) * sigma
+    x = ar1_filter(drive, phi, overwrite=True)
+    x *= sigma
+    return x
 
 
 def flicker(n: int, dt_s: float, instability: np.ndarray, rng: np.random.Generator) -> np.ndarray:

@@ -65,15 +65,20 @@ def _engine(t: np.ndarray, rms: float, freq_hz: float, dt_s: float, increment: b
 
 def _road(n: int, rms: float, band_hz: list[float], dt_s: float,
           rng: np.random.Generator) -> np.ndarray:
-    """Unit-rms-scaled band-limited white noise, shape (n, 3)."""
-    noise = rng.standard_normal((n, 3))
+    """Unit-rms-scaled band-limited white noise, shape (n, 3): the spectrum of white noise kept
+    inside the band, drawn directly in the frequency domain (the real FFT of n unit normals has
+    independent N(0, n/2) real and imaginary parts per bin, the Nyquist bin real N(0, n)) and
+    transformed back."""
     freq = np.fft.rfftfreq(n, dt_s)
-    keep = (freq >= band_hz[0]) & (freq <= band_hz[1])
-    if not keep.any():
+    keep = np.flatnonzero((freq >= band_hz[0]) & (freq <= band_hz[1]))
+    if not len(keep):
         return np.zeros((n, 3))
-    spectrum = np.fft.rfft(noise, axis=0)
-    spectrum[~keep] = 0.0
-    fraction = keep.sum() / len(freq)  # share of the white variance inside the band
+    draws = rng.standard_normal((2, len(keep), 3)) * np.sqrt(n / 2.0)
+    spectrum = np.zeros((len(freq), 3), dtype=complex)
+    spectrum[keep] = draws[0] + 1j * draws[1]
+    if n % 2 == 0 and keep[-1] == len(freq) - 1:  # the Nyquist bin is real
+        spectrum[-1] = np.sqrt(2.0) * draws[0, -1]
+    fraction = len(keep) / len(freq)  # share of the white variance inside the band
     return np.fft.irfft(spectrum, n, axis=0) * (rms / np.sqrt(fraction))
 
 

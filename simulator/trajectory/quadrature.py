@@ -40,10 +40,14 @@ def cubic_interval_integrals(f: np.ndarray, h: float) -> np.ndarray:
 
 
 def cubic_rule_error(f: np.ndarray, h: float) -> np.ndarray:
-    """Estimated error of ``cubic_interval_integrals`` on each interval, shape (n - 1, ...):
-    (11/720) h |d4| with d4 the largest fourth difference of the samples around the interval
-    (infinite where the grid does not give one)."""
+    """Estimated error of ``cubic_interval_integrals`` on each interval, shape (n - 1,):
+    (11/720) h |d4| with d4 the largest fourth difference of the samples around the interval,
+    over every component of f (shape (n, ...)); infinite where the grid does not give one."""
     f = np.asarray(f, dtype=float)
-    d4 = np.full(f.shape, np.inf)
-    d4[2:-2] = np.abs(f[:-4] - 4 * f[1:-3] + 6 * f[2:-2] - 4 * f[3:-1] + f[4:])
+    columns = f.reshape(len(f), -1).T  # one contiguous row per component for F-ordered f
+    d4 = np.full(len(f), np.inf)
+    if len(f) >= 5:
+        inner = np.abs(columns[:, :-4] - 4 * columns[:, 1:-3] + 6 * columns[:, 2:-2]
+                       - 4 * columns[:, 3:-1] + columns[:, 4:])
+        d4[2:-2] = inner.max(axis=0) if len(columns) > 1 else inner[0]
     return 11.0 / 720.0 * h * np.maximum(d4[:-1], d4[1:])
