@@ -16,6 +16,7 @@ build_profile, build_truth, sensor_rng, generate_streams, build_manifest, genera
 from __future__ import annotations
 
 import importlib
+import os
 import platform
 import zlib
 from collections.abc import Callable
@@ -62,8 +63,9 @@ def build_truth(scenario: dict, built: tuple[RoadProfile, dict] | None = None) -
     return truth
 
 
-# worker threads for the sensors (the dataset writer has its own two)
-_SENSOR_WORKERS = 2
+# worker threads for the sensors (the dataset writer has its own two): the IMU's three draws
+# and the other sensors keep up to four busy
+_SENSOR_WORKERS = max(2, min(4, os.cpu_count() or 2))
 
 
 def sensor_rng(seed: int, name: str) -> np.random.Generator:
