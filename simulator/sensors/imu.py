@@ -387,16 +387,19 @@ class Imu:
             y = _low_pass(y, _per_axis(p["bandwidth"]), 1.0 / self.rate_hz)
         if p["range"] is not None:
             limit = _per_axis(p["range"]) * scale
-            y = np.clip(y, -limit, limit)
+            np.clip(y, -limit, limit, out=y)
         quantum = _per_axis(p["resolution"]) * scale
         if quantum.any():
             q = np.where(quantum > 0, quantum, 1.0)
             if self.increment:
-                counts = np.round(np.cumsum(y, axis=0) / q)
-                stepped = np.diff(counts, axis=0, prepend=0.0) * q
+                counts = np.cumsum(y, axis=0)
+                counts /= q
+                stepped = np.diff(np.round(counts, out=counts), axis=0, prepend=0.0)
             else:
-                stepped = np.round(y / q) * q
-            y = np.where(quantum > 0, stepped, y)
+                stepped = y / q
+                np.round(stepped, out=stepped)
+            stepped *= q
+            y = stepped if quantum.all() else np.where(quantum > 0, stepped, y)
         self.drawn[group] = draws.drawn
         return y
 
@@ -464,7 +467,7 @@ def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarra
     a = np.exp(-2 * np.pi * np.asarray(bandwidth_hz, dtype=float) * dt_s)
     u = (1 - a) * y
     u[0] = y[0]  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]
-    return ar1_filter(u, a)
+    return ar1_filter(u, a, overwrite=True)
 
 
 def _centripetal(w: np.ndarray, lever_arm: np.ndarray) -> np.ndarray:

@@ -135,7 +135,9 @@ def white(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generator,
     """
     density = np.atleast_1d(np.asarray(density, dtype=float))
     scale = np.sqrt(dt_s) if increment else 1.0 / np.sqrt(dt_s)
-    return rng.standard_normal((n, density.size)) * (density * scale)
+    noise = rng.standard_normal((n, density.size))
+    noise *= density * scale
+    return noise
 
 
 def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -144,9 +146,10 @@ def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generat
     Allan variance K^2 tau / 3 (IEEE Std 952, Annex C). Returns shape (n, m).
     """
     density = np.atleast_1d(np.asarray(density, dtype=float))
-    steps = rng.standard_normal((n, density.size)) * (density * np.sqrt(dt_s))
+    steps = rng.standard_normal((n, density.size))
+    steps *= density * np.sqrt(dt_s)
     steps[0] = 0.0
-    return np.cumsum(steps, axis=0)
+    return np.cumsum(steps, axis=0, out=steps)
 
 
 def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarray,
