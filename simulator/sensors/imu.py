@@ -278,7 +278,7 @@ class Imu:
         self._prepared = _Draws(duration_s, t, time_error, shake,
                                 {group: run(self._draw_group, group, t, stream)
                                  for group, stream in zip(("gyro", "accel"), groups,
-                                                          strict=True)})
+                                                          strict=True)}, run)
 
     def _draw_group(self, group: str, t: np.ndarray, rng: np.random.Generator) -> _GroupDraws:
         """One group's drawn constants and its additive error b(t) x (1 or dt) + n (white)."""
@@ -420,8 +420,11 @@ class Imu:
             dw, df = vibration_at_speed(draws.vibration.result(), speed, dt,
                                         self.config["vibration"], self.increment)
             w, f = w + dw, f + df
-        gyro = self._apply_errors("gyro", w, f, draws.groups["gyro"].result())
+        # the gyro group in the pool (behind its draws) while this thread does the accel group
+        gyro_job = draws.submit(lambda: self._apply_errors("gyro", w, f,
+                                                           draws.groups["gyro"].result()))
         accel = self._apply_errors("accel", f, f, draws.groups["accel"].result())
+        gyro = gyro_job.result()
         table = {"t": t}
         for i, axis in enumerate(col.IMU_AXES):
             if axis in self.config["axes"]:
@@ -445,13 +448,15 @@ class _GroupDraws:
 @dataclass
 class _Draws:
     """What ``Imu.prepare`` drew for a drive of ``duration_s``: the vibration and the groups as
-    futures (done at once without a pool)."""
+    futures (done at once without a pool), and how to run more work (the pool's ``submit``,
+    which must still be open when ``generate`` runs)."""
 
     duration_s: float
     t: np.ndarray
     time_error: np.ndarray | None
     vibration: Future | None
     groups: dict[str, Future]
+    submit: Callable[..., Future]
 
 
 def _run_now(function: Callable, *args: Any) -> Future:
