@@ -49,6 +49,7 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 # for one (n, 3) x (3, 3) product on a busy machine, against 1 ms on one thread). Set before the
 # command imports numpy; a user's own setting wins.
 BLAS_THREADS = {"OPENBLAS_NUM_THREADS": "1"}
+_M_ARENA_MAX = -8  # mallopt parameter, glibc malloc.h
 
 
 def _one_malloc_arena() -> None:
@@ -65,9 +66,6 @@ def _one_malloc_arena() -> None:
         ctypes.CDLL("libc.so.6").mallopt(_M_ARENA_MAX, 1)
     except (OSError, AttributeError):  # not glibc
         pass
-
-
-_M_ARENA_MAX = -8  # glibc malloc.h
 
 
 def main(argv: list[str] | None = None) -> int:

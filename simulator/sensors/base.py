@@ -30,7 +30,13 @@ CUBIC_RULE_TOLERANCE = {"w_body": 1e-12, "f_body": 1e-11}
 
 class SensorModel(Protocol):
     """A sensor: ``generate`` returns ``{stream_name: table}`` and records the drawn true error
-    parameters in ``drawn`` (they go into the manifest's ``sensors`` block)."""
+    parameters in ``drawn`` (they go into the manifest's ``sensors`` block).
+
+    A model may also have ``prepare(duration_s, rng, pool)``, drawing the random terms that need
+    no trajectory as jobs of ``pool`` before the truth exists; the dataset generator calls it
+    when present (``simulator.dataset.generate``), and ``generate`` must give the same result
+    whether or not it was called (the IMU, ``simulator.sensors.imu.Imu.prepare``).
+    """
 
     name: str
     drawn: dict
