@@ -34,7 +34,8 @@ import pandas as pd
 from estimators.base import GNSS_STREAMS, Estimator, InitialState
 from estimators.registry import get_estimator
 from simulator import columns as col
-from simulator.dataset.io import Dataset, read_table, write_table
+from simulator.dataset.io import Dataset
+from simulator.dataset.parquet import read_table, write_table
 from simulator.earth import (
     ecef_to_geodetic,
     geodetic_to_ecef,

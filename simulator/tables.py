@@ -8,7 +8,7 @@ The sensors without pandas code (IMU, odometer, barometer, magnetometer) return 
 directly, so that generating a dataset without GNSS and faults never imports pandas (about 0.3 s
 of the process start). The GNSS receiver returns DataFrames, the faults convert the tables they
 act on with ``as_frame``, and everything that reads a dataset gets DataFrames
-(``simulator.dataset.io.read_table``). A ``Table`` is either kind; ``n_rows`` and ``column``
+(``simulator.dataset.parquet.read_table``). A ``Table`` is either kind; ``n_rows`` and ``column``
 read both.
 
 ``as_frame`` of a column table is the DataFrame the sensors returned before column tables

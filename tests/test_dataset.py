@@ -18,7 +18,8 @@ from simulator import columns as col
 from simulator.cli import main
 from simulator.dataset.events import events_table
 from simulator.dataset.generate import generate_streams
-from simulator.dataset.io import open_dataset, read_table, write_table
+from simulator.dataset.io import open_dataset
+from simulator.dataset.parquet import read_table, write_table
 from simulator.errors import InputError
 from simulator.scenario import validate_data
 from simulator.tables import as_frame
@@ -90,12 +91,12 @@ def test_failed_generation_leaves_nothing(tmp_path, monkeypatch):
     """A write that fails (here every Parquet file, the truth written early in a worker thread
     included) leaves no output directory and no temporary one."""
     from simulator.dataset import generate as gen
-    from simulator.dataset import io
+    from simulator.dataset import parquet
 
     def boom(*args, **kwargs):
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr(io, "write_table", boom)
+    monkeypatch.setattr(parquet, "write_table", boom)
     with pytest.raises(RuntimeError):
         gen.generate_dataset(__import__("simulator.scenario", fromlist=["x"]).load_scenario(
             QUICK), tmp_path / "ds")

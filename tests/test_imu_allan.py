@@ -278,3 +278,22 @@ def test_ar1_filter_short_and_one_dimensional_inputs_match_scipy_lfilter(n):
     expected = np.stack([lfilter([1.0], [1.0, -f], u3[:, j]) for j, f in enumerate(mixed)],
                         axis=1)
     np.testing.assert_allclose(ar1_filter(u3, mixed), expected, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("n", [1, 7, 4096, 4097, 50_000])
+def test_ar1_filter_gains_match_scipy_lfilter(n):
+    """x[k] = phi x[k-1] + g u[k], returned times h, per column: h * lfilter([g], [1, -phi])."""
+    from scipy.signal import lfilter
+
+    from simulator.sensors.noise import ar1_filter
+
+    phi = np.array([0.0, 0.905, 0.999999, 1.0])
+    gain_in, gain_out = np.array([2.0, 0.5, 1e-3, 3.0]), np.array([0.1, 4.0, 7.0, 1e-6])
+    u = np.random.default_rng(n).standard_normal((n, 4))
+    expected = np.stack([h * lfilter([g], [1.0, -f], u[:, j]) for j, (f, g, h)
+                         in enumerate(zip(phi, gain_in, gain_out, strict=True))], axis=1)
+    out = ar1_filter(u.copy(), phi, overwrite=True, gain_in=gain_in, gain_out=gain_out)
+    np.testing.assert_allclose(out, expected, rtol=1e-9, atol=1e-9 * np.abs(expected).max())
+    slow = ar1_filter(u[:, 1:], phi[1:], gain_in=gain_in[1:], gain_out=gain_out[1:])
+    np.testing.assert_allclose(slow, expected[:, 1:], rtol=1e-9,
+                               atol=1e-9 * np.abs(expected).max())

@@ -24,7 +24,7 @@ import pyarrow.parquet as pq
 
 from simulator.campaign.plan import PLAN_FORMAT
 from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, score_unit
-from simulator.dataset.io import read_table, write_table
+from simulator.dataset.parquet import read_table, write_table
 from simulator.errors import InputError, Problem
 
 CAMPAIGN_FILE = "campaign.json"

@@ -1,17 +1,13 @@
 """The dataset on disk (SPEC section 5): a directory with ``manifest.json`` and one Parquet file
-per stream, every column's unit in the Parquet field metadata.
-
-Streams are written from column tables (``simulator.tables``) or DataFrames, to the same Parquet
-schema either way: float and integer columns as they are, NaN as null (pandas' convention), text
-columns as ``large_string`` (what pandas' ``str`` dtype writes), no schema-level metadata. Writing
-imports pandas only for a DataFrame; reading returns DataFrames.
+per stream, every column's unit in the Parquet field metadata (the files themselves:
+``simulator.dataset.parquet``, imported on first use since pyarrow takes about 60 ms to load).
 
 Writing is atomic: everything goes into a temporary sibling directory that is renamed into place
 when complete, so an interrupted or failed run never leaves a half-written dataset.
 
 Public names
 ------------
-DatasetWriter, write_dataset, open_dataset, Dataset, write_table, read_table, atomic_output_dir.
+DatasetWriter, write_dataset, open_dataset, Dataset, atomic_output_dir.
 """
 
 from __future__ import annotations
@@ -23,11 +19,8 @@ import shutil
 from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
+from types import ModuleType
 from typing import TYPE_CHECKING
-
-import numpy as np
-import pyarrow as pa
-import pyarrow.parquet as pq
 
 from simulator import columns as col
 from simulator.errors import InputError, Problem
@@ -48,86 +41,15 @@ def _units_for(name: str, table: Table) -> dict[str, str]:
     return {c: declared[c] for c in names}
 
 
-def _arrow_column(values: np.ndarray) -> pa.Array:
-    """One column of a column table as an Arrow array, built from its buffers: ``pyarrow.array``
-    would import pandas (it checks every argument for pandas types). NaN becomes null, as in
-    ``pyarrow.Table.from_pandas``; text becomes ``large_string``."""
-    values = np.asarray(values)
-    if values.dtype.kind in "UO":
-        return _text_column(values)
-    if values.dtype.kind == "b":
-        bits = np.packbits(values, bitorder="little")
-        return pa.Array.from_buffers(pa.bool_(), len(values), [None, pa.py_buffer(bits)])
-    values = np.ascontiguousarray(values, dtype=values.dtype.newbyteorder("="))
-    validity, null_count = None, 0
-    if values.dtype.kind == "f":
-        nan = np.isnan(values)
-        null_count = int(np.count_nonzero(nan))
-        if null_count:
-            validity = pa.py_buffer(np.packbits(~nan, bitorder="little"))
-    return pa.Array.from_buffers(pa.from_numpy_dtype(values.dtype), len(values),
-                                 [validity, pa.py_buffer(values)], null_count=null_count)
+def _parquet() -> ModuleType:
+    """``simulator.dataset.parquet``, imported on first use (it loads pyarrow)."""
+    from simulator.dataset import parquet
+
+    return parquet
 
 
-def _text_column(values: np.ndarray) -> pa.Array:
-    """A text column (None as null) as ``large_string``, run by run: the columns written this
-    way (truth zone, event kinds) hold long runs of one value."""
-    n = len(values)
-    changes = np.ones(n, dtype=bool)
-    changes[1:] = values[1:] != values[:-1]
-    starts = np.flatnonzero(changes)
-    runs = np.diff(np.append(starts, n))
-    run_values = [values[i] for i in starts]
-    valid = np.array([v is not None and v == v for v in run_values], dtype=bool)  # v != v: NaN
-    encoded = [str(v).encode() if ok else b"" for v, ok in zip(run_values, valid, strict=True)]
-    row_bytes = np.repeat(np.array([len(e) for e in encoded], dtype=np.int64), runs)
-    offsets = np.concatenate([[0], np.cumsum(row_bytes)]).astype(np.int64)
-    data = b"".join(e * int(r) for e, r in zip(encoded, runs, strict=True))
-    validity, null_count = None, int(runs[~valid].sum())
-    if null_count:
-        validity = pa.py_buffer(np.packbits(np.repeat(valid, runs), bitorder="little"))
-    return pa.Array.from_buffers(pa.large_string(), n, [validity, pa.py_buffer(offsets),
-                                                        pa.py_buffer(data)],
-                                 null_count=null_count)
-
-
-def _arrow_table(table: Table, units: dict[str, str]) -> pa.Table:
-    """The Arrow table of a column table or DataFrame, each field with its unit and no
-    schema-level metadata (no ``pandas`` key)."""
-    if isinstance(table, dict):
-        names, arrays = list(table), [_arrow_column(v) for v in table.values()]
-    else:
-        converted = pa.Table.from_pandas(table, preserve_index=False)
-        names, arrays = converted.column_names, converted.columns
-    schema = pa.schema([pa.field(name, array.type).with_metadata({"unit": units.get(name, "")})
-                        for name, array in zip(names, arrays, strict=True)], metadata={})
-    return pa.Table.from_arrays(arrays, schema=schema)
-
-
-def write_table(frame: Table, path: Path, units: dict[str, str]) -> None:
-    """Write one table (a column table or a DataFrame) as Parquet with each column's unit in its
-    field metadata."""
-    table = _arrow_table(frame, units)
-    # dictionary encoding for text columns only (on floats it costs time and saves nothing);
-    # floats byte-stream-split before zstd: smooth time series then compress about twice as
-    # well, and faster; no column statistics (nothing here filters row groups by them)
-    text_columns = [f.name for f in table.schema if pa.types.is_string(f.type)
-                    or pa.types.is_large_string(f.type)]
-    float_columns = [f.name for f in table.schema if pa.types.is_floating(f.type)]
-    pq.write_table(table, path, compression="zstd", compression_level=1,
-                   use_dictionary=text_columns, use_byte_stream_split=float_columns,
-                   write_statistics=False)
-
-
-def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
-    """Read one Parquet table; raise InputError naming the file if it is missing or corrupt."""
-    try:
-        return pq.read_table(path, columns=columns).to_pandas()
-    except FileNotFoundError:
-        raise InputError([Problem(str(path), None, "", "file not found")]) from None
-    except (pa.ArrowException, OSError) as exc:
-        raise InputError([Problem(str(path), None, "", f"not a readable Parquet file: {exc}")]
-                         ) from None
+def _write(table: Table, path: Path, units: dict[str, str]) -> None:
+    _parquet().write_table(table, path, units)
 
 
 @contextlib.contextmanager
@@ -174,6 +96,8 @@ class DatasetWriter:
         self.directory = Path(directory)
         self._pool = ThreadPoolExecutor(max_workers=2)
         self._jobs: dict[str, Future] = {}
+        # pyarrow loads in a writer thread while the caller starts making the streams
+        self._pool.submit(_parquet)
 
     def __enter__(self) -> DatasetWriter:
         return self
@@ -186,7 +110,7 @@ class DatasetWriter:
         return col.STREAMS[name][0] if name in col.STREAMS else f"{name}.parquet"
 
     def write(self, name: str, table: Table) -> None:
-        self._jobs[name] = self._pool.submit(write_table, table,
+        self._jobs[name] = self._pool.submit(_write, table,
                                              self.directory / self.file_name(name),
                                              _units_for(name, table))
 
@@ -239,11 +163,10 @@ class Dataset:
         if name not in self.manifest["streams"]:
             raise InputError([Problem(str(self.path), None, "", f"the dataset has no {name!r} "
                                       f"stream (it has: {', '.join(self.stream_names)})")])
-        return read_table(self.path / self.manifest["streams"][name]["file"], columns)
+        return _parquet().read_table(self.path / self.manifest["streams"][name]["file"], columns)
 
     def units(self, name: str) -> dict[str, str]:
-        schema = pq.read_schema(self.path / self.manifest["streams"][name]["file"])
-        return {f.name: (f.metadata or {}).get(b"unit", b"").decode() for f in schema}
+        return _parquet().read_units(self.path / self.manifest["streams"][name]["file"])
 
 
 def open_dataset(path: str | Path) -> Dataset:

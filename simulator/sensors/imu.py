@@ -468,11 +468,11 @@ def _run_now(function: Callable, *args: Any) -> Future:
 
 def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarray:
     """First-order low-pass y[k] = a y[k-1] + (1 - a) x[k], a = exp(-2 pi f_c dt), per column,
-    started in steady state on the first sample (the sensor's internal digital filter)."""
+    started in steady state on the first sample (the sensor's internal digital filter). Filters
+    ``y`` in place."""
     a = np.exp(-2 * np.pi * np.asarray(bandwidth_hz, dtype=float) * dt_s)
-    u = (1 - a) * y
-    u[0] = y[0]  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]
-    return ar1_filter(u, a, overwrite=True)
+    y[0] /= 1 - a  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]: the first output is x[0]
+    return ar1_filter(y, a, overwrite=True, gain_in=1 - a)
 
 
 def _centripetal(w: np.ndarray, lever_arm: np.ndarray) -> np.ndarray:

@@ -75,23 +75,28 @@ def gm_adev_peak() -> tuple[float, float]:
 
 
 # largest exponent |ln phi| k used inside one block of ``ar1_filter`` (e^300 = 2e130: the scaled
-# inputs stay far from overflow)
+# inputs stay far from overflow), and the longest block (its factor tables stay in the cache)
 _AR1_BLOCK_LOG_RANGE = 300.0
+_AR1_MAX_BLOCK = 4096
 
 
-def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False) -> np.ndarray:
-    """x[k] = phi x[k-1] + u[k] along axis 0, x[-1] = 0 (the first-order recursion of an exact
-    Gauss-Markov discretisation), vectorised without a loop over the samples.
+def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False,
+               gain_in: float | np.ndarray = 1.0,
+               gain_out: float | np.ndarray = 1.0) -> np.ndarray:
+    """x[k] = phi x[k-1] + gain_in u[k] along axis 0, x[-1] = 0 (the first-order recursion of an
+    exact Gauss-Markov discretisation), returned times ``gain_out``, vectorised without a loop
+    over the samples.
 
-    ``phi`` (0 <= phi <= 1) is one factor, or one per column of a 2-D ``u`` (shape (m,)). Blocks
-    of L samples are solved in closed form, x[j] = phi^j cumsum(phi^-i u[i]) (L chosen so that
-    phi^-L stays below e^300 for every column; the rounding error stays that of the recursion,
-    since each partial sum is scaled back by phi^j), then the state at the end of each block is
-    carried into the next by the same recursion on the block ends (factor phi^L) and added with
-    the factors phi^(j+1). About five passes over the data whatever phi; a factor too small for
+    ``phi`` (0 <= phi <= 1) and the gains are one number, or one per column of a 2-D ``u`` (shape
+    (m,)). Blocks of L samples are solved in closed form, x[j] = phi^j (S[j] + phi c) with
+    S[j] = cumsum(phi^-i gain_in u[i]) and c the state at the end of the previous block (L
+    chosen so that phi^-L stays below e^300 for every column, at most 4096; the rounding error
+    stays that of the recursion, since each partial sum is scaled back by phi^j). The block-end
+    states follow from the same recursion on the block ends (factor phi^L). Four passes over the
+    data whatever phi, the gains folded into the first and the last; a factor too small for
     blocks of two (phi < e^-150) falls back to recursive doubling, which then stops after a few
-    passes once phi^(2^p) underflows. With ``overwrite`` a float array ``u`` is filtered in
-    place (no copy).
+    passes once phi^(2^p) underflows. With ``overwrite`` a float array ``u`` is filtered in place
+    (no copy).
     """
     x = u if overwrite and u.dtype == float else np.array(u, dtype=float)
     flat = x.ndim == 1
@@ -99,30 +104,40 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False) 
         x = x[:, None]
     n, m = x.shape
     phi = np.broadcast_to(np.asarray(phi, dtype=float), (m,))
+    gain_in = np.broadcast_to(np.asarray(gain_in, dtype=float), (m,))
+    gain_out = np.broadcast_to(np.asarray(gain_out, dtype=float), (m,))
     if n == 0:
         return x[:, 0] if flat else x
     with np.errstate(divide="ignore"):
         decay = -np.log(phi)  # |ln phi| per column, inf for phi = 0
     fastest = float(decay.max())
-    length = n if fastest <= _AR1_BLOCK_LOG_RANGE / n else int(_AR1_BLOCK_LOG_RANGE / fastest)
+    length = min(n, _AR1_MAX_BLOCK)
+    if fastest > _AR1_BLOCK_LOG_RANGE / length:
+        length = int(_AR1_BLOCK_LOG_RANGE / fastest)
     if length < 2:
+        x *= gain_in
         power, shift = phi.copy(), 1
         while shift < n and np.any(power > 0.0):
             x[shift:] += power * x[:-shift]
             power, shift = power * power, shift * 2
+        x *= gain_out
         return x[:, 0] if flat else x
-    blocks = -(-n // length)
-    if blocks * length != n:
-        x = np.concatenate([x, np.zeros((blocks * length - n, m))])
-    xb = x.reshape(blocks, length, m)
     j = np.arange(length)[:, None]
-    xb *= np.exp(j * decay)
-    np.cumsum(xb, axis=1, out=xb)
-    xb *= np.exp(-j * decay)
-    if blocks > 1:
-        carry = ar1_filter(xb[:-1, -1, :], np.exp(-length * decay))
-        xb[1:] += carry[:, None, :] * np.exp(-(j + 1) * decay)
-    x = x[:n]
+    up, down = gain_in * np.exp(j * decay), gain_out * np.exp(-j * decay)
+    blocks = n // length
+    full = x[:blocks * length].reshape(blocks, length, m)
+    tail = x[blocks * length:]
+    full *= up
+    np.cumsum(full, axis=1, out=full)
+    tail *= up[:len(tail)]
+    np.cumsum(tail, axis=0, out=tail)
+    # the state at the end of block b: c[b] = phi^(L-1) S_b[L-1] + phi^L c[b-1]
+    ends = ar1_filter(full[:, -1, :] * np.exp(-(length - 1) * decay), np.exp(-length * decay))
+    carried = phi * ends  # what each block's state adds to the next block's partial sums
+    full[1:] += carried[:-1, None, :]
+    tail += carried[-1]
+    full *= down
+    tail *= down[:len(tail)]
     return x[:, 0] if flat else x
 
 
@@ -172,11 +187,9 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
     phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
     drive = rng.standard_normal((n, sigma.size))
-    drive *= np.sqrt(q_unit)
-    drive[0] = rng.standard_normal(sigma.size)
-    x = ar1_filter(drive, phi, overwrite=True)
-    x *= sigma
-    return x
+    drive[0] = rng.standard_normal(sigma.size)  # the stationary state x[0] / sigma
+    drive[0] /= np.sqrt(q_unit)  # which the filter's gain_in turns back into N(0, 1)
+    return ar1_filter(drive, phi, overwrite=True, gain_in=np.sqrt(q_unit), gain_out=sigma)
 
 
 def flicker(n: int, dt_s: float, instability: np.ndarray, rng: np.random.Generator) -> np.ndarray:

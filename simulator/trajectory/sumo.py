@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import contextlib
 import difflib
-import hashlib
 import json
 import os
 import sys
@@ -155,6 +154,8 @@ def run_sumo(traj: dict, network: Network) -> SumoDrive:
 
 
 def _run_key(traj: dict, network: Network) -> str:
+    import hashlib  # imported where used (as in sumo_network)
+
     digest = hashlib.sha256(_RUN_VERSION.encode() + network.path.read_bytes())
     block = {k: traj[k] for k in ("route", "traffic", "step_length", "ego", "initial_stop",
                                   "max_duration", "seed")}

@@ -39,19 +39,20 @@ ASAM OpenDRIVE 1.6, section 13.3 (tunnels).
 
 from __future__ import annotations
 
-import hashlib
 import os
 import re
 import shutil
-import subprocess
 import tempfile
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from simulator.scenario.schema import Boolean, Either, Integer, Number, Record, Text
+
+if TYPE_CHECKING:
+    import xml.etree.ElementTree as ET
 
 NETGENERATE_FIELD = Record({
     "type": Text("grid", choices=["grid", "spider", "random"], doc="kind of network"),
@@ -226,6 +227,9 @@ def _build(args: list[str], inputs: list[Path], key: tuple) -> Path:
 
 def _run_tool(tool: str, args: list[str], inputs: list[Path], key: tuple) -> Path:
     """Run a SUMO network tool into the cache (keyed by its arguments, inputs and version)."""
+    import hashlib  # hashlib, subprocess and xml are imported where used: a drive that is not
+    import subprocess  # SUMO's (every parametric one) never needs them (10 ms at start)
+
     digest = hashlib.sha256("\0".join([tool, _sumo_version(), *args]).encode())
     for path in inputs:
         digest.update(path.read_bytes())
@@ -247,6 +251,8 @@ def _run_tool(tool: str, args: list[str], inputs: list[Path], key: tuple) -> Pat
 
 def _read_network(path: Path) -> Network:
     """Georeference and zone edges of a ``.net.xml``."""
+    import xml.etree.ElementTree as ET
+
     proj, offset = "", np.zeros(2)
     zones: dict[str, list[tuple[float, float, str]]] = {}
     try:
@@ -287,6 +293,8 @@ def _opendrive_tunnels(xodr: Path, net: Path) -> dict[str, list[tuple[float, flo
     road's s (right-hand lanes), the others against it; each covers s from OFFSET to the next
     edge's offset of the same road (or the road's length).
     """
+    import xml.etree.ElementTree as ET
+
     roads: dict[str, tuple[float, list[tuple[float, float]]]] = {}
     for road in ET.parse(xodr).getroot().iter("road"):
         spans = [(float(t.get("s", 0)), float(t.get("s", 0)) + float(t.get("length", 0)))
