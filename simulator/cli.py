@@ -7,6 +7,7 @@ Bad input ends with one clear message per problem on stderr and exit code 2, nev
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import os
 import sys
@@ -74,8 +75,24 @@ def main(argv: list[str] | None = None) -> int:
     _one_malloc_arena()
     argv = sys.argv[1:] if argv is None else argv
     command = next((a for a in argv if not a.startswith("-")), None)
-    parser = build_parser(command if command in SUMMARIES else None)
-    args = parser.parse_args(argv)
+    # importing the command makes some 100 000 objects that live to the end: no collections
+    # while they are made, and none that scans them again later (about 10 ms of collections
+    # that free nothing); unfrozen at the end, for callers that run several commands
+    collecting = gc.isenabled()
+    gc.disable()
+    try:
+        args = build_parser(command if command in SUMMARIES else None).parse_args(argv)
+        gc.freeze()
+        if collecting:
+            gc.enable()
+        return _run(args)
+    finally:
+        gc.unfreeze()
+        if collecting:
+            gc.enable()
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         return int(args.run(args) or 0)
     except InputError as exc:

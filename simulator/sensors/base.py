@@ -109,18 +109,22 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
         for key in keys:
             out[key] = cubic_interval_integrals(grid[key], dt)[interval]
             gauss |= cubic_rule_error(grid[key], dt)[interval] > CUBIC_RULE_TOLERANCE[key]
-    # intervals without a breakpoint in one vectorised piece; only those holding breakpoints
-    # (a few per manoeuvre) are split one by one
-    smooth = np.flatnonzero(gauss & (last <= first))
-    starts, lengths, owner = [lo[smooth]], [np.full(len(smooth), dt)], [smooth]
-    for i in np.flatnonzero(gauss & (last > first)):
-        edges = np.concatenate([[lo[i]], breaks[first[i]:last[i]], [hi[i]]])
-        starts.append(edges[:-1])
-        lengths.append(np.diff(edges))
-        owner.append(np.full(len(edges) - 1, i))
     if not gauss.any():
         return out
-    start, length, idx = (np.concatenate(a) for a in (starts, lengths, owner))
+    # intervals without a breakpoint are one piece; one holding c breakpoints (a few per
+    # manoeuvre) is split into c + 1 pieces at them
+    smooth = np.flatnonzero(gauss & (last <= first))
+    held = np.flatnonzero(gauss & (last > first))
+    pieces = last[held] - first[held] + 1
+    owner = np.repeat(held, pieces)
+    piece = np.arange(len(owner)) - np.repeat(np.cumsum(pieces) - pieces, pieces)
+    ends_at = np.repeat(first[held], pieces) + piece  # the breakpoint that ends each piece
+    is_last = piece == np.repeat(pieces, pieces) - 1
+    piece_start = np.where(piece == 0, lo[owner], breaks[np.maximum(ends_at - 1, 0)])
+    piece_end = np.where(is_last, hi[owner], breaks[np.minimum(ends_at, len(breaks) - 1)])
+    start = np.concatenate([lo[smooth], piece_start])
+    length = np.concatenate([np.full(len(smooth), dt), piece_end - piece_start])
+    idx = np.concatenate([smooth, owner])
     nodes = (start[:, None] + length[:, None] * GL_NODES[None, :]).ravel()
     values = truth.inertial(nodes)
     for key in keys:

@@ -387,7 +387,8 @@ class Imu:
             y = _low_pass(y, _per_axis(p["bandwidth"]), 1.0 / self.rate_hz)
         if p["range"] is not None:
             limit = _per_axis(p["range"]) * scale
-            np.clip(y, -limit, limit, out=y)
+            np.minimum(y, limit, out=y)  # np.clip does the same at twice the cost
+            np.maximum(y, -limit, out=y)
         quantum = _per_axis(p["resolution"]) * scale
         if quantum.any():
             q = np.where(quantum > 0, quantum, 1.0)
