@@ -151,6 +151,28 @@ def test_generate_without_gnss_and_faults_does_not_import_pandas(tmp_path):
     assert list(ds.read("events")["kind"]) == ["zone"]
 
 
+def test_program_ends_generate_with_its_exit_code_and_complete_files(tmp_path):
+    """``landnav generate`` ends without the interpreter's teardown: its exit code, its printed
+    line and its files are those of a normal end; a bad scenario still exits with 2 and its
+    message, and nothing is written."""
+    scenario, out = _no_gnss_scenario(tmp_path / "s.yaml"), tmp_path / "out"
+    run = [sys.executable, "-m", "simulator.cli", "generate"]
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    done = subprocess.run([*run, str(scenario), "-o", str(out)], capture_output=True,
+                          text=True, cwd=REPO, env=env)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith(f"wrote {out} ")
+    manifest = json.loads((out / "manifest.json").read_text())
+    rows = manifest["streams"]["imu"]["rows"]
+    assert rows == int(manifest["duration"] * 100)  # 100 Hz increments over the whole drive
+    assert open_dataset(out).read("imu").shape == (rows, 7)
+    bad = subprocess.run([*run, str(tmp_path / "missing.yaml"), "-o", str(tmp_path / "no")],
+                         capture_output=True, text=True, cwd=REPO, env=env)
+    assert bad.returncode == 2
+    assert "missing.yaml: file not found" in bad.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.yaml"]
+
+
 def test_column_tables_and_dataframes_write_the_same_files(tmp_path):
     """The writer gives the same bytes for a stream whether it is a column table or the
     DataFrame of it (text, integers, NaN as null, empty tables)."""
