@@ -297,3 +297,9 @@ def test_ar1_filter_gains_match_scipy_lfilter(n):
     slow = ar1_filter(u[:, 1:], phi[1:], gain_in=gain_in[1:], gain_out=gain_out[1:])
     np.testing.assert_allclose(slow, expected[:, 1:], rtol=1e-9,
                                atol=1e-9 * np.abs(expected).max())
+    # a strided or Fortran-ordered input is filtered in a copy, even when it may be overwritten
+    for strange in (np.asfortranarray(u[:, 1:]).copy(order="F"), u.copy()[:, 1:]):
+        out = ar1_filter(strange, phi[1:], overwrite=True, gain_in=gain_in[1:],
+                         gain_out=gain_out[1:])
+        np.testing.assert_allclose(out, expected[:, 1:], rtol=1e-9,
+                                   atol=1e-9 * np.abs(expected).max())

@@ -95,10 +95,11 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False,
     states follow from the same recursion on the block ends (factor phi^L). Four passes over the
     data whatever phi, the gains folded into the first and the last; a factor too small for
     blocks of two (phi < e^-150) falls back to recursive doubling, which then stops after a few
-    passes once phi^(2^p) underflows. With ``overwrite`` a float array ``u`` is filtered in place
-    (no copy).
+    passes once phi^(2^p) underflows. With ``overwrite`` a C-contiguous float array ``u`` is
+    filtered in place (no copy).
     """
-    x = u if overwrite and u.dtype == float else np.array(u, dtype=float)
+    in_place = overwrite and u.dtype == float and u.flags.c_contiguous  # blocks are views
+    x = u if in_place else np.array(u, dtype=float, order="C")
     flat = x.ndim == 1
     if flat:
         x = x[:, None]
