@@ -418,9 +418,12 @@ class Imu:
             dt = 1.0 / self.rate_hz
             t_speed = t - dt / 2 if self.increment else t
             speed = np.maximum(truth.profile.distance_of_time(np.clip(t_speed, 0, None), 1), 0)
-            dw, df = vibration_at_speed(draws.vibration.result(), speed, dt,
-                                        self.config["vibration"], self.increment)
-            w, f = w + dw, f + df
+            shaking = vibration_at_speed(draws.vibration.result(), speed, dt,
+                                         self.config["vibration"], self.increment)
+            if shaking["gyro"] is not None:
+                w = np.add(shaking["gyro"], w, out=shaking["gyro"])
+            if shaking["accel"] is not None:
+                f = np.add(shaking["accel"], f, out=shaking["accel"])
         # the gyro group in the pool (behind its draws) while this thread does the accel group
         gyro_job = draws.submit(lambda: self._apply_errors("gyro", w, f,
                                                            draws.groups["gyro"].result()))

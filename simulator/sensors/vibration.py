@@ -12,10 +12,12 @@ to what the IMU senses, not to the truth trajectory.
 
 Public names
 ------------
-VIBRATION_FIELD, draw_vibration, vibration_at_speed.
+VIBRATION_FIELD, DrawnVibration, draw_vibration, vibration_at_speed.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -61,30 +63,18 @@ def _engine_basis(t: np.ndarray, freq_hz: float, dt_s: float,
     return np.sin(theta), np.cos(theta), gain
 
 
-def _engine(basis: tuple[np.ndarray, np.ndarray, float], rms: float, rng: np.random.Generator,
-            out: np.ndarray) -> None:
-    """Into ``out`` (n, 3): a sine of amplitude rms sqrt(2) and a drawn phase per axis (or its
-    integral over each interval), written as sin(theta) cos(phase) + cos(theta) sin(phase), so
-    that one sine and one cosine serve every axis."""
-    sin_theta, cos_theta, gain = basis
-    phase = rng.uniform(0.0, 2 * np.pi, 3)
-    amplitude = rms * gain
-    np.multiply(sin_theta[:, None], amplitude * np.cos(phase), out=out)
-    out += cos_theta[:, None] * (amplitude * np.sin(phase))
-
-
-def _road(n: int, rms: float, band_hz: list[float], dt_s: float, rng: np.random.Generator,
-          out: np.ndarray) -> None:
-    """Into ``out`` (n, 3): band-limited white noise of rms ``rms``, its spectrum drawn directly
-    in the frequency domain (the real FFT of n unit normals has independent N(0, n/2) real and
-    imaginary parts per bin, the Nyquist bin real N(0, n)) and transformed back. In single
-    precision, 2.5 times quicker: a noise realisation rounded to 6e-8 of its rms, far below any
-    sensor's resolution."""
+def _road(n: int, rms: float, band_hz: list[float], dt_s: float,
+          rng: np.random.Generator) -> np.ndarray | None:
+    """Band-limited white noise of rms ``rms``, shape (n, 3), single precision (None when no
+    frequency of the band is below the Nyquist frequency): its spectrum drawn directly in the
+    frequency domain (the real FFT of n unit normals has independent N(0, n/2) real and
+    imaginary parts per bin, the Nyquist bin real N(0, n)) and transformed back. Single
+    precision is 2.5 times quicker and half the memory: a noise realisation rounded to 6e-8 of
+    its rms, far below any sensor's resolution."""
     freq = np.fft.rfftfreq(n, dt_s)
     keep = np.flatnonzero((freq >= band_hz[0]) & (freq <= band_hz[1]))
     if not len(keep):
-        out[:] = 0.0
-        return
+        return None
     band = slice(keep[0], keep[-1] + 1)  # the band is one run of bins
     draws = rng.standard_normal((2, len(keep), 3))
     spectrum = np.zeros((3, len(freq)), dtype=np.complex64)
@@ -93,38 +83,66 @@ def _road(n: int, rms: float, band_hz: list[float], dt_s: float, rng: np.random.
     if n % 2 == 0 and keep[-1] == len(freq) - 1:  # the Nyquist bin is real
         spectrum[:, -1] = np.sqrt(2.0) * draws[0, -1]
     fraction = len(keep) / len(freq)  # share of the white variance inside the band
-    scale = rms * np.sqrt(n / 2.0 / fraction)
-    np.multiply(np.fft.irfft(spectrum, n, axis=1).T, scale, out=out)
+    road = np.fft.irfft(spectrum, n, axis=1)
+    road *= rms * np.sqrt(n / 2.0 / fraction)
+    return road.T
+
+
+@dataclass
+class DrawnVibration:
+    """The random part of the vibration (``draw_vibration``): the engine line's sine and cosine
+    (None without an engine term), and per group ("gyro", "accel") the engine amplitudes along
+    them (shape (2, 3), None when off) and the road vibration at ``road_speed`` (shape (n, 3),
+    single precision, None when off)."""
+
+    sin_theta: np.ndarray | None
+    cos_theta: np.ndarray | None
+    engine: dict[str, np.ndarray | None]
+    road: dict[str, np.ndarray | None]
 
 
 def draw_vibration(t: np.ndarray, dt_s: float, config: dict, increment: bool,
-                   rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """The random part of the vibration, which needs no trajectory: per group (gyro, accel) the
-    engine term plus the road term at ``road_speed``, stacked as shape (2, n, 3) each.
+                   rng: np.random.Generator) -> DrawnVibration:
+    """The random part of the vibration, which needs no trajectory: the engine line's drawn
+    phases (a sine of amplitude rms sqrt(2) per axis, or its integral over each interval,
+    written as sin(theta) cos(phase) + cos(theta) sin(phase), so that one sine and one cosine
+    serve every axis of both groups) and the road vibration at ``road_speed``.
 
-    ``vibration_at_speed`` scales the road term by the speed once the truth is known.
+    ``vibration_at_speed`` adds them up once the speed is known.
     """
     c = config
-    basis = None
-    out = []
-    for engine_rms, road_rms in ((c["engine_gyro"], c["road_gyro"]),
-                                 (c["engine_accel"], c["road_accel"])):
-        parts = np.zeros((2, len(t), 3))
+    sin_theta = cos_theta = None
+    engine: dict[str, np.ndarray | None] = {}
+    road: dict[str, np.ndarray | None] = {}
+    for group, engine_rms, road_rms in (("gyro", c["engine_gyro"], c["road_gyro"]),
+                                        ("accel", c["engine_accel"], c["road_accel"])):
+        engine[group] = road[group] = None
         if engine_rms > 0:
-            if basis is None:
-                basis = _engine_basis(t, c["engine_frequency"], dt_s, increment)
-            _engine(basis, engine_rms, rng, parts[0])
+            if sin_theta is None:
+                sin_theta, cos_theta, gain = _engine_basis(t, c["engine_frequency"], dt_s,
+                                                           increment)
+            phase = rng.uniform(0.0, 2 * np.pi, 3)
+            engine[group] = engine_rms * gain * np.stack([np.cos(phase), np.sin(phase)])
         if road_rms > 0:
-            _road(len(t), road_rms, c["road_band"], dt_s, rng, parts[1])
-        out.append(parts)
-    return out[0], out[1]
+            road[group] = _road(len(t), road_rms, c["road_band"], dt_s, rng)
+    return DrawnVibration(sin_theta, cos_theta, engine, road)
 
 
-def vibration_at_speed(drawn: tuple[np.ndarray, np.ndarray], speed: np.ndarray, dt_s: float,
-                       config: dict, increment: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Angular-rate and specific-force vibration (or their increments), body frame, shape (n, 3)
-    each: the engine term plus the road term scaled by speed / ``road_speed`` (``drawn`` from
-    ``draw_vibration``; ``speed`` at the samples, m/s, shape (n,))."""
-    scale = dt_s if increment else 1.0
-    road = (speed / config["road_speed"])[:, None] * scale
-    return tuple(parts[0] + parts[1] * road for parts in drawn)
+def vibration_at_speed(drawn: DrawnVibration, speed: np.ndarray, dt_s: float, config: dict,
+                       increment: bool) -> dict[str, np.ndarray | None]:
+    """Angular-rate ("gyro") and specific-force ("accel") vibration (or their increments), body
+    frame, shape (n, 3) each (None for a group without vibration): the engine term plus the road
+    term scaled by speed / ``road_speed`` (``speed`` at the samples, m/s, shape (n,))."""
+    road_scale = (speed * ((dt_s if increment else 1.0) / config["road_speed"]))[:, None]
+    out: dict[str, np.ndarray | None] = {}
+    for group in ("gyro", "accel"):
+        engine, road = drawn.engine[group], drawn.road[group]
+        total = None
+        if engine is not None:
+            total = drawn.sin_theta[:, None] * engine[0]
+            total += drawn.cos_theta[:, None] * engine[1]
+        if road is not None:
+            scaled = road * road_scale
+            total = scaled if total is None else np.add(total, scaled, out=total)
+        out[group] = total
+    return out
