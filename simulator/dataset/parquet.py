@@ -42,7 +42,8 @@ def _arrow_column(values: np.ndarray) -> pa.Array:
         return pa.Array.from_buffers(pa.bool_(), len(values), [None, pa.py_buffer(bits)])
     values = np.ascontiguousarray(values, dtype=values.dtype.newbyteorder("="))
     validity, null_count = None, 0
-    if values.dtype.kind == "f":
+    # a sum is NaN when a value is (one read-only pass, against two and a mask)
+    if values.dtype.kind == "f" and np.isnan(np.add.reduce(values)):
         nan = np.isnan(values)
         null_count = int(np.count_nonzero(nan))
         if null_count:
