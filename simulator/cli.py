@@ -116,12 +116,18 @@ _EXIT_WITHOUT_TEARDOWN = {"generate"}
 
 def program() -> None:
     """The ``landnav`` program: ``main`` on the command line, then the process ends with its
-    exit code (without the interpreter's teardown after ``landnav generate``)."""
+    exit code (without the interpreter's teardown after ``landnav generate``). Output into a
+    pipe closed early (``landnav ... | head -1``) ends it quietly with code 1, as Python's
+    documentation advises, instead of a traceback."""
     argv = sys.argv[1:]
-    code = main(argv)
-    if _command_name(argv) in _EXIT_WITHOUT_TEARDOWN:
+    try:
+        code = main(argv)
         sys.stdout.flush()
         sys.stderr.flush()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write
+        code = 1
+    if _command_name(argv) in _EXIT_WITHOUT_TEARDOWN:
         os._exit(code)
     sys.exit(code)
 

@@ -173,6 +173,20 @@ def test_program_ends_generate_with_its_exit_code_and_complete_files(tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out", "s.yaml"]
 
 
+def test_program_into_a_closed_pipe_ends_quietly(tmp_path):
+    """``landnav generate ... | head -0``: the dataset is written, and the line that cannot be
+    printed ends the program with code 1 and no traceback."""
+    scenario, out = _no_gnss_scenario(tmp_path / "s.yaml"), tmp_path / "out"
+    done = subprocess.Popen([sys.executable, "-m", "simulator.cli", "generate", str(scenario),
+                             "-o", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)})
+    done.stdout.close()
+    stderr = done.stderr.read().decode()
+    assert done.wait() == 1
+    assert stderr == ""
+    assert open_dataset(out).has("imu")
+
+
 def test_column_tables_and_dataframes_write_the_same_files(tmp_path):
     """The writer gives the same bytes for a stream whether it is a column table or the
     DataFrame of it (text, integers, NaN as null, empty tables)."""
