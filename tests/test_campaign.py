@@ -344,6 +344,25 @@ def test_a_folder_that_is_not_a_campaign_is_never_replaced(tmp_path, capsys):
     assert [p.name for p in out.iterdir()] == ["thesis.tex"]
 
 
+def test_a_folder_another_campaign_is_writing_is_refused(tmp_path, capsys):
+    """While one campaign holds its folder, a second one into it exits 2 naming the holder and
+    writes nothing; once the first ends, the folder is free (the lock dies with its holder)."""
+    import os
+
+    from simulator.campaign.store import campaign_lock
+
+    out = tmp_path / "busy"
+    argv = ["campaign", str(_scenario(tmp_path, [HOLD])), "--runs", "1", "--workers", "1",
+            "-o", str(out)]
+    with campaign_lock(out):
+        assert main(argv) == 2 and main([*argv, "--force"]) == 2
+        err = capsys.readouterr().err
+        assert f"another landnav campaign (process {os.getpid()})" in err
+        assert "Traceback" not in err and not out.exists()
+    assert main(argv) == 0
+    assert _runs(out)["status"].tolist() == ["ok"]
+
+
 def test_a_scheduler_that_does_not_answer_exits_2(tmp_path, capsys):
     out = tmp_path / "out"
     address = f"tcp://127.0.0.1:{_closed_port()}"

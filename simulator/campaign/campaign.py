@@ -20,6 +20,7 @@ from simulator.campaign.plan import CampaignPlan
 from simulator.campaign.report import write_campaign_report
 from simulator.campaign.store import (
     RUNS_FILE,
+    campaign_lock,
     check_campaign_dir,
     done_parts,
     init_campaign_dir,
@@ -73,12 +74,21 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
     Raises
     ------
     InputError
-        ``out`` cannot be used (another campaign without ``force``), or the scheduler does not
-        answer; nothing is written then.
+        ``out`` cannot be used (another campaign without ``force``, or a campaign that another
+        process is running into it), or the scheduler does not answer; nothing is written
+        then.
     """
     out = Path(out)
     fingerprint, record = plan.fingerprint(), plan.record()
-    check_campaign_dir(out, record, fingerprint, options.force)
+    check_campaign_dir(out, record, fingerprint, options.force)  # refused: nothing written
+    with campaign_lock(out):
+        # checked again: another campaign may have written the folder in between
+        check_campaign_dir(out, record, fingerprint, options.force)
+        return _run_locked(plan, out, options, fingerprint, record)
+
+
+def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerprint: str,
+                record: dict) -> CampaignResult:
     tasks = plan.tasks(options.runs,
                        out.resolve() / DATASETS if options.keep_datasets else None)
     with open_executor(options.workers, options.scheduler, options.scheduler_timeout_s) as (

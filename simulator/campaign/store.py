@@ -4,19 +4,23 @@
 the rows of one finished run, written under a temporary name and renamed when complete, so an
 interrupted campaign leaves only whole runs; ``DIR/runs.parquet`` is every requested run's rows
 merged at the end (written the same way). A rerun with the same plan skips the runs whose part
-exists; a different plan is refused unless ``force``, which starts over.
+exists; a different plan is refused unless ``force``, which starts over. While a campaign runs,
+it holds an exclusive lock on ``.DIR.lock`` beside the folder (``campaign_lock``), so that a
+second campaign into the same folder is refused instead of mixing its runs in.
 
 Public names
 ------------
-CAMPAIGN_FILE, PARTS, RUNS_FILE, check_campaign_dir, init_campaign_dir, done_parts,
-write_part, merge_parts, write_frame.
+CAMPAIGN_FILE, PARTS, RUNS_FILE, campaign_lock, check_campaign_dir, init_campaign_dir,
+done_parts, write_part, merge_parts, write_frame.
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import shutil
+from collections.abc import Iterator
 from pathlib import Path
 
 import pandas as pd
@@ -41,6 +45,44 @@ def _stored(out: Path) -> dict | None:
     except (OSError, ValueError):
         return {}
     return stored if isinstance(stored, dict) else {}
+
+
+@contextlib.contextmanager
+def campaign_lock(out: Path) -> Iterator[None]:
+    """Hold the campaign folder ``out`` for this process: an exclusive ``flock`` on the hidden
+    file ``.NAME.lock`` beside it (holding this process id), which the system releases when the
+    campaign ends or its process dies, so a lock is never left stale. The file itself stays (a
+    lock file removed while held could be locked twice). Without ``fcntl`` (Windows) there is
+    no lock.
+
+    Raises
+    ------
+    InputError
+        Another process holds the folder.
+    """
+    try:
+        import fcntl
+    except ImportError:  # not POSIX
+        yield
+        return
+    out.parent.mkdir(parents=True, exist_ok=True)
+    with open(out.parent / f".{out.name}.lock", "a+", encoding="utf-8") as handle:
+        try:
+            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            handle.seek(0)
+            holder = handle.read().strip() or "?"
+            raise InputError([Problem(str(out), None, "", f"another landnav campaign (process "
+                                      f"{holder}) is writing this folder; wait for it to end "
+                                      "or choose another -o DIR")]) from None
+        handle.seek(0)
+        handle.truncate()
+        handle.write(f"{os.getpid()}\n")
+        handle.flush()
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -> None:
