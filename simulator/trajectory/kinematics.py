@@ -381,8 +381,8 @@ def _by_pieces(evaluate: Callable[[slice], dict[str, np.ndarray]],
     """``evaluate(rows)`` over rows 0 to n, assembled piece by piece into full arrays when n is
     long: the dozens of intermediate arrays of a piece stay small and are reused by the next
     one, where a whole hour's would first touch some 90 MB (page faults were two thirds of the
-    time). ``evaluate`` returns arrays of len(rows) or (len(rows), 3); the latter are
-    assembled in (3, n) storage and handed out as (n, 3), like the vectors of one piece."""
+    time). ``evaluate`` returns arrays of len(rows) or (len(rows), k); the latter are
+    assembled in (k, n) storage and handed out as (n, k), like the vectors of one piece."""
     if n <= 2 * _PIECE:
         return evaluate(slice(0, n))
     out: dict[str, np.ndarray] = {}
@@ -390,7 +390,7 @@ def _by_pieces(evaluate: Callable[[slice], dict[str, np.ndarray]],
         rows = slice(start, start + _PIECE)
         piece = evaluate(rows)
         if not out:
-            out = {key: np.empty((3, n)).T if value.ndim == 2 else np.empty(n)
+            out = {key: np.empty((value.shape[1], n)).T if value.ndim == 2 else np.empty(n)
                    for key, value in piece.items()}
         for key, value in piece.items():
             out[key][rows] = value
