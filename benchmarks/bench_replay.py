@@ -18,9 +18,9 @@ import numpy as np
 import pandas as pd
 
 from estimators.base import Estimator
-from estimators.replay import run_estimator
 from simulator import columns as col
 from simulator.dataset.io import open_dataset, write_dataset
+from simulator.replay import run_estimator
 
 
 class DoNothing(Estimator):

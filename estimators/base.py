@@ -16,7 +16,7 @@ An estimator is a subclass of ``Estimator``. The class declares
   of SPEC section 7, then optionally ``std_*`` columns and free extra columns);
 * ``initialises_itself``: True if it needs no initial state (it starts from the first fixes).
 
-The replay (``estimators.replay``) builds it with its merged configuration, its initial state
+The replay (``simulator.replay``) builds it with its merged configuration, its initial state
 (``InitialState``: the truth at its start time perturbed by the scenario's ``init`` errors, or
 None) and the layout of the streams it receives, then calls ``setup()``. Each message goes to the
 method ``on_<stream>(t, row)``: ``row`` is a read-only float64 row of the stream's table whose

@@ -27,8 +27,8 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 
 # name -> "module:Class"; imported on demand so listing names imports nothing
 BUILTINS = {
-    "gnss_only": "estimators.baselines:GnssOnly",
-    "dead_reckoning": "estimators.baselines:DeadReckoning",
+    "gnss_only": "estimators.builtin.baselines:GnssOnly",
+    "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
 }
 
 

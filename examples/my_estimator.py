@@ -16,7 +16,7 @@ import math
 import numpy as np
 
 from estimators.base import NAV_COLUMNS, Estimator
-from estimators.kalman import predict, update
+from estimators.toolbox.kalman import predict, update
 from simulator.earth import radii_of_curvature
 
 

@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from estimators.replay import run_estimator
 from simulator.dataset.io import open_dataset
 from simulator.earth import radii_of_curvature
+from simulator.replay import run_estimator
 from simulator.scenario import validate_data
 from tests.synthetic import FLAT_LOOP, scenario, write_synthetic
 

@@ -1,13 +1,13 @@
 """Motion-constraint Jacobians against finite differences taken with the error convention of
-``estimators.nav_error`` (estimate = truth perturbed by dx)."""
+``estimators.toolbox.nav_error`` (estimate = truth perturbed by dx)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from estimators.constraints import height, nonholonomic
-from estimators.nav_error import correct, perturb
+from estimators.toolbox.constraints import height, nonholonomic
+from estimators.toolbox.nav_error import correct, perturb
 from simulator.earth import euler_to_quat, quat_to_euler
 
 Q_TRUE = euler_to_quat(0.05, -0.08, 2.3)

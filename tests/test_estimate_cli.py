@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from estimators.registry import get_estimator, list_estimators
-from estimators.replay import read_solution
 from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
+from simulator.replay import read_solution
 from simulator.scenario import load_scenario
 from tests.synthetic import write_synthetic
 from tests.test_baselines import horizontal_error

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from estimators.gauss_markov import gauss_markov_continuous, gauss_markov_discrete, van_loan
+from estimators.toolbox.gauss_markov import gauss_markov_continuous, gauss_markov_discrete, van_loan
 
 
 def test_first_order_closed_form_and_van_loan_agree():

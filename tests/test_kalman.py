@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from scipy.linalg import solve_discrete_are
 
-from estimators.kalman import ErrorState, predict, update
+from estimators.toolbox.kalman import ErrorState, predict, update
 
 DT = 0.1
 PHI = np.array([[1.0, DT], [0.0, 1.0]])  # position-velocity, white acceleration

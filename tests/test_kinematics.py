@@ -8,7 +8,7 @@ import pytest
 from conftest import scenario_data, ten_minute_drive
 from scipy.integrate import quad
 
-from estimators.strapdown import rates_to_increments, run_strapdown
+from estimators.toolbox.strapdown import rates_to_increments, run_strapdown
 from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.sensors.imu import Imu

@@ -7,7 +7,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from estimators.replay import (
+from simulator import columns as col
+from simulator.dataset.io import atomic_output_dir, open_dataset, write_dataset
+from simulator.earth import ecef_to_ned, geodetic_to_ecef, wrap_angle
+from simulator.errors import InputError
+from simulator.replay import (
     STREAM_ORDER,
     merge_streams,
     output_times,
@@ -15,10 +19,6 @@ from estimators.replay import (
     run_estimator,
     write_solution,
 )
-from simulator import columns as col
-from simulator.dataset.io import atomic_output_dir, open_dataset, write_dataset
-from simulator.earth import ecef_to_ned, geodetic_to_ecef, wrap_angle
-from simulator.errors import InputError
 from tests.recording import Recorder
 from tests.synthetic import write_synthetic
 
@@ -208,9 +208,9 @@ def test_replay_benchmark_dataset_runs(tmp_path):
 def test_sensor_error_priors_reach_the_initial_state():
     from conftest import scenario_data
 
-    from estimators.replay import initial_state
     from simulator.dataset.generate import build_truth
     from simulator.errors import InputError
+    from simulator.replay import initial_state
 
     segments = [{"accelerate": {"to_speed": 5.0, "accel": 1.0}}, {"straight": {"length": 20}}]
     truth = build_truth(scenario_data(segments)).table()

@@ -12,11 +12,11 @@ from test_baselines import horizontal_error
 from test_kinematics import _closure
 from test_odometer import make as make_odometer
 
-from estimators.replay import run_estimator
 from simulator import earth
 from simulator.cli import main
 from simulator.dataset.generate import build_truth
 from simulator.dataset.io import open_dataset
+from simulator.replay import run_estimator
 from simulator.sensors.imu import Imu
 from simulator.tables import as_frame
 from tests.synthetic import scenario, write_synthetic

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from estimators.sigma_points import simplex_points, symmetric_points, unscented_transform
+from estimators.toolbox.sigma_points import simplex_points, symmetric_points, unscented_transform
 
 RNG = np.random.default_rng(4)
 A = RNG.normal(size=(4, 4))

@@ -13,7 +13,7 @@ import pymap3d
 import pytest
 import yaml
 
-from estimators.strapdown import run_strapdown
+from estimators.toolbox.strapdown import run_strapdown
 from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.scenario import load_scenario

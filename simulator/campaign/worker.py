@@ -20,10 +20,10 @@ from typing import Any
 
 import numpy as np
 
-from estimators.replay import run_estimator
 from simulator.campaign.plan import RunTask, entry_labels
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
+from simulator.replay import run_estimator
 from simulator.scoring.evaluate import score_solutions
 
 STATUS_OK = "ok"

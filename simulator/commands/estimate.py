@@ -8,10 +8,10 @@ import sys
 import yaml
 
 from estimators.registry import entry_problems
-from estimators.replay import run_estimator, write_solution
 from simulator.commands import SUMMARIES
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
+from simulator.replay import run_estimator, write_solution
 from simulator.scenario.schema import INVALID, Context
 from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
 

@@ -8,13 +8,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from estimators.replay import run_estimator, write_solution
 from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
 from simulator.commands.score import print_scores
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import atomic_output_dir, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.replay import run_estimator, write_solution
 from simulator.scenario import load_scenario
 from simulator.scoring.evaluate import score_solutions, write_scores
 from simulator.scoring.report import write_report

@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from estimators.replay import read_solution, run_estimator
 from simulator.commands import SUMMARIES
 from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.replay import read_solution, run_estimator
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
 from simulator.scoring.report import text_table, write_report
 

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from estimators.gauss_markov import gauss_markov_discrete
+from estimators.toolbox.gauss_markov import gauss_markov_discrete
 
 # Allan deviation floor of flicker noise per unit bias instability, sqrt(2 ln 2 / pi) (IEEE 952)
 FLICKER_ADEV_FACTOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))

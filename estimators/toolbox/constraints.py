@@ -1,5 +1,6 @@
-"""Pseudo-measurements of land-vehicle motion constraints, with their Jacobians with respect to
-the navigation error state of ``estimators.nav_error`` ([dr, dv, psi], estimate minus truth).
+"""Pseudo-measurements of land-vehicle motion constraints, with their Jacobians with respect
+to the navigation error state of ``estimators.toolbox.nav_error`` ([dr, dv, psi], estimate minus
+truth).
 
 * Non-holonomic constraint: a wheeled vehicle does not slide sideways or leave the road, so the
   body-frame velocity v^b = C_n^b v^n has zero lateral (y) and vertical (z) components (Chan et
