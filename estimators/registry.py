@@ -29,6 +29,8 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
+    "dr2d_odo_ekf": "estimators.builtin.park2019_dr:Dr2dOdoEkf",
+    "dr3d_ekf": "estimators.builtin.park2019_dr:Dr3dEkf",
 }
 
 
