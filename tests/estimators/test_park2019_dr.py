@@ -69,3 +69,72 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     assert np.abs(out[:, 2] - truth["alt"]).max() < 0.2
     yaw = np.arctan2(c[1, 0], c[0, 0])
     assert abs(math.remainder(yaw - truth["yaw"].iloc[-1], 2 * math.pi)) < math.radians(0.01)
+
+
+@pytest.fixture(scope="module")
+def garage(tmp_path_factory) -> dict:
+    """The garage (true odometer scale factor 1.03) over ten seeds, every registered filter."""
+    return cmp.compare_seeds(SEEDS, work=tmp_path_factory.mktemp("garage"))
+
+
+@pytest.fixture(scope="module")
+def flat_garage(tmp_path_factory) -> dict:
+    """The same garage made flat with a perfect odometer, ten seeds."""
+    return cmp.compare_seeds(SEEDS, cmp.FLAT_PERFECT, work=tmp_path_factory.mktemp("flat"))
+
+
+def _column(results: dict, name: str, key: str) -> np.ndarray:
+    return np.array([results[s][name][key] for s in SEEDS])
+
+
+def _others() -> list[str]:
+    return [n for n in cmp.registered_filters() if n != "dr3d_ekf"]
+
+
+@pytest.mark.xfail(strict=True, reason="not shown: dr3d_ekf beats dr2d_odo_ekf in 4/10 seeds on "
+                   "exit error (medians 15.8 m vs 13.2 m); the unestimated z-gyro scale factor "
+                   "(0.5 % 1-sigma) over six helix turns dominates both filters' heading error "
+                   "(docs/reproduction_park2019.md)")
+def test_dr3d_beats_the_baselines_in_the_garage(garage):
+    """Park Table 3: dr3d_ekf beats each baseline on exit and maximum horizontal error in at
+    least 8 of 10 seeds (paired per seed)."""
+    for other in _others():
+        for key in ("exit_horizontal", "max_horizontal"):
+            wins = _column(garage, "dr3d_ekf", key) < _column(garage, other, key)
+            assert wins.sum() >= 8, (other, key, wins.sum())
+
+
+def test_flat_garage_with_perfect_odometer_removes_the_advantage(flat_garage):
+    """Without ramps and odometer scale-factor error, the median per-seed ratio of dr3d_ekf's
+    exit and maximum error to each baseline's lies between 0.7 and 1.3."""
+    for other in _others():
+        for key in ("exit_horizontal", "max_horizontal"):
+            ratio = _column(flat_garage, "dr3d_ekf", key) / _column(flat_garage, other, key)
+            assert 0.7 <= np.median(ratio) <= 1.3, (other, key, np.median(ratio))
+
+
+def test_dr3d_height_change_through_the_garage(garage):
+    """Park Fig. 19: the height change from garage entry to exit within 2 m of the truth
+    (paper: 1.22 m change for the 3-D DR, 22.34 m for INS/GPS/odometer), every seed."""
+    err = _column(garage, "dr3d_ekf", "height_change_error")
+    assert np.all(err < 2.0), err
+
+
+@pytest.mark.parametrize("scale", [1.03, 0.97])
+def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, scale):
+    """Park section III-E, Fig. 9: the odometer scale factor (true 1.03 and 0.97) estimated
+    within 0.5 % when GNSS is lost at the garage entry, every seed."""
+    if scale == 1.03:
+        rel = _column(garage, "dr3d_ekf", "scale_at_entry")
+    else:
+        runs = cmp.compare_seeds(SEEDS, [f"sensors.odometer.scale_factor={scale}"],
+                                 names=["dr3d_ekf"], work=tmp_path)
+        rel = _column(runs, "dr3d_ekf", "scale_at_entry")
+    assert np.all(np.abs(rel) < 0.005), rel
+
+
+def test_baselines_are_working_filters(garage):
+    """Every filter's horizontal RMS outside the GNSS outages is under 5 m, every seed."""
+    for name in cmp.registered_filters():
+        rms = _column(garage, name, "rms_outside")
+        assert np.all(rms < 5.0), (name, rms)
