@@ -46,6 +46,14 @@ class FaultKind:
     streams: tuple[str, ...]  # streams it acts on (one of them must exist)
     doc: str
 
+    @property
+    def changed_streams(self) -> tuple[str, ...]:
+        """Every stream ``apply`` may change: those it acts on and, for a fault on the GNSS
+        measurements, the GNSS truth table, which records the signals tracked and their true
+        errors. A stream is written only once no fault will change it."""
+        gnss = any(name.startswith("gnss_") for name in self.streams)
+        return self.streams + (("truth_gnss",) if gnss else ())
+
 
 FAULT_REGISTRY: dict[str, FaultKind] = {}
 
