@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from simulator.faults.triggers import TRIGGER_FIELDS
-from simulator.scenario.schema import Field, Record
+from simulator.schema import Field, Record
 
 if TYPE_CHECKING:
     import pandas as pd
