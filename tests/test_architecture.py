@@ -136,8 +136,9 @@ def _import_alone(module: str) -> tuple[str, int, str]:
 
 @pytest.mark.parametrize("package", PACKAGES)
 def test_every_module_imports_on_its_own(package):
-    """One fresh interpreter per module (four per core at a time: most of an import waits on the disk and the other processes of a busy machine): an import cycle or a module
-    that only works after another has been imported fails here."""
+    """One fresh interpreter per module, four per core at a time (much of an import waits on
+    the disk and on the other processes of a busy machine): an import cycle, or a module that
+    works only after another has been imported, fails here."""
     modules = [m for m in MODULES if _matches(m, package)]
     with ThreadPoolExecutor(max_workers=4 * (os.cpu_count() or 1)) as pool:
         failed = [f"{module}: {error}" for module, code, error in pool.map(_import_alone, modules)
