@@ -12,8 +12,8 @@ from simulator.commands import SUMMARIES
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 from simulator.replay import run_estimator, write_solution
-from simulator.scenario.schema import INVALID, Context
 from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
+from simulator.schema import INVALID, Context
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

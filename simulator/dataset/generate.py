@@ -116,7 +116,7 @@ def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = 
         # and the outage table unless asked for
         gnss = sensors.get("gnss")
         unsettled = {name for fault in scenario["faults"]
-                     for name in FAULT_REGISTRY[fault["kind"]].streams}
+                     for name in FAULT_REGISTRY[fault["kind"]].changed_streams}
         if gnss is not None and "raw" not in gnss["outputs"]:
             unsettled.add("gnss_raw")
         if on_final is not None:
