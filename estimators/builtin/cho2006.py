@@ -25,9 +25,10 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
 * Eq. 24c multiplies g sin(theta) by the accelerometer scale factor as well; eqs. 6, 11 and the
   appendix scale only the measured specific force. We use ((1 - d_ax) f_x - g sin theta)
   cos theta, whose derivative in theta is eq. 17c.
-* Eq. 24 moves the position with the previous step's speed and heading; both filters use that
-  (explicit Euler) form, and the EKF's transition matrix is the Jacobian of the same function
-  (eqs. 16-17).
+* Eq. 24 moves the position with the previous step's speed and heading, eq. 5 with the new
+  ones; DRM2 uses their mean (the trapezoidal rule: in a 15 deg/s turn either one alone lags or
+  leads the heading by 0.75 deg, which the filter mistakes for a scale-factor error). The EKF's
+  transition matrix is the Jacobian of the same function (eqs. 16-17).
 * Q (eq. 34) is read as the variance growth per second: the EKF adds Q dt per 0.1 s step; the
   SPKF augments the non-zero terms of Q over one second (eqs. 19-20 with the singular zero rows
   left out) and each 10 Hz step adds its sigma point's noise times dt / 1 s; the points are
@@ -95,19 +96,23 @@ R_GPS = np.diag([15.0**2, 15.0**2, 0.3**2])  # eq. 35: north, east (m), speed (m
 
 def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: float,
                     g: float) -> np.ndarray:
-    """DRM2 propagation of states ``x`` (k, 8) over ``dt`` (Cho & Choi eqs. 24a-h).
+    """DRM2 propagation of states ``x`` (k, 8) over ``dt`` (Cho & Choi eqs. 24a-h, 4-7).
 
     ``u`` = [f_x (m/s^2), w_y, w_z (rad/s)], bias-compensated means over the step; ``w``
-    (k, 8) is the noise of each point over one second, added in proportion dt / 1 s.
+    (k, 8) is the noise of each point over one second, added in proportion dt / 1 s. The
+    position moves with the mean of the step's old (eq. 24a-b) and new (eq. 5) velocity
+    vectors (the trapezoidal rule).
     """
     pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T
     f_x, w_y, w_z = u
     out = np.empty_like(x)
-    out[:, 0] = pn + v * np.cos(psi) * dt  # eq. 24a
-    out[:, 1] = pe + v * np.sin(psi) * dt  # eq. 24b
-    out[:, 2] = v + ((1.0 - d_ax) * f_x - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
+    v_new = v + ((1.0 - d_ax) * f_x - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
+    psi_new = psi + (1.0 - d_gz) * w_z * dt  # eq. 24e
+    out[:, 0] = pn + 0.5 * (v * np.cos(psi) + v_new * np.cos(psi_new)) * dt  # eqs. 24a, 5
+    out[:, 1] = pe + 0.5 * (v * np.sin(psi) + v_new * np.sin(psi_new)) * dt  # eqs. 24b, 5
+    out[:, 2] = v_new
     out[:, 3] = th + (1.0 - d_gy) * w_y * dt  # eq. 24d
-    out[:, 4] = wrap_angle(psi + (1.0 - d_gz) * w_z * dt)  # eq. 24e
+    out[:, 4] = wrap_angle(psi_new)
     out[:, 5:] = x[:, 5:]  # eqs. 24f-h
     if w is not None:
         out += w * (dt / DRAW_INTERVAL_S)
@@ -116,19 +121,28 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
 
 
 def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarray:
-    """Transition matrix of ``drm2_transition`` at ``x`` (8,) (Cho & Choi eqs. 16-17)."""
+    """Transition matrix of ``drm2_transition`` at ``x`` (8,) (Cho & Choi eqs. 16-17, with the
+    trapezoidal position step)."""
     _, _, v, th, psi, d_ax, d_gy, d_gz = x
     f_x, w_y, w_z = u
-    c, s = math.cos(psi), math.sin(psi)
-    phi = np.eye(8)
-    phi[0, 2], phi[0, 4] = c * dt, -v * s * dt  # A_1, A_2 (eq. 17a-b)
-    phi[1, 2], phi[1, 4] = s * dt, v * c * dt
     st, ct = math.sin(th), math.cos(th)
+    v_new = v + ((1.0 - d_ax) * f_x - g * st) * ct * dt
+    psi_new = psi + (1.0 - d_gz) * w_z * dt
+    phi = np.eye(8)
     # A_3 (eq. 17c) with SF_ax = 1 - d_ax, and the scale-factor column
     phi[2, 3] = (g * st * st - (1.0 - d_ax) * f_x * st - g * ct * ct) * dt
     phi[2, 5] = -f_x * ct * dt
     phi[3, 6] = -w_y * dt  # A_4 (eq. 17d)
     phi[4, 7] = -w_z * dt
+    # position rows: A_1 and A_2 (eq. 17a-b) at the old and at the new velocity vector
+    c0, s0, c1, s1 = math.cos(psi), math.sin(psi), math.cos(psi_new), math.sin(psi_new)
+    half = 0.5 * dt
+    phi[0, 2] += half * c0
+    phi[0, 4] -= half * v * s0
+    phi[1, 2] += half * s0
+    phi[1, 4] += half * v * c0
+    phi[0] += half * (c1 * phi[2] - v_new * s1 * phi[4])
+    phi[1] += half * (s1 * phi[2] + v_new * c1 * phi[4])
     return phi
 
 

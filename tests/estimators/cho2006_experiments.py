@@ -63,12 +63,17 @@ def moving_off(ds: Dataset) -> float:
     return float(truth["t"].to_numpy()[np.argmax(truth["speed"].to_numpy() > 0.1)])
 
 
-def heading_rms(ds: Dataset, name: str, heading_error_deg: float,
-                config: dict | None = None) -> float:
+_HEADING_RMS: dict[tuple[str, str, float], float] = {}  # shared by the tests of one session
+
+
+def heading_rms(ds: Dataset, name: str, heading_error_deg: float) -> float:
     """Heading RMS (deg) from 60 s after moving off to the end, from ``heading_error_deg``."""
-    t, _, d_yaw = errors(ds, run(ds, name, {"heading_error": heading_error_deg}, config))
-    late = t >= moving_off(ds) + SETTLE_S
-    return float(np.sqrt(np.mean(d_yaw[late] ** 2)))
+    key = (str(ds.path), name, heading_error_deg)
+    if key not in _HEADING_RMS:
+        t, _, d_yaw = errors(ds, run(ds, name, {"heading_error": heading_error_deg}))
+        late = t >= moving_off(ds) + SETTLE_S
+        _HEADING_RMS[key] = float(np.sqrt(np.mean(d_yaw[late] ** 2)))
+    return _HEADING_RMS[key]
 
 
 def dr_error(ds: Dataset, name: str) -> float:
