@@ -32,6 +32,8 @@ BUILTINS = {
     "dr2d_drm1_ekf": "estimators.builtin.cho2006:Drm1Ekf",
     "dr2d_drm2_ekf": "estimators.builtin.cho2006:Drm2Ekf",
     "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",
+    "dr2d_odo_ekf": "estimators.builtin.park2019_dr:Dr2dOdoEkf",
+    "dr3d_ekf": "estimators.builtin.park2019_dr:Dr3dEkf",
 }
 
 
