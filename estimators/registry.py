@@ -29,6 +29,8 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
+    "tc_ukf": "estimators.builtin.chan:TcUkf",
+    "tc_ekf": "estimators.builtin.chan:TcEkf",
 }
 
 

@@ -14,7 +14,7 @@ The update per interval:
 
 Public functions
 ----------------
-propagate, run_strapdown, rates_to_increments.
+propagate, run_strapdown, rates_to_increments, nav_derivative, rk4_step.
 """
 
 from __future__ import annotations
@@ -161,3 +161,46 @@ def rates_to_increments(t: np.ndarray, rates: np.ndarray) -> tuple[np.ndarray, n
     """Trapezoidal increments over [t_{k-1}, t_k] from rate samples; returns (increments, dt)."""
     dt = np.diff(t)
     return 0.5 * (rates[1:] + rates[:-1]) * dt[:, None], dt
+
+
+@njit(cache=True)
+def nav_derivative(pos: np.ndarray, v: np.ndarray, q: np.ndarray, w_ib: np.ndarray,
+                   f_b: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Time derivatives of the total navigation state in the NED frame (Chan et al. eqs. 1-3;
+    Titterton & Weston 2004, section 3.5.3):
+
+    L' = v_N / (R_m + h), l' = v_E / ((R_t + h) cos L), h' = -v_D (eq. 1);
+    v' = C_b^n f^b - (2 w_ie + w_en) x v + g^n (eq. 2, g the normal gravity);
+    q' = 1/2 q * (0, w_nb^b), w_nb^b = w_ib^b - C_n^b (w_ie + w_en) (eq. 3, whose Omega matrix
+    is this product for a scalar-last quaternion; here scalar first, body to NED).
+
+    pos: latitude, longitude (rad), height (m); v: NED velocity, m/s; q: body-to-NED quaternion;
+    w_ib, f_b: body angular rate (rad/s) and specific force (m/s^2), FRD."""
+    lat, h = pos[0], pos[2]
+    rm, rt = _radii(lat)
+    pos_dot = np.array([v[0] / (rm + h), v[1] / ((rt + h) * np.cos(lat)), -v[2]])
+    w_ie, w_en = _nav_rates(lat, h, v)
+    c_bn = _quat_dcm(q)
+    g = np.array([0.0, 0.0, _normal_gravity(lat, h)])
+    v_dot = c_bn @ f_b - np.cross(2.0 * w_ie + w_en, v) + g
+    w_nb = w_ib - c_bn.T @ (w_ie + w_en)
+    q_dot = 0.5 * _quat_mul(q, np.array([0.0, w_nb[0], w_nb[1], w_nb[2]]))
+    return pos_dot, v_dot, q_dot
+
+
+@njit(cache=True)
+def rk4_step(pos: np.ndarray, v: np.ndarray, q: np.ndarray, w0: np.ndarray, w_mid: np.ndarray,
+             w1: np.ndarray, f0: np.ndarray, f_mid: np.ndarray, f1: np.ndarray, dt: float
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """One classical fourth-order Runge-Kutta step of ``nav_derivative`` over ``dt`` with the
+    body rates and specific forces at the step's start, middle and end (the quaternion is
+    normalised after the step). Returns new (pos, v, q)."""
+    p1, v1, q1 = nav_derivative(pos, v, q, w0, f0)
+    h2 = 0.5 * dt
+    p2, v2, q2 = nav_derivative(pos + h2 * p1, v + h2 * v1, q + h2 * q1, w_mid, f_mid)
+    p3, v3, q3 = nav_derivative(pos + h2 * p2, v + h2 * v2, q + h2 * q2, w_mid, f_mid)
+    p4, v4, q4 = nav_derivative(pos + dt * p3, v + dt * v3, q + dt * q3, w1, f1)
+    s = dt / 6.0
+    q_new = q + s * (q1 + 2.0 * q2 + 2.0 * q3 + q4)
+    return (pos + s * (p1 + 2.0 * p2 + 2.0 * p3 + p4), v + s * (v1 + 2.0 * v2 + 2.0 * v3 + v4),
+            q_new / np.sqrt(np.sum(q_new * q_new)))
