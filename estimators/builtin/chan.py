@@ -240,28 +240,62 @@ def _propagate_points(pos: np.ndarray, v: np.ndarray, q: np.ndarray, ba: np.ndar
     of Chan eqs. 1-3 per interval, bias-corrected rates at its start (row j), end (row j + 1)
     and their mean at its middle. pos, v, ba, bg: (k, 3); q: (k, 4); w, f: (m + 1, 3);
     dt: (m,)."""
+    x = np.empty(10)
+    work = np.empty((5, 10))
+    rates = np.empty((6, 3))  # w0, w_mid, w1, f0, f_mid, f1
     for i in range(pos.shape[0]):
-        p_i, v_i, q_i = pos[i].copy(), v[i].copy(), q[i].copy()
+        x[0:3], x[3:6], x[6:10] = pos[i], v[i], q[i]
         for j in range(dt.shape[0]):
-            w0, w1 = w[j] - bg[i], w[j + 1] - bg[i]
-            f0, f1 = f[j] - ba[i], f[j + 1] - ba[i]
-            p_i, v_i, q_i = rk4_step(p_i, v_i, q_i, w0, 0.5 * (w0 + w1), w1, f0,
-                                     0.5 * (f0 + f1), f1, dt[j])
-        pos[i], v[i], q[i] = p_i, v_i, q_i
+            for a in range(3):
+                rates[0, a] = w[j, a] - bg[i, a]
+                rates[2, a] = w[j + 1, a] - bg[i, a]
+                rates[1, a] = 0.5 * (rates[0, a] + rates[2, a])
+                rates[3, a] = f[j, a] - ba[i, a]
+                rates[5, a] = f[j + 1, a] - ba[i, a]
+                rates[4, a] = 0.5 * (rates[3, a] + rates[5, a])
+            rk4_step(x, rates[0], rates[1], rates[2], rates[3], rates[4], rates[5], dt[j], work)
+        pos[i], v[i], q[i] = x[0:3], x[3:6], x[6:10]
 
 
-def _quat_conj(q: np.ndarray) -> np.ndarray:
-    return q * np.array([1.0, -1.0, -1.0, -1.0])
+@njit(cache=True)
+def _tangent(pos: np.ndarray, v: np.ndarray, q: np.ndarray, ba: np.ndarray, bg: np.ndarray,
+             clock: np.ndarray, ref: int, rm: float, rt: float) -> np.ndarray:
+    """Tangent vectors (k, 17) of the points around point ``ref`` (the ``boxminus`` of
+    ``TcUkf``): NED position displacement (m), velocity, the rotation vector of
+    q_i * conj(q_ref) (NED-frame attitude error, ``nav_error`` convention), biases, clock."""
+    k = pos.shape[0]
+    out = np.empty((k, 17))
+    lat0, lon0, h0 = pos[ref, 0], pos[ref, 1], pos[ref, 2]
+    a2, b2, c2, d2 = q[ref, 0], -q[ref, 1], -q[ref, 2], -q[ref, 3]
+    for i in range(k):
+        out[i, 0] = (pos[i, 0] - lat0) * (rm + h0)
+        out[i, 1] = (pos[i, 1] - lon0) * (rt + h0) * np.cos(lat0)
+        out[i, 2] = h0 - pos[i, 2]
+        a1, b1, c1, d1 = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        w = a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2
+        x = a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2
+        y = a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2
+        z = a1 * d2 + b1 * c2 - c1 * b2 + d1 * a2
+        if w < 0:
+            w, x, y, z = -w, -x, -y, -z
+        s = np.sqrt(x * x + y * y + z * z)
+        scale = 2.0 * np.arctan2(s, w) / s if s > 1e-12 else 2.0
+        for j in range(3):
+            out[i, 3 + j] = v[i, j] - v[ref, j]
+            out[i, 9 + j] = ba[i, j] - ba[ref, j]
+            out[i, 12 + j] = bg[i, j] - bg[ref, j]
+        out[i, 6], out[i, 7], out[i, 8] = x * scale, y * scale, z * scale
+        out[i, 15] = clock[i, 0] - clock[ref, 0]
+        out[i, 16] = clock[i, 1] - clock[ref, 1]
+    return out
 
 
-def _quat_rotvec(q: np.ndarray) -> np.ndarray:
-    """Rotation vectors (..., 3) of unit quaternions (..., 4) (the shorter rotation)."""
-    q = np.where(q[..., :1] < 0, -q, q)
-    vec = q[..., 1:]
-    s = np.linalg.norm(vec, axis=-1)
-    angle = 2.0 * np.arctan2(s, q[..., 0])
-    scale = np.where(s > 1e-12, angle / np.maximum(s, 1e-300), 2.0)
-    return vec * scale[..., None]
+def _plus_one(state: dict, dx: np.ndarray) -> dict:
+    """One state moved by a tangent vector (``TcUkf.boxplus`` of a single point, through the
+    ``nav_error`` convention)."""
+    q, v, pos = nav_error.perturb(state["q"], state["v"], state["pos"], dx[:9])
+    return {"pos": pos, "v": v, "q": q, "ba": state["ba"] + dx[9:12],
+            "bg": state["bg"] + dx[12:15], "clock": state["clock"] + dx[15:17]}
 
 
 class TcUkf(_TightlyCoupled):
@@ -304,20 +338,11 @@ class TcUkf(_TightlyCoupled):
                 "clock": mean["clock"] + dx[:, 15:17]}
 
     @staticmethod
-    def boxminus(pts: dict, ref: dict) -> np.ndarray:
-        """Tangent vectors (k, 17) of the points ``pts`` around the single state ``ref``."""
-        pos = ref["pos"]
-        rm, rt = radii_of_curvature(pos[0])
-        d = np.empty((len(pts["pos"]), N_STATES))
-        d[:, 0] = (pts["pos"][:, 0] - pos[0]) * (rm + pos[2])
-        d[:, 1] = (pts["pos"][:, 1] - pos[1]) * (rt + pos[2]) * np.cos(pos[0])
-        d[:, 2] = pos[2] - pts["pos"][:, 2]
-        d[:, 3:6] = pts["v"] - ref["v"]
-        d[:, 6:9] = _quat_rotvec(quat_multiply(pts["q"], _quat_conj(ref["q"])[None, :]))
-        d[:, 9:12] = pts["ba"] - ref["ba"]
-        d[:, 12:15] = pts["bg"] - ref["bg"]
-        d[:, 15:17] = pts["clock"] - ref["clock"]
-        return d
+    def boxminus(pts: dict, ref: int = 0) -> np.ndarray:
+        """Tangent vectors (k, 17) of the points ``pts`` around their point ``ref``."""
+        rm, rt = radii_of_curvature(pts["pos"][ref, 0])
+        return _tangent(pts["pos"], pts["v"], pts["q"], pts["ba"], pts["bg"], pts["clock"], ref,
+                        float(rm), float(rt))
 
     def _draw(self) -> None:
         """Sigma points of N(mean, P) on the tangent space (paper step 1), as states."""
@@ -336,9 +361,9 @@ class TcUkf(_TightlyCoupled):
         """Weighted mean and covariance of the propagated points (paper step 3), and the
         points' tangent deviations from the mean."""
         center = {k: v[0] for k, v in self._pts.items()}
-        d = self.boxminus(self._pts, center)
+        d = self.boxminus(self._pts)
         mean_dx = self._wm @ d
-        mean = {k: v[0] for k, v in self.boxplus(center, mean_dx[None, :]).items()}
+        mean = _plus_one(center, mean_dx)
         dev = d - mean_dx
         return mean, (self._wc[:, None] * dev).T @ dev, dev
 
@@ -416,7 +441,7 @@ class TcUkf(_TightlyCoupled):
         z = np.concatenate(z_parts + ([np.zeros(2)] if nhc else []))
         gain = np.linalg.solve(p_yy, p_xy.T).T
         correction = gain @ (z - y_mean)
-        self._mean = {k: v[0] for k, v in self.boxplus(self._mean, correction[None, :]).items()}
+        self._mean = _plus_one(self._mean, correction)
         p = self._p - gain @ p_yy @ gain.T
         self._p = 0.5 * (p + p.T)
         self._draw()
