@@ -34,6 +34,8 @@ BUILTINS = {
     "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",
     "dr2d_odo_ekf": "estimators.builtin.park2019_dr:Dr2dOdoEkf",
     "dr3d_ekf": "estimators.builtin.park2019_dr:Dr3dEkf",
+    "tc_ukf": "estimators.builtin.chan:TcUkf",
+    "tc_ekf": "estimators.builtin.chan:TcEkf",
 }
 
 
