@@ -29,6 +29,7 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
+    "riss3d_tc_ekf": "estimators.builtin.karamat2015:RissTcEkf",
 }
 
 
