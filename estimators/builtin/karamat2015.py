@@ -67,6 +67,7 @@ import math
 import numpy as np
 
 from estimators.base import Estimator
+from estimators.toolbox import gnss_model
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.kalman import ErrorState
 from simulator.earth import (
@@ -78,8 +79,6 @@ from simulator.earth import (
     wrap_angle,
 )
 from simulator.errors import InputError
-
-C_M_S = 299792458.0  # speed of light, m/s (IS-GPS-200)
 
 STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
@@ -262,11 +261,7 @@ class RissTcEkf(Estimator):
         self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
         self._t_accel_update = init.t
         if "gnss_raw" in self.columns:
-            g = self.columns["gnss_raw"]
-            self._raw_cols = [g[k] for k in ("pseudorange", "pseudorange_rate", "sat_x", "sat_y",
-                                             "sat_z", "sat_vx", "sat_vy", "sat_vz", "sat_clock",
-                                             "sat_clock_drift", "iono", "tropo")]
-            self._raw_std = (g.get("pseudorange_std"), g.get("pseudorange_rate_std"))
+            self._col_pr = self.columns["gnss_raw"]["pseudorange"]
         if "gnss_fix" in self.columns:
             g = self.columns["gnss_fix"]
             self._fix_cols = [g[k] for k in ("lat", "lon", "alt", "vn", "ve", "vd", "fix")]
@@ -295,10 +290,10 @@ class RissTcEkf(Estimator):
         if not self._tight:
             return
         self._catch_up(t)
-        rows = rows[np.isfinite(rows[:, self._raw_cols[0]])]
+        rows = rows[np.isfinite(rows[:, self._col_pr])]
         if len(rows) == 0:
             return
-        self._update_ranges(rows)
+        self._update_ranges(gnss_model.raw_epoch(rows, self.columns["gnss_raw"]))
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         if self._tight:
@@ -435,54 +430,41 @@ class RissTcEkf(Estimator):
         self._filter.update(dz, h, np.eye(2) * sigma**2)
         self._feedback()
 
-    def _update_ranges(self, rows: np.ndarray) -> None:
-        """Eqs. 45-49: dz = rho_RISS - rho_GPS, and the same for the rates, with
-        H = [-u^T C_n^e ..., +1 for the clock] (errors as estimate minus truth)."""
-        (pr, prr, sx, sy, sz, svx, svy, svz, sclk, sclkd, iono, tropo) = (
-            rows[:, k] for k in self._raw_cols)
-        rho = pr + sclk - iono - tropo  # geometric range + receiver clock (SPEC section 5)
-        rate = prr + sclkd
+    def _update_ranges(self, epoch: gnss_model.RawEpoch) -> None:
+        """Eqs. 45-49: dz = rho_RISS - rho_GPS and the same for the rates, predicted by the
+        shared model (``estimators.toolbox.gnss_model``: Sagnac, broadcast corrections), with
+        H = [-los^T C_n^e, +1 for the clock] (eqs. 46-49 with errors as estimate minus truth)."""
         pos = geodetic_to_ecef(self._lat, self._lon, self._h).reshape(3)
         c_ne = ned_to_ecef_matrix(self._lat, self._lon)
         v_ecef = c_ne @ np.array([self._vn, self._ve, -self._vu])
-        sat = np.stack([sx, sy, sz], axis=1)
-        sat_v = np.stack([svx, svy, svz], axis=1)
-        # Earth rotation during the signal's flight (Sagnac; Groves eq. 8.36)
-        theta = OMEGA_E_RAD_S * np.linalg.norm(sat - pos, axis=1) / C_M_S
-        ct, st = np.cos(theta), np.sin(theta)
-        sat = np.stack([ct * sat[:, 0] + st * sat[:, 1], -st * sat[:, 0] + ct * sat[:, 1],
-                        sat[:, 2]], axis=1)
-        sat_v = np.stack([ct * sat_v[:, 0] + st * sat_v[:, 1],
-                          -st * sat_v[:, 0] + ct * sat_v[:, 1], sat_v[:, 2]], axis=1)
-        diff = sat - pos
-        geo = np.linalg.norm(diff, axis=1)
-        u = diff / geo[:, None]  # receiver-to-satellite unit vectors, ECEF
-        geo_rate = np.einsum("ij,ij->i", u, sat_v - v_ecef)
         if not self._clock_ready:
-            self._cb = float(np.median(rho - geo))
-            self._cd = float(np.median(rate - geo_rate))
+            rho0, rate0, _ = gnss_model.predict(epoch.sat_pos, epoch.sat_vel, pos, v_ecef)
+            self._cb = float(np.median(epoch.pseudorange - rho0))
+            self._cd = float(np.median(epoch.range_rate - rate0))
             self._clock_ready = True
-        u_ned = u @ c_ne  # rows: u in NED
-        m = len(rows)
+        rho, rate, los = gnss_model.predict(epoch.sat_pos, epoch.sat_vel, pos, v_ecef,
+                                            self._cb, self._cd)
+        jac = gnss_model.los_jacobians(los)  # [-los (ECEF), 1]
+        d_ned = jac[:, :3] @ c_ne  # d rho / d (north, east, down) of the antenna
+        m = len(rho)
         h = np.zeros((2 * m, self._n))
-        h[:m, _I["N"]] = -u_ned[:, 0]
-        h[:m, _I["E"]] = -u_ned[:, 1]
-        h[:m, _I["h"]] = u_ned[:, 2]  # d(down) = -dh
+        h[:m, _I["N"]] = d_ned[:, 0]
+        h[:m, _I["E"]] = d_ned[:, 1]
+        h[:m, _I["h"]] = -d_ned[:, 2]  # d(down) = -dh
         h[:m, _I["cb"]] = 1.0
-        h[m:, _I["ve"]] = -u_ned[:, 1]
-        h[m:, _I["vn"]] = -u_ned[:, 0]
-        h[m:, _I["vu"]] = u_ned[:, 2]
+        h[m:, _I["ve"]] = d_ned[:, 1]
+        h[m:, _I["vn"]] = d_ned[:, 0]
+        h[m:, _I["vu"]] = -d_ned[:, 2]
         h[m:, _I["cd"]] = 1.0
-        dz = np.concatenate([geo + self._cb - rho, geo_rate + self._cd - rate])
-        std_pr, std_rate = self._raw_std
-        var_pr = rows[:, std_pr] ** 2 if std_pr is not None else np.full(m, 9.0)
-        var_rate = rows[:, std_rate] ** 2 if std_rate is not None else np.full(m, 0.01)
+        dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
+        var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
+        var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
         r = np.diag(np.concatenate([var_pr, var_rate]))
         # the mechanised velocity carries the white noise of the last odometer speed: it enters
         # every predicted rate through the forward axis, so R gains sigma^2 g g^T
         forward = np.array([math.cos(self._az), math.sin(self._az), 0.0]) * math.cos(self._pitch)
         forward[2] = -math.sin(self._pitch)
-        g = -u_ned @ forward
+        g = d_ned @ forward
         r[m:, m:] += self.config["odometer_speed_noise"] ** 2 * np.outer(g, g)
         self._filter.update(dz, h, r)
         self._feedback()
