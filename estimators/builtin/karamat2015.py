@@ -41,9 +41,20 @@ plain averaged accelerometers.
 
 System model: F of eqs. 13, 16, 17, 20, 24, 28, 31, 32 (``system_matrix``; the paper drops the
 terms over (R + h)^2 and so does it), first-order Gauss-Markov tilt errors, accelerometer biases,
-odometer-acceleration error and gyro bias (eqs. 33-38), random-walk clock drift (eqs. 40-41),
-discretised over each odometer interval with Phi = I + F dt + (F dt)^2 / 2 and Q_d = G Q G^T dt
-(the Gauss-Markov diagonal in closed form, ``estimators.toolbox.gauss_markov``).
+odometer-acceleration error and gyro bias (eqs. 33-38), random-walk clock drift (eqs. 40-41,
+its noise from the TCXO Allan parameters of the shared ``gnss_model.clock_noise``), discretised
+over each odometer interval with Phi = I + F dt + (F dt)^2 / 2 and Q_d = G Q G^T dt (the
+Gauss-Markov diagonal in closed form, ``estimators.toolbox.gauss_markov``).
+
+Velocity: the paper's error model treats the velocities as states driven by eqs. 22, 26 and 30
+(the time derivatives of eqs. 4-6), while its mechanisation recomputes them from the odometer
+(eqs. 4-6). Recomputing them each step throws the filter's velocity corrections away, and the
+heading then diverged in the first sharp turn of every drive we tried (the filter explains the
+persistent innovation with a huge azimuth correction). So the direction of the horizontal
+velocity is propagated as eqs. 22 and 26 do (turned by dA/dt each step, corrected by the
+filter) and its magnitude is the odometer's, v_o cos p (eqs. 4-5); v_u is eq. 6. Integrating
+eqs. 22/26 fully instead lets the a_od corrections accumulate into a speed error no measurement
+anchors (1 m/s in a 60 s one-satellite window).
 
 Measurements: pseudoranges and pseudorange rates (eqs. 45-49; ``coupling: tight``), or the
 receiver's 3-D fixes (position and velocity; ``coupling: loose``; a loosely coupled filter has
@@ -107,9 +118,10 @@ _P0_SIGMA = {"N": 3.0, "E": 3.0, "h": 5.0, "ve": 0.3, "vn": 0.3, "vu": 0.3, "A":
              "bx": 30.0 * MG, "by": 30.0 * MG,  # Table 1: accelerometer bias 30 mg
              "vo": 0.2}
 # white-noise densities (per second) of the states without a Gauss-Markov model
-_Q_WHITE = {"ve": 1e-4, "vn": 1e-4, "vu": 1e-4,  # (m/s)^2/s: unmodelled motion
+# (m/s)^2/s: unmodelled motion; v_u = v_o sin p (eq. 6) takes the noise of the accelerometer
+# pitch of eq. 2 directly (about 0.5 deg, 0.1 m/s at 14 m/s), which eq. 31 does not model
+_Q_WHITE = {"ve": 1e-4, "vn": 1e-4, "vu": 0.05,
             "A": (2.25 * DEG / 60.0) ** 2,  # Table 1: gyro random walk 2.25 deg/sqrt(h)
-            "cb": 0.1, "cd": 0.01,  # m^2/s and (m/s)^2/s: a TCXO receiver clock
             "vo": 1e-4}  # (m/s)^2/s
 
 
@@ -375,11 +387,21 @@ class RissTcEkf(Estimator):
         az_mid = self._az + 0.5 * a_dot * dt
         self._az = float(wrap_angle(self._az + a_dot * dt))
         cos_p = math.cos(pitch)
-        self._ve = vo * math.sin(az_mid) * cos_p  # eq. 4
-        self._vn = vo * math.cos(az_mid) * cos_p  # eq. 5
+        # eqs. 4-5 with eqs. 22 and 26: the direction of the horizontal velocity turns with
+        # the azimuth rate (the form the error model of eqs. 24 and 28 linearises, so that a
+        # corrected direction persists), its magnitude is the odometer speed v_o cos p
+        ve0, vn0 = self._ve, self._vn
+        turn = a_dot * dt
+        c_t, s_t = math.cos(turn), math.sin(turn)
+        ue, un = ve0 * c_t + vn0 * s_t, vn0 * c_t - ve0 * s_t
+        norm = math.hypot(ue, un)
+        if norm < 0.1:  # too slow for a direction of its own: along the azimuth
+            ue, un, norm = math.sin(az_mid), math.cos(az_mid), 1.0
+        self._ve = vo * cos_p * ue / norm
+        self._vn = vo * cos_p * un / norm
         self._vu = vo * math.sin(pitch)  # eq. 6
-        self._lat += self._vn * dt / (rm + h)  # eq. 7
-        self._lon += self._ve * dt / ((rn + h) * math.cos(lat))  # eq. 8
+        self._lat += 0.5 * (vn0 + self._vn) * dt / (rm + h)  # eq. 7
+        self._lon += 0.5 * (ve0 + self._ve) * dt / ((rn + h) * math.cos(lat))  # eq. 8
         self._h += self._vu * dt  # eq. 9
         self._cb += self._cd * dt  # eq. 40
         self._pitch, self._roll = pitch, roll
@@ -405,7 +427,10 @@ class RissTcEkf(Estimator):
             phi_k, q_k = gauss_markov_discrete(tau, sigma, dt)
             phi[k, k] = phi_k
             q[k] = q_k
-        self._filter.predict(phi, np.diag(q))
+        q_d = np.diag(q)
+        clock = slice(_I["cb"], _I["cd"] + 1)
+        q_d[clock, clock] = gnss_model.clock_noise(dt)  # a TCXO (the shared clock model)
+        self._filter.predict(phi, q_d)
 
     # --- measurement updates ------------------------------------------------------------------
     def _update_accelerometers(self, g: float, ffwd: float, flat: float, wz: float) -> None:
