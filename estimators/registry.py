@@ -36,6 +36,7 @@ BUILTINS = {
     "dr3d_ekf": "estimators.builtin.park2019_dr:Dr3dEkf",
     "tc_ukf": "estimators.builtin.chan:TcUkf",
     "tc_ekf": "estimators.builtin.chan:TcEkf",
+    "riss3d_tc_ekf": "estimators.builtin.karamat2015:RissTcEkf",
 }
 
 
