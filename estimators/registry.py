@@ -29,6 +29,8 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
+    "ins_odo_ekf": "estimators.builtin.park2019_ins:ParkInsOdometer",
+    "ins_lkf": "estimators.builtin.tan2008:TanLinearisedKF",
 }
 
 

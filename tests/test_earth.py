@@ -119,3 +119,12 @@ def test_ned_to_body_is_the_transposed_dcm():
     v = rng.normal(size=(50, 3))
     expected = np.einsum("nji,nj->ni", earth.euler_to_dcm(roll, pitch, yaw), v)
     np.testing.assert_allclose(earth.ned_to_body(roll, pitch, yaw, v), expected, atol=1e-14)
+
+
+def test_single_vector_fast_paths_equal_the_stacked_forms():
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(4, 3))
+    q = earth.euler_to_quat(*rng.normal(size=(3, 4)))
+    np.testing.assert_array_equal(earth.skew(v[1]), earth.skew(v)[1])
+    np.testing.assert_allclose(earth.skew(v[2]) @ v[3], np.cross(v[2], v[3]), atol=1e-14)
+    np.testing.assert_allclose(earth.quat_to_dcm(q[3]), earth.quat_to_dcm(q)[3], atol=1e-15)

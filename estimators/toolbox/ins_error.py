@@ -49,6 +49,7 @@ from simulator.earth import OMEGA_E_RAD_S, normal_gravity, radii_of_curvature, s
 N_STATES = 15
 BA = slice(9, 12)  # accelerometer-bias error block
 BG = slice(12, 15)  # gyro-bias error block
+_BIAS_DIAG = np.arange(9, 15)
 
 
 def _rate_jacobians(lat: float, h: float, v: np.ndarray, rn: float, re: float
@@ -118,8 +119,8 @@ def system_matrix(lat: float, h: float, v_ned: np.ndarray, c_bn: np.ndarray,
     f[6:9, 6:9] = -skew(w_ie + w_en)
     f[6:9, BG] = -c_bn
     # biases
-    f[BA, BA] = np.diag(-1.0 / np.broadcast_to(np.asarray(tau_accel, float), (3,)))
-    f[BG, BG] = np.diag(-1.0 / np.broadcast_to(np.asarray(tau_gyro, float), (3,)))
+    f[_BIAS_DIAG, _BIAS_DIAG] = -1.0 / np.concatenate([np.broadcast_to(tau_accel, 3),
+                                                       np.broadcast_to(tau_gyro, 3)])
     return f
 
 
@@ -136,14 +137,11 @@ def noise_psd(c_bn: np.ndarray, accel_psd: np.ndarray | float, gyro_psd: np.ndar
     accel_bias_psd, gyro_bias_psd : PSD of the bias driving noises, (m/s^2)^2/s and
         (rad/s)^2/s (2 sigma^2 / tau for a Gauss-Markov bias).
     """
-    def body(psd: np.ndarray | float) -> np.ndarray:
-        return np.diag(np.broadcast_to(np.asarray(psd, float), (3,)))
-
     gqg = np.zeros((N_STATES, N_STATES))
-    gqg[3:6, 3:6] = c_bn @ body(accel_psd) @ c_bn.T
-    gqg[6:9, 6:9] = c_bn @ body(gyro_psd) @ c_bn.T
-    gqg[BA, BA] = body(accel_bias_psd)
-    gqg[BG, BG] = body(gyro_bias_psd)
+    gqg[3:6, 3:6] = (c_bn * np.broadcast_to(accel_psd, 3)) @ c_bn.T
+    gqg[6:9, 6:9] = (c_bn * np.broadcast_to(gyro_psd, 3)) @ c_bn.T
+    gqg[_BIAS_DIAG, _BIAS_DIAG] = np.concatenate([np.broadcast_to(accel_bias_psd, 3),
+                                                  np.broadcast_to(gyro_bias_psd, 3)])
     return gqg
 
 
