@@ -37,6 +37,8 @@ BUILTINS = {
     "tc_ukf": "estimators.builtin.chan:TcUkf",
     "tc_ekf": "estimators.builtin.chan:TcEkf",
     "riss3d_tc_ekf": "estimators.builtin.karamat2015:RissTcEkf",
+    "ins_odo_ekf": "estimators.builtin.park2019_ins:ParkInsOdometer",
+    "ins_lkf": "estimators.builtin.tan2008:TanLinearisedKF",
 }
 
 
