@@ -7,9 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from sensor_truths import drive_truth
-from simulator.scenario.schema import Context
 
 from simulator import columns as col
+from simulator.schema import Context
 from simulator.sensors.imu import IMU_FIELD, Imu
 from simulator.tables import as_frame
 
