@@ -33,8 +33,9 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   ``odometer_scale_factor`` column is SPEC section 7's ratio of measured to true speed, 1 / s.
 * Tilt measurement Jacobian. Eq. 37 is the level, small-roll approximation of the exact
   linearisation d(roll, pitch)/d psi = rows 1-2 of M(roll, pitch) C_n^b (M the Euler-rate
-  matrix); the exact rows are used (identical on level ground, better on a 15 % ramp). The same
-  holds for the course row of eq. 41 (row 3). The accelerometers give roll = atan2(-f_y, -f_z),
+  matrix); the exact rows are used (identical on level ground, better on a 15 % ramp). The
+  course row of eq. 41 is likewise the exact yaw Jacobian (``toolbox.aiding.heading``: the
+  course is the heading of the body x axis, the car does not slide). The accelerometers give roll = atan2(-f_y, -f_z),
   pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) in the FRD frame (eqs. 34-35 written for FRD) from the
   mean specific force of the step.
 * GPS speed is the horizontal ground speed, so its prediction is s u cos(pitch), not s u
@@ -74,7 +75,7 @@ import numpy as np
 from numba import njit
 
 from estimators.base import NAV_COLUMNS, Estimator
-from estimators.toolbox.constraints import height as height_measurement
+from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.gating import threshold_variance
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
@@ -86,6 +87,7 @@ DEG = math.pi / 180.0
 ACCEL_NORM_THRESHOLD_M_S2 = 0.059  # Park section III-D rule 1 (0.006 g)
 LOW_SPEED_THRESHOLD_M_S = 5.0  # Park section III-D rule 2 ("approximately 4 ~ 6 m/s")
 BARO_INNOVATION_THRESHOLD_M = 2.5  # Park section III-D rule 3 (80 % of one floor)
+_LEVEL = np.array([1.0, 0.0, 0.0, 0.0])  # identity quaternion
 
 
 def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
@@ -148,14 +150,6 @@ class _FixColumns:
         self.lat, self.lon, self.alt = columns["lat"], columns["lon"], columns["alt"]
         self.speed, self.course = columns["speed"], columns["course"]
         self.fix, self.vdop = columns["fix"], columns["vdop"]
-
-
-def _ned_offset(lat: float, lon: float, h: float, lat_ref: float, lon_ref: float,
-                h_ref: float) -> np.ndarray:
-    """(lat, lon, h) minus the reference as north and east arc lengths and down, m (rad in)."""
-    rn, re = radii(lat)
-    return np.array([(lat - lat_ref) * (rn + h), (lon - lon_ref) * (re + h) * math.cos(lat),
-                     -(h - h_ref)])
 
 
 class _StepAccumulator:
@@ -289,9 +283,9 @@ class Dr3dEkf(Estimator):
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
         if good_height and math.isfinite(self._baro_h):
             self._track_baro_offset(t, self._baro_h - alt)
-        dz = _ned_offset(*self._pos, lat, lon, alt)
         n = 3 if good_height else 2
-        rows = [np.eye(10)[:n]]
+        dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=10)
+        rows = [h_pos[:n]]
         dzs = [dz[:n]]
         var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
         speed = self._s * self._u
@@ -306,11 +300,12 @@ class Dr3dEkf(Estimator):
             dzs.append([abs(speed) * math.cos(pitch) - row[fx.speed]])
             var.append(c["gps_speed_sigma_inflated" if slow else "gps_speed_sigma"] ** 2)
         if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
-            h = np.zeros(10)
-            h[4:7] = jac[2]
-            rows.append(h[None])
-            yaw = math.atan2(self._cbn[1, 0], self._cbn[0, 0])
-            dzs.append([math.remainder(yaw - row[fx.course], 2.0 * math.pi)])
+            # the course is the heading of the body x axis (no side slip; eq. 41's last row)
+            dz_c, h_c = heading(self._q, float(row[fx.course]), n_states=9)
+            h = np.zeros((1, 10))
+            h[0, 4:7] = h_c[0, 6:9]  # the INS layout's psi columns to this filter's
+            rows.append(h)
+            dzs.append(dz_c)
             var.append(c["gps_course_sigma_inflated" if slow else "gps_course_sigma"] ** 2)
         self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(var))
         self._feedback()
@@ -357,7 +352,7 @@ class Dr3dEkf(Estimator):
             var = c["tilt_sigma"] ** 2
         rows, dzs, variances = [h], [dz], [var, var]
         if self._use_baro and self._baro_new and self._baro_offset is not None:
-            dz_h, h_h = height_measurement(self._pos[2], self._baro_h - self._baro_offset, 10)
+            dz_h, h_h = barometric_height(self._pos[2], self._baro_h, self._baro_offset, 10)
             var_h = c["baro_sigma"] ** 2
             if c["adaptive"]:
                 var_h = threshold_variance(abs(dz_h[0]), BARO_INNOVATION_THRESHOLD_M,
@@ -479,8 +474,11 @@ class Dr2dOdoEkf(Estimator):
         if self._imu.dt > 0.0:
             self._step()
         c = self.config
-        dz = _ned_offset(self._lat, self._lon, self._h, math.radians(row[fx.lat]),
-                         math.radians(row[fx.lon]), self._h)[:2]
+        # no lever arm: the attitude argument is not used
+        dz, _ = gnss_position(_LEVEL, np.array([self._lat, self._lon, self._h]),
+                              np.array([math.radians(row[fx.lat]), math.radians(row[fx.lon]),
+                                        self._h]), n_states=5)
+        dz = dz[:2]
         h = np.eye(5)[:2]
         var = [c["gps_horizontal_sigma"] ** 2] * 2
         if self._u != 0.0 and math.isfinite(row[fx.speed]):
