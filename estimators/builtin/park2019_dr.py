@@ -35,9 +35,9 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   linearisation d(roll, pitch)/d psi = rows 1-2 of M(roll, pitch) C_n^b (M the Euler-rate
   matrix); the exact rows are used (identical on level ground, better on a 15 % ramp). The
   course row of eq. 41 is likewise the exact yaw Jacobian (``toolbox.aiding.heading``: the
-  course is the heading of the body x axis, the car does not slide). The accelerometers give roll = atan2(-f_y, -f_z),
-  pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) in the FRD frame (eqs. 34-35 written for FRD) from the
-  mean specific force of the step.
+  course is the heading of the body x axis, the car does not slide). The accelerometers give
+  roll = atan2(-f_y, -f_z), pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) in the FRD frame (eqs.
+  34-35 written for FRD) from the mean specific force of the step.
 * GPS speed is the horizontal ground speed, so its prediction is s u cos(pitch), not s u
   (eq. 39); the Jacobian has u cos(pitch) on ds and -s u sin(pitch) on the pitch error. Course
   is used only while moving forwards faster than ``course_min_speed`` (it is undefined at
@@ -50,8 +50,14 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   inflates the tilt noise from ``tilt_sigma`` to ``tilt_sigma_inflated``; (2) a speed below
   5 m/s inflates the GPS speed and course noise to their ``*_inflated`` values; (3) a barometric
   innovation over 2.5 m inflates the barometer noise to ``baro_sigma_inflated``. The inflated
-  values are not printed: chosen as ten times (tilt), five times (speed, course) and twenty
-  times (barometer) the nominal. With ``adaptive: false`` the nominal values are used always.
+  values are not printed: five times (speed, course) and twenty times (barometer) the nominal;
+  for the tilt 30 deg, thirty times: a manoeuvre flagged by rule 1 lasts seconds, and its tilt
+  error (9 deg at 1.5 m/s^2) must not pull the attitude through 20 updates a second (with
+  10 deg it still did, by 9 deg). The "g" of rule 1 is the specific-force norm measured at
+  standstill (odometer reading zero), normal gravity before the first standstill: the residual
+  accelerometer bias Park assumes (7 mg, section III-B) exceeds the 0.059 m/s^2 threshold
+  itself, so against normal gravity the rule flags standstill and passes moderate
+  accelerations. With ``adaptive: false`` the nominal values are used always.
 * Gauss-Markov time constants (eq. 29) are not printed: tau_1 = 3600 s for the scale factor
   (tyre wear and pressure change over hours), tau_2 = 600 s for the gyro biases; process noise
   from the SMI130 gyro noise density (Table 1) and small steady-state sigmas.
@@ -153,34 +159,49 @@ class _FixColumns:
 
 
 class _StepAccumulator:
-    """IMU samples summed over one filter step: gyro increments, mean specific force."""
+    """IMU samples summed over one filter step: gyro increments, mean specific force. Rate
+    samples are integrated by the trapezoidal rule between consecutive samples (the first
+    sample holds over the interval before it); increments are summed."""
 
     def __init__(self, columns: dict[str, int], units: dict[str, str], t0: float):
-        self.gyro = [columns["gyro_x"], columns["gyro_y"], columns["gyro_z"]]
-        self.accel = [columns[a] for a in ("accel_x", "accel_y", "accel_z") if a in columns]
+        # column of each axis, None for an axis the unit lacks (read as zero)
+        self.cols = [columns.get(a) for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x",
+                                              "accel_y", "accel_z")]
+        self.has_accel = None not in self.cols[3:]
         self.increments = units.get("gyro_z") == "rad"
         self.t = t0
+        self.prev: list[float] | None = None
         self.reset()
 
     def reset(self) -> None:
-        self.dtheta = [0.0, 0.0, 0.0]  # rad, body FRD
-        self.dvel = [0.0, 0.0, 0.0]  # m/s (specific force integrated)
+        self.sums = [0.0] * len(self.cols)  # rad, then m/s (body FRD)
         self.dt = 0.0
+
+    @property
+    def dtheta(self) -> list[float]:
+        """Summed angle increment of the step, rad."""
+        return self.sums[:3]
+
+    @property
+    def dvel(self) -> list[float]:
+        """Summed velocity increment (specific force integrated) of the step, m/s."""
+        return self.sums[3:6]
 
     def add(self, t: float, row: np.ndarray) -> None:
         dt = t - self.t
         if dt <= 0.0:
             return
         self.t = t
-        g, a = self.gyro, self.accel
-        w = 1.0 if self.increments else dt  # a rate sample holds over the interval before it
-        self.dtheta[0] += row[g[0]] * w
-        self.dtheta[1] += row[g[1]] * w
-        self.dtheta[2] += row[g[2]] * w
-        if a:
-            self.dvel[0] += row[a[0]] * w
-            self.dvel[1] += row[a[1]] * w
-            self.dvel[2] += row[a[2]] * w
+        now = [0.0 if c is None else float(row[c]) for c in self.cols]
+        sums = self.sums
+        if self.increments:
+            for k, x in enumerate(now):
+                sums[k] += x
+        else:
+            prev = now if self.prev is None else self.prev
+            for k, x in enumerate(now):
+                sums[k] += 0.5 * (x + prev[k]) * dt
+            self.prev = now
         self.dt += dt
 
 
@@ -209,7 +230,7 @@ class Dr3dEkf(Estimator):
         "attitude_initial": 1.0 * DEG,  # rad, P0 roll and pitch
         "heading_initial": 5.0 * DEG,  # rad, P0 yaw
         "tilt_sigma": 1.0 * DEG,  # rad, accelerometer roll/pitch noise
-        "tilt_sigma_inflated": 10.0 * DEG,
+        "tilt_sigma_inflated": 30.0 * DEG,
         "baro_sigma": 0.5,  # m
         "baro_sigma_inflated": 10.0,  # m
         "baro_offset_time_constant": 60.0,  # s
@@ -247,7 +268,11 @@ class Dr3dEkf(Estimator):
                            [c["attitude_initial"] ** 2] * 2, c["heading_initial"] ** 2,
                            [c["gyro_bias_initial"] ** 2] * 3])
         self._kf = ErrorState(p0)
+        # rule 1's reference norm: normal gravity until the first standstill, then the mean
+        # specific-force norm measured at standstill (it absorbs the accelerometer bias)
         self._g = float(np.squeeze(normal_gravity(self._pos[0], self._pos[2])))
+        self._still_norm_sum = 0.0
+        self._still_steps = 0
         self._eye = np.eye(10)
         self._f = np.zeros((10, 10))  # eq. 30; the time-varying blocks are filled each step
         self._f[3, 3] = -1.0 / c["scale_time_constant"]
@@ -330,7 +355,7 @@ class Dr3dEkf(Estimator):
             self._q, self._cbn, self._pos, self._v_ned, dtheta, self._s * self._u, self._u,
             dt, self._f)
         self._kf.predict(self._eye + self._f * dt, np.diag(self._q_c * dt))
-        if self._imu.accel:
+        if self._imu.has_accel:
             self._step_one(f_b)
 
     def _step_one(self, f_b: np.ndarray) -> None:
@@ -344,8 +369,13 @@ class Dr3dEkf(Estimator):
         roll_acc = math.atan2(-f_b[1], -f_b[2])
         pitch_acc = math.atan2(f_b[0], math.hypot(f_b[1], f_b[2]))
         dz = [math.remainder(roll - roll_acc, 2.0 * math.pi), pitch - pitch_acc]
+        norm = math.sqrt(f_b @ f_b)
+        if self._u == 0.0:
+            self._still_norm_sum += norm
+            self._still_steps += 1
+            self._g = self._still_norm_sum / self._still_steps
         if c["adaptive"]:
-            var = threshold_variance(abs(math.sqrt(f_b @ f_b) - self._g),
+            var = threshold_variance(abs(norm - self._g),
                                      ACCEL_NORM_THRESHOLD_M_S2, c["tilt_sigma"],
                                      c["tilt_sigma_inflated"])
         else:
