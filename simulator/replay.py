@@ -119,9 +119,7 @@ class _Stream:
         self.data.flags.writeable = False
         self.columns = {c: i for i, c in enumerate(numeric)}
         self.units = {c: units.get(c, "") for c in numeric}
-        t = self.data[:, self.columns["t"]]
-        if not np.all(np.diff(t) >= 0):
-            raise InputError([Problem(str(where), None, name, "time t decreases or is missing")])
+        t = self.data[:, self.columns["t"]]  # increasing: checked when the dataset is read
         if name == "gnss_raw":  # one message per epoch: a 2-D block of its satellites
             starts = np.flatnonzero(np.r_[True, np.diff(t) > 0])
             bounds = np.r_[starts, len(t)]
