@@ -171,7 +171,8 @@ def test_read_solution_rejects_bad_files(tmp_path):
 
 
 def test_wrong_number_of_solution_values_names_the_columns(dataset):
-    with pytest.raises(ValueError, match=r"returned 3 values at t = .* output_columns has 9"):
+    with pytest.raises(InputError, match=r"returned 3 values; it must return None or 9 numbers, "
+                                         r"one per output column \(lat, lon"):
         run_estimator(dataset, "tests.recording:Miscounted", show_progress=False)
 
 
