@@ -9,10 +9,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import os
+import signal
 import sys
+import threading
+from types import FrameType
 
 from simulator.commands import SUMMARIES
-from simulator.errors import InputError
+from simulator.errors import InputError, Terminated
 
 DESCRIPTION = """\
 landnav: synthetic land-vehicle drives and navigation-sensor datasets, with estimator replay
@@ -73,7 +76,50 @@ def main(argv: list[str] | None = None) -> int:
     return code
 
 
+def _importing(frame: FrameType | None) -> bool:
+    """Whether the interrupted code is an import (the import system on its stack)."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _stop(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM and SIGINT: raise ``Terminated`` or ``KeyboardInterrupt`` in the main thread, so
+    every ``with`` block unwinds and removes its temporaries. Not during an import: an exception
+    between the import system's taking and releasing its global lock would leave the lock held
+    and hang every thread that imports, and a module's own bare ``except:`` may swallow it;
+    there the signal is retried 20 ms later."""
+    if _importing(frame):
+        _deferred.append(signum)
+        signal.setitimer(signal.ITIMER_REAL, 0.02)
+        return
+    raise KeyboardInterrupt if signum == signal.SIGINT else Terminated(signum)
+
+
+def _retry(signum: int, frame: FrameType | None) -> None:
+    if _deferred:
+        _stop(_deferred.pop(), frame)
+
+
+_deferred: list[int] = []
+
+
+def _install_stop_handlers() -> dict[int, object]:
+    """Handlers for SIGTERM, SIGINT (unless ignored, as in a background job) and the retry
+    timer; returns the previous ones."""
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _stop),
+                signal.SIGALRM: signal.signal(signal.SIGALRM, _retry)}
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, _stop)
+    return previous
+
+
 def _run(args: argparse.Namespace) -> int:
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = _install_stop_handlers()
     try:
         return int(args.run(args) or 0)
     except InputError as exc:
@@ -81,8 +127,16 @@ def _run(args: argparse.Namespace) -> int:
             print(f"error: {problem}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("interrupted: unfinished outputs were removed", file=sys.stderr)
         return 130
+    except Terminated:
+        print("terminated: unfinished outputs were removed", file=sys.stderr)
+        return 143
+    finally:
+        if previous:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
 # the console script of installations made before 2026-11-24 calls ``program``

@@ -31,8 +31,9 @@ from typing import Any
 import pandas as pd
 
 from simulator.dataset.generate import generate_dataset
-from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
+from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
 from simulator.scenario import Scenario, load_scenario
 from simulator.scoring import report

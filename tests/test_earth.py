@@ -138,3 +138,12 @@ def test_geodetic_rates_of_a_velocity_and_an_offset():
     # (the series for the WGS-84 meridian degree, e.g. the "Latitude" article's table)
     metres_per_degree = np.radians(1.0) / geodetic_rates(lat0, 0.0, [1.0, 0.0, 0.0])[0]
     assert abs(metres_per_degree - (111132.954 - 1.175)) < 0.01
+
+
+def test_single_vector_fast_paths_equal_the_stacked_forms():
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(4, 3))
+    q = earth.euler_to_quat(*rng.normal(size=(3, 4)))
+    np.testing.assert_array_equal(earth.skew(v[1]), earth.skew(v)[1])
+    np.testing.assert_allclose(earth.skew(v[2]) @ v[3], np.cross(v[2], v[3]), atol=1e-14)
+    np.testing.assert_allclose(earth.quat_to_dcm(q[3]), earth.quat_to_dcm(q)[3], atol=1e-15)

@@ -36,6 +36,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="initial error: position_error=[n,e,d] (m), velocity_error=[n,e,d] "
                         "(m/s), attitude_error=[roll,pitch,yaw] (deg), heading_error=DEG")
     p.add_argument("--label", default=None, help="solution label (default: the name)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing SOLUTION file")
     p.set_defaults(run=run)
 
 
@@ -77,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
     solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
-    write_solution(solution, args.output)
+    write_solution(solution, args.output, args.force, [dataset.path])
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
           f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")
     return 0

@@ -28,10 +28,11 @@ import numpy as np
 
 import simulator
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
-from simulator.dataset.io import DatasetWriter, atomic_output_dir
+from simulator.dataset.io import DatasetWriter
 from simulator.errors import InputError
 from simulator.faults.apply import apply_faults
 from simulator.faults.base import FAULT_REGISTRY
+from simulator.outputs import atomic_output_dir
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
