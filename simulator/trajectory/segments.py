@@ -296,29 +296,41 @@ def _grade_ramp_length(v: float, gamma: float, lim: dict, available: float) -> f
 
 
 def _helix(seg: dict, v: float, lim: dict) -> list[_PathPiece]:
-    theta = 2 * np.pi * seg["turns"] * (1 if seg["direction"] == "right" else -1)
-    radius, rise = seg["radius"], seg["rise"]
+    """Path pieces of a helix whose grade meets its ``rise`` exactly."""
+    shape = (seg["turns"], seg["radius"], seg["direction"], seg["bank"], v)
+    gamma = _helix_grade(*shape, seg["rise"], tuple(sorted(lim.items())))
+    turn, lvc = _helix_turn(*shape, lim, gamma)
+    return _with_grade(turn, gamma, lvc)
 
-    def turn_and_ramp(gamma: float) -> tuple[list[_PathPiece], float]:
-        kappa0 = np.cos(gamma) / radius
-        turn = _clothoid_turn(theta, kappa0, v, lim, np.radians(seg["bank"]))
-        total = sum(p.length for p in turn)
-        return turn, _grade_ramp_length(v, gamma, lim, total)
 
-    def build(gamma: float) -> list[_PathPiece]:
-        turn, lvc = turn_and_ramp(gamma)
-        return _with_grade(turn, gamma, lvc)
+def _helix_turn(turns: float, radius: float, direction: str, bank_deg: float, v: float,
+                lim: dict, gamma: float) -> tuple[list[_PathPiece], float]:
+    """The level turn of a helix climbing at ``gamma`` (its curvature cos(gamma) / radius, so
+    that the radius holds in plan view) and the length of its vertical curves."""
+    theta = 2 * np.pi * turns * (1 if direction == "right" else -1)
+    kappa0 = np.cos(gamma) / radius
+    turn = _clothoid_turn(theta, kappa0, v, lim, np.radians(bank_deg))
+    total = sum(p.length for p in turn)
+    return turn, _grade_ramp_length(v, gamma, lim, total)
 
-    def rise_error(gamma: float) -> float:  # the grade pieces alone, as ``build`` lays them
-        turn, lvc = turn_and_ramp(gamma)
+
+@functools.lru_cache(maxsize=256)
+def _helix_grade(turns: float, radius: float, direction: str, bank_deg: float, v: float,
+                 rise: float, limits: tuple) -> float:
+    """The grade (rad) at which a helix rises ``rise`` (bisection to machine precision). A pure
+    function of the helix, its entry speed and the limits, kept for the helices met again (a
+    garage's ramps, a campaign's runs)."""
+    lim = dict(limits)
+
+    def rise_error(gamma: float) -> float:  # the grade pieces alone, as ``_helix`` lays them
+        turn, lvc = _helix_turn(turns, radius, direction, bank_deg, v, lim, gamma)
         cuts = _grade_cuts(turn, gamma, lvc)
         return sum(_rise_of(length, g) for length, _, _, g in cuts) - rise
 
     if abs(rise) < 1e-9:
-        return build(0.0)
+        return 0.0
     bound = np.arctan(1.0) * np.sign(rise)
-    gamma = _bisect(rise_error, 1e-9 * np.sign(rise), bound)
-    return build(gamma)
+    return _bisect(rise_error, 1e-9 * np.sign(rise), bound)
 
 
 # 8-point Gauss-Legendre as Python floats: the nodes shifted to [0, 2] (x + 1), the weights
