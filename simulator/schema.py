@@ -42,6 +42,8 @@ class Context:
         self.lines = lines or {}
         self.overridden = overridden or set()
         self.problems: list[Problem] = []
+        # what a check built that its caller reuses (the scenario's road profile), by name
+        self.built: dict[str, Any] = {}
 
     def line_of(self, path: Path) -> int | str | None:
         for n in range(len(path), -1, -1):

@@ -9,6 +9,7 @@ SCENARIO_FIELD, START_FIELD, ESTIMATOR_ENTRY_FIELD.
 from __future__ import annotations
 
 from estimators.registry import entry_problems
+from simulator.drive import build_profile
 from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
 from simulator.faults import FAULT_FIELD, check_faults
 from simulator.schema import (
@@ -28,7 +29,7 @@ from simulator.schema import (
     Vector,
 )
 from simulator.sensors import SENSOR_FIELDS
-from simulator.trajectory import PROFILE_BUILDERS, TRAJECTORY_KINDS
+from simulator.trajectory import TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
 
 START_FIELD = Record({
@@ -72,8 +73,9 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     elif imu and traj["rate"] < imu["rate"]:
         ctx.error(path + ("trajectory", "rate"),
                   f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
-    profile = PROFILE_BUILDERS[traj["kind"]](value, ctx)
+    profile = build_profile(value, ctx)
     if profile is not None:
+        ctx.built["profile"] = profile
         _check_job_size(traj["rate"], profile.duration_s, path, ctx)
         check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
                      float(profile.distance_of_time(profile.duration_s)))
