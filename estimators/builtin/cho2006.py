@@ -210,7 +210,7 @@ class _ChoDr(Estimator):
         self._increment = self.units["imu"].get(self._imu_columns[-1]) in ("rad", "m/s")
         fix = self.columns["gnss_fix"]
         self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
-        self._sum = np.zeros(3)  # sums of the three inputs x time over the current DR step
+        self._s0 = self._s1 = self._s2 = 0.0  # the three inputs integrated over the DR step
         self._acc_t = 0.0  # time accumulated in the current DR step
         self._t_imu = init.t
         self._bias = np.zeros(3)  # calibrated gyro biases (zero for accelerometer inputs)
@@ -243,10 +243,14 @@ class _ChoDr(Estimator):
             return
         self._t_imu = t
         c0, c1, c2 = self._cols
-        if self._increment:
-            self._sum += (row[c0], row[c1], row[c2])
+        if self._increment:  # plain floats: this runs for every IMU sample
+            self._s0 += row[c0]
+            self._s1 += row[c1]
+            self._s2 += row[c2]
         else:
-            self._sum += (row[c0] * dt, row[c1] * dt, row[c2] * dt)
+            self._s0 += row[c0] * dt
+            self._s1 += row[c1] * dt
+            self._s2 += row[c2] * dt
         self._acc_t += dt
         if self._acc_t >= DR_STEP_S - 1e-9:
             self._step()
@@ -256,8 +260,8 @@ class _ChoDr(Estimator):
         dt = self._acc_t
         if dt <= 0.0:
             return
-        u = self._sum / dt
-        self._sum = np.zeros(3)
+        u = np.array([self._s0, self._s1, self._s2]) / dt
+        self._s0 = self._s1 = self._s2 = 0.0
         self._acc_t = 0.0
         if self._still:
             f_index = self._accel_index

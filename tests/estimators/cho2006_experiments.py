@@ -4,7 +4,8 @@ measure each claim's figure, paired per seed.
 
 Run ``python -m tests.estimators.cho2006_experiments [--seeds 10] [--set key=value ...]`` from
 the checkout to print the table of docs/reproduction_cho2006.md (``--set`` overrides every
-scenario, e.g. ``--set limits.roll_gradient=4`` for the leaning car).
+scenario, e.g. ``--set limits.roll_gradient=0.0071189`` (4 deg per g, landnav's default lean, in
+rad s^2/m) for the leaning car).
 """
 
 from __future__ import annotations
