@@ -20,7 +20,7 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
 * ``b_in``: in-run bias instability B. With ``bias_correlation_time`` tau_c: a first-order
   Gauss-Markov process whose Allan-deviation peak (at 1.89 tau_c) is 0.664 B, i.e. its stationary
   std is 0.664 B / 0.6174; without: a flicker process (sum of Gauss-Markov processes, see
-  ``simulator.sensors.noise``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
+  ``simulator.stochastic``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
   discretised exactly, so their statistics do not depend on the rate.
 * ``b_gm``: a correlated bias besides ``b_in``, so that an axis can have both the flicker floor
   and an exponentially correlated bias, as real MEMS units do (the ADIS16448 y accelerometer's
@@ -28,7 +28,7 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
   Gauss-Markov process of stationary std ``gauss_markov_sigma`` and correlation time
   ``gauss_markov_correlation_time`` T_c, both per axis (sigma 0, the default, is off), discretised
   exactly. Its Allan variance is IEEE Std 952's Markov noise
-  (``simulator.sensors.noise.gauss_markov_avar``), peaking at 0.617 sigma at 1.89 T_c.
+  (``simulator.stochastic.gauss_markov_avar``), peaking at 0.617 sigma at 1.89 T_c.
   El-Sheimy et al. (IEEE Trans. Instrum. Meas. 57(1), 2008) list this correlated noise among the
   error terms of MEMS inertial sensors; it is commonly attributed to temperature variation inside
   the unit.
@@ -85,7 +85,7 @@ import numpy as np
 
 from simulator import columns as col
 from simulator.earth import euler_to_dcm
-from simulator.scenario.schema import (
+from simulator.schema import (
     INVALID,
     Context,
     Either,
@@ -105,7 +105,9 @@ from simulator.sensors.base import (
     truth_at,
 )
 from simulator.sensors.imu_presets import IMU_PRESETS
-from simulator.sensors.noise import (
+from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.vibration import VIBRATION_FIELD, draw_vibration, vibration_at_speed
+from simulator.stochastic import (
     FLICKER_ADEV_FACTOR,
     GM_ADEV_PEAK,
     ar1_filter,
@@ -114,8 +116,6 @@ from simulator.sensors.noise import (
     random_walk,
     white,
 )
-from simulator.sensors.presets import fill_from_preset, known_preset
-from simulator.sensors.vibration import VIBRATION_FIELD, draw_vibration, vibration_at_speed
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
