@@ -76,6 +76,7 @@ from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
 from simulator.earth import normal_gravity, radii_of_curvature, wrap_angle
+from simulator.errors import InputError, Problem
 
 PAPER = "Cho & Choi 2006, ETRI J. 28(2) (seeds/000)"
 DR_STEP_S = 0.1  # the DR propagation interval (10 Hz, section III)
@@ -435,6 +436,13 @@ class Drm2Spkf(_Drm2):
     defaults = {"standstill_calibration": True, "alpha": 0.3, "beta": 2.0, "w0": 0.0}
 
     def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
+        checks = (("alpha", 1e-4 <= self.config["alpha"] <= 1.0, "must be in [1e-4, 1] (eq. 21)"),
+                  ("w0", 0.0 <= self.config["w0"] < 1.0, "must be in [0, 1)"),
+                  ("beta", self.config["beta"] >= 0.0, "must not be negative"))
+        problems = [f"config key {key!r} of estimator {self.name} {rule}, got "
+                    f"{self.config[key]!r}" for key, ok, rule in checks if not ok]
+        if problems:
+            raise InputError([Problem("config", None, "", p) for p in problems])
         plus, minus = angle_hooks([4])
         self._ukf = SigmaPointFilter(x0, p0, points="simplex", alpha=self.config["alpha"],
                                      beta=self.config["beta"], w0=self.config["w0"],
