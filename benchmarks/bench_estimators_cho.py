@@ -103,7 +103,7 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         base = load_scenario(SCENARIO)
         data = {k: v for k, v in base.data.items() if k in ("name", "seed", "start", "limits")}
-        data["sensors"] = {"imu": {"preset": "crossbow-imu300cc", "rate": 100},
+        data["sensors"] = {"imu": {"preset": "crossbow-dmu300cc", "rate": 100},
                            "gnss": {"preset": "automotive", "rate": 1, "outputs": ["fix"]}}
         segments = base.data["trajectory"]["segments"]
         repeats = math.ceil(args.hours * 3600 / 160.0)
