@@ -98,9 +98,9 @@ def test_standstill_calibration_finds_fixed_gyro_biases(root, name):
 def test_error_free_sensors_track_the_drive(root):
     """Ideal IMU and receiver, no initial error. The EKF keeps only the 10 Hz integration and
     the flat-Earth position of eq. 18 (measured 0.12 m, 0.11 deg). The SPKF starts from the
-    180 deg heading sigma of eq. 33 as well, and its simplex points, which match only the
-    first two moments, correlate the scale factors with the heading spread while it is wide:
-    measured 19 m and 12 deg while it settles, 1.3 m and 0.6 deg from 60 s after moving off."""
+    180 deg heading sigma of eq. 33 too, and its update is a statistical linearisation over
+    points half a turn apart until that shrinks: measured 19 m and 12 deg while it settles,
+    1.3 m and 0.6 deg from 60 s after moving off (docs/reproduction_cho2006.md)."""
     ds = exp.dataset("cho2006_situation2", 1, root / "ideal",
                      ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal"])
     t, horizontal, d_yaw = exp.errors(ds, exp.run(ds, "dr2d_drm2_ekf"))
