@@ -118,15 +118,16 @@ def main() -> None:
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         print(f"seeds {seeds.start}..{seeds.stop - 1}, overrides {args.overrides or 'none'}")
-        for angle in () if args.dr_only else (-45.0, -90.0, -140.0, -160.0, -175.0):
-            # DRM1 beside DRM2 at the moderate errors of the paper's Fig. 3
-            drm1 = ("dr2d_drm1_ekf",) if angle > -100.0 else ()
-            for name in (*drm1, "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
-                rms = [heading_rms(dataset("cho2006_situation2", s, root, args.overrides),
-                                   name, angle) for s in seeds]
-                ok = sum(r < CONVERGED_DEG for r in rms)
-                print(f"situation II {angle:+.0f} deg {name}: converged {ok}/{len(rms)}; "
-                      f"heading RMS {_summary(rms)} deg")
+        runs = [] if args.dr_only else [
+            *(("dr2d_drm1_ekf", a) for a in (0.0, -45.0, -90.0)),  # beside DRM2, paper Fig. 3
+            *((name, a) for a in (-45.0, -90.0, -140.0, -160.0, -175.0)
+              for name in ("dr2d_drm2_ekf", "dr2d_drm2_spkf"))]
+        for name, angle in runs:
+            rms = [heading_rms(dataset("cho2006_situation2", s, root, args.overrides),
+                               name, angle) for s in seeds]
+            ok = sum(r < CONVERGED_DEG for r in rms)
+            print(f"situation II {angle:+.0f} deg {name}: converged {ok}/{len(rms)}; "
+                  f"heading RMS {_summary(rms)} deg")
         drm1, drm2 = [], []
         for s in seeds:
             ds = dataset("cho2006_dr_outage", s, root, args.overrides)
