@@ -29,6 +29,7 @@ from estimators.toolbox.ins_error import BA, BG, discretise, noise_psd, system_m
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate
 from simulator.earth import quat_to_dcm, quat_to_euler
+from simulator.errors import InputError
 
 IMU_AXES = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 
@@ -124,6 +125,10 @@ class InsFilter:
         self.ba, self.bg = biases[:3].copy(), biases[3:].copy()
         self.kf = ErrorState(np.diag(np.asarray(p0_sigma, float) ** 2), closed_loop)
         self.noise = noise
+        missing = [c for c in IMU_AXES if c not in imu_columns]
+        if missing:
+            raise InputError(f"imu: an INS filter needs all six axes; the dataset's IMU lacks "
+                             f"{', '.join(missing)} (sensors.imu.axes)")
         self._idx = np.array([imu_columns[c] for c in IMU_AXES])
         self._increments = increments
         self._buf_t = np.empty(buffer_size)

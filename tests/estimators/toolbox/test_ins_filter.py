@@ -11,6 +11,7 @@ from estimators.toolbox import aiding
 from estimators.toolbox.ins_filter import InsFilter, InsNoise
 from simulator.dataset.generate import generate_streams
 from simulator.earth import radii_of_curvature, wrap_angle
+from simulator.errors import InputError
 from simulator.replay import initial_state
 from tests.conftest import scenario_data
 
@@ -72,3 +73,11 @@ def test_covariance_grows_unaided_and_an_update_shrinks_it():
     assert np.all(grown[:6] > P0[:6] ** 2)
     ins.update(*aiding.gnss_position(ins.q, ins.pos, ins.pos), np.eye(3))
     assert np.all(np.diag(ins.kf.p)[:3] < grown[:3])
+
+
+def test_a_reduced_imu_is_refused_with_a_clear_message():
+    truth, imu = _streams("increment")
+    init = initial_state(truth, float(imu["t"].iloc[0]), None)
+    cols = {c: i for i, c in enumerate(imu.columns) if c != "gyro_x"}
+    with pytest.raises(InputError, match="lacks gyro_x"):
+        InsFilter(init, cols, True, P0, NOISE)
