@@ -7,7 +7,7 @@ before every measurement and every solution, so always causally) integrates the 
 in one compiled loop (``strapdown.propagate`` per sample, with the bias estimates removed and
 rate samples turned into trapezoidal increments) and then propagates the covariance once over
 the flushed interval with the mean specific force of the interval (the usual practice of running
-the covariance propagation slower than the mechanisation, Groves 2013, section 14.1.2). With a
+the covariance propagation slower than the mechanisation, Groves 2013, chapter 14). With a
 10 Hz solution rate the covariance is propagated at 10 Hz or faster.
 
 Public names
