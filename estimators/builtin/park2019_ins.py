@@ -84,11 +84,11 @@ class ParkInsOdometer(Estimator):
         self.ins.add_imu(t, row)
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        if row[self._fix] < 2 or not math.isfinite(row[self._fix_idx[0]]):
+        values = row[self._fix_idx]
+        if row[self._fix] < 2 or not np.isfinite(values).all():
             return
         ins = self.ins
         ins.flush()
-        values = row[self._fix_idx]
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
         dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos)
         dz_v, h_v = aiding.gnss_velocity(ins.v, values[3:6])

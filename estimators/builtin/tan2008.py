@@ -164,7 +164,11 @@ class TanLinearisedKF(Estimator):
             ins.set_closed_loop(True)
         values = row[self._fix_idx]
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
-        ins.update(*aiding.gnss_position(ins.q, ins.pos, pos), self.R_POSITION)
+        dz, h = aiding.gnss_position(ins.q, ins.pos, pos)
+        if math.isfinite(values[2]):
+            ins.update(dz, h, self.R_POSITION)
+        else:  # a 2-D fix: horizontal rows only
+            ins.update(dz[:2], h[:2], self.R_POSITION[:2, :2])
         speed = float(row[self._speed])
         self._moving_fix = speed > self.config["course_speed"]
         if self._moving_fix and t - self._t0 >= self.config["standstill"]:

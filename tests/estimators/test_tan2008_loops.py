@@ -77,3 +77,14 @@ def test_without_aids_the_open_loop_estimate_only_propagates(aids):
     # closed loop until 4 s leaves a zero estimate; with no aids it stays zero in the outage
     assert not est.ins.kf.closed_loop
     assert bool(np.abs(est.ins.kf.estimate).max() > 0) == bool(not aids)
+
+
+def test_a_2d_fix_updates_the_horizontal_position_only():
+    est = _estimator()
+    for k in range(1, 101):
+        est.on_imu(k / 100, _imu_row(k / 100))
+    row = _fix_row(1.0, 1)
+    row[list(col.GNSS_FIX).index("alt")] = np.nan
+    est.on_gnss_fix(1.0, row)
+    assert np.isfinite(est.ins.kf.p).all() and np.isfinite(est.ins.pos).all()
+    assert est.ins.pos[0] > LAT  # pulled towards the fix north of the car
