@@ -2,15 +2,14 @@
 under 5 m outside the GNSS outages of an underground-garage drive, on each of ten seeds
 (issue 14), and it really uses its aids (the odometer/NHC update bounds the garage error). Two
 garages: Park's (``park2019_underground_garage.yaml``, 20 Hz IMU, odometer scale factor 1.03,
-shipped with the Park DR estimators; skipped until it is in the checkout) and the shipped
-``parking_garage.yaml`` (100 Hz IMU)."""
+shipped with the Park DR estimators) and ``parking_garage.yaml`` (100 Hz IMU)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tests.estimators.paired_runs import REPO, paired_scores, spread
+from tests.estimators.paired_runs import paired_scores, spread
 
 SCENARIOS = ["scenarios/park2019_underground_garage.yaml", "scenarios/parking_garage.yaml"]
 SEEDS = range(1, 11)
@@ -33,9 +32,6 @@ def _garage_max(scored, events) -> float:
 
 @pytest.fixture(scope="module", params=SCENARIOS)
 def runs(request, tmp_path_factory) -> dict[str, np.ndarray]:
-    if not (REPO / request.param).exists():
-        pytest.skip(f"{request.param} is not in this checkout (it comes with the Park DR "
-                    "estimators)")
     entries = {"nhc": {"name": "ins_odo_ekf"},
                "no_nhc": {"name": "ins_odo_ekf", "config": {"nhc": False}}}
     return paired_scores(request.param, entries, SEEDS, tmp_path_factory.mktemp("park"), (),
