@@ -18,6 +18,8 @@ What the paper gives and what is chosen here:
   utilized when the GPS signal is available and the open loop KF is applied when GPS is
   outage"): an epoch without a fix opens the loop (``kalman.ErrorState.set_closed_loop``); the
   next fix closes it and feeds the open-loop estimate back before its own update.
+  ``open_loop_outages: false`` stays closed through outages (not the paper's design; for
+  comparison).
 * Velocity constraint, eqs. 6-7 (``nhc``): zero lateral and vertical body velocity. Eq. 6 prints
   V_x^b = 0, which would stop the car: the lateral axis is y (V_y^b = 0, V_z^b = 0). 1-sigma
   0.1 m/s (chosen). Used during outages only (section 5: "utilizes the vehicle motion
@@ -70,7 +72,8 @@ class TanLinearisedKF(Estimator):
     paper = ("Tan et al. 2008 (VNU J. Sci.): linearised KF INS/GPS, closed loop with GPS, open "
              "loop with NHC, height and magnetometer aiding in outages")
     defaults = {"nhc": True, "height_constraint": True, "mag_heading": True,
-                "update_interval": 0.5, "standstill": 60.0, "course_speed": 5.0}
+                "update_interval": 0.5, "standstill": 60.0, "course_speed": 5.0,
+                "open_loop_outages": True}
     output_columns = SOLUTION_COLUMNS
 
     NOISE = InsNoise(accel_noise=0.2e-3 * G0, gyro_noise=0.1 * DEG,
@@ -155,7 +158,7 @@ class TanLinearisedKF(Estimator):
                 ins.flush()
                 self._outage = True
                 self._h_ref = float(ins.pos[2])
-                ins.set_closed_loop(False)
+                ins.set_closed_loop(not self.config["open_loop_outages"])
             self._moving_fix = False
             return
         ins.flush()

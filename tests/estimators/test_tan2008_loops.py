@@ -88,3 +88,13 @@ def test_a_2d_fix_updates_the_horizontal_position_only():
     est.on_gnss_fix(1.0, row)
     assert np.isfinite(est.ins.kf.p).all() and np.isfinite(est.ins.pos).all()
     assert est.ins.pos[0] > LAT  # pulled towards the fix north of the car
+
+
+def test_open_loop_outages_false_stays_closed():
+    est = _estimator(open_loop_outages=False)
+    for k in range(1, 801):
+        t = k / 100
+        est.on_imu(t, _imu_row(t))
+        if k % 100 == 0:
+            est.on_gnss_fix(t, _fix_row(t, 0 if t >= 5 else 2))
+            assert est.ins.kf.closed_loop and not est.ins.kf.estimate.any()
