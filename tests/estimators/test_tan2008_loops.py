@@ -12,13 +12,13 @@ from estimators.base import InitialState
 from estimators.builtin.tan2008 import TanLinearisedKF
 from estimators.toolbox import nav_error
 from simulator import columns as col
-from simulator.earth import OMEGA_E_RAD_S, normal_gravity
+from simulator.earth import OMEGA_E_RAD_S, normal_gravity, radii_of_curvature
 
 LAT, LON, ALT = np.radians(21.0), np.radians(105.8), 15.0
 
 
-def _estimator(**config) -> TanLinearisedKF:
-    initial = InitialState(0.0, np.array([LAT, LON, ALT]), np.zeros(3), np.zeros(3))
+def _estimator(velocity=(0.0, 0.0, 0.0), **config) -> TanLinearisedKF:
+    initial = InitialState(0.0, np.array([LAT, LON, ALT]), np.array(velocity), np.zeros(3))
     columns = {"imu": {c: i for i, c in enumerate(col.IMU)},
                "gnss_fix": {c: i for i, c in enumerate(col.GNSS_FIX)}}
     units = {"imu": dict(col.IMU), "gnss_fix": dict(col.GNSS_FIX)}
@@ -98,3 +98,19 @@ def test_open_loop_outages_false_stays_closed():
         if k % 100 == 0:
             est.on_gnss_fix(t, _fix_row(t, 0 if t >= 5 else 2))
             assert est.ins.kf.closed_loop and not est.ins.kf.estimate.any()
+
+
+def test_no_standstill_updates_for_a_car_that_starts_moving():
+    """With the default 60 s standstill, a car driving north at 10 m/s from the start is not held
+    still by zero-velocity updates."""
+    est = _estimator(velocity=(10.0, 0.0, 0.0), standstill=60.0)
+    rn, _ = radii_of_curvature(LAT)
+    speed, lat = list(col.GNSS_FIX).index("speed"), list(col.GNSS_FIX).index("lat")
+    for k in range(1, 501):
+        t = k / 100
+        est.on_imu(t, _imu_row(t))
+        if k % 100 == 0:
+            row = _fix_row(t, 2)
+            row[lat], row[speed] = np.degrees(LAT + 10.0 * t / rn), 10.0
+            est.on_gnss_fix(t, row)
+    assert est.ins.v[0] > 9.5
