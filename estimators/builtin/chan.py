@@ -85,7 +85,7 @@ SENSOR_COLUMNS = ("accel_bias_x", "accel_bias_y", "accel_bias_z", "gyro_bias_x",
                   "gyro_bias_z", "clock_bias", "clock_drift")
 PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Vehicle' "
          "(tightly coupled INS/GPS, UKF vs EKF, NHC)")
-COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation rate
+COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
 
 
@@ -486,6 +486,18 @@ def error_dynamics(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, f_b: np.nda
     return f
 
 
+@njit(cache=True)
+def _strapdown_block(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dth: np.ndarray,
+                     dv: np.ndarray, dth_prev: np.ndarray, dv_prev: np.ndarray, dt: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``strapdown.propagate`` through a block of increments (m, 3), carrying the previous
+    interval's increments for the coning and sculling terms; returns the final (q, v, pos)."""
+    for j in range(dt.shape[0]):
+        q, v, pos = propagate(q, v, pos, dth[j], dv[j], dth_prev, dv_prev, dt[j])
+        dth_prev, dv_prev = dth[j], dv[j]
+    return q, v, pos
+
+
 class TcEkf(_TightlyCoupled):
     """Tightly coupled error-state EKF (Chan et al. eqs. 4-6; see the module docstring).
 
@@ -506,34 +518,41 @@ class TcEkf(_TightlyCoupled):
         self._err = ErrorState(self._p0)
         self._dth_prev = np.zeros(3)
         self._dv_prev = np.zeros(3)
-        self._acc_f = np.zeros(3)
-        self._acc_dt = 0.0
+        self._buf_w: list[np.ndarray] = []
+        self._buf_f: list[np.ndarray] = []
+        self._buf_dt: list[float] = []
 
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        if self._increments:  # the interval's mean rates
-            w_c, f_c = w - self._bg, f - self._ba
-        else:  # trapezoid over the interval
-            w_c = 0.5 * (w + self._w_prev) - self._bg
-            f_c = 0.5 * (f + self._f_prev) - self._ba
-        dth, dv = w_c * dt, f_c * dt
-        self._q, self._v, self._pos = propagate(self._q, self._v, self._pos, dth, dv,
-                                                self._dth_prev, self._dv_prev, dt)
-        self._dth_prev, self._dv_prev = dth, dv
-        self._clock[0] += self._clock[1] * dt
-        self._acc_f += f_c * dt
-        self._acc_dt += dt
-        if self._acc_dt >= 1.0 / COVARIANCE_RATE_HZ - 1e-9:
-            self._propagate_covariance()
+        if not self._buf_dt:  # the interval's start
+            self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
+        self._buf_w.append(w)
+        self._buf_f.append(f)
+        self._buf_dt.append(dt)
+        if sum(self._buf_dt) >= 1.0 / COVARIANCE_RATE_HZ - 1e-9:
+            self._flush()
 
-    def _propagate_covariance(self) -> None:
-        dt = self._acc_dt
-        if dt <= 0:
+    def _flush(self) -> None:
+        """Strapdown through the buffered IMU intervals (bias-corrected increments: the
+        trapezoid of the rates, or the increments themselves), then the covariance over them."""
+        if not self._buf_dt:
             return
-        fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), self._acc_f / dt) * dt
+        w, f, dt = np.array(self._buf_w), np.array(self._buf_f), np.array(self._buf_dt)
+        if self._increments:  # the intervals' mean rates
+            w_c, f_c = w[1:] - self._bg, f[1:] - self._ba
+        else:
+            w_c = 0.5 * (w[1:] + w[:-1]) - self._bg
+            f_c = 0.5 * (f[1:] + f[:-1]) - self._ba
+        dth, dv = w_c * dt[:, None], f_c * dt[:, None]
+        self._q, self._v, self._pos = _strapdown_block(self._q, self._v, self._pos, dth, dv,
+                                                       self._dth_prev, self._dv_prev, dt)
+        self._dth_prev, self._dv_prev = dth[-1], dv[-1]
+        total = float(dt.sum())
+        self._clock[0] += self._clock[1] * total
+        self._buf_dt = []
+        fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), dv.sum(axis=0) / total)
+        fm *= total
         phi = np.eye(N_STATES) + fm + 0.5 * fm @ fm
-        self._err.predict(phi, self.process_noise(dt))
-        self._acc_f = np.zeros(3)
-        self._acc_dt = 0.0
+        self._err.predict(phi, self.process_noise(total))
 
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         if len(ep.sv) == 0:
@@ -543,7 +562,7 @@ class TcEkf(_TightlyCoupled):
         self._clock = np.array(self._clock_from_residuals(ep, r, v))
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
-        self._propagate_covariance()
+        self._flush()
         nhc = bool(self.config["nhc"])
         dz, rows, noise = [], [], []
         c_bn = quat_to_dcm(self._q)
@@ -584,6 +603,7 @@ class TcEkf(_TightlyCoupled):
         self._clock = self._clock - dx[15:17]
 
     def solution(self, t: float) -> np.ndarray:
+        self._flush()
         return self._output(self._pos, self._v, self._q, np.concatenate([self._ba, self._bg]),
                             self._clock, self._err.p)
 
