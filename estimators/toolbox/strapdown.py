@@ -14,7 +14,8 @@ The update per interval:
 
 Public functions
 ----------------
-propagate, run_strapdown, rates_to_increments, nav_derivative, rk4_step.
+propagate, run_strapdown, rates_to_increments, attitude_step, frame_rates, radii, nav_derivative,
+rk4_step.
 """
 
 from __future__ import annotations
@@ -163,6 +164,31 @@ def rates_to_increments(t: np.ndarray, rates: np.ndarray) -> tuple[np.ndarray, n
     return 0.5 * (rates[1:] + rates[:-1]) * dt[:, None], dt
 
 
+@njit(cache=True)
+def attitude_step(q: np.ndarray, rot_nav: np.ndarray, rot_body: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Rotate a body-to-NED quaternion by a navigation-frame rotation ``rot_nav`` (rad; the
+    frame's own rotation w_in dt, or an estimated attitude error psi) and a body-frame rotation
+    ``rot_body`` (rad; the gyro increment): q <- q(-rot_nav) * q * q(rot_body), normalised
+    (the attitude line of ``propagate``). Returns the quaternion and its body-to-NED DCM."""
+    q_new = _quat_mul(_quat_mul(_rotvec_quat(-rot_nav), q), _rotvec_quat(rot_body))
+    q_new = q_new / np.sqrt(np.sum(q_new * q_new))
+    return q_new, _quat_dcm(q_new)
+
+
+@njit(cache=True)
+def frame_rates(lat: float, h: float, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Earth rate and transport rate resolved in NED (rad/s) at latitude ``lat`` (rad), height
+    ``h`` (m) and NED velocity ``v`` (m/s) (Groves eqs. 5.41, 5.44; compiled, for filters'
+    inner loops; ``simulator.earth.earth_rate_ned`` and ``transport_rate_ned`` vectorised)."""
+    return _nav_rates(lat, h, v)
+
+
+@njit(cache=True)
+def radii(lat: float) -> tuple[float, float]:
+    """Meridian and transverse radii of curvature (m) at latitude ``lat`` (rad) (compiled;
+    ``simulator.earth.radii_of_curvature`` vectorised)."""
+    return _radii(lat)
 
 @njit(cache=True)
 def nav_derivative(x: np.ndarray, w_ib: np.ndarray, f_b: np.ndarray, out: np.ndarray) -> None:
