@@ -130,7 +130,9 @@ class _TightlyCoupled(Estimator):
         self._clock_started = False
         self._t_update = self.initial.t
         self._next_nhc = np.inf
-        self._w_last = np.zeros(3)  # last body rate (bias-corrected), for the lever arm
+        self._buf_w: list[np.ndarray] = []
+        self._buf_f: list[np.ndarray] = []
+        self._buf_dt: list[float] = []
         p0 = np.zeros(N_STATES)
         p0[0:3] = cfg["initial_position_std"]
         p0[3:6] = cfg["initial_velocity_std"]
@@ -199,9 +201,23 @@ class _TightlyCoupled(Estimator):
         return np.concatenate([[np.degrees(pos[0]), np.degrees(pos[1]), pos[2], *v, roll, pitch,
                                 yaw], std, biases, clock])
 
-    # -- filter-specific -----------------------------------------------------------------------
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        raise NotImplementedError
+        """Buffer the IMU interval ending now (its start sample first); the filters integrate
+        a buffer in one compiled call."""
+        if not self._buf_dt:
+            self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
+        self._buf_w.append(w)
+        self._buf_f.append(f)
+        self._buf_dt.append(dt)
+
+    def _take_buffer(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Body rates and specific forces at the m + 1 sample times (m + 1, 3) and the m
+        interval lengths of the buffer, which is emptied."""
+        out = np.array(self._buf_w), np.array(self._buf_f), np.array(self._buf_dt)
+        self._buf_dt = []
+        return out
+
+    # -- filter-specific -----------------------------------------------------------------------
 
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         raise NotImplementedError
@@ -342,26 +358,14 @@ class TcUkf(_TightlyCoupled):
         self.ukf = SigmaPointFilter(x0, self._p0, points="symmetric",
                                     alpha=self.config["alpha"], beta=self.config["beta"],
                                     boxplus=boxplus, boxminus=boxminus)
-        self._buf_w: list[np.ndarray] = []
-        self._buf_f: list[np.ndarray] = []
-        self._buf_dt: list[float] = []
         self._propagated = False  # points moved since the covariance was last formed
 
     # -- propagation ---------------------------------------------------------------------------
-    def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        if not self._buf_dt:  # the interval's start
-            self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
-        self._buf_w.append(w)
-        self._buf_f.append(f)
-        self._buf_dt.append(dt)
-
     def _flush(self) -> None:
         """Move the sigma points (drawn at the last update) through the buffered IMU samples;
         the driver sets the mean (paper steps 2-3)."""
         if self._buf_dt:
-            self.ukf.propagate(_fx, np.array(self._buf_w), np.array(self._buf_f),
-                               np.array(self._buf_dt))
-            self._buf_dt = []
+            self.ukf.propagate(_fx, *self._take_buffer())
             self._propagated = True
 
     def _predict(self, t: float) -> None:
@@ -484,16 +488,9 @@ class TcEkf(_TightlyCoupled):
         self._err = ErrorState(self._p0)
         self._dth_prev = np.zeros(3)
         self._dv_prev = np.zeros(3)
-        self._buf_w: list[np.ndarray] = []
-        self._buf_f: list[np.ndarray] = []
-        self._buf_dt: list[float] = []
 
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        if not self._buf_dt:  # the interval's start
-            self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
-        self._buf_w.append(w)
-        self._buf_f.append(f)
-        self._buf_dt.append(dt)
+        super().inertial_step(w, f, dt)
         if sum(self._buf_dt) >= 1.0 / COVARIANCE_RATE_HZ - 1e-9:
             self._flush()
 
@@ -502,7 +499,7 @@ class TcEkf(_TightlyCoupled):
         trapezoid of the rates, or the increments themselves), then the covariance over them."""
         if not self._buf_dt:
             return
-        w, f, dt = np.array(self._buf_w), np.array(self._buf_f), np.array(self._buf_dt)
+        w, f, dt = self._take_buffer()
         if self._increments:  # the intervals' mean rates
             w_c, f_c = w[1:] - self._bg, f[1:] - self._ba
         else:
@@ -514,7 +511,6 @@ class TcEkf(_TightlyCoupled):
         self._dth_prev, self._dv_prev = dth[-1], dv[-1]
         total = float(dt.sum())
         self._clock[0] += self._clock[1] * total
-        self._buf_dt = []
         fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), dv.sum(axis=0) / total)
         fm *= total
         phi = np.eye(N_STATES) + fm + 0.5 * fm @ fm
