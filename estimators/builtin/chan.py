@@ -41,19 +41,25 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   ``accel_noise``, ``gyro_noise``, velocity and angle random walks of the automotive MEMS
   preset), small bias random walks, and the receiver-clock model of a TCXO
   (``gnss_model.clock_noise``). R: the receiver's reported pseudorange and pseudorange-rate
-  1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``), floored at
-  ``pseudorange_std`` 3 m and ``range_rate_std`` 0.1 m/s when the stream lacks them.
+  1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``); the config's
+  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them.
 * The EKF (eqs. 4-6): position error rate dr' = dv as printed (eq. 4), velocity and attitude error
   equations in the psi convention of ``nav_error`` (eq. 5: -[f^n x] psi - C_b^n dba
   - (2 w_ie + w_en) x dv - (2 dw_ie + dw_en) x v; eq. 6: psi' = -w_in x psi - C_b^n dbg - dw_in,
   with dw_ie from the latitude error and dw_en from the velocity error; the paper's phi is -psi).
   The nominal state is propagated by the toolbox strapdown (``strapdown.propagate``), the
   covariance at 10 Hz with Phi = I + F dt + (F dt)^2 / 2; closed loop (errors fed back after each
-  update). Measurements linearised at the nominal state (the "linearised model given in [2]").
+  update). Measurements linearised at the nominal state (the "linearised model given in [2]"):
+  the pseudorange rows carry the lever arm's attitude term, the range-rate rows only -los on the
+  velocity error and 1 on the drift (the lever arm's rate term is below the noise).
+* The UKF runs on the toolbox's sigma-point driver (``estimators.toolbox.ukf``, symmetric set)
+  with this module's ``boxplus``/``boxminus`` on an 18-number nominal state (position, velocity,
+  quaternion, biases, clock); the whole point set moves through one compiled call per batch of
+  IMU samples (``_propagate_points``).
 
 Public names
 ------------
-TcUkf, TcEkf.
+TcUkf, TcEkf, boxplus, boxminus, error_dynamics.
 """
 
 from __future__ import annotations
