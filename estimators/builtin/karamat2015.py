@@ -378,7 +378,9 @@ class RissTcEkf(Estimator):
         self._by *= decay[5]
         ao = ao_raw - self._c_ao
         self._ao = ao
-        vo = speed - self._c_vo
+        # a wheel that does not turn reads zero whatever its scale error: at a standstill the
+        # speed is exactly zero (the estimated speed error applies to a moving wheel only)
+        vo = speed - self._c_vo if speed != 0.0 else 0.0
         self._vo = vo
         wz_c = wz - self._bz
         pitch = _asin((ffwd_avg - ao - self._by) / g) - self._c_p  # eq. 2
