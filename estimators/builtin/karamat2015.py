@@ -256,6 +256,8 @@ class RissTcEkf(Estimator):
         self._q_white = np.array([_Q_WHITE.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in GM_PARAMETERS.items()
                     if _I[s] < self._n]
+        self._gm_index = np.array([g[0] for g in self._gm])
+        self._noise_cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         # sums over the IMU samples of the current odometer interval
         c = self.columns["imu"]
         self._col_gz, self._col_fx, self._col_fy = c["gyro_z"], c["accel_x"], c["accel_y"]
@@ -387,7 +389,9 @@ class RissTcEkf(Estimator):
         roll = -_asin((flat - self._bx + vo * wz_c) / (g * math.cos(pitch))) - self._c_r  # eq. 3
         a_dot = -wz_c + OMEGA_E_RAD_S * math.sin(lat) + self._ve * math.tan(lat) / (rn + h)  # 1
         az_mid = self._az + 0.5 * a_dot * dt
-        self._az = float(wrap_angle(self._az + a_dot * dt))
+        self._az += a_dot * dt
+        if abs(self._az) > math.pi:
+            self._az = float(wrap_angle(self._az))
         cos_p = math.cos(pitch)
         # eqs. 4-5 with eqs. 22 and 26: the direction of the horizontal velocity turns with
         # the azimuth rate (the form the error model of eqs. 24 and 28 linearises, so that a
@@ -414,6 +418,25 @@ class RissTcEkf(Estimator):
             self._t_accel_update = t
             self._update_accelerometers(g, ffwd_avg, flat, wz)
 
+    def _noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Markov transition factors and the discrete process noise Q_d over ``dt``
+        (cached: the odometer interval is nearly always the same)."""
+        key = round(dt, 9)
+        cached = self._noise_cache.get(key)
+        if cached is None:
+            q = self._q_white * dt
+            sigma = np.array([g[1] for g in self._gm])
+            tau = np.array([g[2] for g in self._gm])
+            phi_gm, q_gm = gauss_markov_discrete(tau, sigma, dt)
+            q[self._gm_index] = q_gm
+            q_d = np.diag(q)
+            clock = slice(_I["cb"], _I["cd"] + 1)
+            q_d[clock, clock] = gnss_model.clock_noise(dt)  # a TCXO (the shared clock model)
+            cached = (phi_gm, q_d)
+            if len(self._noise_cache) < 64:
+                self._noise_cache[key] = cached
+        return cached
+
     def _predict(self, dt: float, rm: float, rn: float, wz_c: float) -> None:
         f = system_matrix(self._lat, self._h, self._ve, self._vn, self._az, self._pitch,
                           self._ao, wz_c, self._n)
@@ -424,14 +447,9 @@ class RissTcEkf(Estimator):
         f = f * scale[:, None] / scale[None, :]
         fdt = f * dt
         phi = np.eye(self._n) + fdt + 0.5 * fdt @ fdt
-        q = self._q_white * dt
-        for k, sigma, tau in self._gm:
-            phi_k, q_k = gauss_markov_discrete(tau, sigma, dt)
-            phi[k, k] = phi_k
-            q[k] = q_k
-        q_d = np.diag(q)
-        clock = slice(_I["cb"], _I["cd"] + 1)
-        q_d[clock, clock] = gnss_model.clock_noise(dt)  # a TCXO (the shared clock model)
+        phi_gm, q_d = self._noise(dt)
+        idx = self._gm_index
+        phi[idx, idx] = phi_gm
         self._filter.predict(phi, q_d)
 
     # --- measurement updates ------------------------------------------------------------------
@@ -507,7 +525,7 @@ class RissTcEkf(Estimator):
         self._ve -= dx[i["ve"]]
         self._vn -= dx[i["vn"]]
         self._vu -= dx[i["vu"]]
-        self._az = float(wrap_angle(self._az - dx[i["A"]]))
+        self._az = float(wrap_angle(self._az - dx[i["A"]]))  # at most once a second
         self._c_ao += dx[i["ao"]]
         self._ao -= dx[i["ao"]]
         self._bz -= dx[i["bz"]]

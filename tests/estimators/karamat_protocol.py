@@ -21,8 +21,8 @@ SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "karamat2015_part
 VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model": "simplified"}}
 
 
-def short_scenario(seed: int, segments: int = 30, end_s: float = 820.0) -> dict:
-    """The shipped scenario cut to its first ``segments`` segments and the windows ending by
+def short_scenario(seed: int, segments: int = 26, end_s: float = 820.0) -> dict:
+    """The shipped scenario cut to its first ``segments`` segments (26: 900 s) and the windows ending by
     ``end_s`` (the first site: 3, 2, 1, 0 satellites at 300, 450, 600, 750 s), no estimators."""
     data, _ = read_yaml(SCENARIO)
     data["trajectory"]["segments"] = data["trajectory"]["segments"][:segments]
