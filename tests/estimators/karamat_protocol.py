@@ -22,8 +22,9 @@ VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model":
 
 
 def short_scenario(seed: int, segments: int = 26, end_s: float = 820.0) -> dict:
-    """The shipped scenario cut to its first ``segments`` segments (26: 900 s) and the windows ending by
-    ``end_s`` (the first site: 3, 2, 1, 0 satellites at 300, 450, 600, 750 s), no estimators."""
+    """The shipped scenario cut to its first ``segments`` segments (26: 900 s) and the windows
+    ending by ``end_s`` (the first site: 3, 2, 1, 0 satellites at 300, 450, 600, 750 s), no
+    estimators."""
     data, _ = read_yaml(SCENARIO)
     data["trajectory"]["segments"] = data["trajectory"]["segments"][:segments]
     data["faults"] = [f for f in data["faults"] if f["start"] + f["duration"] <= end_s]
