@@ -49,13 +49,14 @@ def test_system_matrix_is_the_jacobian_of_the_derivative_form():
         system_matrix(x[0], x[2], x[3], x[4], x[6], x[12], x[7], wz - x[8], 11), f[:11, :11])
 
 
-def test_mechanisation_closes_on_the_truth(tmp_path):
+@pytest.mark.parametrize("output", ["rate", "increment"])
+def test_mechanisation_closes_on_the_truth(tmp_path, output):
     """Ideal reduced IMU and odometer, no GNSS: eqs. 1-9 alone follow the first 5.5 km loop of
     the scenario (slopes, turns, a lane change, a stop). A sign error in eq. 1's Earth-rate term
     (as our copy prints it) would turn the yaw by 2 omega_e sin(lat) t, 1.3 deg in the 430 s."""
     data = short_scenario(1, segments=14, end_s=0.0)
     raw = {k: data[k] for k in ("name", "seed", "start", "trajectory")}
-    raw["sensors"] = {"imu": {"preset": "ideal", "rate": 100, "axes": "riss3d"},
+    raw["sensors"] = {"imu": {"preset": "ideal", "rate": 100, "axes": "riss3d", "output": output},
                       "odometer": {"preset": "ideal", "rate": 10}}
     ds = open_dataset(generate(tmp_path / "ideal", validate_data(raw, "ideal")))
     truth = ds.read("truth")
