@@ -91,7 +91,7 @@ def main() -> None:
     args = parser.parse_args()
     config = {"model": args.model, "coupling": args.coupling}
     with tempfile.TemporaryDirectory() as tmp:
-        data = short_scenario(2015, segments=15 * 8, end_s=3600.0)
+        data = short_scenario(2015, loops=8, site_s=None, end_s=8 * 523.9)
         dataset = open_dataset(generate(Path(tmp) / "hour", data))
         ours, peer, algebra = [], [], []
         for _ in range(args.repeat):

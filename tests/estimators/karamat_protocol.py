@@ -1,6 +1,7 @@
-"""The Karamat et al. 2015 partial-outage protocol on the shipped scenario, shortened: one site
-of four 60 s windows (3, 2, 1, 0 satellites) after 300 s of open sky, per seed; shared by the
-claim tests and by ``benchmarks/bench_estimators_karamat.py``."""
+"""The Karamat et al. 2015 partial-outage protocol on the shipped scenario, shortened to its
+first site: four passes of the same place of the loop (390 s into loops 1-4) with 3, 2, 1 and 0
+satellites, after 390 s of open sky, per seed; shared by the claim tests and by
+``benchmarks/bench_estimators_karamat.py``."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from simulator.dataset.generate import generate_dataset
+from simulator.dataset.generate import build_truth, generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.earth import radii_of_curvature
 from simulator.replay import run_estimator
@@ -21,13 +22,26 @@ SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "karamat2015_part
 VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model": "simplified"}}
 
 
-def short_scenario(seed: int, segments: int = 26, end_s: float = 820.0) -> dict:
-    """The shipped scenario cut to its first ``segments`` segments (26: 900 s) and the windows
-    ending by ``end_s`` (the first site: 3, 2, 1, 0 satellites at 300, 450, 600, 750 s), no
-    estimators."""
+LOOP_SEGMENTS = 15  # segments of one loop of the drive
+
+
+def short_scenario(seed: int, loops: int = 4, site_s: float | None = 390.0,
+                   end_s: float | None = None) -> dict:
+    """The shipped scenario cut to its first ``loops`` loops (4: 2096 s), with the windows of
+    the site ``site_s`` seconds into the loop (None: every window ending by ``end_s``, or none
+    without it), no estimators."""
     data, _ = read_yaml(SCENARIO)
-    data["trajectory"]["segments"] = data["trajectory"]["segments"][:segments]
-    data["faults"] = [f for f in data["faults"] if f["start"] + f["duration"] <= end_s]
+    data["trajectory"]["segments"] = data["trajectory"]["segments"][:loops * LOOP_SEGMENTS]
+    loop_s = build_truth(validate_data({**data, "faults": [], "estimators": []},
+                                       str(SCENARIO))).duration_s / loops
+    if site_s is not None:
+        data["faults"] = [f for f in data["faults"]
+                          if abs((f["start"] - site_s) / loop_s - round((f["start"] - site_s)
+                                                                         / loop_s)) < 1e-3
+                          and f["start"] + f["duration"] <= loops * loop_s]
+    else:
+        data["faults"] = [f for f in data["faults"]
+                          if end_s is not None and f["start"] + f["duration"] <= end_s]
     data.pop("estimators")
     data["seed"] = seed
     return validate_data(data, str(SCENARIO))

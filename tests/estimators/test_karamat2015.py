@@ -54,7 +54,7 @@ def test_mechanisation_closes_on_the_truth(tmp_path, output):
     """Ideal reduced IMU and odometer, no GNSS: eqs. 1-9 alone follow the first 5.5 km loop of
     the scenario (slopes, turns, a lane change, a stop). A sign error in eq. 1's Earth-rate term
     (as our copy prints it) would turn the yaw by 2 omega_e sin(lat) t, 1.3 deg in the 430 s."""
-    data = short_scenario(1, segments=14, end_s=0.0)
+    data = short_scenario(1, loops=1, site_s=None)
     raw = {k: data[k] for k in ("name", "seed", "start", "trajectory")}
     raw["sensors"] = {"imu": {"preset": "ideal", "rate": 100, "axes": "riss3d", "output": output},
                       "odometer": {"preset": "ideal", "rate": 10}}
@@ -71,7 +71,7 @@ def test_mechanisation_closes_on_the_truth(tmp_path, output):
 
 
 def test_unknown_model_is_one_clear_error(tmp_path):
-    data = short_scenario(1, segments=2, end_s=0.0)
+    data = short_scenario(1, loops=1, site_s=None)
     ds = open_dataset(generate(tmp_path / "d", data))
     with pytest.raises(InputError, match="model must be enhanced or simplified"):
         run_estimator(ds, {"name": "riss3d_tc_ekf", "label": None, "init": None,
