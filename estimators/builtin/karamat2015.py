@@ -418,6 +418,14 @@ class RissTcEkf(Estimator):
             self._t_accel_update = t
             self._update_accelerometers(g, ffwd_avg, flat, wz)
 
+    def _heading(self) -> float:
+        """The direction of travel: the horizontal velocity's direction (against it while
+        reversing) when moving, else the azimuth state."""
+        if abs(self._vo) > 1.0 and math.hypot(self._ve, self._vn) > 0.5:
+            sign = 1.0 if self._vo > 0.0 else -1.0
+            return math.atan2(sign * self._ve, sign * self._vn)
+        return self._az
+
     def _noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Gauss-Markov transition factors and the discrete process noise Q_d over ``dt``
         (cached: the odometer interval is nearly always the same)."""
@@ -438,7 +446,7 @@ class RissTcEkf(Estimator):
         return cached
 
     def _predict(self, dt: float, rm: float, rn: float, wz_c: float) -> None:
-        f = system_matrix(self._lat, self._h, self._ve, self._vn, self._az, self._pitch,
+        f = system_matrix(self._lat, self._h, self._ve, self._vn, self._heading(), self._pitch,
                           self._ao, wz_c, self._n)
         # rescale d lat, d lon (rad) to north and east metres: F_m = T F T^-1
         scale = np.ones(self._n)
@@ -552,7 +560,7 @@ class RissTcEkf(Estimator):
         clock = (self._cb, self._cd) if self._clock_ready else (math.nan, math.nan)
         accel = (self._by, self._bx) if self._enhanced else (math.nan, math.nan)
         return [math.degrees(lat), math.degrees(lon), self._h + self._vu * lead,
-                self._vn, self._ve, -self._vu, self._roll, self._pitch, self._az,
+                self._vn, self._ve, -self._vu, self._roll, self._pitch, self._heading(),
                 math.sqrt(p[i["N"], i["N"]]), math.sqrt(p[i["E"], i["E"]]),
                 math.sqrt(p[i["h"], i["h"]]), math.sqrt(p[i["A"], i["A"]]),
                 -self._bz, accel[0], accel[1], *clock]

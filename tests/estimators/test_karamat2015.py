@@ -18,6 +18,7 @@ from tests.estimators.karamat_protocol import (
     generate,
     horizontal_error,
     run_protocol,
+    run_protocol_dataset,
     short_scenario,
 )
 
@@ -139,3 +140,15 @@ def test_gyro_bias_within_005_deg_s_by_300_s(protocol):
     the error at 300 s is at most 0.043 deg/s over the ten seeds)."""
     errors = np.array([protocol[s]["tight"]["bias_error_300s"] for s in SEEDS])
     assert np.all(np.abs(errors) < 0.05)
+
+
+@pytest.mark.slow
+def test_full_drive_all_sites(tmp_path):
+    """The whole shipped scenario (nine sites, 36 windows, 1 h 53 min), seed 2015: the same
+    working-filter bounds and gyro-bias convergence as on site 1."""
+    data = short_scenario(2015, loops=13, site_s=None, end_s=1e9)
+    result = run_protocol_dataset(generate(tmp_path / "full", data))
+    for label, bound in (("tight", 40.0), ("loose", 40.0), ("simplified", 60.0)):
+        for count in (3, 2, 1, 0):
+            assert np.median(result[label]["max"][count]) < bound, (label, count)
+    assert abs(result["tight"]["bias_error_300s"]) < 0.05
