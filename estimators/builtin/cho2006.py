@@ -207,7 +207,7 @@ class _ChoDr(Estimator):
         self._g = float(normal_gravity(self._lat0, self._h0))
         imu = self.columns["imu"]
         self._cols = [imu[c] for c in self._imu_columns]
-        self._increment = self.units["imu"].get(self._imu_columns[-1]) in ("rad", "m/s")
+        self._increment = self.imu_output == "increment"
         fix = self.columns["gnss_fix"]
         self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
         self._sum = np.zeros(3)  # sums of the three inputs x time over the current DR step

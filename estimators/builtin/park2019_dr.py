@@ -161,10 +161,10 @@ def _ned_offset(lat: float, lon: float, h: float, lat_ref: float, lon_ref: float
 class _StepAccumulator:
     """IMU samples summed over one filter step: gyro increments, mean specific force."""
 
-    def __init__(self, columns: dict[str, int], units: dict[str, str], t0: float):
+    def __init__(self, columns: dict[str, int], increments: bool, t0: float):
         self.gyro = [columns["gyro_x"], columns["gyro_y"], columns["gyro_z"]]
         self.accel = [columns[a] for a in ("accel_x", "accel_y", "accel_z") if a in columns]
-        self.increments = units.get("gyro_z") == "rad"
+        self.increments = increments
         self.t = t0
         self.reset()
 
@@ -240,7 +240,7 @@ class Dr3dEkf(Estimator):
         self._bias = np.zeros(3)  # gyro bias estimate, rad/s
         self._u = 0.0  # latest odometer reading, m/s
         self._zero3 = np.zeros(3)
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         self._baro_col = self.columns.get("baro", {}).get("altitude")
@@ -421,7 +421,7 @@ class Dr2dOdoEkf(Estimator):
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
         self._u = 0.0
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,

@@ -62,9 +62,8 @@ class ParkInsOdometer(Estimator):
     R_ODOMETER = 0.1**2  # (m/s)^2, each body axis
 
     def setup(self) -> None:
-        imu_units = self.units["imu"]
-        self.ins = InsFilter(self.initial, self.columns["imu"],
-                             imu_units.get("gyro_x") == "rad", self.P0_SIGMA, self.NOISE)
+        self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
+                             self.P0_SIGMA, self.NOISE)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]

@@ -87,8 +87,7 @@ class TanLinearisedKF(Estimator):
     MAG_SOLVE_INTERVAL = 10.0  # s between re-solving the magnetometer calibration
 
     def setup(self) -> None:
-        units = self.units["imu"]
-        self.ins = InsFilter(self.initial, self.columns["imu"], units.get("gyro_x") == "rad",
+        self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
                              self.P0_SIGMA, self.NOISE)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"]]

@@ -183,5 +183,7 @@ def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
     with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp) as writer:
         generated = generate_streams(scenario, show_progress, frames=False,
                                      on_final=writer.write)
-        writer.finish(build_manifest(scenario, generated), generated.streams)
+        imu = scenario.data["sensors"].get("imu")
+        described = {"imu": {"imu_output": imu["output"]}} if imu is not None else {}
+        writer.finish(build_manifest(scenario, generated), generated.streams, described)
     return out_dir
