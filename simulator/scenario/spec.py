@@ -33,7 +33,8 @@ from simulator.trajectory import TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
 
 START_FIELD = Record({
-    "utc": DateTime("2020-01-01T00:00:00Z", doc="UTC time of t = 0"),
+    "utc": DateTime("2020-01-01T00:00:00Z", earliest="1980-01-06T00:00:00",
+                    doc="UTC time of t = 0 (from the GPS epoch, 1980-01-06, on)"),
     "lat": Number(angle=True, min=-89.0, max=89.0, doc="latitude, deg"),
     "lon": Number(angle=True, min=-180.0, max=180.0, doc="longitude, deg"),
     "alt": Number("m", 0.0, min=-500.0, max=9000.0, doc="ellipsoidal height, m"),
@@ -76,7 +77,8 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     if profile is not None:
         ctx.built["profile"] = profile
         _check_job_size(traj["rate"], profile.duration_s, path, ctx)
-        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones})
+        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
+                     float(profile.distance_of_time(profile.duration_s)))
     labels: set[str] = set()
     for i, entry in enumerate(value["estimators"]):
         label = entry if isinstance(entry, str) else (entry["label"] or entry["name"])
