@@ -30,8 +30,8 @@ import simulator
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
 from simulator.dataset.io import DatasetWriter
 from simulator.drive import build_drive
+from simulator.faults import FAULT_REGISTRY
 from simulator.faults.apply import apply_faults
-from simulator.faults.base import FAULT_REGISTRY
 from simulator.outputs import atomic_output_dir
 from simulator.progress import progress
 from simulator.scenario import Scenario
