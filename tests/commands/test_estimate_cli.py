@@ -16,7 +16,7 @@ from simulator.errors import InputError
 from simulator.replay import read_solution
 from simulator.scenario import load_scenario
 from tests.synthetic import write_synthetic
-from tests.test_baselines import horizontal_error
+from tests.estimators.test_baselines import horizontal_error
 
 PLUGIN = "examples.my_estimator:MyEstimator"
 
