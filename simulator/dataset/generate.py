@@ -38,8 +38,9 @@ from simulator.sensors import SENSOR_MODELS
 from simulator.tables import Table, as_frames, column
 from simulator.timebase import parse_utc, utc_to_gps
 from simulator.trajectory import PROFILE_BUILDERS
-from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
+from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile, truth_grid
 from simulator.trajectory.segments import RoadProfile
+from simulator.vehicle import ROAD_STREAM, vehicle_body
 
 
 def build_profile(scenario: dict) -> tuple[RoadProfile, dict]:
@@ -53,10 +54,15 @@ def build_profile(scenario: dict) -> tuple[RoadProfile, dict]:
 
 
 def build_truth(scenario: dict, built: tuple[RoadProfile, dict] | None = None) -> Kinematics:
-    """The exact truth trajectory of a resolved scenario (of its ``build_profile`` when given)."""
+    """The exact truth trajectory of a resolved scenario (of its ``build_profile`` when given):
+    the road profile, the vehicle's body on it (``simulator.vehicle``), then the kinematics."""
     profile, start = built if built is not None else build_profile(scenario)
-    truth = kinematics_from_profile(profile, start, scenario["trajectory"]["rate"],
-                                    scenario["limits"]["roll_gradient"])
+    rate = scenario["trajectory"]["rate"]
+    profile, body = vehicle_body(profile, scenario["vehicle"],
+                                 truth_grid(profile.duration_s, rate),
+                                 sensor_rng(scenario["seed"], ROAD_STREAM))
+    truth = kinematics_from_profile(profile, start, rate, scenario["limits"]["roll_gradient"],
+                                    body)
     truth.utc_start = parse_utc(scenario["start"]["utc"])
     truth.gps_week, truth.gps_tow = utc_to_gps(truth.utc_start)
     truth.environment = scenario["environment"]

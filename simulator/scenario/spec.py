@@ -29,6 +29,7 @@ from simulator.scenario.schema import (
 from simulator.sensors import SENSOR_FIELDS
 from simulator.trajectory import PROFILE_BUILDERS, TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
+from simulator.vehicle import VEHICLE_FIELD
 
 START_FIELD = Record({
     "utc": DateTime("2020-01-01T00:00:00Z", doc="UTC time of t = 0"),
@@ -112,6 +113,7 @@ SCENARIO_FIELD = Record(
         "start": START_FIELD,
         "limits": LIMITS_FIELD,
         "trajectory": Tagged(TRAJECTORY_KINDS, what="trajectory kind"),
+        "vehicle": VEHICLE_FIELD,
         "environment": ENVIRONMENT_FIELD,
         "sensors": Record(SENSOR_FIELDS, default={}),
         "faults": ListOf(FAULT_FIELD, []),
