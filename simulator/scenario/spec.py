@@ -31,6 +31,7 @@ from simulator.sensors import SENSOR_FIELDS
 from simulator.trajectory import PROFILE_BUILDERS, TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
 from simulator.vehicle import VEHICLE_FIELD
+from simulator.vehicle.params import default_vehicle
 
 START_FIELD = Record({
     "utc": DateTime("2020-01-01T00:00:00Z", doc="UTC time of t = 0"),
@@ -66,6 +67,8 @@ ESTIMATOR_ENTRY_FIELD = Either(
 
 def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     traj = value["trajectory"]
+    if value["vehicle"] is None:
+        value["vehicle"] = default_vehicle(traj["kind"])
     imu = value["sensors"].get("imu")
     if traj.get("rate") is None:
         traj["rate"] = imu["rate"] if imu else 100.0

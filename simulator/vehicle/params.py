@@ -6,12 +6,12 @@ Presets (``VEHICLE_PRESETS``) hold the parameters of three common cars. Masses, 
 tracks and centre-of-gravity heights are typical of their class (Gillespie, *Fundamentals of
 Vehicle Dynamics*, SAE 1992, Table 5.1 and ch. 5: sprung-mass ride frequencies of 1-1.5 Hz,
 damping ratios of 0.2-0.4, wheel-hop near 10 Hz); cornering stiffnesses are those of passenger-car
-tyres (Rajamani, *Vehicle Dynamics and Control*, 2nd ed., Springer 2012, section 2.3 and Table
-2.1 of its examples: some 60-100 kN/rad per tyre). The ``automotive`` preset is the default.
+tyres (Rajamani, *Vehicle Dynamics and Control*, 2nd ed., Springer 2012, ch. 2-3: some 60-100
+kN/rad per tyre). The ``automotive`` preset is the default (``default_vehicle``).
 
 Public names
 ------------
-VEHICLE_FIELD, VEHICLE_PRESETS, ROUGHNESS_CLASSES, vehicle_parameters.
+VEHICLE_FIELD, VEHICLE_PRESETS, ROUGHNESS_CLASSES, default_vehicle, vehicle_parameters.
 """
 
 from __future__ import annotations
@@ -117,9 +117,17 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
 VEHICLE_FIELD = Either(
     Text(choices=[RIGID, *sorted(VEHICLE_PRESETS)]),
     Record(_FIELDS, post=_resolve),
-    default=DEFAULT_PRESET,
-    doc="'rigid' (a point following the road), a car preset, or {preset, overrides}",
+    default=None,
+    doc="'rigid' (a point following the road), a car preset, or {preset, overrides}; "
+        "default: the automotive preset, rigid for a recorded drive (``default_vehicle``)",
 )
+
+
+def default_vehicle(trajectory_kind: str) -> str:
+    """The ``vehicle`` of a scenario that names none: the automotive car, except on a recorded
+    drive, whose log already holds the real body's motion (its roll, its side slip), which a
+    model would add to a second time."""
+    return RIGID if trajectory_kind == "recorded" else DEFAULT_PRESET
 
 
 def vehicle_parameters(block: str | dict) -> dict | None:
