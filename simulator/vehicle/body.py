@@ -20,12 +20,12 @@ piecewise quintic of time that the exact kinematics differentiate.
   heave (its phase drawn from the road's random stream).
 
 Each channel is known on the grid with its first and second derivatives; between grid points it
-is the quintic Hermite interpolant of those six values (``hermite_quintic``), so the channels are
-C2 and exactly differentiable, and on the grid they equal the model's values.
+is the quintic Hermite interpolant of those six values (``quintic_coefficients``), so the
+channels are C2 and exactly differentiable, and on the grid they equal the model's values.
 
 Public names
 ------------
-BodyMotion, build_body, hermite_quintic, side_slip, level_road.
+BodyMotion, build_body, quintic_coefficients, side_slip, level_road.
 """
 
 from __future__ import annotations
@@ -43,26 +43,23 @@ from simulator.vehicle.suspension import FullCar, simulate
 CHANNELS = ("heave", "pitch", "roll", "slip")
 
 
-def hermite_quintic(t: np.ndarray, y: np.ndarray, dy: np.ndarray,
-                    d2y: np.ndarray) -> PiecewisePolynomial:
-    """The C2 piecewise quintic through values, first and second derivatives at the nodes t.
+def quintic_coefficients(h: np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
+                         y1: np.ndarray, dy1: np.ndarray, d2y1: np.ndarray) -> list[np.ndarray]:
+    """Coefficients a5 ... a0 (highest power first) of the quintic on an interval of length h
+    with the given value, first and second derivative at its two ends.
 
-    On [t_k, t_k+1] with dx = t - t_k, p = y_k + y'_k dx + y''_k dx^2 / 2 + a3 dx^3 + a4 dx^4 +
-    a5 dx^5, with a3..a5 from the conditions at t_k+1 (the residuals D0, D1, D2 of value, slope
-    and curvature of the quadratic part there):
-    a3 = (10 D0 - 4 D1 h + D2 h^2 / 2) / h^3, a4 = (-15 D0 + 7 D1 h - D2 h^2) / h^4,
-    a5 = (6 D0 - 3 D1 h + D2 h^2 / 2) / h^5.
+    p = y0 + y0' dx + y0'' dx^2 / 2 + a3 dx^3 + a4 dx^4 + a5 dx^5, dx from the interval's start,
+    with a3..a5 from the conditions at its end (the residuals D0, D1 h, D2 h^2 of value, slope
+    and curvature of the quadratic part there): a3 = (10 D0 - 4 D1 h + D2 h^2 / 2) / h^3,
+    a4 = (-15 D0 + 7 D1 h - D2 h^2) / h^4, a5 = (6 D0 - 3 D1 h + D2 h^2 / 2) / h^5.
     """
-    h = np.diff(t)
-    a0, a1, a2 = y[:-1], dy[:-1], 0.5 * d2y[:-1]
-    d0 = y[1:] - (a0 + h * (a1 + h * a2))
-    d1 = (dy[1:] - (a1 + 2 * a2 * h)) * h
-    d2 = (d2y[1:] - 2 * a2) * h * h
+    a1, a2 = dy0, 0.5 * d2y0
+    d0 = y1 - (y0 + h * (a1 + h * a2))
+    d1 = (dy1 - (a1 + 2 * a2 * h)) * h
+    d2 = (d2y1 - 2 * a2) * h * h
     h3 = h**3
-    a3 = (10 * d0 - 4 * d1 + 0.5 * d2) / h3
-    a4 = (-15 * d0 + 7 * d1 - d2) / (h3 * h)
-    a5 = (6 * d0 - 3 * d1 + 0.5 * d2) / (h3 * h * h)
-    return PiecewisePolynomial(np.stack([a5, a4, a3, a2, a1, a0]), t)
+    return [(6 * d0 - 3 * d1 + 0.5 * d2) / (h3 * h * h), (-15 * d0 + 7 * d1 - d2) / (h3 * h),
+            (10 * d0 - 4 * d1 + 0.5 * d2) / h3, a2, a1, y0]
 
 
 def side_slip(kappa: np.ndarray, dkappa: np.ndarray, d2kappa: np.ndarray, v: np.ndarray,
@@ -97,25 +94,47 @@ def level_road(profile: RoadProfile) -> RoadProfile:
 @dataclass
 class BodyMotion:
     """Heave (m, up), suspension pitch (rad, nose up), suspension roll (rad, right side down)
-    and side slip (rad) of the body as C2 piecewise quintics of time sharing the grid as
-    breakpoints, and the truth's reference point from the centre of gravity (m, FRD)."""
+    and side slip (rad) of the body, each with its first and second time derivatives, on the
+    truth grid ``t`` (``nodes``, shape (12, n): the four channels' values, then their rates,
+    then their accelerations), and the truth's reference point from the centre of gravity
+    (m, FRD). Between grid times the channels are the quintic Hermite curves of the nodes
+    (``quintic_coefficients``), built interval by interval where asked."""
 
-    curves: dict[str, PiecewisePolynomial]
+    t: np.ndarray
+    nodes: np.ndarray
     reference_point: np.ndarray
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
-        """Each channel and its first and second time derivatives at t: keys ``heave``,
-        ``heave_rate``, ``heave_accel`` and so on."""
-        first = self.curves[CHANNELS[0]]
-        idx = first.piece_index(t)
-        out = {}
-        for name in CHANNELS:
-            out[name], out[name + "_rate"], out[name + "_accel"] = \
-                self.curves[name].evaluate(t, (0, 1, 2), idx)
-        return out
+        """Each channel and its first and second time derivatives at t (1-D): keys ``heave``,
+        ``heave_rate``, ``heave_accel`` and so on. On grid times, the nodes themselves;
+        elsewhere the quintic of the interval, built from its two ends' nodes."""
+        h = self.t[1] - self.t[0]
+        n = len(self.t)
+        i = np.clip(np.floor(t / h).astype(np.intp), 0, n - 2)
+        on = t == self.t.take(i)
+        last = t == self.t[-1]  # the grid's last time closes the last interval
+        values = self.nodes.take(np.where(last, n - 1, i), axis=1)
+        off = np.flatnonzero(~(on | last))
+        if len(off):
+            j = i[off]
+            start, end = self.nodes.take(j, axis=1), self.nodes.take(j + 1, axis=1)
+            k = len(CHANNELS)
+            coeffs = quintic_coefficients(np.full(len(off), h), start[:k], start[k:2 * k],
+                                          start[2 * k:], end[:k], end[k:2 * k], end[2 * k:])
+            dx = t[off] - self.t.take(j)
+            for order in range(3):
+                acc = np.zeros((k, len(off)))
+                for power, c in enumerate(coeffs[:len(coeffs) - order]):
+                    degree = 5 - power
+                    factor = np.prod(np.arange(degree, degree - order, -1))
+                    acc = acc * dx + factor * c
+                values[order * k:(order + 1) * k, off] = acc
+        return {name + suffix: values[i + len(CHANNELS) * order]
+                for order, suffix in enumerate(("", "_rate", "_accel"))
+                for i, name in enumerate(CHANNELS)}
 
     def breakpoints(self) -> np.ndarray:
-        return self.curves[CHANNELS[0]].x
+        return self.t
 
 
 def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
@@ -147,25 +166,25 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
     else:
         tracks = draw_roughness(span, ROUGHNESS_CLASSES[params["roughness"]], rng)
     surface = RoadSurface(profile.bumps, tracks, -params["wheelbase"] - 0.5, params["camber"])
-    u = np.empty((len(t), 6))
-    u[:, :4] = surface.heights(s, car.corner_x, car.corner_y)
-    u[:, 4] = d * a
-    u[:, 5] = d * kappa * v * v
-    body = simulate(car, u, h)
-    # engine vibration on the heave
+    u = np.empty((6, len(t)))
+    u[:4] = surface.heights(s, car.corner_x, car.corner_y)
+    np.multiply(d, a, out=u[4])
+    np.multiply(d * kappa, v * v, out=u[5])
+    ride = simulate(car, u, h)  # z, theta, phi, then their rates and accelerations
     omega = 2 * np.pi * params["engine_frequency"]
     amplitude = params["engine_accel"] * np.sqrt(2.0) / omega**2
     if amplitude > 0:
         phase = omega * t + rng.uniform(0.0, 2 * np.pi)
-        sin, cos = np.sin(phase), np.cos(phase)
-        body[:, 0] += amplitude * sin
-        body[:, 3] += amplitude * omega * cos
-        body[:, 6] -= amplitude * omega**2 * sin
+        sin = np.sin(phase)
+        ride[0] += amplitude * sin
+        ride[3] += amplitude * omega * np.cos(phase)
+        ride[6] -= amplitude * omega**2 * sin
     l_f = params["wheelbase"] * (1 - params["front_weight"])
     l_r = params["wheelbase"] - l_f
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
     slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
-    curves = {name: hermite_quintic(t, body[:, i], body[:, 3 + i], body[:, 6 + i])
-              for i, name in enumerate(CHANNELS[:3])}
-    curves["slip"] = hermite_quintic(t, *slip)
-    return BodyMotion(curves, np.asarray(params["imu_position"], dtype=float))
+    nodes = np.empty((3 * len(CHANNELS), len(t)))
+    for order in range(3):  # heave, pitch, roll, slip; then the rates, then the accelerations
+        nodes[4 * order:4 * order + 3] = ride[3 * order:3 * order + 3]
+        nodes[4 * order + 3] = slip[order]
+    return BodyMotion(t, nodes, np.asarray(params["imu_position"], dtype=float))

@@ -74,16 +74,22 @@ class RoadSurface:
 
     def heights(self, s: np.ndarray, corner_x: np.ndarray, corner_y: np.ndarray) -> np.ndarray:
         """Road height (m, up) under each corner (x_i forward, y_i right of the reference point,
-        m) when the reference point is at distance s along the road; shape (len(s), corners)."""
-        at = s[:, None] + corner_x[None, :]
-        z = np.broadcast_to(-self.camber * corner_y, at.shape).copy()
-        if self.tracks is not None:
-            grid = self.track_start + GRID_M * np.arange(self.tracks.shape[1])
-            for i, y in enumerate(corner_y):
-                z[:, i] += np.interp(at[:, i], grid, self.tracks[int(y > 0)])
-        for start, length, height in self.bumps:  # s never decreases: a bump's rows are a run
-            for i, x in enumerate(corner_x):
+        m) when the reference point is at distance s (non-decreasing) along the road; shape
+        (corners, len(s))."""
+        z = np.empty((len(corner_x), len(s)))
+        grid_start, n_grid = self.track_start, 0 if self.tracks is None else self.tracks.shape[1]
+        for i, (x, y) in enumerate(zip(corner_x, corner_y, strict=True)):
+            if self.tracks is None:
+                z[i] = 0.0
+            else:  # the grid's index of s + x, and linear interpolation in the grid cell
+                at = (s + (x - grid_start)) / GRID_M
+                cell = np.clip(at.astype(np.intp), 0, n_grid - 2)
+                track = self.tracks[int(y > 0)]
+                left = track.take(cell)
+                z[i] = left + (at - cell) * (track.take(cell + 1) - left)
+            z[i] -= self.camber * y
+            for start, length, height in self.bumps:  # a bump's rows are a run (s increases)
                 rows = slice(*np.searchsorted(s, [start - x, start + length - x]))
-                u = (at[rows, i] - start) / length
-                z[rows, i] += height * 64.0 * (u * (1 - u)) ** 3
+                u = np.clip((s[rows] + x - start) / length, 0.0, 1.0)
+                z[i, rows] += height * 64.0 * (u * (1 - u)) ** 3
         return z

@@ -114,16 +114,21 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
     Parameters
     ----------
     model : FullCar
-    u : array, shape (n, 6)
-        Inputs at the grid times (see the module doc), linear between them.
+    u : array, shape (6, n)
+        Inputs at the grid times (see the module doc), one row per input, linear between
+        the grid times.
     h : float
         Grid spacing, s.
 
     Returns
     -------
-    array, shape (n, 9)
+    array, shape (9, n)
         z, theta, phi, z', theta', phi', z'', theta'', phi'' (m, rad, per s, per s^2). The model
         starts at rest in the static equilibrium of the first input.
+
+    Every product with the (n,)-long series is a real matrix product of a few rows (the modal
+    matrices split into real and imaginary parts): complex products of that shape cost several
+    times more.
     """
     a, b = model.state_space()
     lam, vec = np.linalg.eig(a)
@@ -132,46 +137,48 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
     keep = lam.imag >= -1e-12 * np.abs(lam)
     weight = np.where(np.abs(lam.imag) > 1e-12 * np.abs(lam), 2.0, 1.0)[keep]
     lam, vec, vec_inv = lam[keep], vec[:, keep], vec_inv[keep]
-    modal_b = vec_inv @ b  # (modes, 6)
+    modal_b = vec_inv @ b  # (modes, 6): y' = lam y + modal_b u
     # exact propagation over h of y' = lam y + beta u(t), u linear: integrals of e^(lam (h-s))
     # times 1 and s over [0, h]
     e = np.exp(lam * h)
     i0 = (e - 1) / lam
     i1 = h * i0 - (h * e / lam - (e - 1) / lam**2)
-    p_now, p_next = i0 - i1 / h, i1 / h
-    drive = u @ modal_b.T  # (n, modes): beta u_k
-    forced = np.empty_like(drive)
-    forced[1:] = drive[:-1] * p_now + drive[1:] * p_next
-    forced[0] = -drive[0] / lam  # the static equilibrium of u_0
+    now, after = (i0 - i1 / h)[:, None] * modal_b, (i1 / h)[:, None] * modal_b
+    forced = np.empty((len(lam), u.shape[1]), dtype=complex)
+    forced.real[:, 1:] = now.real @ u[:, :-1] + after.real @ u[:, 1:]
+    forced.imag[:, 1:] = now.imag @ u[:, :-1] + after.imag @ u[:, 1:]
+    forced[:, 0] = -(modal_b @ u[:, 0]) / lam  # the static equilibrium of u_0
     y = _scan(e, forced)
-    # outputs: positions and rates of the body are states; accelerations are rows of A x + B u
-    pick = np.r_[0:N_BODY, N_DOF:N_DOF + N_BODY]
-    out = np.empty((len(u), 3 * N_BODY))
-    out[:, :2 * N_BODY] = ((y * weight) @ vec[pick].T).real
-    accel_rows = slice(N_DOF, N_DOF + N_BODY)  # q'' = (A x + B u) there, mode by mode
-    out[:, 2 * N_BODY:] = (((y * lam + drive) * weight) @ vec[accel_rows].T).real
+    # positions and rates of the body are states; accelerations are rows of A x + B u
+    rows = np.r_[0:N_BODY, N_DOF:N_DOF + N_BODY]
+    accel = slice(N_DOF, N_DOF + N_BODY)
+    gain = np.vstack([vec[rows], vec[accel] * lam]) * weight
+    out = gain.real @ y.real - gain.imag @ y.imag
+    out[2 * N_BODY:] += b[accel] @ u
     return out
 
 
 def _scan(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
-    """y_0 = forced_0, y_k = factor y_k-1 + forced_k for each column (mode), vectorised.
+    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode), vectorised.
 
     Within blocks of ``b`` samples y = factor^j cumsum(factor^-j forced); the blocks' ends are
     chained by a loop over blocks (not samples). ``b`` keeps |factor|^-b below 1e6, so the
     scaled sums lose at most six digits of the double precision."""
-    n, k = forced.shape
+    k, n = forced.shape
     decay = -np.log(np.abs(factor)).max()
     b = int(np.clip(np.floor(np.log(1e6) / max(decay, 1e-300)), 1, 256))
     n_blocks = -(-n // b)
-    padded = np.zeros((n_blocks * b, k), dtype=complex)
-    padded[:n] = forced
-    blocks = padded.reshape(n_blocks, b, k)
-    powers = factor[None, :] ** np.arange(b)[:, None]  # (b, k)
-    local = np.cumsum(blocks / powers, axis=1) * powers  # each block from a zero start
-    carry_gain = powers * factor  # factor^(j+1): the previous block's end at sample j
-    ends = local[:, -1, :].copy()
+    padded = np.zeros((k, n_blocks * b), dtype=complex)
+    padded[:, :n] = forced
+    blocks = padded.reshape(k, n_blocks, b)
+    powers = factor[:, None] ** np.arange(b)[None, :]  # (k, b)
+    blocks *= (1 / powers)[:, None, :]
+    local = np.cumsum(blocks, axis=2, out=blocks)
+    local *= powers[:, None, :]  # each block from a zero start
+    ends = local[:, :, -1].T.copy()  # (n_blocks, k)
     whole = factor**b
     for i in range(1, n_blocks):
         ends[i] += whole * ends[i - 1]
-    local[1:] += carry_gain[None] * ends[:-1, None, :]
-    return local.reshape(-1, k)[:n]
+    # the previous block's end carried to sample j: factor^(j+1)
+    local[:, 1:, :] += (powers * factor[:, None])[:, None, :] * ends[:-1].T[:, :, None]
+    return padded[:, :n]

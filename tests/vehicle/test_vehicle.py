@@ -11,7 +11,7 @@ from conftest import scenario_data, ten_minute_drive
 from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.errors import InputError
-from simulator.vehicle.body import hermite_quintic
+from simulator.vehicle.body import BodyMotion
 from simulator.vehicle.params import ROUGHNESS_CLASSES, vehicle_parameters
 from simulator.vehicle.road import ISO_N0, draw_roughness
 from simulator.vehicle.suspension import FullCar, simulate
@@ -34,16 +34,25 @@ def _body_velocity(table) -> np.ndarray:
                                         table.vd.to_numpy())
 
 
-def test_hermite_quintic_reproduces_a_sine_and_is_c2():
+def test_body_channels_between_grid_times_are_c2_quintics_through_the_nodes():
+    """Between grid times a channel is the quintic Hermite interpolant of the values and first
+    two derivatives at the ends: a sine sampled every 0.05 s is reproduced within the
+    interpolation error h^6 |f^(6)| / 46080 (below 1e-9 here), and value, rate and
+    acceleration are continuous across every node."""
     t = np.linspace(0.0, 2.0, 41)
     w = 3.0
-    curve = hermite_quintic(t, np.sin(w * t), w * np.cos(w * t), -w * w * np.sin(w * t))
+    rows = [np.sin(w * t), w * np.cos(w * t), -w * w * np.sin(w * t)]
+    nodes = np.vstack([np.tile(row, (4, 1)) for row in rows])
+    body = BodyMotion(t, nodes, np.zeros(3))
     fine = np.linspace(0.0, 2.0, 4001)
-    # sixth-order interpolation error: h^6 |f^(6)| / 46080 with h = 0.05, w = 3: below 1e-9
-    np.testing.assert_allclose(curve(fine), np.sin(w * fine), atol=1e-9)
-    for nu in (0, 1, 2):  # continuous up to the second derivative across every node
-        left = curve(t[1:-1] - 1e-12, nu)
-        np.testing.assert_allclose(left, curve(t[1:-1], nu), atol=1e-7 * w**nu)
+    got = body.evaluate(fine)
+    np.testing.assert_allclose(got["heave"], np.sin(w * fine), atol=1e-9)
+    np.testing.assert_allclose(got["slip_rate"], w * np.cos(w * fine), atol=1e-7)
+    np.testing.assert_allclose(got["roll_accel"], -w * w * np.sin(w * fine), atol=1e-5)
+    before, at = body.evaluate(t[1:-1] - 1e-12), body.evaluate(t[1:-1])
+    for key in ("pitch", "pitch_rate", "pitch_accel"):
+        np.testing.assert_allclose(before[key], at[key], atol=1e-8)
+    np.testing.assert_array_equal(at["heave"], rows[0][1:-1])  # the nodes themselves
 
 
 def test_suspension_integration_matches_runge_kutta():
@@ -55,7 +64,7 @@ def test_suspension_integration_matches_runge_kutta():
     u = np.zeros((n, 6))
     u[50:, 0] = 0.05
     u[100:, 4] = np.minimum(np.arange(n - 100) * h, 1.0) * -3.0
-    out = simulate(car, u, h)
+    out = simulate(car, u.T, h)
     x = np.zeros(14)
     ref = np.empty((n, 9))
     sub = 50
@@ -72,6 +81,7 @@ def test_suspension_integration_matches_runge_kutta():
                 k3 = a @ (x + dt / 2 * k2) + b @ uu(0.5)
                 k4 = a @ (x + dt * k3) + b @ uu(1.0)
                 x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    out = out.T
     np.testing.assert_allclose(out[:, :6], ref[:, :6], atol=1e-10)
     np.testing.assert_allclose(out[:, 6:], ref[:, 6:], atol=1e-8)
 
