@@ -2,11 +2,11 @@
 default, ``automotive``) against the rigid body (``vehicle: rigid``). Issue 13's goal: at most 1.5
 times the rigid time.
 
-Run:  python benchmarks/bench_vehicle.py   (prints the figures recorded in BENCHMARKS.md)
+Run:  python benchmarks/bench_vehicle.py [increment|rate]   (the figures in BENCHMARKS.md)
 
-Both are whole ``landnav generate`` processes (truth and ideal IMU increments at 100 Hz), best of
-five after a warm-up, as in ``bench_truth``; the two are interleaved run by run, so that a load
-on the shared machine hits both alike.
+Both are whole ``landnav generate`` processes (truth and the ideal 100 Hz IMU, as increments by
+default or as rate samples), best of five after a warm-up, as in ``bench_truth``; the two are
+interleaved run by run, so that a load on the shared machine hits both alike.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from bench_truth import hour_scenario, time_generate  # noqa: E402
 
 
-def main(rounds: int = 5) -> None:
+def main(output: str = "increment", rounds: int = 5) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         paths = {}
         for vehicle in ("rigid", "automotive"):
@@ -29,6 +29,7 @@ def main(rounds: int = 5) -> None:
             hour_scenario(path)
             data = yaml.safe_load(path.read_text())
             data["vehicle"] = vehicle
+            data["sensors"]["imu"]["output"] = output
             path.write_text(yaml.safe_dump(data))
             paths[vehicle] = path
         best: dict[str, list[float]] = {"rigid": [], "automotive": []}
@@ -46,4 +47,4 @@ def main(rounds: int = 5) -> None:
 
 
 if __name__ == "__main__":
-    main()
+    main(*sys.argv[1:2])

@@ -29,10 +29,12 @@ START = {"utc": "2024-05-01T08:00:00Z", "lat": 46.9480, "lon": 7.4474, "alt": 54
 
 
 def write_scenario(folder: Path, trajectory: dict, name: str = "drive") -> Path:
+    """A SUMO scenario with a rigid body: these tests hold the fitted road itself (its path,
+    grades, stops) against SUMO's and the networks' (the body on it: tests/vehicle/)."""
     path = folder / f"{name}.yaml"
     path.write_text(yaml.safe_dump({
         "name": name, "start": START, "trajectory": {"kind": "sumo", **trajectory},
-        "sensors": {"imu": {"preset": "ideal", "rate": 100}}}))
+        "vehicle": "rigid", "sensors": {"imu": {"preset": "ideal", "rate": 100}}}))
     return path
 
 
