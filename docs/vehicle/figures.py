@@ -131,7 +131,7 @@ def distributions_figure(shared: Path) -> None:
     sources = {"landnav shipped scenarios": _shipped(), "Turin, Ekinox reference": _turin(shared),
                "comma2k19 RAV4 highway": _comma(shared)}
     keys = list(next(iter(sources.values())))
-    fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+    fig, axes = plt.subplots(2, 3, figsize=(13, 7))  # densities on a log scale: the tails
     for ax, key in zip(axes.ravel(), keys, strict=True):
         values = np.concatenate([v[key] for v in sources.values()])
         bins = np.linspace(*np.percentile(values, [0.5, 99.5]), 40)
@@ -140,6 +140,7 @@ def distributions_figure(shared: Path) -> None:
             print(f"{name}: {key} p5/p50/p95 = "
                   f"{' / '.join(f'{x:.2f}' for x in np.percentile(data[key], [5, 50, 95]))}")
         ax.set_xlabel(key)
+        ax.set_yscale("log")
     axes[0, 0].legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(HERE / "distributions.png", dpi=110)

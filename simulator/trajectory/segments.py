@@ -74,7 +74,8 @@ LIMITS_FIELD = Record(
         "vertical_accel": Number("m/s^2", 0.5, gt=0,
                                  doc="vertical acceleration setting vertical-curve length"),
         "roll_gradient": Number("rad*s^2/m", np.radians(4.0) / G0_M_S2, min=0,
-                                doc="body roll per lateral acceleration (4 deg/g)"),
+                                doc="body roll per lateral acceleration of a rigid body "
+                                    "(vehicle: rigid; 4 deg/g)"),
     },
     default={},
 )
