@@ -136,7 +136,11 @@ def test_standstill_yaw_rate_is_earth_rate(hilly_city):
     np.testing.assert_allclose(k["w_body"], expected, atol=1e-15)
     for start, end in _runs(table.speed.to_numpy() == 0.0, table.t.to_numpy()):
         stop = table[(table.t >= start) & (table.t <= end)]
-        assert np.ptp(stop.yaw) < 1e-12  # no heading change while stopped
+        # no heading change while stopped: at a stop's last sample the fitted distance may
+        # already differ by the rounding of its second differences (about 1e-7 m, fit.py),
+        # worth curvature x 1e-7 m of heading (1e-10 rad on this drive since issue 13's SUMO
+        # braking changed the run)
+        assert np.ptp(stop.yaw) < 1e-9
 
 
 def _runs(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:

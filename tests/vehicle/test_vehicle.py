@@ -290,3 +290,26 @@ def test_bad_vehicle_values_name_the_key(block, where):
     with pytest.raises(InputError) as info:
         scenario_data([{"stop": {"duration": 1}}], vehicle=block)
     assert where in str(info.value)
+
+
+def test_wheels_meet_the_bump_one_wheelbase_apart_and_the_grade_loses_it():
+    """The road under each corner: the segment's bump shape H 64 u^3 (1 - u)^3 at s + x_i, the
+    camber's -c y_i, and the level road keeps no bump in its grade (the rigid body's 8 cm climb
+    is gone from the altitude; the body heaves by about the bump instead)."""
+    from simulator.vehicle.body import level_road
+    from simulator.vehicle.road import RoadSurface
+
+    surface = RoadSurface([(10.0, 1.0, 0.08)], None, 0.0, 0.02)
+    x, y = np.array([1.2, 1.2, -1.5, -1.5]), np.array([-0.8, 0.8, -0.8, 0.8])
+    s = np.linspace(0.0, 20.0, 2001)
+    z = surface.heights(s, x, y)
+    for i in range(4):
+        u = np.clip((s + x[i] - 10.0), 0.0, 1.0)
+        np.testing.assert_allclose(z[i], 0.08 * 64 * (u * (1 - u)) ** 3 - 0.02 * y[i],
+                                   atol=1e-15)
+    segments = [{"accelerate": {"to_speed": 4.0, "accel": 1.0}}, {"straight": {"length": 20}},
+                {"speed_bump": {"height": 0.08, "length": 1.0}}, {"straight": {"length": 20}}]
+    rigid = _truth(segments, "rigid")
+    assert np.ptp(level_road(rigid.profile).grade.c) == 0.0
+    body = _truth(segments, {**QUIET, "imu_position": [0.0, 0.0, 0.0]}).table()
+    assert 0.02 < np.ptp(body.alt) < 0.08
