@@ -11,8 +11,9 @@ from pathlib import Path
 import pandas as pd
 
 from simulator.commands import SUMMARIES
-from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
+from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.outputs import atomic_output_dir
 from simulator.replay import read_solution, run_estimator
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
 from simulator.scoring.report import text_table, write_report
@@ -36,7 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                        help="registered estimator(s) to run over the dataset and score")
     p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
     p.add_argument("--report", metavar="DIR", help="write report.md and plots/ into DIR")
-    p.add_argument("--force", action="store_true", help="overwrite an existing report DIR")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite an existing --json file or report DIR")
     p.set_defaults(run=run)
 
 
@@ -69,14 +71,15 @@ def print_scores(ev: Evaluation) -> None:
 def run(args: argparse.Namespace) -> int:
     dataset = open_dataset(args.dataset)
     with contextlib.ExitStack() as stack:
-        report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force))
+        report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force,
+                                                            [dataset.path]))
                       if args.report else None)
         solutions = (_from_files(args.solution) if args.solution
                      else _from_estimators(dataset, args.estimator))
         ev = score_solutions(dataset, solutions)
         print_scores(ev)
         if args.json:
-            write_scores(ev.scores(), Path(args.json))
+            write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])
             print(f"wrote {args.json}")
         if report_dir is not None:
             write_report(report_dir, ev, f"Scores on {dataset.path.name}")

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
-from simulator.scenario.schema import INVALID, Context, Field, Path, Record, Text
+from simulator.schema import INVALID, Context, Field, Path, Record, Text
 
 
 def known_preset(name: str, presets: dict[str, dict], what: str, path: Path,

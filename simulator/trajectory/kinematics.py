@@ -44,6 +44,7 @@ from simulator import columns as col
 from simulator.earth import (
     OMEGA_E_RAD_S,
     body_to_ned_components,
+    geodetic_rates,
     ned_to_body_components,
     normal_gravity_from_sin,
     radii_of_curvature,
@@ -290,13 +291,12 @@ class Kinematics:
         sin_lat, cos_lat = np.sin(lat), np.cos(lat)
         rn, re = radii_of_curvature_from_sin(sin_lat)
         lat_gauss = at_gauss(lat)
-        lon_rate = v[:, 1] / ((re + alt) * cos_lat)
-        lon = integrate(lon_rate, gauss_v[:, 1] / ((radii_of_curvature(lat_gauss)[1] + alt_gauss)
-                                                   * np.cos(lat_gauss)))
+        rates = geodetic_rates(lat, alt, v, (rn, re))
+        lon = integrate(rates[1], geodetic_rates(lat_gauss, alt_gauss, gauss_v)[1])
         lon += lon0
         self._t_int = t
         self._lla = (lat, lon, alt)
-        self._lla_rates = (v[:, 0] / (rn + alt), lon_rate, -v[:, 2])
+        self._lla_rates = rates
         # for ``grid_inertial``: the grid's positions are the integration's own nodes
         self._grid_motion = {key: values[:n_grid] for key, values in motion.items()}
         if self.body is None:
@@ -498,14 +498,12 @@ def _place(pos: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def _displaced(pos: np.ndarray, offset_ned: np.ndarray) -> np.ndarray:
-    """Geodetic positions (n, 3) moved by small NED offsets (n, 3), m: dlat = dN / (R_N + h),
-    dlon = dE / ((R_E + h) cos lat), dh = -dD (Groves eq. 2.119 to first order; the offsets are
-    about a metre, so the neglected terms are below a micrometre)."""
-    rn, re = radii_of_curvature(pos[:, 0])
+    """Geodetic positions (n, 3) moved by small NED offsets (n, 3), m (``geodetic_rates`` of the
+    offsets: first order, the offsets are about a metre, so the neglected terms are below a
+    micrometre)."""
     out = np.empty_like(pos)
-    out[:, 0] = pos[:, 0] + offset_ned[:, 0] / (rn + pos[:, 2])
-    out[:, 1] = pos[:, 1] + offset_ned[:, 1] / ((re + pos[:, 2]) * np.cos(pos[:, 0]))
-    out[:, 2] = pos[:, 2] - offset_ned[:, 2]
+    for column, change in enumerate(geodetic_rates(pos[:, 0], pos[:, 2], offset_ned)):
+        np.add(pos[:, column], change, out=out[:, column])
     return out
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from simulator.scenario.schema import (
+from simulator.schema import (
     INVALID,
     Context,
     Either,
