@@ -29,6 +29,10 @@ def short_scenario(seed: int, segments: int = 30, end_s: float = 820.0) -> dict:
     data["faults"] = [f for f in data["faults"] if f["start"] + f["duration"] <= end_s]
     data.pop("estimators")
     data["seed"] = seed
+    # the paper's figures are reproduced on a rigid body (issue 13): with the automotive body
+    # (suspension, side slip, roughness) one of the ten seeds leaves a 0.064 deg/s vertical-gyro
+    # bias error at 300 s, over the 0.05 of section 4.3.3
+    data["vehicle"] = "rigid"
     return validate_data(data, str(SCENARIO))
 
 
