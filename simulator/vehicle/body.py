@@ -38,7 +38,7 @@ from simulator.trajectory.piecewise import PiecewisePolynomial
 from simulator.trajectory.segments import RoadProfile
 from simulator.vehicle.params import ROUGHNESS_CLASSES
 from simulator.vehicle.road import RoadSurface, draw_roughness
-from simulator.vehicle.suspension import FullCar, simulate
+from simulator.vehicle.suspension import FullCar, axle_distances, simulate
 
 CHANNELS = ("heave", "pitch", "roll", "slip")
 
@@ -179,8 +179,7 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
         ride[0] += amplitude * sin
         ride[3] += amplitude * omega * np.cos(phase)
         ride[6] -= amplitude * omega**2 * sin
-    l_f = params["wheelbase"] * (1 - params["front_weight"])
-    l_r = params["wheelbase"] - l_f
+    l_f, l_r = axle_distances(params)
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
     slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
     nodes = np.empty((3 * len(CHANNELS), len(t)))

@@ -28,6 +28,7 @@ from simulator.schema import (
     Text,
     Vector,
 )
+from simulator.vehicle.suspension import corner_ride_rates
 
 # ISO 8608:2016 Table 1: the geometric mean of each class's displacement PSD Gd(n0) at the
 # reference spatial frequency n0 = 0.1 cycle/m, m^3 (waviness w = 2)
@@ -105,13 +106,27 @@ _FIELDS = {
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
     """Fill the keys not given from the preset (checked by their field, so a preset is held to
-    the same limits as a scenario)."""
+    the same limits as a scenario), then check that the car can be built: the wheels lighter
+    than the car, and each tyre stiffer than the ride rate it carries (the spring in series
+    with it, ``suspension.FullCar``, would otherwise be negative)."""
     preset = VEHICLE_PRESETS[value["preset"]]
     out = dict(value)
     for key, field in _FIELDS.items():
         if out[key] is None:
             out[key] = field.check(preset[key], path + (key,), ctx)
-    return INVALID if any(v is INVALID for v in out.values()) else out
+    if any(v is INVALID for v in out.values()):
+        return INVALID
+    if out["mass"] <= 4 * out["unsprung_mass"]:
+        return ctx.error(path + ("unsprung_mass",), f"four wheels of {out['unsprung_mass']:g} "
+                                                    f"kg weigh more than the car's mass "
+                                                    f"{out['mass']:g} kg")
+    ride = corner_ride_rates(out)[1].max()
+    if out["tyre_stiffness"] <= ride:
+        return ctx.error(path + ("tyre_stiffness",),
+                         f"{out['tyre_stiffness']:g} N/m is not stiffer than the ride rate of "
+                         f"a corner ({ride:.0f} N/m, from the mass and the ride frequency); "
+                         "raise it or lower the frequencies")
+    return out
 
 
 VEHICLE_FIELD = Either(

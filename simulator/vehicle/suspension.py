@@ -26,7 +26,7 @@ q u_k+1). The recursion is evaluated in blocks with numpy (``_scan``), never sam
 
 Public names
 ------------
-FullCar, simulate.
+FullCar, axle_distances, corner_ride_rates, simulate.
 """
 
 from __future__ import annotations
@@ -38,6 +38,24 @@ import numpy as np
 N_BODY = 3  # heave, pitch, roll
 N_DOF = 7
 N_INPUT = 6  # four road heights, a_x, a_y
+
+
+def axle_distances(p: dict) -> tuple[float, float]:
+    """Distances l_f, l_r (m) of the centre of gravity from the front and rear axles: the
+    front axle carries ``front_weight`` of the weight, so l_r = front_weight x wheelbase."""
+    l_r = p["wheelbase"] * p["front_weight"]
+    return p["wheelbase"] - l_r, l_r
+
+
+def corner_ride_rates(p: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Sprung mass on each corner (kg; front-left, front-right, rear-left, rear-right) and the
+    ride rate that gives its axle's ride frequency there, m (2 pi f)^2 (N/m; Gillespie eq.
+    5-5): the suspension spring in series with the tyre."""
+    sprung = p["mass"] - 4 * p["unsprung_mass"]
+    front = p["front_weight"]
+    corner_mass = np.array([front, front, 1 - front, 1 - front]) * sprung / 2
+    freq = np.array([p["front_frequency"]] * 2 + [p["rear_frequency"]] * 2)
+    return corner_mass, corner_mass * (2 * np.pi * freq) ** 2
 
 
 @dataclass
@@ -58,19 +76,14 @@ class FullCar:
     @classmethod
     def from_parameters(cls, p: dict) -> FullCar:
         """Build the model from a resolved ``vehicle`` parameter mapping."""
-        m, L = p["mass"], p["wheelbase"]
+        m = p["mass"]
         m_u = p["unsprung_mass"]
         m_s = m - 4 * m_u
-        lf = L * (1 - p["front_weight"])  # centre of gravity to front axle
-        lr = L - lf
+        lf, lr = axle_distances(p)
         half = p["track"] / 2
         x = np.array([lf, lf, -lr, -lr])
         y = np.array([-half, half, -half, half])
-        # sprung load per corner and the spring rates that give the ride frequencies there
-        corner_mass = np.array([lr, lr, lf, lf]) / L * m_s / 2
-        freq = np.array([p["front_frequency"]] * 2 + [p["rear_frequency"]] * 2)
-        omega = 2 * np.pi * freq
-        k_ride = corner_mass * omega**2
+        corner_mass, k_ride = corner_ride_rates(p)
         # the ride rate is the spring in series with the tyre: k_s = k_ride k_t / (k_t - k_ride)
         k_t = p["tyre_stiffness"]
         k_s = k_ride * k_t / (k_t - k_ride)

@@ -285,6 +285,8 @@ def test_camber_rolls_the_body_by_the_cross_slope():
     ({"roughness": "Z"}, "vehicle.roughness"),
     ({"wheelbase": "2.7 s"}, "vehicle.wheelbase"),
     ("tank", "vehicle"),
+    ({"mass": 150.0, "unsprung_mass": 40.0}, "vehicle.unsprung_mass"),
+    ({"tyre_stiffness": 2e4}, "vehicle.tyre_stiffness"),
 ])
 def test_bad_vehicle_values_name_the_key(block, where):
     with pytest.raises(InputError) as info:
