@@ -252,12 +252,14 @@ def test_strapdown_closes_on_a_rough_road_with_an_suv():
     drive with bumps, helices and turns, here with the SUV on a class C road."""
     from test_kinematics import _closure
 
+    from simulator.sensors import resolve_block
     from simulator.sensors.imu import Imu
     from simulator.tables import as_frame
 
     truth = _truth(ten_minute_drive(), {"preset": "suv", "roughness": "C"})
-    imu = Imu({"preset": "ideal", "rate": 100.0, "output": "increment",
-               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
+                                    "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x",
+                                             "accel_y", "accel_z"]}))
     err = _closure(truth, as_frame(imu.generate(truth, None)["imu"]), increments=True)
     assert err["horizontal"] < 2.0
     assert err["yaw_deg"] < 0.2
