@@ -166,12 +166,12 @@ class _StepAccumulator:
     samples are integrated by the trapezoidal rule between consecutive samples (the first
     sample holds over the interval before it); increments are summed."""
 
-    def __init__(self, columns: dict[str, int], units: dict[str, str], t0: float):
+    def __init__(self, columns: dict[str, int], increments: bool, t0: float):
         # column of each axis, None for an axis the unit lacks (read as zero)
         self.cols = [columns.get(a) for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x",
                                               "accel_y", "accel_z")]
         self.has_accel = None not in self.cols[3:]
-        self.increments = units.get("gyro_z") == "rad"
+        self.increments = increments
         self.t = t0
         self.prev: list[float] | None = None
         self.reset()
@@ -258,7 +258,7 @@ class Dr3dEkf(Estimator):
         self._bias = np.zeros(3)  # gyro bias estimate, rad/s
         self._u = 0.0  # latest odometer reading, m/s
         self._zero3 = np.zeros(3)
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         self._baro_col = self.columns.get("baro", {}).get("altitude")
@@ -453,7 +453,7 @@ class Dr2dOdoEkf(Estimator):
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
         self._u = 0.0
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
