@@ -90,14 +90,13 @@ from simulator.earth import (
     wrap_angle,
 )
 from simulator.errors import InputError
+from simulator.units import DEG, DEG_RT_H, MILLI_G
 
 STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
 _I = {name: i for i, name in enumerate(STATES)}
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
 
-DEG = math.pi / 180.0
-MG = 9.80665e-3
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
 # IMU300CC of the paper's Table 1: the gyro and accelerometer biases start at the Table 1
 # turn-on values (P0) and wander as a slow Gauss-Markov process whose noise equals an in-run
@@ -106,8 +105,8 @@ MG = 9.80665e-3
 # dynamics the accelerometer tilt of eqs. 2-3 cannot tell from gravity).
 GM_PARAMETERS = {
     "bz": (0.02 * DEG * math.sqrt(3600.0 / 300.0), 3600.0),  # rad/s
-    "bx": (1.0 * MG * math.sqrt(3600.0 / 300.0), 3600.0),  # m/s^2
-    "by": (1.0 * MG * math.sqrt(3600.0 / 300.0), 3600.0),
+    "bx": (1.0 * MILLI_G * math.sqrt(3600.0 / 300.0), 3600.0),  # m/s^2
+    "by": (1.0 * MILLI_G * math.sqrt(3600.0 / 300.0), 3600.0),
     "ao": (0.1, 10.0),  # m/s^2
     "r": (1.0 * DEG, 10.0),  # rad
     "p": (1.0 * DEG, 10.0),
@@ -115,13 +114,13 @@ GM_PARAMETERS = {
 _P0_SIGMA = {"N": 3.0, "E": 3.0, "h": 5.0, "ve": 0.3, "vn": 0.3, "vu": 0.3, "A": 1.0 * DEG,
              "ao": 0.1, "bz": 2.0 * DEG,  # Table 1: gyro bias 2 deg/s (data sheet)
              "cb": 30.0, "cd": 3.0, "r": 1.0 * DEG, "p": 1.0 * DEG,
-             "bx": 30.0 * MG, "by": 30.0 * MG,  # Table 1: accelerometer bias 30 mg
+             "bx": 30.0 * MILLI_G, "by": 30.0 * MILLI_G,  # Table 1: accelerometer bias 30 mg
              "vo": 0.2}
 # white-noise densities (per second) of the states without a Gauss-Markov model
 # (m/s)^2/s: unmodelled motion; v_u = v_o sin p (eq. 6) takes the noise of the accelerometer
 # pitch of eq. 2 directly (about 0.5 deg, 0.1 m/s at 14 m/s), which eq. 31 does not model
 _Q_WHITE = {"ve": 1e-4, "vn": 1e-4, "vu": 0.05,
-            "A": (2.25 * DEG / 60.0) ** 2,  # Table 1: gyro random walk 2.25 deg/sqrt(h)
+            "A": (2.25 * DEG_RT_H) ** 2,  # Table 1: gyro random walk 2.25 deg/sqrt(h)
             "vo": 1e-4}  # (m/s)^2/s
 
 
@@ -191,7 +190,7 @@ def riss_rates(x: np.ndarray, wz: float) -> np.ndarray:
     (the Gauss-Markov states enter as their mean dynamics -x / tau); ``wz`` is the up-axis gyro
     rate, rad/s.
     """
-    lat, _, h, ve, vn, _, az, ao, bz, _, cd, r, p, bx, by, _ = x
+    lat, _, h, ve, vn, _, az, ao, bz, _, cd, _, p, _, _, _ = x
     rm, rn = (float(v) for v in radii_of_curvature(lat))
     a_dot = -(wz - bz) + OMEGA_E_RAD_S * math.sin(lat) + ve * math.tan(lat) / (rn + h)
     out = np.zeros(len(STATES))
@@ -206,7 +205,6 @@ def riss_rates(x: np.ndarray, wz: float) -> np.ndarray:
     for name, (_, tau) in GM_PARAMETERS.items():
         out[_I[name]] = -x[_I[name]] / tau
     out[15] = ao
-    del r, bx, by
     return out
 
 
