@@ -54,7 +54,13 @@ persistent innovation with a huge azimuth correction). So the direction of the h
 velocity is propagated as eqs. 22 and 26 do (turned by dA/dt each step, corrected by the
 filter) and its magnitude is the odometer's, v_o cos p (eqs. 4-5); v_u is eq. 6. Integrating
 eqs. 22/26 fully instead lets the a_od corrections accumulate into a speed error no measurement
-anchors (1 m/s in a 60 s one-satellite window).
+anchors (1 m/s in a 60 s one-satellite window). The azimuth state is observed only through the
+acceleration terms of eqs. 24/28 and the gyro bias and drifted up to 17 deg from the direction
+of travel, so the direction of travel (the horizontal velocity's, against it while reversing)
+gives F's sin A, cos A and the reported yaw above 1 m/s. A wheel at a standstill reads zero
+whatever its scale error, so the speed is exactly zero while the odometer reads zero. The
+odometer's own speed noise (``odometer_speed_noise``) is in the mechanised velocity the rates
+are predicted from, so it enters the Doppler rows' R through the forward axis.
 
 Measurements: pseudoranges and pseudorange rates (eqs. 45-49; ``coupling: tight``), or the
 receiver's 3-D fixes (position and velocity; ``coupling: loose``; a loosely coupled filter has
