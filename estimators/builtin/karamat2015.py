@@ -270,7 +270,7 @@ class RissTcEkf(Estimator):
         # sums over the IMU samples of the current odometer interval
         c = self.columns["imu"]
         self._col_gz, self._col_fx, self._col_fy = c["gyro_z"], c["accel_x"], c["accel_y"]
-        self._increments = self.units["imu"].get("gyro_z") == "rad"
+        self._increments = self.imu_output == "increment"
         self._t_imu = init.t
         self._sum_wz = self._sum_ffwd = self._sum_flat = self._sum_dt = 0.0
         self._n_imu = 0

@@ -9,6 +9,7 @@ SCENARIO_FIELD, START_FIELD, ESTIMATOR_ENTRY_FIELD.
 from __future__ import annotations
 
 from estimators.registry import entry_problems
+from simulator.drive import build_profile
 from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
 from simulator.faults import FAULT_FIELD, check_faults
 from simulator.schema import (
@@ -28,11 +29,14 @@ from simulator.schema import (
     Vector,
 )
 from simulator.sensors import SENSOR_FIELDS
-from simulator.trajectory import PROFILE_BUILDERS, TRAJECTORY_KINDS
+from simulator.trajectory import TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
+from simulator.vehicle import VEHICLE_FIELD
+from simulator.vehicle.params import default_vehicle
 
 START_FIELD = Record({
-    "utc": DateTime("2020-01-01T00:00:00Z", doc="UTC time of t = 0"),
+    "utc": DateTime("2020-01-01T00:00:00Z", earliest="1980-01-06T00:00:00",
+                    doc="UTC time of t = 0 (from the GPS epoch, 1980-01-06, on)"),
     "lat": Number(angle=True, min=-89.0, max=89.0, doc="latitude, deg"),
     "lon": Number(angle=True, min=-180.0, max=180.0, doc="longitude, deg"),
     "alt": Number("m", 0.0, min=-500.0, max=9000.0, doc="ellipsoidal height, m"),
@@ -65,16 +69,20 @@ ESTIMATOR_ENTRY_FIELD = Either(
 
 def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     traj = value["trajectory"]
+    if value["vehicle"] is None:
+        value["vehicle"] = default_vehicle(traj["kind"])
     imu = value["sensors"].get("imu")
     if traj.get("rate") is None:
         traj["rate"] = imu["rate"] if imu else 100.0
     elif imu and traj["rate"] < imu["rate"]:
         ctx.error(path + ("trajectory", "rate"),
                   f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
-    profile = PROFILE_BUILDERS[traj["kind"]](value, ctx)
+    profile = build_profile(value, ctx)
     if profile is not None:
+        ctx.built["profile"] = profile
         _check_job_size(traj["rate"], profile.duration_s, path, ctx)
-        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones})
+        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
+                     float(profile.distance_of_time(profile.duration_s)))
     labels: set[str] = set()
     for i, entry in enumerate(value["estimators"]):
         label = entry if isinstance(entry, str) else (entry["label"] or entry["name"])
@@ -132,6 +140,7 @@ SCENARIO_FIELD = Record(
         "start": START_FIELD,
         "limits": LIMITS_FIELD,
         "trajectory": Tagged(TRAJECTORY_KINDS, what="trajectory kind"),
+        "vehicle": VEHICLE_FIELD,
         "environment": ENVIRONMENT_FIELD,
         "sensors": Record(SENSOR_FIELDS, default={}),
         "faults": ListOf(FAULT_FIELD, []),
