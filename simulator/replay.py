@@ -218,7 +218,8 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
         ``t`` (strictly increasing) and the estimator's ``output_columns`` (SPEC section 7).
     info : dict
         ``label``, ``name``, ``runtime_s`` (wall time of the estimator run, s) and
-        ``realtime_factor`` (data duration / runtime).
+        ``realtime_factor`` (data duration / runtime) and ``uses_gnss`` (whether a GNSS stream
+        reached the estimator).
 
     Raises
     ------
@@ -274,7 +275,8 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     frame.insert(0, "t", out_t[kept])
     duration = float(t[-1] - t[0])
     info = {"label": label, "name": name, "runtime_s": runtime,
-            "realtime_factor": duration / runtime if runtime > 0 else float("inf")}
+            "realtime_factor": duration / runtime if runtime > 0 else float("inf"),
+            "uses_gnss": bool(gnss)}
     return frame, info
 
 

@@ -12,12 +12,15 @@ truth's time span are dropped and counted):
 
 Position errors are the ECEF difference (solution minus truth) resolved in the NED frame at the
 interpolated true position (C_e^n, Groves eq. 2.150); velocity errors are NED differences;
-attitude errors are wrapped Euler-angle differences (solution minus truth), rad. NaN in a solution
-row propagates to the errors it feeds; the metrics skip those rows.
+attitude errors are wrapped Euler-angle differences (solution minus truth), rad. Estimated sensor
+errors (SPEC section 7 names, ``columns.SENSOR_ERRORS``) are compared with ``truth_sensors``
+interpolated linearly at the solution times (``err_`` + the column name, solution minus truth, in
+the column's own unit). NaN in a solution row propagates to the errors it feeds; the metrics skip
+those rows.
 
 Public names
 ------------
-SolutionErrors, solution_errors, local_ned, ERR_POS, ERR_VEL, ERR_ATT, ERR_H.
+SolutionErrors, solution_errors, sensor_error_name, local_ned, ERR_POS, ERR_VEL, ERR_ATT, ERR_H.
 
 References
 ----------
@@ -53,7 +56,8 @@ class SolutionErrors:
     errors : DataFrame
         One row per solution row inside the truth span: ``t`` (s), ``err_n, err_e, err_d`` (m),
         ``err_h`` (m), ``err_vn, err_ve, err_vd`` (m/s), ``err_roll, err_pitch, err_yaw`` (rad),
-        and the solution's own ``std_*`` columns when it has them.
+        the solution's own ``std_*`` columns when it has them, and ``err_<name>`` for each
+        sensor-error column of the solution that the truth sensors table also has.
     total_rows : int
         Rows of the solution.
     outside_truth : int
@@ -86,7 +90,13 @@ def local_ned(frame: pd.DataFrame, origin: tuple[float, float, float]) -> np.nda
     return ecef_to_ned(_ecef(frame), np.radians(origin[0]), np.radians(origin[1]), origin[2])
 
 
-def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErrors:
+def sensor_error_name(column: str) -> str:
+    """The per-sample error column of an estimated sensor-error column."""
+    return f"err_{column}"
+
+
+def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame,
+                    truth_sensors: pd.DataFrame | None = None) -> SolutionErrors:
     """Errors of a solution against the truth interpolated at the solution times.
 
     Parameters
@@ -96,6 +106,8 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErro
         strictly increasing.
     solution : DataFrame
         A solution table (SPEC section 7), t increasing.
+    truth_sensors : DataFrame or None
+        ``truth_sensors.parquet`` (``t`` and true sensor-error columns), or None.
 
     Returns
     -------
@@ -126,4 +138,11 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErro
     for name in col.SOLUTION_STD:
         if name in sol:
             out[name] = sol[name].to_numpy(float)
+    if truth_sensors is not None and len(truth_sensors):
+        t_sensors = truth_sensors["t"].to_numpy(float)
+        for name in col.SENSOR_ERRORS:
+            if name in sol and name in truth_sensors:
+                true_value = np.interp(t, t_sensors, truth_sensors[name].to_numpy(float),
+                                       left=np.nan, right=np.nan)
+                out[sensor_error_name(name)] = sol[name].to_numpy(float) - true_value
     return SolutionErrors(pd.DataFrame(out), len(solution), int((~inside).sum()))

@@ -3,7 +3,7 @@ write the scores as JSON (SPEC section 8, keyed by label).
 
 Public names
 ------------
-Scored, Evaluation, score_solutions, write_scores.
+Scored, Evaluation, score_solutions, canyon_zones, write_scores.
 """
 
 from __future__ import annotations
@@ -38,6 +38,7 @@ class Evaluation:
     truth: pd.DataFrame
     events: pd.DataFrame
     results: dict[str, Scored]
+    canyon_zones: frozenset[str] = frozenset()
 
     def scores(self) -> dict[str, dict]:
         """The JSON-ready scores keyed by label."""
@@ -57,24 +58,40 @@ class Evaluation:
         return out
 
 
+def canyon_zones(manifest: dict) -> frozenset[str]:
+    """Names of the zones whose sky is an urban canyon in a dataset's resolved scenario."""
+    zones = ((manifest.get("scenario") or {}).get("environment") or {}).get("zones") or {}
+    return frozenset(name for name, zone in zones.items() if (zone or {}).get("sky") == "canyon")
+
+
 def score_solutions(dataset: Dataset,
                     solutions: dict[str, tuple[pd.DataFrame, dict | None]]) -> Evaluation:
     """Score solutions against a dataset's truth.
 
     Parameters
     ----------
-    dataset : the opened dataset (must have ``truth``; ``events`` is optional).
-    solutions : label -> (solution table, runtime info ``{"runtime_s", "realtime_factor"}`` or
-        None).
+    dataset : the opened dataset (must have ``truth``; ``events``, ``truth_sensors`` and
+        ``gnss_fix`` are used when present).
+    solutions : label -> (solution table, info or None). ``info`` of an estimator run inside
+        landnav (``simulator.replay.run_estimator``) gives ``runtime_s``, ``realtime_factor``
+        and ``uses_gnss``; a solution file (None) is taken to use GNSS, so its outages are
+        scored.
     """
     truth = dataset.read("truth")
     events = (dataset.read("events") if dataset.has("events")
               else pd.DataFrame(columns=list(col.EVENTS)))
+    truth_sensors = dataset.read("truth_sensors") if dataset.has("truth_sensors") else None
+    gnss_fix = (dataset.read("gnss_fix", ["t", "num_sats"]) if dataset.has("gnss_fix")
+                else None)
+    canyons = canyon_zones(dataset.manifest)
     results = {}
-    for label, (frame, runtime) in solutions.items():
-        errors = solution_errors(truth, frame)
-        results[label] = Scored(label, frame, errors, score_errors(errors, truth, events, runtime))
-    return Evaluation(truth, events, results)
+    for label, (frame, info) in solutions.items():
+        errors = solution_errors(truth, frame, truth_sensors)
+        scores = score_errors(errors, truth, events, info,
+                              uses_gnss=(info or {}).get("uses_gnss", True),
+                              canyon_zones=canyons, gnss_fix=gnss_fix)
+        results[label] = Scored(label, frame, errors, scores)
+    return Evaluation(truth, events, results, canyons)
 
 
 def write_scores(scores: dict, path: Path) -> None:

@@ -81,7 +81,7 @@ def text_table(scores: dict[str, dict]) -> str:
     header = ["label", *(title for _, _, title in _TEXT_COLUMNS), "worst_outage_end_%"]
     rows = []
     for label, s in scores.items():
-        ends = [o["end_percent"] for o in s["outages"] if o["end_percent"] is not None]
+        ends = [o["end_percent"] for o in s["outages"] or () if o["end_percent"] is not None]
         rows.append([label, *(format_number(_value(s, g, k)) for g, k, _ in _TEXT_COLUMNS),
                      format_number(max(ends) if ends else None)])
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
@@ -180,12 +180,13 @@ def _outage_lines(scores: dict[str, dict], outages: list[tuple[float, float]]) -
         header += [f"{label} max (m)", f"{label} end (m)", f"{label} end (%)"]
     rows = []
     for i, (a, b) in enumerate(outages):
-        entries = [s["outages"][i] for s in scores.values()]
-        distance = entries[0]["distance"] if entries else None
+        entries = [s["outages"][i] if s["outages"] is not None else {}
+                   for s in scores.values()]
+        distance = next((o["distance"] for o in entries if o), None)
         row = [str(i + 1), format_number(a), format_number(b - a), format_number(distance)]
         for o in entries:
-            row += [format_number(o[k]) for k in ("max_horizontal", "end_horizontal",
-                                                   "end_percent")]
+            row += [format_number(o.get(k)) for k in ("max_horizontal", "end_horizontal",
+                                                       "end_percent")]
         rows.append(row)
     return markdown_table(header, rows)
 
