@@ -10,7 +10,8 @@ pandas.
 
 Public functions
 ----------------
-build_profile, build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
+build_profile, build_truth, sensor_rng, generate_streams, build_manifest, stream_units,
+generate_dataset.
 """
 
 from __future__ import annotations
@@ -27,8 +28,10 @@ from pathlib import Path
 import numpy as np
 
 import simulator
+from simulator import columns as col
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
 from simulator.dataset.io import DatasetWriter, atomic_output_dir
+from simulator.dataset.truth_sensors import truth_sensors_table
 from simulator.errors import InputError
 from simulator.faults.apply import apply_faults
 from simulator.faults.base import FAULT_REGISTRY
@@ -133,7 +136,13 @@ def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = 
             for stream, table in made.items():
                 if on_final is not None and stream not in unsettled:
                     on_final(stream, table)
-    rows = zone_events(truth.profile.zones) + apply_faults(streams, scenario, truth)
+    fault_rows = apply_faults(streams, scenario, truth)
+    rows = zone_events(truth.profile.zones) + fault_rows
+    true_errors = {name: series for model in models.values()
+                   for name, series in getattr(model, "true_errors", {}).items()}
+    truth_sensors = truth_sensors_table(true_errors, truth.duration_s, fault_rows)
+    if truth_sensors is not None:
+        streams["truth_sensors"] = truth_sensors
     for t_start, t_end in _outages(streams, truth.duration_s):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
     if gnss is not None and "raw" not in gnss["outputs"]:
@@ -185,13 +194,24 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
     }
 
 
+def stream_units(scenario: dict) -> dict[str, dict[str, str]]:
+    """Column units that differ from ``columns.STREAMS`` for this scenario: an IMU with
+    ``output: increment`` writes angle (rad) and velocity (m/s) increments over each sample
+    interval, so its file's ``unit`` metadata says so."""
+    imu = scenario["sensors"].get("imu")
+    if imu is not None and imu.get("output") == "increment":
+        return {"imu": dict(col.IMU_INCREMENT_UNITS)}
+    return {}
+
+
 def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
                      show_progress: bool = True) -> Path:
     """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
     ``force``). Returns ``out_dir``. Each stream no fault changes is written while the others are
     made."""
     out_dir = Path(out_dir)
-    with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp) as writer:
+    with (atomic_output_dir(out_dir, force) as tmp,
+          DatasetWriter(tmp, stream_units(scenario.data)) as writer):
         generated = generate_streams(scenario.data, show_progress, frames=False,
                                      on_final=writer.write)
         writer.finish(build_manifest(scenario, generated), generated.streams)

@@ -270,6 +270,7 @@ class Gnss(PresetSensor):
         # errors and measurements
         bias_s, drift_s_s, self.drawn["clock"] = draw_receiver_clock(rng, cfg["clock"], len(t),
                                                                       dt_s)
+        self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         err = draw_error_terms(rng, cfg, el, cn0, dt_s)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]

@@ -57,8 +57,12 @@ Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 m
 (Karamat 2015: vertical gyro, forward and lateral accelerometers), ``drm1`` (Cho 2006: two
 accelerometers and a yaw gyro) and ``drm2`` (Cho 2006: forward accelerometer, pitch and yaw gyros).
 The drawn values (turn-on biases, scale factors, misalignment and g-sensitivity matrices,
-temperature coefficients) are in ``drawn``. The ``ideal`` preset turns every error off: its rate
-output is the truth sampled at the IMU rate and its increment output the exact integral.
+temperature coefficients) are in ``drawn``; the true bias b0 + b_in + b_gm + b_rw + ramp + k_T dT
+(rad/s, m/s^2, white noise excluded) and diagonal scale-factor error s + s_T dT of every axis over
+time, at about ``TRUE_ERROR_RATE_HZ``, are in ``true_errors`` (written to truth_sensors.parquet;
+misalignment and g-sensitivity are constant and stay in ``drawn``). The ``ideal`` preset turns
+every error off: its rate output is the truth sampled at the IMU rate and its increment output the
+exact integral.
 
 Public names
 ------------
@@ -94,6 +98,7 @@ from simulator.scenario.schema import (
     Vector,
 )
 from simulator.sensors.base import (
+    TRUE_ERROR_RATE_HZ,
     grid_index,
     grid_rows,
     integrate_over_samples,
@@ -248,6 +253,8 @@ class Imu:
         self.rate_hz = float(self.config["rate"])
         self.increment = self.config["output"] == "increment"
         self.drawn: dict = {"preset": self.config["preset"]}
+        # column (columns.SENSOR_ERRORS) -> (t, true value), filled by ``generate``
+        self.true_errors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._prepared: _Draws | None = None
 
     # -- the random part, drawn before the truth exists ---------------------------------------
@@ -326,6 +333,13 @@ class Imu:
             additive += np.multiply.outer(t, ramp)
         if k_temp.any():
             additive += np.multiply.outer(d_temp, k_temp)
+        # the true bias and scale-factor error over time, before the white noise, at about
+        # TRUE_ERROR_RATE_HZ (every ``step``-th sample) for truth_sensors.parquet
+        step = max(1, round(self.rate_hz / TRUE_ERROR_RATE_HZ))
+        true_scale = np.broadcast_to(sf, (len(t[::step]), 3))
+        if k_sf_temp.any():
+            true_scale = true_scale + np.multiply.outer(d_temp[::step], k_sf_temp)
+        truth = {"t": t[::step], "bias": additive[::step].copy(), "scale_factor": true_scale}
         if self.increment:
             additive *= dt  # rate terms -> increment terms
         density = _per_axis(p["noise_density"])
@@ -333,7 +347,8 @@ class Imu:
             additive += white(n, dt, density, rng, increment=self.increment)
         return _GroupDraws(drawn, np.eye(3) + np.diag(sf) + mis,
                            d_temp[:, None] * k_sf_temp if k_sf_temp.any() else None,
-                           additive, g_matrix if g_matrix is not None and g_matrix.any() else None)
+                           additive, g_matrix if g_matrix is not None and g_matrix.any() else None,
+                           truth)
 
     # -- truth at the unit ------------------------------------------------------------------
     def _true_values(self, truth: Kinematics, t: np.ndarray,
@@ -402,6 +417,11 @@ class Imu:
             stepped *= q
             y = stepped if quantum.all() else np.where(quantum > 0, stepped, y)
         self.drawn[group] = draws.drawn
+        for i, axis in enumerate("xyz"):
+            if f"{group}_{axis}" in self.config["axes"]:
+                for kind in ("bias", "scale_factor"):
+                    self.true_errors[f"{group}_{kind}_{axis}"] = (draws.truth["t"],
+                                                                  draws.truth[kind][:, i])
         return y
 
     def generate(self, truth: Kinematics,
@@ -447,6 +467,7 @@ class _GroupDraws:
     sf_temperature: np.ndarray | None
     additive: np.ndarray
     g_matrix: np.ndarray | None
+    truth: dict[str, np.ndarray]  # t, bias (rate units) and scale_factor, decimated, (m, 3)
 
 
 @dataclass

@@ -77,6 +77,7 @@ class Odometer(PresetSensor):
         scale = c["scale_factor"] + random_walk(len(t), dt, c["scale_drift"], rng)[:, 0]
         measured = np.cumsum(scale * np.diff(distance, prepend=distance[0]))
         self.drawn.update(scale_factor=float(scale[0]), scale_factor_end=float(scale[-1]))
+        self.true_errors["odometer_scale_factor"] = (t, scale)
         table = {"t": t}
         if c["ticks_per_meter"] > 0:
             phase = float(rng.uniform())
