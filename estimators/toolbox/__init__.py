@@ -4,6 +4,7 @@ Modules
 -------
 kalman        KF prediction, Joseph-form update, closed/open-loop error states
 sigma_points  symmetric and spherical-simplex sigma points, the unscented transform
+ukf           the sigma-point filter driver (manifold hooks, augmented or additive noise)
 strapdown     NED quaternion INS mechanisation
 gauss_markov  first-order Gauss-Markov and Van Loan discretisation
 nav_error     the [dr, dv, psi] navigation error convention

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import datetime as dt
 import difflib
+import re
 from collections.abc import Callable
 from typing import Any
 
@@ -153,6 +154,21 @@ class Text(Field):
             return ctx.error(path, f"expected text, got {value!r}")
         if self.choices is not None and value not in self.choices:
             return ctx.error(path, f"{value!r} is not one of: {', '.join(self.choices)}")
+        return value
+
+
+class SafeName(Text):
+    """Text that may become a file or folder name: letters, digits, ``.``, ``_`` and ``-``, at
+    most 100 characters, not starting with a dot or a dash (so never ``..``, a hidden file, an
+    option, or a path with separators)."""
+
+    PATTERN = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9._-]{0,99}$")
+
+    def check(self, value: Any, path: Path, ctx: Context) -> Any:
+        value = super().check(value, path, ctx)
+        if isinstance(value, str) and not self.PATTERN.match(value):
+            return ctx.error(path, f"{value!r} cannot be a file name: use letters, digits, '.', "
+                             "'_' and '-' (at most 100, not starting with '.' or '-')")
         return value
 
 

@@ -22,6 +22,7 @@ from simulator.scenario.schema import (
     Number,
     Path,
     Record,
+    SafeName,
     Tagged,
     Text,
     Vector,
@@ -54,7 +55,8 @@ ESTIMATOR_ENTRY_FIELD = Either(
     Text(),
     Record({
         "name": Text(doc="registered name, or module:Class"),
-        "label": Text(None, doc="solution name (default: the estimator name)"),
+        "label": SafeName(None, doc="solution name (default: the estimator name); it names the "
+                          "solution file, so letters, digits, '.', '_' and '-' only"),
         "init": _INIT_FIELD,
         "config": Anything(None, doc="the estimator's own options"),
     }),
@@ -71,6 +73,7 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
                   f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
     profile = PROFILE_BUILDERS[traj["kind"]](value, ctx)
     if profile is not None:
+        _check_job_size(traj["rate"], profile.duration_s, path, ctx)
         check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones})
     labels: set[str] = set()
     for i, entry in enumerate(value["estimators"]):
@@ -96,6 +99,22 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     return value
 
 
+# Truth samples one generation may hold: about 750 bytes each with every sensor on (an hour at
+# 100 Hz peaks near 300 MB), so this bound keeps a job under about 8 GB.
+MAX_TRUTH_SAMPLES = 10_000_000
+
+
+def _check_job_size(rate_hz: float, duration_s: float, path: Path, ctx: Context) -> None:
+    samples = rate_hz * duration_s
+    if samples > MAX_TRUTH_SAMPLES:
+        hours = MAX_TRUTH_SAMPLES / rate_hz / 3600
+        ctx.error(path + ("trajectory",),
+                  f"the drive lasts {duration_s / 3600:.4g} h: at {rate_hz:g} Hz that is "
+                  f"{samples:.3g} truth samples (about {samples * 750 / 1e9:.3g} GB), more than "
+                  f"one job may hold ({MAX_TRUTH_SAMPLES:.0e}); split it into drives of at most "
+                  f"{hours:.3g} h, or lower trajectory.rate")
+
+
 def _zones_used(value: dict) -> set[str] | None:
     """Zone names the segments carry (None for sources whose zones come from elsewhere)."""
     traj = value["trajectory"]
@@ -106,7 +125,8 @@ def _zones_used(value: dict) -> set[str] | None:
 
 SCENARIO_FIELD = Record(
     {
-        "name": Text(None),
+        "name": SafeName(None, doc="the drive's name; `landnav run` without -o writes to "
+                         "runs/<name>, so letters, digits, '.', '_' and '-' only"),
         "description": Text(None),
         "seed": Integer(0, min=0, max=2**63 - 1),
         "start": START_FIELD,

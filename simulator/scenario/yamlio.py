@@ -1,5 +1,12 @@
 """Reading scenario YAML with the line of every key, and applying ``--set key.path=value``.
 
+The reader is bounded: alias expansion and nesting depth are limited (``MAX_NODES``,
+``MAX_DEPTH``), so a small "billion laughs" file or a self-referencing alias is refused with its
+line instead of exhausting memory or the stack. Plain scalars that YAML 1.1 leaves as strings but
+every reader means as numbers (``1.0e9``, ``1e-3``: YAML 1.1 wants a sign in the exponent and a dot
+in the mantissa) are read as floats, and a timestamp that is not a real date (``2024-13-45``) is
+refused with its line.
+
 Public functions
 ----------------
 read_yaml, apply_overrides.
@@ -7,6 +14,7 @@ read_yaml, apply_overrides.
 
 from __future__ import annotations
 
+import re
 from pathlib import Path as FsPath
 from typing import Any
 
@@ -14,10 +22,58 @@ import yaml
 
 from simulator.errors import InputError, Problem
 
+MAX_NODES = 200_000  # values built from one file, aliases expanded; a scenario has a few thousand
+MAX_DEPTH = 64  # nesting of mappings and lists
+
+# a number in scientific notation without the sign or dot YAML 1.1's float pattern requires
+_PLAIN_FLOAT = re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$")
+
+
+class _Budget:
+    """What a file may still build: a node count and the mappings/lists open on the path."""
+
+    def __init__(self) -> None:
+        self.nodes = 0
+        self.open: set[int] = set()
+
+
+def _refuse(file: str, node: yaml.Node, path: tuple, message: str) -> InputError:
+    return InputError([Problem(file, node.start_mark.line + 1, ".".join(map(str, path)),
+                               message)])
+
+
+def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader, path: tuple, file: str) -> Any:
+    if not node.style and node.tag == "tag:yaml.org,2002:str" and _PLAIN_FLOAT.match(
+            node.value):
+        return float(node.value)
+    try:
+        return loader.construct_object(node, deep=True)
+    except (ValueError, OverflowError) as exc:
+        raise _refuse(file, node, path, f"{node.value!r} is not a valid value ({exc})") from None
+
 
 def _construct(node: yaml.Node, loader: yaml.SafeLoader, path: tuple, lines: dict,
-               file: str) -> Any:
+               file: str, budget: _Budget) -> Any:
     lines.setdefault(path, node.start_mark.line + 1)
+    budget.nodes += 1
+    if budget.nodes > MAX_NODES:
+        raise _refuse(file, node, path, f"the file expands to more than {MAX_NODES} values "
+                      "(aliases repeated inside aliases?); write the content out")
+    if not isinstance(node, (yaml.MappingNode, yaml.SequenceNode)):
+        return _scalar(node, loader, path, file)
+    if len(path) >= MAX_DEPTH:
+        raise _refuse(file, node, path, f"nested more than {MAX_DEPTH} levels deep")
+    if id(node) in budget.open:
+        raise _refuse(file, node, path, "an alias refers to a mapping or list that contains it")
+    budget.open.add(id(node))
+    try:
+        return _construct_collection(node, loader, path, lines, file, budget)
+    finally:
+        budget.open.discard(id(node))
+
+
+def _construct_collection(node: yaml.Node, loader: yaml.SafeLoader, path: tuple, lines: dict,
+                          file: str, budget: _Budget) -> Any:
     if isinstance(node, yaml.MappingNode):
         loader.flatten_mapping(node)
         out: dict[Any, Any] = {}
@@ -30,12 +86,10 @@ def _construct(node: yaml.Node, loader: yaml.SafeLoader, path: tuple, lines: dic
                 raise InputError([Problem(file, key_node.start_mark.line + 1,
                                           ".".join(map(str, path + (key,))), "duplicate key")])
             lines[path + (key,)] = key_node.start_mark.line + 1
-            out[key] = _construct(value_node, loader, path + (key,), lines, file)
+            out[key] = _construct(value_node, loader, path + (key,), lines, file, budget)
         return out
-    if isinstance(node, yaml.SequenceNode):
-        return [_construct(item, loader, path + (i,), lines, file)
-                for i, item in enumerate(node.value)]
-    return loader.construct_object(node, deep=True)
+    return [_construct(item, loader, path + (i,), lines, file, budget)
+            for i, item in enumerate(node.value)]
 
 
 def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
@@ -58,7 +112,7 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
     try:
         node = loader.get_single_node()
         lines: dict[tuple, int] = {}
-        data = {} if node is None else _construct(node, loader, (), lines, file)
+        data = {} if node is None else _construct(node, loader, (), lines, file, _Budget())
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
@@ -86,8 +140,10 @@ def apply_overrides(data: Any, overrides: list[str], file: str) -> tuple[Any, se
         key, raw = text.split("=", 1)
         try:
             value = yaml.safe_load(raw) if raw.strip() else ""
-        except yaml.YAMLError:
+        except (yaml.YAMLError, ValueError):
             value = raw
+        if isinstance(value, str) and _PLAIN_FLOAT.match(value.strip()):
+            value = float(value)
         parts: list[Any] = [int(p) if p.lstrip("-").isdigit() else p for p in key.split(".")]
         if not all(str(p) for p in parts):
             problems.append(Problem(file, "--set", key, "empty part in the key path"))

@@ -1,0 +1,79 @@
+"""Innovation gating and adaptive measurement noise, the opt-in robustness blocks of the filter
+toolbox (off unless a paper's filter uses them).
+
+* Chi-square gating: with a consistent filter the innovation nu of an m-row measurement has
+  covariance S = H P H^T + R, so its normalised innovation squared d^2 = nu^T S^-1 nu is
+  chi-square distributed with m degrees of freedom (Bar-Shalom, Li & Kirubarajan, *Estimation
+  with Applications to Tracking and Navigation*, 2001, section 5.4.2; Groves 2013, section
+  17.3.1). A measurement whose d^2 exceeds the chi-square quantile of the chosen probability
+  is rejected.
+* Threshold adaptation of R (Park et al. 2019, section III-D): a measurement's noise variance
+  is raised from its nominal to an inflated value while a test statistic (the accelerometer's
+  specific-force norm minus gravity, the vehicle speed, the innovation) is beyond a threshold.
+  ``threshold_variance`` gives the variance for one such rule; the rules themselves, with the
+  paper's thresholds, live with the filter that uses them.
+
+``update`` of ``estimators.toolbox.kalman`` returns S, so a filter gates by computing the
+prediction, calling ``passes_gate(nu, s)`` with S = H P H^T + R (``innovation_covariance``), and
+updating only when it passes.
+
+Public functions
+----------------
+chi2_threshold, innovation_covariance, normalised_innovation_squared, passes_gate,
+threshold_variance.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+
+@lru_cache(maxsize=64)
+def chi2_threshold(dof: int, probability: float = 0.999) -> float:
+    """The chi-square quantile: P(d^2 <= threshold) = ``probability`` for ``dof`` degrees of
+    freedom (scipy.stats.chi2.ppf; cached, as a filter asks for the same few values).
+
+    Parameters
+    ----------
+    dof : int
+        Degrees of freedom, the number of measurement rows (>= 1).
+    probability : float
+        Probability of accepting a measurement that fits the model, in (0, 1).
+    """
+    from scipy.stats import chi2  # imported here: scipy.stats costs 0.2 s and gating is opt-in
+
+    if dof < 1 or not 0.0 < probability < 1.0:
+        raise ValueError(f"chi2_threshold needs dof >= 1 and 0 < probability < 1, "
+                         f"got {dof}, {probability}")
+    return float(chi2.ppf(probability, dof))
+
+
+def innovation_covariance(p: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """S = H P H^T + R, shape (m, m), symmetrised (Groves 2013, eq. 3.25's denominator)."""
+    h = np.atleast_2d(h)
+    s = h @ p @ h.T + np.atleast_2d(r)
+    return 0.5 * (s + s.T)
+
+
+def normalised_innovation_squared(nu: np.ndarray, s: np.ndarray) -> float:
+    """d^2 = nu^T S^-1 nu for an innovation ``nu`` (m,) with covariance ``s`` (m, m)."""
+    nu = np.atleast_1d(np.asarray(nu, dtype=float))
+    return float(nu @ np.linalg.solve(np.atleast_2d(s), nu))
+
+
+def passes_gate(nu: np.ndarray, s: np.ndarray, probability: float = 0.999) -> bool:
+    """True when the innovation is consistent with its covariance at ``probability``
+    (d^2 <= chi-square quantile with len(nu) degrees of freedom)."""
+    nu = np.atleast_1d(nu)
+    return normalised_innovation_squared(nu, s) <= chi2_threshold(nu.size, probability)
+
+
+def threshold_variance(statistic: float, threshold: float, sigma_nominal: float,
+                       sigma_inflated: float, above: bool = True) -> float:
+    """The measurement variance of a threshold adaptation rule (Park et al. 2019, section
+    III-D): ``sigma_inflated``^2 when ``statistic`` is beyond ``threshold`` (above it, or below
+    it with ``above=False``), else ``sigma_nominal``^2."""
+    beyond = statistic > threshold if above else statistic < threshold
+    return (sigma_inflated if beyond else sigma_nominal) ** 2
