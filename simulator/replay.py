@@ -17,7 +17,8 @@ roll/pitch/yaw added to the Euler angles, ``heading_error`` added to yaw).
 
 Public functions
 ----------------
-run_estimator, initial_state, merge_streams, output_times, write_solution, read_solution.
+run_estimator, initial_state, merge_streams, output_times, write_solution, read_solution,
+solution_problems.
 """
 
 from __future__ import annotations
@@ -280,7 +281,9 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     return frame, info
 
 
-def _solution_problems(frame: pd.DataFrame) -> list[str]:
+def solution_problems(frame: pd.DataFrame) -> list[str]:
+    """What makes a table not a solution (SPEC section 7): missing columns, t not finite or
+    not increasing; empty when it is one."""
     missing = [c for c in col.SOLUTION if c not in frame.columns]
     if missing:
         return [f"missing column(s) {', '.join(missing)} (a solution needs "
@@ -299,7 +302,7 @@ def _solution_problems(frame: pd.DataFrame) -> list[str]:
 def write_solution(frame: pd.DataFrame, path: str | Path) -> None:
     """Write a solution table as Parquet (SPEC section 7), atomically; extra columns get unit
     ""."""
-    problems = _solution_problems(frame)
+    problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     units = {**col.SOLUTION, **col.SOLUTION_STD}
@@ -323,7 +326,7 @@ def read_solution(path: str | Path) -> pd.DataFrame:
         increase.
     """
     frame = read_table(Path(path))
-    problems = _solution_problems(frame)
+    problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     return frame

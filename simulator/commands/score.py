@@ -1,5 +1,5 @@
-"""``landnav score DATASET (--solution FILE... | -e NAME...)``: truth-referenced metrics of one
-or more solutions (SPEC section 8), optionally as JSON and as a markdown report with plots."""
+"""``landnav score DATASET [--solution FILE...] [-e NAME...]``: truth-referenced metrics of one
+or more solutions (docs/scores.md), optionally as JSON and as a markdown report with plots."""
 
 from __future__ import annotations
 
@@ -13,8 +13,9 @@ import pandas as pd
 from simulator.commands import SUMMARIES
 from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
 from simulator.errors import InputError, Problem
-from simulator.replay import read_solution, run_estimator
+from simulator.replay import run_estimator
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
+from simulator.scoring.readers import check_solution, read_solution_file
 from simulator.scoring.report import text_table, write_report
 
 
@@ -22,32 +23,40 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "score", help=SUMMARIES["score"],
         description="Score navigation solutions against the truth of a dataset: horizontal, "
-                    "vertical, velocity and attitude errors, per-GNSS-outage drift, NEES when "
-                    "the solution has standard deviations (SPEC section 8). Solutions are files "
-                    "(--solution, labelled by file stem; written by any program, SPEC section 7)"
-                    " or registered estimators run here (-e, labelled by name). Prints a compact "
-                    "table; --json writes the scores keyed by label; --report writes report.md "
-                    "with plots into DIR (atomically; an existing DIR needs --force).")
+                    "vertical, velocity and attitude errors, coverage, drift in each GNSS outage "
+                    "and degraded window, estimated sensor errors, NEES when the solution has "
+                    "standard deviations (docs/scores.md). Solutions are files (--solution, "
+                    "labelled by file stem: Parquet or CSV with the columns of "
+                    "docs/solution-format.md, RTKLIB .pos, NMEA GGA/RMC) and/or estimators run "
+                    "here (-e, a registered name or module:Class, labelled by name). Prints a "
+                    "compact table; --json writes the scores keyed by label; --report writes "
+                    "report.md with plots into DIR (atomically; an existing DIR needs --force).")
     p.add_argument("dataset", metavar="DATASET", help="dataset directory")
-    which = p.add_mutually_exclusive_group(required=True)
-    which.add_argument("--solution", nargs="+", action="extend", metavar="FILE",
-                       help="solution Parquet file(s)")
-    which.add_argument("-e", "--estimator", nargs="+", action="extend", metavar="NAME",
-                       help="registered estimator(s) to run over the dataset and score")
+    p.add_argument("--solution", nargs="+", action="extend", metavar="FILE", default=[],
+                   help="solution file(s): .parquet, .csv, RTKLIB .pos, NMEA")
+    p.add_argument("-e", "--estimator", nargs="+", action="extend", metavar="NAME", default=[],
+                   help="estimator(s) to run over the dataset and score (registered name or "
+                        "module:Class, found from the current directory as python -m does)")
     p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
     p.add_argument("--report", metavar="DIR", help="write report.md and plots/ into DIR")
     p.add_argument("--force", action="store_true", help="overwrite an existing report DIR")
     p.set_defaults(run=run)
 
 
-def _from_files(paths: list[str]) -> dict[str, tuple[pd.DataFrame, None]]:
+def _from_files(paths: list[str], dataset: Dataset, truth: pd.DataFrame
+                ) -> dict[str, tuple[pd.DataFrame, None]]:
+    gps = dataset.manifest.get("gps_time_start") or {"week": 0, "tow": 0.0}
     out: dict[str, tuple[pd.DataFrame, None]] = {}
     for path in paths:
         label = Path(path).stem
         if label in out:
             raise InputError([Problem(path, None, "", f"another solution file is also labelled "
                                       f"{label!r} (labels are file stems); rename one")])
-        out[label] = (read_solution(path), None)
+        frame, notes = read_solution_file(path, (gps["week"], gps["tow"]))
+        check_solution(path, frame, truth)
+        for note in notes:
+            print(f"note: {note}", file=sys.stderr)
+        out[label] = (frame, None)
     return out
 
 
@@ -67,12 +76,19 @@ def print_scores(ev: Evaluation) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    if not args.solution and not args.estimator:
+        raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
+                                  "FILE... and/or -e NAME...")])
     dataset = open_dataset(args.dataset)
     with contextlib.ExitStack() as stack:
         report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force))
                       if args.report else None)
-        solutions = (_from_files(args.solution) if args.solution
-                     else _from_estimators(dataset, args.estimator))
+        solutions = _from_files(args.solution, dataset, dataset.read("truth"))
+        for label, solved in _from_estimators(dataset, args.estimator).items():
+            if label in solutions:
+                raise InputError([Problem(args.dataset, None, "", f"label {label!r} is both a "
+                                          "solution file's stem and an estimator's name")])
+            solutions[label] = solved
         ev = score_solutions(dataset, solutions)
         print_scores(ev)
         if args.json:

@@ -7,19 +7,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simulator.dataset.generate import generate_dataset
-from simulator.dataset.io import open_dataset
 from simulator.replay import run_estimator
-from simulator.scenario import load_scenario
 from simulator.scoring.align import solution_errors
 from simulator.scoring.evaluate import score_solutions
-from tests.scoring_helpers import QUICKSTART
-
-
-@pytest.fixture(scope="module")
-def quickstart(tmp_path_factory):
-    out = tmp_path_factory.mktemp("q") / "quickstart"
-    return open_dataset(generate_dataset(load_scenario(QUICKSTART), out, show_progress=False))
 
 
 def test_gnss_only_outside_the_tunnel_scores_like_its_fixes(quickstart):
