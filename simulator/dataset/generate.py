@@ -86,6 +86,8 @@ class Generated:
     truth: Kinematics
     streams: dict[str, Table]  # DataFrames unless generate_streams(frames=False)
     drawn: dict[str, dict] = field(default_factory=dict)
+    timing: dict[str, dict] = field(default_factory=dict)  # stream -> how it is stamped
+    truth_keys: dict[str, dict] = field(default_factory=dict)  # sensor -> {key: nominal}
 
 
 def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = True,
@@ -148,7 +150,10 @@ def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = 
     if gnss is not None and "raw" not in gnss["outputs"]:
         streams.pop("gnss_raw", None)
     streams["events"] = events_table(rows)
-    return Generated(truth, as_frames(streams) if frames else streams, drawn)
+    timing = {stream: how for model in models.values() for stream, how in model.timing().items()
+              if stream in streams}
+    return Generated(truth, as_frames(streams) if frames else streams, drawn, timing,
+                     {name: dict(model.truth_keys) for name, model in models.items()})
 
 
 def _outages(streams: dict[str, Table], end_t: float) -> list[tuple[float, float]]:
@@ -176,11 +181,47 @@ def _versions(data: dict) -> dict[str, str]:
             **{name: importlib.import_module(name).__version__ for name in used}}
 
 
+# what a real user of the dataset would know, and what only the scorer may read
+KNOWLEDGE = {
+    "user": ["datasheet", "timing", "gps_time_start", "utc_start", "streams", "duration",
+             "software"],
+    "truth": ["scenario", "overrides", "sensors", "truth_parameters", "origin", "seed",
+              "truth*.parquet", "events.parquet"],
+}
+
+
+def _datasheet(data: dict, truth_keys: dict[str, dict]) -> tuple[dict, dict]:
+    """Each sensor's block as a user would know it (the true-value keys replaced by their
+    nominal values), and the true values replaced."""
+    datasheet, true_values = {}, {}
+    for name, block in data["sensors"].items():
+        if block is None:
+            continue
+        keys = truth_keys.get(name, {})
+        datasheet[name] = {k: keys.get(k, v) for k, v in block.items()}
+        if keys:
+            true_values[name] = {k: block[k] for k in keys if k in block}
+    return datasheet, true_values
+
+
 def build_manifest(scenario: Scenario, generated: Generated) -> dict:
-    """The manifest (SPEC section 5) without its ``streams`` block."""
+    """The manifest (SPEC section 5) without its ``streams`` block.
+
+    Besides the SPEC keys: ``datasheet`` (each sensor's parameters as a user knows them: the
+    datasheet and nominal values, with the scenario keys that set a true value, such as the
+    odometer's ``scale_factor``, replaced by the nominal value a user assumes), the values so
+    replaced in ``truth_parameters``, ``timing`` (how each stream is stamped and its effective
+    delay) and ``knowledge`` (which keys a real user would know, and which are truth that only
+    scoring may read: the resolved ``scenario``, the drawn ``sensors``, ...).
+    """
     data = scenario.data
     truth = generated.truth
+    datasheet, true_values = _datasheet(data, generated.truth_keys)
     return {
+        "knowledge": KNOWLEDGE,
+        "datasheet": datasheet,
+        "truth_parameters": true_values,
+        "timing": generated.timing,
         "scenario": data,
         "seed": data["seed"],
         "overrides": scenario.overrides,

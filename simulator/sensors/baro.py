@@ -72,6 +72,8 @@ class Barometer(PresetSensor):
     """A barometer built from its resolved scenario block (``sensors.baro``)."""
 
     name = "baro"
+    # the weather is truth: a user assumes the standard atmosphere, steady
+    truth_keys = {"sea_level_pressure": P0_PA, "drift": 0.0}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config

@@ -172,6 +172,18 @@ class Gnss(PresetSensor):
         super().__init__(config)
         self.drawn["constellation"] = config["constellation"]
 
+    def timing(self) -> dict[str, dict]:
+        """Epochs are stamped with the true GPS time of the measurement (the receiver's clock
+        error is in the measurements, not in ``t``); the fix of an epoch uses that epoch's
+        measurements only."""
+        stamp = "the true GPS time of the measurement epoch"
+        return {"gnss_fix": {"stamp": stamp, "delay_s": 0.0,
+                             "no_fix": "epochs without a fix are rows with fix = 0 and NaN "
+                                       "position and velocity"},
+                "gnss_raw": {"stamp": stamp, "delay_s": 0.0,
+                             "no_fix": "one row per tracked satellite; an epoch with no "
+                                       "satellite has no row"}}
+
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:
         """The navigation table used for the drive (nominal constellation or the named file)."""

@@ -254,8 +254,21 @@ class Imu:
         self.increment = self.config["output"] == "increment"
         self.drawn: dict = {"preset": self.config["preset"]}
         # column (columns.SENSOR_ERRORS) -> (t, true value), filled by ``generate``
+        self.truth_keys: dict[str, float] = {}  # every key is a datasheet figure
         self.true_errors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._prepared: _Draws | None = None
+
+    def timing(self) -> dict[str, dict]:
+        """Rates are sampled at their stamp; increments cover (t - 1/rate, t], stamped at its
+        end (their mean is half a sample behind). A ``bandwidth`` low-pass delays the signal by
+        about 1/(2 pi bandwidth) at low frequencies (first-order filter)."""
+        bandwidth = [self.config[g]["bandwidth"] for g in ("gyro", "accel")]
+        delay = max((1.0 / (2 * np.pi * min(np.atleast_1d(b))) for b in bandwidth
+                     if b is not None), default=0.0)
+        if self.increment:
+            return {"imu": {"stamp": "the end of the integration interval (t - 1/rate, t]",
+                            "delay_s": 0.5 / self.rate_hz + delay}}
+        return {"imu": {"stamp": "the sampling instant", "delay_s": delay}}
 
     # -- the random part, drawn before the truth exists ---------------------------------------
     def prepare(self, duration_s: float, rng: np.random.Generator | None,

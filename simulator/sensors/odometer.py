@@ -67,6 +67,17 @@ class Odometer(PresetSensor):
     """An odometer built from its resolved scenario block (``sensors.odometer``)."""
 
     name = "odometer"
+    truth_keys = {"scale_factor": 1.0}  # the true scale factor; a user assumes 1
+
+    def timing(self) -> dict[str, dict]:
+        """With ticks the speed is the count over the interval (t - 1/rate, t] divided by its
+        length: a mean, 0.5/rate behind its stamp, plus the latency."""
+        c = self.config
+        if c["ticks_per_meter"] > 0:
+            return {"odometer": {"stamp": "the end of the tick-counting interval; speed is the "
+                                          "mean over the interval",
+                                 "delay_s": c["latency"] + 0.5 / self.rate_hz}}
+        return {"odometer": {"stamp": "the sampling instant", "delay_s": c["latency"]}}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config

@@ -73,9 +73,17 @@ class PresetSensor:
     of ``columns.SENSOR_ERRORS`` -> (t, values)), filled by ``generate``."""
 
     name = ""
+    # scenario keys that set a true value rather than a datasheet figure, with the nominal value
+    # a user would assume instead (the manifest's ``datasheet`` shows that one)
+    truth_keys: dict[str, float] = {}
 
     def __init__(self, config: dict):
         self.config = config
         self.rate_hz = float(config["rate"])
         self.drawn: dict = {"preset": config["preset"]}
         self.true_errors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def timing(self) -> dict[str, dict]:
+        """How each stream of the sensor is stamped (the manifest's ``timing``): stream ->
+        {stamp, delay_s (the effective delay of the value behind its stamp)}."""
+        return {self.name: {"stamp": "the sampling instant", "delay_s": 0.0}}
