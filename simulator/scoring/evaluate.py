@@ -39,6 +39,7 @@ class Evaluation:
     events: pd.DataFrame
     results: dict[str, Scored]
     canyon_zones: frozenset[str] = frozenset()
+    dataset: Dataset | None = None  # for the report's GNSS plots
 
     def scores(self) -> dict[str, dict]:
         """The JSON-ready scores keyed by label."""
@@ -91,7 +92,7 @@ def score_solutions(dataset: Dataset,
                               uses_gnss=(info or {}).get("uses_gnss", True),
                               canyon_zones=canyons, gnss_fix=gnss_fix)
         results[label] = Scored(label, frame, errors, scores)
-    return Evaluation(truth, events, results, canyons)
+    return Evaluation(truth, events, results, canyons, dataset)
 
 
 def write_scores(scores: dict, path: Path) -> None:
