@@ -21,7 +21,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "estimate", help=SUMMARIES["estimate"],
         description="Replay a dataset into one estimator, message by message in time order "
                     "(the estimator never sees the truth), and write its solution as Parquet "
-                    "(SPEC section 7). The estimator starts from the truth at its first "
+                    "(docs/solution-format.md). The estimator starts from the truth at its first "
                     "message, perturbed by --init errors (unless it initialises itself).")
     p.add_argument("dataset", metavar="DATASET", help="dataset directory (landnav generate)")
     p.add_argument("-e", "--estimator", required=True, metavar="NAME",

@@ -54,8 +54,9 @@ def register(name: str, params: dict[str, Field], streams: tuple[str, ...], doc:
              ) -> Callable[[Apply], Apply]:
     """Decorator registering a fault kind's parameters and its ``apply`` function."""
     def wrap(apply: Apply) -> Apply:
-        FAULT_REGISTRY[name] = FaultKind(name, Record({**TRIGGER_FIELDS, **params}), apply,
-                                         streams, doc)
+        record = Record({**TRIGGER_FIELDS, **params},
+                        doc=f"{doc} (acts on: {', '.join(streams)})")
+        FAULT_REGISTRY[name] = FaultKind(name, record, apply, streams, doc)
         return apply
     return wrap
 
