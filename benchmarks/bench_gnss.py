@@ -24,7 +24,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
 from benchmarks.bench_truth import LOOP  # noqa: E402
-from simulator.scenario.schema import Context  # noqa: E402
+from simulator.schema import Context  # noqa: E402
 from simulator.sensors.gnss import GNSS_FIELD, Gnss  # noqa: E402
 from simulator.trajectory.kinematics import kinematics_from_profile  # noqa: E402
 from simulator.trajectory.segments import (  # noqa: E402

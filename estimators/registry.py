@@ -31,6 +31,16 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
+    "dr2d_drm1_ekf": "estimators.builtin.cho2006:Drm1Ekf",
+    "dr2d_drm2_ekf": "estimators.builtin.cho2006:Drm2Ekf",
+    "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",
+    "dr2d_odo_ekf": "estimators.builtin.park2019_dr:Dr2dOdoEkf",
+    "dr3d_ekf": "estimators.builtin.park2019_dr:Dr3dEkf",
+    "tc_ukf": "estimators.builtin.chan:TcUkf",
+    "tc_ekf": "estimators.builtin.chan:TcEkf",
+    "riss3d_tc_ekf": "estimators.builtin.karamat2015:RissTcEkf",
+    "ins_odo_ekf": "estimators.builtin.park2019_ins:ParkInsOdometer",
+    "ins_lkf": "estimators.builtin.tan2008:TanLinearisedKF",
 }
 
 

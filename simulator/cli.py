@@ -8,13 +8,15 @@ Bad input ends with one clear message per problem on stderr and exit code 2, nev
 from __future__ import annotations
 
 import argparse
-import gc
 import importlib
 import os
+import signal
 import sys
+import threading
+from types import FrameType
 
 from simulator.commands import SUMMARIES
-from simulator.errors import InputError
+from simulator.errors import InputError, Terminated
 
 DESCRIPTION = """\
 landnav: synthetic land-vehicle drives and navigation-sensor datasets, with estimator replay
@@ -53,23 +55,6 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
 # for one (n, 3) x (3, 3) product on a busy machine, against 1 ms on one thread). Set before the
 # command imports numpy; a user's own setting wins.
 BLAS_THREADS = {"OPENBLAS_NUM_THREADS": "1"}
-_M_ARENA_MAX = -8  # mallopt parameter, glibc malloc.h
-
-
-def _one_malloc_arena() -> None:
-    """Let every thread allocate from one glibc heap (mallopt M_ARENA_MAX = 1) unless the user
-    set MALLOC_ARENA_MAX. glibc gives each thread its own heap, so the arrays a worker thread
-    frees are not reused by the others and every new array touches fresh pages: one arena cuts a
-    generation's page faults by a third (a tenth of its CPU). Linux with glibc only; set before
-    any thread starts. The few allocator calls of large arrays make the shared lock cheap."""
-    if not sys.platform.startswith("linux") or "MALLOC_ARENA_MAX" in os.environ:
-        return
-    import ctypes
-
-    try:
-        ctypes.CDLL("libc.so.6").mallopt(_M_ARENA_MAX, 1)
-    except (OSError, AttributeError):  # not glibc
-        pass
 
 
 def _command_name(argv: list[str]) -> str | None:
@@ -77,29 +62,67 @@ def _command_name(argv: list[str]) -> str | None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The ``landnav`` program (the console script): run one command, return its exit code.
+    Output into a pipe closed early (``landnav ... | head -1``) ends it quietly with code 1, as
+    Python's documentation advises, instead of a traceback."""
     for name, value in BLAS_THREADS.items():
         os.environ.setdefault(name, value)
-    _one_malloc_arena()
     argv = sys.argv[1:] if argv is None else argv
     command = _command_name(argv)
-    # importing the command makes some 100 000 objects that live to the end: no collections
-    # while they are made, and none that scans them again later (about 10 ms of collections
-    # that free nothing); unfrozen at the end, for callers that run several commands
-    collecting = gc.isenabled()
-    gc.disable()
+    args = build_parser(command if command in SUMMARIES else None).parse_args(argv)
     try:
-        args = build_parser(command if command in SUMMARIES else None).parse_args(argv)
-        gc.freeze()
-        if collecting:
-            gc.enable()
-        return _run(args)
-    finally:
-        gc.unfreeze()
-        if collecting:
-            gc.enable()
+        code = _run(args)
+        sys.stdout.flush()
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write
+        return 1
+    return code
+
+
+def _importing(frame: FrameType | None) -> bool:
+    """Whether the interrupted code is an import (the import system on its stack)."""
+    while frame is not None:
+        if frame.f_code.co_filename.startswith("<frozen importlib"):
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _stop(signum: int, frame: FrameType | None) -> None:
+    """SIGTERM and SIGINT: raise ``Terminated`` or ``KeyboardInterrupt`` in the main thread, so
+    every ``with`` block unwinds and removes its temporaries. Not during an import: an exception
+    between the import system's taking and releasing its global lock would leave the lock held
+    and hang every thread that imports, and a module's own bare ``except:`` may swallow it;
+    there the signal is retried 20 ms later."""
+    if _importing(frame):
+        _deferred.append(signum)
+        signal.setitimer(signal.ITIMER_REAL, 0.02)
+        return
+    raise KeyboardInterrupt if signum == signal.SIGINT else Terminated(signum)
+
+
+def _retry(signum: int, frame: FrameType | None) -> None:
+    if _deferred:
+        _stop(_deferred.pop(), frame)
+
+
+_deferred: list[int] = []
+
+
+def _install_stop_handlers() -> dict[int, object]:
+    """Handlers for SIGTERM, SIGINT (unless ignored, as in a background job) and the retry
+    timer; returns the previous ones."""
+    previous = {signal.SIGTERM: signal.signal(signal.SIGTERM, _stop),
+                signal.SIGALRM: signal.signal(signal.SIGALRM, _retry)}
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        previous[signal.SIGINT] = signal.signal(signal.SIGINT, _stop)
+    return previous
 
 
 def _run(args: argparse.Namespace) -> int:
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = _install_stop_handlers()
     try:
         return int(args.run(args) or 0)
     except InputError as exc:
@@ -107,33 +130,20 @@ def _run(args: argparse.Namespace) -> int:
             print(f"error: {problem}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("interrupted: unfinished outputs were removed", file=sys.stderr)
         return 130
+    except Terminated:
+        print("terminated: unfinished outputs were removed", file=sys.stderr)
+        return 143
+    finally:
+        if previous:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
 
 
-# commands that run no user code and have written and closed every file when ``main`` returns:
-# the program ends without the interpreter's teardown, whose finalisers of numpy and pyarrow
-# take 40-60 ms (pandas' over 100 ms) and have nothing left to do
-_EXIT_WITHOUT_TEARDOWN = {"generate"}
-
-
-def program() -> None:
-    """The ``landnav`` program: ``main`` on the command line, then the process ends with its
-    exit code (without the interpreter's teardown after ``landnav generate``). Output into a
-    pipe closed early (``landnav ... | head -1``) ends it quietly with code 1, as Python's
-    documentation advises, instead of a traceback."""
-    argv = sys.argv[1:]
-    try:
-        code = main(argv)
-        sys.stdout.flush()
-        sys.stderr.flush()
-    except BrokenPipeError:
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write
-        code = 1
-    if _command_name(argv) in _EXIT_WITHOUT_TEARDOWN:
-        os._exit(code)
-    sys.exit(code)
-
+# the console script of installations made before 2026-11-24 calls ``program``
+program = main
 
 if __name__ == "__main__":
-    program()
+    sys.exit(main())

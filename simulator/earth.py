@@ -11,7 +11,7 @@ and longitude are in radians inside this module unless a name ends in ``_deg``.
 Public functions
 ----------------
 radii_of_curvature, radii_of_curvature_from_sin, normal_gravity, normal_gravity_from_sin,
-gravity_ned, earth_rate_ned, transport_rate_ned, geodetic_to_ecef, ecef_to_geodetic,
+gravity_ned, earth_rate_ned, transport_rate_ned, geodetic_rates, geodetic_to_ecef, ecef_to_geodetic,
 ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef, ned_to_ecef_vector, euler_to_dcm, ned_to_body,
 ned_to_body_trig, ned_to_body_components, dcm_to_euler, euler_to_quat, quat_to_dcm, quat_to_euler,
 quat_multiply, rotvec_to_quat, wrap_angle, skew.
@@ -120,6 +120,25 @@ def transport_rate_ned(lat_rad: np.ndarray, alt_m: np.ndarray, v_ned: np.ndarray
     )
 
 
+def geodetic_rates(lat_rad: np.ndarray, alt_m: np.ndarray, v_ned: np.ndarray,
+                   radii: tuple[np.ndarray, np.ndarray] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Latitude, longitude and height rates (rad/s, rad/s, m/s) of a NED velocity (Groves eq.
+    2.111): v_N / (R_N + h), v_E / ((R_E + h) cos L), -v_D. Given a small NED displacement
+    (m) instead of a velocity, the same expressions are its change of latitude, longitude
+    (rad) and height (m) to first order: the one home of "NED offset to geodetic".
+
+    Parameters
+    ----------
+    lat_rad, alt_m : float or array, shape (n,); latitude L and ellipsoidal height h.
+    v_ned : array, shape (3,) or (n, 3).
+    radii : ``radii_of_curvature(lat_rad)`` when the caller already has them.
+    """
+    rn, re = radii_of_curvature(lat_rad) if radii is None else radii
+    v = np.asarray(v_ned)
+    return v[..., 0] / (rn + alt_m), v[..., 1] / ((re + alt_m) * np.cos(lat_rad)), -v[..., 2]
+
+
 def geodetic_to_ecef(lat_rad: np.ndarray, lon_rad: np.ndarray, alt_m: np.ndarray) -> np.ndarray:
     """Geodetic (rad, rad, m) to ECEF, shape (n, 3), m (pymap3d.geodetic2ecef, WGS-84)."""
     pymap3d, wgs84 = _pymap3d()
@@ -180,6 +199,8 @@ def ned_to_ecef_vector(v_ned: np.ndarray, lat_rad: np.ndarray, lon_rad: np.ndarr
 def skew(v: np.ndarray) -> np.ndarray:
     """Skew-symmetric (cross-product) matrix of vectors, shape (..., 3, 3)."""
     v = np.asarray(v, dtype=float)
+    if v.ndim == 1:  # one vector: 20 times faster than the stacked form (filter inner loops)
+        return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
     z = np.zeros(v.shape[:-1])
     return np.stack(
         [
@@ -289,6 +310,12 @@ def euler_to_quat(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.nd
 def quat_to_dcm(q: np.ndarray) -> np.ndarray:
     """DCM of a scalar-first unit quaternion, shape (..., 3, 3) (Groves eq. 2.34)."""
     q = np.asarray(q, dtype=float)
+    if q.ndim == 1:  # one quaternion: the same matrix built without stacking (filter loops)
+        a, b, c, d = (float(x) for x in q)
+        return np.array([
+            [a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)],
+            [2 * (b * c + a * d), a * a - b * b + c * c - d * d, 2 * (c * d - a * b)],
+            [2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d]])
     a, b, c, d = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
     return np.stack(
         [

@@ -2,7 +2,7 @@
 
 Public classes
 --------------
-Problem, InputError.
+Problem, InputError, Terminated.
 """
 
 from __future__ import annotations
@@ -37,3 +37,9 @@ class InputError(Exception):
             problems = [Problem("landnav", None, "", problems)]
         self.problems = list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class Terminated(BaseException):
+    """The process was asked to stop (SIGTERM). Raised in the main thread by the command line's
+    handler so that, as with Ctrl-C, every ``with`` block unwinds and removes its temporaries;
+    the command line then exits with 143 (128 + SIGTERM)."""

@@ -23,9 +23,8 @@ solution_problems.
 
 from __future__ import annotations
 
-import os
 import time
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +43,7 @@ from simulator.earth import (
     wrap_angle,
 )
 from simulator.errors import InputError, Problem
+from simulator.outputs import atomic_output_file
 from simulator.progress import progress
 
 STREAM_ORDER = ("imu", "odometer", "baro", "mag", "gnss_fix", "gnss_raw")
@@ -299,21 +299,17 @@ def solution_problems(frame: pd.DataFrame) -> list[str]:
     return []
 
 
-def write_solution(frame: pd.DataFrame, path: str | Path) -> None:
+def write_solution(frame: pd.DataFrame, path: str | Path, force: bool = False,
+                   inputs: Iterable[Path | str] = ()) -> None:
     """Write a solution table as Parquet (SPEC section 7), atomically; extra columns get unit
-    ""."""
+    "". An existing file is replaced only with ``force``; a path inside one of ``inputs`` (the
+    dataset read) is refused."""
     problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     units = {**col.SOLUTION, **col.SOLUTION_STD}
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"  # never a half-written file
-    try:
+    with atomic_output_file(path, force, inputs) as tmp:
         write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns})
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
 
 
 def read_solution(path: str | Path) -> pd.DataFrame:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import datetime as dt
 
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors.gnss import GNSS_FIELD, Gnss
 from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
 from simulator.trajectory.segments import LIMITS_FIELD, SEGMENT_FIELD, build_road_profile

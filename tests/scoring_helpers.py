@@ -16,8 +16,9 @@ import pandas as pd
 from estimators.base import Estimator
 from simulator import columns as col
 from simulator.dataset.generate import build_truth
-from simulator.dataset.io import atomic_output_dir, write_dataset
+from simulator.dataset.io import write_dataset
 from simulator.earth import radii_of_curvature, wrap_angle
+from simulator.outputs import atomic_output_dir
 from simulator.scenario import load_scenario
 
 QUICKSTART = Path(__file__).resolve().parents[1] / "scenarios" / "quickstart.yaml"

@@ -10,7 +10,8 @@ import numpy as np
 import pandas as pd
 
 from simulator.dataset.generate import build_truth
-from simulator.dataset.io import atomic_output_dir, write_dataset
+from simulator.dataset.io import write_dataset
+from simulator.outputs import atomic_output_dir
 from simulator.scenario import validate_data
 from simulator.sensors.imu import Imu
 

@@ -15,7 +15,7 @@ from simulator.environment.atmosphere import (
     pressure_pa,
     temperature_k,
 )
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.baro import BARO_FIELD, Barometer
 from simulator.tables import as_frame

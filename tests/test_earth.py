@@ -119,3 +119,31 @@ def test_ned_to_body_is_the_transposed_dcm():
     v = rng.normal(size=(50, 3))
     expected = np.einsum("nji,nj->ni", earth.euler_to_dcm(roll, pitch, yaw), v)
     np.testing.assert_allclose(earth.ned_to_body(roll, pitch, yaw, v), expected, atol=1e-14)
+
+
+def test_geodetic_rates_of_a_velocity_and_an_offset():
+    """Groves eq. 2.111 against the exact ECEF route: a 1 m north and east offset at 45 deg
+    moves the geodetic position as the rates say (to the offset's second order), and a
+    meridian degree has its tabulated length."""
+    from simulator.earth import ecef_to_geodetic, geodetic_rates, ned_to_ecef
+
+    lat0, lon0, alt0 = np.radians(45.0), np.radians(10.0), 300.0
+    offset = np.array([1.0, 1.0, -2.0])
+    d_lat, d_lon, d_alt = geodetic_rates(lat0, alt0, offset)
+    moved = ecef_to_geodetic(ned_to_ecef(offset[None, :], lat0, lon0, alt0))
+    lat, lon, alt = (float(np.ravel(x)[0]) for x in moved)
+    np.testing.assert_allclose([lat - lat0, lon - lon0], [d_lat, d_lon], rtol=1e-6)
+    np.testing.assert_allclose(alt - alt0, d_alt, atol=1e-6)
+    # a degree of latitude at 45 deg: 111 132.954 - 559.822 cos 2L + 1.175 cos 4L = 111 131.78 m
+    # (the series for the WGS-84 meridian degree, e.g. the "Latitude" article's table)
+    metres_per_degree = np.radians(1.0) / geodetic_rates(lat0, 0.0, [1.0, 0.0, 0.0])[0]
+    assert abs(metres_per_degree - (111132.954 - 1.175)) < 0.01
+
+
+def test_single_vector_fast_paths_equal_the_stacked_forms():
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(4, 3))
+    q = earth.euler_to_quat(*rng.normal(size=(3, 4)))
+    np.testing.assert_array_equal(earth.skew(v[1]), earth.skew(v)[1])
+    np.testing.assert_allclose(earth.skew(v[2]) @ v[3], np.cross(v[2], v[3]), atol=1e-14)
+    np.testing.assert_allclose(earth.quat_to_dcm(q[3]), earth.quat_to_dcm(q)[3], atol=1e-15)

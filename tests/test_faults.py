@@ -337,6 +337,16 @@ def test_every_kind_is_covered():
 
 
 @pytest.mark.parametrize("kind, params, touched", EVERY_KIND, ids=[k[0] for k in EVERY_KIND])
+def test_kind_declares_every_stream_it_changes(kind, params, touched):
+    """The dataset writer writes a stream early unless a fault may change it: a fault changing
+    a stream it does not declare would race with that write (the GNSS truth table of
+    ``gnss_satellite_limit`` was written either before or after its ``tracked`` flags)."""
+    # truth_sensors is made from the applied faults' events after every fault ran, and written
+    # with the last streams
+    assert set(touched) - {"truth_sensors"} <= set(FAULT_REGISTRY[kind].changed_streams)
+
+
+@pytest.mark.parametrize("kind, params, touched", EVERY_KIND, ids=[k[0] for k in EVERY_KIND])
 def test_fault_acts_only_inside_its_interval(clean_all, kind, params, touched):
     """Faulted against clean dataset of the same seed: the touched streams differ inside the
     interval and are identical outside it; every other stream is identical."""

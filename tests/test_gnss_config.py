@@ -11,7 +11,7 @@ import pytest
 from gnss_helpers import drive, receiver
 
 from simulator.errors import InputError
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors import SENSOR_FIELDS, SENSOR_MODELS
 from simulator.sensors.gnss import GNSS_FIELD, PRESETS, Gnss
 

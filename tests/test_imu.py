@@ -10,7 +10,7 @@ from sensor_truths import drive_truth, truth_from_segments
 
 from simulator import columns as col
 from simulator.earth import G0_M_S2
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors import SENSOR_FIELDS, SENSOR_MODELS
 from simulator.sensors.imu import IMU_FIELD, REDUCED_UNITS, Imu
 from simulator.sensors.imu_presets import IMU_PRESETS

@@ -11,9 +11,9 @@ import pytest
 from sensor_truths import SHARED, static_truth
 
 from simulator import columns as col
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors.imu import IMU_FIELD, Imu
-from simulator.sensors.noise import (
+from simulator.stochastic import (
     FLICKER_ADEV_FACTOR,
     GM_ADEV_PEAK,
     GM_ADEV_PEAK_TAU,
@@ -244,7 +244,7 @@ def test_fitted_presets_follow_real_curves_long(preset, device):
 def test_ar1_filter_matches_scipy_lfilter(phi):
     from scipy.signal import lfilter
 
-    from simulator.sensors.noise import ar1_filter
+    from simulator.stochastic import ar1_filter
 
     u = np.random.default_rng(3).standard_normal((50_000, 3))
     np.testing.assert_allclose(ar1_filter(u, phi), lfilter([1.0], [1.0, -phi], u, axis=0),
@@ -254,7 +254,7 @@ def test_ar1_filter_matches_scipy_lfilter(phi):
 def test_ar1_filter_one_factor_per_column_matches_scipy_lfilter():
     from scipy.signal import lfilter
 
-    from simulator.sensors.noise import ar1_filter
+    from simulator.stochastic import ar1_filter
 
     phi = np.array([0.0, 0.905, 0.999999])
     u = np.random.default_rng(4).standard_normal((50_000, 3))
@@ -267,7 +267,7 @@ def test_ar1_filter_short_and_one_dimensional_inputs_match_scipy_lfilter(n):
     """Blocks that do not divide the length, a single block, and 1-D input."""
     from scipy.signal import lfilter
 
-    from simulator.sensors.noise import ar1_filter
+    from simulator.stochastic import ar1_filter
 
     u = np.random.default_rng(n).standard_normal(n)
     for phi in (0.5, 0.99, 0.99999):
@@ -285,7 +285,7 @@ def test_ar1_filter_gains_match_scipy_lfilter(n):
     """x[k] = phi x[k-1] + g u[k], returned times h, per column: h * lfilter([g], [1, -phi])."""
     from scipy.signal import lfilter
 
-    from simulator.sensors.noise import ar1_filter
+    from simulator.stochastic import ar1_filter
 
     phi = np.array([0.0, 0.905, 0.999999, 1.0])
     gain_in, gain_out = np.array([2.0, 0.5, 1e-3, 3.0]), np.array([0.1, 4.0, 7.0, 1e-6])

@@ -86,3 +86,30 @@ def test_error_state_matches_total_state_filter(closed_loop):
     if not closed_loop:
         with pytest.raises(RuntimeError, match="closed-loop"):
             es.feedback()
+
+
+def test_switching_loops_mid_run_still_matches_the_total_state_filter():
+    """Closed loop, then open loop (an outage), then closed again: on a linear system the output
+    is the total-state filter's throughout, and closing the loop hands back the open-loop
+    estimate once."""
+    rng = np.random.default_rng(11)
+    x_true = np.array([0.0, 1.0])
+    nominal = np.array([5.0, 0.0])
+    p0 = np.diag([25.0, 1.0])
+    x_total, p_total = nominal.copy(), p0.copy()
+    es = ErrorState(p0)
+    for k in range(150):
+        if k in (50, 100):
+            nominal = nominal - es.set_closed_loop(k == 100)
+            assert not es.estimate.any()
+        x_true = PHI @ x_true + rng.multivariate_normal(np.zeros(2), Q)
+        z = H @ x_true + rng.normal(0.0, 2.0, 1)
+        x_total, p_total = predict(x_total, p_total, PHI, Q)
+        x_total, p_total, _ = update(x_total, p_total, z - H @ x_total, H, R)
+        nominal = PHI @ nominal
+        es.predict(PHI, Q)
+        es.update(H @ nominal - z, H, R)
+        if es.closed_loop:
+            nominal = nominal - es.feedback()
+        np.testing.assert_allclose(nominal - es.estimate, x_total, rtol=1e-9, atol=1e-9)
+    assert not es.set_closed_loop(True).any()  # already closed: nothing to hand back

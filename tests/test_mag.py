@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from sensor_truths import truth_from_segments
 
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.mag import (
     MAG_FIELD,

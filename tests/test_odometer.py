@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 from sensor_truths import drive_truth
 
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.odometer import ODOMETER_FIELD, Odometer
 from simulator.tables import as_frame

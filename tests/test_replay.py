@@ -8,9 +8,10 @@ import pandas as pd
 import pytest
 
 from simulator import columns as col
-from simulator.dataset.io import atomic_output_dir, open_dataset, write_dataset
+from simulator.dataset.io import open_dataset, write_dataset
 from simulator.earth import ecef_to_ned, geodetic_to_ecef, wrap_angle
 from simulator.errors import InputError
+from simulator.outputs import atomic_output_dir
 from simulator.replay import (
     STREAM_ORDER,
     merge_streams,

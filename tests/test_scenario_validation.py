@@ -80,7 +80,7 @@ def test_each_class_of_problem(tmp_path, capsys, edit, key, words):
 
 
 def test_wrong_unit_for_gyro_noise_density(tmp_path, capsys):
-    from simulator.scenario.schema import Context, Number
+    from simulator.schema import Context, Number
 
     ctx = Context("x.yaml")
     Number("rad/s/sqrt(Hz)").check("0.02 m/s", ("sensors", "imu", "gyro", "noise_density"), ctx)

@@ -8,7 +8,7 @@ import pytest
 from sensor_truths import static_truth, truth_from_segments
 
 from simulator import columns as col
-from simulator.scenario.schema import Context
+from simulator.schema import Context
 from simulator.sensors.imu import IMU_FIELD, Imu
 from simulator.tables import as_frame
 

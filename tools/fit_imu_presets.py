@@ -4,7 +4,7 @@ Reads the imu_utils curves in ``shared/refdata/allan/imu_utils_real_imus/`` (2 h
 gyro in deg/h with imu_utils' factor 57.3 * 3600, accelerometer in m/s^2) and fits, per axis:
 
 * the white-noise density N, flicker bias instability B, random-walk density K and rate ramp R of
-  ``simulator.sensors.noise.adev_model``, minimising the largest log misfit (from a least-squares
+  ``simulator.stochastic.adev_model``, minimising the largest log misfit (from a least-squares
   start) over tau from 5 samples to a tenth of the record;
 * on an axis that these four terms miss by more than ``MARKOV_WHEN`` (10 %) somewhere, also the
   exponentially correlated (Markov) bias of std sigma and correlation time T_c
@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq, least_squares, minimize
 
-from simulator.sensors.noise import adev_model
+from simulator.stochastic import adev_model
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "refdata" / "allan" / "imu_utils_real_imus"
 IMU_UTILS_DEG_H = 57.3 * 3600.0  # imu_utils' rad/s -> deg/h factor

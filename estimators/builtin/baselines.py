@@ -30,7 +30,13 @@ import math
 import numpy as np
 
 from estimators.base import Estimator
-from simulator.earth import earth_rate_ned, radii_of_curvature, transport_rate_ned, wrap_angle
+from simulator.earth import (
+    earth_rate_ned,
+    geodetic_rates,
+    radii_of_curvature,
+    transport_rate_ned,
+    wrap_angle,
+)
 
 
 class GnssOnly(Estimator):
@@ -143,8 +149,10 @@ class DeadReckoning(Estimator):
         self._t_imu = t
 
     def _move(self, d_north: float, d_east: float) -> None:
-        self._lat += d_north / (self._rn + self._alt)
-        self._lon += d_east / ((self._re + self._alt) * math.cos(self._lat))
+        d_lat, d_lon, _ = geodetic_rates(self._lat, self._alt, (d_north, d_east, 0.0),
+                                         (self._rn, self._re))
+        self._lat += d_lat
+        self._lon += d_lon
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         speed = float(row[self._speed_col])
@@ -164,8 +172,9 @@ class DeadReckoning(Estimator):
 
     def solution(self, t: float) -> list[float]:
         # the speed is held since the last odometer sample
-        lat = self._lat + self._speed * self._a_n / (self._rn + self._alt)
-        lon = self._lon + self._speed * self._a_e / ((self._re + self._alt) * math.cos(lat))
+        d_lat, d_lon, _ = geodetic_rates(self._lat, self._alt, (self._speed * self._a_n,
+                                         self._speed * self._a_e, 0.0), (self._rn, self._re))
+        lat, lon = self._lat + d_lat, self._lon + d_lon
         return [math.degrees(lat), math.degrees(lon), self._alt,
                 self._speed * math.cos(self._yaw), self._speed * math.sin(self._yaw), 0.0,
                 math.nan, math.nan, float(wrap_angle(self._yaw))]

@@ -14,48 +14,17 @@ Phi = M22^T and Q_d = Phi M12 (Brown & Hwang section 3.9).
 
 Public functions
 ----------------
-gauss_markov_continuous, gauss_markov_discrete, van_loan.
+van_loan; gauss_markov_continuous and gauss_markov_discrete (the closed forms, whose home is
+``simulator.stochastic``: the sensors draw the same processes).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from simulator.stochastic import gauss_markov_continuous, gauss_markov_discrete
 
-def gauss_markov_continuous(tau: np.ndarray, sigma: np.ndarray
-                            ) -> tuple[np.ndarray, np.ndarray]:
-    """Continuous model of first-order Gauss-Markov processes.
-
-    Parameters
-    ----------
-    tau : float or array, shape (k,)
-        Correlation times, s.
-    sigma : float or array, shape (k,)
-        Steady-state standard deviations (any unit u).
-
-    Returns
-    -------
-    f : (k,) diagonal of the system matrix, -1 / tau, 1/s; q_c : (k,) white-noise power
-    spectral densities 2 sigma^2 / tau, u^2/s.
-    """
-    tau = np.asarray(tau, dtype=float)
-    sigma = np.asarray(sigma, dtype=float)
-    return -1.0 / tau, 2.0 * sigma**2 / tau
-
-
-def gauss_markov_discrete(tau: np.ndarray, sigma: np.ndarray, dt: float
-                          ) -> tuple[np.ndarray, np.ndarray]:
-    """Exact discrete model of first-order Gauss-Markov processes over a step ``dt`` (s).
-
-    Returns
-    -------
-    phi : (k,) transition factors exp(-dt / tau); q_d : (k,) discrete noise variances
-    sigma^2 (1 - exp(-2 dt / tau)).
-    """
-    tau = np.asarray(tau, dtype=float)
-    sigma = np.asarray(sigma, dtype=float)
-    phi = np.exp(-dt / tau)
-    return phi, sigma**2 * -np.expm1(-2.0 * dt / tau)
+__all__ = ["gauss_markov_continuous", "gauss_markov_discrete", "van_loan"]
 
 
 def van_loan(f: np.ndarray, gqg: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

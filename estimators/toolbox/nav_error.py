@@ -23,16 +23,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from simulator.earth import quat_multiply, radii_of_curvature, rotvec_to_quat
+from simulator.earth import geodetic_rates, quat_multiply, rotvec_to_quat
 
 NAV_ERROR_STATES = ("dr_n", "dr_e", "dr_d", "dv_n", "dv_e", "dv_d", "psi_n", "psi_e", "psi_d")
 
 
 def _shift(pos: np.ndarray, d_ned: np.ndarray) -> np.ndarray:
     lat, lon, h = pos
-    rn, re = radii_of_curvature(lat)
-    return np.array([lat + d_ned[0] / (rn + h), lon + d_ned[1] / ((re + h) * np.cos(lat)),
-                     h - d_ned[2]])
+    d_lat, d_lon, d_h = geodetic_rates(lat, h, d_ned)
+    return np.array([lat + d_lat, lon + d_lon, h + d_h])
 
 
 def perturb(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dx: np.ndarray

@@ -14,7 +14,8 @@ The update per interval:
 
 Public functions
 ----------------
-propagate, run_strapdown, rates_to_increments.
+propagate, run_strapdown, rates_to_increments, attitude_step, frame_rates, radii, nav_derivative,
+rk4_step.
 """
 
 from __future__ import annotations
@@ -161,3 +162,93 @@ def rates_to_increments(t: np.ndarray, rates: np.ndarray) -> tuple[np.ndarray, n
     """Trapezoidal increments over [t_{k-1}, t_k] from rate samples; returns (increments, dt)."""
     dt = np.diff(t)
     return 0.5 * (rates[1:] + rates[:-1]) * dt[:, None], dt
+
+
+@njit(cache=True)
+def attitude_step(q: np.ndarray, rot_nav: np.ndarray, rot_body: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Rotate a body-to-NED quaternion by a navigation-frame rotation ``rot_nav`` (rad; the
+    frame's own rotation w_in dt, or an estimated attitude error psi) and a body-frame rotation
+    ``rot_body`` (rad; the gyro increment): q <- q(-rot_nav) * q * q(rot_body), normalised
+    (the attitude line of ``propagate``). Returns the quaternion and its body-to-NED DCM."""
+    q_new = _quat_mul(_quat_mul(_rotvec_quat(-rot_nav), q), _rotvec_quat(rot_body))
+    q_new = q_new / np.sqrt(np.sum(q_new * q_new))
+    return q_new, _quat_dcm(q_new)
+
+
+@njit(cache=True)
+def frame_rates(lat: float, h: float, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Earth rate and transport rate resolved in NED (rad/s) at latitude ``lat`` (rad), height
+    ``h`` (m) and NED velocity ``v`` (m/s) (Groves eqs. 5.41, 5.44; compiled, for filters'
+    inner loops; ``simulator.earth.earth_rate_ned`` and ``transport_rate_ned`` vectorised)."""
+    return _nav_rates(lat, h, v)
+
+
+@njit(cache=True)
+def radii(lat: float) -> tuple[float, float]:
+    """Meridian and transverse radii of curvature (m) at latitude ``lat`` (rad) (compiled;
+    ``simulator.earth.radii_of_curvature`` vectorised)."""
+    return _radii(lat)
+
+@njit(cache=True)
+def nav_derivative(x: np.ndarray, w_ib: np.ndarray, f_b: np.ndarray, out: np.ndarray) -> None:
+    """Time derivative of the total navigation state in the NED frame, written into ``out``
+    without allocating (Chan et al. eqs. 1-3; Titterton & Weston 2004, section 3.5.3):
+
+    L' = v_N / (R_m + h), l' = v_E / ((R_t + h) cos L), h' = -v_D (eq. 1);
+    v' = C_b^n f^b - (2 w_ie + w_en) x v + g^n (eq. 2, g the normal gravity);
+    q' = 1/2 q * (0, w_nb^b), w_nb^b = w_ib^b - C_n^b (w_ie + w_en) (eq. 3, whose Omega matrix
+    is this product).
+
+    x, out : (10,) latitude, longitude (rad), height (m), NED velocity (m/s), body-to-NED
+    quaternion (scalar first); w_ib, f_b : (3,) body angular rate (rad/s) and specific force
+    (m/s^2), FRD."""
+    lat, h, vn, ve, vd = x[0], x[2], x[3], x[4], x[5]
+    a, b, c, d = x[6], x[7], x[8], x[9]
+    sl, cl = np.sin(lat), np.cos(lat)
+    rm, rt = _radii(lat)
+    out[0] = vn / (rm + h)
+    out[1] = ve / ((rt + h) * cl)
+    out[2] = -vd
+    ie_n, ie_d = OMEGA_E_RAD_S * cl, -OMEGA_E_RAD_S * sl
+    en_n, en_e, en_d = ve / (rt + h), -vn / (rm + h), -ve * sl / cl / (rt + h)
+    c00, c01, c02 = a * a + b * b - c * c - d * d, 2 * (b * c - a * d), 2 * (b * d + a * c)
+    c10, c11, c12 = 2 * (b * c + a * d), a * a - b * b + c * c - d * d, 2 * (c * d - a * b)
+    c20, c21, c22 = 2 * (b * d - a * c), 2 * (c * d + a * b), a * a - b * b - c * c + d * d
+    fx, fy, fz = f_b[0], f_b[1], f_b[2]
+    an, ae, ad = 2.0 * ie_n + en_n, en_e, 2.0 * ie_d + en_d  # 2 w_ie + w_en
+    out[3] = c00 * fx + c01 * fy + c02 * fz - (ae * vd - ad * ve)
+    out[4] = c10 * fx + c11 * fy + c12 * fz - (ad * vn - an * vd)
+    out[5] = c20 * fx + c21 * fy + c22 * fz - (an * ve - ae * vn) + _normal_gravity(lat, h)
+    wn, we, wd = ie_n + en_n, en_e, ie_d + en_d  # w_in
+    p = w_ib[0] - (c00 * wn + c10 * we + c20 * wd)
+    q = w_ib[1] - (c01 * wn + c11 * we + c21 * wd)
+    r = w_ib[2] - (c02 * wn + c12 * we + c22 * wd)
+    out[6] = 0.5 * (-b * p - c * q - d * r)
+    out[7] = 0.5 * (a * p + c * r - d * q)
+    out[8] = 0.5 * (a * q - b * r + d * p)
+    out[9] = 0.5 * (a * r + b * q - c * p)
+
+
+@njit(cache=True)
+def rk4_step(x: np.ndarray, w0: np.ndarray, w_mid: np.ndarray, w1: np.ndarray, f0: np.ndarray,
+             f_mid: np.ndarray, f1: np.ndarray, dt: float, work: np.ndarray) -> None:
+    """One classical fourth-order Runge-Kutta step of ``nav_derivative`` over ``dt``, in place
+    on x (10,), with the body rates and specific forces at the step's start, middle and end;
+    the quaternion is normalised after the step. ``work`` is a (5, 10) scratch array."""
+    k1, k2, k3, k4, xt = work[0], work[1], work[2], work[3], work[4]
+    nav_derivative(x, w0, f0, k1)
+    for i in range(10):
+        xt[i] = x[i] + 0.5 * dt * k1[i]
+    nav_derivative(xt, w_mid, f_mid, k2)
+    for i in range(10):
+        xt[i] = x[i] + 0.5 * dt * k2[i]
+    nav_derivative(xt, w_mid, f_mid, k3)
+    for i in range(10):
+        xt[i] = x[i] + dt * k3[i]
+    nav_derivative(xt, w1, f1, k4)
+    for i in range(10):
+        x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    norm = np.sqrt(x[6] ** 2 + x[7] ** 2 + x[8] ** 2 + x[9] ** 2)
+    for i in range(6, 10):
+        x[i] /= norm

@@ -206,16 +206,20 @@ class SigmaPointFilter:
         self._p_stale = True
         return self.x
 
-    def covariance(self, q: np.ndarray | None = None) -> np.ndarray:
-        """P from the propagated points (Cho & Choi eq. 26), plus an additive ``q`` (n, n)."""
+    def covariance(self, q: np.ndarray | None = None, redraw: bool = False) -> np.ndarray:
+        """P from the propagated points (Cho & Choi eq. 26), plus an additive ``q`` (n, n).
+        With ``redraw`` (or a ``q``) the points are released: the next ``propagate`` or
+        ``update`` draws fresh ones from (x, P)."""
         if self.sigma is None:
             raise RuntimeError("covariance() needs propagated sigma points")
         d = self._minus(self.sigma, self.x)
         p = (self._wc[:, None] * d).T @ d
         self._p_stale = False
         if q is not None:
-            p = p + q
-            self.sigma = None  # the points do not carry q: an update redraws them
+            p = p + q  # the points do not carry q: they are redrawn
+        if q is not None or redraw:
+            self.sigma = None
+            self._noise = None
         self.p = 0.5 * (p + p.T)
         return self.p
 

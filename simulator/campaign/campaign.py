@@ -109,7 +109,7 @@ def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerp
               "sweep": plan.sweep_values(),
               "labels": plan.labels, "fingerprint": fingerprint}
     summary = summarise(runs, plan.labels, [p.values for p in plan.points], header)
-    write_scores(summary, out / SUMMARY_FILE)
+    write_scores(summary, out / SUMMARY_FILE, force=True)  # the campaign owns its folder
     write_campaign_report(out, runs, summary)
     return CampaignResult(runs, len(todo), len(tasks) - len(todo))
 

@@ -12,8 +12,8 @@ from simulator.commands import SUMMARIES
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 from simulator.replay import run_estimator, write_solution
-from simulator.scenario.schema import INVALID, Context
 from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
+from simulator.schema import INVALID, Context
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -35,6 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="initial error: position_error=[n,e,d] (m), velocity_error=[n,e,d] "
                         "(m/s), attitude_error=[roll,pitch,yaw] (deg), heading_error=DEG")
     p.add_argument("--label", default=None, help="solution label (default: the name)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing SOLUTION file")
     p.set_defaults(run=run)
 
 
@@ -76,7 +77,7 @@ def run(args: argparse.Namespace) -> int:
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
     solution, info = run_estimator(dataset, entry, show_progress=sys.stderr.isatty())
-    write_solution(solution, args.output)
+    write_solution(solution, args.output, args.force, [dataset.path])
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
           f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")
     return 0

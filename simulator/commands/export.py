@@ -15,6 +15,7 @@ from simulator.earth import geodetic_to_ecef
 from simulator.errors import InputError, Problem
 from simulator.gnss.nmea import write_nmea
 from simulator.gnss.rinex_writer import write_rinex_nav, write_rinex_obs
+from simulator.outputs import atomic_output_file
 from simulator.timebase import gps_to_utc, leap_seconds
 
 
@@ -28,6 +29,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("dataset", metavar="DATASET", help="dataset directory")
     p.add_argument("--rinex", metavar="DIR", help="directory for the .obs and .nav files")
     p.add_argument("--nmea", metavar="FILE", help="NMEA 0183 output file")
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
     p.set_defaults(run=run)
 
 
@@ -54,17 +56,21 @@ def run(args: argparse.Namespace) -> int:
         approx = np.ravel(geodetic_to_ecef(np.radians(origin["lat"]), np.radians(origin["lon"]),
                                            origin["alt"]))
         out = Path(args.rinex)
-        out.mkdir(parents=True, exist_ok=True)
         name = Path(args.dataset).resolve().name
-        obs = write_rinex_obs(out / f"{name}.obs", raw, week, tow, approx)
+        obs, nav = out / f"{name}.obs", out / f"{name}.nav"
         iono = gnss.get("broadcast_iono", {})
-        nav = write_rinex_nav(out / f"{name}.nav", dataset.read("gnss_nav"),
-                              leap_seconds(gps_to_utc(week, tow)), iono.get("alpha"),
-                              iono.get("beta"))
+        # both files are made before either is moved into place: never an .obs without its .nav
+        with (atomic_output_file(obs, args.force, [dataset.path]) as obs_tmp,
+              atomic_output_file(nav, args.force, [dataset.path]) as nav_tmp):
+            write_rinex_obs(obs_tmp, raw, week, tow, approx)
+            write_rinex_nav(nav_tmp, dataset.read("gnss_nav"),
+                            leap_seconds(gps_to_utc(week, tow)), iono.get("alpha"),
+                            iono.get("beta"))
         print(f"wrote {obs} and {nav}")
     if args.nmea:
         _need(dataset, "gnss_fix", "--nmea")
         raw = dataset.read("gnss_raw") if dataset.has("gnss_raw") else pd.DataFrame()
-        path = write_nmea(args.nmea, dataset.read("gnss_fix"), raw, week, tow)
-        print(f"wrote {path}")
+        with atomic_output_file(args.nmea, args.force, [dataset.path]) as tmp:
+            write_nmea(tmp, dataset.read("gnss_fix"), raw, week, tow)
+        print(f"wrote {args.nmea}")
     return 0

@@ -12,8 +12,9 @@ from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
 from simulator.commands.score import print_scores
 from simulator.dataset.generate import generate_dataset
-from simulator.dataset.io import atomic_output_dir, open_dataset
+from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
+from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
 from simulator.scenario import load_scenario
 from simulator.scoring.evaluate import score_solutions, write_scores

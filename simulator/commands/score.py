@@ -11,8 +11,9 @@ from pathlib import Path
 import pandas as pd
 
 from simulator.commands import SUMMARIES
-from simulator.dataset.io import Dataset, atomic_output_dir, open_dataset
+from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
 from simulator.scoring.readers import check_solution, read_solution_file
@@ -39,7 +40,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "module:Class, found from the current directory as python -m does)")
     p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
     p.add_argument("--report", metavar="DIR", help="write report.md and plots/ into DIR")
-    p.add_argument("--force", action="store_true", help="overwrite an existing report DIR")
+    p.add_argument("--force", action="store_true",
+                   help="overwrite an existing --json file or report DIR")
     p.set_defaults(run=run)
 
 
@@ -81,7 +83,8 @@ def run(args: argparse.Namespace) -> int:
                                   "FILE... and/or -e NAME...")])
     dataset = open_dataset(args.dataset)
     with contextlib.ExitStack() as stack:
-        report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force))
+        report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force,
+                                                            [dataset.path]))
                       if args.report else None)
         solutions = _from_files(args.solution, dataset, dataset.read("truth"))
         for label, solved in _from_estimators(dataset, args.estimator).items():
@@ -92,7 +95,7 @@ def run(args: argparse.Namespace) -> int:
         ev = score_solutions(dataset, solutions)
         print_scores(ev)
         if args.json:
-            write_scores(ev.scores(), Path(args.json))
+            write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])
             print(f"wrote {args.json}")
         if report_dir is not None:
             write_report(report_dir, ev, f"Scores on {dataset.path.name}")

@@ -30,11 +30,12 @@ import numpy as np
 import simulator
 from simulator import columns as col
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
-from simulator.dataset.io import DatasetWriter, atomic_output_dir
+from simulator.dataset.io import DatasetWriter
 from simulator.dataset.truth_sensors import truth_sensors_table
 from simulator.errors import InputError
 from simulator.faults.apply import apply_faults
 from simulator.faults.base import FAULT_REGISTRY
+from simulator.outputs import atomic_output_dir
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
@@ -120,7 +121,7 @@ def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = 
         # and the outage table unless asked for
         gnss = sensors.get("gnss")
         unsettled = {name for fault in scenario["faults"]
-                     for name in FAULT_REGISTRY[fault["kind"]].streams}
+                     for name in FAULT_REGISTRY[fault["kind"]].changed_streams}
         if gnss is not None and "raw" not in gnss["outputs"]:
             unsettled.add("gnss_raw")
         if on_final is not None:

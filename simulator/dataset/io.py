@@ -3,20 +3,17 @@ per stream, every column's unit in the Parquet field metadata (the files themsel
 ``simulator.dataset.parquet``, imported on first use since pyarrow takes about 60 ms to load).
 
 Writing is atomic: everything goes into a temporary sibling directory that is renamed into place
-when complete, so an interrupted or failed run never leaves a half-written dataset.
+when complete (``simulator.outputs.atomic_output_dir``), so an interrupted or failed run never
+leaves a half-written dataset.
 
 Public names
 ------------
-DatasetWriter, write_dataset, open_dataset, Dataset, atomic_output_dir.
+DatasetWriter, write_dataset, open_dataset, Dataset.
 """
 
 from __future__ import annotations
 
-import contextlib
 import json
-import os
-import shutil
-from collections.abc import Iterator
 from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 from types import ModuleType
@@ -54,39 +51,11 @@ def _write(table: Table, path: Path, units: dict[str, str]) -> None:
     _parquet().write_table(table, path, units)
 
 
-@contextlib.contextmanager
-def atomic_output_dir(out_dir: Path, force: bool) -> Iterator[Path]:
-    """Yield a temporary directory beside ``out_dir``; on success it replaces ``out_dir``.
-
-    Refuses an existing ``out_dir`` unless ``force``. On any error the temporary directory is
-    removed and ``out_dir`` is left as it was.
-    """
-    out_dir = Path(out_dir)
-    if out_dir.exists() and not force:
-        raise InputError([Problem(str(out_dir), None, "",
-                                  "already exists; use --force to overwrite it")])
-    if out_dir.exists() and not out_dir.is_dir():
-        raise InputError([Problem(str(out_dir), None, "", "exists and is not a directory")])
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = out_dir.parent / f".{out_dir.name}.tmp-{os.getpid()}"
-    shutil.rmtree(tmp, ignore_errors=True)
-    tmp.mkdir()
-    try:
-        yield tmp
-    except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
-        raise
-    old = out_dir.parent / f".{out_dir.name}.old-{os.getpid()}"
-    if out_dir.exists():
-        out_dir.rename(old)
-    tmp.rename(out_dir)
-    shutil.rmtree(old, ignore_errors=True)
-
-
 class DatasetWriter:
-    """Writes a dataset's streams into ``directory`` (inside ``atomic_output_dir``), each as soon
-    as it is handed over, two at a time (Parquet encoding and compression release the GIL, so
-    the files are written side by side, and beside the work that makes the next streams).
+    """Writes a dataset's streams into ``directory`` (inside
+    ``simulator.outputs.atomic_output_dir``), each as soon as it is handed over, two at a time
+    (Parquet encoding and compression release the GIL, so the files are written side by side,
+    and beside the work that makes the next streams).
 
     ``write(name, table)`` starts one stream; ``finish(manifest, streams)`` writes those not yet
     started, waits for all and writes the manifest, its ``streams`` block filled from the

@@ -12,7 +12,7 @@ ENVIRONMENT_FIELD, ZONE_FIELD, COVERED_ZONE_NAMES.
 
 from __future__ import annotations
 
-from simulator.scenario.schema import MapOf, Number, Record, Text
+from simulator.schema import MapOf, Number, Record, Text
 
 ZONE_FIELD = Record(
     {

@@ -13,7 +13,7 @@ from __future__ import annotations
 from simulator.faults import gnss_faults, sensor_faults  # noqa: F401  (register the kinds)
 from simulator.faults.base import FAULT_REGISTRY
 from simulator.faults.triggers import trigger_problems
-from simulator.scenario.schema import Context, Path, Record, Tagged
+from simulator.schema import Context, Path, Record, Tagged
 
 FAULT_KINDS: dict[str, Record] = {name: kind.record for name, kind in FAULT_REGISTRY.items()}
 

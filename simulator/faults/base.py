@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from simulator.faults.triggers import TRIGGER_FIELDS
-from simulator.scenario.schema import Field, Record
+from simulator.schema import Field, Record
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -45,6 +45,14 @@ class FaultKind:
     apply: Apply
     streams: tuple[str, ...]  # streams it acts on (one of them must exist)
     doc: str
+
+    @property
+    def changed_streams(self) -> tuple[str, ...]:
+        """Every stream ``apply`` may change: those it acts on and, for a fault on the GNSS
+        measurements, the GNSS truth table, which records the signals tracked and their true
+        errors. A stream is written only once no fault will change it."""
+        gnss = any(name.startswith("gnss_") for name in self.streams)
+        return self.streams + (("truth_gnss",) if gnss else ())
 
 
 FAULT_REGISTRY: dict[str, FaultKind] = {}

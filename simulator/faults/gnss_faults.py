@@ -12,10 +12,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from simulator.earth import radii_of_curvature
+from simulator.earth import geodetic_rates
 from simulator.faults.base import in_intervals, register
-from simulator.scenario.schema import Integer, ListOf, Number, Vector
-from simulator.sensors.noise import gauss_markov
+from simulator.gnss.fix import receiver_fixes
+from simulator.schema import Integer, ListOf, Number, Vector
+from simulator.stochastic import gauss_markov
 
 # fix columns that describe the solution (blanked when there is none, delayed by latency)
 FIX_SOLUTION = ("lat", "lon", "alt", "vn", "ve", "vd", "speed", "course", "hdop", "vdop")
@@ -51,12 +52,10 @@ def _gnss_fix_jump(streams, intervals, params, context) -> None:
     mask = in_intervals(fix["t"].to_numpy(), intervals) & (fix["fix"].to_numpy() > 0)
     lat = np.radians(fix.loc[mask, "lat"].to_numpy())
     alt = fix.loc[mask, "alt"].to_numpy()
-    rn, re = radii_of_curvature(lat)
-    north, east, down = params["offset"]
-    fix.loc[mask, "lat"] = np.degrees(lat + north / (rn + alt))
-    fix.loc[mask, "lon"] = fix.loc[mask, "lon"].to_numpy() + np.degrees(
-        east / ((re + alt) * np.cos(lat)))
-    fix.loc[mask, "alt"] = alt - down
+    d_lat, d_lon, d_alt = geodetic_rates(lat, alt, np.asarray(params["offset"], dtype=float))
+    fix.loc[mask, "lat"] = np.degrees(lat + d_lat)
+    fix.loc[mask, "lon"] = fix.loc[mask, "lon"].to_numpy() + np.degrees(d_lon)
+    fix.loc[mask, "alt"] = alt + d_alt
 
 
 @register("gnss_latency", {"latency": Number("s", gt=0, doc="how late the fixes are")},
@@ -94,8 +93,6 @@ def _gnss_rate_drop(streams, intervals, params, context) -> None:
 def _refix(streams, intervals, context) -> None:
     """Recompute the receiver's fixes inside the intervals from the (faulted) measurements, as
     the receiver itself would; fixes outside are untouched."""
-    from simulator.gnss.fix import receiver_fixes  # the GNSS package imports the scenario spec
-
     if "gnss_fix" not in streams:
         return
     fix, raw = streams["gnss_fix"], streams["gnss_raw"]

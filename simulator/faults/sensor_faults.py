@@ -12,7 +12,7 @@ import numpy as np
 
 from simulator import columns as col
 from simulator.faults.base import in_intervals, register
-from simulator.scenario.schema import ListOf, Number, Text
+from simulator.schema import ListOf, Number, Text
 
 if TYPE_CHECKING:
     import pandas as pd

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from simulator.scenario.schema import Context, Number, Path, Record, Text, Vector
+from simulator.schema import Context, Number, Path, Record, Text, Vector
 
 _DURATION_DISTRIBUTION = Record({
     "distribution": Text("fixed", choices=["fixed", "uniform", "exponential"],

@@ -2,7 +2,7 @@
 signal-in-space error, ionosphere and troposphere residuals, multipath, code and carrier
 tracking noise) for satellites x epochs, and the 1-sigma the receiver reports for weighting.
 
-The processes themselves are in ``simulator.sensors.noise`` (Gauss-Markov) and
+The processes themselves are in ``simulator.stochastic`` (Gauss-Markov) and
 ``simulator.gnss.receiver`` (two-state clock, DLL/FLL jitter, multipath shape); this module sets
 how large each is and how they are shared.
 
@@ -25,7 +25,7 @@ import numpy as np
 
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
-from simulator.sensors.noise import gauss_markov
+from simulator.stochastic import gauss_markov
 
 # receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
 # crystal) and the 1-sigma spread of the clock state at switch-on

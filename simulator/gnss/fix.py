@@ -29,7 +29,7 @@ from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
-from simulator.sensors.noise import ar1_filter
+from simulator.stochastic import ar1_filter
 
 if TYPE_CHECKING:
     import pandas as pd

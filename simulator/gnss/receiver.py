@@ -4,7 +4,7 @@ frequency tracking noise, and the correlated error processes (multipath, atmosph
 signal-in-space error).
 
 Every function works on whole arrays (satellites x epochs). The correlated (Gauss-Markov)
-processes come from ``simulator.sensors.noise``, the one home of sensor noise processes.
+processes come from ``simulator.stochastic``, the one home of sensor noise processes.
 
 Public functions
 ----------------

@@ -13,8 +13,9 @@ from pathlib import Path
 from typing import Any
 
 from simulator.errors import InputError, Problem
-from simulator.scenario.schema import INVALID, Context
+from simulator.scenario.spec import SCENARIO_FIELD
 from simulator.scenario.yamlio import apply_overrides, read_yaml
+from simulator.schema import INVALID, Context
 
 
 @dataclass
@@ -38,8 +39,6 @@ def validate_data(data: Any, file: str, lines: dict | None = None,
                   overridden: set | None = None) -> dict:
     """Validate scenario data; return the resolved scenario or raise InputError with every
     problem found."""
-    from simulator.scenario.spec import SCENARIO_FIELD  # the spec imports every model's part
-
     ctx = Context(file, lines, overridden)
     resolved = SCENARIO_FIELD.check(copy.deepcopy(data), (), ctx)
     if ctx.problems or resolved is INVALID:

@@ -22,7 +22,8 @@ import inspect
 import json
 from typing import Any
 
-from simulator.scenario.schema import (
+from simulator.scenario.spec import SCENARIO_FIELD
+from simulator.schema import (
     REQUIRED,
     Anything,
     Boolean,
@@ -39,7 +40,6 @@ from simulator.scenario.schema import (
     Text,
     Vector,
 )
-from simulator.scenario.spec import SCENARIO_FIELD
 from simulator.sensors import baro, gnss, imu_presets, mag, odometer
 
 # sensor -> (its presets, the module whose docstring names their sources)
@@ -105,6 +105,8 @@ def _schema(field: Field) -> dict:
         out = {"anyOf": [_schema(field.name), _schema(field.record)]}
     elif isinstance(field, Anything):
         out = {}
+    elif hasattr(field, "sigma") and hasattr(field, "fixed"):  # a 1-sigma, or {fixed: value}
+        out = {"anyOf": [_schema(field.sigma), _schema(field.fixed)]}
     elif hasattr(field, "number"):  # one number for every axis, or one per axis (x, y, z)
         number = _number_schema(field.number.unit, "")
         out = {"anyOf": [number, {"type": "array", "items": number, "minItems": 3,
@@ -162,6 +164,8 @@ def _type(field: Field) -> str:
         return f"mapping with `{field.key}`"
     if isinstance(field, Either):
         return f"{_type(field.name)}, or {_type(field.record)}"
+    if hasattr(field, "sigma") and hasattr(field, "fixed"):
+        return f"1-sigma {_type(field.sigma)}, or {{fixed: true value}}"
     if hasattr(field, "number"):
         return f"number or [x, y, z] ({field.number.unit or '1'})"
     return "any"

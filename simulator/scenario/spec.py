@@ -11,7 +11,7 @@ from __future__ import annotations
 from estimators.registry import entry_problems
 from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
 from simulator.faults import FAULT_FIELD, check_faults
-from simulator.scenario.schema import (
+from simulator.schema import (
     Anything,
     Context,
     DateTime,

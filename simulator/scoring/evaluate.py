@@ -9,7 +9,7 @@ Scored, Evaluation, score_solutions, canyon_zones, write_scores.
 from __future__ import annotations
 
 import json
-import os
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -17,6 +17,7 @@ import pandas as pd
 
 from simulator import columns as col
 from simulator.dataset.io import Dataset
+from simulator.outputs import atomic_output_file
 from simulator.scoring.align import SolutionErrors, solution_errors
 from simulator.scoring.metrics import score_errors
 
@@ -95,11 +96,11 @@ def score_solutions(dataset: Dataset,
     return Evaluation(truth, events, results, canyons, dataset)
 
 
-def write_scores(scores: dict, path: Path) -> None:
+def write_scores(scores: dict, path: Path, force: bool = False,
+                 inputs: Iterable[Path | str] = ()) -> None:
     """Write scores as JSON (no NaN: missing values are null) under a temporary name, then
-    rename it into place."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
-    tmp.write_text(json.dumps(scores, indent=2, allow_nan=False) + "\n", encoding="utf-8")
-    os.replace(tmp, path)
+    move it into place; an existing file is replaced only with ``force``, a path inside one of
+    ``inputs`` is refused."""
+    text = json.dumps(scores, indent=2, allow_nan=False) + "\n"
+    with atomic_output_file(path, force, inputs) as tmp:
+        tmp.write_text(text, encoding="utf-8")

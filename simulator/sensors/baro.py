@@ -33,7 +33,7 @@ from __future__ import annotations
 import numpy as np
 
 from simulator.environment.atmosphere import P0_PA, pressure_altitude_m, pressure_pa
-from simulator.scenario.schema import Context, Number, Path, Vector
+from simulator.schema import Context, Number, Path, Vector
 from simulator.sensors.base import sample_times
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.tables import ColumnTable

@@ -45,9 +45,9 @@ from simulator.earth import (
     earth_rate_ned,
     ecef_to_geodetic,
     euler_to_dcm,
+    geodetic_rates,
     geodetic_to_ecef,
     ned_to_ecef_matrix,
-    radii_of_curvature,
 )
 from simulator.environment import ZONE_FIELD
 from simulator.environment.sky import canyon_visibility
@@ -65,7 +65,7 @@ from simulator.gnss.errors import (
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
 from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
-from simulator.scenario.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
+from simulator.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
 from simulator.sensors.base import sample_times
 from simulator.sensors.presets import PresetSensor, fill_from_preset, known_preset
 from simulator.timebase import utc_to_gps
@@ -350,13 +350,11 @@ def _signals(eph: dict[str, np.ndarray], t_gps: np.ndarray, ant: dict[str, np.nd
     (n_sat, n_epoch) received by the antenna ``ant`` (arrays over the same n_epoch)."""
     geo = signal_geometry(eph, t_gps, ant["pos"], ant["vel"])
     look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
-    rn, re = radii_of_curvature(ant["lat"])
+    lat_rate, lon_rate, alt_rate = geodetic_rates(ant["lat"], ant["alt"], ant["v_ned"])
     model = broadcast_delays(
         ant["lat"], ant["lon"], ant["alt"], look["azimuth"], look["elevation"], t_gps,
         day_of_year, alpha, beta,
-        rates={"lat": ant["v_ned"][:, 0] / (rn + ant["alt"]),
-               "lon": ant["v_ned"][:, 1] / ((re + ant["alt"]) * np.cos(ant["lat"])),
-               "alt": -ant["v_ned"][:, 2], "azimuth": look["azimuth_rate"],
+        rates={"lat": lat_rate, "lon": lon_rate, "alt": alt_rate, "azimuth": look["azimuth_rate"],
                "elevation": look["elevation_rate"]})
     return {**geo, **look, **model}
 

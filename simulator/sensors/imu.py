@@ -13,10 +13,14 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
 * ``S + M``: diagonal scale-factor errors and off-diagonal misalignment / cross-axis coupling,
   each drawn once per run, N(0, ``scale_factor``^2) and N(0, ``misalignment``^2).
 * ``b0``: turn-on bias, N(0, ``bias``^2) per axis.
+* ``bias`` and ``scale_factor`` may instead be given as ``{fixed: value}`` (one number or a
+  list of three, any sign): the true value of this run rather than a 1-sigma, for a paper's
+  situation that fixes the errors (Cho & Choi 2006, eq. 36:
+  ``scale_factor: {fixed: [0.2, 0.1, -0.1]}``). The values in ``drawn`` are then the fixed ones.
 * ``b_in``: in-run bias instability B. With ``bias_correlation_time`` tau_c: a first-order
   Gauss-Markov process whose Allan-deviation peak (at 1.89 tau_c) is 0.664 B, i.e. its stationary
   std is 0.664 B / 0.6174; without: a flicker process (sum of Gauss-Markov processes, see
-  ``simulator.sensors.noise``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
+  ``simulator.stochastic``) with the flat Allan floor 0.664 B (IEEE Std 952-1997). Both are
   discretised exactly, so their statistics do not depend on the rate.
 * ``b_gm``: a correlated bias besides ``b_in``, so that an axis can have both the flicker floor
   and an exponentially correlated bias, as real MEMS units do (the ADIS16448 y accelerometer's
@@ -24,7 +28,7 @@ Measurement model (Groves 2013, eqs. 4.16-4.17), per group (gyro, accel) in the 
   Gauss-Markov process of stationary std ``gauss_markov_sigma`` and correlation time
   ``gauss_markov_correlation_time`` T_c, both per axis (sigma 0, the default, is off), discretised
   exactly. Its Allan variance is IEEE Std 952's Markov noise
-  (``simulator.sensors.noise.gauss_markov_avar``), peaking at 0.617 sigma at 1.89 T_c.
+  (``simulator.stochastic.gauss_markov_avar``), peaking at 0.617 sigma at 1.89 T_c.
   El-Sheimy et al. (IEEE Trans. Instrum. Meas. 57(1), 2008) list this correlated noise among the
   error terms of MEMS inertial sensors; it is commonly attributed to temperature variation inside
   the unit.
@@ -85,7 +89,7 @@ import numpy as np
 
 from simulator import columns as col
 from simulator.earth import euler_to_dcm
-from simulator.scenario.schema import (
+from simulator.schema import (
     INVALID,
     Context,
     Either,
@@ -106,7 +110,9 @@ from simulator.sensors.base import (
     truth_at,
 )
 from simulator.sensors.imu_presets import IMU_PRESETS
-from simulator.sensors.noise import (
+from simulator.sensors.presets import fill_from_preset, known_preset
+from simulator.sensors.vibration import VIBRATION_FIELD, draw_vibration, vibration_at_speed
+from simulator.stochastic import (
     FLICKER_ADEV_FACTOR,
     GM_ADEV_PEAK,
     ar1_filter,
@@ -115,8 +121,6 @@ from simulator.sensors.noise import (
     random_walk,
     white,
 )
-from simulator.sensors.presets import fill_from_preset, known_preset
-from simulator.sensors.vibration import VIBRATION_FIELD, draw_vibration, vibration_at_speed
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import GL_NODES, GL_WEIGHTS, cubic_interval_integrals
@@ -144,9 +148,34 @@ class AxisNumber(Field):
         return self.number.check(value, path, ctx)
 
 
+class DrawnOrFixed(Field):
+    """A per-run constant given as its 1-sigma (``AxisNumber``, drawn N(0, sigma^2) per axis) or
+    as ``{fixed: value}``, the true value itself (one number or three, any sign), for a paper's
+    situation that fixes it (Cho & Choi 2006, eq. 36: scale factors 0.2, 0.1, -0.1)."""
+
+    def __init__(self, unit: str):
+        super().__init__(None)
+        self.sigma = AxisNumber(unit, min=0)
+        self.fixed = Record({"fixed": AxisNumber(unit)})
+
+    def check(self, value: Any, path: Path, ctx: Context) -> Any:
+        if isinstance(value, dict):
+            return self.fixed.check(value, path, ctx)
+        return self.sigma.check(value, path, ctx)
+
+
+def _constant(value: float | list[float] | dict | None, rng: np.random.Generator) -> np.ndarray:
+    """A group's per-axis constant: drawn N(0, sigma^2), or the ``fixed`` value. The normal
+    draw is taken either way, so fixing one constant leaves every other draw unchanged."""
+    draw = rng.standard_normal(3)
+    if isinstance(value, dict):
+        return _per_axis(value["fixed"]).copy()
+    return _per_axis(value) * draw
+
+
 def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Field]:
     fields: dict[str, Field] = {
-        "bias": AxisNumber(unit, min=0),
+        "bias": DrawnOrFixed(unit),
         "bias_instability": AxisNumber(unit, min=0),
         "bias_correlation_time": Number("s", None, gt=0),
         "gauss_markov_sigma": AxisNumber(unit, min=0),
@@ -154,7 +183,7 @@ def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Fie
         "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
         "random_walk": AxisNumber(random_walk_unit, min=0),
         "ramp": AxisNumber(f"{unit}/s", min=0),
-        "scale_factor": AxisNumber("", min=0),
+        "scale_factor": DrawnOrFixed(""),
         "misalignment": AxisNumber("rad", min=0),
         "range": AxisNumber(unit, gt=0),
         "resolution": AxisNumber(unit, min=0),
@@ -305,8 +334,8 @@ class Imu:
         p = self.config[group]
         n = len(t)
         dt = 1.0 / self.rate_hz
-        bias0 = _per_axis(p["bias"]) * rng.standard_normal(3)
-        sf = _per_axis(p["scale_factor"]) * rng.standard_normal(3)
+        bias0 = _constant(p["bias"], rng)
+        sf = _constant(p["scale_factor"], rng)
         mis = _per_axis(p["misalignment"])[:, None] * rng.standard_normal((3, 3))
         np.fill_diagonal(mis, 0.0)
         k_temp = _per_axis(p["temperature_coefficient"]) * rng.standard_normal(3)

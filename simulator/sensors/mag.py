@@ -38,10 +38,10 @@ import datetime as dt
 import numpy as np
 
 from simulator.earth import euler_to_dcm
-from simulator.scenario.schema import Number
+from simulator.schema import Number
 from simulator.sensors.base import sample_times, truth_at
-from simulator.sensors.noise import gauss_markov
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
+from simulator.stochastic import gauss_markov
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MICRO_T

@@ -32,10 +32,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from simulator.scenario.schema import Number
+from simulator.schema import Number
 from simulator.sensors.base import sample_times
-from simulator.sensors.noise import random_walk
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
+from simulator.stochastic import random_walk
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
 from simulator.units import MILLI, PERCENT_RT_H

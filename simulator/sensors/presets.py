@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from simulator.scenario.schema import INVALID, Context, Field, Path, Record, Text
+from simulator.schema import INVALID, Context, Field, Path, Record, Text
 
 
 def known_preset(name: str, presets: dict[str, dict], what: str, path: Path,

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from simulator.scenario.schema import INVALID, Context, Number, Path, Record, Vector
+from simulator.schema import INVALID, Context, Number, Path, Record, Vector
 
 
 def _check(value: dict, path: Path, ctx: Context) -> dict:

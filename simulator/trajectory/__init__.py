@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-from simulator.scenario.schema import Context, ListOf, Number, Record
+from simulator.schema import Context, ListOf, Number, Record
 from simulator.trajectory.recorded import RECORDED_FIELD, build_recorded_profile
 from simulator.trajectory.segments import SEGMENT_FIELD, RoadProfile, build_road_profile
 from simulator.trajectory.sumo import SUMO_FIELD, build_sumo_profile

@@ -38,6 +38,7 @@ import numpy as np
 from simulator import columns as col
 from simulator.earth import (
     OMEGA_E_RAD_S,
+    geodetic_rates,
     ned_to_body_components,
     normal_gravity_from_sin,
     radii_of_curvature,
@@ -216,13 +217,12 @@ class Kinematics:
         sin_lat, cos_lat = np.sin(lat), np.cos(lat)
         rn, re = radii_of_curvature_from_sin(sin_lat)
         lat_gauss = at_gauss(lat)
-        lon_rate = v[:, 1] / ((re + alt) * cos_lat)
-        lon = integrate(lon_rate, gauss_v[:, 1] / ((radii_of_curvature(lat_gauss)[1] + alt_gauss)
-                                                   * np.cos(lat_gauss)))
+        rates = geodetic_rates(lat, alt, v, (rn, re))
+        lon = integrate(rates[1], geodetic_rates(lat_gauss, alt_gauss, gauss_v)[1])
         lon += lon0
         self._t_int = t
         self._lla = (lat, lon, alt)
-        self._lla_rates = (v[:, 0] / (rn + alt), lon_rate, -v[:, 2])
+        self._lla_rates = rates
         # for ``grid_inertial``: the grid's positions are the integration's own nodes
         self._grid_motion = {key: values[:n_grid] for key, values in motion.items()}
         self._grid_place = dict(lat=lat[:n_grid], lon=lon[:n_grid], alt=alt[:n_grid],

@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from simulator.scenario.schema import Context, Number, Record, Text
+from simulator.schema import Context, Number, Record, Text
 from simulator.trajectory.fit import (
     fit_along,
     fit_drive,

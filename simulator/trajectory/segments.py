@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from simulator.earth import G0_M_S2
-from simulator.scenario.schema import (
+from simulator.schema import (
     Context,
     Number,
     OneKey,

@@ -55,7 +55,7 @@ from pathlib import Path
 import numpy as np
 
 from simulator.earth import ecef_to_geodetic, ned_to_ecef
-from simulator.scenario.schema import Context, Integer, ListOf, Number, Record, Text
+from simulator.schema import Context, Integer, ListOf, Number, Record, Text
 from simulator.trajectory.fit import (
     LocalFrame,
     fit_drive,

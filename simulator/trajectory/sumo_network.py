@@ -49,7 +49,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from simulator.scenario.schema import Boolean, Either, Integer, Number, Record, Text
+from simulator.schema import Boolean, Either, Integer, Number, Record, Text
 
 if TYPE_CHECKING:
     import xml.etree.ElementTree as ET

@@ -1,5 +1,6 @@
-"""Random error processes of sensors, generated vectorised and discretised exactly, and their
-analytic Allan variances.
+"""Random error processes (white noise, random walk, first-order Gauss-Markov, AR(1), flicker),
+generated vectorised and discretised exactly, their discrete models and their analytic Allan
+variances: the one home of the processes the sensors draw and the estimators model.
 
 Every process here is defined in continuous time and sampled exactly at the sample times, so its
 statistics do not depend on the sample rate (a first-order Gauss-Markov process is the exact
@@ -18,6 +19,7 @@ Annex C, Markov noise, with sigma^2 = q_c^2 T_c / 2), rising as sqrt(tau) well b
 Public names
 ------------
 FLICKER_ADEV_FACTOR, GM_ADEV_PEAK, GM_ADEV_PEAK_TAU, FLICKER_TAUS_S, gm_adev_peak,
+gauss_markov_continuous, gauss_markov_discrete,
 ar1_filter, white, random_walk, gauss_markov, flicker, gauss_markov_avar, flicker_avar,
 adev_model.
 
@@ -26,6 +28,10 @@ References
 IEEE Std 952-1997, *IEEE Standard Specification Format Guide and Test Procedure for Single-Axis
 Interferometric Fiber Optic Gyros*, Annex C (Allan variance of the noise terms).
 Gelb, *Applied Optimal Estimation*, 1974, Table 3.8-1 (exact discrete first-order Markov process).
+Brown & Hwang, *Introduction to Random Signals and Applied Kalman Filtering*, 4th ed., chapters 2
+and 3: a Gauss-Markov process x' = -x / tau + w, E[w(t) w(s)] = q_c delta(t - s) with
+q_c = 2 sigma^2 / tau keeps the stationary std sigma; over a step dt, phi = exp(-dt / tau) and
+q_d = sigma^2 (1 - exp(-2 dt / tau)).
 Keshner, "1/f noise", Proc. IEEE 70(3), 1982 (1/f spectrum as a sum of Lorentzians with
 log-uniform time constants).
 """
@@ -33,8 +39,6 @@ log-uniform time constants).
 from __future__ import annotations
 
 import numpy as np
-
-from estimators.toolbox.gauss_markov import gauss_markov_discrete
 
 # Allan deviation floor of flicker noise per unit bias instability, sqrt(2 ln 2 / pi) (IEEE 952)
 FLICKER_ADEV_FACTOR = float(np.sqrt(2.0 * np.log(2.0) / np.pi))
@@ -48,6 +52,42 @@ _FLICKER_RATIO = 10.0 ** 0.5  # ratio of consecutive time constants
 # a coarser grid of this many points per correlation time and interpolated linearly (the part of
 # its variance the interpolation misses is about 1 / (2 x 64), under 1 %)
 _POINTS_PER_TAU = 64
+
+
+def gauss_markov_continuous(tau: np.ndarray, sigma: np.ndarray
+                            ) -> tuple[np.ndarray, np.ndarray]:
+    """Continuous model of first-order Gauss-Markov processes.
+
+    Parameters
+    ----------
+    tau : float or array, shape (k,)
+        Correlation times, s.
+    sigma : float or array, shape (k,)
+        Steady-state standard deviations (any unit u).
+
+    Returns
+    -------
+    f : (k,) diagonal of the system matrix, -1 / tau, 1/s; q_c : (k,) white-noise power
+    spectral densities 2 sigma^2 / tau, u^2/s.
+    """
+    tau = np.asarray(tau, dtype=float)
+    sigma = np.asarray(sigma, dtype=float)
+    return -1.0 / tau, 2.0 * sigma**2 / tau
+
+
+def gauss_markov_discrete(tau: np.ndarray, sigma: np.ndarray, dt: float
+                          ) -> tuple[np.ndarray, np.ndarray]:
+    """Exact discrete model of first-order Gauss-Markov processes over a step ``dt`` (s).
+
+    Returns
+    -------
+    phi : (k,) transition factors exp(-dt / tau); q_d : (k,) discrete noise variances
+    sigma^2 (1 - exp(-2 dt / tau)).
+    """
+    tau = np.asarray(tau, dtype=float)
+    sigma = np.asarray(sigma, dtype=float)
+    phi = np.exp(-dt / tau)
+    return phi, sigma**2 * -np.expm1(-2.0 * dt / tau)
 
 
 def _gm_avar_unit(x: np.ndarray) -> np.ndarray:

@@ -1,0 +1,455 @@
+"""Cho & Choi 2006, "Performance Enhancement of Low-Cost Land Navigation System for
+Location-Based Service" (ETRI J. 28(2)): two-dimensional dead reckoning (DR) on reduced inertial
+units, loosely coupled with GPS.
+
+Estimators
+----------
+* ``dr2d_drm1_ekf``: DRM1 (eqs. 2-3: two accelerometers and a yaw gyro) with an EKF.
+* ``dr2d_drm2_ekf``: DRM2 (eqs. 4-7: forward accelerometer, pitch and yaw gyros), state eq. 8
+  with the sensor-error model 2 (eq. 14b), EKF (eqs. 15-17).
+* ``dr2d_drm2_spkf``: the same model with the scaled simplex sigma-point filter (eqs. 19-32),
+  through ``estimators.toolbox.ukf``.
+
+All three propagate at 10 Hz (the IMU samples of each 0.1 s are averaged; the paper's DR runs
+at 10 Hz) and update with each 1 Hz GPS fix: north and east position and horizontal speed
+(eq. 18). P0, Q and R are eqs. 33-35.
+
+Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction_cho2006.md)
+----------------------------------------------------------------------------------------
+* Scale-factor states. Eqs. 12-13 define the measured value as (1 + delta) times the true one,
+  but the propagation (eqs. 24c-e) compensates by multiplying with (1 - delta). We follow the
+  propagation: the state ``d`` is the compensation error, true = (1 - d) measured, which stays
+  regular when a sigma point has d near -1 (P0 gives the scale factors a 1-sigma of 1). The
+  solution's ``*_scale_factor_*`` columns convert it to SPEC section 7's convention, measured =
+  (1 + s) true: s = d / (1 - d).
+* Eq. 24c multiplies g sin(theta) by the accelerometer scale factor as well; eqs. 6, 11 and the
+  appendix scale only the measured specific force. We use ((1 - d_ax) f_x - g sin theta)
+  cos theta, whose derivative in theta is eq. 17c.
+* Eq. 24 moves the position with the previous step's speed and heading, eq. 5 with the new
+  ones; DRM2 uses their mean (the trapezoidal rule: in a 15 deg/s turn either one alone lags or
+  leads the heading by 0.75 deg, which the filter mistakes for a scale-factor error). The EKF's
+  transition matrix is the Jacobian of the same function (eqs. 16-17).
+* Q (eq. 34) is read as the variance growth per second: the EKF adds Q dt per 0.1 s step; the
+  SPKF augments the non-zero terms of Q over one second (eqs. 19-20 with the singular zero rows
+  left out) and each 10 Hz step adds its sigma point's noise times dt / 1 s; the points are
+  drawn at every GPS epoch and after each second of propagation without one, and the
+  covariance (eq. 26) is formed from them before each draw.
+* Standstill gyro calibration (the paper: "the bias of a gyro can be calibrated during the
+  standing phase"): the run starts at rest; until the forward specific force moves more than
+  0.2 m/s^2 from its mean at rest, or a GPS fix reports more than 0.5 m/s, the filter holds
+  its state and averages the gyros; the averages are removed from every later sample and
+  written as ``gyro_bias_*``. ``standstill_calibration: false`` skips it.
+* DRM1's filter state is not printed: [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], the level-
+  frame velocity of eq. 2 without its "+ g^n" (a typo: the horizontal components of g^n are
+  zero) and the scale-factor model 2 of both accelerometers and the yaw gyro. P0 and Q follow
+  eqs. 33-34 term by term (5 m/s and 0.1 m/s^2 on each velocity axis). Its speed measurement
+  is linearised (and left out below 0.5 m/s, where the speed's direction is undefined).
+* Eq. 18 converts GPS latitude and longitude to metres with one Earth radius R_e; we use the
+  WGS-84 meridian and transverse radii at the start (``simulator.earth``).
+* No Earth rate (the paper ignores it); the standstill calibration removes its vertical part.
+* The paper gives no alpha or w0 for the simplex set. w0 = 0 (Julier 2003: the simplex set
+  without a central weight), beta = 2 (Gaussian prior, eq. 21), and alpha = 0.3, from the
+  heading's initial 1-sigma of 180 deg (eq. 33): with L = 11 (8 states and the 3 non-zero
+  noise terms) the farthest simplex point lies 3.16 sigma from the mean on the heading axis,
+  so alpha = 1 puts heading points 569 deg away, where the 2 pi-periodic model aliases them
+  onto arbitrary headings and their wrapped spread no longer matches P; alpha <= 1 / 3.16
+  keeps every initial heading point within +-180 deg, and 0.3 is the round value below that.
+  Much smaller alphas shrink the points towards a linearisation, the EKF's weakness. All three
+  are ``config`` keys (docs/reproduction_cho2006.md gives the figures for alpha = 1 and 0.1).
+
+Outputs: latitude, longitude, horizontal velocity, yaw (and DRM2's pitch); height, vertical
+velocity and roll (and DRM1's pitch) are NaN, as they are not estimated.
+
+Public classes
+--------------
+Drm1Ekf, Drm2Ekf, Drm2Spkf.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from estimators.base import NAV_COLUMNS, Estimator
+from estimators.toolbox.kalman import predict as kf_predict
+from estimators.toolbox.kalman import update as kf_update
+from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
+from simulator.earth import normal_gravity, radii_of_curvature, wrap_angle
+
+PAPER = "Cho & Choi 2006, ETRI J. 28(2) (seeds/000)"
+DR_STEP_S = 0.1  # the DR propagation interval (10 Hz, section III)
+DRAW_INTERVAL_S = 1.0  # longest SPKF propagation between sigma-point draws (the GPS period)
+MOVE_ACCEL_M_S2 = 0.2  # forward specific-force change that ends the initial standstill
+MOVE_SPEED_M_S = 0.5  # GPS speed that ends the initial standstill
+MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
+DEG = math.pi / 180.0
+
+# eqs. 33-35 (DRM2 state order [P_N, P_E, V, theta, psi, d_ax, d_gy, d_gz])
+P0_DRM2 = np.diag([50.0**2, 50.0**2, 5.0**2, (10 * DEG) ** 2, (180 * DEG) ** 2, 1.0, 1.0, 1.0])
+Q_DRM2 = np.diag([0.0, 0.0, 0.1**2, (0.1 * DEG) ** 2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0])
+# DRM1 state order [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], eqs. 33-34 term by term
+P0_DRM1 = np.diag([50.0**2, 50.0**2, 5.0**2, 5.0**2, (180 * DEG) ** 2, 1.0, 1.0, 1.0])
+Q_DRM1 = np.diag([0.0, 0.0, 0.1**2, 0.1**2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0])
+R_GPS = np.diag([15.0**2, 15.0**2, 0.3**2])  # eq. 35: north, east (m), speed (m/s)
+
+
+def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: float,
+                    g: float) -> np.ndarray:
+    """DRM2 propagation of states ``x`` (k, 8) over ``dt`` (Cho & Choi eqs. 24a-h, 4-7).
+
+    ``u`` = [f_x (m/s^2), w_y, w_z (rad/s)], bias-compensated means over the step; ``w``
+    (k, 8) is the noise of each point over one second, added in proportion dt / 1 s. The
+    position moves with the mean of the step's old (eq. 24a-b) and new (eq. 5) velocity
+    vectors (the trapezoidal rule).
+    """
+    pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T
+    f_x, w_y, w_z = u
+    out = np.empty_like(x)
+    v_new = v + ((1.0 - d_ax) * f_x - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
+    psi_new = psi + (1.0 - d_gz) * w_z * dt  # eq. 24e
+    out[:, 0] = pn + 0.5 * (v * np.cos(psi) + v_new * np.cos(psi_new)) * dt  # eqs. 24a, 5
+    out[:, 1] = pe + 0.5 * (v * np.sin(psi) + v_new * np.sin(psi_new)) * dt  # eqs. 24b, 5
+    out[:, 2] = v_new
+    out[:, 3] = th + (1.0 - d_gy) * w_y * dt  # eq. 24d
+    out[:, 4] = wrap_angle(psi_new)
+    out[:, 5:] = x[:, 5:]  # eqs. 24f-h
+    if w is not None:
+        out += w * (dt / DRAW_INTERVAL_S)
+        out[:, 4] = wrap_angle(out[:, 4])
+    return out
+
+
+def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarray:
+    """Transition matrix of ``drm2_transition`` at ``x`` (8,) (Cho & Choi eqs. 16-17, with the
+    trapezoidal position step)."""
+    _, _, v, th, psi, d_ax, d_gy, d_gz = x
+    f_x, w_y, w_z = u
+    st, ct = math.sin(th), math.cos(th)
+    v_new = v + ((1.0 - d_ax) * f_x - g * st) * ct * dt
+    psi_new = psi + (1.0 - d_gz) * w_z * dt
+    phi = np.eye(8)
+    # A_3 (eq. 17c) with SF_ax = 1 - d_ax, and the scale-factor column
+    phi[2, 3] = (g * st * st - (1.0 - d_ax) * f_x * st - g * ct * ct) * dt
+    phi[2, 5] = -f_x * ct * dt
+    phi[3, 6] = -w_y * dt  # A_4 (eq. 17d)
+    phi[4, 7] = -w_z * dt
+    # position rows: A_1 and A_2 (eq. 17a-b) at the old and at the new velocity vector
+    c0, s0, c1, s1 = math.cos(psi), math.sin(psi), math.cos(psi_new), math.sin(psi_new)
+    half = 0.5 * dt
+    phi[0, 2] += half * c0
+    phi[0, 4] -= half * v * s0
+    phi[1, 2] += half * s0
+    phi[1, 4] += half * v * c0
+    phi[0] += half * (c1 * phi[2] - v_new * s1 * phi[4])
+    phi[1] += half * (s1 * phi[2] + v_new * c1 * phi[4])
+    return phi
+
+
+def drm1_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: float,
+                    g: float) -> np.ndarray:
+    """DRM1 propagation of states ``x`` (k, 8) (Cho & Choi eqs. 2-3, level frame, no g^n).
+
+    ``u`` = [f_x, f_y (m/s^2), w_z (rad/s)]; the velocity is updated first and the position
+    moves with the new velocity (eq. 3).
+    """
+    pn, pe, vn, ve, psi, d_ax, d_ay, d_gz = x.T
+    f_x, f_y, w_z = u
+    fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
+    c, s = np.cos(psi), np.sin(psi)
+    out = np.empty_like(x)
+    out[:, 2] = vn + (c * fxc - s * fyc) * dt  # eq. 2, C_b^n f^b
+    out[:, 3] = ve + (s * fxc + c * fyc) * dt
+    out[:, 0] = pn + out[:, 2] * dt  # eq. 3
+    out[:, 1] = pe + out[:, 3] * dt
+    out[:, 4] = wrap_angle(psi + (1.0 - d_gz) * w_z * dt)
+    out[:, 5:] = x[:, 5:]
+    if w is not None:
+        out += w * (dt / DRAW_INTERVAL_S)
+        out[:, 4] = wrap_angle(out[:, 4])
+    return out
+
+
+def drm1_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarray:
+    """Transition matrix of ``drm1_transition`` at ``x`` (8,)."""
+    psi, d_ax, d_ay = x[4], x[5], x[6]
+    f_x, f_y, w_z = u
+    c, s = math.cos(psi), math.sin(psi)
+    fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
+    phi = np.eye(8)
+    # velocity rows: d/d psi, d/d d_ax, d/d d_ay
+    phi[2, 4], phi[2, 5], phi[2, 6] = (-s * fxc - c * fyc) * dt, -c * f_x * dt, s * f_y * dt
+    phi[3, 4], phi[3, 5], phi[3, 6] = (c * fxc - s * fyc) * dt, -s * f_x * dt, -c * f_y * dt
+    phi[0] += dt * phi[2]  # the position moves with the new velocity (eq. 3)
+    phi[1] += dt * phi[3]
+    phi[4, 7] = -w_z * dt
+    return phi
+
+
+class _ChoDr(Estimator):
+    """Shared part: IMU averaging to 10 Hz, standstill gyro calibration, GPS measurement
+    (eq. 18), local north/east metres, the solution row."""
+
+    needs = ("imu", "gnss_fix")
+    paper = PAPER
+    output_rate_hz = 10.0
+    defaults = {"standstill_calibration": True}
+    # set by the model
+    _imu_columns: tuple[str, str, str] = ("", "", "")
+    _gyro_channels: tuple[int, ...] = ()  # which of the three inputs are gyros
+    _p0 = _q = np.zeros((8, 8))
+
+    def setup(self) -> None:
+        init = self.initial
+        self._lat0, self._lon0, self._h0 = (float(v) for v in init.position)
+        rn, re = radii_of_curvature(self._lat0)
+        self._rn, self._re = float(rn) + self._h0, float(re) + self._h0
+        self._g = float(normal_gravity(self._lat0, self._h0))
+        imu = self.columns["imu"]
+        self._cols = [imu[c] for c in self._imu_columns]
+        self._increment = self.units["imu"].get(self._imu_columns[-1]) in ("rad", "m/s")
+        fix = self.columns["gnss_fix"]
+        self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
+        self._sum = np.zeros(3)  # sums of the three inputs x time over the current DR step
+        self._acc_t = 0.0  # time accumulated in the current DR step
+        self._t_imu = init.t
+        self._bias = np.zeros(3)  # calibrated gyro biases (zero for accelerometer inputs)
+        speed = float(np.hypot(init.velocity[0], init.velocity[1]))
+        self._still = bool(self.config["standstill_calibration"]) and speed < MOVE_SPEED_M_S
+        self._still_sum = np.zeros(3)
+        self._still_t = 0.0
+        self._start_filter(self._initial_state(), self._p0.copy())
+
+    # -- to be provided by the model and filter -------------------------------------------
+    def _initial_state(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def _propagate(self, u: np.ndarray, dt: float) -> None:
+        raise NotImplementedError
+
+    def _update(self, z: np.ndarray) -> None:
+        raise NotImplementedError
+
+    def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        raise NotImplementedError
+
+    # -- messages --------------------------------------------------------------------------
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        dt = t - self._t_imu
+        if dt <= 0.0:
+            return
+        self._t_imu = t
+        c0, c1, c2 = self._cols
+        if self._increment:
+            self._sum += (row[c0], row[c1], row[c2])
+        else:
+            self._sum += (row[c0] * dt, row[c1] * dt, row[c2] * dt)
+        self._acc_t += dt
+        if self._acc_t >= DR_STEP_S - 1e-9:
+            self._step()
+
+    def _step(self) -> None:
+        """One DR step with the mean inputs of the accumulated interval."""
+        dt = self._acc_t
+        if dt <= 0.0:
+            return
+        u = self._sum / dt
+        self._sum = np.zeros(3)
+        self._acc_t = 0.0
+        if self._still:
+            f_index = self._accel_index
+            if (self._still_t > 0.0
+                    and abs(u[f_index] - self._still_sum[f_index] / self._still_t)
+                    > MOVE_ACCEL_M_S2):
+                self._end_standstill()
+            else:
+                self._still_sum += u * dt
+                self._still_t += dt
+                return
+        u = u - self._bias
+        self._propagate(u, dt)
+
+    def _end_standstill(self) -> None:
+        self._still = False
+        if self._still_t > 0.0:
+            mean = self._still_sum / self._still_t
+            for i in self._gyro_channels:
+                self._bias[i] = mean[i]
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        fix, lat, lon, vn, ve = (float(row[i]) for i in self._fix_cols)
+        if not (fix > 0 and math.isfinite(lat) and math.isfinite(vn)):
+            return
+        if self._still and math.hypot(vn, ve) > MOVE_SPEED_M_S:
+            self._end_standstill()
+        self._step()  # bring the state to the fix time (no-op on the 10 Hz grid)
+        z = np.array([(math.radians(lat) - self._lat0) * self._rn,
+                      (math.radians(lon) - self._lon0) * self._re * math.cos(self._lat0),
+                      math.hypot(vn, ve)])  # eq. 18
+        self._update(z)
+
+    # -- output ----------------------------------------------------------------------------
+    @property
+    def _accel_index(self) -> int:
+        return self._imu_columns.index("accel_x")
+
+    def _row(self, x: np.ndarray, p: np.ndarray, vn: float, ve: float,
+             pitch: float) -> list[float]:
+        """The navigation columns (NaN where not estimated), then std_n and std_e."""
+        lat = self._lat0 + x[0] / self._rn
+        lon = self._lon0 + x[1] / (self._re * math.cos(self._lat0))
+        nan = math.nan
+        return [math.degrees(lat), math.degrees(lon), nan, vn, ve, nan, nan, pitch,
+                float(wrap_angle(x[4])), math.sqrt(p[0, 0]), math.sqrt(p[1, 1])]
+
+
+def _sf(d: float) -> float:
+    """SPEC section 7 scale-factor error s (measured = (1 + s) true) of the compensation
+    error d (true = (1 - d) measured)."""
+    return d / (1.0 - d)
+
+
+class _Drm2(_ChoDr):
+    """DRM2 model (eqs. 4-8, 14b)."""
+
+    _imu_columns = ("accel_x", "gyro_y", "gyro_z")
+    _gyro_channels = (1, 2)
+    _p0, _q = P0_DRM2, Q_DRM2
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_pitch", "std_yaw",
+                      "accel_scale_factor_x", "gyro_scale_factor_y", "gyro_scale_factor_z",
+                      "gyro_bias_y", "gyro_bias_z", "speed_h")
+
+    def _initial_state(self) -> np.ndarray:
+        init = self.initial
+        yaw = float(init.attitude[2])
+        v = float(init.velocity[0] * math.cos(yaw) + init.velocity[1] * math.sin(yaw))
+        return np.array([0.0, 0.0, v, float(init.attitude[1]), yaw, 0.0, 0.0, 0.0])
+
+    def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
+                    dt: float) -> np.ndarray:
+        return drm2_transition(x, w, u, dt, self._g)
+
+    def _jacobian(self, x: np.ndarray, u: np.ndarray, dt: float) -> np.ndarray:
+        return drm2_jacobian(x, u, dt, self._g)
+
+    def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """h(x) = [P_N, P_E, V] for states (k, 8) and its (constant) Jacobian (eq. 16)."""
+        return x[:, :3], np.eye(3, 8)
+
+    def solution(self, t: float) -> list[float]:
+        x, p = self._estimate()
+        v, th, psi = x[2], x[3], x[4]
+        return [*self._row(x, p, v * math.cos(psi), v * math.sin(psi), th),
+                math.sqrt(p[3, 3]), math.sqrt(p[4, 4]), _sf(x[5]), _sf(x[6]), _sf(x[7]),
+                self._bias[1], self._bias[2], v]
+
+
+class _Drm1(_ChoDr):
+    """DRM1 model (eqs. 2-3)."""
+
+    _imu_columns = ("accel_x", "accel_y", "gyro_z")
+    _gyro_channels = (2,)
+    _p0, _q = P0_DRM1, Q_DRM1
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "accel_scale_factor_x",
+                      "accel_scale_factor_y", "gyro_scale_factor_z", "gyro_bias_z")
+
+    def _initial_state(self) -> np.ndarray:
+        init = self.initial
+        return np.array([0.0, 0.0, float(init.velocity[0]), float(init.velocity[1]),
+                         float(init.attitude[2]), 0.0, 0.0, 0.0])
+
+    def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
+                    dt: float) -> np.ndarray:
+        return drm1_transition(x, w, u, dt, self._g)
+
+    def _jacobian(self, x: np.ndarray, u: np.ndarray, dt: float) -> np.ndarray:
+        return drm1_jacobian(x, u, dt, self._g)
+
+    def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """h(x) = [P_N, P_E, |V|] for states (k, 8) and its Jacobian at the first row."""
+        speed = np.hypot(x[:, 2], x[:, 3])
+        h = np.zeros((3, 8))
+        h[0, 0] = h[1, 1] = 1.0
+        if speed[0] > 0.0:
+            h[2, 2:4] = x[0, 2:4] / speed[0]
+        return np.column_stack([x[:, 0], x[:, 1], speed]), h
+
+    def solution(self, t: float) -> list[float]:
+        x, p = self._estimate()
+        return [*self._row(x, p, x[2], x[3], math.nan), math.sqrt(p[4, 4]),
+                _sf(x[5]), _sf(x[6]), _sf(x[7]), self._bias[2]]
+
+
+class _Ekf(_ChoDr):
+    """The EKF (eqs. 15-17): total-state propagation, the Jacobian's covariance, and the
+    Joseph-form update of ``estimators.toolbox.kalman``."""
+
+    def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
+        self._x, self._p = x0, p0
+
+    def _propagate(self, u: np.ndarray, dt: float) -> None:
+        phi = self._jacobian(self._x, u, dt)
+        self._x = self._transition(self._x[None, :], None, u, dt)[0]
+        _, self._p = kf_predict(self._x, self._p, phi, self._q * dt)
+
+    def _update(self, z: np.ndarray) -> None:
+        zhat, h = self._measure(self._x[None, :])
+        rows = [0, 1, 2] if h[2].any() else [0, 1]
+        nu = z[rows] - zhat[0, rows]
+        self._x, self._p, _ = kf_update(self._x, self._p, nu, h[rows], R_GPS[np.ix_(rows, rows)])
+        self._x[4] = wrap_angle(self._x[4])
+
+    def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._x, self._p
+
+
+class Drm1Ekf(_Drm1, _Ekf):
+    """2-D DR/GPS EKF on the DRM1 unit (two accelerometers + yaw gyro)."""
+
+    name = "dr2d_drm1_ekf"
+
+    def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        zhat, h = super()._measure(x)
+        if np.hypot(x[0, 2], x[0, 3]) < MIN_SPEED_UPDATE_M_S:
+            h[2] = 0.0  # no speed row: the EKF leaves it out
+        return zhat, h
+
+
+class Drm2Ekf(_Drm2, _Ekf):
+    """2-D DR/GPS EKF on the DRM2 unit (forward accelerometer + pitch and yaw gyros)."""
+
+    name = "dr2d_drm2_ekf"
+
+
+class Drm2Spkf(_Drm2):
+    """2-D DR/GPS scaled simplex sigma-point filter on the DRM2 unit (eqs. 19-32)."""
+
+    name = "dr2d_drm2_spkf"
+    defaults = {"standstill_calibration": True, "alpha": 0.3, "beta": 2.0, "w0": 0.0}
+
+    def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
+        plus, minus = angle_hooks([4])
+        self._ukf = SigmaPointFilter(x0, p0, points="simplex", alpha=self.config["alpha"],
+                                     beta=self.config["beta"], w0=self.config["w0"],
+                                     boxplus=plus, boxminus=minus, augment=True)
+        self._since_draw = 0.0
+        self._q_draw = self._q * DRAW_INTERVAL_S
+
+    def _propagate(self, u: np.ndarray, dt: float) -> None:
+        if self._since_draw >= DRAW_INTERVAL_S - 1e-9:
+            self._ukf.covariance(redraw=True)  # eq. 26; the next propagation draws afresh
+            self._since_draw = 0.0
+        self._ukf.propagate(self._transition, u, dt, q=self._q_draw)  # eqs. 22-25
+        self._since_draw += dt
+
+    def _update(self, z: np.ndarray) -> None:
+        if self._ukf.sigma is not None:
+            self._ukf.covariance()  # eq. 26
+        self._ukf.update(lambda xs: self._measure(xs)[0], z, R_GPS)  # eqs. 27-32
+        self._since_draw = 0.0
+
+    def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._ukf.x, self._ukf.p

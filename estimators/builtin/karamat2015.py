@@ -1,0 +1,542 @@
+"""The 3D RISS/GPS integration of Karamat et al. 2015 (``riss3d_tc_ekf``).
+
+Karamat, Atia, Noureldin, "An Enhanced Error Model for EKF-Based Tightly-Coupled Integration of
+GPS and Land Vehicle's Motion Sensors", Sensors 15, 2015 (``seeds/002_...``; "the paper" below).
+
+The reduced inertial sensor system (RISS) is one vertical gyro, a forward and a lateral
+accelerometer and the odometer. Frames: the paper's local frame is ENU and its body frame is
+x transversal (right), y forward, z up. landnav's body frame is FRD, so the inputs are mapped once,
+on arrival: ``w_z = -gyro_z`` (the up-axis rate), ``f_y = accel_x`` (forward), ``f_x = accel_y``
+(lateral, right). The paper's pitch (nose up) and roll (eq. 3; right side down positive) are the
+FRD Euler pitch and roll, its azimuth A (clockwise from north) the yaw. The state's gyro bias
+``b_z`` is on the up axis, so the solution's ``gyro_bias_z`` (FRD, down axis) is ``-b_z``.
+
+Mechanisation (eqs. 1-9), once per odometer interval (the odometer speed of an interval is its
+mean speed, so the distance is exact; the gyro and accelerometer samples of the interval are
+averaged, the azimuth is integrated to the interval's middle for the velocity):
+
+* eq. 1: dA/dt = -(w_z - b_z - omega_e sin(lat) - v_e tan(lat) / (R_N + h)). Our copy prints
+  -(w_z - b_z) - omega_e sin(lat) - ..., which would double the Earth rate a level gyro at rest
+  senses (it reads +omega_e sin(lat) about the up axis) instead of removing it; the bracketed
+  form is the paper's own eq. 20 (its F71 and F74 are positive) and Groves eq. 5.44;
+* eq. 2: p = asin((f_y - a_od - b_y) / g). The paper derives a_od "from the vehicle speed
+  measurements" without saying how; differencing 10 Hz wheel-tick speeds gives metres per second
+  squared of noise, so a_od is the difference of two consecutive ``tilt_window`` / 2 averages of
+  the speed divided by their spacing, and f_y is averaged over the same ``tilt_window``, so both
+  lag alike (by a quarter of the window);
+* eq. 3: r = -asin((f_x - b_x + v_o (w_z - b_z)) / (g cos p));
+* eqs. 4-6: v_e = v_o sin A cos p, v_n = v_o cos A cos p, v_u = v_o sin p;
+* eqs. 7-9: position from v_n / (R_M + h), v_e / ((R_N + h) cos(lat)), v_u.
+
+Error state (the ordering of the paper's H, eqs. 46 and 57; its F of eq. 42 orders the same
+states differently): ``dN, dE, dh, dv_e, dv_n, dv_u, dA, da_od, db_z, dc_b, dc_d, dr, dp, db_x,
+db_y, dv_o``. The position errors are carried as north and east metres (dN = (R_M + h) d lat,
+dE = (R_N + h) cos(lat) d lon) instead of radians: the same states rescaled, so that the
+covariance holds numbers of like size (``system_matrix`` gives F in the paper's radians and the
+filter rescales it). Errors are estimate minus truth (``estimators.toolbox.kalman``), which flips
+the sign of the paper's clock column in eq. 46. ``model: simplified`` is the earlier model the
+paper improves on (its refs. 14, 28): the first eleven states, no tilt-error, accelerometer-bias
+or speed-error states and no accelerometer update; pitch and roll are then eqs. 2-3 from the
+plain averaged accelerometers.
+
+System model: F of eqs. 13, 16, 17, 20, 24, 28, 31, 32 (``system_matrix``; the paper drops the
+terms over (R + h)^2 and so does it), first-order Gauss-Markov tilt errors, accelerometer biases,
+odometer-acceleration error and gyro bias (eqs. 33-38), random-walk clock drift (eqs. 40-41,
+its noise from the TCXO Allan parameters of the shared ``gnss_model.clock_noise``), discretised
+over each odometer interval with Phi = I + F dt + (F dt)^2 / 2 and Q_d = G Q G^T dt (the
+Gauss-Markov diagonal in closed form, ``estimators.toolbox.gauss_markov``).
+
+Velocity: the paper's error model treats the velocities as states driven by eqs. 22, 26 and 30
+(the time derivatives of eqs. 4-6), while its mechanisation recomputes them from the odometer
+(eqs. 4-6). Recomputing them each step throws the filter's velocity corrections away, and the
+heading then diverged in the first sharp turn of every drive we tried (the filter explains the
+persistent innovation with a huge azimuth correction). So the direction of the horizontal
+velocity is propagated as eqs. 22 and 26 do (turned by dA/dt each step, corrected by the
+filter) and its magnitude is the odometer's, v_o cos p (eqs. 4-5); v_u is eq. 6. Integrating
+eqs. 22/26 fully instead lets the a_od corrections accumulate into a speed error no measurement
+anchors (1 m/s in a 60 s one-satellite window).
+
+Measurements: pseudoranges and pseudorange rates (eqs. 45-49; ``coupling: tight``), or the
+receiver's 3-D fixes (position and velocity; ``coupling: loose``; a loosely coupled filter has
+nothing while fewer than four satellites are seen, as the paper's LC comparisons assume), and the
+accelerometer update (eqs. 50-58; ``model: enhanced``) once a second. Closed loop: after each
+update the estimated errors are removed from the navigation state and sensor-error estimates.
+The Gauss-Markov tilt and odometer-acceleration corrections decay as their models do.
+
+The Gauss-Markov parameters are images lost from our copy of the paper; chosen here from the
+IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md).
+
+Public names
+------------
+RissTcEkf, system_matrix, riss_rates, STATES, GM_PARAMETERS.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from estimators.base import Estimator
+from estimators.toolbox import gnss_model
+from estimators.toolbox.gauss_markov import gauss_markov_discrete
+from estimators.toolbox.kalman import ErrorState
+from simulator.earth import (
+    OMEGA_E_RAD_S,
+    geodetic_to_ecef,
+    ned_to_ecef_matrix,
+    normal_gravity,
+    radii_of_curvature,
+    wrap_angle,
+)
+from simulator.errors import InputError
+
+STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
+          "r", "p", "bx", "by", "vo")
+_I = {name: i for i, name in enumerate(STATES)}
+SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
+
+DEG = math.pi / 180.0
+MG = 9.80665e-3
+# Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
+# IMU300CC of the paper's Table 1: the gyro and accelerometer biases start at the Table 1
+# turn-on values (P0) and wander as a slow Gauss-Markov process whose noise equals an in-run
+# instability of 1 % (gyro) and 3 % (accelerometers) of them over 300 s; the tilt errors and
+# the odometer-derived acceleration error are short-correlated (a few seconds of vehicle
+# dynamics the accelerometer tilt of eqs. 2-3 cannot tell from gravity).
+GM_PARAMETERS = {
+    "bz": (0.02 * DEG * math.sqrt(3600.0 / 300.0), 3600.0),  # rad/s
+    "bx": (1.0 * MG * math.sqrt(3600.0 / 300.0), 3600.0),  # m/s^2
+    "by": (1.0 * MG * math.sqrt(3600.0 / 300.0), 3600.0),
+    "ao": (0.1, 10.0),  # m/s^2
+    "r": (1.0 * DEG, 10.0),  # rad
+    "p": (1.0 * DEG, 10.0),
+}
+_P0_SIGMA = {"N": 3.0, "E": 3.0, "h": 5.0, "ve": 0.3, "vn": 0.3, "vu": 0.3, "A": 1.0 * DEG,
+             "ao": 0.1, "bz": 2.0 * DEG,  # Table 1: gyro bias 2 deg/s (data sheet)
+             "cb": 30.0, "cd": 3.0, "r": 1.0 * DEG, "p": 1.0 * DEG,
+             "bx": 30.0 * MG, "by": 30.0 * MG,  # Table 1: accelerometer bias 30 mg
+             "vo": 0.2}
+# white-noise densities (per second) of the states without a Gauss-Markov model
+# (m/s)^2/s: unmodelled motion; v_u = v_o sin p (eq. 6) takes the noise of the accelerometer
+# pitch of eq. 2 directly (about 0.5 deg, 0.1 m/s at 14 m/s), which eq. 31 does not model
+_Q_WHITE = {"ve": 1e-4, "vn": 1e-4, "vu": 0.05,
+            "A": (2.25 * DEG / 60.0) ** 2,  # Table 1: gyro random walk 2.25 deg/sqrt(h)
+            "vo": 1e-4}  # (m/s)^2/s
+
+
+def system_matrix(lat: float, h: float, ve: float, vn: float, azimuth: float, pitch: float,
+                  ao: float, wz_corrected: float, n_states: int = len(STATES)) -> np.ndarray:
+    """The continuous error dynamics F of the paper, in its units (position errors d lat,
+    d lon in rad, ordered ``d lat, d lon, dh, ...`` as ``STATES``).
+
+    Parameters
+    ----------
+    lat : latitude, rad; h : height, m; ve, vn : east and north velocity, m/s;
+    azimuth, pitch : rad; ao : odometer-derived acceleration, m/s^2;
+    wz_corrected : the up-axis gyro rate minus its estimated bias, w_z - b_z, rad/s.
+    n_states : 16 (enhanced) or 11 (simplified, the first eleven states).
+
+    Entries (paper's F_ab in brackets, its state numbers): eq. 13 (F15), eq. 16 (F24, F21),
+    eq. 17 (F36), eq. 20 (F79, F71, F74), eq. 24 (F48, F47, F45, F49, F41, F44), eq. 28 (F58,
+    F57, F54, F59, F51), eq. 31 (F68), eq. 32 (F14,8), eqs. 33-38 and 40-41 (the Gauss-Markov
+    and clock rows). With errors as estimate minus truth, eq. 20 reads dA' = +db_z + (omega_e
+    cos(lat) + v_e sec^2(lat) / (R_N + h)) d lat + tan(lat) / (R_N + h) dv_e, as printed.
+    """
+    i = _I
+    rm, rn = (float(x) for x in radii_of_curvature(lat))
+    tan_lat, cos_lat = math.tan(lat), math.cos(lat)
+    sec2 = 1.0 / (cos_lat * cos_lat)
+    cos_p = math.cos(pitch)
+    sin_a, cos_a = math.sin(azimuth), math.cos(azimuth)
+    a_dot = -wz_corrected + OMEGA_E_RAD_S * math.sin(lat) + ve * tan_lat / (rn + h)
+    da_dlat = OMEGA_E_RAD_S * cos_lat + ve * sec2 / (rn + h)  # d(A')/d lat
+    da_dve = tan_lat / (rn + h)  # d(A')/d v_e
+    f = np.zeros((n_states, n_states))
+    f[i["N"], i["vn"]] = 1.0 / (rm + h)  # eq. 13
+    f[i["E"], i["ve"]] = 1.0 / ((rn + h) * cos_lat)  # eq. 16
+    f[i["E"], i["N"]] = ve * tan_lat / ((rn + h) * cos_lat)
+    f[i["h"], i["vu"]] = 1.0  # eq. 17
+    f[i["A"], i["bz"]] = 1.0  # eq. 20
+    f[i["A"], i["N"]] = da_dlat
+    f[i["A"], i["ve"]] = da_dve
+    # eq. 24: v_e' = a_od sin A cos p + v_n A'
+    f[i["ve"], i["ao"]] = sin_a * cos_p
+    f[i["ve"], i["A"]] = ao * cos_a * cos_p
+    f[i["ve"], i["vn"]] = a_dot
+    f[i["ve"], i["bz"]] = vn
+    f[i["ve"], i["N"]] = vn * da_dlat
+    f[i["ve"], i["ve"]] = vn * da_dve
+    # eq. 28: v_n' = a_od cos A cos p - v_e A'
+    f[i["vn"], i["ao"]] = cos_a * cos_p
+    f[i["vn"], i["A"]] = -ao * sin_a * cos_p
+    f[i["vn"], i["ve"]] = -a_dot - ve * da_dve
+    f[i["vn"], i["bz"]] = -ve
+    f[i["vn"], i["N"]] = -ve * da_dlat
+    f[i["vu"], i["ao"]] = math.sin(pitch)  # eq. 31
+    f[i["cb"], i["cd"]] = 1.0  # eq. 40
+    for name, (_, tau) in GM_PARAMETERS.items():  # eqs. 33-38
+        if i[name] < n_states:
+            f[i[name], i[name]] = -1.0 / tau
+    if n_states > i["vo"]:
+        f[i["vo"], i["ao"]] = 1.0  # eq. 32
+    return f
+
+
+def riss_rates(x: np.ndarray, wz: float) -> np.ndarray:
+    """Time derivatives of the RISS quantities in the derivative form the paper linearises
+    (eqs. 1, 7-9, 22, 26, 30, 32), for checking ``system_matrix`` by numerical differentiation.
+
+    ``x`` holds ``lat (rad), lon (rad), h, ve, vn, vu, A, ao, bz, cb, cd, r, p, bx, by, vo``
+    (the Gauss-Markov states enter as their mean dynamics -x / tau); ``wz`` is the up-axis gyro
+    rate, rad/s.
+    """
+    lat, _, h, ve, vn, _, az, ao, bz, _, cd, r, p, bx, by, _ = x
+    rm, rn = (float(v) for v in radii_of_curvature(lat))
+    a_dot = -(wz - bz) + OMEGA_E_RAD_S * math.sin(lat) + ve * math.tan(lat) / (rn + h)
+    out = np.zeros(len(STATES))
+    out[0] = vn / (rm + h)
+    out[1] = ve / ((rn + h) * math.cos(lat))
+    out[2] = x[5]
+    out[3] = ao * math.sin(az) * math.cos(p) + vn * a_dot
+    out[4] = ao * math.cos(az) * math.cos(p) - ve * a_dot
+    out[5] = ao * math.sin(p)
+    out[6] = a_dot
+    out[9] = cd
+    for name, (_, tau) in GM_PARAMETERS.items():
+        out[_I[name]] = -x[_I[name]] / tau
+    out[15] = ao
+    del r, bx, by
+    return out
+
+
+class RissTcEkf(Estimator):
+    """3D RISS/GPS augmented error-state EKF (Karamat et al. 2015); see the module docstring."""
+
+    name = "riss3d_tc_ekf"
+    needs = ("imu", "odometer")
+    uses = ("gnss_raw", "gnss_fix")
+    paper = ("Karamat et al. 2015, Sensors 15: 3D RISS/GPS tightly coupled augmented EKF "
+             "(eqs. 1-58)")
+    # model: enhanced | simplified; coupling: tight | loose; tilt_window: s, the averaging of
+    # eq. 2's accelerometer and odometer acceleration; accel_update_interval: s between the
+    # accelerometer updates of eqs. 50-58
+    # odometer_speed_noise: m/s, 1-sigma white noise of one odometer speed sample (a 48-tooth
+    # ABS wheel at 10 Hz quantises the speed in steps of 0.43 m/s)
+    defaults = {"model": "enhanced", "coupling": "tight", "tilt_window": 2.0,
+                "accel_update_interval": 1.0, "odometer_speed_noise": 0.2}
+    output_columns = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
+                      "std_n", "std_e", "std_d", "std_yaw",
+                      "gyro_bias_z", "accel_bias_x", "accel_bias_y", "clock_bias", "clock_drift")
+
+    def setup(self) -> None:
+        cfg = self.config
+        problems = []
+        if cfg["model"] not in ("enhanced", "simplified"):
+            problems.append(f"model must be enhanced or simplified, got {cfg['model']!r}")
+        if cfg["coupling"] not in ("tight", "loose"):
+            problems.append(f"coupling must be tight or loose, got {cfg['coupling']!r}")
+        if problems:
+            raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
+        self._enhanced = cfg["model"] == "enhanced"
+        self._tight = cfg["coupling"] == "tight"
+        self._n = len(STATES) if self._enhanced else SIMPLIFIED_STATES
+        init = self.initial
+        self._lat, self._lon, self._h = (float(v) for v in init.position)
+        vn0, ve0, vd0 = (float(v) for v in init.velocity)
+        self._roll, self._pitch, self._az = (float(v) for v in init.attitude)
+        self._ve, self._vn, self._vu = ve0, vn0, -vd0
+        self._vo = math.hypot(math.hypot(vn0, ve0), vd0)
+        # sensor-error estimates (paper axes) and the decaying Gauss-Markov corrections
+        self._bz = self._bx = self._by = 0.0
+        self._c_ao = self._c_r = self._c_p = self._c_vo = 0.0
+        self._cb = self._cd = 0.0
+        self._clock_ready = False
+        self._filter = ErrorState(np.diag([_P0_SIGMA[s] ** 2 for s in STATES[:self._n]]))
+        self._q_white = np.array([_Q_WHITE.get(s, 0.0) for s in STATES[:self._n]])
+        self._gm = [(_I[s], sig, tau) for s, (sig, tau) in GM_PARAMETERS.items()
+                    if _I[s] < self._n]
+        # sums over the IMU samples of the current odometer interval
+        c = self.columns["imu"]
+        self._col_gz, self._col_fx, self._col_fy = c["gyro_z"], c["accel_x"], c["accel_y"]
+        self._increments = self.units["imu"].get("gyro_z") == "rad"
+        self._t_imu = init.t
+        self._sum_wz = self._sum_ffwd = self._sum_flat = self._sum_dt = 0.0
+        self._n_imu = 0
+        self._col_speed = self.columns["odometer"]["speed"]
+        self._t_odo = init.t
+        self._t = init.t  # time of the navigation state
+        self._half = 0  # odometer intervals in half a tilt window, set at the first interval
+        self._speeds: list[float] = []
+        self._ffwd: list[float] = []
+        self._ao = 0.0
+        self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
+        self._t_accel_update = init.t
+        if "gnss_raw" in self.columns:
+            self._col_pr = self.columns["gnss_raw"]["pseudorange"]
+        if "gnss_fix" in self.columns:
+            g = self.columns["gnss_fix"]
+            self._fix_cols = [g[k] for k in ("lat", "lon", "alt", "vn", "ve", "vd", "fix")]
+
+    # --- inputs -----------------------------------------------------------------------------
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        dt = t - self._t_imu
+        if dt <= 0.0:
+            return
+        self._t_imu = t
+        if self._increments:
+            self._sum_wz -= row[self._col_gz]
+            self._sum_ffwd += row[self._col_fx]
+            self._sum_flat += row[self._col_fy]
+        else:
+            self._sum_wz -= row[self._col_gz] * dt
+            self._sum_ffwd += row[self._col_fx] * dt
+            self._sum_flat += row[self._col_fy] * dt
+        self._sum_dt += dt
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        speed = float(row[self._col_speed])
+        self._mechanise(t, speed)
+
+    def on_gnss_raw(self, t: float, rows: np.ndarray) -> None:
+        if not self._tight:
+            return
+        self._catch_up(t)
+        rows = rows[np.isfinite(rows[:, self._col_pr])]
+        if len(rows) == 0:
+            return
+        self._update_ranges(gnss_model.raw_epoch(rows, self.columns["gnss_raw"]))
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        if self._tight:
+            return
+        lat, lon, alt, vn, ve, vd, fix = (row[k] for k in self._fix_cols)
+        if fix < 2 or not math.isfinite(lat):  # 3-D fixes only: four satellites or more
+            return
+        self._catch_up(t)
+        rm, rn = (float(v) for v in radii_of_curvature(self._lat))
+        dz = np.array([(self._lat - math.radians(lat)) * (rm + self._h),
+                       (self._lon - math.radians(lon)) * (rn + self._h) * math.cos(self._lat),
+                       self._h - alt, self._ve - ve, self._vn - vn, self._vu + vd])
+        h = np.zeros((6, self._n))
+        h[:, :6] = np.eye(6)
+        r = np.diag([3.0**2, 3.0**2, 5.0**2, 0.1**2, 0.1**2, 0.15**2])
+        forward = np.array([math.sin(self._az), math.cos(self._az), 0.0]) * math.cos(self._pitch)
+        forward[2] = math.sin(self._pitch)  # east, north, up: the odometer noise (as on_raw)
+        r[3:, 3:] += self.config["odometer_speed_noise"] ** 2 * np.outer(forward, forward)
+        self._filter.update(dz, h, r)
+        self._feedback()
+
+    # --- mechanisation (eqs. 1-9) -------------------------------------------------------------
+    def _catch_up(self, t: float) -> None:
+        """Mechanise the IMU samples since the last odometer sample with the speed held."""
+        if self._sum_dt > 0.0:
+            self._mechanise(t, self._vo_raw_last(), count_speed=False)
+
+    def _vo_raw_last(self) -> float:
+        return self._speeds[-1] if self._speeds else self._vo + self._c_vo
+
+    def _mechanise(self, t: float, speed: float, count_speed: bool = True) -> None:
+        dt = t - self._t
+        if dt <= 0.0:
+            return
+        n = self._sum_dt
+        if n > 0.0:
+            wz = self._sum_wz / n
+            ffwd = self._sum_ffwd / n
+            flat = self._sum_flat / n
+        else:
+            wz, ffwd, flat = self._wz, (self._ffwd[-1] if self._ffwd else 0.0), 0.0
+        self._sum_wz = self._sum_ffwd = self._sum_flat = self._sum_dt = 0.0
+        if count_speed:
+            if not self._half:
+                self._half = max(1, round(0.5 * self.config["tilt_window"] / (t - self._t_odo)))
+                self._dt_odo = t - self._t_odo
+            self._t_odo = t
+            self._speeds.append(speed)
+            self._ffwd.append(ffwd)
+            keep = 2 * self._half
+            if len(self._speeds) > keep:
+                del self._speeds[0], self._ffwd[0]
+        self._wz = wz
+        lat, h = self._lat, self._h
+        rm, rn = (float(v) for v in radii_of_curvature(lat))
+        g = float(normal_gravity(lat, h))
+        # odometer-derived acceleration and the matching accelerometer average (eq. 2)
+        if len(self._speeds) == 2 * self._half:
+            k = self._half
+            ao_raw = (sum(self._speeds[k:]) - sum(self._speeds[:k])) / (k * k * self._dt_odo)
+            ffwd_avg = sum(self._ffwd) / (2 * k)
+        else:
+            ao_raw, ffwd_avg = 0.0, ffwd
+        decay = [math.exp(-dt / GM_PARAMETERS[s][1]) for s in ("ao", "r", "p", "bz", "bx", "by")]
+        self._c_ao *= decay[0]
+        self._c_r *= decay[1]
+        self._c_p *= decay[2]
+        self._bz *= decay[3]
+        self._bx *= decay[4]
+        self._by *= decay[5]
+        ao = ao_raw - self._c_ao
+        self._ao = ao
+        vo = speed - self._c_vo
+        self._vo = vo
+        wz_c = wz - self._bz
+        pitch = _asin((ffwd_avg - ao - self._by) / g) - self._c_p  # eq. 2
+        roll = -_asin((flat - self._bx + vo * wz_c) / (g * math.cos(pitch))) - self._c_r  # eq. 3
+        a_dot = -wz_c + OMEGA_E_RAD_S * math.sin(lat) + self._ve * math.tan(lat) / (rn + h)  # 1
+        az_mid = self._az + 0.5 * a_dot * dt
+        self._az = float(wrap_angle(self._az + a_dot * dt))
+        cos_p = math.cos(pitch)
+        # eqs. 4-5 with eqs. 22 and 26: the direction of the horizontal velocity turns with
+        # the azimuth rate (the form the error model of eqs. 24 and 28 linearises, so that a
+        # corrected direction persists), its magnitude is the odometer speed v_o cos p
+        ve0, vn0 = self._ve, self._vn
+        turn = a_dot * dt
+        c_t, s_t = math.cos(turn), math.sin(turn)
+        ue, un = ve0 * c_t + vn0 * s_t, vn0 * c_t - ve0 * s_t
+        norm = math.hypot(ue, un)
+        if norm < 0.1:  # too slow for a direction of its own: along the azimuth
+            ue, un, norm = math.sin(az_mid), math.cos(az_mid), 1.0
+        self._ve = vo * cos_p * ue / norm
+        self._vn = vo * cos_p * un / norm
+        self._vu = vo * math.sin(pitch)  # eq. 6
+        self._lat += 0.5 * (vn0 + self._vn) * dt / (rm + h)  # eq. 7
+        self._lon += 0.5 * (ve0 + self._ve) * dt / ((rn + h) * math.cos(lat))  # eq. 8
+        self._h += self._vu * dt  # eq. 9
+        self._cb += self._cd * dt  # eq. 40
+        self._pitch, self._roll = pitch, roll
+        self._t = t
+        self._predict(dt, rm, rn, wz_c)
+        if (self._enhanced and t - self._t_accel_update >= self.config["accel_update_interval"]
+                - 1e-9):
+            self._t_accel_update = t
+            self._update_accelerometers(g, ffwd_avg, flat, wz)
+
+    def _predict(self, dt: float, rm: float, rn: float, wz_c: float) -> None:
+        f = system_matrix(self._lat, self._h, self._ve, self._vn, self._az, self._pitch,
+                          self._ao, wz_c, self._n)
+        # rescale d lat, d lon (rad) to north and east metres: F_m = T F T^-1
+        scale = np.ones(self._n)
+        scale[0] = rm + self._h
+        scale[1] = (rn + self._h) * math.cos(self._lat)
+        f = f * scale[:, None] / scale[None, :]
+        fdt = f * dt
+        phi = np.eye(self._n) + fdt + 0.5 * fdt @ fdt
+        q = self._q_white * dt
+        for k, sigma, tau in self._gm:
+            phi_k, q_k = gauss_markov_discrete(tau, sigma, dt)
+            phi[k, k] = phi_k
+            q[k] = q_k
+        q_d = np.diag(q)
+        clock = slice(_I["cb"], _I["cd"] + 1)
+        q_d[clock, clock] = gnss_model.clock_noise(dt)  # a TCXO (the shared clock model)
+        self._filter.predict(phi, q_d)
+
+    # --- measurement updates ------------------------------------------------------------------
+    def _update_accelerometers(self, g: float, ffwd: float, flat: float, wz: float) -> None:
+        """Eqs. 50-57: f_x = -g sin r cos p - v_o (w_z - b_z) + b_x (eq. 51) and f_y = g sin p +
+        a_od + b_y (eq. 54), linearised in r, p, b_z, v_o, b_x, a_od, b_y (eqs. 53, 56)."""
+        i = _I
+        r, p, vo = self._roll, self._pitch, self._vo
+        wz_c = wz - self._bz
+        fx_est = -g * math.sin(r) * math.cos(p) - vo * wz_c + self._bx
+        fy_est = g * math.sin(p) + self._ao + self._by
+        h = np.zeros((2, self._n))
+        h[0, i["r"]] = -g * math.cos(r) * math.cos(p)
+        h[0, i["p"]] = g * math.sin(r) * math.sin(p)
+        h[0, i["vo"]] = -wz_c
+        h[0, i["bz"]] = vo
+        h[0, i["bx"]] = 1.0
+        h[1, i["p"]] = g * math.cos(p)
+        h[1, i["ao"]] = 1.0
+        h[1, i["by"]] = 1.0
+        dz = np.array([fx_est - flat, fy_est - ffwd])
+        sigma = 0.05  # m/s^2: accelerometer noise and vibration over an odometer interval
+        self._filter.update(dz, h, np.eye(2) * sigma**2)
+        self._feedback()
+
+    def _update_ranges(self, epoch: gnss_model.RawEpoch) -> None:
+        """Eqs. 45-49: dz = rho_RISS - rho_GPS and the same for the rates, predicted by the
+        shared model (``estimators.toolbox.gnss_model``: Sagnac, broadcast corrections), with
+        H = [-los^T C_n^e, +1 for the clock] (eqs. 46-49 with errors as estimate minus truth)."""
+        pos = geodetic_to_ecef(self._lat, self._lon, self._h).reshape(3)
+        c_ne = ned_to_ecef_matrix(self._lat, self._lon)
+        v_ecef = c_ne @ np.array([self._vn, self._ve, -self._vu])
+        if not self._clock_ready:
+            rho0, rate0, _ = gnss_model.predict(epoch.sat_pos, epoch.sat_vel, pos, v_ecef)
+            self._cb = float(np.median(epoch.pseudorange - rho0))
+            self._cd = float(np.median(epoch.range_rate - rate0))
+            self._clock_ready = True
+        rho, rate, los = gnss_model.predict(epoch.sat_pos, epoch.sat_vel, pos, v_ecef,
+                                            self._cb, self._cd)
+        jac = gnss_model.los_jacobians(los)  # [-los (ECEF), 1]
+        d_ned = jac[:, :3] @ c_ne  # d rho / d (north, east, down) of the antenna
+        m = len(rho)
+        h = np.zeros((2 * m, self._n))
+        h[:m, _I["N"]] = d_ned[:, 0]
+        h[:m, _I["E"]] = d_ned[:, 1]
+        h[:m, _I["h"]] = -d_ned[:, 2]  # d(down) = -dh
+        h[:m, _I["cb"]] = 1.0
+        h[m:, _I["ve"]] = d_ned[:, 1]
+        h[m:, _I["vn"]] = d_ned[:, 0]
+        h[m:, _I["vu"]] = -d_ned[:, 2]
+        h[m:, _I["cd"]] = 1.0
+        dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
+        var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
+        var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
+        r = np.diag(np.concatenate([var_pr, var_rate]))
+        # the mechanised velocity carries the white noise of the last odometer speed: it enters
+        # every predicted rate through the forward axis, so R gains sigma^2 g g^T
+        forward = np.array([math.cos(self._az), math.sin(self._az), 0.0]) * math.cos(self._pitch)
+        forward[2] = -math.sin(self._pitch)
+        g = d_ned @ forward
+        r[m:, m:] += self.config["odometer_speed_noise"] ** 2 * np.outer(g, g)
+        self._filter.update(dz, h, r)
+        self._feedback()
+
+    def _feedback(self) -> None:
+        """Closed loop: remove the estimated errors (estimate minus truth) from the state."""
+        dx = self._filter.feedback()
+        i = _I
+        rm, rn = (float(v) for v in radii_of_curvature(self._lat))
+        self._lat -= dx[i["N"]] / (rm + self._h)
+        self._lon -= dx[i["E"]] / ((rn + self._h) * math.cos(self._lat))
+        self._h -= dx[i["h"]]
+        self._ve -= dx[i["ve"]]
+        self._vn -= dx[i["vn"]]
+        self._vu -= dx[i["vu"]]
+        self._az = float(wrap_angle(self._az - dx[i["A"]]))
+        self._c_ao += dx[i["ao"]]
+        self._ao -= dx[i["ao"]]
+        self._bz -= dx[i["bz"]]
+        self._cb -= dx[i["cb"]]
+        self._cd -= dx[i["cd"]]
+        if self._enhanced:
+            self._c_r += dx[i["r"]]
+            self._roll -= dx[i["r"]]
+            self._c_p += dx[i["p"]]
+            self._pitch -= dx[i["p"]]
+            self._bx -= dx[i["bx"]]
+            self._by -= dx[i["by"]]
+            self._c_vo += dx[i["vo"]]
+            self._vo -= dx[i["vo"]]
+
+    # --- output -------------------------------------------------------------------------------
+    def solution(self, t: float) -> list[float]:
+        rm, rn = (float(v) for v in radii_of_curvature(self._lat))
+        lead = t - self._t  # IMU samples not yet mechanised: the velocity is held
+        lat = self._lat + self._vn * lead / (rm + self._h)
+        lon = self._lon + self._ve * lead / ((rn + self._h) * math.cos(self._lat))
+        p = self._filter.p
+        i = _I
+        clock = (self._cb, self._cd) if self._clock_ready else (math.nan, math.nan)
+        accel = (self._by, self._bx) if self._enhanced else (math.nan, math.nan)
+        return [math.degrees(lat), math.degrees(lon), self._h + self._vu * lead,
+                self._vn, self._ve, -self._vu, self._roll, self._pitch, self._az,
+                math.sqrt(p[i["N"], i["N"]]), math.sqrt(p[i["E"], i["E"]]),
+                math.sqrt(p[i["h"], i["h"]]), math.sqrt(p[i["A"], i["A"]]),
+                -self._bz, accel[0], accel[1], *clock]
+
+
+def _asin(x: float) -> float:
+    return math.asin(min(1.0, max(-1.0, x)))

@@ -1,0 +1,505 @@
+"""The dead-reckoning filters of Park et al., "MEMS 3D DR/GPS Integrated System for Land Vehicle
+Application Robust to GPS Outages", IEEE Access 7, 2019 (``seeds/004_...``).
+
+* ``dr2d_odo_ekf`` (``Dr2dOdoEkf``): the conventional 2-D DR/GPS of section II-B. The position
+  integrates the odometer speed along the heading (eqs. 15-16); a 5-state EKF on
+  [dp_N, dp_E, dv, dpsi, deps_z] (eq. 17) is updated with the GPS north/east position and
+  ground speed (eqs. 18-19).
+* ``dr3d_ekf`` (``Dr3dEkf``): the proposed 3-D DR/GPS of section III. The attitude quaternion
+  integrates the three gyros (eq. 3), the position integrates the odometer speed, scaled by
+  the estimated odometer scale factor, along the body x axis resolved in NED (eqs. 20-21); a
+  10-state EKF on [dp_N, dp_E, dp_D, ds, psi_N, psi_E, psi_D, deps_x, deps_y, deps_z]
+  (eq. 23) with the error model of eqs. 28-32 is updated in two steps (section III-C): step 1
+  at 20 Hz with roll and pitch from the accelerometers (g-slave, eqs. 34-35) and the
+  barometric height (eqs. 36-37); step 2 at each GPS epoch with the GPS position, ground speed
+  and course (eqs. 38-41). The three noise adaptation rules of section III-D are on with
+  ``adaptive`` (default).
+
+Both are closed-loop error-state EKFs on ``estimators.toolbox.kalman.ErrorState``; the nominal
+solution is propagated at every IMU sample's arrival in lean scalar form, the covariance and the
+20 Hz measurements once per ``step`` (0.05 s, the paper's 20 Hz) with the gyro increments of
+the step summed (coning over 50 ms is negligible at a car's rates).
+
+Choices where the paper is silent or inconsistent (also in docs/reproduction_park2019.md):
+
+* Sign of the attitude error. Park writes C_b^n(estimate) = (I - [dpsi x]) C_b^n (eq. 24); the
+  toolbox convention (``estimators.toolbox.nav_error``) is C_b^n(estimate) = (I + [psi x])
+  C_b^n, so psi = -dpsi and the signs of the psi columns of eqs. 30, 37 and 41 flip: eq. 28
+  becomes dp' = C_b^n [u, 0, 0]^T ds - (v^n x) psi, the gyro-bias block of eq. 30 stays
+  -C_b^n (the bias state is estimate minus truth, so the corrected rate is too low by it).
+* Odometer scale factor. Eq. 20 writes v = s u (u the odometer reading) with a multiplicative
+  error s (1 + ds), while eqs. 26, 30 and 41 use an additive ds (dv = ds u). The additive form
+  of eqs. 26/30/41 is implemented (ds = s(estimate) - s). The solution's
+  ``odometer_scale_factor`` column is SPEC section 7's ratio of measured to true speed, 1 / s.
+* Tilt measurement Jacobian. Eq. 37 is the level, small-roll approximation of the exact
+  linearisation d(roll, pitch)/d psi = rows 1-2 of M(roll, pitch) C_n^b (M the Euler-rate
+  matrix); the exact rows are used (identical on level ground, better on a 15 % ramp). The same
+  holds for the course row of eq. 41 (row 3). The accelerometers give roll = atan2(-f_y, -f_z),
+  pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) in the FRD frame (eqs. 34-35 written for FRD) from the
+  mean specific force of the step.
+* GPS speed is the horizontal ground speed, so its prediction is s u cos(pitch), not s u
+  (eq. 39); the Jacobian has u cos(pitch) on ds and -s u sin(pitch) on the pitch error. Course
+  is used only while moving forwards faster than ``course_min_speed`` (it is undefined at
+  standstill and points backwards while reversing).
+* Barometer: its bias is removed "simply" with GPS height (section III-C): the offset
+  h_baro - h_GPS is averaged (first-order filter, ``baro_offset_time_constant``) over good 3-D
+  fixes (``gps_height_max_vdop``) and frozen without them; the barometer is used from the first
+  such fix on. GPS height enters step 2 only on such fixes.
+* Adaptation rules (section III-D), thresholds as printed: (1) | ||f|| - g | > 0.059 m/s^2
+  inflates the tilt noise from ``tilt_sigma`` to ``tilt_sigma_inflated``; (2) a speed below
+  5 m/s inflates the GPS speed and course noise to their ``*_inflated`` values; (3) a barometric
+  innovation over 2.5 m inflates the barometer noise to ``baro_sigma_inflated``. The inflated
+  values are not printed: chosen as ten times (tilt), five times (speed, course) and twenty
+  times (barometer) the nominal. With ``adaptive: false`` the nominal values are used always.
+* Gauss-Markov time constants (eq. 29) are not printed: tau_1 = 3600 s for the scale factor
+  (tyre wear and pressure change over hours), tau_2 = 600 s for the gyro biases; process noise
+  from the SMI130 gyro noise density (Table 1) and small steady-state sigmas.
+* The 2-D filter's velocity-error state dv (eq. 17) is an additive odometer speed error with a
+  Gauss-Markov model (sigma ``speed_error_sigma``, tau ``speed_error_time_constant``), applied
+  while the wheels turn (a wheel-speed sensor reads exactly zero at standstill). Its heading
+  integrates the z gyro with the vertical Earth and transport rate of a level frame (a 2-D DR
+  has no tilt: eq. 3 reduces to a rotation about the body z axis). It estimates no height:
+  ``alt``, ``vd``, roll and pitch are NaN.
+
+Public classes
+--------------
+Dr2dOdoEkf, Dr3dEkf.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from estimators.base import NAV_COLUMNS, Estimator
+from estimators.toolbox.constraints import height as height_measurement
+from estimators.toolbox.gating import threshold_variance
+from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
+from simulator.earth import OMEGA_E_RAD_S, dcm_to_euler, normal_gravity, quat_to_dcm, wrap_angle
+
+PAPER = ("Park et al. 2019, MEMS 3D DR/GPS Integrated System for Land Vehicle Application "
+         "Robust to GPS Outages, IEEE Access 7")
+DEG = math.pi / 180.0
+ACCEL_NORM_THRESHOLD_M_S2 = 0.059  # Park section III-D rule 1 (0.006 g)
+LOW_SPEED_THRESHOLD_M_S = 5.0  # Park section III-D rule 2 ("approximately 4 ~ 6 m/s")
+BARO_INNOVATION_THRESHOLD_M = 2.5  # Park section III-D rule 3 (80 % of one floor)
+
+
+def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
+    """d(roll, pitch, yaw) / d psi, shape (3, 3), at the attitude of the body-to-NED DCM
+    ``c_bn``, for the toolbox attitude error psi (C_b^n(estimate) = (I + [psi x]) C_b^n): the
+    Euler-rate matrix M(roll, pitch) times C_n^b, since psi is the body-frame rotation
+    C_n^b psi (Groves 2013, eq. 2.56 for M)."""
+    roll = math.atan2(c_bn[2, 1], c_bn[2, 2])
+    sr, cr = math.sin(roll), math.cos(roll)
+    sp = -c_bn[2, 0]
+    cp = math.sqrt(max(1.0 - sp * sp, 1e-12))
+    m = np.array([[1.0, sr * sp / cp, cr * sp / cp], [0.0, cr, -sr], [0.0, sr / cp, cr / cp]])
+    return m @ c_bn.T
+
+
+@njit(cache=True)
+def _dr3d_navigate(q: np.ndarray, c_old: np.ndarray, pos: np.ndarray, v_prev: np.ndarray,
+                   dtheta: np.ndarray, v_body: float, u: float, dt: float,
+                   f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The 3-D DR navigation processor over one step (eqs. 3, 20-21) and the error model's
+    time-varying blocks (eqs. 28-32, toolbox psi sign) written into ``f`` (10, 10).
+
+    q, c_old: attitude at the step start; pos: latitude, longitude (rad), height (m); v_prev:
+    NED velocity of the previous step (for the transport rate); dtheta: bias-corrected gyro
+    increment (rad); v_body: s u (m/s); u: odometer reading (m/s). Returns q, C_b^n, position,
+    NED velocity at the step end."""
+    lat, lon, h = pos[0], pos[1], pos[2]
+    w_ie, w_en = frame_rates(lat, h, v_prev)
+    w_in = w_ie + w_en
+    q_new, c_new = attitude_step(q, w_in * dt, dtheta)
+    x_axis = 0.5 * (c_old[:, 0] + c_new[:, 0])
+    v = v_body * x_axis
+    rn, re = radii(lat)
+    lat_new = lat + v[0] * dt / (rn + h)
+    lon_new = lon + v[1] * dt / ((re + h) * np.cos(lat_new))
+    h_new = h - v[2] * dt
+    # eq. 28: dp' = C_b^n [u, 0, 0]^T ds - (v^n x) psi
+    f[0:3, 3] = u * x_axis
+    f[0, 4], f[0, 5], f[0, 6] = 0.0, v[2], -v[1]
+    f[1, 4], f[1, 5], f[1, 6] = -v[2], 0.0, v[0]
+    f[2, 4], f[2, 5], f[2, 6] = v[1], -v[0], 0.0
+    # eqs. 30-32: psi' = -w_in x psi - dw_in + C_b^n dw_ib, dw_ib = -(gyro bias error)
+    f[4, 4], f[4, 5], f[4, 6] = 0.0, w_in[2], -w_in[1]
+    f[5, 4], f[5, 5], f[5, 6] = -w_in[2], 0.0, w_in[0]
+    f[6, 4], f[6, 5], f[6, 6] = w_in[1], -w_in[0], 0.0
+    # F_31: dw_in from latitude (north error) and height (down error; h = -p_D)
+    d_lat = 1.0 / (rn + h)
+    f[4, 0] = d_lat * OMEGA_E_RAD_S * np.sin(lat)
+    f[5, 0] = 0.0
+    f[6, 0] = d_lat * (OMEGA_E_RAD_S * np.cos(lat) + v[1] / ((re + h) * np.cos(lat) ** 2))
+    f[4:7, 2] = -w_en * d_lat
+    f[4:7, 7:10] = -c_new
+    return q_new, c_new, np.array([lat_new, lon_new, h_new]), v
+
+
+class _FixColumns:
+    """Column positions of the ``gnss_fix`` stream used by both filters."""
+
+    def __init__(self, columns: dict[str, int]):
+        self.lat, self.lon, self.alt = columns["lat"], columns["lon"], columns["alt"]
+        self.speed, self.course = columns["speed"], columns["course"]
+        self.fix, self.vdop = columns["fix"], columns["vdop"]
+
+
+def _ned_offset(lat: float, lon: float, h: float, lat_ref: float, lon_ref: float,
+                h_ref: float) -> np.ndarray:
+    """(lat, lon, h) minus the reference as north and east arc lengths and down, m (rad in)."""
+    rn, re = radii(lat)
+    return np.array([(lat - lat_ref) * (rn + h), (lon - lon_ref) * (re + h) * math.cos(lat),
+                     -(h - h_ref)])
+
+
+class _StepAccumulator:
+    """IMU samples summed over one filter step: gyro increments, mean specific force."""
+
+    def __init__(self, columns: dict[str, int], units: dict[str, str], t0: float):
+        self.gyro = [columns["gyro_x"], columns["gyro_y"], columns["gyro_z"]]
+        self.accel = [columns[a] for a in ("accel_x", "accel_y", "accel_z") if a in columns]
+        self.increments = units.get("gyro_z") == "rad"
+        self.t = t0
+        self.reset()
+
+    def reset(self) -> None:
+        self.dtheta = [0.0, 0.0, 0.0]  # rad, body FRD
+        self.dvel = [0.0, 0.0, 0.0]  # m/s (specific force integrated)
+        self.dt = 0.0
+
+    def add(self, t: float, row: np.ndarray) -> None:
+        dt = t - self.t
+        if dt <= 0.0:
+            return
+        self.t = t
+        g, a = self.gyro, self.accel
+        w = 1.0 if self.increments else dt  # a rate sample holds over the interval before it
+        self.dtheta[0] += row[g[0]] * w
+        self.dtheta[1] += row[g[1]] * w
+        self.dtheta[2] += row[g[2]] * w
+        if a:
+            self.dvel[0] += row[a[0]] * w
+            self.dvel[1] += row[a[1]] * w
+            self.dvel[2] += row[a[2]] * w
+        self.dt += dt
+
+
+class Dr3dEkf(Estimator):
+    """Park et al. 2019 proposed 10-state 3-D DR/GPS EKF (eqs. 20-41, section III-D)."""
+
+    name = "dr3d_ekf"
+    needs = ("imu", "odometer", "gnss_fix")
+    uses = ("baro",)
+    paper = PAPER + ", section III (eqs. 20-41)"
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_d", "std_roll", "std_pitch",
+                      "std_yaw", "odometer_scale_factor", "gyro_bias_x", "gyro_bias_y",
+                      "gyro_bias_z")
+    defaults = {
+        "adaptive": True,  # section III-D noise adaptation rules
+        "baro": True,  # barometric height in step 1
+        "step": 0.05,  # s, step-1 period (20 Hz, section III-C)
+        "gyro_noise_density": 0.02 * DEG,  # rad/s/sqrt(Hz), SMI130 (Table 1)
+        "gyro_bias_sigma": 0.01 * DEG,  # rad/s, Gauss-Markov steady state
+        "gyro_bias_time_constant": 600.0,  # s, tau_2 of eq. 29
+        "gyro_bias_initial": 1.0 * DEG,  # rad/s, P0 (Table 1 zero-point offset)
+        "scale_sigma": 0.01,  # Gauss-Markov steady state of s (1 = true distance per reading)
+        "scale_time_constant": 3600.0,  # s, tau_1 of eq. 29
+        "scale_initial": 0.05,  # P0 of the scale factor
+        "position_initial": 3.0,  # m, P0 per axis
+        "attitude_initial": 1.0 * DEG,  # rad, P0 roll and pitch
+        "heading_initial": 5.0 * DEG,  # rad, P0 yaw
+        "tilt_sigma": 1.0 * DEG,  # rad, accelerometer roll/pitch noise
+        "tilt_sigma_inflated": 10.0 * DEG,
+        "baro_sigma": 0.5,  # m
+        "baro_sigma_inflated": 10.0,  # m
+        "baro_offset_time_constant": 60.0,  # s
+        "gps_horizontal_sigma": 3.0,  # m
+        "gps_vertical_sigma": 5.0,  # m
+        "gps_height_max_vdop": 3.0,
+        "gps_speed_sigma": 0.1,  # m/s
+        "gps_speed_sigma_inflated": 0.5,
+        "gps_course_sigma": 1.0 * DEG,  # rad
+        "gps_course_sigma_inflated": 5.0 * DEG,
+        "course_min_speed": 1.0,  # m/s
+    }
+
+    def setup(self) -> None:
+        c = self.config
+        init = self.initial
+        self._pos = np.array(init.position, dtype=float)  # latitude, longitude (rad), height
+        self._q = init.quaternion
+        self._cbn = quat_to_dcm(self._q)
+        self._v_ned = np.zeros(3)
+        self._s = 1.0  # metres per odometer metre (eq. 20)
+        self._bias = np.zeros(3)  # gyro bias estimate, rad/s
+        self._u = 0.0  # latest odometer reading, m/s
+        self._zero3 = np.zeros(3)
+        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._odo = self.columns["odometer"]["speed"]
+        self._fix = _FixColumns(self.columns["gnss_fix"])
+        self._baro_col = self.columns.get("baro", {}).get("altitude")
+        self._use_baro = bool(c["baro"]) and self._baro_col is not None
+        self._baro_h = math.nan
+        self._baro_new = False
+        self._baro_offset: float | None = None
+        self._t_offset = init.t
+        p0 = np.diag(np.r_[[c["position_initial"] ** 2] * 3, c["scale_initial"] ** 2,
+                           [c["attitude_initial"] ** 2] * 2, c["heading_initial"] ** 2,
+                           [c["gyro_bias_initial"] ** 2] * 3])
+        self._kf = ErrorState(p0)
+        self._g = float(np.squeeze(normal_gravity(self._pos[0], self._pos[2])))
+        self._eye = np.eye(10)
+        self._f = np.zeros((10, 10))  # eq. 30; the time-varying blocks are filled each step
+        self._f[3, 3] = -1.0 / c["scale_time_constant"]
+        self._f[7:10, 7:10] = -np.eye(3) / c["gyro_bias_time_constant"]
+        self._q_c = np.zeros(10)
+        self._q_c[3] = 2.0 * c["scale_sigma"] ** 2 / c["scale_time_constant"]
+        self._q_c[4:7] = c["gyro_noise_density"] ** 2
+        self._q_c[7:10] = 2.0 * c["gyro_bias_sigma"] ** 2 / c["gyro_bias_time_constant"]
+
+    # -- messages ---------------------------------------------------------------------------
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        acc = self._imu
+        acc.add(t, row)
+        if acc.dt >= self.config["step"] - 1e-9:
+            self._step()
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        self._u = float(row[self._odo])
+
+    def on_baro(self, t: float, row: np.ndarray) -> None:
+        if self._baro_col is not None:
+            self._baro_h = float(row[self._baro_col])
+            self._baro_new = True
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        fx = self._fix
+        if not (row[fx.fix] > 0 and math.isfinite(row[fx.lat])):
+            return
+        if self._imu.dt > 0.0:
+            self._step()
+        c = self.config
+        lat, lon, alt = math.radians(row[fx.lat]), math.radians(row[fx.lon]), float(row[fx.alt])
+        good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
+        if good_height and math.isfinite(self._baro_h):
+            self._track_baro_offset(t, self._baro_h - alt)
+        dz = _ned_offset(*self._pos, lat, lon, alt)
+        n = 3 if good_height else 2
+        rows = [np.eye(10)[:n]]
+        dzs = [dz[:n]]
+        var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
+        speed = self._s * self._u
+        slow = c["adaptive"] and speed < LOW_SPEED_THRESHOLD_M_S
+        jac = euler_error_jacobian(self._cbn)
+        pitch = -math.asin(self._cbn[2, 0])
+        if math.isfinite(row[fx.speed]):
+            h = np.zeros(10)
+            h[3] = abs(self._u) * math.cos(pitch)
+            h[4:7] = -abs(speed) * math.sin(pitch) * jac[1]
+            rows.append(h[None])
+            dzs.append([abs(speed) * math.cos(pitch) - row[fx.speed]])
+            var.append(c["gps_speed_sigma_inflated" if slow else "gps_speed_sigma"] ** 2)
+        if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
+            h = np.zeros(10)
+            h[4:7] = jac[2]
+            rows.append(h[None])
+            yaw = math.atan2(self._cbn[1, 0], self._cbn[0, 0])
+            dzs.append([math.remainder(yaw - row[fx.course], 2.0 * math.pi)])
+            var.append(c["gps_course_sigma_inflated" if slow else "gps_course_sigma"] ** 2)
+        self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(var))
+        self._feedback()
+
+    # -- filter -----------------------------------------------------------------------------
+    def _track_baro_offset(self, t: float, offset: float) -> None:
+        if self._baro_offset is None:
+            self._baro_offset = offset
+        else:
+            a = min(1.0, (t - self._t_offset) / self.config["baro_offset_time_constant"])
+            self._baro_offset += a * (offset - self._baro_offset)
+        self._t_offset = t
+
+    def _step(self) -> None:
+        """Navigation processor (eqs. 3, 20-21) and covariance over one step, then step 1."""
+        acc = self._imu
+        dt = acc.dt
+        dtheta = np.array(acc.dtheta) - self._bias * dt
+        f_b = np.array(acc.dvel) / dt
+        acc.reset()
+        self._q, self._cbn, self._pos, self._v_ned = _dr3d_navigate(
+            self._q, self._cbn, self._pos, self._v_ned, dtheta, self._s * self._u, self._u,
+            dt, self._f)
+        self._kf.predict(self._eye + self._f * dt, np.diag(self._q_c * dt))
+        if self._imu.accel:
+            self._step_one(f_b)
+
+    def _step_one(self, f_b: np.ndarray) -> None:
+        """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer."""
+        c = self.config
+        cbn = self._cbn
+        roll, pitch = math.atan2(cbn[2, 1], cbn[2, 2]), -math.asin(cbn[2, 0])
+        jac = euler_error_jacobian(cbn)
+        h = np.zeros((2, 10))
+        h[:, 4:7] = jac[:2]
+        roll_acc = math.atan2(-f_b[1], -f_b[2])
+        pitch_acc = math.atan2(f_b[0], math.hypot(f_b[1], f_b[2]))
+        dz = [math.remainder(roll - roll_acc, 2.0 * math.pi), pitch - pitch_acc]
+        if c["adaptive"]:
+            var = threshold_variance(abs(math.sqrt(f_b @ f_b) - self._g),
+                                     ACCEL_NORM_THRESHOLD_M_S2, c["tilt_sigma"],
+                                     c["tilt_sigma_inflated"])
+        else:
+            var = c["tilt_sigma"] ** 2
+        rows, dzs, variances = [h], [dz], [var, var]
+        if self._use_baro and self._baro_new and self._baro_offset is not None:
+            dz_h, h_h = height_measurement(self._pos[2], self._baro_h - self._baro_offset, 10)
+            var_h = c["baro_sigma"] ** 2
+            if c["adaptive"]:
+                var_h = threshold_variance(abs(dz_h[0]), BARO_INNOVATION_THRESHOLD_M,
+                                           c["baro_sigma"], c["baro_sigma_inflated"])
+            rows.append(h_h)
+            dzs.append(dz_h)
+            variances.append(var_h)
+            self._baro_new = False
+        self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(variances))
+        self._feedback()
+
+    def _feedback(self) -> None:
+        dx = self._kf.feedback()
+        pos = self._pos
+        rn, re = radii(pos[0])
+        pos[0] -= dx[0] / (rn + pos[2])
+        pos[1] -= dx[1] / ((re + pos[2]) * math.cos(pos[0]))
+        pos[2] += dx[2]
+        self._s -= dx[3]
+        self._q, self._cbn = attitude_step(self._q, dx[4:7], self._zero3)
+        self._bias -= dx[7:10]
+
+    def solution(self, t: float) -> list[float]:
+        p = self._kf.p
+        std = np.sqrt(np.diag(p))
+        jac = euler_error_jacobian(self._cbn)
+        std_att = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", jac, p[4:7, 4:7], jac), 0.0))
+        roll, pitch, yaw = dcm_to_euler(self._cbn)
+        lat, lon, h = self._pos
+        return [math.degrees(lat), math.degrees(lon), h, *self._v_ned, float(roll),
+                float(pitch), float(yaw), *std[0:3], *std_att, 1.0 / self._s, *self._bias]
+
+
+class Dr2dOdoEkf(Estimator):
+    """Park et al. 2019 conventional 2-D DR/GPS with odometer (section II-B, eqs. 15-19)."""
+
+    name = "dr2d_odo_ekf"
+    needs = ("imu", "odometer", "gnss_fix")
+    paper = PAPER + ", section II-B (eqs. 15-19)"
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "gyro_bias_z")
+    defaults = {
+        "step": 0.05,  # s, covariance propagation period
+        "gyro_noise_density": 0.02 * DEG,  # rad/s/sqrt(Hz), SMI130 (Table 1)
+        "gyro_bias_sigma": 0.01 * DEG,  # rad/s, Gauss-Markov steady state
+        "gyro_bias_time_constant": 600.0,  # s
+        "gyro_bias_initial": 1.0 * DEG,  # rad/s
+        "speed_error_sigma": 0.3,  # m/s, Gauss-Markov steady state of dv
+        "speed_error_time_constant": 100.0,  # s
+        "position_initial": 3.0,  # m
+        "heading_initial": 5.0 * DEG,  # rad
+        "gps_horizontal_sigma": 3.0,  # m
+        "gps_speed_sigma": 0.1,  # m/s
+    }
+
+    def setup(self) -> None:
+        c = self.config
+        init = self.initial
+        self._lat, self._lon = float(init.position[0]), float(init.position[1])
+        self._h = float(init.position[2])  # for the radii only: the 2-D filter has no height
+        self._yaw = float(init.attitude[2])
+        self._speed_error = 0.0  # estimated additive odometer speed error, m/s
+        self._bias = 0.0  # z-gyro bias estimate, rad/s
+        self._u = 0.0
+        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._odo = self.columns["odometer"]["speed"]
+        self._fix = _FixColumns(self.columns["gnss_fix"])
+        p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
+                                                         c["heading_initial"] ** 2,
+                                                         c["gyro_bias_initial"] ** 2])
+        self._kf = ErrorState(p0)
+        self._q_c = np.array([0.0, 0.0,
+                              2.0 * c["speed_error_sigma"] ** 2 / c["speed_error_time_constant"],
+                              c["gyro_noise_density"] ** 2,
+                              2.0 * c["gyro_bias_sigma"] ** 2 / c["gyro_bias_time_constant"]])
+        self._f = np.zeros((5, 5))
+        self._f[2, 2] = -1.0 / c["speed_error_time_constant"]
+        self._f[3, 4] = -1.0
+        self._f[4, 4] = -1.0 / c["gyro_bias_time_constant"]
+
+    def _speed(self) -> float:
+        return self._u - self._speed_error if self._u != 0.0 else 0.0
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        acc = self._imu
+        acc.add(t, row)
+        if acc.dt >= self.config["step"] - 1e-9:
+            self._step()
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        self._u = float(row[self._odo])
+
+    def _step(self) -> None:
+        """Heading (eq. 3 about the body z axis) and position (eqs. 15-16), covariance."""
+        acc = self._imu
+        dt = acc.dt
+        v = self._speed()
+        rn, re = radii(self._lat)
+        v_ned = np.array([v * math.cos(self._yaw), v * math.sin(self._yaw), 0.0])
+        w_ie, w_en = frame_rates(self._lat, self._h, v_ned)
+        w_in_d = w_ie[2] + w_en[2]
+        yaw_old = self._yaw
+        self._yaw += acc.dtheta[2] - (self._bias + w_in_d) * dt
+        acc.reset()
+        yaw_mid = 0.5 * (yaw_old + self._yaw)
+        cy, sy = math.cos(yaw_mid), math.sin(yaw_mid)
+        self._lat += v * cy * dt / (rn + self._h)
+        self._lon += v * sy * dt / ((re + self._h) * math.cos(self._lat))
+        f = self._f
+        moving = 1.0 if self._u != 0.0 else 0.0
+        f[0, 2], f[1, 2] = cy * moving, sy * moving
+        f[0, 3], f[1, 3] = -v * sy, v * cy
+        self._kf.predict(np.eye(5) + f * dt, np.diag(self._q_c * dt))
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        """Eqs. 18-19: GPS north, east position and ground speed."""
+        fx = self._fix
+        if not (row[fx.fix] > 0 and math.isfinite(row[fx.lat])):
+            return
+        if self._imu.dt > 0.0:
+            self._step()
+        c = self.config
+        dz = _ned_offset(self._lat, self._lon, self._h, math.radians(row[fx.lat]),
+                         math.radians(row[fx.lon]), self._h)[:2]
+        h = np.eye(5)[:2]
+        var = [c["gps_horizontal_sigma"] ** 2] * 2
+        if self._u != 0.0 and math.isfinite(row[fx.speed]):
+            dz = np.r_[dz, abs(self._speed()) - row[fx.speed]]
+            h = np.eye(5)[:3]
+            var.append(c["gps_speed_sigma"] ** 2)
+        self._kf.update(dz, h, np.diag(var))
+        dx = self._kf.feedback()
+        rn, re = radii(self._lat)
+        self._lat -= dx[0] / (rn + self._h)
+        self._lon -= dx[1] / ((re + self._h) * math.cos(self._lat))
+        self._speed_error += dx[2]
+        self._yaw -= dx[3]
+        self._bias -= dx[4]
+
+    def solution(self, t: float) -> list[float]:
+        v = self._speed()
+        std = np.sqrt(np.diag(self._kf.p))
+        nan = math.nan
+        return [math.degrees(self._lat), math.degrees(self._lon), nan,
+                v * math.cos(self._yaw), v * math.sin(self._yaw), nan, nan, nan,
+                float(wrap_angle(self._yaw)), std[0], std[1], std[3], self._bias]

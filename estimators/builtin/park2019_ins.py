@@ -1,0 +1,99 @@
+"""``ins_odo_ekf``: the INS/GPS/odometer EKF with the non-holonomic constraint, the baseline of
+Park et al., "MEMS 3D DR/GPS Integrated System for Land Vehicle Application Robust to GPS
+Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
+
+* Mechanisation, eqs. 1-3: NED position, velocity and quaternion attitude with Earth rate,
+  transport rate and WGS-84 gravity (``toolbox.strapdown``; Park integrates trapezoidally, the
+  toolbox's two-sample form is the same to first order).
+* Error state, eq. 4: position, velocity, attitude errors, accelerometer and gyro biases, 15
+  states. The system matrix F_0 of eq. 5 is "described in [1]" (Titterton & Weston); here it is
+  ``toolbox.ins_error`` (the same NED error model; attitude error sign per ``nav_error``). Park
+  gives no bias model or Q: the biases are first-order Gauss-Markov (chosen: accelerometer
+  sigma 5 mg, gyro sigma 0.05 deg/s, both tau 600 s: the temperature drifts of Table 1 over a
+  few kelvin), the white noises are Table 1's RMS noise densities (0.19 mg/sqrt(Hz),
+  0.02 deg/s/sqrt(Hz)), the initial bias uncertainties Table 1's zero-point offsets (70 mg,
+  1 deg/s).
+* GPS, eqs. 6-8: position and NED velocity of the receiver's 3-D fixes (1-sigma 2.5 m
+  horizontal, 5 m vertical, 0.1 m/s horizontal and 0.2 m/s vertical velocity: chosen, Park
+  prints no R).
+* Odometer with NHC, eqs. 9-14: body velocity [v_odo, 0, 0] (1-sigma 0.1 m/s on each row,
+  chosen), "used sequentially after the GPS measurement update". Park does not say at what rate;
+  here at every odometer sample (10 Hz), so that it also aids during outages, which is the point
+  of the comparison in Park's Table 3. With ``nhc: false`` only the forward (odometer) row is
+  used. There is no odometer scale-factor state (the 15 states of eq. 4), as in the paper.
+
+The filter is closed loop (errors fed back after each update).
+
+Public classes
+--------------
+ParkInsOdometer.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from estimators.base import Estimator
+from estimators.toolbox import aiding
+from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
+
+G0 = 9.80665  # standard gravity, m/s^2 (datasheet mg)
+DEG = math.pi / 180.0
+
+
+class ParkInsOdometer(Estimator):
+    """15-state INS/GPS/odometer EKF with NHC (Park et al. 2019, eqs. 1-14)."""
+
+    name = "ins_odo_ekf"
+    needs = ("imu", "odometer", "gnss_fix")
+    paper = "Park et al. 2019 (IEEE Access), eqs. 1-14: INS/GPS/odometer EKF with NHC"
+    defaults = {"nhc": True}
+    output_columns = SOLUTION_COLUMNS
+
+    NOISE = InsNoise(accel_noise=0.19e-3 * G0, gyro_noise=0.02 * DEG,
+                     accel_bias_sigma=5e-3 * G0, gyro_bias_sigma=0.05 * DEG,
+                     accel_bias_tau=600.0, gyro_bias_tau=600.0)
+    P0_SIGMA = np.r_[[5.0, 5.0, 5.0], [0.5] * 3, [2 * DEG, 2 * DEG, 5 * DEG],
+                     [70e-3 * G0] * 3, [1.0 * DEG] * 3]
+    R_POSITION = np.diag([2.5, 2.5, 5.0]) ** 2  # m^2
+    R_VELOCITY = np.diag([0.1, 0.1, 0.2]) ** 2  # (m/s)^2
+    R_ODOMETER = 0.1**2  # (m/s)^2, each body axis
+
+    def setup(self) -> None:
+        imu_units = self.units["imu"]
+        self.ins = InsFilter(self.initial, self.columns["imu"],
+                             imu_units.get("gyro_x") == "rad", self.P0_SIGMA, self.NOISE)
+        c = self.columns["gnss_fix"]
+        self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
+        self._fix = c["fix"]
+        self._speed = self.columns["odometer"]["speed"]
+        n_rows = 3 if self.config["nhc"] else 1
+        self._r_odo = np.eye(n_rows) * self.R_ODOMETER
+        self._r_fix = np.zeros((6, 6))
+        self._r_fix[:3, :3], self._r_fix[3:, 3:] = self.R_POSITION, self.R_VELOCITY
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        self.ins.add_imu(t, row)
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        if row[self._fix] < 2 or not math.isfinite(row[self._fix_idx[0]]):
+            return
+        ins = self.ins
+        ins.flush()
+        values = row[self._fix_idx]
+        pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
+        dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos)
+        dz_v, h_v = aiding.gnss_velocity(ins.v, values[3:6])
+        ins.update(np.concatenate([dz_p, dz_v]), np.vstack([h_p, h_v]), self._r_fix)
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        ins = self.ins
+        ins.flush()
+        dz, h = aiding.odometer(ins.q, ins.v, float(row[self._speed]), self.config["nhc"])
+        ins.update(dz, h, self._r_odo)
+
+    def solution(self, t: float) -> list[float]:
+        self.ins.flush()
+        return self.ins.solution_row()

@@ -1,0 +1,175 @@
+"""``ins_lkf``: the linearised Kalman filter INS/GPS of Tan et al., "Land-vehicle MEMS INS/GPS
+positioning during GPS signal blockage periods", VNU J. Sci., Math.-Phys. 23 (2007/2008).
+
+What the paper gives and what is chosen here:
+
+* Linearised KF, eqs. 1-5: x' = F x + G u, Phi = I + F dt (eq. 3), Q_k = Phi G Q G^T Phi^T dt
+  (eq. 4), GPS position measurements with R = diag(sigma_lat^2, sigma_lon^2, sigma_h^2) (eq. 5).
+  The KF runs every 0.5 s on 64 Hz IMU increments and 1 Hz GPS (section 5). Here the
+  covariance is propagated at every batch of increments (at least 10 Hz, ``ins_filter``) with the
+  second-order Phi and trapezoidal Q_d of ``ins_error.discretise``, the finer form of eqs. 3-4;
+  the aiding updates of outages run every ``update_interval`` = 0.5 s.
+* State: the paper prints eight states (three velocity errors, three gyro drifts, two attitude
+  errors), but its GPS position measurement needs position errors and its heading aiding needs
+  a heading error. A consistent model is used instead: the 15-state NED error model of
+  ``toolbox.ins_error`` (position, velocity, three attitude errors, accelerometer and gyro
+  biases).
+* Closed loop while GPS aids, open loop during outages (section 5, "the closed loop KF is
+  utilized when the GPS signal is available and the open loop KF is applied when GPS is
+  outage"): an epoch without a fix opens the loop (``kalman.ErrorState.set_closed_loop``); the
+  next fix closes it and feeds the open-loop estimate back before its own update.
+* Velocity constraint, eqs. 6-7 (``nhc``): zero lateral and vertical body velocity. Eq. 6 prints
+  V_x^b = 0, which would stop the car: the lateral axis is y (V_y^b = 0, V_z^b = 0). 1-sigma
+  0.1 m/s (chosen). Used during outages only (section 5: "utilizes the vehicle motion
+  constraints and the magnetometer measurement during GPS outages").
+* Height constraint, section 3.2 (``height_constraint``): the height stays at the last
+  GPS-aided height through the outage, 1-sigma 2 m (the paper asks for "a realistic measurement
+  uncertainty" and prints none).
+* Heading aiding, section 4 and eq. 8 (``mag_heading``): a magnetometer heading during outages,
+  1-sigma 2 deg (chosen). The paper does not say how the magnetometer was calibrated or where
+  the declination came from: it is calibrated against GPS (``aiding.MagneticHeading``: the
+  Earth field in NED and the hard iron learnt from the GPS-aided attitude while driving, which
+  calibrates the declination in). Section 4 also names the GPS heading for in-motion alignment:
+  the GPS course is used as a heading measurement while GPS aids and the car moves faster than
+  ``course_speed`` (1-sigma 2 deg).
+* The 60 s standstill at the start ("in order to estimate the determined errors", section 5)
+  is used as it is known from the protocol: zero-velocity and zero-angular-rate updates during
+  the first ``standstill`` seconds.
+* Noise (Tan prints no Q): the BP3010's ADXRS300 gyro and ADXL210E accelerometer data-sheet
+  densities (0.1 deg/s/sqrt(Hz), 0.2 mg/sqrt(Hz)); the initial bias uncertainties are the
+  ``bp3010`` preset's (0.5 deg/s, 10 mg), in-run Gauss-Markov biases of 0.01 deg/s and 1 mg with
+  300 s correlation time (chosen).
+
+Public classes
+--------------
+TanLinearisedKF.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from estimators.base import Estimator
+from estimators.toolbox import aiding
+from estimators.toolbox.constraints import height, nonholonomic
+from estimators.toolbox.ins_error import N_STATES
+from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
+
+G0 = 9.80665  # standard gravity, m/s^2 (datasheet mg)
+DEG = math.pi / 180.0
+
+
+class TanLinearisedKF(Estimator):
+    """Linearised KF INS/GPS with outage constraints and magnetometer heading (Tan et al. 2008)."""
+
+    name = "ins_lkf"
+    needs = ("imu", "gnss_fix")
+    uses = ("mag",)
+    paper = ("Tan et al. 2008 (VNU J. Sci.): linearised KF INS/GPS, closed loop with GPS, open "
+             "loop with NHC, height and magnetometer aiding in outages")
+    defaults = {"nhc": True, "height_constraint": True, "mag_heading": True,
+                "update_interval": 0.5, "standstill": 60.0, "course_speed": 5.0}
+    output_columns = SOLUTION_COLUMNS
+
+    NOISE = InsNoise(accel_noise=0.2e-3 * G0, gyro_noise=0.1 * DEG,
+                     accel_bias_sigma=1e-3 * G0, gyro_bias_sigma=0.01 * DEG,
+                     accel_bias_tau=300.0, gyro_bias_tau=300.0)
+    P0_SIGMA = np.r_[[3.0, 3.0, 5.0], [0.3] * 3, [2 * DEG, 2 * DEG, 5 * DEG],
+                     [10e-3 * G0] * 3, [0.5 * DEG] * 3]
+    R_POSITION = np.diag([3.0, 3.0, 5.0]) ** 2  # m^2 (eq. 5)
+    R_NHC = np.eye(2) * 0.1**2  # (m/s)^2
+    R_HEIGHT = np.array([[2.0**2]])  # m^2
+    R_HEADING = np.array([[(2 * DEG) ** 2]])  # rad^2, magnetometer and GPS course
+    R_ZUPT = np.eye(3) * 0.01**2  # (m/s)^2
+    R_ZARU = np.eye(3) * (0.01 * DEG) ** 2  # (rad/s)^2 (mean over a batch)
+    MAG_SOLVE_INTERVAL = 10.0  # s between re-solving the magnetometer calibration
+
+    def setup(self) -> None:
+        units = self.units["imu"]
+        self.ins = InsFilter(self.initial, self.columns["imu"], units.get("gyro_x") == "rad",
+                             self.P0_SIGMA, self.NOISE)
+        c = self.columns["gnss_fix"]
+        self._fix_idx = [c["lat"], c["lon"], c["alt"]]
+        self._fix, self._speed, self._course = c["fix"], c["speed"], c["course"]
+        self._t0 = self.initial.t
+        self._next_cycle = self._t0 + self.config["update_interval"]
+        self._outage = False
+        self._h_ref = 0.0
+        self._mag = aiding.MagneticHeading()
+        self._mag_row: np.ndarray | None = None
+        self._mag_idx = ([self.columns["mag"][k] for k in ("mag_x", "mag_y", "mag_z")]
+                         if "mag" in self.columns else None)
+        self._moving_fix = False
+        self._next_solve = self._t0
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        self.ins.add_imu(t, row)
+        if t >= self._next_cycle:
+            self._next_cycle += self.config["update_interval"]
+            self._cycle(t)
+
+    def on_mag(self, t: float, row: np.ndarray) -> None:
+        self._mag_row = row
+
+    def _cycle(self, t: float) -> None:
+        """The periodic KF step (every ``update_interval``): standstill updates at the start,
+        outage aiding in open loop, magnetometer calibration while GPS aids."""
+        ins = self.ins
+        ins.flush()
+        cfg = self.config
+        if t - self._t0 < cfg["standstill"]:
+            ins.update(*aiding.zero_velocity(ins.v), self.R_ZUPT)
+            ins.update(*aiding.zero_rate(ins.q, ins.pos[0], ins.mean_rate), self.R_ZARU)
+            return
+        mag = self._magnetometer()
+        if not self._outage:
+            if mag is not None and self._moving_fix:
+                self._mag.learn(mag, ins.q)
+                if t >= self._next_solve:
+                    self._mag.solve()
+                    self._next_solve = t + self.MAG_SOLVE_INTERVAL
+            return
+        q = ins.corrected()[0]  # levels the magnetometer with the best roll and pitch
+        if cfg["nhc"]:
+            dz, h = nonholonomic(ins.q, ins.v, N_STATES)
+            ins.update(dz, h, self.R_NHC)
+        if cfg["height_constraint"]:
+            ins.update(*height(ins.pos[2], self._h_ref, N_STATES), self.R_HEIGHT)
+        if cfg["mag_heading"] and mag is not None:
+            yaw = self._mag.heading(mag, q)
+            if yaw is not None:
+                ins.update(*aiding.heading(ins.q, yaw), self.R_HEADING)
+
+    def _magnetometer(self) -> np.ndarray | None:
+        if self._mag_idx is None or self._mag_row is None:
+            return None
+        return self._mag_row[self._mag_idx]
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        ins = self.ins
+        valid = row[self._fix] >= 1 and math.isfinite(row[self._fix_idx[0]])
+        if not valid:
+            if not self._outage and t - self._t0 >= self.config["standstill"]:
+                ins.flush()
+                self._outage = True
+                self._h_ref = float(ins.pos[2])
+                ins.set_closed_loop(False)
+            self._moving_fix = False
+            return
+        ins.flush()
+        if self._outage:
+            self._outage = False
+            ins.set_closed_loop(True)
+        values = row[self._fix_idx]
+        pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
+        ins.update(*aiding.gnss_position(ins.q, ins.pos, pos), self.R_POSITION)
+        speed = float(row[self._speed])
+        self._moving_fix = speed > self.config["course_speed"]
+        if self._moving_fix and t - self._t0 >= self.config["standstill"]:
+            ins.update(*aiding.heading(ins.q, float(row[self._course])), self.R_HEADING)
+
+    def solution(self, t: float) -> list[float]:
+        self.ins.flush()
+        return self.ins.solution_row()

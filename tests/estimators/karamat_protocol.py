@@ -1,0 +1,87 @@
+"""The Karamat et al. 2015 partial-outage protocol on the shipped scenario, shortened: one site
+of four 60 s windows (3, 2, 1, 0 satellites) after 300 s of open sky, per seed; shared by the
+claim tests and by ``benchmarks/bench_estimators_karamat.py``."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from simulator.dataset.generate import generate_dataset
+from simulator.dataset.io import open_dataset
+from simulator.earth import radii_of_curvature
+from simulator.replay import run_estimator
+from simulator.scenario import Scenario, validate_data
+from simulator.scenario.yamlio import read_yaml
+
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "karamat2015_partial_outages.yaml"
+VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model": "simplified"}}
+
+
+def short_scenario(seed: int, segments: int = 30, end_s: float = 820.0) -> dict:
+    """The shipped scenario cut to its first ``segments`` segments and the windows ending by
+    ``end_s`` (the first site: 3, 2, 1, 0 satellites at 300, 450, 600, 750 s), no estimators."""
+    data, _ = read_yaml(SCENARIO)
+    data["trajectory"]["segments"] = data["trajectory"]["segments"][:segments]
+    data["faults"] = [f for f in data["faults"] if f["start"] + f["duration"] <= end_s]
+    data.pop("estimators")
+    data["seed"] = seed
+    return validate_data(data, str(SCENARIO))
+
+
+def generate(directory: Path, data: dict) -> Path:
+    return generate_dataset(Scenario(SCENARIO, data, []), directory, force=True,
+                            show_progress=False)
+
+
+def horizontal_error(solution: pd.DataFrame, truth: pd.DataFrame) -> np.ndarray:
+    lat = np.interp(solution["t"], truth["t"], truth["lat"])
+    lon = np.interp(solution["t"], truth["t"], truth["lon"])
+    rn, re = radii_of_curvature(np.radians(lat))
+    return np.hypot(np.radians(solution["lat"] - lat) * rn,
+                    np.radians(solution["lon"] - lon) * re * np.cos(np.radians(lat)))
+
+
+def true_gyro_bias_z(dataset_path: Path, t: np.ndarray, smooth_s: float = 20.0) -> np.ndarray:
+    """The true z-gyro bias at times ``t`` (rad/s): the reading minus the true rate scaled by
+    the drawn scale factor, averaged over ``smooth_s`` (the white noise removed), from the
+    dataset's truth and manifest (there is no truth_sensors stream yet)."""
+    ds = open_dataset(dataset_path)
+    imu, truth = ds.read("imu"), ds.read("truth")
+    sf = ds.manifest["sensors"]["imu"]["gyro"]["scale_factor"][2]
+    wz = np.interp(imu["t"], truth["t"], truth["wz"])
+    err = imu["gyro_z"].to_numpy() - (1.0 + sf) * wz
+    n = max(1, int(round(smooth_s / float(imu["t"].iloc[1] - imu["t"].iloc[0]))))
+    kernel = np.ones(n) / n
+    smooth = np.convolve(err, kernel, mode="same")
+    return np.interp(t, imu["t"], smooth)
+
+
+def run_protocol(directory: Path, seed: int) -> dict:
+    """Per variant: the maximum horizontal error of each window {satellites: m}, the gyro-bias
+    error at 300 s (deg/s) and the realtime factor."""
+    path = generate(directory / f"seed{seed}", short_scenario(seed))
+    ds = open_dataset(path)
+    truth, events = ds.read("truth"), ds.read("events")
+    windows = events[events["kind"] == "gnss_satellite_limit"]
+    out = {}
+    for label, config in VARIANTS.items():
+        solution, info = run_estimator(ds, {"name": "riss3d_tc_ekf", "label": label,
+                                            "init": None, "config": config},
+                                       show_progress=False)
+        t = solution["t"].to_numpy()
+        err = horizontal_error(solution, truth)
+        maxima = {}
+        for _, w in windows.iterrows():
+            inside = (t >= w["t_start"]) & (t <= w["t_end"])
+            count = int(json.loads(w["detail"])["count"])
+            maxima[count] = float(err[inside].max())
+        k = int(np.searchsorted(t, 300.0))
+        bias_err = float(np.degrees(solution["gyro_bias_z"].iloc[k]
+                                    - true_gyro_bias_z(path, t[k:k + 1])[0]))
+        out[label] = {"max": maxima, "bias_error_300s": bias_err,
+                      "realtime": info["realtime_factor"]}
+    return out

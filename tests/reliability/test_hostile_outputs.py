@@ -1,0 +1,214 @@
+"""Hostile and careless output paths on every writing command: existing files without
+``--force``, outputs inside the input dataset, file-system errors, concurrent writers, SIGTERM.
+Each ends with exit 2 (143/130 for signals), one message naming the path, no traceback, and a
+file system unchanged apart from what the user named."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from simulator.cli import main
+
+REPO = Path(__file__).resolve().parents[2]
+SCENARIO = """\
+name: t
+start: {lat: 37.5, lon: 127.0}
+trajectory:
+  kind: segments
+  segments:
+    - accelerate: {to_speed: 10, accel: 1.5}
+    - straight: {length: 200}
+sensors:
+  imu: {preset: ideal, rate: 50}
+  gnss: {rate: 1, outputs: [fix, raw]}
+"""
+
+
+def _tree(root: Path) -> dict[str, tuple[int, int]]:
+    """Every path under ``root`` with its size and modification time."""
+    out = {}
+    for path in sorted(root.rglob("*")):
+        stat = path.lstat()
+        out[str(path.relative_to(root))] = (stat.st_size, stat.st_mtime_ns)
+    return out
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory) -> Path:
+    root = tmp_path_factory.mktemp("hostile_out")
+    scenario = root / "s.yaml"
+    scenario.write_text(SCENARIO)
+    assert main(["generate", str(scenario), "-o", str(root / "ds")]) == 0
+    return root / "ds"
+
+
+@pytest.fixture
+def solution(dataset, tmp_path) -> Path:
+    path = tmp_path / "sol.parquet"
+    assert main(["estimate", str(dataset), "-e", "gnss_only", "-o", str(path)]) == 0
+    return path
+
+
+def _refused(args: list[str], capsys, watch: list[Path], words: str) -> str:
+    before = {str(w): _tree(w) for w in watch}
+    code = main(args)
+    out = capsys.readouterr()
+    text = out.err + out.out
+    assert code == 2, text
+    assert "Traceback" not in text
+    assert words in text, text
+    errors = [line for line in text.splitlines() if line.startswith("error:")]
+    assert len(errors) == 1, text
+    assert {str(w): _tree(w) for w in watch} == before
+    return text
+
+
+def test_estimate_refuses_to_overwrite(dataset, solution, capsys):
+    _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(solution)], capsys,
+             [solution.parent, dataset], "already exists; use --force")
+
+
+def test_estimate_never_writes_into_the_dataset(dataset, capsys):
+    for target in (dataset / "imu.parquet", dataset / "new.parquet"):
+        _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(target), "--force"],
+                 capsys, [dataset], "is inside the input")
+
+
+def test_export_nmea_never_overwrites_the_manifest(dataset, capsys):
+    _refused(["export", str(dataset), "--nmea", str(dataset / "manifest.json"), "--force"],
+             capsys, [dataset], "is inside the input")
+
+
+def test_score_json_refuses_to_overwrite(dataset, solution, tmp_path, capsys):
+    target = tmp_path / "scores.json"
+    target.write_text("{}")
+    _refused(["score", str(dataset), "--solution", str(solution), "--json", str(target)],
+             capsys, [tmp_path, dataset], "already exists; use --force")
+    assert main(["score", str(dataset), "--solution", str(solution), "--json", str(target),
+                 "--force"]) == 0
+    assert target.read_text() != "{}"
+
+
+def test_export_rinex_refuses_existing_files_and_writes_both_or_none(dataset, tmp_path, capsys):
+    out = tmp_path / "rinex"
+    out.mkdir()
+    (out / f"{dataset.name}.nav").write_text("mine")
+    _refused(["export", str(dataset), "--rinex", str(out)], capsys, [tmp_path, dataset],
+             "already exists")
+    assert sorted(p.name for p in out.iterdir()) == [f"{dataset.name}.nav"]
+
+
+@pytest.mark.parametrize("option", ["--json", "--nmea", "--rinex", "-o"])
+def test_output_is_a_folder_or_file_of_the_wrong_kind(dataset, solution, tmp_path, capsys,
+                                                      option):
+    folder = tmp_path / "a_folder"
+    folder.mkdir()
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    args = {
+        "--json": ["score", str(dataset), "--solution", str(solution), "--json", str(folder)],
+        "--nmea": ["export", str(dataset), "--nmea", str(folder)],
+        "--rinex": ["export", str(dataset), "--rinex", str(a_file)],
+        "-o": ["estimate", str(dataset), "-e", "gnss_only", "-o", str(a_file / "x.parquet")],
+    }[option]
+    _refused(args, capsys, [tmp_path, dataset], str(folder if option in ("--json", "--nmea")
+                                                       else a_file))
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root writes into read-only folders")
+def test_read_only_parent(dataset, tmp_path, capsys):
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o500)
+    try:
+        _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(locked / "s.parquet")],
+                 capsys, [tmp_path], "cannot write here")
+    finally:
+        locked.chmod(0o700)
+
+
+def test_dangling_symlink_as_output(dataset, tmp_path, capsys):
+    link = tmp_path / "dangling.parquet"
+    link.symlink_to(tmp_path / "nowhere" / "x.parquet")
+    _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(link)], capsys,
+             [tmp_path], "dangling symbolic link")
+
+
+def test_generate_under_an_existing_file(tmp_path, capsys):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO)
+    (tmp_path / "f").write_text("x")
+    _refused(["generate", str(scenario), "-o", str(tmp_path / "f" / "ds")], capsys, [tmp_path],
+             "is a file, not a folder")
+
+
+def test_a_claimed_folder_is_refused_and_a_stale_claim_taken_over(tmp_path, capsys):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO)
+    claim = tmp_path / ".ds.tmp"
+    claim.mkdir()
+    (claim / ".landnav-owner").write_text(str(os.getpid()))  # a live process holds it
+    _refused(["generate", str(scenario), "-o", str(tmp_path / "ds")], capsys, [tmp_path],
+             f"process {os.getpid()}")
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                          capture_output=True, text=True).stdout.strip()
+    (claim / ".landnav-owner").write_text(dead)  # its writer was killed
+    assert main(["generate", str(scenario), "-o", str(tmp_path / "ds")]) == 0
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds", "s.yaml"]
+
+
+def _landnav(args: list[str], cwd: Path) -> subprocess.Popen:
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    # as from a terminal: a shell without job control starts background jobs with SIGINT
+    # ignored, and Python keeps an ignored SIGINT ignored
+    return subprocess.Popen([sys.executable, "-m", "simulator.cli", *args], cwd=cwd, env=env,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+
+
+LONG = SCENARIO.replace("straight: {length: 200}", "straight: {duration: 1800}").replace(
+    "rate: 50}", "rate: 100}")
+
+
+def test_two_concurrent_generations_into_one_folder(tmp_path):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(LONG)
+    procs = [_landnav(["generate", str(scenario), "-o", "ds", "--seed", str(seed)], tmp_path)
+             for seed in (1, 2)]
+    results = [(p.wait(timeout=300), *p.communicate()) for p in procs]
+    codes = sorted(r[0] for r in results)
+    assert codes == [0, 2], results
+    loser = next(r for r in results if r[0] == 2)
+    assert "Traceback" not in loser[2] and "ds" in loser[2]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds", "s.yaml"]
+    assert main(["estimate", str(tmp_path / "ds"), "-e", "gnss_only", "-o",
+                 str(tmp_path / "sol.parquet")]) == 0  # the survivor is complete and readable
+
+
+@pytest.mark.parametrize("sig, code", [(signal.SIGTERM, 143), (signal.SIGINT, 130)])
+@pytest.mark.parametrize("command", ["generate", "run"])
+def test_signal_during_generation_leaves_nothing(tmp_path, sig, code, command):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(LONG)
+    proc = _landnav([command, str(scenario), "-o", "out"], tmp_path)
+    deadline = time.monotonic() + 60
+    while not any(p.name.startswith(".out") for p in tmp_path.iterdir()):
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.02)
+    proc.send_signal(sig)
+    start = time.monotonic()
+    rc = proc.wait(timeout=30)
+    _, err = proc.communicate()
+    assert time.monotonic() - start < 5
+    assert rc == code, err
+    assert "Traceback" not in err and ("terminated" in err or "interrupted" in err)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
+    rerun = _landnav([command, str(scenario), "-o", "out"], tmp_path)
+    assert rerun.wait(timeout=300) == 0, rerun.communicate()
