@@ -80,3 +80,14 @@ def test_help_points_to_docs_not_to_spec(capsys, command):
     assert "SPEC" not in text
     if command in (None, "score", "generate", "estimate"):
         assert "docs/" in text
+
+
+def test_faults_page_lists_every_kind_and_readme_shows_the_garage_plots():
+    from simulator.faults.base import FAULT_REGISTRY
+
+    faults = (REPO / "docs" / "faults.md").read_text(encoding="utf-8")
+    assert all(f"| `{kind}` | {fk.doc} |" in faults for kind, fk in FAULT_REGISTRY.items())
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    for png in ("parking_garage_altitude.png", "parking_garage_outage_zoom.png"):
+        assert f"(docs/images/{png})" in readme and (REPO / "docs" / "images" / png).is_file()
+    assert "SPEC" not in readme
