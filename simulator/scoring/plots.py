@@ -6,7 +6,9 @@ limits, multipath, canyon zones) of the events table.
 * ``map``: the truth and every solution on a local map (east, north in m about the first truth
   point), the outages drawn over the truth;
 * ``map_windows``: one panel per outage or degraded window (at most ``MAX_WINDOW_PANELS``, the
-  longest), zoomed on the truth during the window and 10 s either side, so metre errors show;
+  longest): the truth during the window and 10 s either side, or, where that path is over
+  ``ZOOM_RATIO`` times the largest error in the window, a zoom on the window's end, so that
+  metre errors show;
 * ``position_errors``: north, east and down errors against time, with the solution's +-3 sigma
   (``std_n, std_e, std_d``) as a band where it has them;
 * ``attitude_errors``: roll, pitch and yaw errors (deg), +-3 sigma where ``std_roll...`` exist;
@@ -42,6 +44,10 @@ from simulator.scoring.evaluate import Evaluation
 from simulator.scoring.metrics import NEES_DOF, OUTAGE_KIND, degraded_windows
 
 MAX_WINDOW_PANELS = 6  # zoomed map panels, the longest windows first
+NEES_FLOOR = 1e-2  # lower end of the NEES plot's axis
+# a window's panel shows its whole path unless that is over ZOOM_RATIO times the largest error
+# in it; then it zooms on the window's end (+-3 times that error, at least 10 m)
+ZOOM_RATIO = 20.0
 _OUTAGE_COLOUR, _DEGRADED_COLOUR = "tab:red", "tab:orange"
 _DPI = 110
 _NEES_BOUNDS = chi2.ppf([0.025, 0.975], NEES_DOF)  # two-sided 95 % bounds of one epoch's NEES
@@ -133,15 +139,38 @@ def plot_map_windows(ev: Evaluation, path: Path) -> None:
                 _, sol = _gaps(st[rows_in], local_ned(r.solution.loc[rows_in], origin))
                 ax.plot(sol[:, 1], sol[:, 0], lw=1.0, marker=".", ms=2, label=label)
         east, north = truth_ned[span, 1], truth_ned[span, 0]
-        margin = 10.0 + 0.1 * max(np.ptp(east), np.ptp(north))
-        ax.set_xlim(east.min() - margin, east.max() + margin)
-        ax.set_ylim(north.min() - margin, north.max() + margin)
+        extent = max(np.ptp(east), np.ptp(north))
+        worst = _worst_error(ev, a, b)
+        title = f"{kind} {a:.0f}-{b:.0f} s"
+        if extent > ZOOM_RATIO * max(worst, 1.0):  # the errors would not show: zoom on the end
+            half = max(10.0, 3.0 * worst)
+            centre = [np.interp(b, truth_t, truth_ned[:, i]) for i in (1, 0)]
+            ax.set_xlim(centre[0] - half, centre[0] + half)
+            ax.set_ylim(centre[1] - half, centre[1] + half)
+            title += ", its end"
+        else:  # a square around the window's path
+            half = 0.5 * extent + 10.0 + 0.1 * extent
+            mid_e, mid_n = 0.5 * (east.min() + east.max()), 0.5 * (north.min() + north.max())
+            ax.set_xlim(mid_e - half, mid_e + half)
+            ax.set_ylim(mid_n - half, mid_n + half)
         ax.set_aspect("equal", adjustable="box")
-        ax.set(xlabel="east (m)", ylabel="north (m)", title=f"{kind} {a:.0f}-{b:.0f} s")
+        ax.set(xlabel="east (m)", ylabel="north (m)", title=title)
         ax.legend(loc="best", fontsize="x-small")
     for ax in axes[n:]:
         ax.set_visible(False)
     _save(fig, path)
+
+
+def _worst_error(ev: Evaluation, a: float, b: float) -> float:
+    """The largest horizontal error of any solution in [a, b) (0 without rows)."""
+    worst = 0.0
+    for r in ev.results.values():
+        e = r.errors.errors
+        h = e[ERR_H].to_numpy(float)[(e["t"] >= a) & (e["t"] < b)]
+        h = h[np.isfinite(h)]
+        if h.size:
+            worst = max(worst, float(h.max()))
+    return worst
 
 
 def _error_panels(ev: Evaluation, path: Path, names: tuple[str, ...], stds: tuple[str, ...],
@@ -186,7 +215,7 @@ def has_std(ev: Evaluation) -> bool:
 
 
 def plot_nees(ev: Evaluation, path: Path) -> None:
-    fig = Figure(figsize=(9, 4.5), layout="constrained")
+    fig = Figure(figsize=(10, 4.5), layout="constrained")
     ax = fig.add_subplot()
     _shade(ax, ev)
     for label, r in ev.results.items():
@@ -201,10 +230,12 @@ def plot_nees(ev: Evaluation, path: Path) -> None:
     for bound in _NEES_BOUNDS:
         ax.axhline(bound, color="black", ls="--", lw=1.0)
     ax.set_yscale("log")
+    # an estimator started from the truth has NEES near 0 at first: the axis starts at 1e-2
+    ax.set_ylim(bottom=NEES_FLOOR)
     ax.set(xlabel="t (s)", ylabel="NEES",
            title=f"NEES per epoch; dashed: 95 % chi-square bounds, {NEES_DOF} dof "
                  f"({_NEES_BOUNDS[0]:.3g}, {_NEES_BOUNDS[1]:.3g})")
-    ax.legend(loc="upper left", fontsize="x-small", ncol=2)
+    fig.legend(loc="outside right upper", fontsize="x-small")
     _save(fig, path)
 
 
