@@ -183,10 +183,16 @@ def _cell(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
 
 
-def _table(fields: dict[str, Field]) -> list[str]:
+def _table(fields: dict[str, Field], path: str = "") -> list[str]:
+    """A table of ``fields``; a key whose value has its own section and no doc points to it."""
+    sections = dict(_children(path, fields))
     lines = ["| key | type | default | description |", "|---|---|---|---|"]
-    lines += [f"| `{k}` | {_cell(_type(f))} | {_default(f)} | {_cell(f.doc)} |"
-              for k, f in fields.items()]
+    for key, field in fields.items():
+        doc = field.doc
+        if not doc:
+            below = next((p for p in sections if p.split(".")[-1].startswith(key)), None)
+            doc = f"see `{below}` below" if below else ""
+        lines.append(f"| `{key}` | {_cell(_type(field))} | {_default(field)} | {_cell(doc)} |")
     return lines
 
 
@@ -211,7 +217,7 @@ def _section(path: str, field: Field, level: int) -> list[str]:
         lines += [f"{head} `{path}`", ""]
         if field.doc:
             lines += [field.doc, ""]
-        lines += [*_table(field.fields), ""]
+        lines += [*_table(field.fields, path), ""]
         for child, sub in _children(path, field.fields):
             lines += _section(child, sub, level + 1)
     elif isinstance(field, (OneKey, Tagged)):
@@ -235,7 +241,8 @@ def _section(path: str, field: Field, level: int) -> list[str]:
             lines += [f"{'#' * min(level + 1, 5)} {what} `{kind}`", ""]
             if record.doc:
                 lines += [record.doc, ""]
-            lines += [*_table(own), ""] if own else ["(no keys of its own)", ""]
+            lines += [*_table(own, f"{path}.{kind}"), ""] if own else ["(no keys of its own)",
+                                                                     ""]
             for child, sub in _children(f"{path}.{kind}", own):
                 lines += _section(child, sub, level + 2)
     return lines
@@ -259,12 +266,16 @@ def _preset_lines() -> list[str]:
     for sensor, (presets, module) in SENSOR_PRESETS.items():
         lines += [f"### {sensor}", "", "| preset | parameters |", "|---|---|"]
         for name, values in presets.items():
-            text = ", ".join(f"{k}={_value(v)}" for k, v in values.items()) or "(all errors off)"
-            lines.append(f"| `{name}` | {_cell(text)} |")
+            lines.append(f"| `{name}` | {_cell(_parameters(values))} |")
         sources = _sources(module)
         lines += ["", f"Sources ({module.__name__}):", "", "```", sources, "```", ""] \
             if sources else [""]
     return lines
+
+
+def _parameters(values: dict) -> str:
+    """A preset's parameters as ``key=value, ...``."""
+    return ", ".join(f"{k}={_value(v)}" for k, v in values.items()) or "(all errors off)"
 
 
 def _value(v: Any) -> str:
@@ -286,7 +297,7 @@ def reference_markdown() -> str:
              "any dimensional value may be a string with its unit (`\"0.02 deg/s/sqrt(Hz)\"`, "
              "`\"70 mg\"`, `\"2 %\"`). `–` as default: optional, absent unless given. "
              "`landnav schema` prints the same tree as a JSON Schema.", "",
-             "## Top level", "", *_table(SCENARIO_FIELD.fields), ""]
+             "## Top level", "", *_table(SCENARIO_FIELD.fields, ""), ""]
     for child, sub in _children("", SCENARIO_FIELD.fields):
         lines += _section(child, sub, 2)
     lines += _preset_lines()
@@ -298,8 +309,7 @@ def presets_text() -> str:
     lines = []
     for sensor, (presets, _) in SENSOR_PRESETS.items():
         for name, values in presets.items():
-            text = ", ".join(f"{k}={_value(v)}" for k, v in values.items()) or "(all errors off)"
-            lines.append(f"{sensor:9s} {name:20s} {text}")
+            lines.append(f"{sensor:9s} {name:20s} {_parameters(values)}")
     return "\n".join(lines)
 
 

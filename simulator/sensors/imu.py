@@ -137,8 +137,8 @@ _LEVER_ARM_STEP_S = 1e-3  # central-difference step for the angular acceleration
 class AxisNumber(Field):
     """One number for all three axes, or a list of three (x, y, z), in ``unit``."""
 
-    def __init__(self, unit: str, default: Any = None, **limits: float):
-        super().__init__(default)
+    def __init__(self, unit: str, default: Any = None, doc: str = "", **limits: float):
+        super().__init__(default, doc)
         self.number = Number(unit, **limits)
         self.vector = Vector(3, self.number)
 
@@ -153,8 +153,8 @@ class DrawnOrFixed(Field):
     as ``{fixed: value}``, the true value itself (one number or three, any sign), for a paper's
     situation that fixes it (Cho & Choi 2006, eq. 36: scale factors 0.2, 0.1, -0.1)."""
 
-    def __init__(self, unit: str):
-        super().__init__(None)
+    def __init__(self, unit: str, doc: str = ""):
+        super().__init__(None, doc)
         self.sigma = AxisNumber(unit, min=0)
         self.fixed = Record({"fixed": AxisNumber(unit)})
 
@@ -175,24 +175,33 @@ def _constant(value: float | list[float] | dict | None, rng: np.random.Generator
 
 def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Field]:
     fields: dict[str, Field] = {
-        "bias": DrawnOrFixed(unit),
-        "bias_instability": AxisNumber(unit, min=0),
-        "bias_correlation_time": Number("s", None, gt=0),
-        "gauss_markov_sigma": AxisNumber(unit, min=0),
-        "gauss_markov_correlation_time": AxisNumber("s", min=0),
-        "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
-        "random_walk": AxisNumber(random_walk_unit, min=0),
-        "ramp": AxisNumber(f"{unit}/s", min=0),
-        "scale_factor": DrawnOrFixed(""),
-        "misalignment": AxisNumber("rad", min=0),
-        "range": AxisNumber(unit, gt=0),
-        "resolution": AxisNumber(unit, min=0),
-        "temperature_coefficient": AxisNumber(f"{unit}/K", min=0),
-        "scale_factor_temperature_coefficient": AxisNumber("1/K", min=0),
-        "bandwidth": AxisNumber("Hz", gt=0),
+        "bias": DrawnOrFixed(unit, doc="turn-on bias, 1-sigma, drawn once per run"),
+        "bias_instability": AxisNumber(unit, min=0, doc="bias instability B (Allan floor "
+                                                        "0.664 B), IEEE Std 952"),
+        "bias_correlation_time": Number("s", None, gt=0, doc="with it, the instability is a "
+                                        "Gauss-Markov bias; without, a flicker bias"),
+        "gauss_markov_sigma": AxisNumber(unit, min=0, doc="stationary std of an extra "
+                                                          "Gauss-Markov bias"),
+        "gauss_markov_correlation_time": AxisNumber("s", min=0,
+                                                    doc="its correlation time"),
+        "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0,
+                                    doc="white noise density (angle / velocity random walk)"),
+        "random_walk": AxisNumber(random_walk_unit, min=0, doc="bias random walk density"),
+        "ramp": AxisNumber(f"{unit}/s", min=0, doc="rate ramp, drawn sign"),
+        "scale_factor": DrawnOrFixed("", doc="scale-factor error, 1-sigma, drawn once"),
+        "misalignment": AxisNumber("rad", min=0, doc="axis misalignment / cross-coupling, "
+                                                     "1-sigma"),
+        "range": AxisNumber(unit, gt=0, doc="saturation limit"),
+        "resolution": AxisNumber(unit, min=0, doc="quantisation step"),
+        "temperature_coefficient": AxisNumber(f"{unit}/K", min=0,
+                                              doc="bias change per kelvin, 1-sigma"),
+        "scale_factor_temperature_coefficient": AxisNumber(
+            "1/K", min=0, doc="scale-factor change per kelvin, 1-sigma"),
+        "bandwidth": AxisNumber("Hz", gt=0, doc="first-order low-pass cut-off"),
     }
     if gyro:
-        fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0)
+        fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0,
+                                         doc="gyro bias per specific force, 1-sigma")
     return fields
 
 
@@ -240,7 +249,8 @@ IMU_FIELD = Record(
         "preset": Text("ideal", doc="named parameter set; 'ideal' turns every error off"),
         "rate": Number("Hz", None, gt=0, max=10000, doc="sample rate (default: the preset's, "
                                                         "else 100 Hz)"),
-        "output": Text(None, choices=["rate", "increment"]),
+        "output": Text(None, choices=["rate", "increment"],
+                       doc="rates (rad/s, m/s^2) or increments over each sample (rad, m/s)"),
         "axes": Either(Text(choices=list(REDUCED_UNITS)),
                        ListOf(Text(choices=list(col.IMU_AXES)), min_len=1), default="full",
                        doc="channels of the unit, or a reduced unit: " + ", ".join(REDUCED_UNITS)),

@@ -49,7 +49,7 @@ ODOMETER_PRESETS: dict[str, dict] = {
 }
 
 _FIELDS = {
-    "rate": Number("Hz", None, gt=0, max=1000),
+    "rate": Number("Hz", None, gt=0, max=1000, doc="sample rate"),
     "scale_factor": Number("", None, gt=0, doc="measured / true distance at t = 0"),
     "scale_drift": Number("1/sqrt(s)", None, min=0,
                           doc="random-walk density of the scale factor"),

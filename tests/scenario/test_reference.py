@@ -23,6 +23,8 @@ def test_committed_reference_is_the_generated_one():
     assert committed == reference_markdown(), (
         "docs/scenario-reference.md drifted from the schema: regenerate it with "
         "`python -m simulator.scenario.reference > docs/scenario-reference.md`")
+    undocumented = [line for line in committed.splitlines() if line.endswith("|  |")]
+    assert undocumented == [], "keys without a doc= string in the schema"
 
 
 def _yaml(path: Path) -> dict:
