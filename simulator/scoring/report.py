@@ -50,7 +50,7 @@ _TABLE_ROWS = [
 _TEXT_COLUMNS = [
     ("horizontal", "rms", "h_rms"), ("horizontal", "cep95", "h_cep95"),
     ("horizontal", "max", "h_max"), ("vertical", "rms", "v_rms"), ("velocity", "rms", "vel_rms"),
-    ("attitude", "yaw_rms", "yaw_rms"),
+    ("attitude", "yaw_rms", "yaw_rms"), ("coverage", "fraction", "coverage"),
 ]
 
 
