@@ -299,17 +299,23 @@ def solution_problems(frame: pd.DataFrame) -> list[str]:
     return []
 
 
+USES_GNSS_KEY = "landnav.uses_gnss"  # Parquet schema metadata of a solution: "true" / "false"
+
+
 def write_solution(frame: pd.DataFrame, path: str | Path, force: bool = False,
-                   inputs: Iterable[Path | str] = ()) -> None:
-    """Write a solution table as Parquet (SPEC section 7), atomically; extra columns get unit
-    "". An existing file is replaced only with ``force``; a path inside one of ``inputs`` (the
-    dataset read) is refused."""
+                   inputs: Iterable[Path | str] = (), uses_gnss: bool | None = None) -> None:
+    """Write a solution table as Parquet (docs/solution-format.md), atomically; extra columns
+    get unit "". An existing file is replaced only with ``force``; a path inside one of
+    ``inputs`` (the dataset read) is refused. ``uses_gnss`` (whether the estimator had GNSS) is
+    kept in the schema metadata, so that scoring the file later leaves out the outage scores of
+    an estimator without GNSS, as scoring the run did."""
     problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
-    units = {**col.SOLUTION, **col.SOLUTION_STD}
+    units = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
+    metadata = None if uses_gnss is None else {USES_GNSS_KEY: "true" if uses_gnss else "false"}
     with atomic_output_file(path, force, inputs) as tmp:
-        write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns})
+        write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns}, metadata)
 
 
 def read_solution(path: str | Path) -> pd.DataFrame:

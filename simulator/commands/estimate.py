@@ -77,7 +77,8 @@ def run(args: argparse.Namespace) -> int:
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
     solution, info = run_estimator(dataset, entry, show_progress=sys.stderr.isatty())
-    write_solution(solution, args.output, args.force, [dataset.path])
+    write_solution(solution, args.output, args.force, [dataset.path],
+                   uses_gnss=info["uses_gnss"])
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
           f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")
     return 0

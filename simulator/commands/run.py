@@ -54,7 +54,8 @@ def run(args: argparse.Namespace) -> int:
             if Path(label).name != label or label.startswith("."):
                 raise InputError([Problem(str(scenario.path), None, f"estimators.{i}.label",
                                           f"{label!r} cannot name a file; give a plain label")])
-            write_solution(frame, tmp / "solutions" / f"{label}.parquet")
+            write_solution(frame, tmp / "solutions" / f"{label}.parquet",
+                           uses_gnss=info["uses_gnss"])
             solutions[label] = (frame, info)
         ev = score_solutions(dataset, solutions)
         write_scores(ev.scores(), tmp / "scores.json")

@@ -46,19 +46,19 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def _from_files(paths: list[str], dataset: Dataset, truth: pd.DataFrame
-                ) -> dict[str, tuple[pd.DataFrame, None]]:
+                ) -> dict[str, tuple[pd.DataFrame, dict]]:
     gps = dataset.manifest.get("gps_time_start") or {"week": 0, "tow": 0.0}
-    out: dict[str, tuple[pd.DataFrame, None]] = {}
+    out: dict[str, tuple[pd.DataFrame, dict]] = {}
     for path in paths:
         label = Path(path).stem
         if label in out:
             raise InputError([Problem(path, None, "", f"another solution file is also labelled "
                                       f"{label!r} (labels are file stems); rename one")])
-        frame, notes = read_solution_file(path, (gps["week"], gps["tow"]))
+        frame, notes, uses_gnss = read_solution_file(path, (gps["week"], gps["tow"]))
         check_solution(path, frame, truth)
         for note in notes:
             print(f"note: {note}", file=sys.stderr)
-        out[label] = (frame, None)
+        out[label] = (frame, {"uses_gnss": uses_gnss})
     return out
 
 

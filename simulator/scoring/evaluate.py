@@ -76,7 +76,8 @@ def score_solutions(dataset: Dataset,
         ``gnss_fix`` are used when present).
     solutions : label -> (solution table, info or None). ``info`` of an estimator run inside
         landnav (``simulator.replay.run_estimator``) gives ``runtime_s``, ``realtime_factor``
-        and ``uses_gnss``; a solution file (None) is taken to use GNSS, so its outages are
+        and ``uses_gnss``; a solution file gives ``{"uses_gnss": ...}`` as its reader found
+        (``simulator.scoring.readers``), and None is taken to use GNSS, so its outages are
         scored.
     """
     truth = dataset.read("truth")
@@ -89,8 +90,10 @@ def score_solutions(dataset: Dataset,
     results = {}
     for label, (frame, info) in solutions.items():
         errors = solution_errors(truth, frame, truth_sensors)
-        scores = score_errors(errors, truth, events, info,
-                              uses_gnss=(info or {}).get("uses_gnss", True),
+        info = info or {}
+        runtime = info if "runtime_s" in info else None
+        scores = score_errors(errors, truth, events, runtime,
+                              uses_gnss=info.get("uses_gnss", True),
                               canyon_zones=canyons, gnss_fix=gnss_fix)
         results[label] = Scored(label, frame, errors, scores)
     return Evaluation(truth, events, results, canyons, dataset)

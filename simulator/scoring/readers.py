@@ -47,7 +47,7 @@ import pandas as pd
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic
 from simulator.errors import InputError, Problem
-from simulator.replay import solution_problems
+from simulator.replay import USES_GNSS_KEY, solution_problems
 from simulator.scoring.align import solution_errors
 from simulator.timebase import GPS_EPOCH, SECONDS_PER_WEEK, leap_seconds
 
@@ -90,11 +90,12 @@ def _honour_units(frame: pd.DataFrame, units: dict[str, str], path: Path) -> lis
     return notes
 
 
-def _parquet(path: Path) -> tuple[pd.DataFrame, list[str]]:
-    from simulator.dataset.parquet import read_table, read_units
+def _parquet(path: Path) -> tuple[pd.DataFrame, list[str], bool]:
+    from simulator.dataset.parquet import read_metadata, read_table, read_units
 
     frame = read_table(path)
-    return frame, _honour_units(frame, read_units(path), path)
+    uses_gnss = read_metadata(path).get(USES_GNSS_KEY, "true") != "false"
+    return frame, _honour_units(frame, read_units(path), path), uses_gnss
 
 
 def _csv(path: Path) -> pd.DataFrame:
@@ -215,7 +216,7 @@ def _kind(path: Path) -> str:
 
 
 def read_solution_file(path: str | Path, gps_start: tuple[int, float]
-                       ) -> tuple[pd.DataFrame, list[str]]:
+                       ) -> tuple[pd.DataFrame, list[str], bool]:
     """Read a solution in any supported format (module docstring).
 
     Parameters
@@ -227,6 +228,8 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
     -------
     frame : the solution table, SPEC section 7 columns, t increasing.
     notes : lines telling what was converted (units, format), for the user.
+    uses_gnss : False only for a Parquet file landnav wrote for an estimator without GNSS
+        (schema metadata ``landnav.uses_gnss``); any other solution is taken to use GNSS.
 
     Raises
     ------
@@ -239,8 +242,9 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
         raise _problem(path, "no such solution file")
     kind = _kind(path)
     notes: list[str] = []
+    uses_gnss = True
     if kind == "parquet":
-        frame, notes = _parquet(path)
+        frame, notes, uses_gnss = _parquet(path)
     elif kind == "csv":
         frame = _csv(path)
     elif kind == "pos":
@@ -250,7 +254,7 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
     problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
-    return frame, notes
+    return frame, notes, uses_gnss
 
 
 def _cause(frame: pd.DataFrame, truth: pd.DataFrame) -> str:

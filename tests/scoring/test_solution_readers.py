@@ -39,7 +39,8 @@ def _score(ds, tmp_path: Path, *files: Path, extra: tuple[str, ...] = ()) -> dic
 
 
 def test_one_solution_in_five_formats_scores_the_same(quickstart, tmp_path, capsys):
-    frame, _ = read_solution_file(DATA / "quickstart_llh_gpst.pos", _gps(quickstart))
+    frame, _, uses_gnss = read_solution_file(DATA / "quickstart_llh_gpst.pos", _gps(quickstart))
+    assert uses_gnss
     write_solution(frame, tmp_path / "as_parquet.parquet")
     frame.to_csv(tmp_path / "as_csv.csv", index=False)
     files = [DATA / "quickstart_llh_gpst.pos", DATA / "quickstart_xyz_utc.pos",
