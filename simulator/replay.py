@@ -191,7 +191,8 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
 
 def _units(dataset: Dataset, name: str) -> dict[str, str]:
     """Column units of a stream; an IMU configured for increment output has rad and m/s
-    increments whatever its files say (the manifest's resolved scenario is authoritative)."""
+    increments whatever its files say (the manifest's resolved scenario is authoritative):
+    datasets written before the writer labelled increments say rad/s and m/s^2 there."""
     units = dataset.units(name)
     imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
     if name == "imu" and imu.get("output") == "increment":
