@@ -27,7 +27,9 @@ from simulator.scoring.report import PLOTS, format_number, markdown_table
 # (column, title) of the summary table and of the plots, in order
 _TABLE = [("horizontal.rms", "horizontal RMS (m)"), ("horizontal.cep95", "horizontal CEP95 (m)"),
           ("vertical.rms", "vertical RMS (m)"), ("attitude.yaw_rms", "yaw RMS (deg)"),
-          ("outages.end_horizontal", "outage end error (m)"), ("runtime.seconds", "runtime (s)")]
+          ("outages.end_horizontal", "outage end error (m)"),
+          ("degraded.end_horizontal", "degraded-window end error (m)"),
+          ("coverage.fraction", "coverage"), ("runtime.seconds", "runtime (s)")]
 _PLOTTED = [("horizontal.rms", "horizontal RMS (m)", "horizontal_rms"),
             ("outages.end_horizontal", "horizontal error at the end of GNSS outages (m)",
              "outage_end")]
@@ -114,7 +116,8 @@ def write_campaign_report(directory: Path, runs: pd.DataFrame, summary: dict) ->
              f"estimator(s){sweep}: {ok} result(s) ok, {len(runs) - ok} failed.", "",
              "## Summary", "",
              "Each cell is mean / median / p95 over the runs that succeeded; metres, degrees, "
-             "seconds. Outage scores are each run's mean over its GNSS outages.", "",
+             "seconds. Outage (degraded-window) scores are each run's mean over its GNSS outages "
+             "(degraded windows); a solution without GNSS has none.", "",
              *_summary_lines(summary), "", "## Failed runs", "", *_failure_lines(runs, keys), ""]
     for column, title, name in _PLOTTED:
         if _has(summary, column):
