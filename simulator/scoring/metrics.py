@@ -19,8 +19,9 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   the solution rows with t_start <= t < t_end (the epoch at t_end already has GNSS again):
   ``start`` (s), ``duration`` (s), ``distance`` (m travelled by the truth), ``max_horizontal``,
   ``end_horizontal`` (the error of the last scored row before t_end) and ``end_percent``
-  (end_horizontal as a percentage of distance; ``None`` for a stationary outage). An outage in
-  which the solution has no row gets ``None`` entries (never left out);
+  (end_horizontal as a percentage of distance; ``None`` for a stationary outage) and
+  ``coverage`` (the share of the outage within 1.5 output periods of a row). An outage in
+  which the solution has no row gets ``None`` entries and coverage 0 (never left out);
 * ``degraded`` (like ``outages``): one entry per window where GNSS is limited but not gone,
   the events of kinds ``gnss_satellite_limit`` and ``gnss_multipath`` and the zones whose sky
   is ``canyon``, with ``kind`` (the event kind, or ``canyon``) and ``satellites`` (the median
@@ -112,36 +113,53 @@ def _horizontal(h: np.ndarray) -> dict:
             "cep50": _number(cep50), "cep95": _number(cep95)}
 
 
+def _reach(t_valid: np.ndarray) -> float:
+    """How far either side of its time a row covers: 1.5 output periods (median spacing)."""
+    return COVERAGE_PERIODS * float(np.median(np.diff(t_valid))) if t_valid.size > 1 else 0.0
+
+
+def _covered(t_valid: np.ndarray, reach: float, a: float, b: float) -> float:
+    """Length of [a, b] within ``reach`` of a row: the union of the rows' intervals
+    [t - reach, t + reach] clipped to [a, b] (starts and ends both increase, so each interval
+    adds what it reaches beyond the next one's start)."""
+    starts = np.clip(t_valid - reach, a, b)
+    ends = np.clip(t_valid + reach, a, b)
+    if not starts.size:
+        return 0.0
+    nxt = np.append(starts[1:], np.inf)
+    return float(np.maximum(np.minimum(ends, nxt) - starts, 0.0).sum())
+
+
 def _coverage(t_valid: np.ndarray, t_end: float) -> dict:
     """``coverage`` (module docstring) of the times of the rows with a finite position."""
     if t_valid.size == 0:
         return {"fraction": 0.0, "longest_gap": None}
     span = t_end - t_valid[0]
-    gaps = np.append(np.diff(t_valid), max(t_end - t_valid[-1], 0.0))
-    longest = float(gaps.max())
+    longest = float(np.append(np.diff(t_valid), max(t_end - t_valid[-1], 0.0)).max())
     if span <= 0:
         return {"fraction": 1.0, "longest_gap": longest}
-    period = float(np.median(gaps[:-1])) if t_valid.size > 1 else span
-    reach = COVERAGE_PERIODS * period
-    # each row covers [t - reach, t + reach]; a gap g between rows leaves g - 2 reach uncovered,
-    # the stretch after the last row t_end - t_last - reach
-    uncovered = np.maximum(gaps[:-1] - 2.0 * reach, 0.0).sum() + max(gaps[-1] - reach, 0.0)
-    return {"fraction": float(min(max(1.0 - uncovered / span, 0.0), 1.0)),
-            "longest_gap": longest}
+    covered = _covered(t_valid, _reach(t_valid), float(t_valid[0]), t_end)
+    return {"fraction": float(min(covered / span, 1.0)), "longest_gap": longest}
 
 
 def _window_scores(t_start: float, t_end: float, t: np.ndarray, h: np.ndarray,
                    truth: pd.DataFrame) -> dict:
-    """``start, duration, distance, max_horizontal, end_horizontal, end_percent`` of one window
-    over the scored rows (times ``t``, horizontal errors ``h``) with t_start <= t < t_end."""
+    """``start, duration, distance, max_horizontal, end_horizontal, end_percent, coverage`` of
+    one window over the scored rows (times ``t``, horizontal errors ``h``) with
+    t_start <= t < t_end; ``coverage`` is the share of the window within 1.5 output periods of a
+    row (as the solution's ``coverage``), so that a solution that stops early in a window is
+    seen to."""
     travelled = np.interp([t_start, t_end], truth["t"].to_numpy(float),
                           truth["distance"].to_numpy(float))
     distance = float(travelled[1] - travelled[0])
     inside = h[(t >= t_start) & (t < t_end)]
     end = _number(inside[-1]) if inside.size else None
-    return {"start": float(t_start), "duration": float(t_end - t_start), "distance": distance,
+    duration = t_end - t_start
+    covered = _covered(t, _reach(t), t_start, t_end) / duration if duration > 0 else 1.0
+    return {"start": float(t_start), "duration": float(duration), "distance": distance,
             "max_horizontal": _max(inside), "end_horizontal": end,
-            "end_percent": None if end is None or distance <= 0 else 100.0 * end / distance}
+            "end_percent": None if end is None or distance <= 0 else 100.0 * end / distance,
+            "coverage": covered}
 
 
 def degraded_windows(events: pd.DataFrame, canyon_zones: set[str] | frozenset[str] = frozenset()

@@ -94,14 +94,16 @@ def _metrics_lines(scores: dict[str, dict]) -> list[str]:
 
 def _window_lines(scores: dict[str, dict], group: str, n: int, empty: str) -> list[str]:
     """One row per outage (``group`` = outages) or degraded window: its span and distance,
-    then each solution's max, end and end-% error (``-`` where it has no row or no GNSS)."""
+    then each solution's max, end and end-% error (``-`` where it has no row or no GNSS) and
+    the share of the window it covers."""
     if not n:
         return [empty]
     header = ["#", "start (s)", "duration (s)", "distance (m)"]
     if group == "degraded":
         header[1:1] = ["kind", "satellites"]
     for label in scores:
-        header += [f"{label} max (m)", f"{label} end (m)", f"{label} end (%)"]
+        header += [f"{label} max (m)", f"{label} end (m)", f"{label} end (%)",
+                   f"{label} coverage"]
     rows = []
     for i in range(n):
         entries = [s[group][i] if s.get(group) is not None else {} for s in scores.values()]
@@ -112,7 +114,7 @@ def _window_lines(scores: dict[str, dict], group: str, n: int, empty: str) -> li
             row[1:1] = [str(first.get("kind", "-")), format_number(first.get("satellites"))]
         for o in entries:
             row += [format_number(o.get(k)) for k in ("max_horizontal", "end_horizontal",
-                                                       "end_percent")]
+                                                       "end_percent", "coverage")]
         rows.append(row)
     return markdown_table(header, rows)
 

@@ -37,6 +37,9 @@ def test_solution_stopping_in_an_outage_gets_null_entries_and_less_coverage(trut
     assert first["end_horizontal"] == pytest.approx(1.0, abs=1e-5)
     assert second["max_horizontal"] is None and second["end_horizontal"] is None
     assert second["end_percent"] is None and second["duration"] == 30.0
+    # the window is covered only 0.15 s past the last row at 119.9 s
+    assert first["coverage"] == pytest.approx(1.0)
+    assert second["coverage"] == pytest.approx(0.05 / 30.0, abs=1e-9)
     # rows every 0.1 s cover 0.15 s either side; the last row is at 119.9 s
     last = float(stopped["t"].iloc[-1])
     expected = 1.0 - (t_end - last - 0.15) / t_end
@@ -54,6 +57,8 @@ def test_rows_missing_inside_an_outage_count_against_coverage(truth):
     assert s["coverage"]["fraction"] == pytest.approx(1.0 - (30.1 - 0.3) / t_end, abs=1e-9)
     assert s["coverage"]["longest_gap"] == pytest.approx(30.1, abs=1e-9)
     assert s["outages"][0]["max_horizontal"] is None
+    # the row at 119.9 s reaches 0.05 s into the window, the row at 150 s 0.15 s back into it
+    assert s["outages"][0]["coverage"] == pytest.approx(0.2 / 30.0, abs=1e-9)
 
 
 def test_solution_without_gnss_has_no_outage_scores(truth):

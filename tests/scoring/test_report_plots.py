@@ -33,7 +33,7 @@ def test_report_of_a_raw_gnss_dataset_has_every_plot(evaluation, tmp_path):
     assert "## Degraded GNSS windows" in text and "coverage (fraction of the drive)" in text
     # the tunnel outage row: gnss_only has its last extrapolated row there
     row = next(line for line in text.splitlines() if line.startswith("| 1 | 73.000"))
-    assert row.count("|") == 4 + 2 * 3 + 1
+    assert row.count("|") == 4 + 2 * 4 + 1
 
 
 def test_nees_bounds_are_the_chi_square_95_percent_quantiles():
