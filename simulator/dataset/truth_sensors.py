@@ -1,6 +1,6 @@
-"""``truth_sensors.parquet`` (SPEC section 5): the true value over time of every sensor error an
-estimator may estimate, named as the solution's sensor-error columns (``columns.SENSOR_ERRORS``),
-for scoring only.
+"""``truth_sensors.parquet`` (docs/dataset-format.md): the true value over time of every sensor
+error an estimator may estimate, named as the solution's sensor-error columns
+(``columns.SENSOR_ERRORS``), for scoring only.
 
 Rows are on a common grid t = k / ``TRUE_ERROR_RATE_HZ`` (10 Hz) over the drive; each sensor's
 own series (``true_errors`` of the sensor models: the IMU's kept every ``rate / 10``-th sample,

@@ -13,10 +13,10 @@ truth's time span are dropped and counted):
 Position errors are the ECEF difference (solution minus truth) resolved in the NED frame at the
 interpolated true position (C_e^n, Groves eq. 2.150); velocity errors are NED differences;
 attitude errors are wrapped Euler-angle differences (solution minus truth), rad. Estimated sensor
-errors (SPEC section 7 names, ``columns.SENSOR_ERRORS``) are compared with ``truth_sensors``
-interpolated linearly at the solution times (``err_`` + the column name, solution minus truth, in
-the column's own unit). NaN in a solution row propagates to the errors it feeds; the metrics skip
-those rows.
+errors (named as in docs/solution-format.md, ``columns.SENSOR_ERRORS``) are compared with
+``truth_sensors`` interpolated linearly at the solution times (``err_`` + the column name,
+solution minus truth, in the column's own unit). NaN in a solution row propagates to the errors
+it feeds; the metrics skip those rows.
 
 Public names
 ------------
@@ -105,7 +105,7 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame,
         ``truth.parquet`` (at least ``t, lat, lon, alt, vn, ve, vd, roll, pitch, yaw``), t
         strictly increasing.
     solution : DataFrame
-        A solution table (SPEC section 7), t increasing.
+        A solution table (docs/solution-format.md), t increasing.
     truth_sensors : DataFrame or None
         ``truth_sensors.parquet`` (``t`` and true sensor-error columns), or None.
 

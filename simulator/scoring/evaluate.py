@@ -1,5 +1,5 @@
 """Several solutions on one dataset: read the truth and events once, score each solution, and
-write the scores as JSON (SPEC section 8, keyed by label).
+write the scores as JSON (docs/scores.md, keyed by label).
 
 Public names
 ------------

@@ -1,4 +1,4 @@
-"""The scores of one solution against the truth (SPEC section 8).
+"""The scores of one solution against the truth (docs/scores.md).
 
 Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be scored):
 
@@ -28,10 +28,10 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   ``num_sats`` of the receiver's fixes at the epochs inside the window; ``None`` without a
   ``gnss_fix`` stream), so that partial-outage protocols (Karamat et al. 2015; Chan et al.)
   are scored with no extra code;
-* ``sensor_errors`` {column: {rms, final}} for every estimated sensor-error column of SPEC
-  section 7 that the dataset's ``truth_sensors`` also has: the RMS of the solution minus the
-  true value over the rows where both are finite, and the last such error, in the column's own
-  unit (rad/s, m/s^2, dimensionless, m, m/s);
+* ``sensor_errors`` {column: {rms, final}} for every estimated sensor-error column of
+  docs/solution-format.md that the dataset's ``truth_sensors`` also has: the RMS of the
+  solution minus the true value over the rows where both are finite, and the last such error,
+  in the column's own unit (rad/s, m/s^2, dimensionless, m, m/s);
 * ``nees`` (only when the solution has ``std_*`` columns): the mean normalised estimation error
   squared of each 3-axis group, e^T P^-1 e with the diagonal covariance of the 1-sigma columns
   (``position``: std_n/e/d, ``velocity``: std_vn/ve/vd, ``attitude``: std_roll/pitch/yaw;
@@ -42,8 +42,9 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
 * ``rows`` {total, outside_truth, position, velocity, attitude}: rows in the solution, rows
   dropped outside the truth's time span, and rows scored in each group.
 
-Every metric uses only the rows where the solution has the quantities it needs (SPEC section 7:
-a quantity not estimated is NaN and is left out of its own metrics, not of the others): the
+Every metric uses only the rows where the solution has the quantities it needs
+(docs/solution-format.md: a quantity not estimated is NaN and is left out of its own metrics, not
+of the others): the
 horizontal metrics, coverage and windows the rows with finite lat and lon, the vertical ones
 finite alt, velocity all three of vn, ve, vd, each attitude angle its own column (a 2-D filter
 with NaN roll and pitch still has its yaw scored).
@@ -272,7 +273,7 @@ def score_errors(errors: SolutionErrors, truth: pd.DataFrame, events: pd.DataFra
 def score_solution(truth: pd.DataFrame, events: pd.DataFrame, solution: pd.DataFrame,
                    runtime: dict | None = None, *, truth_sensors: pd.DataFrame | None = None,
                    **options: object) -> dict:
-    """Score a solution table (SPEC section 7) against a dataset's truth and events tables
+    """Score a solution table (docs/solution-format.md) against a dataset's truth and events tables
     (``options`` as for ``score_errors``)."""
     return score_errors(_solution_errors(truth, solution, truth_sensors), truth, events, runtime,
                         **options)

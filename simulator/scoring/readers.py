@@ -1,14 +1,14 @@
-"""Solutions from any tool: Parquet and CSV with the SPEC section 7 columns, RTKLIB ``.pos``
-files and NMEA 0183 logs, each turned into the one solution table; and the checks that refuse a
-solution that cannot belong to the dataset.
+"""Solutions from any tool: Parquet and CSV with the columns of docs/solution-format.md, RTKLIB
+``.pos`` files and NMEA 0183 logs, each turned into the one solution table; and the checks that
+refuse a solution that cannot belong to the dataset.
 
 Formats (chosen by the file's suffix, else by its first bytes):
 
-* **Parquet** (``.parquet``, ``.pq``): the SPEC columns. A column whose field metadata ``unit``
-  differs from the SPEC unit is converted, with a note (``lat``/``lon`` in ``rad``, attitude in
-  ``deg``, ``std_*`` in ``cm``: any unit pint converts to the SPEC one); an inconvertible unit is
-  refused naming the column.
-* **CSV** (``.csv``): a header row with the SPEC column names, SPEC units (no metadata to read).
+* **Parquet** (``.parquet``, ``.pq``): those columns. A column whose field metadata ``unit``
+  differs from the documented unit is converted, with a note (``lat``/``lon`` in ``rad``,
+  attitude in ``deg``, ``std_*`` in ``cm``: any unit pint converts to the documented one); an
+  inconvertible unit is refused naming the column.
+* **CSV** (``.csv``): a header row with the documented column names and units (no metadata to read).
 * **RTKLIB** ``.pos`` (the output of ``rnx2rtkp``/``rtkpost``, RTKLIB 2.4.3 manual, appendix
   B.5): ``%`` header lines, the last naming the columns. The time is GPS week and seconds
   (``2312 270018.000``) or a date (``2024/05/01 03:00:18.000``), in ``GPST`` or ``UTC`` as the
@@ -226,7 +226,7 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
 
     Returns
     -------
-    frame : the solution table, SPEC section 7 columns, t increasing.
+    frame : the solution table, docs/solution-format.md columns, t increasing.
     notes : lines telling what was converted (units, format), for the user.
     uses_gnss : False only for a Parquet file landnav wrote for an estimator without GNSS
         (schema metadata ``landnav.uses_gnss``); any other solution is taken to use GNSS.
@@ -265,8 +265,8 @@ def _cause(frame: pd.DataFrame, truth: pd.DataFrame) -> str:
     true_lon = float(truth["lon"].median())
     if (np.nanmax(np.abs(lat)) <= math.pi / 2 and np.nanmax(np.abs(lon)) <= math.pi
             and abs(math.degrees(np.nanmedian(lat)) - true_lat) < 1.0):
-        return ("lat and lon look like radians: write degrees (SPEC section 7), or give the "
-                "Parquet columns the unit 'rad'")
+        return ("lat and lon look like radians: write degrees (docs/solution-format.md), or "
+                "give the Parquet columns the unit 'rad'")
     if abs(np.nanmedian(lat) - true_lon) < 1.0 and abs(np.nanmedian(lon) - true_lat) < 1.0:
         return "lat and lon look swapped"
     return ("is it a solution of another dataset (this one starts at lat "
@@ -299,8 +299,8 @@ def check_solution(path: str | Path, frame: pd.DataFrame, truth: pd.DataFrame) -
         values = frame[name].to_numpy(float)
         if np.any(np.abs(values[np.isfinite(values)]) > 2 * math.pi + 1e-6):
             raise _problem(path, f"{name} has values beyond 2 pi: degrees? Attitude is in "
-                                 "radians (SPEC section 7), or give the Parquet column the unit "
-                                 "'deg'", name)
+                                 "radians (docs/solution-format.md), or give the Parquet "
+                                 "column the unit 'deg'", name)
     h = solution_errors(truth, frame).errors["err_h"].to_numpy()
     h = h[np.isfinite(h)]
     if h.size == 0:
