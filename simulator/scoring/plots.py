@@ -21,7 +21,7 @@ limits, multipath, canyon zones) of the events table.
   shows as its staircase of floors);
 * ``horizontal_cdf``: the empirical CDF of the horizontal error, logarithmic error axis;
 * ``gnss_sky`` (datasets with raw GNSS): a sky plot of the tracked satellites' tracks, and the
-  number of satellites, HDOP/VDOP and C/N0 against time.
+  number of satellites, HDOP/VDOP and C/N0 against time, every other fault hatched grey.
 
 Public names
 ------------
@@ -41,7 +41,7 @@ from scipy.stats import chi2
 
 from simulator.scoring.align import ERR_ATT, ERR_H, ERR_POS, ERR_VEL, local_ned
 from simulator.scoring.evaluate import Evaluation
-from simulator.scoring.metrics import NEES_DOF, OUTAGE_KIND, degraded_windows
+from simulator.scoring.metrics import DEGRADED_KINDS, NEES_DOF, OUTAGE_KIND, degraded_windows
 
 MAX_WINDOW_PANELS = 6  # zoomed map panels, the longest windows first
 NEES_FLOOR = 1e-2  # lower end of the NEES plot's axis
@@ -77,12 +77,21 @@ def shaded_windows(ev: Evaluation) -> list[tuple[float, float, str]]:
     return [(float(a), float(b), str(k)) for a, b, k in windows]
 
 
-def _shade(ax: Axes, ev: Evaluation) -> None:
+def _shade(ax: Axes, ev: Evaluation, other_faults: bool = False) -> None:
+    """Shade the outages and degraded windows; with ``other_faults`` also every other fault
+    of the events table (grey, hatched), e.g. a fix jump or latency on a GNSS panel."""
     seen: set[str] = set()
     for a, b, kind in shaded_windows(ev):
         colour = _OUTAGE_COLOUR if kind == "GNSS outage" else _DEGRADED_COLOUR
         ax.axvspan(a, b, color=colour, alpha=0.15, lw=0, label=None if kind in seen else kind)
         seen.add(kind)
+    if other_faults:
+        shown = {OUTAGE_KIND, "zone", *DEGRADED_KINDS}
+        rest = ev.events.loc[~ev.events["kind"].isin(shown)]
+        for a, b, kind in zip(rest["t_start"], rest["t_end"], rest["kind"], strict=True):
+            ax.axvspan(a, b, facecolor="none", edgecolor="grey", hatch="//", lw=0,
+                       label=None if kind in seen else kind)
+            seen.add(kind)
 
 
 def _save(fig: Figure, path: Path) -> None:
@@ -295,7 +304,7 @@ def plot_gnss_sky(ev: Evaluation, path: Path, raw: pd.DataFrame,
         dop.legend(loc="upper left", fontsize="x-small")
     cn0.scatter(raw["t"], raw["cn0"], s=1, c=raw["sv"], cmap="tab20")
     for ax, label in ((count, "satellites"), (dop, "DOP"), (cn0, "C/N0 (dB-Hz)")):
-        _shade(ax, ev)
+        _shade(ax, ev, other_faults=True)
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
     count.legend(loc="lower left", fontsize="x-small")
