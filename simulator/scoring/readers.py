@@ -167,6 +167,11 @@ def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[s
     return out, [f"{path}: RTKLIB {system} solution, {len(out)} rows"]
 
 
+def _float(value: object) -> float:
+    """An NMEA field as a float, NaN where it is empty."""
+    return float(value) if value not in ("", None) else math.nan
+
+
 def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[str]]:
     from pynmeagps import NMEAReader
 
@@ -181,9 +186,10 @@ def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[
             if msg.msgID == "RMC" and msg.date:
                 date = msg.date
                 if msg.status == "A":
-                    rmc[(date, msg.time)] = (msg.spd, msg.cog)
+                    rmc[(date, msg.time)] = (_float(msg.spd), _float(msg.cog))
             elif msg.msgID == "GGA" and msg.quality and msg.lat != "":
-                gga.append((date, msg.time, msg.lat, msg.lon, msg.alt + (msg.sep or 0.0)))
+                gga.append((date, msg.time, msg.lat, msg.lon,
+                             _float(msg.alt) + (_float(msg.sep) if msg.sep != "" else 0.0)))
     if not gga:
         return pd.DataFrame(columns=list(col.SOLUTION)), []
     stamps = pd.Series([dt.datetime.combine(d, tm) for d, tm, *_ in gga])

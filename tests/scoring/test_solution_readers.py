@@ -157,3 +157,19 @@ def test_module_class_is_found_from_the_current_directory(quickstart, tmp_path):
         cwd=work, capture_output=True, text=True, env={"PYTHONPATH": str(REPO), "PATH": ""})
     assert result.returncode == 0, result.stderr
     assert "my_plugin:Mine" in result.stdout or "mine" in result.stdout
+
+
+def test_nmea_without_rmc_or_altitude_takes_the_dataset_date(tmp_path):
+    """A bare GGA (no RMC, empty altitude): the date is the dataset's start date, UTC 03:00:10
+    is GPS 03:00:28 (18 leap seconds), 10 s after a start at GPS week 2312, 270018 s."""
+    body = "GPGGA,030010.00,3733.9903602,N,12658.6785914,E,1,06,1.0,,M,,M,,"
+    checksum = 0
+    for ch in body:
+        checksum ^= ord(ch)
+    path = tmp_path / "bare.nmea"
+    path.write_text(f"${body}*{checksum:02X}\r\n")
+    frame, _, _ = read_solution_file(path, (2312, 270018.0))
+    assert frame["t"].tolist() == [pytest.approx(10.0)]
+    assert frame["lat"].iloc[0] == pytest.approx(37 + 33.9903602 / 60, abs=1e-9)
+    assert frame["lon"].iloc[0] == pytest.approx(126 + 58.6785914 / 60, abs=1e-9)
+    assert np.isnan(frame["alt"].iloc[0]) and np.isnan(frame["vn"].iloc[0])
