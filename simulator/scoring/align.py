@@ -11,12 +11,13 @@ truth's time span are dropped and counted):
   interpolates through 180 deg, not through 0.
 
 Position errors are the ECEF difference (solution minus truth) resolved in the NED frame at the
-interpolated true position (C_e^n, Groves eq. 2.150); velocity errors are NED differences;
-attitude errors are wrapped Euler-angle differences (solution minus truth), rad. Estimated sensor
-errors (named as in docs/solution-format.md, ``columns.SENSOR_ERRORS``) are compared with
-``truth_sensors`` interpolated linearly at the solution times (``err_`` + the column name,
-solution minus truth, in the column's own unit). NaN in a solution row propagates to the errors
-it feeds; the metrics skip those rows.
+interpolated true position (C_e^n, Groves eq. 2.150); a row without a height (NaN ``alt``, e.g. a
+bare NMEA GGA) is placed at the true height for its horizontal error and has a NaN down error;
+velocity errors are NED differences; attitude errors are wrapped Euler-angle differences
+(solution minus truth), rad. Estimated sensor errors (named as in docs/solution-format.md,
+``columns.SENSOR_ERRORS``) are compared with ``truth_sensors`` interpolated linearly at the
+solution times (``err_`` + the column name, solution minus truth, in the column's own unit). NaN
+in a solution row propagates to the errors it feeds; the metrics skip those rows.
 
 Public names
 ------------
@@ -126,7 +127,15 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame,
     # the NED frame of the interpolated true position (lat/lon interpolated only for the rotation)
     c_ne = ned_to_ecef_matrix(np.radians(interp(truth["lat"].to_numpy(float))),
                               np.radians(interp(truth["lon"].to_numpy(float))))
-    err_pos = np.einsum("kji,kj->ki", c_ne, _ecef(sol) - truth_ecef)
+    # a solution without a height (NaN alt) still has a horizontal error: its point is taken at
+    # the true height for that, and its down error stays NaN
+    alt = sol["alt"].to_numpy(float)
+    no_alt = ~np.isfinite(alt)
+    sol_ecef = geodetic_to_ecef(np.radians(sol["lat"].to_numpy(float)),
+                                np.radians(sol["lon"].to_numpy(float)),
+                                np.where(no_alt, interp(truth["alt"].to_numpy(float)), alt))
+    err_pos = np.einsum("kji,kj->ki", c_ne, sol_ecef - truth_ecef)
+    err_pos[no_alt, 2] = np.nan
     out = {"t": t}
     out.update(zip(ERR_POS, err_pos.T, strict=True))
     out[ERR_H] = np.hypot(err_pos[:, 0], err_pos[:, 1])
