@@ -155,6 +155,9 @@ def _kind(value: Any) -> str | None:
     return type(value).__name__
 
 
+MAX_OUTPUT_RATE_HZ = 1000.0  # solution rows per second of data an estimator may ask for
+
+
 def check_estimator_class(cls: Any, where: str) -> list[str]:
     """Problems with a class offered as an estimator (empty if it satisfies the contract)."""
     if not (isinstance(cls, type) and issubclass(cls, Estimator)):
@@ -172,6 +175,21 @@ def check_estimator_class(cls: Any, where: str) -> list[str]:
     missing = [c for c in NAV_COLUMNS if c not in cls.output_columns]
     if missing:
         problems.append(f"{where}: output_columns lacks {', '.join(missing)}")
-    if not cls.output_rate_hz > 0:
-        problems.append(f"{where}: output_rate_hz must be positive")
+    columns = cls.output_columns
+    if not isinstance(columns, (tuple, list)) or not all(isinstance(c, str) for c in columns):
+        problems.append(f"{where}: output_columns must be a tuple of column names")
+    else:
+        repeated = sorted({c for c in columns if columns.count(c) > 1} | (
+            {"t"} & set(columns)))
+        if repeated:
+            problems.append(f"{where}: output_columns names {', '.join(repeated)} twice "
+                            "(t is added by the replay)")
+    if not isinstance(cls.defaults, Mapping):
+        problems.append(f"{where}: defaults must be a mapping of config keys to default values, "
+                        f"got {cls.defaults!r}")
+    rate = cls.output_rate_hz
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (
+            0 < rate <= MAX_OUTPUT_RATE_HZ):
+        problems.append(f"{where}: output_rate_hz must be a number in (0, "
+                        f"{MAX_OUTPUT_RATE_HZ:g}] Hz, got {rate!r}")
     return problems

@@ -20,10 +20,8 @@ def drive(segments: list[dict], zones: dict | None = None, start: dict | None = 
     segs = [SEGMENT_FIELD.check(s, ("segments", i), ctx) for i, s in enumerate(segments)]
     profile = build_road_profile(segs, limits, ctx)
     assert not ctx.problems, ctx.problems
-    truth = kinematics_from_profile(profile, start or START, rate_hz, limits["roll_gradient"])
-    truth.environment = {"zones": zones or {}}
-    truth.utc_start = utc
-    return truth
+    return kinematics_from_profile(profile, start or START, rate_hz, limits["roll_gradient"],
+                                   utc, {"zones": zones or {}})
 
 
 def receiver(**config) -> Gnss:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import datetime as dt
 from pathlib import Path
 
 from simulator.schema import Context
@@ -19,14 +20,17 @@ DRIVE = [
 
 
 def truth_from_segments(segments: list[dict], rate_hz: float = 100.0,
-                        start: dict | None = None) -> Kinematics:
+                        start: dict | None = None,
+                        utc: dt.datetime = dt.datetime(2020, 1, 1),
+                        environment: dict | None = None) -> Kinematics:
     ctx = Context("test")
     limits = LIMITS_FIELD.check({}, ("limits",), ctx)
     segs = [SEGMENT_FIELD.check(s, ("segments", i), ctx) for i, s in enumerate(segments)]
     profile = build_road_profile(segs, limits, ctx)
     assert not ctx.problems, ctx.problems
     start = start or {"lat": 37.0, "lon": 127.0, "alt": 40.0, "heading": 30.0}
-    return kinematics_from_profile(profile, start, rate_hz, limits["roll_gradient"])
+    return kinematics_from_profile(profile, start, rate_hz, limits["roll_gradient"], utc,
+                                   environment)
 
 
 def static_truth(duration_s: float) -> Kinematics:

@@ -17,6 +17,7 @@ from estimators.toolbox.strapdown import run_strapdown
 from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.scenario import load_scenario
+from simulator.sensors import resolve_block
 from simulator.sensors.imu import Imu
 from simulator.tables import as_frame
 from simulator.trajectory.sumo import place_drive, run_sumo
@@ -77,8 +78,8 @@ def test_strapdown_closure_on_sumo_drive(hilly_city):
     2 m horizontally and 0.2 deg in yaw of the truth over the ten-minute drive. Measured: see
     the figures in the report (a few mm and 1e-6 deg)."""
     truth, _, _ = hilly_city
-    imu = Imu({"preset": "ideal", "rate": 100.0, "output": "increment",
-               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
+               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]}))
     table = as_frame(imu.generate(truth, None)["imu"])
     t = np.concatenate([[0.0], table.t.to_numpy()])
     ref = truth.table(t)

@@ -41,19 +41,25 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   ``accel_noise``, ``gyro_noise``, velocity and angle random walks of the automotive MEMS
   preset), small bias random walks, and the receiver-clock model of a TCXO
   (``gnss_model.clock_noise``). R: the receiver's reported pseudorange and pseudorange-rate
-  1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``), floored at
-  ``pseudorange_std`` 3 m and ``range_rate_std`` 0.1 m/s when the stream lacks them.
+  1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``); the config's
+  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them.
 * The EKF (eqs. 4-6): position error rate dr' = dv as printed (eq. 4), velocity and attitude error
   equations in the psi convention of ``nav_error`` (eq. 5: -[f^n x] psi - C_b^n dba
   - (2 w_ie + w_en) x dv - (2 dw_ie + dw_en) x v; eq. 6: psi' = -w_in x psi - C_b^n dbg - dw_in,
   with dw_ie from the latitude error and dw_en from the velocity error; the paper's phi is -psi).
   The nominal state is propagated by the toolbox strapdown (``strapdown.propagate``), the
   covariance at 10 Hz with Phi = I + F dt + (F dt)^2 / 2; closed loop (errors fed back after each
-  update). Measurements linearised at the nominal state (the "linearised model given in [2]").
+  update). Measurements linearised at the nominal state (the "linearised model given in [2]"):
+  the pseudorange rows carry the lever arm's attitude term, the range-rate rows only -los on the
+  velocity error and 1 on the drift (the lever arm's rate term is below the noise).
+* The UKF runs on the toolbox's sigma-point driver (``estimators.toolbox.ukf``, symmetric set)
+  with this module's ``boxplus``/``boxminus`` on an 18-number nominal state (position, velocity,
+  quaternion, biases, clock); the whole point set moves through one compiled call per batch of
+  IMU samples (``_propagate_points``).
 
 Public names
 ------------
-TcUkf, TcEkf.
+TcUkf, TcEkf, boxplus, boxminus, error_dynamics.
 """
 
 from __future__ import annotations
@@ -64,8 +70,8 @@ from numba import njit
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gnss_model, nav_error
 from estimators.toolbox.kalman import ErrorState
-from estimators.toolbox.sigma_points import symmetric_points
 from estimators.toolbox.strapdown import propagate, rk4_step
+from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import (
     OMEGA_E_RAD_S,
     earth_rate_ned,
@@ -85,12 +91,8 @@ SENSOR_COLUMNS = ("accel_bias_x", "accel_bias_y", "accel_bias_z", "gyro_bias_x",
                   "gyro_bias_z", "clock_bias", "clock_drift")
 PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Vehicle' "
          "(tightly coupled INS/GPS, UKF vs EKF, NHC)")
-COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation rate
+COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
-
-
-def _rad_deg(x: float) -> float:
-    return float(np.radians(x))
 
 
 DEFAULTS = {
@@ -134,7 +136,9 @@ class _TightlyCoupled(Estimator):
         self._clock_started = False
         self._t_update = self.initial.t
         self._next_nhc = np.inf
-        self._w_last = np.zeros(3)  # last body rate (bias-corrected), for the lever arm
+        self._buf_w: list[np.ndarray] = []
+        self._buf_f: list[np.ndarray] = []
+        self._buf_dt: list[float] = []
         p0 = np.zeros(N_STATES)
         p0[0:3] = cfg["initial_position_std"]
         p0[3:6] = cfg["initial_velocity_std"]
@@ -203,9 +207,23 @@ class _TightlyCoupled(Estimator):
         return np.concatenate([[np.degrees(pos[0]), np.degrees(pos[1]), pos[2], *v, roll, pitch,
                                 yaw], std, biases, clock])
 
-    # -- filter-specific -----------------------------------------------------------------------
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        raise NotImplementedError
+        """Buffer the IMU interval ending now (its start sample first); the filters integrate
+        a buffer in one compiled call."""
+        if not self._buf_dt:
+            self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
+        self._buf_w.append(w)
+        self._buf_f.append(f)
+        self._buf_dt.append(dt)
+
+    def _take_buffer(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Body rates and specific forces at the m + 1 sample times (m + 1, 3) and the m
+        interval lengths of the buffer, which is emptied."""
+        out = np.array(self._buf_w), np.array(self._buf_f), np.array(self._buf_dt)
+        self._buf_dt = []
+        return out
+
+    # -- filter-specific -----------------------------------------------------------------------
 
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         raise NotImplementedError
@@ -233,45 +251,52 @@ def _earth_rate_body(c_bn: np.ndarray, lat: np.ndarray) -> np.ndarray:
 # ----------------------------------------------------------------------------------------------
 # tc_ukf
 # ----------------------------------------------------------------------------------------------
+# the UKF's nominal state: one flat vector (k points: rows of a (k, 19) array)
+POS, VEL, QUAT, BA, BG, CLOCK = (slice(0, 3), slice(3, 6), slice(6, 10), slice(10, 13),
+                                 slice(13, 16), slice(16, 18))
+N_NOMINAL = 18
+
+
 @njit(cache=True)
-def _propagate_points(pos: np.ndarray, v: np.ndarray, q: np.ndarray, ba: np.ndarray,
-                      bg: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray) -> None:
-    """Integrate every sigma point in place through the buffered IMU intervals: one RK4 step
-    of Chan eqs. 1-3 per interval, bias-corrected rates at its start (row j), end (row j + 1)
-    and their mean at its middle. pos, v, ba, bg: (k, 3); q: (k, 4); w, f: (m + 1, 3);
-    dt: (m,)."""
-    x = np.empty(10)
+def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray) -> None:
+    """Integrate every point (rows of x, the ``TcUkf`` nominal layout) in place through the
+    buffered IMU intervals: one RK4 step of Chan eqs. 1-3 per interval, bias-corrected rates at
+    its start (row j of w, f), end (row j + 1) and their mean at its middle; cb' = d."""
+    nav = np.empty(10)
     work = np.empty((5, 10))
     rates = np.empty((6, 3))  # w0, w_mid, w1, f0, f_mid, f1
-    for i in range(pos.shape[0]):
-        x[0:3], x[3:6], x[6:10] = pos[i], v[i], q[i]
+    total = 0.0
+    for j in range(dt.shape[0]):
+        total += dt[j]
+    for i in range(x.shape[0]):
+        nav[:] = x[i, 0:10]
         for j in range(dt.shape[0]):
             for a in range(3):
-                rates[0, a] = w[j, a] - bg[i, a]
-                rates[2, a] = w[j + 1, a] - bg[i, a]
+                rates[0, a] = w[j, a] - x[i, 13 + a]
+                rates[2, a] = w[j + 1, a] - x[i, 13 + a]
                 rates[1, a] = 0.5 * (rates[0, a] + rates[2, a])
-                rates[3, a] = f[j, a] - ba[i, a]
-                rates[5, a] = f[j + 1, a] - ba[i, a]
+                rates[3, a] = f[j, a] - x[i, 10 + a]
+                rates[5, a] = f[j + 1, a] - x[i, 10 + a]
                 rates[4, a] = 0.5 * (rates[3, a] + rates[5, a])
-            rk4_step(x, rates[0], rates[1], rates[2], rates[3], rates[4], rates[5], dt[j], work)
-        pos[i], v[i], q[i] = x[0:3], x[3:6], x[6:10]
+            rk4_step(nav, rates[0], rates[1], rates[2], rates[3], rates[4], rates[5], dt[j], work)
+        x[i, 0:10] = nav
+        x[i, 16] += x[i, 17] * total
 
 
 @njit(cache=True)
-def _tangent(pos: np.ndarray, v: np.ndarray, q: np.ndarray, ba: np.ndarray, bg: np.ndarray,
-             clock: np.ndarray, ref: int, rm: float, rt: float) -> np.ndarray:
-    """Tangent vectors (k, 17) of the points around point ``ref`` (the ``boxminus`` of
-    ``TcUkf``): NED position displacement (m), velocity, the rotation vector of
-    q_i * conj(q_ref) (NED-frame attitude error, ``nav_error`` convention), biases, clock."""
-    k = pos.shape[0]
-    out = np.empty((k, 17))
-    lat0, lon0, h0 = pos[ref, 0], pos[ref, 1], pos[ref, 2]
-    a2, b2, c2, d2 = q[ref, 0], -q[ref, 1], -q[ref, 2], -q[ref, 3]
+def _boxminus(xs: np.ndarray, ref: np.ndarray, rm: float, rt: float) -> np.ndarray:
+    """Tangent vectors (k, 17) of the states xs (k, 18) around ``ref`` (18,): NED position
+    displacement (m), velocity, the rotation vector of q_i * conj(q_ref) (the NED-frame attitude
+    error of ``nav_error``), biases, clock."""
+    k = xs.shape[0]
+    out = np.empty((k, N_STATES))
+    lat0, lon0, h0 = ref[0], ref[1], ref[2]
+    a2, b2, c2, d2 = ref[6], -ref[7], -ref[8], -ref[9]
     for i in range(k):
-        out[i, 0] = (pos[i, 0] - lat0) * (rm + h0)
-        out[i, 1] = (pos[i, 1] - lon0) * (rt + h0) * np.cos(lat0)
-        out[i, 2] = h0 - pos[i, 2]
-        a1, b1, c1, d1 = q[i, 0], q[i, 1], q[i, 2], q[i, 3]
+        out[i, 0] = (xs[i, 0] - lat0) * (rm + h0)
+        out[i, 1] = (xs[i, 1] - lon0) * (rt + h0) * np.cos(lat0)
+        out[i, 2] = h0 - xs[i, 2]
+        a1, b1, c1, d1 = xs[i, 6], xs[i, 7], xs[i, 8], xs[i, 9]
         w = a1 * a2 - b1 * b2 - c1 * c2 - d1 * d2
         x = a1 * b2 + b1 * a2 + c1 * d2 - d1 * c2
         y = a1 * c2 - b1 * d2 + c1 * a2 + d1 * b2
@@ -280,26 +305,49 @@ def _tangent(pos: np.ndarray, v: np.ndarray, q: np.ndarray, ba: np.ndarray, bg: 
             w, x, y, z = -w, -x, -y, -z
         s = np.sqrt(x * x + y * y + z * z)
         scale = 2.0 * np.arctan2(s, w) / s if s > 1e-12 else 2.0
-        for j in range(3):
-            out[i, 3 + j] = v[i, j] - v[ref, j]
-            out[i, 9 + j] = ba[i, j] - ba[ref, j]
-            out[i, 12 + j] = bg[i, j] - bg[ref, j]
         out[i, 6], out[i, 7], out[i, 8] = x * scale, y * scale, z * scale
-        out[i, 15] = clock[i, 0] - clock[ref, 0]
-        out[i, 16] = clock[i, 1] - clock[ref, 1]
+        for j in range(3):
+            out[i, 3 + j] = xs[i, 3 + j] - ref[3 + j]
+        for j in range(8):  # biases and clock
+            out[i, 9 + j] = xs[i, 10 + j] - ref[10 + j]
     return out
 
 
-def _plus_one(state: dict, dx: np.ndarray) -> dict:
-    """One state moved by a tangent vector (``TcUkf.boxplus`` of a single point, through the
-    ``nav_error`` convention)."""
-    q, v, pos = nav_error.perturb(state["q"], state["v"], state["pos"], dx[:9])
-    return {"pos": pos, "v": v, "q": q, "ba": state["ba"] + dx[9:12],
-            "bg": state["bg"] + dx[12:15], "clock": state["clock"] + dx[15:17]}
+def boxplus(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+    """States (k, 18) of the nominal state ``x`` (18,) moved by tangent vectors dx (k, 17), or
+    one state (18,) for one dx (17,) (the inverse of ``boxminus``; ``nav_error`` convention for
+    position and attitude)."""
+    if np.ndim(dx) == 1:
+        return boxplus(x, dx[None, :])[0]
+    rm, rt = radii_of_curvature(x[0])
+    out = np.empty((len(dx), N_NOMINAL))
+    out[:, 0] = x[0] + dx[:, 0] / (rm + x[2])
+    out[:, 1] = x[1] + dx[:, 1] / ((rt + x[2]) * np.cos(x[0]))
+    out[:, 2] = x[2] - dx[:, 2]
+    out[:, VEL] = x[VEL] + dx[:, 3:6]
+    out[:, QUAT] = quat_multiply(rotvec_to_quat(dx[:, 6:9]), x[QUAT])
+    out[:, 10:] = x[10:] + dx[:, 9:]
+    return out
+
+
+def boxminus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Tangent vectors (k, 17) of the states xs (k, 18) around the nominal state x (18,)."""
+    rm, rt = radii_of_curvature(x[0])
+    return _boxminus(np.ascontiguousarray(xs), x, float(rm), float(rt))
+
+
+def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray
+        ) -> np.ndarray:
+    """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook)."""
+    points = np.ascontiguousarray(points)
+    _propagate_points(points, w, f, dt)
+    return points
 
 
 class TcUkf(_TightlyCoupled):
-    """Tightly coupled total-state UKF (Chan et al.; see the module docstring).
+    """Tightly coupled total-state UKF (Chan et al.; see the module docstring), on the shared
+    sigma-point driver ``estimators.toolbox.ukf.SigmaPointFilter`` with this module's
+    ``boxplus``/``boxminus`` hooks (17-dimensional tangent space, quaternion in the state).
 
     Config: ``nhc`` (bool), ``alpha``, ``beta`` (sigma-point spread and prior, 0.99 and 2),
     and the noise and prior keys of ``DEFAULTS``.
@@ -311,147 +359,75 @@ class TcUkf(_TightlyCoupled):
     def setup(self) -> None:
         super().setup()
         init = self.initial
-        self._mean = {"pos": np.array(init.position, dtype=float),
-                      "v": np.array(init.velocity, dtype=float), "q": init.quaternion,
-                      "ba": np.zeros(3), "bg": np.zeros(3), "clock": np.zeros(2)}
-        self._p = self._p0.copy()
-        self._draw()
-        self._buf_w: list[np.ndarray] = []
-        self._buf_f: list[np.ndarray] = []
-        self._buf_dt: list[float] = []
-        self._fresh = True  # the points still are the drawn set (mean known)
-
-    # manifold hooks: x (+) dx and x1 (-) x0 on the 17-dim tangent space --------------------
-    @staticmethod
-    def boxplus(mean: dict, dx: np.ndarray) -> dict:
-        """States ``mean`` moved by tangent vectors dx (k, 17); returns arrays over k."""
-        pos = mean["pos"]
-        rm, rt = radii_of_curvature(pos[0])
-        k = len(dx)
-        new_pos = np.empty((k, 3))
-        new_pos[:, 0] = pos[0] + dx[:, 0] / (rm + pos[2])
-        new_pos[:, 1] = pos[1] + dx[:, 1] / ((rt + pos[2]) * np.cos(pos[0]))
-        new_pos[:, 2] = pos[2] - dx[:, 2]
-        q = quat_multiply(rotvec_to_quat(dx[:, 6:9]), mean["q"][None, :])
-        return {"pos": new_pos, "v": mean["v"] + dx[:, 3:6], "q": q,
-                "ba": mean["ba"] + dx[:, 9:12], "bg": mean["bg"] + dx[:, 12:15],
-                "clock": mean["clock"] + dx[:, 15:17]}
-
-    @staticmethod
-    def boxminus(pts: dict, ref: int = 0) -> np.ndarray:
-        """Tangent vectors (k, 17) of the points ``pts`` around their point ``ref``."""
-        rm, rt = radii_of_curvature(pts["pos"][ref, 0])
-        return _tangent(pts["pos"], pts["v"], pts["q"], pts["ba"], pts["bg"], pts["clock"], ref,
-                        float(rm), float(rt))
-
-    def _draw(self) -> None:
-        """Sigma points of N(mean, P) on the tangent space (paper step 1), as states."""
-        try:
-            dx, self._wm, self._wc = symmetric_points(np.zeros(N_STATES), self._p,
-                                                      self.config["alpha"], self.config["beta"])
-        except np.linalg.LinAlgError:  # lost positive definiteness: clip the eigenvalues
-            val, vec = np.linalg.eigh(self._p)
-            self._p = (vec * np.maximum(val, 1e-12)) @ vec.T
-            dx, self._wm, self._wc = symmetric_points(np.zeros(N_STATES), self._p,
-                                                      self.config["alpha"], self.config["beta"])
-        self._pts = self.boxplus(self._mean, dx)
-        self._pts_dx = dx
-
-    def _mean_cov(self) -> tuple[dict, np.ndarray, np.ndarray]:
-        """Weighted mean and covariance of the propagated points (paper step 3), and the
-        points' tangent deviations from the mean."""
-        center = {k: v[0] for k, v in self._pts.items()}
-        d = self.boxminus(self._pts)
-        mean_dx = self._wm @ d
-        mean = _plus_one(center, mean_dx)
-        dev = d - mean_dx
-        return mean, (self._wc[:, None] * dev).T @ dev, dev
+        x0 = np.zeros(N_NOMINAL)
+        x0[POS], x0[VEL], x0[QUAT] = init.position, init.velocity, init.quaternion
+        self.ukf = SigmaPointFilter(x0, self._p0, points="symmetric",
+                                    alpha=self.config["alpha"], beta=self.config["beta"],
+                                    boxplus=boxplus, boxminus=boxminus)
+        self._propagated = False  # points moved since the covariance was last formed
 
     # -- propagation ---------------------------------------------------------------------------
-    def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        if not self._buf_dt:  # the interval's start
-            self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
-        self._buf_w.append(w)
-        self._buf_f.append(f)
-        self._buf_dt.append(dt)
-
     def _flush(self) -> None:
-        if not self._buf_dt:
-            return
-        p = self._pts
-        _propagate_points(p["pos"], p["v"], p["q"], p["ba"], p["bg"], np.array(self._buf_w),
-                          np.array(self._buf_f), np.array(self._buf_dt))
-        p["clock"][:, 0] += p["clock"][:, 1] * sum(self._buf_dt)  # cb' = d
-        self._buf_dt = []
-        self._fresh = False
+        """Move the sigma points (drawn at the last update) through the buffered IMU samples;
+        the driver sets the mean (paper steps 2-3)."""
+        if self._buf_dt:
+            self.ukf.propagate(_fx, *self._take_buffer())
+            self._propagated = True
 
     def _predict(self, t: float) -> None:
-        """Propagate to t: mean and covariance of the points plus Q (paper step 3)."""
+        """Covariance of the propagated points plus Q over the interval (paper step 3)."""
         self._flush()
-        if not self._fresh:
-            self._mean, p_xx, _ = self._mean_cov()
-            self._p = p_xx + self.process_noise(t - self._t_update)
+        if self._propagated:
+            self.ukf.covariance(self.process_noise(t - self._t_update))
             self._t_update = t
+            self._propagated = False
 
     # -- measurements --------------------------------------------------------------------------
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         if len(ep.sv) == 0:
             return
         self._predict(t)
-        m = self._mean
-        c_bn = quat_to_dcm(m["q"])
-        r, v, _ = _antenna_ecef(m["pos"], m["v"], c_bn, self._lever, np.zeros(3))
-        m["clock"] = np.array(self._clock_from_residuals(ep, r, v))
-        self._p[15:17, :] = 0.0
-        self._p[:, 15:17] = 0.0
-        self._p[15:17, 15:17] = np.diag(np.square(CLOCK_INIT_STD))
-        self._draw()
-        self._fresh = True
+        x = self.ukf.x
+        c_bn = quat_to_dcm(x[QUAT])
+        r, v, _ = _antenna_ecef(x[POS], x[VEL], c_bn, self._lever, np.zeros(3))
+        x[CLOCK] = self._clock_from_residuals(ep, r, v)
+        p = self.ukf.p
+        p[15:17, :] = 0.0
+        p[:, 15:17] = 0.0
+        p[15:17, 15:17] = np.diag(np.square(CLOCK_INIT_STD))
+        self.ukf.sigma = None  # drawn again from the new clock
 
-    def _observe(self, pts: dict, ep: gnss_model.RawEpoch | None, nhc: bool) -> np.ndarray:
+    def _observe(self, pts: np.ndarray, ep: gnss_model.RawEpoch | None, nhc: bool
+                 ) -> np.ndarray:
         """Predicted measurements of every point (paper step 4): pseudoranges, range rates
         (eqs. 7-8) and the NHC body y, z velocities; shape (k, m)."""
-        c_bn = quat_to_dcm(pts["q"])
+        c_bn = quat_to_dcm(pts[:, QUAT])
         parts = []
         if ep is not None:
-            w_ib = self._w_prev[None, :] - pts["bg"]
-            w_eb = w_ib - _earth_rate_body(c_bn, pts["pos"][:, 0])
-            r, v, _ = _antenna_ecef(pts["pos"], pts["v"], c_bn, self._lever, w_eb)
-            pr, rate, _ = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, pts["clock"][:, 0],
-                                             pts["clock"][:, 1])
+            w_eb = self._w_prev[None, :] - pts[:, BG] - _earth_rate_body(c_bn, pts[:, 0])
+            r, v, _ = _antenna_ecef(pts[:, POS], pts[:, VEL], c_bn, self._lever, w_eb)
+            pr, rate, _ = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, pts[:, 16],
+                                             pts[:, 17])
             parts += [pr, rate]
         if nhc:
-            parts.append(np.einsum("kji,kj->ki", c_bn, pts["v"])[:, 1:3])
+            parts.append(np.einsum("kji,kj->ki", c_bn, pts[:, VEL])[:, 1:3])
         return np.concatenate(parts, axis=1)
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         nhc = bool(self.config["nhc"])
         self._predict(t)
-        self._draw()  # the points of N(x_bar, P^xx + Q)
-        y = self._observe(self._pts, ep, nhc)
-        y_mean = self._wm @ y
-        dy = y - y_mean
-        dx = self._pts_dx - self._wm @ self._pts_dx
-        p_yy = (self._wc[:, None] * dy).T @ dy
-        r = (self._measurement_noise(ep, nhc) if ep is not None
-             else np.eye(2) * self.config["nhc_std"] ** 2)
-        p_yy = p_yy + r
-        p_xy = (self._wc[:, None] * dx).T @ dy  # no R here (the paper's misprint)
-        z_parts = [ep.pseudorange, ep.range_rate] if ep is not None else []
-        z = np.concatenate(z_parts + ([np.zeros(2)] if nhc else []))
-        gain = np.linalg.solve(p_yy, p_xy.T).T
-        correction = gain @ (z - y_mean)
-        self._mean = _plus_one(self._mean, correction)
-        p = self._p - gain @ p_yy @ gain.T
-        self._p = 0.5 * (p + p.T)
-        self._draw()
-        self._fresh = True
+        if ep is None:
+            z, r = np.zeros(2), np.eye(2) * self.config["nhc_std"] ** 2
+        else:
+            z = np.concatenate([ep.pseudorange, ep.range_rate] + ([np.zeros(2)] if nhc else []))
+            r = self._measurement_noise(ep, nhc)
+        # the driver draws the points of N(x_bar, P^xx + Q), P^xy without R, P -= K P^yy K^T
+        self.ukf.update(self._observe, z, r, ep, nhc)
 
     def solution(self, t: float) -> np.ndarray:
         self._flush()
-        mean, p, _ = self._mean_cov() if not self._fresh else (self._mean, self._p, None)
-        return self._output(mean["pos"], mean["v"], mean["q"],
-                            np.concatenate([mean["ba"], mean["bg"]]), mean["clock"], p)
+        x = self.ukf.x
+        return self._output(x[POS], x[VEL], x[QUAT], x[10:16], x[CLOCK], self.ukf.p)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -486,6 +462,18 @@ def error_dynamics(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, f_b: np.nda
     return f
 
 
+@njit(cache=True)
+def _strapdown_block(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dth: np.ndarray,
+                     dv: np.ndarray, dth_prev: np.ndarray, dv_prev: np.ndarray, dt: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``strapdown.propagate`` through a block of increments (m, 3), carrying the previous
+    interval's increments for the coning and sculling terms; returns the final (q, v, pos)."""
+    for j in range(dt.shape[0]):
+        q, v, pos = propagate(q, v, pos, dth[j], dv[j], dth_prev, dv_prev, dt[j])
+        dth_prev, dv_prev = dth[j], dv[j]
+    return q, v, pos
+
+
 class TcEkf(_TightlyCoupled):
     """Tightly coupled error-state EKF (Chan et al. eqs. 4-6; see the module docstring).
 
@@ -506,34 +494,33 @@ class TcEkf(_TightlyCoupled):
         self._err = ErrorState(self._p0)
         self._dth_prev = np.zeros(3)
         self._dv_prev = np.zeros(3)
-        self._acc_f = np.zeros(3)
-        self._acc_dt = 0.0
 
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
-        if self._increments:  # the interval's mean rates
-            w_c, f_c = w - self._bg, f - self._ba
-        else:  # trapezoid over the interval
-            w_c = 0.5 * (w + self._w_prev) - self._bg
-            f_c = 0.5 * (f + self._f_prev) - self._ba
-        dth, dv = w_c * dt, f_c * dt
-        self._q, self._v, self._pos = propagate(self._q, self._v, self._pos, dth, dv,
-                                                self._dth_prev, self._dv_prev, dt)
-        self._dth_prev, self._dv_prev = dth, dv
-        self._clock[0] += self._clock[1] * dt
-        self._acc_f += f_c * dt
-        self._acc_dt += dt
-        if self._acc_dt >= 1.0 / COVARIANCE_RATE_HZ - 1e-9:
-            self._propagate_covariance()
+        super().inertial_step(w, f, dt)
+        if sum(self._buf_dt) >= 1.0 / COVARIANCE_RATE_HZ - 1e-9:
+            self._flush()
 
-    def _propagate_covariance(self) -> None:
-        dt = self._acc_dt
-        if dt <= 0:
+    def _flush(self) -> None:
+        """Strapdown through the buffered IMU intervals (bias-corrected increments: the
+        trapezoid of the rates, or the increments themselves), then the covariance over them."""
+        if not self._buf_dt:
             return
-        fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), self._acc_f / dt) * dt
+        w, f, dt = self._take_buffer()
+        if self._increments:  # the intervals' mean rates
+            w_c, f_c = w[1:] - self._bg, f[1:] - self._ba
+        else:
+            w_c = 0.5 * (w[1:] + w[:-1]) - self._bg
+            f_c = 0.5 * (f[1:] + f[:-1]) - self._ba
+        dth, dv = w_c * dt[:, None], f_c * dt[:, None]
+        self._q, self._v, self._pos = _strapdown_block(self._q, self._v, self._pos, dth, dv,
+                                                       self._dth_prev, self._dv_prev, dt)
+        self._dth_prev, self._dv_prev = dth[-1], dv[-1]
+        total = float(dt.sum())
+        self._clock[0] += self._clock[1] * total
+        fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), dv.sum(axis=0) / total)
+        fm *= total
         phi = np.eye(N_STATES) + fm + 0.5 * fm @ fm
-        self._err.predict(phi, self.process_noise(dt))
-        self._acc_f = np.zeros(3)
-        self._acc_dt = 0.0
+        self._err.predict(phi, self.process_noise(total))
 
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         if len(ep.sv) == 0:
@@ -543,7 +530,7 @@ class TcEkf(_TightlyCoupled):
         self._clock = np.array(self._clock_from_residuals(ep, r, v))
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
-        self._propagate_covariance()
+        self._flush()
         nhc = bool(self.config["nhc"])
         dz, rows, noise = [], [], []
         c_bn = quat_to_dcm(self._q)
@@ -584,6 +571,7 @@ class TcEkf(_TightlyCoupled):
         self._clock = self._clock - dx[15:17]
 
     def solution(self, t: float) -> np.ndarray:
+        self._flush()
         return self._output(self._pos, self._v, self._q, np.concatenate([self._ba, self._bg]),
                             self._clock, self._err.p)
 

@@ -7,7 +7,7 @@ before every measurement and every solution, so always causally) integrates the 
 in one compiled loop (``strapdown.propagate`` per sample, with the bias estimates removed and
 rate samples turned into trapezoidal increments) and then propagates the covariance once over
 the flushed interval with the mean specific force of the interval (the usual practice of running
-the covariance propagation slower than the mechanisation, Groves 2013, section 14.1.2). With a
+the covariance propagation slower than the mechanisation, Groves 2013, chapter 14). With a
 10 Hz solution rate the covariance is propagated at 10 Hz or faster.
 
 Public names
@@ -29,6 +29,7 @@ from estimators.toolbox.ins_error import BA, BG, discretise, noise_psd, system_m
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate
 from simulator.earth import quat_to_dcm, quat_to_euler
+from simulator.errors import InputError
 
 IMU_AXES = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 
@@ -124,6 +125,10 @@ class InsFilter:
         self.ba, self.bg = biases[:3].copy(), biases[3:].copy()
         self.kf = ErrorState(np.diag(np.asarray(p0_sigma, float) ** 2), closed_loop)
         self.noise = noise
+        missing = [c for c in IMU_AXES if c not in imu_columns]
+        if missing:
+            raise InputError(f"imu: an INS filter needs all six axes; the dataset's IMU lacks "
+                             f"{', '.join(missing)} (sensors.imu.axes)")
         self._idx = np.array([imu_columns[c] for c in IMU_AXES])
         self._increments = increments
         self._buf_t = np.empty(buffer_size)

@@ -8,16 +8,14 @@ import contextlib
 import sys
 from pathlib import Path
 
-import pandas as pd
-
+from simulator import pipeline
 from simulator.commands import SUMMARIES
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
 from simulator.outputs import atomic_output_dir
-from simulator.replay import run_estimator
-from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
+from simulator.scoring.evaluate import write_scores
 from simulator.scoring.readers import check_solution, read_solution_file
-from simulator.scoring.report import text_table, write_report
+from simulator.scoring.report import print_scores, write_report
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -45,10 +43,12 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
-def _from_files(paths: list[str], dataset: Dataset, truth: pd.DataFrame
-                ) -> dict[str, tuple[pd.DataFrame, dict]]:
+def _from_files(paths: list[str], dataset: Dataset) -> pipeline.Solutions:
+    """Read and check each solution file (any format of docs/solution-format.md); the notes
+    on what was converted go to stderr."""
     gps = dataset.manifest.get("gps_time_start") or {"week": 0, "tow": 0.0}
-    out: dict[str, tuple[pd.DataFrame, dict]] = {}
+    truth = dataset.read("truth")
+    out: pipeline.Solutions = {}
     for path in paths:
         label = Path(path).stem
         if label in out:
@@ -62,21 +62,6 @@ def _from_files(paths: list[str], dataset: Dataset, truth: pd.DataFrame
     return out
 
 
-def _from_estimators(dataset: Dataset, names: list[str]) -> dict[str, tuple[pd.DataFrame, dict]]:
-    out: dict[str, tuple[pd.DataFrame, dict]] = {}
-    for name in dict.fromkeys(names):
-        frame, info = run_estimator(dataset, name)
-        out[info["label"]] = (frame, info)
-    return out
-
-
-def print_scores(ev: Evaluation) -> None:
-    """The compact table on stdout and the scoring warnings on stderr."""
-    for line in ev.warnings():
-        print(f"warning: {line}", file=sys.stderr)
-    print(text_table(ev.scores()))
-
-
 def run(args: argparse.Namespace) -> int:
     if not args.solution and not args.estimator:
         raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
@@ -86,13 +71,14 @@ def run(args: argparse.Namespace) -> int:
         report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force,
                                                             [dataset.path]))
                       if args.report else None)
-        solutions = _from_files(args.solution, dataset, dataset.read("truth"))
-        for label, solved in _from_estimators(dataset, args.estimator).items():
+        solutions = _from_files(args.solution, dataset)
+        for label, solved in pipeline.run_estimators(dataset,
+                                                     dict.fromkeys(args.estimator)).items():
             if label in solutions:
                 raise InputError([Problem(args.dataset, None, "", f"label {label!r} is both a "
                                           "solution file's stem and an estimator's name")])
             solutions[label] = solved
-        ev = score_solutions(dataset, solutions)
+        ev = pipeline.score(dataset, solutions)
         print_scores(ev)
         if args.json:
             write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])

@@ -33,11 +33,12 @@ def _has_stream(sensors: dict, stream: str) -> bool:
 
 
 def check_faults(scenario: dict, path: Path, ctx: Context, duration_s: float,
-                 zones: set[str]) -> None:
-    """Cross-checks of every fault against the drive and the configured sensors."""
+                 zones: set[str], length_m: float | None = None) -> None:
+    """Cross-checks of every fault against the drive (its duration, zones and length travelled)
+    and the configured sensors."""
     for i, fault in enumerate(scenario["faults"]):
         where = path + ("faults", i)
-        trigger_problems(fault, where, ctx, duration_s, zones)
+        trigger_problems(fault, where, ctx, duration_s, zones, length_m)
         kind = FAULT_REGISTRY[fault["kind"]]
         wanted = [fault["stream"]] if "stream" in fault else list(kind.streams)
         if not any(_has_stream(scenario["sensors"], s) for s in wanted):

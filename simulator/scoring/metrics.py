@@ -40,14 +40,15 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   no cross-covariances, so P is taken diagonal;
 * ``runtime`` {seconds, realtime_factor} when the estimator ran inside landnav;
 * ``rows`` {total, outside_truth, position, velocity, attitude}: rows in the solution, rows
-  dropped outside the truth's time span, and rows scored in each group.
+  dropped outside the truth's time span, and rows with the whole group (a position row: finite
+  north and east errors; a velocity or attitude row: all three columns finite).
 
 Every metric uses only the rows where the solution has the quantities it needs
 (docs/solution-format.md: a quantity not estimated is NaN and is left out of its own metrics, not
-of the others): the
-horizontal metrics, coverage and windows the rows with finite lat and lon, the vertical ones
-finite alt, velocity all three of vn, ve, vd, each attitude angle its own column (a 2-D filter
-with NaN roll and pitch still has its yaw scored).
+of the others): the horizontal metrics, coverage and windows the rows with finite lat and lon,
+the vertical ones finite alt, velocity all three of vn, ve, vd, each attitude angle its own
+column (a 2-D filter with NaN height, roll and pitch still has its horizontal and yaw errors
+scored).
 
 Public functions
 ----------------
@@ -266,7 +267,7 @@ def score_errors(errors: SolutionErrors, truth: pd.DataFrame, events: pd.DataFra
                              "realtime_factor": _number(runtime["realtime_factor"])}
     scores["rows"] = {"total": errors.total_rows, "outside_truth": errors.outside_truth,
                       "position": int(pos_ok.sum()), "velocity": int(vel_ok.sum()),
-                      "attitude": int(att_ok.any(axis=1).sum())}
+                      "attitude": int(att_ok.all(axis=1).sum())}
     return scores
 
 

@@ -9,17 +9,17 @@ Numbers are printed with three decimals; a missing value prints as ``-``.
 
 Public functions
 ----------------
-write_report, text_table, format_number, markdown_table.
+write_report, print_scores, text_table, format_number, markdown_table.
 """
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
-from simulator.scoring import plots as plot
 from simulator.scoring.evaluate import Evaluation
-from simulator.scoring.metrics import OUTAGE_KIND
+from simulator.scoring.metrics import OUTAGE_KIND, degraded_windows
 
 PLOTS = "plots"  # sub-directory of the report directory holding the PNGs
 
@@ -85,6 +85,14 @@ def text_table(scores: dict[str, dict]) -> str:
                      for r in [header, *rows])
 
 
+def print_scores(ev: Evaluation) -> None:
+    """The compact table of every solution's scores on stdout and the scoring warnings (rows
+    that could not be scored) on stderr."""
+    for line in ev.warnings():
+        print(f"warning: {line}", file=sys.stderr)
+    print(text_table(ev.scores()))
+
+
 def _metrics_lines(scores: dict[str, dict]) -> list[str]:
     rows = [[title, *(format_number(_value(s, g, k)) for s in scores.values())]
             for g, k, title in _TABLE_ROWS
@@ -128,7 +136,11 @@ def _sensor_lines(scores: dict[str, dict]) -> list[str]:
 
 
 def _plots(ev: Evaluation) -> list[tuple[str, str, Callable[[Evaluation, Path], None]]]:
-    """(file stem, heading, function(ev, path)) of the plots this evaluation calls for."""
+    """(file stem, heading, function(ev, path)) of the plots this evaluation calls for.
+    matplotlib loads here, when a report is written (a third of a second that the commands
+    which only print scores do not pay)."""
+    from simulator.scoring import plots as plot
+
     out: list[tuple[str, str, Callable[[Evaluation, Path], None]]] = [
         ("map", "Trajectories", plot.plot_map)]
     if plot.shaded_windows(ev):
@@ -171,7 +183,7 @@ def write_report(directory: Path, ev: Evaluation, title: str, note: str | None =
     (directory / PLOTS).mkdir(exist_ok=True)
     scores = ev.scores()
     n_outages = int((ev.events["kind"] == OUTAGE_KIND).sum())
-    n_degraded = len(plot.shaded_windows(ev)) - n_outages
+    n_degraded = len(degraded_windows(ev.events, ev.canyon_zones))
     t = ev.truth["t"].to_numpy(float)
     lines = [f"# {title}", ""]
     if note:

@@ -192,3 +192,14 @@ IMU_PRESETS["bosch-smi130-calibrated"] = {
     **IMU_PRESETS["bosch-smi130"],
     "accel": {**IMU_PRESETS["bosch-smi130"]["accel"], "bias": 7 * MILLI_G},
 }
+# Karamat et al. 2015 (Table 1, the IMU300CC) with an in-run first-order Gauss-Markov bias beside
+# the turn-on bias: Table 1 prints none, so 1 % of the gyro's and 3 % of the accelerometers'
+# turn-on bias, correlation time 300 s (assumed; docs/reproduction_karamat2015.md). Use it with
+# ``axes: riss3d`` for the paper's reduced unit (vertical gyro, forward and lateral accelerometers)
+IMU_PRESETS["crossbow-imu300cc-gm"] = {
+    **IMU_PRESETS["crossbow-imu300cc"],
+    "gyro": {**IMU_PRESETS["crossbow-imu300cc"]["gyro"],
+             "gauss_markov_sigma": 0.02 * DEG_S, "gauss_markov_correlation_time": 300.0},
+    "accel": {**IMU_PRESETS["crossbow-imu300cc"]["accel"],
+              "gauss_markov_sigma": 1 * MILLI_G, "gauss_markov_correlation_time": 300.0},
+}
