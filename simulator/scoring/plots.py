@@ -203,7 +203,8 @@ def _error_panels(ev: Evaluation, path: Path, names: tuple[str, ...], stds: tupl
         ax.set(ylabel=f"{title} ({unit})")
         ax.grid(alpha=0.3)
     axes[0].set_title(heading)
-    axes[0].legend(loc="upper left", fontsize="x-small", ncol=3)
+    if axes[0].get_legend_handles_labels()[0]:  # nothing to list when no solution has the axis
+        axes[0].legend(loc="upper left", fontsize="x-small", ncol=3)
     axes[-1].set_xlabel("t (s)")
     _save(fig, path)
 
@@ -272,7 +273,8 @@ def plot_horizontal_cdf(ev: Evaluation, path: Path) -> None:
     ax.set(xlabel="horizontal error (m, log scale)", ylabel="fraction of epochs",
            ylim=(0, 1.02), title="CDF of horizontal error")
     ax.grid(alpha=0.3, which="both")
-    ax.legend(loc="lower right", fontsize="small")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="lower right", fontsize="small")
     _save(fig, path)
 
 
