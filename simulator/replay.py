@@ -188,6 +188,17 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
     return [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
 
 
+def imu_output(dataset: Dataset) -> str | None:
+    """What a dataset's IMU rows hold: ``"rate"`` or ``"increment"`` (None without an IMU), from
+    the IMU stream's description in the manifest (``imu_output``), else from the resolved
+    scenario's ``sensors.imu.output`` (datasets written before the field existed)."""
+    stream = dataset.manifest.get("streams", {}).get("imu")
+    if stream is None:
+        return None
+    imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
+    return stream.get("imu_output") or imu.get("output") or "rate"
+
+
 def _units(dataset: Dataset, name: str) -> dict[str, str]:
     """Column units of a stream; an IMU configured for increment output has rad and m/s
     increments whatever its files say (the manifest's resolved scenario is authoritative):
@@ -244,7 +255,7 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                 dataset.manifest.get("sensors"))
     with _plugin_call(cls, "setup"):
         estimator = cls(config, initial, {s.name: s.columns for s in streams},
-                        {s.name: s.units for s in streams})
+                        {s.name: s.units for s in streams}, imu_output=imu_output(dataset))
     gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
     out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
     out = np.full((len(out_t), len(cls.output_columns)), np.nan)

@@ -88,7 +88,10 @@ class DatasetWriter:
                                              self.directory / self.file_name(name),
                                              _units_for(name, table, self._units.get(name)))
 
-    def finish(self, manifest: dict, streams: dict[str, Table]) -> None:
+    def finish(self, manifest: dict, streams: dict[str, Table],
+               described: dict[str, dict] | None = None) -> None:
+        """Write what is left, then the manifest with its ``streams`` block: each stream's file,
+        rows and rate, and the fields of ``described[name]`` (the IMU's ``imu_output``)."""
         manifest = dict(manifest)
         manifest["format"] = col.DATASET_FORMAT
         manifest["streams"] = {}
@@ -106,7 +109,7 @@ class DatasetWriter:
                 t = column(table, "t")
                 rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
             manifest["streams"][name] = {"file": self.file_name(name), "rows": rows,
-                                         "rate_hz": rate}
+                                         "rate_hz": rate, **(described or {}).get(name, {})}
         text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
         (self.directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
 

@@ -85,7 +85,7 @@ def test_help_points_to_docs_not_to_spec(capsys, command):
 
 
 def test_faults_page_lists_every_kind_and_readme_shows_the_garage_plots():
-    from simulator.faults.base import FAULT_REGISTRY
+    from simulator.faults import FAULT_REGISTRY
 
     faults = (REPO / "docs" / "faults.md").read_text(encoding="utf-8")
     assert all(f"| `{kind}` | {fk.doc} |" in faults for kind, fk in FAULT_REGISTRY.items())
