@@ -31,6 +31,8 @@ from simulator.schema import (
 from simulator.sensors import SENSOR_FIELDS
 from simulator.trajectory import TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
+from simulator.vehicle import VEHICLE_FIELD
+from simulator.vehicle.params import default_vehicle
 
 START_FIELD = Record({
     "utc": DateTime("2020-01-01T00:00:00Z", earliest="1980-01-06T00:00:00",
@@ -67,6 +69,8 @@ ESTIMATOR_ENTRY_FIELD = Either(
 
 def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     traj = value["trajectory"]
+    if value["vehicle"] is None:
+        value["vehicle"] = default_vehicle(traj["kind"])
     imu = value["sensors"].get("imu")
     if traj.get("rate") is None:
         traj["rate"] = imu["rate"] if imu else 100.0
@@ -136,6 +140,7 @@ SCENARIO_FIELD = Record(
         "start": START_FIELD,
         "limits": LIMITS_FIELD,
         "trajectory": Tagged(TRAJECTORY_KINDS, what="trajectory kind"),
+        "vehicle": VEHICLE_FIELD,
         "environment": ENVIRONMENT_FIELD,
         "sensors": Record(SENSOR_FIELDS, default={}),
         "faults": ListOf(FAULT_FIELD, []),

@@ -77,7 +77,8 @@ LIMITS_FIELD = Record(
         "vertical_accel": Number("m/s^2", 0.5, gt=0,
                                  doc="vertical acceleration setting vertical-curve length"),
         "roll_gradient": Number("rad*s^2/m", np.radians(4.0) / G0_M_S2, min=0,
-                                doc="body roll per lateral acceleration (4 deg/g)"),
+                                doc="body roll per lateral acceleration of a rigid body "
+                                    "(vehicle: rigid; 4 deg/g)"),
     },
     default={},
 )
@@ -154,6 +155,9 @@ class RoadProfile:
     # d(t): +1 driving forward, -1 reversing, piecewise constant in time, switching only at
     # standstill; None: forward throughout (SUMO and recorded drives)
     direction: PiecewisePolynomial | None = None
+    # speed bumps as (start s, length, height), m: their shape is also in ``grade`` (a rigid
+    # body rides over it); the vehicle model takes it out there and puts it under the wheels
+    bumps: list[tuple[float, float, float]] = field(default_factory=list)
 
     def direction_at(self, t: np.ndarray) -> np.ndarray | float:
         """d(t), +1 forward and -1 reversing, at times t (the scalar 1.0 if never reversing)."""
@@ -475,6 +479,7 @@ def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None =
     path_pieces: list[_PathPiece] = []
     time_pieces: list[_TimePiece] = []
     zones: list[tuple[float, float, str]] = []
+    bumps: list[tuple[float, float, float]] = []
     v = 0.0
     t = 0.0
     failed = False
@@ -559,6 +564,8 @@ def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None =
                 pieces = _helix(seg, v, limits)
             elif kind == "speed_bump":
                 pieces = _speed_bump(seg["height"], seg["length"])
+                bumps.append((sum(p.length for p in path_pieces), seg["length"],
+                              seg["height"]))
             else:  # lane_change
                 if abs(seg["offset"]) > 0.4 * seg["length"]:
                     fail(i, kind, "offset is too large for the length (at most 0.4 x length)")
@@ -571,7 +578,9 @@ def build_road_profile(segments: list[dict], limits: dict, ctx: Context | None =
             zones.append((t_start, t, seg["zone"]))
     if failed:
         return None
-    return _assemble(path_pieces, time_pieces, zones)
+    profile = _assemble(path_pieces, time_pieces, zones)
+    profile.bumps = bumps
+    return profile
 
 
 def _ppoly(lengths: list[float], polys: list[np.ndarray]) -> PiecewisePolynomial:

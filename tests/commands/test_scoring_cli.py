@@ -174,10 +174,13 @@ def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
     sol = pd.read_parquet(out / "solutions" / "hold.parquet")
     at = truth.set_index(np.round(truth["t"], 6)).loc[np.round(sol["t"], 6)]
     v = at[["vn", "ve", "vd"]].to_numpy()
+    # rows matched by times rounded to the microsecond: with the body's vibration (some m/s^2)
+    # the truth moves by up to 1e-6 m/s within that rounding
     assert scores["hold"]["velocity"]["rms"] == pytest.approx(
-        np.sqrt(np.mean(np.sum(v**2, axis=1))), rel=1e-9)
+        np.sqrt(np.mean(np.sum(v**2, axis=1))), rel=1e-7)
+    # the held roll is the start's (the road's camber under the car), not zero
     assert scores["hold"]["attitude"]["roll_rms"] == pytest.approx(
-        np.degrees(np.sqrt(np.mean(at["roll"] ** 2))), rel=1e-9)
+        np.degrees(np.sqrt(np.mean((at["roll"] - truth["roll"].iloc[0]) ** 2))), rel=1e-7)
     assert scores["hold"]["horizontal"]["cep50"] > 100.0
     assert scores["hold"]["runtime"]["seconds"] > 0
     text = (out / "report.md").read_text()

@@ -27,7 +27,7 @@ def _flat(roll_gradient: float | None, output: str) -> dict:
     data = scenario(imu_output=output)
     if roll_gradient is None:
         return data
-    raw = {k: data[k] for k in ("name", "seed", "start", "sensors")}
+    raw = {k: data[k] for k in ("name", "seed", "start", "sensors", "vehicle")}
     raw["limits"] = {"roll_gradient": roll_gradient}
     raw["trajectory"] = {"kind": "segments", "segments": FLAT_LOOP}
     return validate_data(raw, "flat")

@@ -56,7 +56,7 @@ def test_mechanisation_closes_on_the_truth(tmp_path, output):
     the scenario (slopes, turns, a lane change, a stop). A sign error in eq. 1's Earth-rate term
     (as our copy prints it) would turn the yaw by 2 omega_e sin(lat) t, 1.3 deg in the 430 s."""
     data = short_scenario(1, loops=1, site_s=None)
-    raw = {k: data[k] for k in ("name", "seed", "start", "trajectory")}
+    raw = {k: data[k] for k in ("name", "seed", "start", "trajectory", "vehicle")}
     raw["sensors"] = {"imu": {"preset": "ideal", "rate": 100, "axes": "riss3d", "output": output},
                       "odometer": {"preset": "ideal", "rate": 10}}
     ds = open_dataset(generate(tmp_path / "ideal", validate_data(raw, "ideal")))
