@@ -112,8 +112,7 @@ class CampaignPlan:
                 seed = self.base.seed + i
                 part = (f"sweep-{point.index:04d}-run-{i:06d}" if self.sweeps
                         else f"run-{i:06d}")
-                # the validated drive with this run's seed (its road's random stream): the
-                # profile is not built again
+                # the drive's random road is the run's too: the validated profile is kept
                 drive = (None if scenario.drive is None
                          else dataclasses.replace(scenario.drive, seed=seed))
                 run_scenario = dataclasses.replace(
