@@ -25,7 +25,9 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
 * Propagation (paper: each sigma point integrated through the noise-free dynamics with 10 RK4
   steps per GPS interval): every sigma point is integrated with one RK4 step of eqs. 1-3 per IMU
   interval (``strapdown.rk4_step``; rates at the interval's ends and their mean at its middle),
-  i.e. 100 steps per second at 100 Hz rather than 10, so that no IMU sample is skipped. The
+  i.e. 100 steps per second at 100 Hz rather than 10, so that no IMU sample is skipped (an
+  IMU that outputs increments gives the intervals' mean rates, used at the interval's end and,
+  from the interval before, at its start). The
   process noise is added to the propagated covariance (additive Q) and the points are drawn
   again from it before the measurement update.
 * Eq. 7 lacks the receiver position and prints "+" for a product: the model is
