@@ -44,8 +44,8 @@ def main() -> None:
     segs = [SEGMENT_FIELD.check(s, ("segments", i), ctx) for i, s in enumerate(LOOP * 21)]
     profile = build_road_profile(segs, limits, ctx)
     truth = kinematics_from_profile(profile, {"lat": 37.5665, "lon": 126.978, "alt": 40.0,
-                                              "heading": 0.0}, 10.0, limits["roll_gradient"])
-    truth.utc_start = dt.datetime(2010, 7, 1, 6, 0)
+                                              "heading": 0.0}, 10.0, limits["roll_gradient"],
+                                    dt.datetime(2010, 7, 1, 6, 0))
     config = GNSS_FIELD.check({"rate": 1, "constellation": str(NAV)}, ("gnss",), ctx)
     assert not ctx.problems, ctx.problems
     times, cpu = [], []

@@ -20,7 +20,9 @@ The replay (``simulator.replay``) builds it with its merged configuration, its i
 (``InitialState``: the truth at its start time perturbed by the scenario's ``init`` errors, or
 None) and the layout of the streams it receives, then calls ``setup()``. Each message goes to the
 method ``on_<stream>(t, row)``: ``row`` is a read-only float64 row of the stream's table whose
-column positions are ``self.columns[stream][column]`` (units in ``self.units[stream]``); a
+column positions are ``self.columns[stream][column]`` (units in ``self.units[stream]``;
+``self.imu_output`` says whether the IMU rows are rates, ``"rate"``, or increments over the
+interval before each sample, ``"increment"``, from the dataset's IMU stream description); a
 ``gnss_raw`` message is one whole epoch, a 2-D array with one row per satellite. After the
 messages of an output instant the replay calls ``solution(t)``, which returns the values of
 ``output_columns`` for time ``t`` (or None while the estimator has no solution yet).
@@ -95,11 +97,13 @@ class Estimator:
 
     def __init__(self, config: Mapping[str, Any] | None, initial: InitialState | None,
                  columns: Mapping[str, Mapping[str, int]],
-                 units: Mapping[str, Mapping[str, str]]):
+                 units: Mapping[str, Mapping[str, str]], *, imu_output: str | None = None):
         self.config = resolve_config(type(self), config)
         self.initial = initial
         self.columns = {k: dict(v) for k, v in columns.items()}
         self.units = {k: dict(v) for k, v in units.items()}
+        # "rate" or "increment" (None without an IMU stream): what the IMU rows hold
+        self.imu_output = imu_output
         self.setup()
 
     def setup(self) -> None:
@@ -155,6 +159,9 @@ def _kind(value: Any) -> str | None:
     return type(value).__name__
 
 
+MAX_OUTPUT_RATE_HZ = 1000.0  # solution rows per second of data an estimator may ask for
+
+
 def check_estimator_class(cls: Any, where: str) -> list[str]:
     """Problems with a class offered as an estimator (empty if it satisfies the contract)."""
     if not (isinstance(cls, type) and issubclass(cls, Estimator)):
@@ -172,6 +179,21 @@ def check_estimator_class(cls: Any, where: str) -> list[str]:
     missing = [c for c in NAV_COLUMNS if c not in cls.output_columns]
     if missing:
         problems.append(f"{where}: output_columns lacks {', '.join(missing)}")
-    if not cls.output_rate_hz > 0:
-        problems.append(f"{where}: output_rate_hz must be positive")
+    columns = cls.output_columns
+    if not isinstance(columns, (tuple, list)) or not all(isinstance(c, str) for c in columns):
+        problems.append(f"{where}: output_columns must be a tuple of column names")
+    else:
+        repeated = sorted({c for c in columns if columns.count(c) > 1} | (
+            {"t"} & set(columns)))
+        if repeated:
+            problems.append(f"{where}: output_columns names {', '.join(repeated)} twice "
+                            "(t is added by the replay)")
+    if not isinstance(cls.defaults, Mapping):
+        problems.append(f"{where}: defaults must be a mapping of config keys to default values, "
+                        f"got {cls.defaults!r}")
+    rate = cls.output_rate_hz
+    if isinstance(rate, bool) or not isinstance(rate, (int, float)) or not (
+            0 < rate <= MAX_OUTPUT_RATE_HZ):
+        problems.append(f"{where}: output_rate_hz must be a number in (0, "
+                        f"{MAX_OUTPUT_RATE_HZ:g}] Hz, got {rate!r}")
     return problems

@@ -43,7 +43,7 @@ class MyEstimator(Estimator):
         self.speed = float(np.hypot(*self.initial.velocity[:2]))
         self.t = self.initial.t
         self.gz = self.columns["imu"]["gyro_z"]
-        self.increments = self.units["imu"]["gyro_z"] == "rad"
+        self.increments = self.imu_output == "increment"
         self.v = self.columns["odometer"]["speed"]
         if "gnss_fix" in self.columns:
             g = self.columns["gnss_fix"]

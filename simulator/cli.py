@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import multiprocessing
 import os
 import signal
 import sys
@@ -76,10 +77,15 @@ def main(argv: list[str] | None = None) -> int:
     return code
 
 
-def _importing(frame: FrameType | None) -> bool:
-    """Whether the interrupted code is an import (the import system on its stack)."""
+_MULTIPROCESSING_DIR = os.path.dirname(multiprocessing.__file__)
+
+
+def _in_critical_section(frame: FrameType | None) -> bool:
+    """Whether the interrupted code is an import or the start of a child process (the import
+    system or ``multiprocessing`` on its stack)."""
     while frame is not None:
-        if frame.f_code.co_filename.startswith("<frozen importlib"):
+        name = frame.f_code.co_filename
+        if name.startswith("<frozen importlib") or name.startswith(_MULTIPROCESSING_DIR):
             return True
         frame = frame.f_back
     return False
@@ -87,11 +93,12 @@ def _importing(frame: FrameType | None) -> bool:
 
 def _stop(signum: int, frame: FrameType | None) -> None:
     """SIGTERM and SIGINT: raise ``Terminated`` or ``KeyboardInterrupt`` in the main thread, so
-    every ``with`` block unwinds and removes its temporaries. Not during an import: an exception
-    between the import system's taking and releasing its global lock would leave the lock held
-    and hang every thread that imports, and a module's own bare ``except:`` may swallow it;
-    there the signal is retried 20 ms later."""
-    if _importing(frame):
+    every ``with`` block unwinds and removes its temporaries. Not during an import or while a
+    worker process is being started: an exception between the import system's taking and
+    releasing its global lock would leave the lock held and hang every thread that imports (and
+    a module's own bare ``except:`` may swallow it), and one inside a process start leaves a
+    child half made that no one can stop; there the signal is retried 20 ms later."""
+    if _in_critical_section(frame):
         _deferred.append(signum)
         signal.setitimer(signal.ITIMER_REAL, 0.02)
         return

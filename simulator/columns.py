@@ -6,7 +6,7 @@ Parquet field metadata. Extra columns a model adds must be declared here too.
 Public names
 ------------
 TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV, BARO, MAG, EVENTS, TRUTH_GNSS, STREAMS,
-IMU_AXES, SOLUTION, SOLUTION_STD, DATASET_FORMAT.
+IMU_AXES, SOLUTION, SOLUTION_STD, DATASET_FORMAT, REQUIRED, TEXT_COLUMNS.
 """
 
 from __future__ import annotations
@@ -98,3 +98,22 @@ STREAMS = {
     "truth_gnss": ("truth_gnss.parquet", TRUTH_GNSS),
 }
 SCORING_ONLY = ("truth", "truth_gnss", "events")
+
+# the columns a stream must have (SPEC section 5); an IMU needs ``t`` and at least one axis
+REQUIRED = {
+    "truth": ("t", "lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw", "wx", "wy",
+              "wz", "fx", "fy", "fz", "speed", "distance", "zone"),
+    "imu": ("t",),
+    "odometer": ("t", "speed"),
+    "gnss_fix": ("t", "lat", "lon", "alt", "vn", "ve", "vd", "speed", "course", "num_sats",
+                 "hdop", "vdop", "fix"),
+    "gnss_raw": ("t", "sv", "pseudorange", "pseudorange_rate", "doppler", "cn0", "sat_x",
+                 "sat_y", "sat_z", "sat_vx", "sat_vy", "sat_vz", "sat_clock", "sat_clock_drift",
+                 "iono", "tropo", "elevation", "azimuth"),
+    "gnss_nav": tuple(GNSS_NAV),
+    "baro": ("t", "pressure"),
+    "mag": ("t", "mag_x", "mag_y", "mag_z"),
+    "events": tuple(EVENTS),
+    "truth_gnss": ("t", "sv"),
+}
+TEXT_COLUMNS = ("zone", "kind", "detail")  # every other column of a stream is numeric

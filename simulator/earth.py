@@ -14,7 +14,7 @@ radii_of_curvature, radii_of_curvature_from_sin, normal_gravity, normal_gravity_
 gravity_ned, earth_rate_ned, transport_rate_ned, geodetic_rates, geodetic_to_ecef, ecef_to_geodetic,
 ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef, ned_to_ecef_vector, euler_to_dcm, ned_to_body,
 ned_to_body_trig, ned_to_body_components, dcm_to_euler, euler_to_quat, quat_to_dcm, quat_to_euler,
-quat_multiply, rotvec_to_quat, wrap_angle, skew.
+quat_multiply, rotvec_to_quat, quat_to_rotvec, wrap_angle, skew.
 
 References
 ----------
@@ -216,6 +216,21 @@ def skew(v: np.ndarray) -> np.ndarray:
 # that k times each of them is exact for whole turns |k| < 2^20
 _TWO_PI_PARTS = (float.fromhex("0x1.921fb544p+2"), float.fromhex("0x1.0b4611a6p-32"),
                  float.fromhex("0x1.3198a2e037073p-67"))
+
+
+def quat_to_rotvec(q: np.ndarray) -> np.ndarray:
+    """Rotation vector (rad) of scalar-first unit quaternions, shape (..., 3): the inverse of
+    ``rotvec_to_quat``, the shorter of the two rotations (angle in [0, pi])."""
+    q = np.asarray(q, dtype=float)
+    q = np.where(q[..., :1] < 0.0, -q, q)  # q and -q are the same rotation
+    v = q[..., 1:]
+    s = np.linalg.norm(v, axis=-1)
+    angle = 2.0 * np.arctan2(s, q[..., 0])
+    # angle / s, with its limit 2 / q0 (times 1 + s^2 / 3 q0^2) for tiny rotations
+    small = s < 1e-6
+    k = np.where(small, 2.0 / q[..., 0] * (1.0 + s**2 / (3.0 * q[..., 0] ** 2)),
+                 angle / np.where(small, 1.0, s))
+    return v * k[..., None]
 
 
 def wrap_angle(angle_rad: np.ndarray) -> np.ndarray:

@@ -23,6 +23,7 @@ run_estimator, initial_state, merge_streams, output_times, write_solution, read_
 from __future__ import annotations
 
 import time
+import traceback
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -41,7 +42,7 @@ from simulator.earth import (
     ned_to_ecef_vector,
     wrap_angle,
 )
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, Terminated
 from simulator.outputs import atomic_output_file
 from simulator.progress import progress
 
@@ -119,9 +120,7 @@ class _Stream:
         self.data.flags.writeable = False
         self.columns = {c: i for i, c in enumerate(numeric)}
         self.units = {c: units.get(c, "") for c in numeric}
-        t = self.data[:, self.columns["t"]]
-        if not np.all(np.diff(t) >= 0):
-            raise InputError([Problem(str(where), None, name, "time t decreases or is missing")])
+        t = self.data[:, self.columns["t"]]  # increasing: checked when the dataset is read
         if name == "gnss_raw":  # one message per epoch: a 2-D block of its satellites
             starts = np.flatnonzero(np.r_[True, np.diff(t) > 0])
             bounds = np.r_[starts, len(t)]
@@ -188,6 +187,17 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
     return [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
 
 
+def imu_output(dataset: Dataset) -> str | None:
+    """What a dataset's IMU rows hold: ``"rate"`` or ``"increment"`` (None without an IMU), from
+    the IMU stream's description in the manifest (``imu_output``), else from the resolved
+    scenario's ``sensors.imu.output`` (datasets written before the field existed)."""
+    stream = dataset.manifest.get("streams", {}).get("imu")
+    if stream is None:
+        return None
+    imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
+    return stream.get("imu_output") or imu.get("output") or "rate"
+
+
 def _units(dataset: Dataset, name: str) -> dict[str, str]:
     """Column units of a stream; an IMU configured for increment output has rad and m/s
     increments whatever its files say (the manifest's resolved scenario is authoritative)."""
@@ -240,8 +250,9 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                       "stream; use an estimator that initialises itself")])
         initial = initial_state(dataset.read("truth"), float(t[0]), init,
                                 dataset.manifest.get("sensors"))
-    estimator = cls(config, initial, {s.name: s.columns for s in streams},
-                    {s.name: s.units for s in streams})
+    with _plugin_call(cls, "setup"):
+        estimator = cls(config, initial, {s.name: s.columns for s in streams},
+                        {s.name: s.units for s in streams}, imu_output=imu_output(dataset))
     gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
     out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
     out = np.full((len(out_t), len(cls.output_columns)), np.nan)
@@ -254,21 +265,26 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     start = time.perf_counter()
     k = 0
     asks = zip(out_t.tolist(), upto.tolist(), strict=True)
-    for j, (t_out, n_before) in enumerate(progress(asks, label, show_progress, len(out_t))):
-        while k < n_before:
-            s = sid_list[k]
-            handlers[s](t_list[k], messages[s][idx_list[k]])
-            k += 1
-        row = solution(t_out)
-        if row is not None:
-            try:
-                out[j] = row
-            except ValueError:
-                raise ValueError(f"estimator {name!r} returned {len(row)} values at t = "
-                                 f"{t_out} s; its output_columns has {out.shape[1]}: "
-                                 f"{', '.join(cls.output_columns)}") from None
-            kept[j] = True
+    call = _Call(cls)
+    with call:
+        for j, (t_out, n_before) in enumerate(progress(asks, label, show_progress,
+                                                       len(out_t))):
+            while k < n_before:
+                s = sid_list[k]
+                call.at = (streams[s].name, t_list[k])
+                handlers[s](t_list[k], messages[s][idx_list[k]])
+                k += 1
+            call.at = ("solution", t_out)
+            row = solution(t_out)
+            if row is not None:
+                out[j] = _solution_row(row, cls, t_out)
+                kept[j] = True
     runtime = time.perf_counter() - start
+    position = out[kept][:, [cls.output_columns.index("lat"), cls.output_columns.index("lon")]]
+    if not np.isfinite(position).all(axis=1).any():
+        raise InputError([Problem(_where(cls), None, "", "gave no solution row with a position "
+                                  f"over the whole dataset ({int(kept.sum())} row(s), all "
+                                  "without lat/lon); nothing to score")])
 
     frame = pd.DataFrame(out[kept], columns=list(cls.output_columns))
     frame.insert(0, "t", out_t[kept])
@@ -276,6 +292,60 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     info = {"label": label, "name": name, "runtime_s": runtime,
             "realtime_factor": duration / runtime if runtime > 0 else float("inf")}
     return frame, info
+
+
+def _where(cls: type) -> str:
+    return f"estimator {cls.name!r} ({cls.__module__}.{cls.__qualname__})"
+
+
+class _Call:
+    """Turns anything a plug-in raises (``sys.exit`` included) into one ``InputError`` naming
+    the estimator, the call, the message time and the reason, with the line of the
+    estimator's code where it happened."""
+
+    def __init__(self, cls: type, at: tuple[str, float | None] = ("setup", None)):
+        self.cls, self.at = cls, at
+
+    def __enter__(self) -> _Call:
+        return self
+
+    def __exit__(self, kind: type | None, exc: BaseException | None, tb: Any) -> bool:
+        if exc is None or isinstance(exc, (InputError, KeyboardInterrupt, Terminated)):
+            return False
+        call, t = self.at
+        method = call if call in ("setup", "solution") else f"on_{call}"
+        when = "" if t is None else f" at t = {t:.6f} s"
+        if isinstance(exc, SystemExit):
+            reason = f"called sys.exit({exc.code!r}); an estimator must return, not exit"
+        else:
+            reason = f"{type(exc).__name__}: {exc}"
+            frames = [f for f in traceback.extract_tb(tb)
+                      if Path(f.filename).resolve() != Path(__file__).resolve()]
+            if frames:
+                reason += f" ({frames[-1].filename}:{frames[-1].lineno})"
+        raise InputError([Problem(_where(self.cls), None, "",
+                                  f"failed in {method}(){when}: {reason}")]) from None
+
+
+def _plugin_call(cls: type, method: str) -> _Call:
+    return _Call(cls, (method, None))
+
+
+def _solution_row(row: Any, cls: type, t: float) -> np.ndarray:
+    """A solution row as floats, or InputError saying what the estimator returned instead."""
+    n = len(cls.output_columns)
+    try:
+        values = np.asarray(row, dtype=float)
+    except (TypeError, ValueError):
+        values = None
+    if values is None or values.shape != (n,):
+        got = (f"a {type(row).__name__}" if values is None or values.ndim != 1
+               else f"{values.size} values")
+        raise InputError([Problem(_where(cls), None, "",
+                                  f"solution({t:.6f}) returned {got}; it must return None or "
+                                  f"{n} numbers, one per output column "
+                                  f"({', '.join(cls.output_columns)})")])
+    return values
 
 
 def _solution_problems(frame: pd.DataFrame) -> list[str]:

@@ -42,6 +42,8 @@ class Context:
         self.lines = lines or {}
         self.overridden = overridden or set()
         self.problems: list[Problem] = []
+        # what a check built that its caller reuses (the scenario's road profile), by name
+        self.built: dict[str, Any] = {}
 
     def line_of(self, path: Path) -> int | str | None:
         for n in range(len(path), -1, -1):
@@ -180,7 +182,12 @@ class Boolean(Field):
 
 
 class DateTime(Field):
-    """An ISO 8601 UTC time; resolved to text ``YYYY-MM-DDTHH:MM:SS(.ffffff)Z``."""
+    """An ISO 8601 UTC time, not before ``earliest`` (ISO text) if given; resolved to text
+    ``YYYY-MM-DDTHH:MM:SS(.ffffff)Z``."""
+
+    def __init__(self, default: Any = REQUIRED, *, earliest: str | None = None, doc: str = ""):
+        super().__init__(default, doc)
+        self.earliest = None if earliest is None else dt.datetime.fromisoformat(earliest)
 
     def check(self, value: Any, path: Path, ctx: Context) -> Any:
         if isinstance(value, dt.datetime):
@@ -195,6 +202,9 @@ class DateTime(Field):
             return ctx.error(path, f"expected an ISO 8601 UTC time, got {value!r}")
         if stamp.tzinfo is not None:
             stamp = stamp.astimezone(dt.UTC).replace(tzinfo=None)
+        if self.earliest is not None and stamp < self.earliest:
+            return ctx.error(path, f"{stamp.isoformat()}Z is before {self.earliest.isoformat()}Z"
+                                   " (the GPS epoch: GPS time and broadcast orbits start there)")
         return stamp.isoformat() + "Z"
 
 

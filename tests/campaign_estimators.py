@@ -4,6 +4,7 @@ logs every run it makes."""
 from __future__ import annotations
 
 import os
+import time
 
 import numpy as np
 
@@ -37,3 +38,15 @@ class Counting(HoldStart):
     def setup(self) -> None:
         with open(self.config["log"], "a", encoding="utf-8") as log:
             log.write(f"{os.getpid()}\n")
+
+
+class Stuck(HoldStart):
+    """Never returns from its first IMU message while the file ``config["stuck_while"]`` exists:
+    a worker stuck in an endless loop."""
+
+    name = "stuck"
+    defaults = {"stuck_while": ""}
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        while os.path.exists(self.config["stuck_while"]):
+            time.sleep(0.05)

@@ -29,7 +29,7 @@ PACKAGES = ("simulator", "estimators")
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("simulator", "simulator.earth", "simulator.units", "simulator.columns",
               "simulator.errors", "simulator.schema", "simulator.tables", "simulator.timebase",
-              "simulator.progress", "simulator.stochastic")),
+              "simulator.progress", "simulator.stochastic", "simulator.outputs")),
     ("trajectory", ("simulator.trajectory", "simulator.vehicle", "simulator.environment")),
     ("drive", ("simulator.drive",)),
     ("gnss", ("simulator.gnss",)),

@@ -147,3 +147,19 @@ def test_single_vector_fast_paths_equal_the_stacked_forms():
     np.testing.assert_array_equal(earth.skew(v[1]), earth.skew(v)[1])
     np.testing.assert_allclose(earth.skew(v[2]) @ v[3], np.cross(v[2], v[3]), atol=1e-14)
     np.testing.assert_allclose(earth.quat_to_dcm(q[3]), earth.quat_to_dcm(q)[3], atol=1e-15)
+
+
+def test_quat_to_rotvec_inverts_rotvec_to_quat():
+    rng = np.random.default_rng(11)
+    axis = rng.normal(size=(6, 3))
+    axis /= np.linalg.norm(axis, axis=1)[:, None]
+    angles = np.array([0.0, 1e-9, 1e-4, 0.5, 3.0, np.pi - 1e-6])
+    rotvec = axis * angles[:, None]
+    np.testing.assert_allclose(earth.quat_to_rotvec(earth.rotvec_to_quat(rotvec)), rotvec,
+                               rtol=1e-9, atol=1e-15)
+    # -q is the same rotation; beyond pi the shorter rotation the other way comes back
+    q = earth.rotvec_to_quat(rotvec[3])
+    np.testing.assert_allclose(earth.quat_to_rotvec(-q), rotvec[3], rtol=1e-12)
+    long_way = axis[4] * (2 * np.pi - 0.5)
+    np.testing.assert_allclose(earth.quat_to_rotvec(earth.rotvec_to_quat(long_way)),
+                               -axis[4] * 0.5, rtol=1e-9)

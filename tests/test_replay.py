@@ -171,7 +171,8 @@ def test_read_solution_rejects_bad_files(tmp_path):
 
 
 def test_wrong_number_of_solution_values_names_the_columns(dataset):
-    with pytest.raises(ValueError, match=r"returned 3 values at t = .* output_columns has 9"):
+    with pytest.raises(InputError, match=r"returned 3 values; it must return None or 9 numbers, "
+                                         r"one per output column \(lat, lon"):
         run_estimator(dataset, "tests.recording:Miscounted", show_progress=False)
 
 
@@ -190,7 +191,8 @@ def test_stream_with_decreasing_time_is_refused(tmp_path, dataset):
     imu.loc[10, "t"] = 100.0
     with atomic_output_dir(tmp_path / "bad", force=False) as tmp:
         write_dataset(tmp, {}, {"imu": imu, "truth": dataset.read("truth")})
-    with pytest.raises(InputError, match=r"bad: imu: time t decreases"):
+    with pytest.raises(InputError, match=r"bad/imu.parquet: corrupt imu stream: time runs "
+                                         r"backwards at row 11"):
         run_estimator(open_dataset(tmp_path / "bad"), "tests.recording:Recorder",
                       show_progress=False)
 
@@ -226,3 +228,24 @@ def test_sensor_error_priors_reach_the_initial_state():
     with pytest.raises(InputError, match="sensor_errors"):
         scenario_data(segments, estimators=[{"name": "gnss_only",
                                              "init": {"sensor_errors": "exact"}}])
+
+
+@pytest.mark.parametrize("output", ["rate", "increment"])
+def test_estimator_is_told_what_the_imu_rows_hold(tmp_path, output):
+    """``imu_output`` comes from the IMU stream's description in the manifest (written by the
+    generator), not from the units: the estimator sees the IMU's configured output."""
+    from simulator.dataset.generate import generate_dataset
+    from simulator.scenario import Scenario, validate_data
+    from tests.recording import Recorder
+
+    data = validate_data({"start": {"lat": 37.5, "lon": 127.0},
+                          "trajectory": {"kind": "segments",
+                                         "segments": [{"stop": {"duration": 2}}]},
+                          "sensors": {"imu": {"preset": "ideal", "rate": 100,
+                                              "output": output}}}, "s.yaml")
+    out = generate_dataset(Scenario(tmp_path / "s.yaml", data, []), tmp_path / "d",
+                           show_progress=False)
+    dataset = open_dataset(out)
+    assert dataset.manifest["streams"]["imu"]["imu_output"] == output
+    run_estimator(dataset, "tests.recording:Recorder", show_progress=False)
+    assert Recorder.last.imu_output == output

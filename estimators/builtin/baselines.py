@@ -83,7 +83,7 @@ class DeadReckoning(Estimator):
         self._speed = float(init.velocity[0] * math.cos(self._yaw)
                             + init.velocity[1] * math.sin(self._yaw))
         self._gz = self.columns["imu"]["gyro_z"]
-        self._increments = self.units["imu"].get("gyro_z") == "rad"
+        self._increments = self.imu_output == "increment"
         self._speed_col = self.columns["odometer"]["speed"]
         self._t_imu = init.t
         self._bias = 0.0  # yaw-gyro bias learned at standstill, rad/s

@@ -42,8 +42,10 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
 * DRM1's filter state is not printed: [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], the level-
   frame velocity of eq. 2 without its "+ g^n" (a typo: the horizontal components of g^n are
   zero) and the scale-factor model 2 of both accelerometers and the yaw gyro. P0 and Q follow
-  eqs. 33-34 term by term (5 m/s and 0.1 m/s^2 on each velocity axis). Its speed measurement
-  is linearised (and left out below 0.5 m/s, where the speed's direction is undefined).
+  eqs. 33-34 term by term (5 m/s and 0.1 m/s^2 on each velocity axis). Its specific force is
+  resolved at the step's mid heading and its position moves with the mean of the old and new
+  velocity (``drm1_transition``). Its speed measurement is linearised (and left out below
+  0.5 m/s, where the speed's direction is undefined).
 * Eq. 18 converts GPS latitude and longitude to metres with one Earth radius R_e; we use the
   WGS-84 meridian and transverse radii at the start (``simulator.earth``).
 * No Earth rate (the paper ignores it); the standstill calibration removes its vertical part.
@@ -76,6 +78,7 @@ from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
 from simulator.earth import normal_gravity, radii_of_curvature, wrap_angle
+from simulator.errors import InputError, Problem
 
 PAPER = "Cho & Choi 2006, ETRI J. 28(2) (seeds/000)"
 DR_STEP_S = 0.1  # the DR propagation interval (10 Hz, section III)
@@ -150,19 +153,23 @@ def drm1_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
                     g: float) -> np.ndarray:
     """DRM1 propagation of states ``x`` (k, 8) (Cho & Choi eqs. 2-3, level frame, no g^n).
 
-    ``u`` = [f_x, f_y (m/s^2), w_z (rad/s)]; the velocity is updated first and the position
-    moves with the new velocity (eq. 3).
+    ``u`` = [f_x, f_y (m/s^2), w_z (rad/s)]; the specific force is resolved at the step's
+    mid heading (eq. 2 names the new one, C_b^n at k; in a turn either end alone turns the
+    velocity by half a step too far or too little), the velocity is updated first and the
+    position moves with the mean of the old and the new velocity (eq. 3 names the new one,
+    which puts the position a dt / 2 ahead while accelerating).
     """
     pn, pe, vn, ve, psi, d_ax, d_ay, d_gz = x.T
     f_x, f_y, w_z = u
     fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
-    c, s = np.cos(psi), np.sin(psi)
+    turn = (1.0 - d_gz) * w_z * dt
+    c, s = np.cos(psi + 0.5 * turn), np.sin(psi + 0.5 * turn)
     out = np.empty_like(x)
     out[:, 2] = vn + (c * fxc - s * fyc) * dt  # eq. 2, C_b^n f^b
     out[:, 3] = ve + (s * fxc + c * fyc) * dt
-    out[:, 0] = pn + out[:, 2] * dt  # eq. 3
-    out[:, 1] = pe + out[:, 3] * dt
-    out[:, 4] = wrap_angle(psi + (1.0 - d_gz) * w_z * dt)
+    out[:, 0] = pn + 0.5 * (vn + out[:, 2]) * dt  # eq. 3, trapezoidal as DRM2's
+    out[:, 1] = pe + 0.5 * (ve + out[:, 3]) * dt
+    out[:, 4] = wrap_angle(psi + turn)
     out[:, 5:] = x[:, 5:]
     if w is not None:
         out += w * (dt / DRAW_INTERVAL_S)
@@ -172,16 +179,21 @@ def drm1_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
 
 def drm1_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarray:
     """Transition matrix of ``drm1_transition`` at ``x`` (8,)."""
-    psi, d_ax, d_ay = x[4], x[5], x[6]
+    psi, d_ax, d_ay, d_gz = x[4], x[5], x[6], x[7]
     f_x, f_y, w_z = u
-    c, s = math.cos(psi), math.sin(psi)
+    mid = psi + 0.5 * (1.0 - d_gz) * w_z * dt
+    c, s = math.cos(mid), math.sin(mid)
     fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
     phi = np.eye(8)
-    # velocity rows: d/d psi, d/d d_ax, d/d d_ay
-    phi[2, 4], phi[2, 5], phi[2, 6] = (-s * fxc - c * fyc) * dt, -c * f_x * dt, s * f_y * dt
-    phi[3, 4], phi[3, 5], phi[3, 6] = (c * fxc - s * fyc) * dt, -s * f_x * dt, -c * f_y * dt
-    phi[0] += dt * phi[2]  # the position moves with the new velocity (eq. 3)
-    phi[1] += dt * phi[3]
+    # velocity rows: d/d psi, d/d d_ax, d/d d_ay, d/d d_gz (through the mid heading)
+    dvn_dpsi, dve_dpsi = (-s * fxc - c * fyc) * dt, (c * fxc - s * fyc) * dt
+    phi[2, 4], phi[2, 5], phi[2, 6] = dvn_dpsi, -c * f_x * dt, s * f_y * dt
+    phi[3, 4], phi[3, 5], phi[3, 6] = dve_dpsi, -s * f_x * dt, -c * f_y * dt
+    phi[2, 7], phi[3, 7] = -0.5 * w_z * dt * dvn_dpsi, -0.5 * w_z * dt * dve_dpsi
+    phi[0] += 0.5 * dt * phi[2]  # the position moves with the old and new velocity (eq. 3)
+    phi[1] += 0.5 * dt * phi[3]
+    phi[0, 2] += 0.5 * dt
+    phi[1, 3] += 0.5 * dt
     phi[4, 7] = -w_z * dt
     return phi
 
@@ -207,10 +219,10 @@ class _ChoDr(Estimator):
         self._g = float(normal_gravity(self._lat0, self._h0))
         imu = self.columns["imu"]
         self._cols = [imu[c] for c in self._imu_columns]
-        self._increment = self.units["imu"].get(self._imu_columns[-1]) in ("rad", "m/s")
+        self._increment = self.imu_output == "increment"
         fix = self.columns["gnss_fix"]
         self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
-        self._sum = np.zeros(3)  # sums of the three inputs x time over the current DR step
+        self._s0 = self._s1 = self._s2 = 0.0  # the three inputs integrated over the DR step
         self._acc_t = 0.0  # time accumulated in the current DR step
         self._t_imu = init.t
         self._bias = np.zeros(3)  # calibrated gyro biases (zero for accelerometer inputs)
@@ -243,10 +255,14 @@ class _ChoDr(Estimator):
             return
         self._t_imu = t
         c0, c1, c2 = self._cols
-        if self._increment:
-            self._sum += (row[c0], row[c1], row[c2])
+        if self._increment:  # plain floats: this runs for every IMU sample
+            self._s0 += row[c0]
+            self._s1 += row[c1]
+            self._s2 += row[c2]
         else:
-            self._sum += (row[c0] * dt, row[c1] * dt, row[c2] * dt)
+            self._s0 += row[c0] * dt
+            self._s1 += row[c1] * dt
+            self._s2 += row[c2] * dt
         self._acc_t += dt
         if self._acc_t >= DR_STEP_S - 1e-9:
             self._step()
@@ -256,8 +272,8 @@ class _ChoDr(Estimator):
         dt = self._acc_t
         if dt <= 0.0:
             return
-        u = self._sum / dt
-        self._sum = np.zeros(3)
+        u = np.array([self._s0, self._s1, self._s2]) / dt
+        self._s0 = self._s1 = self._s2 = 0.0
         self._acc_t = 0.0
         if self._still:
             f_index = self._accel_index
@@ -410,6 +426,7 @@ class Drm1Ekf(_Drm1, _Ekf):
     """2-D DR/GPS EKF on the DRM1 unit (two accelerometers + yaw gyro)."""
 
     name = "dr2d_drm1_ekf"
+    paper = f"{PAPER}: DRM1 (eqs. 2-3) with an EKF, GPS position and speed (eq. 18)"
 
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         zhat, h = super()._measure(x)
@@ -422,15 +439,24 @@ class Drm2Ekf(_Drm2, _Ekf):
     """2-D DR/GPS EKF on the DRM2 unit (forward accelerometer + pitch and yaw gyros)."""
 
     name = "dr2d_drm2_ekf"
+    paper = f"{PAPER}: DRM2 (eqs. 4-8, 14b) with the EKF of eqs. 15-17"
 
 
 class Drm2Spkf(_Drm2):
     """2-D DR/GPS scaled simplex sigma-point filter on the DRM2 unit (eqs. 19-32)."""
 
     name = "dr2d_drm2_spkf"
+    paper = f"{PAPER}: DRM2 with the scaled simplex sigma-point filter (eqs. 19-32)"
     defaults = {"standstill_calibration": True, "alpha": 0.3, "beta": 2.0, "w0": 0.0}
 
     def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
+        checks = (("alpha", 1e-4 <= self.config["alpha"] <= 1.0, "must be in [1e-4, 1] (eq. 21)"),
+                  ("w0", 0.0 <= self.config["w0"] < 1.0, "must be in [0, 1)"),
+                  ("beta", self.config["beta"] >= 0.0, "must not be negative"))
+        problems = [f"config key {key!r} of estimator {self.name} {rule}, got "
+                    f"{self.config[key]!r}" for key, ok, rule in checks if not ok]
+        if problems:
+            raise InputError([Problem("config", None, "", p) for p in problems])
         plus, minus = angle_hooks([4])
         self._ukf = SigmaPointFilter(x0, p0, points="simplex", alpha=self.config["alpha"],
                                      beta=self.config["beta"], w0=self.config["w0"],

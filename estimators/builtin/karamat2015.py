@@ -256,10 +256,12 @@ class RissTcEkf(Estimator):
         self._q_white = np.array([_Q_WHITE.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in GM_PARAMETERS.items()
                     if _I[s] < self._n]
+        self._gm_index = np.array([g[0] for g in self._gm])
+        self._noise_cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         # sums over the IMU samples of the current odometer interval
         c = self.columns["imu"]
         self._col_gz, self._col_fx, self._col_fy = c["gyro_z"], c["accel_x"], c["accel_y"]
-        self._increments = self.units["imu"].get("gyro_z") == "rad"
+        self._increments = self.imu_output == "increment"
         self._t_imu = init.t
         self._sum_wz = self._sum_ffwd = self._sum_flat = self._sum_dt = 0.0
         self._n_imu = 0
@@ -378,14 +380,18 @@ class RissTcEkf(Estimator):
         self._by *= decay[5]
         ao = ao_raw - self._c_ao
         self._ao = ao
-        vo = speed - self._c_vo
+        # a wheel that does not turn reads zero whatever its scale error: at a standstill the
+        # speed is exactly zero (the estimated speed error applies to a moving wheel only)
+        vo = speed - self._c_vo if speed != 0.0 else 0.0
         self._vo = vo
         wz_c = wz - self._bz
         pitch = _asin((ffwd_avg - ao - self._by) / g) - self._c_p  # eq. 2
         roll = -_asin((flat - self._bx + vo * wz_c) / (g * math.cos(pitch))) - self._c_r  # eq. 3
         a_dot = -wz_c + OMEGA_E_RAD_S * math.sin(lat) + self._ve * math.tan(lat) / (rn + h)  # 1
         az_mid = self._az + 0.5 * a_dot * dt
-        self._az = float(wrap_angle(self._az + a_dot * dt))
+        self._az += a_dot * dt
+        if abs(self._az) > math.pi:
+            self._az = float(wrap_angle(self._az))
         cos_p = math.cos(pitch)
         # eqs. 4-5 with eqs. 22 and 26: the direction of the horizontal velocity turns with
         # the azimuth rate (the form the error model of eqs. 24 and 28 linearises, so that a
@@ -412,8 +418,35 @@ class RissTcEkf(Estimator):
             self._t_accel_update = t
             self._update_accelerometers(g, ffwd_avg, flat, wz)
 
+    def _heading(self) -> float:
+        """The direction of travel: the horizontal velocity's direction (against it while
+        reversing) when moving, else the azimuth state."""
+        if abs(self._vo) > 1.0 and math.hypot(self._ve, self._vn) > 0.5:
+            sign = 1.0 if self._vo > 0.0 else -1.0
+            return math.atan2(sign * self._ve, sign * self._vn)
+        return self._az
+
+    def _noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """Gauss-Markov transition factors and the discrete process noise Q_d over ``dt``
+        (cached: the odometer interval is nearly always the same)."""
+        key = round(dt, 9)
+        cached = self._noise_cache.get(key)
+        if cached is None:
+            q = self._q_white * dt
+            sigma = np.array([g[1] for g in self._gm])
+            tau = np.array([g[2] for g in self._gm])
+            phi_gm, q_gm = gauss_markov_discrete(tau, sigma, dt)
+            q[self._gm_index] = q_gm
+            q_d = np.diag(q)
+            clock = slice(_I["cb"], _I["cd"] + 1)
+            q_d[clock, clock] = gnss_model.clock_noise(dt)  # a TCXO (the shared clock model)
+            cached = (phi_gm, q_d)
+            if len(self._noise_cache) < 64:
+                self._noise_cache[key] = cached
+        return cached
+
     def _predict(self, dt: float, rm: float, rn: float, wz_c: float) -> None:
-        f = system_matrix(self._lat, self._h, self._ve, self._vn, self._az, self._pitch,
+        f = system_matrix(self._lat, self._h, self._ve, self._vn, self._heading(), self._pitch,
                           self._ao, wz_c, self._n)
         # rescale d lat, d lon (rad) to north and east metres: F_m = T F T^-1
         scale = np.ones(self._n)
@@ -422,14 +455,9 @@ class RissTcEkf(Estimator):
         f = f * scale[:, None] / scale[None, :]
         fdt = f * dt
         phi = np.eye(self._n) + fdt + 0.5 * fdt @ fdt
-        q = self._q_white * dt
-        for k, sigma, tau in self._gm:
-            phi_k, q_k = gauss_markov_discrete(tau, sigma, dt)
-            phi[k, k] = phi_k
-            q[k] = q_k
-        q_d = np.diag(q)
-        clock = slice(_I["cb"], _I["cd"] + 1)
-        q_d[clock, clock] = gnss_model.clock_noise(dt)  # a TCXO (the shared clock model)
+        phi_gm, q_d = self._noise(dt)
+        idx = self._gm_index
+        phi[idx, idx] = phi_gm
         self._filter.predict(phi, q_d)
 
     # --- measurement updates ------------------------------------------------------------------
@@ -505,7 +533,7 @@ class RissTcEkf(Estimator):
         self._ve -= dx[i["ve"]]
         self._vn -= dx[i["vn"]]
         self._vu -= dx[i["vu"]]
-        self._az = float(wrap_angle(self._az - dx[i["A"]]))
+        self._az = float(wrap_angle(self._az - dx[i["A"]]))  # at most once a second
         self._c_ao += dx[i["ao"]]
         self._ao -= dx[i["ao"]]
         self._bz -= dx[i["bz"]]
@@ -532,7 +560,7 @@ class RissTcEkf(Estimator):
         clock = (self._cb, self._cd) if self._clock_ready else (math.nan, math.nan)
         accel = (self._by, self._bx) if self._enhanced else (math.nan, math.nan)
         return [math.degrees(lat), math.degrees(lon), self._h + self._vu * lead,
-                self._vn, self._ve, -self._vu, self._roll, self._pitch, self._az,
+                self._vn, self._ve, -self._vu, self._roll, self._pitch, self._heading(),
                 math.sqrt(p[i["N"], i["N"]]), math.sqrt(p[i["E"], i["E"]]),
                 math.sqrt(p[i["h"], i["h"]]), math.sqrt(p[i["A"], i["A"]]),
                 -self._bz, accel[0], accel[1], *clock]

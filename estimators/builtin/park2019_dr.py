@@ -33,24 +33,33 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   ``odometer_scale_factor`` column is SPEC section 7's ratio of measured to true speed, 1 / s.
 * Tilt measurement Jacobian. Eq. 37 is the level, small-roll approximation of the exact
   linearisation d(roll, pitch)/d psi = rows 1-2 of M(roll, pitch) C_n^b (M the Euler-rate
-  matrix); the exact rows are used (identical on level ground, better on a 15 % ramp). The same
-  holds for the course row of eq. 41 (row 3). The accelerometers give roll = atan2(-f_y, -f_z),
-  pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) in the FRD frame (eqs. 34-35 written for FRD) from the
-  mean specific force of the step.
+  matrix); the exact rows are used (identical on level ground, better on a 15 % ramp). The
+  course row of eq. 41 is likewise the exact yaw Jacobian (``toolbox.aiding.heading``: the
+  course is the heading of the body x axis, the car does not slide). The accelerometers give
+  roll = atan2(-f_y, -f_z), pitch = atan2(f_x, sqrt(f_y^2 + f_z^2)) in the FRD frame (eqs.
+  34-35 written for FRD) from the mean specific force of the step.
 * GPS speed is the horizontal ground speed, so its prediction is s u cos(pitch), not s u
   (eq. 39); the Jacobian has u cos(pitch) on ds and -s u sin(pitch) on the pitch error. Course
   is used only while moving forwards faster than ``course_min_speed`` (it is undefined at
   standstill and points backwards while reversing).
-* Barometer: its bias is removed "simply" with GPS height (section III-C): the offset
-  h_baro - h_GPS is averaged (first-order filter, ``baro_offset_time_constant``) over good 3-D
-  fixes (``gps_height_max_vdop``) and frozen without them; the barometer is used from the first
-  such fix on. GPS height enters step 2 only on such fixes.
+* Barometer: the ``altitude`` column of the ``baro`` stream (its standard-atmosphere pressure
+  altitude; a stream without it is not used). Its bias is removed "simply" with GPS height
+  (section III-C): the offset h_baro - h_GPS is averaged (first-order filter,
+  ``baro_offset_time_constant``) over good 3-D fixes (``gps_height_max_vdop``) and frozen
+  without them; the barometer is used from the first such fix on. GPS height enters step 2
+  only on such fixes.
 * Adaptation rules (section III-D), thresholds as printed: (1) | ||f|| - g | > 0.059 m/s^2
   inflates the tilt noise from ``tilt_sigma`` to ``tilt_sigma_inflated``; (2) a speed below
   5 m/s inflates the GPS speed and course noise to their ``*_inflated`` values; (3) a barometric
   innovation over 2.5 m inflates the barometer noise to ``baro_sigma_inflated``. The inflated
-  values are not printed: chosen as ten times (tilt), five times (speed, course) and twenty
-  times (barometer) the nominal. With ``adaptive: false`` the nominal values are used always.
+  values are not printed: five times (speed, course) and twenty times (barometer) the nominal;
+  for the tilt 30 deg, thirty times: a manoeuvre flagged by rule 1 lasts seconds, and its tilt
+  error (9 deg at 1.5 m/s^2) must not pull the attitude through 20 updates a second (with
+  10 deg it still did, by 9 deg). The "g" of rule 1 is the specific-force norm measured at
+  standstill (odometer reading zero), normal gravity before the first standstill: the residual
+  accelerometer bias Park assumes (7 mg, section III-B) exceeds the 0.059 m/s^2 threshold
+  itself, so against normal gravity the rule flags standstill and passes moderate
+  accelerations. With ``adaptive: false`` the nominal values are used always.
 * Gauss-Markov time constants (eq. 29) are not printed: tau_1 = 3600 s for the scale factor
   (tyre wear and pressure change over hours), tau_2 = 600 s for the gyro biases; process noise
   from the SMI130 gyro noise density (Table 1) and small steady-state sigmas.
@@ -74,8 +83,9 @@ import numpy as np
 from numba import njit
 
 from estimators.base import NAV_COLUMNS, Estimator
-from estimators.toolbox.constraints import height as height_measurement
+from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.gating import threshold_variance
+from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
 from simulator.earth import OMEGA_E_RAD_S, dcm_to_euler, normal_gravity, quat_to_dcm, wrap_angle
@@ -86,6 +96,7 @@ DEG = math.pi / 180.0
 ACCEL_NORM_THRESHOLD_M_S2 = 0.059  # Park section III-D rule 1 (0.006 g)
 LOW_SPEED_THRESHOLD_M_S = 5.0  # Park section III-D rule 2 ("approximately 4 ~ 6 m/s")
 BARO_INNOVATION_THRESHOLD_M = 2.5  # Park section III-D rule 3 (80 % of one floor)
+_LEVEL = np.array([1.0, 0.0, 0.0, 0.0])  # identity quaternion
 
 
 def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
@@ -150,43 +161,50 @@ class _FixColumns:
         self.fix, self.vdop = columns["fix"], columns["vdop"]
 
 
-def _ned_offset(lat: float, lon: float, h: float, lat_ref: float, lon_ref: float,
-                h_ref: float) -> np.ndarray:
-    """(lat, lon, h) minus the reference as north and east arc lengths and down, m (rad in)."""
-    rn, re = radii(lat)
-    return np.array([(lat - lat_ref) * (rn + h), (lon - lon_ref) * (re + h) * math.cos(lat),
-                     -(h - h_ref)])
-
-
 class _StepAccumulator:
-    """IMU samples summed over one filter step: gyro increments, mean specific force."""
+    """IMU samples summed over one filter step: gyro increments, mean specific force. Rate
+    samples are integrated by the trapezoidal rule between consecutive samples (the first
+    sample holds over the interval before it); increments are summed."""
 
-    def __init__(self, columns: dict[str, int], units: dict[str, str], t0: float):
-        self.gyro = [columns["gyro_x"], columns["gyro_y"], columns["gyro_z"]]
-        self.accel = [columns[a] for a in ("accel_x", "accel_y", "accel_z") if a in columns]
-        self.increments = units.get("gyro_z") == "rad"
+    def __init__(self, columns: dict[str, int], increments: bool, t0: float):
+        # column of each axis, None for an axis the unit lacks (read as zero)
+        self.cols = [columns.get(a) for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x",
+                                              "accel_y", "accel_z")]
+        self.has_accel = None not in self.cols[3:]
+        self.increments = increments
         self.t = t0
+        self.prev: list[float] | None = None
         self.reset()
 
     def reset(self) -> None:
-        self.dtheta = [0.0, 0.0, 0.0]  # rad, body FRD
-        self.dvel = [0.0, 0.0, 0.0]  # m/s (specific force integrated)
+        self.sums = [0.0] * len(self.cols)  # rad, then m/s (body FRD)
         self.dt = 0.0
+
+    @property
+    def dtheta(self) -> list[float]:
+        """Summed angle increment of the step, rad."""
+        return self.sums[:3]
+
+    @property
+    def dvel(self) -> list[float]:
+        """Summed velocity increment (specific force integrated) of the step, m/s."""
+        return self.sums[3:6]
 
     def add(self, t: float, row: np.ndarray) -> None:
         dt = t - self.t
         if dt <= 0.0:
             return
         self.t = t
-        g, a = self.gyro, self.accel
-        w = 1.0 if self.increments else dt  # a rate sample holds over the interval before it
-        self.dtheta[0] += row[g[0]] * w
-        self.dtheta[1] += row[g[1]] * w
-        self.dtheta[2] += row[g[2]] * w
-        if a:
-            self.dvel[0] += row[a[0]] * w
-            self.dvel[1] += row[a[1]] * w
-            self.dvel[2] += row[a[2]] * w
+        now = [0.0 if c is None else float(row[c]) for c in self.cols]
+        sums = self.sums
+        if self.increments:
+            for k, x in enumerate(now):
+                sums[k] += x
+        else:
+            prev = now if self.prev is None else self.prev
+            for k, x in enumerate(now):
+                sums[k] += 0.5 * (x + prev[k]) * dt
+            self.prev = now
         self.dt += dt
 
 
@@ -215,7 +233,7 @@ class Dr3dEkf(Estimator):
         "attitude_initial": 1.0 * DEG,  # rad, P0 roll and pitch
         "heading_initial": 5.0 * DEG,  # rad, P0 yaw
         "tilt_sigma": 1.0 * DEG,  # rad, accelerometer roll/pitch noise
-        "tilt_sigma_inflated": 10.0 * DEG,
+        "tilt_sigma_inflated": 30.0 * DEG,
         "baro_sigma": 0.5,  # m
         "baro_sigma_inflated": 10.0,  # m
         "baro_offset_time_constant": 60.0,  # s
@@ -240,7 +258,7 @@ class Dr3dEkf(Estimator):
         self._bias = np.zeros(3)  # gyro bias estimate, rad/s
         self._u = 0.0  # latest odometer reading, m/s
         self._zero3 = np.zeros(3)
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         self._baro_col = self.columns.get("baro", {}).get("altitude")
@@ -253,15 +271,23 @@ class Dr3dEkf(Estimator):
                            [c["attitude_initial"] ** 2] * 2, c["heading_initial"] ** 2,
                            [c["gyro_bias_initial"] ** 2] * 3])
         self._kf = ErrorState(p0)
+        # rule 1's reference norm: normal gravity until the first standstill, then the mean
+        # specific-force norm measured at standstill (it absorbs the accelerometer bias)
         self._g = float(np.squeeze(normal_gravity(self._pos[0], self._pos[2])))
+        self._still_norm_sum = 0.0
+        self._still_steps = 0
         self._eye = np.eye(10)
         self._f = np.zeros((10, 10))  # eq. 30; the time-varying blocks are filled each step
-        self._f[3, 3] = -1.0 / c["scale_time_constant"]
-        self._f[7:10, 7:10] = -np.eye(3) / c["gyro_bias_time_constant"]
+        # eq. 29: first-order Gauss-Markov scale factor and gyro biases
+        f_gm, q_gm = gauss_markov_continuous(
+            [c["scale_time_constant"], *[c["gyro_bias_time_constant"]] * 3],
+            [c["scale_sigma"], *[c["gyro_bias_sigma"]] * 3])
+        self._f[3, 3] = f_gm[0]
+        self._f[7:10, 7:10] = np.diag(f_gm[1:])
         self._q_c = np.zeros(10)
-        self._q_c[3] = 2.0 * c["scale_sigma"] ** 2 / c["scale_time_constant"]
+        self._q_c[3] = q_gm[0]
         self._q_c[4:7] = c["gyro_noise_density"] ** 2
-        self._q_c[7:10] = 2.0 * c["gyro_bias_sigma"] ** 2 / c["gyro_bias_time_constant"]
+        self._q_c[7:10] = q_gm[1:]
 
     # -- messages ---------------------------------------------------------------------------
     def on_imu(self, t: float, row: np.ndarray) -> None:
@@ -289,9 +315,9 @@ class Dr3dEkf(Estimator):
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
         if good_height and math.isfinite(self._baro_h):
             self._track_baro_offset(t, self._baro_h - alt)
-        dz = _ned_offset(*self._pos, lat, lon, alt)
         n = 3 if good_height else 2
-        rows = [np.eye(10)[:n]]
+        dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=10)
+        rows = [h_pos[:n]]
         dzs = [dz[:n]]
         var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
         speed = self._s * self._u
@@ -306,11 +332,12 @@ class Dr3dEkf(Estimator):
             dzs.append([abs(speed) * math.cos(pitch) - row[fx.speed]])
             var.append(c["gps_speed_sigma_inflated" if slow else "gps_speed_sigma"] ** 2)
         if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
-            h = np.zeros(10)
-            h[4:7] = jac[2]
-            rows.append(h[None])
-            yaw = math.atan2(self._cbn[1, 0], self._cbn[0, 0])
-            dzs.append([math.remainder(yaw - row[fx.course], 2.0 * math.pi)])
+            # the course is the heading of the body x axis (no side slip; eq. 41's last row)
+            dz_c, h_c = heading(self._q, float(row[fx.course]), n_states=9)
+            h = np.zeros((1, 10))
+            h[0, 4:7] = h_c[0, 6:9]  # the INS layout's psi columns to this filter's
+            rows.append(h)
+            dzs.append(dz_c)
             var.append(c["gps_course_sigma_inflated" if slow else "gps_course_sigma"] ** 2)
         self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(var))
         self._feedback()
@@ -335,7 +362,7 @@ class Dr3dEkf(Estimator):
             self._q, self._cbn, self._pos, self._v_ned, dtheta, self._s * self._u, self._u,
             dt, self._f)
         self._kf.predict(self._eye + self._f * dt, np.diag(self._q_c * dt))
-        if self._imu.accel:
+        if self._imu.has_accel:
             self._step_one(f_b)
 
     def _step_one(self, f_b: np.ndarray) -> None:
@@ -349,15 +376,20 @@ class Dr3dEkf(Estimator):
         roll_acc = math.atan2(-f_b[1], -f_b[2])
         pitch_acc = math.atan2(f_b[0], math.hypot(f_b[1], f_b[2]))
         dz = [math.remainder(roll - roll_acc, 2.0 * math.pi), pitch - pitch_acc]
+        norm = math.sqrt(f_b @ f_b)
+        if self._u == 0.0:
+            self._still_norm_sum += norm
+            self._still_steps += 1
+            self._g = self._still_norm_sum / self._still_steps
         if c["adaptive"]:
-            var = threshold_variance(abs(math.sqrt(f_b @ f_b) - self._g),
+            var = threshold_variance(abs(norm - self._g),
                                      ACCEL_NORM_THRESHOLD_M_S2, c["tilt_sigma"],
                                      c["tilt_sigma_inflated"])
         else:
             var = c["tilt_sigma"] ** 2
         rows, dzs, variances = [h], [dz], [var, var]
         if self._use_baro and self._baro_new and self._baro_offset is not None:
-            dz_h, h_h = height_measurement(self._pos[2], self._baro_h - self._baro_offset, 10)
+            dz_h, h_h = barometric_height(self._pos[2], self._baro_h, self._baro_offset, 10)
             var_h = c["baro_sigma"] ** 2
             if c["adaptive"]:
                 var_h = threshold_variance(abs(dz_h[0]), BARO_INNOVATION_THRESHOLD_M,
@@ -421,21 +453,22 @@ class Dr2dOdoEkf(Estimator):
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
         self._u = 0.0
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
                                                          c["heading_initial"] ** 2,
                                                          c["gyro_bias_initial"] ** 2])
         self._kf = ErrorState(p0)
-        self._q_c = np.array([0.0, 0.0,
-                              2.0 * c["speed_error_sigma"] ** 2 / c["speed_error_time_constant"],
-                              c["gyro_noise_density"] ** 2,
-                              2.0 * c["gyro_bias_sigma"] ** 2 / c["gyro_bias_time_constant"]])
+        # Gauss-Markov speed error and z-gyro bias
+        f_gm, q_gm = gauss_markov_continuous(
+            [c["speed_error_time_constant"], c["gyro_bias_time_constant"]],
+            [c["speed_error_sigma"], c["gyro_bias_sigma"]])
+        self._q_c = np.array([0.0, 0.0, q_gm[0], c["gyro_noise_density"] ** 2, q_gm[1]])
         self._f = np.zeros((5, 5))
-        self._f[2, 2] = -1.0 / c["speed_error_time_constant"]
-        self._f[3, 4] = -1.0
-        self._f[4, 4] = -1.0 / c["gyro_bias_time_constant"]
+        self._f[2, 2] = f_gm[0]
+        self._f[3, 4] = -1.0  # dpsi' = -(z-gyro bias error)
+        self._f[4, 4] = f_gm[1]
 
     def _speed(self) -> float:
         return self._u - self._speed_error if self._u != 0.0 else 0.0
@@ -479,8 +512,11 @@ class Dr2dOdoEkf(Estimator):
         if self._imu.dt > 0.0:
             self._step()
         c = self.config
-        dz = _ned_offset(self._lat, self._lon, self._h, math.radians(row[fx.lat]),
-                         math.radians(row[fx.lon]), self._h)[:2]
+        # no lever arm: the attitude argument is not used
+        dz, _ = gnss_position(_LEVEL, np.array([self._lat, self._lon, self._h]),
+                              np.array([math.radians(row[fx.lat]), math.radians(row[fx.lon]),
+                                        self._h]), n_states=5)
+        dz = dz[:2]
         h = np.eye(5)[:2]
         var = [c["gps_horizontal_sigma"] ** 2] * 2
         if self._u != 0.0 and math.isfinite(row[fx.speed]):

@@ -16,11 +16,16 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
 * GPS, eqs. 6-8: position and NED velocity of the receiver's 3-D fixes (1-sigma 2.5 m
   horizontal, 5 m vertical, 0.1 m/s horizontal and 0.2 m/s vertical velocity: chosen, Park
   prints no R).
-* Odometer with NHC, eqs. 9-14: body velocity [v_odo, 0, 0] (1-sigma 0.1 m/s on each row,
-  chosen), "used sequentially after the GPS measurement update". Park does not say at what rate;
-  here at every odometer sample (10 Hz), so that it also aids during outages, which is the point
-  of the comparison in Park's Table 3. With ``nhc: false`` only the forward (odometer) row is
-  used. There is no odometer scale-factor state (the 15 states of eq. 4), as in the paper.
+* Odometer with NHC, eqs. 9-14: body velocity [v_odo, 0, 0], "used sequentially after the GPS
+  measurement update". 1-sigma (chosen): 0.1 m/s on the NHC rows; on the odometer row
+  sqrt(0.1^2 + (0.03 v_odo)^2) m/s, since eq. 4 has no scale-factor state and an unmodelled scale
+  error is speed-proportional: 3 % is the range Park's section III-E studies (scale factors 0.97
+  to 1.03). (A first version with 0.1 m/s alone trusted the odometer over GPS: on Park's garage
+  drive, true scale factor 1.03, its errors with GPS were 6-10 m against a claimed 0.5 m.)
+  Park does not say at what rate; here at every odometer sample (10 Hz), so that it also aids
+  during outages, which is the point of the comparison in Park's Table 3. With ``nhc: false``
+  only the forward (odometer) row is used. There is no odometer scale-factor state (the 15
+  states of eq. 4), as in the paper.
 
 The filter is closed loop (errors fed back after each update).
 
@@ -59,12 +64,12 @@ class ParkInsOdometer(Estimator):
                      [70e-3 * G0] * 3, [1.0 * DEG] * 3]
     R_POSITION = np.diag([2.5, 2.5, 5.0]) ** 2  # m^2
     R_VELOCITY = np.diag([0.1, 0.1, 0.2]) ** 2  # (m/s)^2
-    R_ODOMETER = 0.1**2  # (m/s)^2, each body axis
+    R_ODOMETER = 0.1**2  # (m/s)^2, each body axis: white noise
+    ODOMETER_SCALE_SIGMA = 0.03  # unmodelled odometer scale-factor error, 1-sigma
 
     def setup(self) -> None:
-        imu_units = self.units["imu"]
-        self.ins = InsFilter(self.initial, self.columns["imu"],
-                             imu_units.get("gyro_x") == "rad", self.P0_SIGMA, self.NOISE)
+        self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
+                             self.P0_SIGMA, self.NOISE)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]
@@ -78,11 +83,11 @@ class ParkInsOdometer(Estimator):
         self.ins.add_imu(t, row)
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        if row[self._fix] < 2 or not math.isfinite(row[self._fix_idx[0]]):
+        values = row[self._fix_idx]
+        if row[self._fix] < 2 or not np.isfinite(values).all():
             return
         ins = self.ins
         ins.flush()
-        values = row[self._fix_idx]
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
         dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos)
         dz_v, h_v = aiding.gnss_velocity(ins.v, values[3:6])
@@ -91,7 +96,9 @@ class ParkInsOdometer(Estimator):
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         ins = self.ins
         ins.flush()
-        dz, h = aiding.odometer(ins.q, ins.v, float(row[self._speed]), self.config["nhc"])
+        speed = float(row[self._speed])
+        dz, h = aiding.odometer(ins.q, ins.v, speed, self.config["nhc"])
+        self._r_odo[0, 0] = self.R_ODOMETER + (self.ODOMETER_SCALE_SIGMA * speed) ** 2
         ins.update(dz, h, self._r_odo)
 
     def solution(self, t: float) -> list[float]:

@@ -18,6 +18,8 @@ What the paper gives and what is chosen here:
   utilized when the GPS signal is available and the open loop KF is applied when GPS is
   outage"): an epoch without a fix opens the loop (``kalman.ErrorState.set_closed_loop``); the
   next fix closes it and feeds the open-loop estimate back before its own update.
+  ``open_loop_outages: false`` stays closed through outages (not the paper's design; for
+  comparison).
 * Velocity constraint, eqs. 6-7 (``nhc``): zero lateral and vertical body velocity. Eq. 6 prints
   V_x^b = 0, which would stop the car: the lateral axis is y (V_y^b = 0, V_z^b = 0). 1-sigma
   0.1 m/s (chosen). Used during outages only (section 5: "utilizes the vehicle motion
@@ -34,7 +36,9 @@ What the paper gives and what is chosen here:
   ``course_speed`` (1-sigma 2 deg).
 * The 60 s standstill at the start ("in order to estimate the determined errors", section 5)
   is used as it is known from the protocol: zero-velocity and zero-angular-rate updates during
-  the first ``standstill`` seconds.
+  the first ``standstill`` seconds, none if the initial state moves faster than 0.5 m/s and
+  ended early by a GPS speed over 0.5 m/s (so a drive that starts moving sooner is not held
+  still).
 * Noise (Tan prints no Q): the BP3010's ADXRS300 gyro and ADXL210E accelerometer data-sheet
   densities (0.1 deg/s/sqrt(Hz), 0.2 mg/sqrt(Hz)); the initial bias uncertainties are the
   ``bp3010`` preset's (0.5 deg/s, 10 mg), in-run Gauss-Markov biases of 0.01 deg/s and 1 mg with
@@ -70,7 +74,8 @@ class TanLinearisedKF(Estimator):
     paper = ("Tan et al. 2008 (VNU J. Sci.): linearised KF INS/GPS, closed loop with GPS, open "
              "loop with NHC, height and magnetometer aiding in outages")
     defaults = {"nhc": True, "height_constraint": True, "mag_heading": True,
-                "update_interval": 0.5, "standstill": 60.0, "course_speed": 5.0}
+                "update_interval": 0.5, "standstill": 60.0, "course_speed": 5.0,
+                "open_loop_outages": True}
     output_columns = SOLUTION_COLUMNS
 
     NOISE = InsNoise(accel_noise=0.2e-3 * G0, gyro_noise=0.1 * DEG,
@@ -83,17 +88,19 @@ class TanLinearisedKF(Estimator):
     R_HEIGHT = np.array([[2.0**2]])  # m^2
     R_HEADING = np.array([[(2 * DEG) ** 2]])  # rad^2, magnetometer and GPS course
     R_ZUPT = np.eye(3) * 0.01**2  # (m/s)^2
-    R_ZARU = np.eye(3) * (0.01 * DEG) ** 2  # (rad/s)^2 (mean over a batch)
+    ZARU_FLOOR = 0.01 * DEG  # rad/s, added to the white noise of the batch-mean rate
     MAG_SOLVE_INTERVAL = 10.0  # s between re-solving the magnetometer calibration
+    MOVING_SPEED = 0.5  # m/s: a GPS speed above it ends the initial standstill early
 
     def setup(self) -> None:
-        units = self.units["imu"]
-        self.ins = InsFilter(self.initial, self.columns["imu"], units.get("gyro_x") == "rad",
+        self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
                              self.P0_SIGMA, self.NOISE)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"]]
         self._fix, self._speed, self._course = c["fix"], c["speed"], c["course"]
         self._t0 = self.initial.t
+        moving = np.linalg.norm(self.initial.velocity) > self.MOVING_SPEED
+        self._still_until = self._t0 + (0.0 if moving else self.config["standstill"])
         self._next_cycle = self._t0 + self.config["update_interval"]
         self._outage = False
         self._h_ref = 0.0
@@ -119,9 +126,11 @@ class TanLinearisedKF(Estimator):
         ins = self.ins
         ins.flush()
         cfg = self.config
-        if t - self._t0 < cfg["standstill"]:
+        if t < self._still_until:
             ins.update(*aiding.zero_velocity(ins.v), self.R_ZUPT)
-            ins.update(*aiding.zero_rate(ins.q, ins.pos[0], ins.mean_rate), self.R_ZARU)
+            if ins.mean_rate_dt > 0:  # the batch mean's noise: density^2 / duration
+                r = (self.NOISE.gyro_noise**2 / ins.mean_rate_dt + self.ZARU_FLOOR**2) * np.eye(3)
+                ins.update(*aiding.zero_rate(ins.q, ins.pos[0], ins.mean_rate), r)
             return
         mag = self._magnetometer()
         if not self._outage:
@@ -151,11 +160,11 @@ class TanLinearisedKF(Estimator):
         ins = self.ins
         valid = row[self._fix] >= 1 and math.isfinite(row[self._fix_idx[0]])
         if not valid:
-            if not self._outage and t - self._t0 >= self.config["standstill"]:
+            if not self._outage and t >= self._still_until:
                 ins.flush()
                 self._outage = True
                 self._h_ref = float(ins.pos[2])
-                ins.set_closed_loop(False)
+                ins.set_closed_loop(not self.config["open_loop_outages"])
             self._moving_fix = False
             return
         ins.flush()
@@ -164,10 +173,16 @@ class TanLinearisedKF(Estimator):
             ins.set_closed_loop(True)
         values = row[self._fix_idx]
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
-        ins.update(*aiding.gnss_position(ins.q, ins.pos, pos), self.R_POSITION)
+        dz, h = aiding.gnss_position(ins.q, ins.pos, pos)
+        if math.isfinite(values[2]):
+            ins.update(dz, h, self.R_POSITION)
+        else:  # a 2-D fix: horizontal rows only
+            ins.update(dz[:2], h[:2], self.R_POSITION[:2, :2])
         speed = float(row[self._speed])
+        if speed > self.MOVING_SPEED:  # the car moved off: the standstill is over
+            self._still_until = min(self._still_until, t)
         self._moving_fix = speed > self.config["course_speed"]
-        if self._moving_fix and t - self._t0 >= self.config["standstill"]:
+        if self._moving_fix and t >= self._still_until:
             ins.update(*aiding.heading(ins.q, float(row[self._course])), self.R_HEADING)
 
     def solution(self, t: float) -> list[float]:

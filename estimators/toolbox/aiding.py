@@ -4,8 +4,8 @@ measurement residual dz = h(nominal) - z and its Jacobian H over the error state
 C_b^n(estimate) = (I + [psi x]) C_b^n(true)).
 
 * ``gnss_position``: receiver position, with the antenna lever arm l^b: r_a = r + C_b^n l^b, so
-  H = [I, 0, -[(C_b^n l^b) x], 0, 0] (Park et al. 2019, eq. 8 without a lever arm; Groves 2013,
-  eq. 14.112);
+  H = [I, 0, -[(C_b^n l^b) x], 0, 0] (Park et al. 2019, eq. 8 without a lever arm; the lever-arm
+  term as in Groves 2013, chapter 14);
 * ``gnss_velocity``: NED velocity, H = [0, I, 0, 0, 0] (Park et al. 2019, eq. 8);
 * ``ground_speed`` and ``course``: GNSS speed sqrt(vn^2 + ve^2) and course atan2(ve, vn) (Park
   et al. 2019, eqs. 38-41);
@@ -14,7 +14,7 @@ C_b^n(estimate) = (I + [psi x]) C_b^n(true)).
   ``nhc=False``); Park's eq. 12 prints -C_n^b (v^n x) for an attitude error of the opposite sign
   to ours, the same Jacobian;
 * ``zero_velocity`` (ZUPT) and ``zero_rate`` (ZARU, the compensated gyro output equals the Earth
-  rate at standstill; Groves 2013, section 15.3);
+  rate at standstill; Groves 2013, chapter 15);
 * ``barometric_height``: the barometer's altitude minus its offset from the ellipsoidal height,
   a height measurement (``constraints.height``);
 * ``heading``: the yaw of C_b^n, atan2(C_21, C_11) (Tan et al. 2008, eq. 8, whose printed

@@ -12,7 +12,7 @@ State (errors are estimate minus truth, the convention of ``estimators.toolbox.n
   FRD axes, m/s^2 and rad/s). The compensated outputs are f - ba_hat = f_true - dba and
   w - bg_hat = w_true - dbg, so a positive dba makes the compensated specific force too small.
 
-Continuous error dynamics (the NED-frame model of Groves 2013, section 14.2.4, eqs. 14.63-14.70,
+Continuous error dynamics (the NED-frame model of Groves 2013, section 14.2.4,
 rewritten for this sign convention; the model Park et al. 2019 cite for eq. 5, F_0, and the one a
 linearised INS filter such as Tan et al. 2008's eqs. 1-4 needs)::
 
@@ -25,7 +25,7 @@ linearised INS filter such as Tan et al. 2008's eqs. 1-4 needs)::
 
 where dw_ie and dw_en are the changes of the Earth and transport rates (Groves eqs. 5.41, 5.44)
 with the position and velocity errors, and dg_d = 2 g dr_d / (sqrt(R_N R_E) + h) is the change of
-normal gravity with height (Groves eq. 14.69: down error grows gravity).
+normal gravity with height (a down error grows gravity: the unstable vertical channel).
 
 Noise: accelerometer white noise (velocity random walk, PSD S_a in (m/s^2)^2/Hz) drives dv
 through C_b^n, gyro white noise (angle random walk, S_g in (rad/s)^2/Hz) drives psi, and the bias

@@ -7,7 +7,7 @@ before every measurement and every solution, so always causally) integrates the 
 in one compiled loop (``strapdown.propagate`` per sample, with the bias estimates removed and
 rate samples turned into trapezoidal increments) and then propagates the covariance once over
 the flushed interval with the mean specific force of the interval (the usual practice of running
-the covariance propagation slower than the mechanisation, Groves 2013, section 14.1.2). With a
+the covariance propagation slower than the mechanisation, Groves 2013, chapter 14). With a
 10 Hz solution rate the covariance is propagated at 10 Hz or faster.
 
 Public names
@@ -29,6 +29,7 @@ from estimators.toolbox.ins_error import BA, BG, discretise, noise_psd, system_m
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate
 from simulator.earth import quat_to_dcm, quat_to_euler
+from simulator.errors import InputError
 
 IMU_AXES = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 
@@ -124,6 +125,10 @@ class InsFilter:
         self.ba, self.bg = biases[:3].copy(), biases[3:].copy()
         self.kf = ErrorState(np.diag(np.asarray(p0_sigma, float) ** 2), closed_loop)
         self.noise = noise
+        missing = [c for c in IMU_AXES if c not in imu_columns]
+        if missing:
+            raise InputError(f"imu: an INS filter needs all six axes; the dataset's IMU lacks "
+                             f"{', '.join(missing)} (sensors.imu.axes)")
         self._idx = np.array([imu_columns[c] for c in IMU_AXES])
         self._increments = increments
         self._buf_t = np.empty(buffer_size)
@@ -132,6 +137,7 @@ class InsFilter:
         self._prev = np.zeros(12)
         self._sums = np.zeros(7)
         self.mean_rate = np.zeros(3)  # compensated body angular rate over the last flush, rad/s
+        self.mean_rate_dt = 0.0  # the length of that flush, s
         # equal noise on the three axes: C Q C^T = Q, so G Q G^T does not depend on attitude
         self._gqg = noise_psd(np.eye(3), noise.accel_noise**2, noise.gyro_noise**2,
                               2 * noise.accel_bias_sigma**2 / noise.accel_bias_tau,
@@ -157,6 +163,7 @@ class InsFilter:
         if dt <= 0.0:
             return
         self.mean_rate = self._sums[3:6] / dt
+        self.mean_rate_dt = dt
         c_bn = quat_to_dcm(self.q)
         f_body = c_bn.T @ (self._sums[0:3] / dt)
         n = self.noise

@@ -9,8 +9,8 @@ manifolds", Information Fusion 14, 2013, the boxplus / boxminus operators):
 * ``boxminus(X, x)``: the error(s) taking ``x`` to the states ``X`` (shape (k, n_x)) -> (k, n).
 
 With the default hooks (plain addition and subtraction) n_x = n and this is the textbook UKF;
-``angle_hooks`` wraps chosen components to (-pi, pi], and a quaternion attitude can be carried
-as a three-parameter rotation error around the mean by hooks that compose rotations.
+``angle_hooks`` wraps chosen components to (-pi, pi], and ``quaternion_hooks`` carries a
+quaternion attitude as a three-parameter rotation error around the mean (composing rotations).
 
 One filter cycle (Cho & Choi 2006, eqs. 19-32; Wan & van der Merwe 2000, Algorithm 3.1):
 
@@ -46,7 +46,7 @@ yields points.
 
 Public names
 ------------
-SigmaPointFilter, angle_hooks, psd_sqrt.
+SigmaPointFilter, angle_hooks, quaternion_hooks, psd_sqrt.
 """
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from estimators.toolbox.sigma_points import simplex_points, symmetric_points
-from simulator.earth import wrap_angle
+from simulator.earth import quat_multiply, quat_to_rotvec, rotvec_to_quat, wrap_angle
 
 Boxplus = Callable[[np.ndarray, np.ndarray], np.ndarray]
 Boxminus = Callable[[np.ndarray, np.ndarray], np.ndarray]
@@ -109,6 +109,35 @@ def angle_hooks(angles: Sequence[int]) -> tuple[Boxplus, Boxminus]:
     def minus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
         d = xs - x
         d[..., idx] = wrap_angle(d[..., idx])
+        return d
+
+    return plus, minus
+
+
+def quaternion_hooks(start: int) -> tuple[Boxplus, Boxminus]:
+    """``boxplus`` / ``boxminus`` for a state with a scalar-first unit quaternion in
+    ``x[start:start + 4]``, carried as a rotation-vector error in ``dx[start:start + 3]``
+    (the other components plain; the error has one component fewer than the state). The error
+    is on the right, in the body frame: q = q_mean * exp(dtheta) (Hertzberg et al. 2013,
+    section 3.6; so a quaternion never enters a covariance, whose rank it would lower)."""
+    q_end, e_end = start + 4, start + 3
+
+    def plus(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
+        x, dx = np.asarray(x, dtype=float), np.asarray(dx, dtype=float)
+        out = np.empty((*dx.shape[:-1], x.shape[-1]))
+        out[..., :start] = x[..., :start] + dx[..., :start]
+        out[..., q_end:] = x[..., q_end:] + dx[..., e_end:]
+        q = quat_multiply(x[..., start:q_end], rotvec_to_quat(dx[..., start:e_end]))
+        out[..., start:q_end] = q / np.linalg.norm(q, axis=-1, keepdims=True)
+        return out
+
+    def minus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
+        xs, x = np.asarray(xs, dtype=float), np.asarray(x, dtype=float)
+        d = np.empty((*xs.shape[:-1], xs.shape[-1] - 1))
+        d[..., :start] = xs[..., :start] - x[..., :start]
+        d[..., e_end:] = xs[..., q_end:] - x[..., q_end:]
+        conj = x[..., start:q_end] * np.array([1.0, -1.0, -1.0, -1.0])
+        d[..., start:e_end] = quat_to_rotvec(quat_multiply(conj, xs[..., start:q_end]))
         return d
 
     return plus, minus

@@ -19,6 +19,8 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import multiprocessing
+import re
+import socket
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
@@ -43,10 +45,32 @@ class _RenewingPool(cf.Executor):
     def _new(self) -> cf.ProcessPoolExecutor:
         return cf.ProcessPoolExecutor(self.workers, mp_context=self.context)
 
+    def __exit__(self, kind: type | None, *rest: object) -> bool:
+        if kind is None:
+            self.shutdown(wait=True)
+        else:  # interrupted or failed: a stuck run must not hold the campaign
+            self.shutdown(wait=False, cancel_futures=True)
+            self.terminate_workers()
+            self.shutdown(wait=True)  # the pool, its workers gone, winds down at once
+        return False
+
+    @staticmethod
+    def terminate_workers() -> None:
+        """SIGTERM to every worker process still running (or still starting): the campaign's
+        only child processes are its pools' workers."""
+        children = multiprocessing.active_children()
+        for process in children:
+            process.terminate()
+        for process in children:  # gone before this process ends and frees their queues
+            process.join(2.0)
+            if process.is_alive():
+                process.kill()
+                process.join(1.0)
+
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> cf.Future:
         try:
             return self.pool.submit(fn, *args, **kwargs)
-        except cf.BrokenExecutor:
+        except (cf.BrokenExecutor, EOFError, OSError):  # a worker died, or could not start
             self.pool.shutdown(wait=False)
             self.pool = self._new()
             return self.pool.submit(fn, *args, **kwargs)
@@ -75,6 +99,7 @@ def open_executor(workers: int, scheduler: str | None, timeout_s: float
         with _RenewingPool(workers) as executor:
             yield executor, workers
         return
+    _check_scheduler(scheduler, timeout_s)
     from distributed import Client
 
     try:
@@ -87,6 +112,24 @@ def open_executor(workers: int, scheduler: str | None, timeout_s: float
         yield client.get_executor(pure=False), 2 * slots
     finally:
         client.close()
+
+
+_ADDRESS = re.compile(r"^(?:(?:tcp|tls|ws|wss)://)?(\[[0-9A-Fa-f:]+\]|[A-Za-z0-9._-]+):(\d{1,5})/?$")
+
+
+def _check_scheduler(address: str, timeout_s: float) -> None:
+    """Refuse an address that is not ``[tcp://]HOST:PORT``, or where nothing listens, before
+    the Dask client is made (a client that fails half-made blocks 20 s on its way out)."""
+    match = _ADDRESS.match(address.strip())
+    if not match:
+        raise InputError([Problem("--scheduler", None, address, "not a scheduler address; give "
+                                  "tcp://HOST:PORT, e.g. tcp://127.0.0.1:8786")])
+    host, port = match.group(1).strip("[]"), int(match.group(2))
+    try:
+        socket.create_connection((host, port), timeout=timeout_s).close()
+    except OSError as exc:
+        raise InputError([Problem("--scheduler", None, address, f"nothing answers there "
+                                  f"within {timeout_s:g} s ({exc.strerror or exc})")]) from None
 
 
 def completed(executor: cf.Executor, in_flight: int, fn: Callable[[T], Any], tasks: Iterable[T]

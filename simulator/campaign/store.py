@@ -5,8 +5,8 @@ the rows of one finished run, written under a temporary name and renamed when co
 interrupted campaign leaves only whole runs; ``DIR/runs.parquet`` is every requested run's rows
 merged at the end (written the same way). A rerun with the same plan skips the runs whose part
 exists; a different plan is refused unless ``force``, which starts over. While a campaign runs,
-it holds an exclusive lock on ``.DIR.lock`` beside the folder (``campaign_lock``), so that a
-second campaign into the same folder is refused instead of mixing its runs in.
+it holds an exclusive lock on ``.DIR.lock`` beside the folder (``campaign_lock``, removed at the
+end), so that a second campaign into the same folder is refused instead of mixing its runs in.
 
 Public names
 ------------
@@ -50,10 +50,11 @@ def _stored(out: Path) -> dict | None:
 @contextlib.contextmanager
 def campaign_lock(out: Path) -> Iterator[None]:
     """Hold the campaign folder ``out`` for this process: an exclusive ``flock`` on the hidden
-    file ``.NAME.lock`` beside it (holding this process id), which the system releases when the
-    campaign ends or its process dies, so a lock is never left stale. The file itself stays (a
-    lock file removed while held could be locked twice). Without ``fcntl`` (Windows) there is
-    no lock.
+    file ``.NAME.lock`` beside it (holding this process id). The system releases the lock when
+    the campaign ends or its process dies, so it is never stale; the file is removed while still
+    held when the campaign ends, and a taker checks that the file it locked is still the one at
+    that name (else it locked a removed file and tries again), so no file is left behind and the
+    folder is never held twice. Without ``fcntl`` (Windows) there is no lock.
 
     Raises
     ------
@@ -66,23 +67,35 @@ def campaign_lock(out: Path) -> Iterator[None]:
         yield
         return
     out.parent.mkdir(parents=True, exist_ok=True)
-    with open(out.parent / f".{out.name}.lock", "a+", encoding="utf-8") as handle:
+    path = out.parent / f".{out.name}.lock"
+    while True:
+        handle = open(path, "a+", encoding="utf-8")  # held across the yield
         try:
             fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             handle.seek(0)
             holder = handle.read().strip() or "?"
+            handle.close()
             raise InputError([Problem(str(out), None, "", f"another landnav campaign (process "
                                       f"{holder}) is writing this folder; wait for it to end "
                                       "or choose another -o DIR")]) from None
+        try:
+            same = os.stat(path).st_ino == os.fstat(handle.fileno()).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            break
+        handle.close()  # the holder removed it between our open and our lock: take the new one
+    try:
         handle.seek(0)
         handle.truncate()
         handle.write(f"{os.getpid()}\n")
         handle.flush()
-        try:
-            yield
-        finally:
-            fcntl.flock(handle, fcntl.LOCK_UN)
+        yield
+    finally:
+        path.unlink(missing_ok=True)
+        fcntl.flock(handle, fcntl.LOCK_UN)
+        handle.close()
 
 
 def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -> None:

@@ -20,11 +20,8 @@ from typing import Any
 
 import numpy as np
 
+from simulator import pipeline
 from simulator.campaign.plan import RunTask, entry_labels
-from simulator.dataset.generate import generate_dataset
-from simulator.dataset.io import open_dataset
-from simulator.replay import run_estimator
-from simulator.scoring.evaluate import score_solutions
 
 STATUS_OK = "ok"
 STATUS_FAILED = "failed"
@@ -86,15 +83,14 @@ def failed_rows(task: RunTask, error: str) -> list[dict[str, Any]]:
 def _score_all(task: RunTask, dataset_dir: Path) -> list[dict[str, Any]]:
     labels = entry_labels(task.scenario.data["estimators"])
     try:
-        dataset = open_dataset(generate_dataset(task.scenario, dataset_dir, force=True,
-                                                show_progress=False))
+        dataset = pipeline.generate(task.scenario, dataset_dir, force=True)
     except Exception:
         return failed_rows(task, traceback.format_exc())
     rows = []
     for label, entry in zip(labels, task.scenario.data["estimators"], strict=True):
         try:
-            frame, info = run_estimator(dataset, entry, show_progress=False)
-            scores = score_solutions(dataset, {label: (frame, info)}).scores()[label]
+            frame, info = pipeline.estimate(dataset, entry)
+            scores = pipeline.score(dataset, {label: (frame, info)}).scores()[label]
             rows.append(_row(task, label, STATUS_OK, flatten_scores(scores)))
         except Exception:
             rows.append(_row(task, label, STATUS_FAILED, error=traceback.format_exc()))

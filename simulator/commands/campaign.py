@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 from pathlib import Path
 
 from simulator.commands import SUMMARIES
@@ -53,12 +52,16 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
+MAX_RUNS = 1_000_000  # seeds per sweep point one campaign plans (its task list is in memory)
+
+
 def _check_counts(args: argparse.Namespace) -> int:
     """The number of local workers; refuses N < 1, K < 1 and --workers with --scheduler."""
     problems = []
-    if args.runs < 1:
+    if not 1 <= args.runs <= MAX_RUNS:
         problems.append(Problem("landnav campaign", None, "--runs",
-                                f"must be at least 1, got {args.runs}"))
+                                f"must be between 1 and {MAX_RUNS:,}, got {args.runs:,}; "
+                                "split a larger study into campaigns"))
     if args.workers is not None and args.scheduler:
         problems.append(Problem("landnav campaign", None, "--workers", "a Dask cluster has its "
                                 "own workers: give --workers or --scheduler, not both"))
@@ -73,12 +76,6 @@ def _check_counts(args: argparse.Namespace) -> int:
     return args.workers or os.cpu_count() or 1
 
 
-def _stop(signum: int, frame: object) -> None:
-    """SIGTERM ends the campaign like Ctrl-C: the runs under way are abandoned, the folder
-    resumes."""
-    raise KeyboardInterrupt
-
-
 def run(args: argparse.Namespace) -> int:
     from simulator.campaign.campaign import CampaignOptions, run_campaign
     from simulator.campaign.plan import plan_campaign
@@ -90,11 +87,7 @@ def run(args: argparse.Namespace) -> int:
         scheduler_timeout_s=args.scheduler_timeout, force=args.force,
         keep_datasets=args.keep_datasets, retry_failed=args.retry_failed)
     out = Path(args.output)
-    previous = signal.signal(signal.SIGTERM, _stop)
-    try:
-        result = run_campaign(plan, out, options)
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    result = run_campaign(plan, out, options)  # SIGTERM and Ctrl-C: the CLI's handlers
     n_runs = len(result.runs) // max(1, len(plan.labels))
     print(f"campaign {plan.base.name}: {n_runs} run(s) x {len(plan.labels)} estimator(s): "
           f"{result.ok} result(s) ok, {result.failed} failed "

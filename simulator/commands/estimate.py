@@ -8,10 +8,11 @@ import sys
 import yaml
 
 from estimators.registry import entry_problems
+from simulator import pipeline
 from simulator.commands import SUMMARIES
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
-from simulator.replay import run_estimator, write_solution
+from simulator.replay import write_solution
 from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
 from simulator.schema import INVALID, Context
 
@@ -76,7 +77,7 @@ def _entry(args: argparse.Namespace) -> dict:
 def run(args: argparse.Namespace) -> int:
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
-    solution, info = run_estimator(dataset, entry, show_progress=sys.stderr.isatty())
+    solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
     write_solution(solution, args.output, args.force, [dataset.path])
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
           f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")

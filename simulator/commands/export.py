@@ -45,14 +45,14 @@ def run(args: argparse.Namespace) -> int:
         raise InputError([Problem("landnav export", None, "", "nothing to do: give --rinex DIR "
                                   "and/or --nmea FILE")])
     dataset = open_dataset(args.dataset)
-    week = int(dataset.manifest["gps_time_start"]["week"])
-    tow = float(dataset.manifest["gps_time_start"]["tow"])
+    week = int(dataset.field("gps_time_start", "week"))
+    tow = float(dataset.field("gps_time_start", "tow"))
     gnss = dataset.manifest.get("sensors", {}).get("gnss", {})
     if args.rinex:
         _need(dataset, "gnss_raw", "--rinex")
         _need(dataset, "gnss_nav", "--rinex")
         raw = dataset.read("gnss_raw")
-        origin = dataset.manifest["origin"]
+        origin = {k: dataset.field("origin", k) for k in ("lat", "lon", "alt")}
         approx = np.ravel(geodetic_to_ecef(np.radians(origin["lat"]), np.radians(origin["lon"]),
                                            origin["alt"]))
         out = Path(args.rinex)

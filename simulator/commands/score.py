@@ -5,18 +5,16 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import sys
 from pathlib import Path
 
-import pandas as pd
-
+from simulator import pipeline
 from simulator.commands import SUMMARIES
-from simulator.dataset.io import Dataset, open_dataset
+from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 from simulator.outputs import atomic_output_dir
-from simulator.replay import read_solution, run_estimator
-from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
-from simulator.scoring.report import text_table, write_report
+from simulator.replay import read_solution
+from simulator.scoring.evaluate import write_scores
+from simulator.scoring.report import print_scores, write_report
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -42,8 +40,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(run=run)
 
 
-def _from_files(paths: list[str]) -> dict[str, tuple[pd.DataFrame, None]]:
-    out: dict[str, tuple[pd.DataFrame, None]] = {}
+def _from_files(paths: list[str]) -> pipeline.Solutions:
+    out: pipeline.Solutions = {}
     for path in paths:
         label = Path(path).stem
         if label in out:
@@ -53,21 +51,6 @@ def _from_files(paths: list[str]) -> dict[str, tuple[pd.DataFrame, None]]:
     return out
 
 
-def _from_estimators(dataset: Dataset, names: list[str]) -> dict[str, tuple[pd.DataFrame, dict]]:
-    out: dict[str, tuple[pd.DataFrame, dict]] = {}
-    for name in dict.fromkeys(names):
-        frame, info = run_estimator(dataset, name)
-        out[info["label"]] = (frame, info)
-    return out
-
-
-def print_scores(ev: Evaluation) -> None:
-    """The compact table on stdout and the scoring warnings on stderr."""
-    for line in ev.warnings():
-        print(f"warning: {line}", file=sys.stderr)
-    print(text_table(ev.scores()))
-
-
 def run(args: argparse.Namespace) -> int:
     dataset = open_dataset(args.dataset)
     with contextlib.ExitStack() as stack:
@@ -75,8 +58,8 @@ def run(args: argparse.Namespace) -> int:
                                                             [dataset.path]))
                       if args.report else None)
         solutions = (_from_files(args.solution) if args.solution
-                     else _from_estimators(dataset, args.estimator))
-        ev = score_solutions(dataset, solutions)
+                     else pipeline.run_estimators(dataset, dict.fromkeys(args.estimator)))
+        ev = pipeline.score(dataset, solutions)
         print_scores(ev)
         if args.json:
             write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])

@@ -10,7 +10,7 @@ pandas.
 
 Public functions
 ----------------
-build_profile, build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
+build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
 """
 
 from __future__ import annotations
@@ -29,39 +29,20 @@ import numpy as np
 import simulator
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
 from simulator.dataset.io import DatasetWriter
-from simulator.errors import InputError
+from simulator.drive import build_drive
+from simulator.faults import FAULT_REGISTRY
 from simulator.faults.apply import apply_faults
-from simulator.faults.base import FAULT_REGISTRY
 from simulator.outputs import atomic_output_dir
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
 from simulator.tables import Table, as_frames, column
-from simulator.timebase import parse_utc, utc_to_gps
-from simulator.trajectory import PROFILE_BUILDERS
-from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
-from simulator.trajectory.segments import RoadProfile
+from simulator.trajectory.kinematics import Kinematics
 
 
-def build_profile(scenario: dict) -> tuple[RoadProfile, dict]:
-    """The road and speed profile of a resolved scenario, and its resolved ``start`` block (a
-    source may set the start itself). Fixes the drive's duration before any kinematics."""
-    try:
-        profile = PROFILE_BUILDERS[scenario["trajectory"]["kind"]](scenario, None)
-    except ValueError as exc:
-        raise InputError(str(exc)) from None
-    return profile, {**scenario["start"], **(profile.start or {})}
-
-
-def build_truth(scenario: dict, built: tuple[RoadProfile, dict] | None = None) -> Kinematics:
-    """The exact truth trajectory of a resolved scenario (of its ``build_profile`` when given)."""
-    profile, start = built if built is not None else build_profile(scenario)
-    truth = kinematics_from_profile(profile, start, scenario["trajectory"]["rate"],
-                                    scenario["limits"]["roll_gradient"])
-    truth.utc_start = parse_utc(scenario["start"]["utc"])
-    truth.gps_week, truth.gps_tow = utc_to_gps(truth.utc_start)
-    truth.environment = scenario["environment"]
-    return truth
+def build_truth(scenario: dict) -> Kinematics:
+    """The exact truth trajectory of a resolved scenario dictionary (a drive built for it)."""
+    return build_drive(scenario).truth
 
 
 # worker threads for the sensors (the dataset writer has its own two): the IMU's three draws
@@ -86,9 +67,12 @@ class Generated:
     drawn: dict[str, dict] = field(default_factory=dict)
 
 
-def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = True,
+def generate_streams(scenario: Scenario | dict, show_progress: bool = True, frames: bool = True,
                      on_final: Callable[[str, Table], None] | None = None) -> Generated:
     """Truth table, every configured sensor's streams, and the events table.
+
+    ``scenario`` is a validated ``Scenario``, whose drive its validation built, or a resolved
+    scenario dictionary, for which a drive is built here.
 
     With ``frames`` (the default) every stream is a DataFrame; without, the tables stay as the
     sensors and faults left them (column tables or DataFrames), which is all the writer needs.
@@ -101,7 +85,11 @@ def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = 
     its array work, so they overlap on several cores. The draws are the same as without the
     threads: each sensor owns its random stream.
     """
-    profile, start = build_profile(scenario)
+    if isinstance(scenario, Scenario):
+        drive, scenario = scenario.drive, scenario.data
+    else:
+        drive = None
+    drive = drive if drive is not None else build_drive(scenario)
     sensors = {k: v for k, v in scenario["sensors"].items() if v is not None}
     models = {name: SENSOR_MODELS[name](block) for name, block in sensors.items()}
     rngs = {name: sensor_rng(scenario["seed"], name) for name in models}
@@ -109,8 +97,8 @@ def generate_streams(scenario: dict, show_progress: bool = True, frames: bool = 
     with ThreadPoolExecutor(max_workers=_SENSOR_WORKERS) as pool:
         for name, model in models.items():
             if hasattr(model, "prepare"):  # its parts go to the pool, ahead of the sensors
-                model.prepare(profile.duration_s, rngs[name], pool)
-        truth = build_truth(scenario, (profile, start))
+                model.prepare(drive.duration_s, rngs[name], pool)
+        truth = drive.truth
         streams: dict[str, Table] = {"truth": truth.columns()}  # caches the grid evaluation
         # streams still to change: those a fault acts on, and raw GNSS kept only for the faults
         # and the outage table unless asked for
@@ -193,7 +181,9 @@ def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
     made."""
     out_dir = Path(out_dir)
     with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp) as writer:
-        generated = generate_streams(scenario.data, show_progress, frames=False,
+        generated = generate_streams(scenario, show_progress, frames=False,
                                      on_final=writer.write)
-        writer.finish(build_manifest(scenario, generated), generated.streams)
+        imu = scenario.data["sensors"].get("imu")
+        described = {"imu": {"imu_output": imu["output"]}} if imu is not None else {}
+        writer.finish(build_manifest(scenario, generated), generated.streams, described)
     return out_dir

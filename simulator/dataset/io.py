@@ -19,6 +19,8 @@ from pathlib import Path
 from types import ModuleType
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from simulator import columns as col
 from simulator.errors import InputError, Problem
 from simulator.tables import Table, column, n_rows
@@ -83,7 +85,10 @@ class DatasetWriter:
                                              self.directory / self.file_name(name),
                                              _units_for(name, table))
 
-    def finish(self, manifest: dict, streams: dict[str, Table]) -> None:
+    def finish(self, manifest: dict, streams: dict[str, Table],
+               described: dict[str, dict] | None = None) -> None:
+        """Write what is left, then the manifest with its ``streams`` block: each stream's file,
+        rows and rate, and the fields of ``described[name]`` (the IMU's ``imu_output``)."""
         manifest = dict(manifest)
         manifest["format"] = col.DATASET_FORMAT
         manifest["streams"] = {}
@@ -101,7 +106,7 @@ class DatasetWriter:
                 t = column(table, "t")
                 rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
             manifest["streams"][name] = {"file": self.file_name(name), "rows": rows,
-                                         "rate_hz": rate}
+                                         "rate_hz": rate, **(described or {}).get(name, {})}
         text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
         (self.directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
 
@@ -132,10 +137,114 @@ class Dataset:
         if name not in self.manifest["streams"]:
             raise InputError([Problem(str(self.path), None, "", f"the dataset has no {name!r} "
                                       f"stream (it has: {', '.join(self.stream_names)})")])
-        return _parquet().read_table(self.path / self.manifest["streams"][name]["file"], columns)
+        path = self.path / self.manifest["streams"][name]["file"]
+        frame = _parquet().read_table(path, columns)
+        problem = stream_problem(name, frame, columns)
+        if problem:
+            raise InputError([Problem(str(path), None, "", f"corrupt {name} stream: {problem}")])
+        return frame
+
+    def field(self, *keys: str) -> object:
+        """A manifest value by key path (``field("gps_time_start", "week")``); InputError
+        naming the manifest and the key when it is absent."""
+        node: object = self.manifest
+        for key in keys:
+            node = node.get(key) if isinstance(node, dict) else None
+        if node is None:
+            raise InputError([Problem(str(self.path / "manifest.json"), None, ".".join(keys),
+                                      "missing; this command needs it")])
+        return node
 
     def units(self, name: str) -> dict[str, str]:
         return _parquet().read_units(self.path / self.manifest["streams"][name]["file"])
+
+
+def stream_problem(name: str, frame: pd.DataFrame, columns: list[str] | None = None
+                   ) -> str | None:
+    """What is wrong with a stream table read from a dataset, or None: a required column
+    missing, a column that should be numeric and is not, times that are not finite or run
+    backwards, an IMU sample with no value."""
+    from pandas.api.types import is_numeric_dtype
+
+    wanted = col.REQUIRED.get(name, ())
+    missing = [c for c in wanted if c not in frame and (columns is None or c in columns)]
+    if missing:
+        return f"column(s) {', '.join(missing)} missing"
+    if name == "imu" and columns is None and not any(a in frame for a in col.IMU_AXES):
+        return f"no IMU axis column (one of {', '.join(col.IMU_AXES)})"
+    for c in frame.columns:
+        if c not in col.TEXT_COLUMNS and not is_numeric_dtype(frame[c].dtype):
+            return f"column {c} holds {frame[c].dtype} values, not numbers"
+    for c in ("t", "t_start", "t_end"):
+        if c not in frame:
+            continue
+        t = frame[c].to_numpy(dtype=float)
+        if not np.isfinite(t).all():
+            return f"column {c} has a missing or infinite value at row {_first(~np.isfinite(t))}"
+        # the truth's time strictly increases; a stream's may repeat (a raw epoch's satellites)
+        backwards = np.diff(t) <= 0 if name == "truth" else np.diff(t) < 0
+        if c == "t" and backwards.any():
+            return (f"time runs backwards at row {_first(backwards) + 1}: "
+                    f"t = {t[_first(backwards) + 1]:.6f} s after {t[_first(backwards)]:.6f} s")
+    if name == "events" and {"t_start", "t_end"} <= set(frame):
+        reversed_rows = frame["t_end"].to_numpy(float) < frame["t_start"].to_numpy(float)
+        if reversed_rows.any():
+            return f"row {_first(reversed_rows)} ends before it starts"
+    if name == "imu":
+        axes = frame[[a for a in col.IMU_AXES if a in frame]].to_numpy(dtype=float)
+        bad = ~np.isfinite(axes).all(axis=1)
+        if bad.any():
+            return (f"{int(bad.sum())} sample(s) have no value, the first at row {_first(bad)} "
+                    f"(t = {frame['t'].iloc[_first(bad)]:.6f} s); an IMU log has none")
+    return None
+
+
+def _first(mask: np.ndarray) -> int:
+    return int(mask.nonzero()[0][0])
+
+
+_MANIFEST_FIELDS = {  # key path -> the JSON types it may have
+    ("gps_time_start", "week"): (int,),
+    ("gps_time_start", "tow"): (int, float),
+    ("origin", "lat"): (int, float),
+    ("origin", "lon"): (int, float),
+    ("origin", "alt"): (int, float),
+    ("utc_start",): (str,),
+}
+
+
+def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
+    where = str(path / "manifest.json")
+    problems = []
+    for keys, types in _MANIFEST_FIELDS.items():
+        node: object = manifest
+        for key in keys:
+            node = node.get(key) if isinstance(node, dict) else None
+        if node is None:  # optional here; a command that needs it asks Dataset.field
+            continue
+        if isinstance(node, bool) or not isinstance(node, types):
+            kinds = " or ".join("an integer" if t is int else "a number" if t is float
+                                else "text" for t in types)
+            problems.append(Problem(where, None, ".".join(keys),
+                                    f"not {kinds} (got {node!r})"))
+    streams = manifest.get("streams")
+    if not isinstance(streams, dict):
+        return [*problems, Problem(where, None, "streams", "missing or malformed")]
+    root = path.resolve()
+    for name, entry in streams.items():
+        file = entry.get("file") if isinstance(entry, dict) else None
+        if not isinstance(file, str) or not file:
+            problems.append(Problem(where, None, f"streams.{name}.file",
+                                    f"missing or not a file name (got {file!r})"))
+            continue
+        target = (path / file).resolve()
+        if Path(file).name != file or target.parent != root:
+            problems.append(Problem(where, None, f"streams.{name}.file",
+                                    f"{file!r} is not a file inside the dataset folder"))
+        elif not target.is_file():
+            problems.append(Problem(where, None, f"streams.{name}",
+                                    f"its file {file!r} is missing"))
+    return problems
 
 
 def open_dataset(path: str | Path) -> Dataset:
@@ -155,11 +264,7 @@ def open_dataset(path: str | Path) -> Dataset:
     if not isinstance(manifest, dict) or manifest.get("format") != col.DATASET_FORMAT:
         raise InputError([Problem(str(manifest_path), None, "format",
                                   f"not a {col.DATASET_FORMAT} manifest")])
-    streams = manifest.get("streams")
-    if not isinstance(streams, dict):
-        raise InputError([Problem(str(manifest_path), None, "streams", "missing or malformed")])
-    for name, entry in streams.items():
-        if not (path / entry.get("file", "")).is_file():
-            raise InputError([Problem(str(manifest_path), None, f"streams.{name}",
-                                      f"its file {entry.get('file')!r} is missing")])
+    problems = _manifest_problems(path, manifest)
+    if problems:
+        raise InputError(problems)
     return Dataset(path, manifest)

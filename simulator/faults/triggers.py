@@ -47,9 +47,9 @@ def _given(fault: dict) -> list[str]:
 
 
 def trigger_problems(fault: dict, path: Path, ctx: Context, duration_s: float,
-                     zones: set[str]) -> None:
-    """Report a fault whose trigger is missing, ambiguous, outside the drive, or names a zone
-    that no stretch of the drive has."""
+                     zones: set[str], length_m: float | None = None) -> None:
+    """Report a fault whose trigger is missing, ambiguous, outside the drive (in time, or
+    beyond the ``length_m`` travelled), or names a zone that no stretch of the drive has."""
     given = _given(fault)
     if len(given) != 1:
         ctx.error(path, "give exactly one trigger: start (+ duration), zone, distance or random"
@@ -71,6 +71,9 @@ def trigger_problems(fault: dict, path: Path, ctx: Context, duration_s: float,
         lo, hi = fault["distance"]
         if hi <= lo:
             ctx.error(path + ("distance",), "the range must increase: [from, to]")
+        elif length_m is not None and lo >= length_m:
+            ctx.error(path + ("distance",), f"starts at {lo:g} m, beyond the drive's end "
+                      f"({length_m:.1f} m travelled)")
     if trigger == "random":
         dist = fault["random"]["duration"]
         kind = dist["distribution"]

@@ -103,6 +103,9 @@ def _record_numbers(block: list[str], first: str) -> list[float]:
     return values
 
 
+MAX_NAVIGATION_FILE_BYTES = 50_000_000  # a day of merged IGS broadcast files is about 1 MB
+
+
 def read_rinex_nav(path: str | Path) -> pd.DataFrame:
     """Read the GPS records of a RINEX 2.x or 3.x navigation file into the navigation table.
 
@@ -111,31 +114,46 @@ def read_rinex_nav(path: str | Path) -> pd.DataFrame:
     lines = Path(path).read_text(errors="replace").splitlines()
     version, attrs, i = _header(lines)
     rows = []
-    while i < len(lines):
-        line = lines[i]
-        if not line.strip():
-            i += 1
-            continue
-        if version >= 3:
-            system = line[0]
-            n_more = _RINEX3_LINES.get(system, 7)
-            if system == "G":
-                parts = line[3:23].split()
-                epoch = dt.datetime(*(int(p) for p in parts))
-                values = _record_numbers(lines[i + 1:i + 1 + n_more], line[23:])
-                rows.append(_record(int(line[1:3]), epoch, values))
-        else:
-            n_more = 7
-            parts = line[:22].split()
-            year = int(parts[1])
-            year += 2000 if year < 80 else 1900
-            second = float(parts[6])
-            epoch = dt.datetime(year, int(parts[2]), int(parts[3]), int(parts[4]), int(parts[5]),
-                                int(second), int(round((second % 1) * 1e6)))
-            values = _record_numbers(lines[i + 1:i + 1 + n_more], line[22:])
-            rows.append(_record(int(parts[0]), epoch, values))
-        i += 1 + n_more
+    _rinex_records(path, lines, i, version, rows)
+    if not rows:
+        raise ValueError(f"{path}: no GPS navigation record")
     return _table(rows, attrs)
+
+
+def _rinex_records(path: str | Path, lines: list[str], i: int, version: float,
+                   rows: list) -> None:
+    while i < len(lines):
+        try:
+            i = _rinex_record(lines, i, version, rows)
+        except (ValueError, IndexError, TypeError, KeyError) as exc:
+            raise ValueError(f"{path}:{i + 1}: not a readable RINEX navigation record ({exc})"
+                             ) from None
+
+
+def _rinex_record(lines: list[str], i: int, version: float, rows: list) -> int:
+    """Read the record at line ``i`` into ``rows``; return the index of the next line."""
+    line = lines[i]
+    if not line.strip():
+        return i + 1
+    if version >= 3:
+        system = line[0]
+        n_more = _RINEX3_LINES.get(system, 7)
+        if system == "G":
+            parts = line[3:23].split()
+            epoch = dt.datetime(*(int(p) for p in parts))
+            values = _record_numbers(lines[i + 1:i + 1 + n_more], line[23:])
+            rows.append(_record(int(line[1:3]), epoch, values))
+    else:
+        n_more = 7
+        parts = line[:22].split()
+        year = int(parts[1])
+        year += 2000 if year < 80 else 1900
+        second = float(parts[6])
+        epoch = dt.datetime(year, int(parts[2]), int(parts[3]), int(parts[4]), int(parts[5]),
+                            int(second), int(round((second % 1) * 1e6)))
+        values = _record_numbers(lines[i + 1:i + 1 + n_more], line[22:])
+        rows.append(_record(int(parts[0]), epoch, values))
+    return i + 1 + n_more
 
 
 _YUMA_KEYS = {
@@ -170,6 +188,13 @@ def read_yuma(path: str | Path, reference_week: int | None = None) -> pd.DataFra
                 break
     if rec:
         rows.append(rec)
+    for n, rec in enumerate(rows, start=1):
+        missing = sorted(set(_YUMA_KEYS.values()) - set(rec))
+        if missing:
+            raise ValueError(f"{path}: almanac record {n} (PRN {rec.get('sv', '?')}) lacks "
+                             f"{', '.join(missing)}: truncated or not a YUMA almanac")
+    if not rows:
+        raise ValueError(f"{path}: no almanac record")
     ref = 2048 + 512 if reference_week is None else reference_week
     out = []
     for rec in rows:
@@ -183,7 +208,16 @@ def read_yuma(path: str | Path, reference_week: int | None = None) -> pd.DataFra
 
 
 def read_navigation(path: str | Path, reference_week: int | None = None) -> pd.DataFrame:
-    """Read a RINEX navigation file or a YUMA almanac, recognised by its content."""
+    """Read a RINEX navigation file or a YUMA almanac, recognised by its content.
+
+    Raises
+    ------
+    ValueError
+        Naming the file (and line) when it is neither, is truncated, or too large to be one.
+    """
+    if Path(path).stat().st_size > MAX_NAVIGATION_FILE_BYTES:
+        raise ValueError(f"{path}: larger than {MAX_NAVIGATION_FILE_BYTES / 1e6:g} MB, not a "
+                         "navigation file or almanac")
     head = Path(path).read_text(errors="replace")[:4000]
     if "RINEX VERSION / TYPE" in head:
         return read_rinex_nav(path)

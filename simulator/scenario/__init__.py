@@ -12,19 +12,23 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from simulator.drive import Drive, build_drive
 from simulator.errors import InputError, Problem
 from simulator.scenario.spec import SCENARIO_FIELD
 from simulator.scenario.yamlio import apply_overrides, read_yaml
 from simulator.schema import INVALID, Context
 
 
-@dataclass
+@dataclass(frozen=True)
 class Scenario:
-    """A validated scenario: ``data`` is the resolved scenario (defaults filled, SI values)."""
+    """A validated scenario: ``data`` is the resolved scenario (defaults filled, SI values) and
+    ``drive`` the drive its validation built (None for a Scenario made in code: the generator
+    then builds it)."""
 
     path: Path
     data: dict
     overrides: list[str]
+    drive: Drive | None = None
 
     @property
     def name(self) -> str:
@@ -35,15 +39,20 @@ class Scenario:
         return self.data["seed"]
 
 
-def validate_data(data: Any, file: str, lines: dict | None = None,
-                  overridden: set | None = None) -> dict:
-    """Validate scenario data; return the resolved scenario or raise InputError with every
-    problem found."""
+def _validate(data: Any, file: str, lines: dict | None = None,
+              overridden: set | None = None) -> tuple[dict, Drive]:
     ctx = Context(file, lines, overridden)
     resolved = SCENARIO_FIELD.check(copy.deepcopy(data), (), ctx)
     if ctx.problems or resolved is INVALID:
         raise InputError(ctx.problems)
-    return resolved
+    return resolved, build_drive(resolved, ctx.built["profile"])
+
+
+def validate_data(data: Any, file: str, lines: dict | None = None,
+                  overridden: set | None = None) -> dict:
+    """Validate scenario data; return the resolved scenario or raise InputError with every
+    problem found."""
+    return _validate(data, file, lines, overridden)[0]
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None,
@@ -71,5 +80,5 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
         overrides.append(f"seed={seed}")
     data, touched = apply_overrides(data, overrides, str(path))
     data.setdefault("name", path.stem.removesuffix(".scenario"))
-    resolved = validate_data(data, str(path), lines, touched)
-    return Scenario(path=path, data=resolved, overrides=overrides)
+    resolved, drive = _validate(data, str(path), lines, touched)
+    return Scenario(path=path, data=resolved, overrides=overrides, drive=drive)

@@ -9,6 +9,7 @@ SCENARIO_FIELD, START_FIELD, ESTIMATOR_ENTRY_FIELD.
 from __future__ import annotations
 
 from estimators.registry import entry_problems
+from simulator.drive import build_profile
 from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
 from simulator.faults import FAULT_FIELD, check_faults
 from simulator.schema import (
@@ -28,11 +29,12 @@ from simulator.schema import (
     Vector,
 )
 from simulator.sensors import SENSOR_FIELDS
-from simulator.trajectory import PROFILE_BUILDERS, TRAJECTORY_KINDS
+from simulator.trajectory import TRAJECTORY_KINDS
 from simulator.trajectory.segments import LIMITS_FIELD
 
 START_FIELD = Record({
-    "utc": DateTime("2020-01-01T00:00:00Z", doc="UTC time of t = 0"),
+    "utc": DateTime("2020-01-01T00:00:00Z", earliest="1980-01-06T00:00:00",
+                    doc="UTC time of t = 0 (from the GPS epoch, 1980-01-06, on)"),
     "lat": Number(angle=True, min=-89.0, max=89.0, doc="latitude, deg"),
     "lon": Number(angle=True, min=-180.0, max=180.0, doc="longitude, deg"),
     "alt": Number("m", 0.0, min=-500.0, max=9000.0, doc="ellipsoidal height, m"),
@@ -71,10 +73,12 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     elif imu and traj["rate"] < imu["rate"]:
         ctx.error(path + ("trajectory", "rate"),
                   f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
-    profile = PROFILE_BUILDERS[traj["kind"]](value, ctx)
+    profile = build_profile(value, ctx)
     if profile is not None:
+        ctx.built["profile"] = profile
         _check_job_size(traj["rate"], profile.duration_s, path, ctx)
-        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones})
+        check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
+                     float(profile.distance_of_time(profile.duration_s)))
     labels: set[str] = set()
     for i, entry in enumerate(value["estimators"]):
         label = entry if isinstance(entry, str) else (entry["label"] or entry["name"])

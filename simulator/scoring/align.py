@@ -114,7 +114,15 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErro
     # the NED frame of the interpolated true position (lat/lon interpolated only for the rotation)
     c_ne = ned_to_ecef_matrix(np.radians(interp(truth["lat"].to_numpy(float))),
                               np.radians(interp(truth["lon"].to_numpy(float))))
-    err_pos = np.einsum("kji,kj->ki", c_ne, _ecef(sol) - truth_ecef)
+    # a 2-D solution writes NaN height (SPEC section 7): its horizontal error is taken at the
+    # true height, and its vertical error stays NaN
+    no_height = ~np.isfinite(sol["alt"].to_numpy(float))
+    placed = sol
+    if no_height.any():
+        placed = sol[["lat", "lon", "alt"]].copy()
+        placed.loc[no_height, "alt"] = interp(truth["alt"].to_numpy(float))[no_height]
+    err_pos = np.einsum("kji,kj->ki", c_ne, _ecef(placed) - truth_ecef)
+    err_pos[no_height, 2] = np.nan
     out = {"t": t}
     out.update(zip(ERR_POS, err_pos.T, strict=True))
     out[ERR_H] = np.hypot(err_pos[:, 0], err_pos[:, 1])

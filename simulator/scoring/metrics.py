@@ -22,8 +22,11 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   no cross-covariances, so P is taken diagonal;
 * ``runtime`` {seconds, realtime_factor} when the estimator ran inside landnav;
 * ``rows`` {total, outside_truth, position, velocity, attitude}: rows in the solution, rows
-  dropped outside the truth's time span, and rows scored in each group (a group's row is scored
-  when all three of its columns are finite; NaN rows are skipped).
+  dropped outside the truth's time span, and rows scored in each group (a position row is
+  scored when its north and east errors are finite, a velocity or attitude row when all three
+  of its columns are; each attitude axis's RMS and the vertical error take the rows where that
+  one column is finite, so a 2-D solution's NaN height, roll and pitch leave its horizontal
+  and yaw scores intact).
 
 Public functions
 ----------------
@@ -128,16 +131,19 @@ def score_errors(errors: SolutionErrors, truth: pd.DataFrame, events: pd.DataFra
     dict, JSON-ready (floats and None, no NaN).
     """
     e = errors.errors
-    pos_ok, vel_ok, att_ok = (_valid(e, names) for names in (ERR_POS, ERR_VEL, ERR_ATT))
+    # each quantity is scored on the rows where it is finite (SPEC section 7: a 2-D filter
+    # writes NaN height, roll and pitch, and its horizontal and yaw errors still count)
+    pos_ok, vel_ok, att_ok = (_valid(e, names) for names in (ERR_POS[:2], ERR_VEL, ERR_ATT))
     h = e[ERR_H].to_numpy(float)[pos_ok]
-    vertical = np.abs(e[ERR_POS[2]].to_numpy(float)[pos_ok])
+    d = e[ERR_POS[2]].to_numpy(float)
+    vertical = np.abs(d[pos_ok & np.isfinite(d)])
     vel = np.linalg.norm(e[list(ERR_VEL)].to_numpy(float)[vel_ok], axis=1)
-    att = np.degrees(e[list(ERR_ATT)].to_numpy(float)[att_ok])
+    att = np.degrees(e[list(ERR_ATT)].to_numpy(float))
     scores: dict = {
         "horizontal": _horizontal(h),
         "vertical": {"rms": _rms(vertical), "max": _max(vertical)},
         "velocity": {"rms": _rms(vel)},
-        "attitude": {f"{axis}_rms": _rms(att[:, i])
+        "attitude": {f"{axis}_rms": _rms(att[np.isfinite(att[:, i]), i])
                      for i, axis in enumerate(("roll", "pitch", "yaw"))},
         "outages": _outages(e, pos_ok, events, truth),
     }

@@ -11,21 +11,25 @@ Numbers are printed with three decimals; a missing value prints as ``-``.
 
 Public functions
 ----------------
-write_report, text_table, format_number, markdown_table.
+write_report, print_scores, text_table, format_number, markdown_table.
 """
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
 
 from simulator.scoring.align import ERR_ATT, ERR_H, local_ned
 from simulator.scoring.evaluate import Evaluation
 from simulator.scoring.metrics import OUTAGE_KIND
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
 
 PLOTS = "plots"  # sub-directory of the report directory holding the PNGs
 _OUTAGE_COLOUR = "tab:red"
@@ -95,6 +99,23 @@ def _outages(events: pd.DataFrame) -> list[tuple[float, float]]:
     return list(zip(rows["t_start"].to_numpy(float), rows["t_end"].to_numpy(float), strict=True))
 
 
+def _figure(size_in: tuple[float, float]) -> Figure:
+    """A new figure (``size_in`` inches) on matplotlib's Agg canvas. matplotlib loads here, when
+    a report is written: it takes a third of a second, which the commands that only print
+    scores or run an estimator do not pay."""
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=size_in, layout="constrained")
+
+
+def print_scores(ev: Evaluation) -> None:
+    """The compact table of every solution's scores on stdout and the scoring warnings (rows
+    that could not be scored) on stderr."""
+    for line in ev.warnings():
+        print(f"warning: {line}", file=sys.stderr)
+    print(text_table(ev.scores()))
+
+
 def _shade(ax: Axes, outages: list[tuple[float, float]]) -> None:
     for i, (a, b) in enumerate(outages):
         ax.axvspan(a, b, color=_OUTAGE_COLOUR, alpha=0.15, lw=0,
@@ -109,7 +130,7 @@ def _plot_map(ev: Evaluation, path: Path) -> None:
     truth = ev.truth
     origin = tuple(truth[["lat", "lon", "alt"]].iloc[0])
     ned = local_ned(truth, origin)
-    fig = Figure(figsize=(7, 6), layout="constrained")
+    fig = _figure((7, 6))
     ax = fig.add_subplot()
     ax.plot(ned[:, 1], ned[:, 0], color="black", lw=2.0, label="truth")
     t = truth["t"].to_numpy()
@@ -127,7 +148,7 @@ def _plot_map(ev: Evaluation, path: Path) -> None:
 
 
 def _plot_horizontal(ev: Evaluation, path: Path) -> None:
-    fig = Figure(figsize=(8, 4), layout="constrained")
+    fig = _figure((8, 4))
     ax = fig.add_subplot()
     _shade(ax, _outages(ev.events))
     for label, r in ev.results.items():
@@ -138,7 +159,7 @@ def _plot_horizontal(ev: Evaluation, path: Path) -> None:
 
 
 def _plot_attitude(ev: Evaluation, path: Path) -> None:
-    fig = Figure(figsize=(8, 7), layout="constrained")
+    fig = _figure((8, 7))
     axes = fig.subplots(3, 1, sharex=True)
     for ax, name, title in zip(axes, ERR_ATT, ("roll", "pitch", "yaw"), strict=True):
         _shade(ax, _outages(ev.events))
@@ -152,7 +173,7 @@ def _plot_attitude(ev: Evaluation, path: Path) -> None:
 
 
 def _plot_cdf(ev: Evaluation, path: Path) -> None:
-    fig = Figure(figsize=(6, 4), layout="constrained")
+    fig = _figure((6, 4))
     ax = fig.add_subplot()
     for label, r in ev.results.items():
         h = np.sort(r.errors.errors[ERR_H].to_numpy(float))

@@ -6,6 +6,7 @@ its model class; the dataset generator builds every configured sensor from these
 
 from __future__ import annotations
 
+from simulator.schema import Context
 from simulator.sensors.baro import BARO_FIELD, Barometer
 from simulator.sensors.gnss import GNSS_FIELD, Gnss
 from simulator.sensors.imu import IMU_FIELD, Imu
@@ -16,3 +17,14 @@ SENSOR_FIELDS = {"imu": IMU_FIELD, "odometer": ODOMETER_FIELD, "gnss": GNSS_FIEL
                  "baro": BARO_FIELD, "mag": MAG_FIELD}
 SENSOR_MODELS = {"imu": Imu, "odometer": Odometer, "gnss": Gnss, "baro": Barometer,
                  "mag": Magnetometer}
+
+
+def resolve_block(name: str, block: dict) -> dict:
+    """A sensor block as a scenario's validation resolves it (preset applied, defaults filled,
+    units converted), for code that builds a sensor by hand; the models take resolved blocks
+    and do not check them again. Raises ValueError naming every problem."""
+    ctx = Context(f"sensors.{name}")
+    resolved = SENSOR_FIELDS[name].check(block, ("sensors", name), ctx)
+    if ctx.problems:
+        raise ValueError("; ".join(str(p) for p in ctx.problems))
+    return resolved

@@ -129,6 +129,10 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
                              f"{source!r} is neither 'nominal-gps' nor an existing RINEX "
                              "navigation or YUMA almanac file")
         value["constellation"] = str(found[0].resolve())
+        try:
+            read_navigation(found[0])
+        except (ValueError, OSError) as exc:
+            return ctx.error(path + ("constellation",), str(exc))
     if value["cn0_horizon"] > value["cn0_zenith"]:
         return ctx.error(path + ("cn0_horizon",), "must not exceed cn0_zenith")
     return value

@@ -38,7 +38,7 @@ Sources
   factor, which are left at zero (override them in the scenario).
 
   Largest misfit per axis (x, y, z), analytic fit over tau from 5 samples to 524 s (ADIS16448) or
-  1068 s (BMI160) / simulated curve against the real one in ``tests/test_imu_allan.py``
+  1068 s (BMI160) / simulated curve against the real one in ``tests/sensors/test_imu_allan.py``
   (one 40 min record, tau up to 40 s; ``--runslow``: four records of twice the longest real tau,
   tau up to a tenth of them); the presets are held to 25 %:
 
@@ -191,4 +191,15 @@ IMU_PRESETS["crossbow-dmu300cc"] = {**IMU_PRESETS["crossbow-imu300cc"], "rate": 
 IMU_PRESETS["bosch-smi130-calibrated"] = {
     **IMU_PRESETS["bosch-smi130"],
     "accel": {**IMU_PRESETS["bosch-smi130"]["accel"], "bias": 7 * MILLI_G},
+}
+# Karamat et al. 2015 (Table 1, the IMU300CC) with an in-run first-order Gauss-Markov bias beside
+# the turn-on bias: Table 1 prints none, so 1 % of the gyro's and 3 % of the accelerometers'
+# turn-on bias, correlation time 300 s (assumed; docs/reproduction_karamat2015.md). Use it with
+# ``axes: riss3d`` for the paper's reduced unit (vertical gyro, forward and lateral accelerometers)
+IMU_PRESETS["crossbow-imu300cc-gm"] = {
+    **IMU_PRESETS["crossbow-imu300cc"],
+    "gyro": {**IMU_PRESETS["crossbow-imu300cc"]["gyro"],
+             "gauss_markov_sigma": 0.02 * DEG_S, "gauss_markov_correlation_time": 300.0},
+    "accel": {**IMU_PRESETS["crossbow-imu300cc"]["accel"],
+              "gauss_markov_sigma": 1 * MILLI_G, "gauss_markov_correlation_time": 300.0},
 }

@@ -29,7 +29,7 @@ Kinematics, kinematics_from_profile.
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -82,7 +82,8 @@ class Kinematics:
     """
 
     def __init__(self, profile: RoadProfile, origin: Origin, rate_hz: float,
-                 roll_gradient: float):
+                 roll_gradient: float, utc_start: dt.datetime = dt.datetime(2020, 1, 1),
+                 environment: Mapping | None = None):
         self.profile = _as_fast(profile)
         curves = (self.profile.curvature, self.profile.grade, self.profile.bank,
                   self.profile.heading)
@@ -95,11 +96,11 @@ class Kinematics:
         self.t_grid = np.arange(n) / self.rate_hz
         self._breaks: np.ndarray | None = None
         self._cache: dict[str, dict] = {}
-        # set by the dataset generator from the scenario: when the drive starts, and the
-        # resolved ``environment`` block (zones and their sky, canyon and magnetic settings)
-        self.utc_start: dt.datetime = dt.datetime(2020, 1, 1)
-        self.gps_week, self.gps_tow = utc_to_gps(self.utc_start)
-        self.environment: dict = {"zones": {}}
+        # when the drive starts, and the resolved ``environment`` block (zones and their sky,
+        # canyon and magnetic settings)
+        self.utc_start = utc_start
+        self.gps_week, self.gps_tow = utc_to_gps(utc_start)
+        self.environment = environment if environment is not None else {"zones": {}}
         self._integrate_position()
 
     # -- along-road quantities --------------------------------------------------------------
@@ -365,7 +366,7 @@ class Kinematics:
         return {
             "t": k["t"],
             "lat": np.degrees(k["lat"]),
-            "lon": np.degrees(k["lon"]),
+            "lon": np.degrees(wrap_angle(k["lon"])),  # across the antimeridian too
             "alt": k["alt"],
             "vn": k["v_ned"][:, 0], "ve": k["v_ned"][:, 1], "vd": k["v_ned"][:, 2],
             "roll": wrap_angle(k["roll"]), "pitch": k["pitch"], "yaw": wrap_angle(k["yaw"]),
@@ -407,8 +408,11 @@ def _as_fast(profile: RoadProfile) -> RoadProfile:
                        direction=direction)
 
 
-def kinematics_from_profile(profile: RoadProfile, start: dict, rate_hz: float,
-                            roll_gradient: float) -> Kinematics:
-    """Build the ``Kinematics`` of a road profile from a resolved scenario ``start`` block."""
+def kinematics_from_profile(profile: RoadProfile, start: Mapping, rate_hz: float,
+                            roll_gradient: float,
+                            utc_start: dt.datetime = dt.datetime(2020, 1, 1),
+                            environment: Mapping | None = None) -> Kinematics:
+    """Build the ``Kinematics`` of a road profile from a resolved scenario ``start`` block (and
+    the drive's UTC epoch and resolved ``environment`` block, which the sensors read)."""
     origin = Origin(start["lat"], start["lon"], start["alt"], start["heading"])
-    return Kinematics(profile, origin, rate_hz, roll_gradient)
+    return Kinematics(profile, origin, rate_hz, roll_gradient, utc_start, environment)

@@ -45,7 +45,10 @@ SEGMENT_FIELD, LIMITS_FIELD, REVERSE_SPEED, RoadProfile, build_road_profile.
 
 from __future__ import annotations
 
+import bisect
 import functools
+import itertools
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -230,34 +233,62 @@ def _clothoid_turn(angle_rad: float, kappa0: float, v: float, lim: dict,
     return pieces
 
 
-def _with_grade(pieces: list[_PathPiece], gamma: float, lvc: float) -> list[_PathPiece]:
-    """Overlay a grade profile 0 -> gamma (over lvc) -> gamma -> 0 (over lvc) on path pieces."""
+def _grade_cuts(pieces: list[_PathPiece], gamma: float, lvc: float
+                ) -> list[tuple[float, int, float, np.ndarray]]:
+    """The pieces of a grade profile 0 -> gamma (over lvc) -> gamma -> 0 (over lvc) laid over
+    path pieces: (length, index of the path piece, offset into it, grade coefficients)."""
     total = sum(p.length for p in pieces)
-    cuts = sorted({0.0, lvc, total - lvc, total, *np.cumsum([p.length for p in pieces])})
+    ends = list(itertools.accumulate(p.length for p in pieces))
+    cuts = sorted({0.0, lvc, total - lvc, total, *ends})
     cuts = [c for c in cuts if 0.0 <= c <= total]
-    out, starts = [], np.concatenate([[0.0], np.cumsum([p.length for p in pieces])])
+    out, starts = [], [0.0, *ends]
     for a, b in zip(cuts[:-1], cuts[1:], strict=True):
         if b - a < 1e-9:
             continue
-        i = min(int(np.searchsorted(starts, a, side="right")) - 1, len(pieces) - 1)
-        base = pieces[i]
-        off = a - starts[i]
+        i = min(bisect.bisect_right(starts, a) - 1, len(pieces) - 1)
         if b <= lvc + 1e-12:
             g = _shift(_ramp(0.0, gamma, lvc), a)
         elif a >= total - lvc - 1e-12:
             g = _shift(_ramp(gamma, 0.0, lvc), a - (total - lvc))
         else:
             g = _poly(gamma)
-        out.append(_PathPiece(b - a, _shift(base.kappa, off), g, _shift(base.bank, off)))
+        out.append((b - a, i, a - starts[i], g))
     return out
 
 
+def _with_grade(pieces: list[_PathPiece], gamma: float, lvc: float) -> list[_PathPiece]:
+    """Overlay a grade profile 0 -> gamma (over lvc) -> gamma -> 0 (over lvc) on path pieces."""
+    return [_PathPiece(length, _shift(pieces[i].kappa, off), g, _shift(pieces[i].bank, off))
+            for length, i, off, g in _grade_cuts(pieces, gamma, lvc)]
+
+
 def _shift(coeffs: np.ndarray, offset: float) -> np.ndarray:
-    """Coefficients of p(x + offset) given those of p(x) (highest power first)."""
+    """Coefficients of p(x + offset) given those of p(x) (highest power first).
+
+    Horner's scheme on the polynomial x + offset, in the very operations (and order) of numpy's
+    ``Polynomial(c)(Polynomial([offset, 1]))``, trailing zero coefficients trimmed as numpy
+    trims them, so the result is bit for bit numpy's; on Python floats, since these polynomials
+    have at most six coefficients (numpy's objects cost 50 times more here, and a helix's grade
+    is solved with some sixty trial profiles)."""
     if offset == 0.0 or len(coeffs) == 1:
         return coeffs
-    return np.polynomial.polynomial.Polynomial(coeffs[::-1])(
-        np.polynomial.polynomial.Polynomial([offset, 1.0])).coef[::-1]
+    c = coeffs.tolist()
+    acc = [c[0]]  # p's coefficients so far, lowest power first
+    for ci in c[1:]:
+        shifted = [a * offset for a in acc] + [0.0]  # acc * (x + offset)
+        for j, a in enumerate(acc):
+            shifted[j + 1] += a
+        _trim(shifted)
+        shifted[0] += ci
+        acc = _trim(shifted)
+    return np.array(acc[::-1])
+
+
+def _trim(coeffs: list[float]) -> list[float]:
+    """Drop trailing zero coefficients (highest powers), keeping one (numpy's ``trimseq``)."""
+    while len(coeffs) > 1 and coeffs[-1] == 0.0:
+        coeffs.pop()
+    return coeffs
 
 
 def _grade_ramp_length(v: float, gamma: float, lim: dict, available: float) -> float:
@@ -265,33 +296,63 @@ def _grade_ramp_length(v: float, gamma: float, lim: dict, available: float) -> f
 
 
 def _helix(seg: dict, v: float, lim: dict) -> list[_PathPiece]:
-    theta = 2 * np.pi * seg["turns"] * (1 if seg["direction"] == "right" else -1)
-    radius, rise = seg["radius"], seg["rise"]
+    """Path pieces of a helix whose grade meets its ``rise`` exactly."""
+    shape = (seg["turns"], seg["radius"], seg["direction"], seg["bank"], v)
+    gamma = _helix_grade(*shape, seg["rise"], tuple(sorted(lim.items())))
+    turn, lvc = _helix_turn(*shape, lim, gamma)
+    return _with_grade(turn, gamma, lvc)
 
-    def build(gamma: float) -> list[_PathPiece]:
-        kappa0 = np.cos(gamma) / radius
-        turn = _clothoid_turn(theta, kappa0, v, lim, np.radians(seg["bank"]))
-        total = sum(p.length for p in turn)
-        return _with_grade(turn, gamma, _grade_ramp_length(v, gamma, lim, total))
 
-    def rise_error(gamma: float) -> float:
-        pieces = build(gamma)
-        return sum(_rise_of(p) for p in pieces) - rise
+def _helix_turn(turns: float, radius: float, direction: str, bank_deg: float, v: float,
+                lim: dict, gamma: float) -> tuple[list[_PathPiece], float]:
+    """The level turn of a helix climbing at ``gamma`` (its curvature cos(gamma) / radius, so
+    that the radius holds in plan view) and the length of its vertical curves."""
+    theta = 2 * np.pi * turns * (1 if direction == "right" else -1)
+    kappa0 = np.cos(gamma) / radius
+    turn = _clothoid_turn(theta, kappa0, v, lim, np.radians(bank_deg))
+    total = sum(p.length for p in turn)
+    return turn, _grade_ramp_length(v, gamma, lim, total)
+
+
+@functools.lru_cache(maxsize=256)
+def _helix_grade(turns: float, radius: float, direction: str, bank_deg: float, v: float,
+                 rise: float, limits: tuple) -> float:
+    """The grade (rad) at which a helix rises ``rise`` (bisection to machine precision). A pure
+    function of the helix, its entry speed and the limits, kept for the helices met again (a
+    garage's ramps, a campaign's runs)."""
+    lim = dict(limits)
+
+    def rise_error(gamma: float) -> float:  # the grade pieces alone, as ``_helix`` lays them
+        turn, lvc = _helix_turn(turns, radius, direction, bank_deg, v, lim, gamma)
+        cuts = _grade_cuts(turn, gamma, lvc)
+        return sum(_rise_of(length, g) for length, _, _, g in cuts) - rise
 
     if abs(rise) < 1e-9:
-        return build(0.0)
+        return 0.0
     bound = np.arctan(1.0) * np.sign(rise)
-    gamma = _bisect(rise_error, 1e-9 * np.sign(rise), bound)
-    return build(gamma)
+    return _bisect(rise_error, 1e-9 * np.sign(rise), bound)
 
 
-_RISE_GL_X, _RISE_GL_W = np.polynomial.legendre.leggauss(8)
+# 8-point Gauss-Legendre as Python floats: the nodes shifted to [0, 2] (x + 1), the weights
+_RISE_GL_NODES, _RISE_GL_WEIGHTS = np.polynomial.legendre.leggauss(8)
+_RISE_GL_X1, _RISE_GL_W = (_RISE_GL_NODES + 1).tolist(), _RISE_GL_WEIGHTS.tolist()
 
 
-def _rise_of(piece: _PathPiece) -> float:
-    """Height gained over a piece: integral of sin(gamma(s)) ds (Gauss-Legendre, 8 nodes)."""
-    s = 0.5 * piece.length * (_RISE_GL_X + 1)
-    return float(0.5 * piece.length * np.sum(_RISE_GL_W * np.sin(np.polyval(piece.grade, s))))
+def _rise_of(length: float, grade: np.ndarray) -> float:
+    """Height gained over a piece of ``length`` with ``grade`` coefficients: integral of
+    sin(gamma(s)) ds (Gauss-Legendre, 8 nodes). On Python floats, in the operations and order
+    of numpy's polyval, sin and eight-term pairwise sum (the same bits, six times quicker for
+    eight nodes)."""
+    half = 0.5 * length
+    coeffs = grade.tolist()
+    terms = []
+    for x, w in zip(_RISE_GL_X1, _RISE_GL_W, strict=True):
+        s, gamma = half * x, 0.0
+        for c in coeffs:
+            gamma = gamma * s + c
+        terms.append(w * math.sin(gamma))
+    t = terms
+    return half * (((t[0] + t[1]) + (t[2] + t[3])) + ((t[4] + t[5]) + (t[6] + t[7])))
 
 
 def _bisect(f, a: float, b: float) -> float:

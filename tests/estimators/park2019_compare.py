@@ -13,8 +13,9 @@ height does not hide them):
   relative (NaN for a filter without the state);
 * ``rms_outside``: horizontal RMS over the rows outside every GNSS outage, m.
 
-Run ``PYTHONPATH=. python -m tests.estimators.park2019_compare [--seeds 10] [--set k=v ...]``
-for the table of docs/reproduction_park2019.md.
+Run ``PYTHONPATH=. python -m tests.estimators.park2019_compare [--seeds 10] [--flat]
+[--scenario FILE] [--config JSON] [--set k=v ...]`` for the tables of
+docs/reproduction_park2019.md (any scenario: its longest GNSS outage is measured).
 
 Public names
 ------------
@@ -124,13 +125,14 @@ def garage_metrics(dataset: Dataset, names: list[str] | None = None,
 
 def compare_seeds(seeds: list[int], overrides: list[str] | None = None,
                   names: list[str] | None = None, configs: dict[str, dict] | None = None,
-                  work: Path | None = None) -> dict[int, dict[str, dict[str, float]]]:
-    """``garage_metrics`` for each seed, the dataset generated in ``work`` (a temporary
-    folder when None)."""
+                  work: Path | None = None, scenario: Path = GARAGE
+                  ) -> dict[int, dict[str, dict[str, float]]]:
+    """``garage_metrics`` for each seed of ``scenario``, the dataset generated in ``work`` (a
+    temporary folder when None)."""
     results = {}
     with tempfile.TemporaryDirectory(dir=work) as tmp:
         for seed in seeds:
-            ds = generate_garage(Path(tmp) / f"seed{seed}", seed, overrides)
+            ds = generate_garage(Path(tmp) / f"seed{seed}", seed, overrides, scenario)
             results[seed] = garage_metrics(ds, names, configs)
     return results
 
@@ -153,11 +155,14 @@ def main() -> None:
     parser.add_argument("--first-seed", type=int, default=1)
     parser.add_argument("--set", dest="overrides", action="append", default=[])
     parser.add_argument("--flat", action="store_true", help="the flat garage, perfect odometer")
+    parser.add_argument("--scenario", type=Path, default=GARAGE)
+    parser.add_argument("--config", type=json.loads, default=None,
+                        help='per-filter config, e.g. {"dr3d_ekf": {"adaptive": false}}')
     parser.add_argument("--json", type=Path)
     args = parser.parse_args()
     overrides = [*(FLAT_PERFECT if args.flat else []), *args.overrides]
     seeds = list(range(args.first_seed, args.first_seed + args.seeds))
-    results = compare_seeds(seeds, overrides)
+    results = compare_seeds(seeds, overrides, configs=args.config, scenario=args.scenario)
     print(_summary(results))
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))

@@ -18,7 +18,12 @@ from estimators.builtin.cho2006 import (
     drm2_transition,
 )
 from estimators.registry import get_estimator
+from simulator.dataset.generate import generate_dataset
+from simulator.dataset.io import open_dataset
+from simulator.errors import InputError
+from simulator.scenario import Scenario, validate_data
 from tests.estimators import cho2006_experiments as exp
+from tests.synthetic import FLAT_LOOP
 
 G = 9.8
 U2 = np.array([0.7, 0.05, -0.2])  # f_x, w_y, w_z
@@ -93,9 +98,9 @@ def test_standstill_calibration_finds_fixed_gyro_biases(root, name):
 def test_error_free_sensors_track_the_drive(root):
     """Ideal IMU and receiver, no initial error. The EKF keeps only the 10 Hz integration and
     the flat-Earth position of eq. 18 (measured 0.12 m, 0.11 deg). The SPKF starts from the
-    180 deg heading sigma of eq. 33 as well, and its simplex points, which match only the
-    first two moments, correlate the scale factors with the heading spread while it is wide:
-    measured 19 m and 12 deg while it settles, 1.3 m and 0.6 deg from 60 s after moving off."""
+    180 deg heading sigma of eq. 33 too, and its update is a statistical linearisation over
+    points half a turn apart until that shrinks: measured 19 m and 12 deg while it settles,
+    1.3 m and 0.6 deg from 60 s after moving off (docs/reproduction_cho2006.md)."""
     ds = exp.dataset("cho2006_situation2", 1, root / "ideal",
                      ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal"])
     t, horizontal, d_yaw = exp.errors(ds, exp.run(ds, "dr2d_drm2_ekf"))
@@ -106,6 +111,43 @@ def test_error_free_sensors_track_the_drive(root):
     late = t >= exp.moving_off(ds) + exp.SETTLE_S
     assert horizontal[late].max() < 2.0
     assert np.abs(d_yaw[late]).max() < 1.0
+
+
+def test_drm1_follows_a_flat_drive_with_error_free_sensors(tmp_path):
+    """DRM1 has no pitch, so on the level FLAT_LOOP with ideal sensors only the integration
+    error is left (measured: 0.22 m, 0.23 deg)."""
+    data = {"name": "flat", "seed": 1, "limits": {"roll_gradient": 0.0},
+            "start": {"utc": "2024-05-01T03:00:00Z", "lat": 36.35, "lon": 127.38, "alt": 60.0,
+                      "heading": 30.0},
+            "trajectory": {"kind": "segments", "segments": FLAT_LOOP},
+            "sensors": {"imu": {"preset": "ideal", "rate": 100},
+                        "gnss": {"preset": "ideal", "rate": 1, "outputs": ["fix"]}}}
+    scenario = Scenario(tmp_path / "flat.yaml", validate_data(data, "flat.yaml"), [])
+    ds = open_dataset(generate_dataset(scenario, tmp_path / "flat", show_progress=False))
+    t, horizontal, d_yaw = exp.errors(ds, exp.run(ds, "dr2d_drm1_ekf"))
+    assert horizontal.max() < 0.5
+    assert np.abs(d_yaw).max() < 0.5
+
+
+def test_increment_output_gives_the_rate_output_solution(root):
+    """The IMU samples are averaged over each 0.1 s step from rates or from increments alike."""
+    rates = exp.dataset("cho2006_situation2", 1, root / "ideal",
+                        ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal"])
+    increments = exp.dataset("cho2006_situation2", 1, root / "increments",
+                             ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal",
+                              "sensors.imu.output=increment"])
+    _, h_rate, yaw_rate = exp.errors(rates, exp.run(rates, "dr2d_drm2_ekf"))
+    _, h_inc, yaw_inc = exp.errors(increments, exp.run(increments, "dr2d_drm2_ekf"))
+    assert h_inc.max() < 0.5 and np.abs(yaw_inc).max() < 0.3
+    assert abs(h_inc.max() - h_rate.max()) < 0.1
+
+
+@pytest.mark.parametrize("config, key", [({"alpha": 0.0}, "alpha"), ({"alpha": 1.5}, "alpha"),
+                                         ({"w0": 1.0}, "w0"), ({"beta": -1.0}, "beta")])
+def test_spkf_refuses_parameters_outside_their_ranges(root, config, key):
+    ds = exp.dataset("cho2006_situation2", 1, root)
+    with pytest.raises(InputError, match=f"'{key}' of estimator dr2d_drm2_spkf"):
+        exp.run(ds, "dr2d_drm2_spkf", config=config)
 
 
 # -- the claims of issue 14, ten seeds each --------------------------------------------------

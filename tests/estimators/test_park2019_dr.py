@@ -69,3 +69,109 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     assert np.abs(out[:, 2] - truth["alt"]).max() < 0.2
     yaw = np.arctan2(c[1, 0], c[0, 0])
     assert abs(math.remainder(yaw - truth["yaw"].iloc[-1], 2 * math.pi)) < math.radians(0.01)
+
+
+# the CI length of the garage: the open road before it and after it shorter, the parking stop
+# shorter; the garage's helices, ramps and laps unchanged (425 s -> about 300 s)
+SHORT = ["trajectory.segments.0.stop.duration=5", "trajectory.segments.2.straight.length=120",
+         "trajectory.segments.4.straight.length=120", "trajectory.segments.6.straight.length=100",
+         "trajectory.segments.17.stop.duration=5", "trajectory.segments.27.straight.length=60",
+         "trajectory.segments.29.straight.length=60"]
+INS_REASON = ("ins_odo_ekf (the INS engineer's filter, as merged) is not a working filter on this "
+              "garage: horizontal RMS outside the outage 5.4-9.7 m, exit error median 73 m; even "
+              "on the flat garage dr3d_ekf's exit error is a fifth of its (median ratio 0.19)")
+
+
+@pytest.fixture(scope="module", params=["short", pytest.param("full", marks=pytest.mark.slow)])
+def length(request) -> list[str]:
+    """Overrides of the drive length: the shortened CI drive, or the scenario as shipped."""
+    return SHORT if request.param == "short" else []
+
+
+@pytest.fixture(scope="module")
+def garage(length, tmp_path_factory) -> dict:
+    """The garage (true odometer scale factor 1.03) over ten seeds, every registered filter."""
+    return cmp.compare_seeds(SEEDS, length, work=tmp_path_factory.mktemp("garage"))
+
+
+@pytest.fixture(scope="module")
+def flat_garage(length, tmp_path_factory) -> dict:
+    """The same garage made flat with a perfect odometer, ten seeds."""
+    return cmp.compare_seeds(SEEDS, [*cmp.FLAT_PERFECT, *length],
+                             work=tmp_path_factory.mktemp("flat"))
+
+
+def _column(results: dict, name: str, key: str) -> np.ndarray:
+    return np.array([results[s][name][key] for s in SEEDS])
+
+
+DR2D_NOT_SHOWN = (
+    "not shown: dr3d_ekf beats dr2d_odo_ekf in 5/10 seeds (exit error medians 14.3 m vs 12.4 m); "
+    "the unestimated z-gyro scale factor (0.5 % 1-sigma) over six helix turns dominates both "
+    "filters' heading error; without it dr3d_ekf wins 10/10 (docs/reproduction_park2019.md)")
+
+
+def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
+    """A filter as a test parameter: skipped when not registered, expected to fail with a
+    reason (the measured figures) when ``xfail`` is given."""
+    marks = [pytest.mark.skipif(name not in cmp.registered_filters(),
+                                reason=f"{name} is not registered")]
+    if xfail:
+        marks.append(pytest.mark.xfail(strict=strict, reason=xfail))
+    return pytest.param(name, marks=marks)
+
+
+@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf", DR2D_NOT_SHOWN, strict=True),
+                                   _case("ins_odo_ekf")])
+def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
+    """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
+    least 8 of 10 seeds (paired per seed)."""
+    for key in ("exit_horizontal", "max_horizontal"):
+        wins = _column(garage, "dr3d_ekf", key) < _column(garage, other, key)
+        assert wins.sum() >= 8, (key, wins.sum())
+
+
+@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf", INS_REASON)])
+def test_flat_garage_with_perfect_odometer_removes_the_advantage(flat_garage, other):
+    """Without ramps and odometer scale-factor error, the median per-seed ratio of dr3d_ekf's
+    exit and maximum error to the baseline's lies between 0.7 and 1.3."""
+    for key in ("exit_horizontal", "max_horizontal"):
+        ratio = _column(flat_garage, "dr3d_ekf", key) / _column(flat_garage, other, key)
+        assert 0.7 <= np.median(ratio) <= 1.3, (key, np.median(ratio))
+
+
+def test_dr3d_height_change_through_the_garage(garage):
+    """Park Fig. 19: the height change from garage entry to exit within 2 m of the truth
+    (paper: 1.22 m change for the 3-D DR, 22.34 m for INS/GPS/odometer), every seed."""
+    err = _column(garage, "dr3d_ekf", "height_change_error")
+    assert np.all(err < 2.0), err
+
+
+@pytest.mark.parametrize("scale", [1.03, 0.97])
+def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, length, scale):
+    """Park section III-E, Fig. 9: the odometer scale factor (true 1.03 and 0.97) estimated
+    within 0.5 % when GNSS is lost at the garage entry, every seed."""
+    if scale == 1.03:
+        rel = _column(garage, "dr3d_ekf", "scale_at_entry")
+    else:
+        runs = cmp.compare_seeds(SEEDS, [f"sensors.odometer.scale_factor={scale}", *length],
+                                 names=["dr3d_ekf"], work=tmp_path)
+        rel = _column(runs, "dr3d_ekf", "scale_at_entry")
+    assert np.all(np.abs(rel) < 0.005), rel
+
+
+@pytest.mark.parametrize("name", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf", INS_REASON),
+                                  "dr3d_ekf"])
+def test_filters_work_outside_the_outages(garage, name):
+    """Horizontal RMS outside the GNSS outages under 5 m, every seed."""
+    rms = _column(garage, name, "rms_outside")
+    assert np.all(rms < 5.0), rms
+
+
+def test_open_sky_blockage_stays_bounded(tmp_path):
+    """Park Figs. 14-15: GNSS blocked for 40 s on an interchange ramp in open sky, the 3-D
+    DR/GPS's horizontal error stays under 7 m, every seed (measured: at most 3.3 m)."""
+    scenario = cmp.REPO / "scenarios" / "park2019_open_sky_blockage.yaml"
+    runs = cmp.compare_seeds(SEEDS, names=["dr3d_ekf"], work=tmp_path, scenario=scenario)
+    worst = _column(runs, "dr3d_ekf", "max_horizontal")
+    assert np.all(worst < 7.0), worst

@@ -1,7 +1,8 @@
 """The sigma-point filter driver against independent references: the linear Kalman filter it
 must equal on a linear-Gaussian model (both point sets, additive and augmented noise, singular
 Q and P), the exact moments of x^2 of a Gaussian, FilterPy's UnscentedKalmanFilter on a
-nonlinear range-bearing problem, and wrapped angles near +-180 deg."""
+nonlinear range-bearing problem, wrapped angles near +-180 deg, and a quaternion carried as a
+rotation-vector error."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import pytest
 
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
-from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks, psd_sqrt
+from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks, psd_sqrt, quaternion_hooks
+from simulator.earth import euler_to_quat, quat_multiply, quat_to_dcm
 
 DT = 0.1
 PHI = np.array([[1.0, DT, 0.5 * DT**2], [0.0, 1.0, DT], [0.0, 0.0, 1.0]])
@@ -180,3 +182,28 @@ def test_update_needs_the_covariance_of_propagated_points():
     ukf.propagate(_linear)
     with pytest.raises(RuntimeError, match="covariance"):
         ukf.update(_measure, np.zeros(2), R)
+
+
+@pytest.mark.parametrize("points", ["symmetric", "simplex"])
+def test_quaternion_attitude_carried_as_a_rotation_error(points):
+    """State [q (4), b]: right-multiplying every point by a fixed rotation r turns the mean
+    into q r and the body-frame rotation error e into C_r^T e, so P_rot -> C_r^T P_rot C_r
+    exactly (the map is linear in the rotation vector); b is untouched."""
+    plus, minus = quaternion_hooks(0)
+    q0 = euler_to_quat(0.3, -0.2, 2.9)
+    r = euler_to_quat(0.1, 0.4, -1.2)
+    a = np.random.default_rng(2).normal(size=(4, 4)) * 0.05
+    p0 = a @ a.T + np.diag([1e-3, 2e-3, 3e-3, 0.5])
+    ukf = SigmaPointFilter(np.append(q0, 7.0), p0, points=points, boxplus=plus, boxminus=minus)
+    assert ukf.draw().shape[1] == 5
+    ukf.propagate(lambda xs, ws: np.column_stack([quat_multiply(xs[:, :4], r), xs[:, 4]]))
+    ukf.covariance()
+    expected_q = quat_multiply(q0, r)
+    assert abs(float(ukf.x[:4] @ expected_q)) == pytest.approx(1.0, abs=1e-12)
+    rot = quat_to_dcm(r)
+    expected = p0.copy()
+    expected[:3, :3] = rot.T @ p0[:3, :3] @ rot
+    expected[:3, 3] = rot.T @ p0[:3, 3]
+    expected[3, :3] = expected[:3, 3]
+    np.testing.assert_allclose(ukf.p, expected, atol=1e-10)
+    assert ukf.x[4] == pytest.approx(7.0)

@@ -112,6 +112,21 @@ def test_nan_rows_are_skipped_and_counted(truth):
     json.dumps(s, allow_nan=False)
 
 
+def test_a_two_dimensional_solution_keeps_its_horizontal_and_yaw_scores(truth):
+    """SPEC section 7: a 2-D filter writes NaN height, roll and pitch; the scorer leaves those
+    cells out of their own metrics only (Cho & Choi's and Park's 2-D DR filters)."""
+    sol = offset_solution(truth.iloc[::10], dpos=(3.0, -4.0, 1.5), datt_deg=(0, 0, 2.0))
+    sol[["alt", "vd", "roll", "pitch"]] = np.nan
+    s = score_solution(truth, events((40.0, 60.0)), sol)
+    assert s["horizontal"]["rms"] == pytest.approx(5.0, abs=ATOL_M)
+    assert s["outages"][0]["max_horizontal"] == pytest.approx(5.0, abs=ATOL_M)
+    assert s["attitude"]["yaw_rms"] == pytest.approx(2.0, abs=1e-9)
+    assert s["attitude"]["roll_rms"] is None and s["attitude"]["pitch_rms"] is None
+    assert s["vertical"] == {"rms": None, "max": None}
+    assert s["rows"]["position"] == len(sol) and s["rows"]["attitude"] == 0
+    json.dumps(s, allow_nan=False)
+
+
 def test_empirical_cep_of_a_known_spread(truth):
     sol = truth.iloc[:100]
     k = np.arange(1, 101)

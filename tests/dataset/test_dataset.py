@@ -24,7 +24,7 @@ from simulator.errors import InputError
 from simulator.scenario import validate_data
 from simulator.tables import as_frame
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 QUICK = REPO / "scenarios" / "quickstart.yaml"
 
 

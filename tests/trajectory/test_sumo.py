@@ -17,14 +17,15 @@ from estimators.toolbox.strapdown import run_strapdown
 from simulator import earth
 from simulator.dataset.generate import build_truth
 from simulator.scenario import load_scenario
+from simulator.sensors import resolve_block
 from simulator.sensors.imu import Imu
 from simulator.tables import as_frame
 from simulator.trajectory.sumo import place_drive, run_sumo
 from simulator.trajectory.sumo_network import prepare_network
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 NETWORKS = REPO / "scenarios" / "networks"
-ESMINI = Path(__file__).resolve().parents[2] / "shared" / "refdata" / "roads" / "esmini"
+ESMINI = Path(__file__).resolve().parents[3] / "shared" / "refdata" / "roads" / "esmini"
 START = {"utc": "2024-05-01T08:00:00Z", "lat": 46.9480, "lon": 7.4474, "alt": 540.0}
 
 
@@ -77,8 +78,8 @@ def test_strapdown_closure_on_sumo_drive(hilly_city):
     2 m horizontally and 0.2 deg in yaw of the truth over the ten-minute drive. Measured: see
     the figures in the report (a few mm and 1e-6 deg)."""
     truth, _, _ = hilly_city
-    imu = Imu({"preset": "ideal", "rate": 100.0, "output": "increment",
-               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
+               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]}))
     table = as_frame(imu.generate(truth, None)["imu"])
     t = np.concatenate([[0.0], table.t.to_numpy()])
     ref = truth.table(t)

@@ -17,6 +17,7 @@ from simulator.cli import main
 from simulator.dataset.generate import build_truth
 from simulator.dataset.io import open_dataset
 from simulator.replay import run_estimator
+from simulator.sensors import resolve_block
 from simulator.sensors.imu import Imu
 from simulator.tables import as_frame
 from tests.synthetic import scenario, write_synthetic
@@ -67,9 +68,10 @@ def _ned(truth, t: np.ndarray, t0: float) -> np.ndarray:
 
 
 def test_strapdown_closure_with_reversing(truth):
-    """The same bounds as the forward ten-minute drive (tests/test_kinematics.py): an
+    """The same bounds as the forward ten-minute drive (tests/trajectory/test_kinematics.py): an
     independent NED strapdown of the ideal IMU closes on the truth through four reverses."""
-    err = _closure(truth, as_frame(Imu(IDEAL_IMU).generate(truth, None)["imu"]), increments=True)
+    imu = Imu(resolve_block("imu", IDEAL_IMU))
+    err = _closure(truth, as_frame(imu.generate(truth, None)["imu"]), increments=True)
     assert err["horizontal"] < 0.1
     assert err["vertical"] < 0.1
     assert err["yaw_deg"] < 1e-4

@@ -41,10 +41,9 @@ def make(block: dict) -> Magnetometer:
 
 def standing(lat: float, lon: float, heading: float = 0.0, alt: float = 5000.0,
              date: dt.datetime = dt.datetime(2020, 1, 1)):
-    truth = truth_from_segments([{"stop": {"duration": 5}}], rate_hz=1.0,
-                                start={"lat": lat, "lon": lon, "alt": alt, "heading": heading})
-    truth.utc_start = date
-    return truth
+    return truth_from_segments([{"stop": {"duration": 5}}], rate_hz=1.0,
+                               start={"lat": lat, "lon": lon, "alt": alt, "heading": heading},
+                               utc=date)
 
 
 def test_registered():
@@ -108,8 +107,8 @@ def test_hard_and_soft_iron():
 def test_disturbance_only_in_covered_zones():
     truth = truth_from_segments([
         {"stop": {"duration": 5}}, {"accelerate": {"to_speed": 10, "accel": 2}},
-        {"straight": {"length": 300, "zone": "tunnel"}}, {"straight": {"length": 200}}])
-    truth.environment = {"zones": {"tunnel": {"sky": "none"}}}
+        {"straight": {"length": 300, "zone": "tunnel"}}, {"straight": {"length": 200}}],
+        environment={"zones": {"tunnel": {"sky": "none"}}})
     block = {"disturbance": "20 uT"}
     ideal = as_frame(make({}).generate(truth, np.random.default_rng(0))["mag"])
     out = as_frame(make(block).generate(truth, np.random.default_rng(0))["mag"])

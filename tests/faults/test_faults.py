@@ -10,7 +10,8 @@ from conftest import scenario_data
 
 from simulator.dataset.generate import build_truth, generate_streams
 from simulator.errors import InputError
-from simulator.faults.base import FAULT_REGISTRY, FaultContext
+from simulator.faults import FAULT_REGISTRY
+from simulator.faults.base import FaultContext
 from simulator.faults.triggers import fault_intervals
 
 DRIVE = [

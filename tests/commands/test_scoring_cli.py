@@ -11,8 +11,8 @@ import pytest
 import yaml
 
 from simulator.cli import main
-from simulator.commands.run import NO_ESTIMATOR
 from simulator.dataset.io import open_dataset
+from simulator.pipeline import NO_ESTIMATOR
 from simulator.replay import run_estimator, write_solution
 from simulator.scoring.metrics import score_solution
 from tests.scoring_helpers import (

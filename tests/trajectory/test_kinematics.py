@@ -11,6 +11,7 @@ from scipy.integrate import quad
 from estimators.toolbox.strapdown import rates_to_increments, run_strapdown
 from simulator import earth
 from simulator.dataset.generate import build_truth
+from simulator.sensors import resolve_block
 from simulator.sensors.imu import Imu
 from simulator.tables import as_frame
 
@@ -64,8 +65,8 @@ def test_strapdown_closure_ideal_increments(drive):
     gravity) integrating the ideal 100 Hz IMU from truth stays within 1 m horizontally and
     0.1 deg in yaw over the whole ten-minute drive. Measured: 1.3 cm and 6e-8 deg, so the
     bounds asserted here are far stricter than the issue's."""
-    imu = Imu({"preset": "ideal", "rate": 100.0, "output": "increment",
-               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
+               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]}))
     err = _closure(drive, as_frame(imu.generate(drive, None)["imu"]), increments=True)
     assert err["horizontal"] < 0.1
     assert err["vertical"] < 0.1
@@ -75,8 +76,8 @@ def test_strapdown_closure_ideal_increments(drive):
 
 
 def test_rate_output_samples_the_truth_exactly(drive):
-    imu = Imu({"preset": "ideal", "rate": 50.0, "output": "rate",
-               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 50.0, "output": "rate",
+               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]}))
     table = as_frame(imu.generate(drive, None)["imu"])
     ref = drive.table(table.t.to_numpy())
     np.testing.assert_array_equal(table[["gyro_x", "gyro_y", "gyro_z"]].to_numpy(),
@@ -89,8 +90,8 @@ def test_strapdown_closure_ideal_rates_smooth_drive():
     without the sharp speed bump the closure is still within a metre over six minutes."""
     segments = [s for s in ten_minute_drive() if "speed_bump" not in s][:-3]
     truth = build_truth(scenario_data(segments))
-    imu = Imu({"preset": "ideal", "rate": 100.0, "output": "rate",
-               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]})
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "rate",
+               "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]}))
     err = _closure(truth, as_frame(imu.generate(truth, None)["imu"]), increments=False)
     assert err["horizontal"] < 1.0
     assert err["yaw_deg"] < 0.01

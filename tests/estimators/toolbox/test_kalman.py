@@ -57,50 +57,24 @@ def test_joseph_form_stays_symmetric_with_a_suboptimal_gain_use():
     np.testing.assert_allclose(s, H @ p @ H.T + 1e-12)
 
 
-@pytest.mark.parametrize("closed_loop", [True, False])
-def test_error_state_matches_total_state_filter(closed_loop):
-    """On a linear system an error-state filter, closed or open loop, gives the output of the
-    total-state filter (errors are estimate minus truth; dz = h(nominal) - z)."""
+@pytest.mark.parametrize("schedule", ["closed", "open", "closed-open-closed"])
+def test_error_state_matches_total_state_filter(schedule):
+    """On a linear system an error-state filter, closed or open loop, or switching mid-run
+    (closed, open for an outage, closed again), gives the output of the total-state filter
+    (errors are estimate minus truth; dz = h(nominal) - z); closing the loop hands back the
+    open-loop estimate once."""
+    def closed_at(k: int) -> bool:
+        return {"closed": True, "open": False}.get(schedule, not 50 <= k < 100)
+
     rng = np.random.default_rng(7)
     x_true = np.array([0.0, 1.0])
     nominal = np.array([5.0, 0.0])  # a wrong start: 5 m and -1 m/s off
     p0 = np.diag([25.0, 1.0])
     x_total, p_total = nominal.copy(), p0.copy()
-    es = ErrorState(p0, closed_loop=closed_loop)
-    for _ in range(200):
-        x_true = PHI @ x_true + rng.multivariate_normal(np.zeros(2), Q)
-        z = H @ x_true + rng.normal(0.0, 2.0, 1)
-        x_total, p_total = predict(x_total, p_total, PHI, Q)
-        x_total, p_total, _ = update(x_total, p_total, z - H @ x_total, H, R)
-        nominal = PHI @ nominal
-        es.predict(PHI, Q)
-        es.update(H @ nominal - z, H, R)
-        if closed_loop:
-            nominal = nominal - es.feedback()
-            assert not es.estimate.any()
-            output = nominal
-        else:
-            output = nominal - es.estimate
-        np.testing.assert_allclose(output, x_total, rtol=1e-9, atol=1e-9)
-        np.testing.assert_allclose(es.p, p_total, rtol=1e-9)
-    if not closed_loop:
-        with pytest.raises(RuntimeError, match="closed-loop"):
-            es.feedback()
-
-
-def test_switching_loops_mid_run_still_matches_the_total_state_filter():
-    """Closed loop, then open loop (an outage), then closed again: on a linear system the output
-    is the total-state filter's throughout, and closing the loop hands back the open-loop
-    estimate once."""
-    rng = np.random.default_rng(11)
-    x_true = np.array([0.0, 1.0])
-    nominal = np.array([5.0, 0.0])
-    p0 = np.diag([25.0, 1.0])
-    x_total, p_total = nominal.copy(), p0.copy()
-    es = ErrorState(p0)
-    for k in range(150):
-        if k in (50, 100):
-            nominal = nominal - es.set_closed_loop(k == 100)
+    es = ErrorState(p0, closed_loop=closed_at(0))
+    for k in range(200):
+        if closed_at(k) != es.closed_loop:
+            nominal = nominal - es.set_closed_loop(closed_at(k))
             assert not es.estimate.any()
         x_true = PHI @ x_true + rng.multivariate_normal(np.zeros(2), Q)
         z = H @ x_true + rng.normal(0.0, 2.0, 1)
@@ -111,5 +85,11 @@ def test_switching_loops_mid_run_still_matches_the_total_state_filter():
         es.update(H @ nominal - z, H, R)
         if es.closed_loop:
             nominal = nominal - es.feedback()
+            assert not es.estimate.any()
         np.testing.assert_allclose(nominal - es.estimate, x_total, rtol=1e-9, atol=1e-9)
-    assert not es.set_closed_loop(True).any()  # already closed: nothing to hand back
+        np.testing.assert_allclose(es.p, p_total, rtol=1e-9)
+    if es.closed_loop:
+        assert not es.set_closed_loop(True).any()  # already closed: nothing to hand back
+    else:
+        with pytest.raises(RuntimeError, match="closed-loop"):
+            es.feedback()

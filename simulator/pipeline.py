@@ -1,0 +1,125 @@
+"""The library's entry points: the main job, scenario -> dataset -> solutions -> scores ->
+report, as the functions a script or a notebook calls. ``landnav run``, ``landnav generate``,
+``landnav estimate``, ``landnav score`` and the campaign worker are thin layers over these.
+
+A notebook session::
+
+    from simulator import pipeline
+
+    scenario = pipeline.load_scenario("scenarios/quickstart.yaml", seed=3)
+    dataset = pipeline.generate(scenario, "out/quick", force=True)
+    solutions = pipeline.run_estimators(dataset, scenario.data["estimators"])
+    evaluation = pipeline.score(dataset, solutions)
+    evaluation.scores()                                  # keyed by label (SPEC section 8)
+    pipeline.write_report("out/quick-report", evaluation, "quickstart")
+
+or the whole job into one directory: ``pipeline.run(scenario, "runs/quick")``.
+
+Public names
+------------
+load_scenario, generate, estimate, run_estimators, score, write_report, run, RunResult,
+Solutions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from simulator.dataset.generate import generate_dataset
+from simulator.dataset.io import Dataset, open_dataset
+from simulator.errors import InputError, Problem
+from simulator.outputs import atomic_output_dir
+from simulator.replay import run_estimator, write_solution
+from simulator.scenario import Scenario, load_scenario
+from simulator.scoring import report
+from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
+
+__all__ = ["NO_ESTIMATOR", "RunResult", "Solutions", "estimate", "generate", "load_scenario",
+           "run", "run_estimators", "score", "write_report"]
+
+# label -> (solution table, run information: label, name, runtime_s, realtime_factor; None for
+# a solution read from a file)
+Solutions = dict[str, tuple[pd.DataFrame, dict | None]]
+
+NO_ESTIMATOR = ("No estimator was named in the scenario (its `estimators:` list is empty): the "
+                "dataset was generated and nothing was scored.")
+
+
+def generate(scenario: Scenario, out_dir: str | Path, force: bool = False,
+             show_progress: bool = False) -> Dataset:
+    """Write a scenario's dataset into ``out_dir`` (atomically; an existing directory only with
+    ``force``) and open it."""
+    return open_dataset(generate_dataset(scenario, Path(out_dir), force=force,
+                                         show_progress=show_progress))
+
+
+def estimate(dataset: Dataset, entry: Mapping[str, Any] | str,
+             show_progress: bool = False) -> tuple[pd.DataFrame, dict]:
+    """Replay ``dataset`` causally into one estimator (a scenario ``estimators:`` entry: a name,
+    ``module:Class``, or a mapping with ``name``, ``label``, ``init`` and ``config``); its
+    solution table and run information (``simulator.replay.run_estimator``)."""
+    return run_estimator(dataset, entry, show_progress=show_progress)
+
+
+def run_estimators(dataset: Dataset, entries: Iterable[Mapping[str, Any] | str],
+                   show_progress: bool = False) -> Solutions:
+    """Every estimator entry over ``dataset``, keyed by label; two entries with one label are
+    refused (give a label)."""
+    out: Solutions = {}
+    for i, entry in enumerate(entries):
+        frame, info = estimate(dataset, entry, show_progress)
+        if info["label"] in out:
+            raise InputError(f"estimators.{i}: label {info['label']!r} is used twice; give a "
+                             "label")
+        out[info["label"]] = (frame, info)
+    return out
+
+
+def score(dataset: Dataset, solutions: Solutions) -> Evaluation:
+    """Score solutions against the dataset's truth (SPEC section 8)."""
+    return score_solutions(dataset, solutions)
+
+
+def write_report(directory: str | Path, evaluation: Evaluation, title: str,
+                 note: str | None = None) -> Path:
+    """Write ``report.md`` (metrics, per-outage table) and its ``plots/`` into ``directory``
+    (made if missing); the path of ``report.md``."""
+    Path(directory).mkdir(parents=True, exist_ok=True)
+    return report.write_report(Path(directory), evaluation, title, note)
+
+
+@dataclass
+class RunResult:
+    """What ``run`` wrote into its directory: ``dataset/``, ``solutions/LABEL.parquet``,
+    ``scores.json`` and ``report.md`` with ``plots/``."""
+
+    directory: Path
+    evaluation: Evaluation
+
+
+def run(scenario: Scenario, out_dir: str | Path, force: bool = False,
+        show_progress: bool = False) -> RunResult:
+    """The main job into one directory, written under a temporary name and renamed when
+    complete: the dataset, every estimator the scenario names, their solutions, the scores and
+    the report. A label that cannot name a file is refused before anything is written."""
+    out = Path(out_dir)
+    entries = scenario.data["estimators"]
+    with atomic_output_dir(out, force) as tmp:
+        dataset = generate(scenario, tmp / "dataset", show_progress=show_progress)
+        (tmp / "solutions").mkdir()
+        solutions = run_estimators(dataset, entries, show_progress)
+        for i, label in enumerate(solutions):
+            if Path(label).name != label or label.startswith("."):
+                raise InputError([Problem(str(scenario.path), None, f"estimators.{i}.label",
+                                          f"{label!r} cannot name a file; give a plain label")])
+            write_solution(solutions[label][0], tmp / "solutions" / f"{label}.parquet")
+        evaluation = score(dataset, solutions)
+        write_scores(evaluation.scores(), tmp / "scores.json")
+        write_report(tmp, evaluation, f"{scenario.name} (seed {scenario.seed})",
+                     note=None if entries else NO_ESTIMATOR)
+    return RunResult(out, evaluation)

@@ -1,0 +1,76 @@
+"""Plug-in estimators that misbehave in every way the reliability tests try."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from estimators.base import Estimator
+
+
+class _Base(Estimator):
+    name = "hostile"
+    needs = ("imu",)
+    paper = "test double"
+
+    def on_imu(self, t, row):
+        self.t = t
+
+    def solution(self, t):
+        lat, lon, alt = self.initial.position
+        return [np.degrees(lat), np.degrees(lon), alt, *self.initial.velocity,
+                *self.initial.attitude]
+
+
+class RaiseInSetup(_Base):
+    def setup(self):
+        raise RuntimeError("deliberate setup failure")
+
+
+class RaiseInHandler(_Base):
+    def on_imu(self, t, row):
+        if t > 1.0:
+            raise ZeroDivisionError("deliberate handler failure")
+
+
+class WriteToRow(_Base):
+    def on_imu(self, t, row):
+        row[1] = 0.0
+
+
+class ReturnDict(_Base):
+    def solution(self, t):
+        return {"lat": 1.0}
+
+
+class ReturnShort(_Base):
+    def solution(self, t):
+        return [1.0, 2.0]
+
+
+class ReturnStrings(_Base):
+    def solution(self, t):
+        return ["a"] * 9
+
+
+class DuplicateColumns(_Base):
+    output_columns = (*_Base.output_columns, "yaw")
+
+
+class NoneDefaults(_Base):
+    defaults = None
+
+
+class CallsExit(_Base):
+    def on_imu(self, t, row):
+        sys.exit(0)
+
+
+class AllNan(_Base):
+    def solution(self, t):
+        return [np.nan] * 9
+
+
+class OneMegahertz(_Base):
+    output_rate_hz = 1e6
