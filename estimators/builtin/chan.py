@@ -77,6 +77,7 @@ from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import (
     OMEGA_E_RAD_S,
     earth_rate_ned,
+    geodetic_rates,
     geodetic_to_ecef,
     ned_to_ecef_matrix,
     quat_multiply,
@@ -321,11 +322,9 @@ def boxplus(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
     position and attitude)."""
     if np.ndim(dx) == 1:
         return boxplus(x, dx[None, :])[0]
-    rm, rt = radii_of_curvature(x[0])
+    d_lat, d_lon, d_h = geodetic_rates(x[0], x[2], dx[:, 0:3])
     out = np.empty((len(dx), N_NOMINAL))
-    out[:, 0] = x[0] + dx[:, 0] / (rm + x[2])
-    out[:, 1] = x[1] + dx[:, 1] / ((rt + x[2]) * np.cos(x[0]))
-    out[:, 2] = x[2] - dx[:, 2]
+    out[:, 0], out[:, 1], out[:, 2] = x[0] + d_lat, x[1] + d_lon, x[2] + d_h
     out[:, VEL] = x[VEL] + dx[:, 3:6]
     out[:, QUAT] = quat_multiply(rotvec_to_quat(dx[:, 6:9]), x[QUAT])
     out[:, 10:] = x[10:] + dx[:, 9:]
