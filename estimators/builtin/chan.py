@@ -426,6 +426,9 @@ class TcUkf(_TightlyCoupled):
         self.ukf.update(self._observe, z, r, ep, nhc)
 
     def solution(self, t: float) -> np.ndarray:
+        """The mean of the propagated points; the std columns are those of the covariance
+        formed at the last GPS or NHC update (the points' spread is formed only there, as in
+        the paper's step 3)."""
         self._flush()
         x = self.ukf.x
         return self._output(x[POS], x[VEL], x[QUAT], x[10:16], x[CLOCK], self.ukf.p)
