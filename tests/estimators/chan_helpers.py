@@ -26,11 +26,10 @@ def error_3d(solution: pd.DataFrame, truth: pd.DataFrame) -> np.ndarray:
 
 
 def run(dataset: Dataset, name: str, **config) -> tuple[pd.DataFrame, np.ndarray]:
-    """Solution and its 3-D error of estimator ``name`` with ``config`` over the lever arm."""
-    entry = {"name": name, "config": {"lever_arm": LEVER_ARM, **config}}
+    """Solution and its 3-D error of estimator ``name`` with ``config`` over the lever arm
+    (``init``, if given, is the entry's initial errors rather than a config key)."""
     init = config.pop("init", None)
-    if init:
-        entry = {"name": name, "init": init, "config": {"lever_arm": LEVER_ARM, **config}}
+    entry = {"name": name, "init": init, "config": {"lever_arm": LEVER_ARM, **config}}
     solution, _ = run_estimator(dataset, entry, show_progress=False)
     return solution, error_3d(solution, dataset.read("truth"))
 
