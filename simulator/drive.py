@@ -1,5 +1,6 @@
 """The drive: what a resolved scenario makes of the road before any sensor looks at it - its road
-profile, its resolved start, the exact truth kinematics, its UTC epoch and its environment. One
+profile, its resolved start, the vehicle on that road (``simulator.vehicle``), the exact truth
+kinematics, its UTC epoch and its environment. One
 immutable object, built once while the scenario is validated (validation needs the profile to
 check what the vehicle can drive and when faults fall) and handed to the generator.
 
@@ -21,10 +22,12 @@ from dataclasses import dataclass
 
 from simulator.errors import InputError
 from simulator.schema import Context
+from simulator.stochastic import stream_rng
 from simulator.timebase import parse_utc
 from simulator.trajectory import PROFILE_BUILDERS
-from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
+from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile, truth_grid
 from simulator.trajectory.segments import RoadProfile
+from simulator.vehicle import ROAD_STREAM, vehicle_body
 
 
 @dataclass(frozen=True)
@@ -40,6 +43,8 @@ class Drive:
     environment: Mapping  # the resolved ``environment`` block: zones, canyon, magnetic field
     rate_hz: float  # of the truth grid
     roll_gradient: float  # rad per m/s^2 of lateral acceleration (``limits.roll_gradient``)
+    vehicle: str | Mapping  # the resolved ``vehicle`` block: "rigid", a preset or parameters
+    seed: int  # the scenario's seed (the road's random stream)
 
     @property
     def duration_s(self) -> float:
@@ -47,9 +52,13 @@ class Drive:
 
     @functools.cached_property
     def truth(self) -> Kinematics:
-        """The exact truth trajectory (built once, on first use)."""
-        return kinematics_from_profile(self.profile, self.start, self.rate_hz,
-                                       self.roll_gradient, self.utc_start, self.environment)
+        """The exact truth trajectory (built once, on first use): the vehicle's body on the road
+        (its own random stream, ``ROAD_STREAM``), then the kinematics of both."""
+        profile, body = vehicle_body(self.profile, self.vehicle,
+                                     truth_grid(self.profile.duration_s, self.rate_hz),
+                                     stream_rng(self.seed, ROAD_STREAM))
+        return kinematics_from_profile(profile, self.start, self.rate_hz, self.roll_gradient,
+                                       self.utc_start, self.environment, body)
 
 
 def build_profile(scenario: dict, ctx: Context | None = None) -> RoadProfile | None:
@@ -70,4 +79,5 @@ def build_drive(scenario: dict, profile: RoadProfile | None = None) -> Drive:
                  utc_start=parse_utc(scenario["start"]["utc"]),
                  environment=scenario["environment"],
                  rate_hz=scenario["trajectory"]["rate"],
-                 roll_gradient=scenario["limits"]["roll_gradient"])
+                 roll_gradient=scenario["limits"]["roll_gradient"],
+                 vehicle=scenario["vehicle"], seed=scenario["seed"])

@@ -13,8 +13,8 @@ Public functions
 radii_of_curvature, radii_of_curvature_from_sin, normal_gravity, normal_gravity_from_sin,
 gravity_ned, earth_rate_ned, transport_rate_ned, geodetic_rates, geodetic_to_ecef, ecef_to_geodetic,
 ned_to_ecef_matrix, ecef_to_ned, ned_to_ecef, ned_to_ecef_vector, euler_to_dcm, ned_to_body,
-ned_to_body_trig, ned_to_body_components, dcm_to_euler, euler_to_quat, quat_to_dcm, quat_to_euler,
-quat_multiply, rotvec_to_quat, quat_to_rotvec, wrap_angle, skew.
+ned_to_body_trig, ned_to_body_components, body_to_ned_components, dcm_to_euler, euler_to_quat,
+quat_to_dcm, quat_to_euler, quat_multiply, rotvec_to_quat, quat_to_rotvec, wrap_angle, skew.
 
 References
 ----------
@@ -294,6 +294,21 @@ def ned_to_body_components(cr: np.ndarray, sr: np.ndarray, cp: np.ndarray, sp: n
     out[0] = cp * h - sp * vd
     out[1] = cr * lateral + sr * vertical
     out[2] = cr * vertical - sr * lateral
+    return np.moveaxis(out, 0, -1)
+
+
+def body_to_ned_components(cr: np.ndarray, sr: np.ndarray, cp: np.ndarray, sp: np.ndarray,
+                           cy: np.ndarray, sy: np.ndarray, x: np.ndarray, y: np.ndarray,
+                           z: np.ndarray) -> np.ndarray:
+    """The inverse of ``ned_to_body_components``: body (FRD) components to NED, C_b^n v, each
+    rotation undone in reverse order (roll, pitch, yaw); returns shape (..., 3)."""
+    lateral = cr * y - sr * z
+    vertical = sr * y + cr * z
+    h = cp * x + sp * vertical
+    out = np.empty((3,) + np.broadcast_shapes(np.shape(cr), np.shape(x)))
+    out[0] = cy * h - sy * lateral
+    out[1] = sy * h + cy * lateral
+    out[2] = cp * vertical - sp * x
     return np.moveaxis(out, 0, -1)
 
 

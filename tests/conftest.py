@@ -102,3 +102,15 @@ def ten_minute_drive() -> list[dict]:
         {"accelerate": {"to_speed": 0.0, "accel": 2.0}},
         {"stop": {"duration": 20}},
     ]
+
+
+@pytest.fixture(scope="session")
+def quickstart(tmp_path_factory):
+    """The shipped quickstart scenario's dataset (seed 1), generated once per session."""
+    from simulator.dataset.generate import generate_dataset
+    from simulator.dataset.io import open_dataset
+    from simulator.scenario import load_scenario
+
+    out = tmp_path_factory.mktemp("quickstart") / "dataset"
+    return open_dataset(generate_dataset(load_scenario(REPO / "scenarios" / "quickstart.yaml"),
+                                         out, show_progress=False))

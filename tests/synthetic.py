@@ -31,8 +31,11 @@ FLAT_LOOP = [  # a flat drive with left and right turns, about 2.2 km in 4 minut
 ]
 
 
-def scenario(segments: list[dict] | None = None, imu_output: str = "rate") -> dict:
-    data = {"name": "synthetic", "seed": 3,
+def scenario(segments: list[dict] | None = None, imu_output: str = "rate",
+             vehicle: str | dict = "rigid") -> dict:
+    """A resolved scenario; a rigid body by default, since the estimator tests built on it
+    check integration against a body that follows the road exactly (NHC exactly true)."""
+    data = {"name": "synthetic", "seed": 3, "vehicle": vehicle,
             "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5665, "lon": 126.978,
                       "alt": 40.0, "heading": 30.0},
             "trajectory": {"kind": "segments", "segments": segments or FLAT_LOOP},

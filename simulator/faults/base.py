@@ -58,10 +58,13 @@ class FaultKind:
 def fault_kind(name: str, params: dict[str, Field], streams: tuple[str, ...], doc: str
                ) -> Callable[[Apply], FaultKind]:
     """Decorator making a fault kind of its ``apply`` function: its name, parameters (the
-    trigger fields added), the streams it acts on and a one-line description. The kinds are
-    listed by name in ``simulator.faults.FAULT_REGISTRY``."""
+    trigger fields added), the streams it acts on and a one-line description (also the
+    record's doc, which the scenario reference prints). The kinds are listed by name in
+    ``simulator.faults.FAULT_REGISTRY``."""
     def wrap(apply: Apply) -> FaultKind:
-        return FaultKind(name, Record({**TRIGGER_FIELDS, **params}), apply, streams, doc)
+        record = Record({**TRIGGER_FIELDS, **params},
+                        doc=f"{doc} (acts on: {', '.join(streams)})")
+        return FaultKind(name, record, apply, streams, doc)
     return wrap
 
 

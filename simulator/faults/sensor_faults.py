@@ -17,7 +17,8 @@ from simulator.schema import ListOf, Number, Text
 if TYPE_CHECKING:
     import pandas as pd
 
-_AXES = ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1)
+_AXES = ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1,
+               doc="the IMU channels it acts on")
 
 
 def _imu_axes(imu: pd.DataFrame, axes: list[str], sensors: dict
@@ -43,6 +44,7 @@ def _imu_bias_step(streams, intervals, params, context) -> None:
 
 @fault_kind("imu_saturation_burst", {
     "axes": ListOf(Text(choices=list(col.IMU_AXES)), ["accel_x", "accel_y", "accel_z"],
+                   doc="the IMU channels it acts on",
                    min_len=1),
     "gyro_amplitude": Number("rad/s", 0.0, min=0, doc="shock oscillation on the gyros"),
     "accel_amplitude": Number("m/s^2", 0.0, min=0, doc="shock oscillation on the accels"),
@@ -98,7 +100,8 @@ def _baro_jump(streams, intervals, params, context) -> None:
         baro.loc[mask, "pressure"] = baro.loc[mask, "pressure"].to_numpy() + delta
 
 
-_STREAM = Text(choices=["imu", "odometer", "gnss_fix", "gnss_raw", "baro", "mag"])
+_STREAM = Text(choices=["imu", "odometer", "gnss_fix", "gnss_raw", "baro", "mag"],
+               doc="the stream it acts on")
 
 
 @fault_kind("sensor_dropout", {"stream": _STREAM}, ("imu", "odometer", "gnss_fix", "gnss_raw",

@@ -18,12 +18,17 @@ by differencing samples:
   normal gravity, and body rate w_ib^b = w_nb^b + C_n^b (w_ie^n + w_en^n), where w_nb^b comes
   from the exact Euler-angle rates (Groves eq. 2.56 inverted).
 
+With a vehicle body (``simulator.vehicle``, issue 13) the road-following point above is the
+body's centre of gravity in its static position; the body then heaves, pitches and rolls on its
+suspension and yaws by the side slip beta relative to the path (``_with_body``), and the truth
+is the motion of its reference point (``BodyMotion.reference_point``) on the body.
+
 The truth table is ``Kinematics.columns`` (a column table of ``simulator.tables``, what the
 dataset writer takes, without pandas) or ``Kinematics.table`` (the same as a DataFrame).
 
 Public names
 ------------
-Kinematics, kinematics_from_profile.
+Kinematics, kinematics_from_profile, truth_grid.
 """
 
 from __future__ import annotations
@@ -38,6 +43,7 @@ import numpy as np
 from simulator import columns as col
 from simulator.earth import (
     OMEGA_E_RAD_S,
+    body_to_ned_components,
     geodetic_rates,
     ned_to_body_components,
     normal_gravity_from_sin,
@@ -53,6 +59,8 @@ from simulator.trajectory.segments import RoadProfile
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from simulator.vehicle.body import BodyMotion
 
 # samples per piece of a long evaluation (``_by_pieces``): its intermediate arrays, 128 kB each
 _PIECE = 16384
@@ -78,13 +86,17 @@ class Kinematics:
     rate_hz : float
         Base rate of the truth table (the grid used for the position integration).
     roll_gradient : float
-        Body roll per lateral acceleration, rad per m/s^2.
+        Body roll per lateral acceleration, rad per m/s^2 (without a ``body`` only).
+    body : BodyMotion, optional
+        The body's motion on its suspension and its side slip (``simulator.vehicle``); None:
+        a rigid point following the road.
     """
 
     def __init__(self, profile: RoadProfile, origin: Origin, rate_hz: float,
                  roll_gradient: float, utc_start: dt.datetime = dt.datetime(2020, 1, 1),
-                 environment: Mapping | None = None):
+                 environment: Mapping | None = None, body: BodyMotion | None = None):
         self.profile = _as_fast(profile)
+        self.body = body
         curves = (self.profile.curvature, self.profile.grade, self.profile.bank,
                   self.profile.heading)
         self._shared_breaks = all(np.array_equal(c.x, curves[0].x) for c in curves)
@@ -92,8 +104,7 @@ class Kinematics:
         self.rate_hz = float(rate_hz)
         self.roll_gradient = float(roll_gradient)
         self.duration_s = profile.duration_s
-        n = int(np.floor(self.duration_s * self.rate_hz + 1e-9)) + 1
-        self.t_grid = np.arange(n) / self.rate_hz
+        self.t_grid = truth_grid(self.duration_s, self.rate_hz)
         self._breaks: np.ndarray | None = None
         self._cache: dict[str, dict] = {}
         # when the drive starts, and the resolved ``environment`` block (zones and their sky,
@@ -122,9 +133,10 @@ class Kinematics:
         d = p.direction_at(t)  # +1 forward, -1 reversing: switches only where v = a = 0
         # the road curves of a parametric drive share their breakpoints: one search serves all
         idx = p.curvature.piece_index(s) if self._shared_breaks else None
-        kappa, dkappa = p.curvature.evaluate(s, (0, 1), idx)
-        gamma, dgamma = p.grade.evaluate(s, (0, 1), idx)
-        bank, dbank = p.bank.evaluate(s, (0, 1), idx)
+        orders = (0, 1) if self.body is None else (0, 1, 2)
+        kappa, dkappa, *d2kappa = p.curvature.evaluate(s, orders, idx)
+        gamma, dgamma, *d2gamma = p.grade.evaluate(s, orders, idx)
+        bank, dbank, *d2bank = p.bank.evaluate(s, orders, idx)
         psi = p.heading.evaluate(s, (0,), idx)[0]
         psi += np.radians(self.origin.heading_deg)
         yaw = wrap_angle(psi)  # the same angle, whose cosine and sine are cheaper
@@ -151,10 +163,72 @@ class Kinematics:
         a_ned[0] = da * u_n - dv * (u_e * yaw_rate + cp * sg_pitch_rate)
         a_ned[1] = da * u_e + dv * (u_n * yaw_rate - sp * sg_pitch_rate)
         a_ned[2] = -da * sg - dv * cg * pitch_rate
+        if self.body is not None:
+            road = dict(s=s, v=v, a=a, psi=psi, kappa=kappa, dkappa=dkappa, gamma=gamma,
+                        dgamma=dgamma, d2gamma=d2gamma[0], bank=bank, dbank=dbank,
+                        d2bank=d2bank[0], v_ned=v_ned, a_ned=a_ned)
+            return self._with_body(t, road, dv + 0.0)
         # + 0.0: a reversing car at rest reads 0.0, not -0.0
         return dict(s=s, v=dv + 0.0, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
                     pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned.T, a_ned=a_ned.T,
                     cos_pitch=cg, sin_pitch=sg, cos_yaw=cp, sin_yaw=sp)
+
+    def _with_body(self, t: np.ndarray, road: dict[str, np.ndarray],
+                   speed: np.ndarray) -> dict[str, np.ndarray]:
+        """``_motion_piece`` with the body: attitude, rates and the reference point's motion.
+
+        Attitude: roll = bank + body roll, pitch = grade + body pitch, yaw = path heading - side
+        slip, each with its exact first and second time derivatives (the road curves' s
+        derivatives times v and a). The reference point sits at r' = r - z e_z from the centre
+        of gravity (FRD; r the reference point, z the heave), so relative to the road-following
+        point its velocity is C_b^n (w x r' - z' e_z) and its acceleration C_b^n (alpha x r' +
+        w x (w x r') - 2 z' w x e_z - z'' e_z), with w = w_nb^b from the Euler-angle rates
+        (Groves eq. 2.56 inverted) and alpha its derivative. The rotation of the NED frame
+        itself (the transport rate, below 1e-5 rad/s) is left out of these lever-arm terms: it
+        moves the point by less than 1e-5 m/s x r. The road-following point's velocity is
+        kept as ``v_road`` for the position integration, the displacement as ``offset``.
+        """
+        b = self.body.evaluate(t)
+        v, a = road["v"], road["a"]
+        v2 = v * v
+        roll = road["bank"] + b["roll"]
+        pitch = road["gamma"] + b["pitch"]
+        yaw = road["psi"] - b["slip"]
+        roll_rate = road["dbank"] * v + b["roll_rate"]
+        pitch_rate = road["dgamma"] * v + b["pitch_rate"]
+        yaw_rate = road["kappa"] * v - b["slip_rate"]
+        roll_acc = road["d2bank"] * v2 + road["dbank"] * a + b["roll_accel"]
+        pitch_acc = road["d2gamma"] * v2 + road["dgamma"] * a + b["pitch_accel"]
+        yaw_acc = road["dkappa"] * v2 + road["kappa"] * a - b["slip_accel"]
+        cr, sr, cp, sp = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch)
+        yaw_wrapped = wrap_angle(yaw)
+        cy, sy = np.cos(yaw_wrapped), np.sin(yaw_wrapped)
+        wx = roll_rate - yaw_rate * sp
+        wy = pitch_rate * cr + yaw_rate * cp * sr
+        wz = -pitch_rate * sr + yaw_rate * cp * cr
+        ax = roll_acc - yaw_acc * sp - yaw_rate * pitch_rate * cp
+        ay = (pitch_acc * cr - pitch_rate * roll_rate * sr + yaw_acc * cp * sr
+              - yaw_rate * pitch_rate * sp * sr + yaw_rate * roll_rate * cp * cr)
+        az = (-pitch_acc * sr - pitch_rate * roll_rate * cr + yaw_acc * cp * cr
+              - yaw_rate * pitch_rate * sp * cr - yaw_rate * roll_rate * cp * sr)
+        rx, ry, r0 = self.body.reference_point
+        rz = r0 - b["heave"]
+        zd, zdd = b["heave_rate"], b["heave_accel"]
+        # w x r' - z' e_z, then alpha x r' + w x (w x r') - 2 z' (w x e_z) - z'' e_z
+        ux = wy * rz - wz * ry
+        uy = wz * rx - wx * rz
+        uz = wx * ry - wy * rx
+        acc_x = ay * rz - az * ry + (wy * uz - wz * uy) - 2 * zd * wy
+        acc_y = az * rx - ax * rz + (wz * ux - wx * uz) + 2 * zd * wx
+        acc_z = ax * ry - ay * rx + (wx * uy - wy * ux) - zdd
+        trig = (cr, sr, cp, sp, cy, sy)
+        v_ned = road["v_ned"].T + body_to_ned_components(*trig, ux, uy, uz - zd)
+        a_ned = road["a_ned"].T + body_to_ned_components(*trig, acc_x, acc_y, acc_z)
+        offset = body_to_ned_components(*trig, rx, ry, rz)
+        return dict(s=road["s"], v=speed, roll=roll, pitch=pitch, yaw=yaw, roll_rate=roll_rate,
+                    pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
+                    cos_pitch=cp, sin_pitch=sp, cos_yaw=cy, sin_yaw=sy,
+                    v_road=road["v_ned"].T, offset=offset)
 
     # -- position ---------------------------------------------------------------------------
     def _integrate_position(self) -> None:
@@ -175,13 +249,13 @@ class Kinematics:
         if t[-1] < self.duration_s - 1e-9:
             t = np.append(t, self.duration_s)
         motion = self._motion(t)
-        v = motion["v_ned"]
+        v = _road_velocity(motion)
         # intervals [t_k, t_k+1] for k >= first_gauss: Gauss-Legendre on the analytic velocity
         first_gauss = n_grid - 1 if n_grid >= 4 else 0
         owner = np.repeat(np.arange(first_gauss, len(t) - 1), len(GL_NODES))
         gauss_t = t[owner] + (t[owner + 1] - t[owner]) * np.tile(GL_NODES, len(t) - 1
                                                                   - first_gauss)
-        gauss_v = self._motion(gauss_t)["v_ned"] if len(gauss_t) else np.empty((0, 3))
+        gauss_v = _road_velocity(self._motion(gauss_t)) if len(gauss_t) else np.empty((0, 3))
         gauss_u = (gauss_t - t[owner]) / (t[owner + 1] - t[owner])
 
         def at_gauss(node_values: np.ndarray) -> np.ndarray:
@@ -226,16 +300,28 @@ class Kinematics:
         self._lla_rates = rates
         # for ``grid_inertial``: the grid's positions are the integration's own nodes
         self._grid_motion = {key: values[:n_grid] for key, values in motion.items()}
-        self._grid_place = dict(lat=lat[:n_grid], lon=lon[:n_grid], alt=alt[:n_grid],
-                                sin_lat=sin_lat[:n_grid], cos_lat=cos_lat[:n_grid],
-                                rn=rn[:n_grid], re=re[:n_grid])
+        if self.body is None:
+            self._grid_place = dict(lat=lat[:n_grid], lon=lon[:n_grid], alt=alt[:n_grid],
+                                    sin_lat=sin_lat[:n_grid], cos_lat=cos_lat[:n_grid],
+                                    rn=rn[:n_grid], re=re[:n_grid])
+        else:
+            pos = np.stack([lat[:n_grid], lon[:n_grid], alt[:n_grid]], axis=1)
+            self._grid_place = _place(_displaced(pos, self._grid_motion["offset"]))
 
     def position(self, t: np.ndarray) -> np.ndarray:
         """Latitude (rad), longitude (rad), altitude (m) at times t, shape (n, 3).
 
         Cubic Hermite interpolation between integration nodes with the exact rates, so the
-        interpolation error is O(dt^4) (far below a millimetre at the base rate).
+        interpolation error is O(dt^4) (far below a millimetre at the base rate); with a body,
+        displaced from the road-following point to the reference point.
         """
+        pos = self._road_position(t)
+        if self.body is None:
+            return pos
+        return _displaced(pos, self._motion(np.clip(t, 0.0, self.duration_s))["offset"])
+
+    def _road_position(self, t: np.ndarray) -> np.ndarray:
+        """``position`` of the road-following point."""
         nodes = self._t_int
         t = np.clip(np.atleast_1d(np.asarray(t, float)), 0.0, nodes[-1])
         out = np.empty((3,) + t.shape)  # component by component, handed out as (n, 3)
@@ -260,13 +346,11 @@ class Kinematics:
     def inertial(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Everything at times t: position, velocity, attitude, w_ib^b and f_ib^b (FRD)."""
         t = np.atleast_1d(np.asarray(t, dtype=float))
-        pos = self.position(t)
-        lat = pos[:, 0]
-        sin_lat, cos_lat = np.sin(lat), np.cos(lat)
-        rn, re = radii_of_curvature_from_sin(sin_lat)
-        place = dict(lat=lat, lon=pos[:, 1], alt=pos[:, 2], sin_lat=sin_lat, cos_lat=cos_lat,
-                     rn=rn, re=re)
-        return self._inertial(t, self._motion(t), place)
+        motion = self._motion(t)
+        pos = self._road_position(t)
+        if self.body is not None:
+            pos = _displaced(pos, motion["offset"])
+        return self._inertial(t, motion, _place(pos))
 
     def _inertial(self, t: np.ndarray, m: dict[str, np.ndarray],
                   place: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -334,7 +418,8 @@ class Kinematics:
             for _ in range(4):  # Newton on s(t) = s_b; the vehicle moves at every road break
                 v = np.maximum(p.distance_of_time(t_breaks, 1), 1e-6)
                 t_breaks = t_breaks - (p.distance_of_time(t_breaks) - s_breaks) / v
-            self._breaks = np.unique(np.concatenate([p.distance_of_time.x, t_breaks]))
+            body = [] if self.body is None else [self.body.breakpoints()]
+            self._breaks = np.unique(np.concatenate([p.distance_of_time.x, t_breaks, *body]))
         return self._breaks
 
     def zone_at(self, t: np.ndarray) -> np.ndarray:
@@ -398,6 +483,31 @@ def _by_pieces(evaluate: Callable[[slice], dict[str, np.ndarray]],
     return out
 
 
+def _road_velocity(motion: dict[str, np.ndarray]) -> np.ndarray:
+    """NED velocity of the road-following point (that of the truth without a body)."""
+    return motion["v_road"] if "v_road" in motion else motion["v_ned"]
+
+
+def _place(pos: np.ndarray) -> dict[str, np.ndarray]:
+    """Latitude, longitude, altitude (rad, rad, m; (n, 3)) with the sine and cosine of latitude
+    and the radii of curvature there: the place ``_inertial`` takes."""
+    lat = pos[:, 0]
+    sin_lat, cos_lat = np.sin(lat), np.cos(lat)
+    rn, re = radii_of_curvature_from_sin(sin_lat)
+    return dict(lat=lat, lon=pos[:, 1], alt=pos[:, 2], sin_lat=sin_lat, cos_lat=cos_lat,
+                rn=rn, re=re)
+
+
+def _displaced(pos: np.ndarray, offset_ned: np.ndarray) -> np.ndarray:
+    """Geodetic positions (n, 3) moved by small NED offsets (n, 3), m (``geodetic_rates`` of the
+    offsets: first order, the offsets are about a metre, so the neglected terms are below a
+    micrometre)."""
+    out = np.empty_like(pos)
+    for column, change in enumerate(geodetic_rates(pos[:, 0], pos[:, 2], offset_ned)):
+        np.add(pos[:, column], change, out=out[:, column])
+    return out
+
+
 def _as_fast(profile: RoadProfile) -> RoadProfile:
     """The profile with every curve a ``PiecewisePolynomial`` (sources may give scipy PPoly)."""
     fields = ("distance_of_time", "curvature", "heading", "grade", "bank")
@@ -405,14 +515,22 @@ def _as_fast(profile: RoadProfile) -> RoadProfile:
     direction = (None if profile.direction is None
                  else PiecewisePolynomial.from_ppoly(profile.direction))
     return RoadProfile(**converted, duration_s=profile.duration_s, zones=profile.zones,
-                       direction=direction)
+                       direction=direction, bumps=profile.bumps)
+
+
+def truth_grid(duration_s: float, rate_hz: float) -> np.ndarray:
+    """The base grid of the truth: every 1 / rate_hz from 0 up to the drive's duration."""
+    n = int(np.floor(duration_s * rate_hz + 1e-9)) + 1
+    return np.arange(n) / rate_hz
 
 
 def kinematics_from_profile(profile: RoadProfile, start: Mapping, rate_hz: float,
                             roll_gradient: float,
                             utc_start: dt.datetime = dt.datetime(2020, 1, 1),
-                            environment: Mapping | None = None) -> Kinematics:
+                            environment: Mapping | None = None,
+                            body: BodyMotion | None = None) -> Kinematics:
     """Build the ``Kinematics`` of a road profile from a resolved scenario ``start`` block (and
-    the drive's UTC epoch and resolved ``environment`` block, which the sensors read)."""
+    the drive's UTC epoch and resolved ``environment`` block, which the sensors read, and the
+    vehicle's body on the road, ``simulator.vehicle``)."""
     origin = Origin(start["lat"], start["lon"], start["alt"], start["heading"])
-    return Kinematics(profile, origin, rate_hz, roll_gradient, utc_start, environment)
+    return Kinematics(profile, origin, rate_hz, roll_gradient, utc_start, environment, body)

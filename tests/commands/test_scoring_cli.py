@@ -117,7 +117,7 @@ def test_score_report_is_written_atomically(dataset, shifted, tmp_path, capsys):
     assert main(args) == 0
     text = (report / "report.md").read_text()
     assert "shifted" in text and "5.000" in text and "20.000" in text
-    for png in ("map", "horizontal_error", "attitude_error", "horizontal_cdf"):
+    for png in ("map", "position_errors", "attitude_errors", "horizontal_cdf"):
         assert f"(plots/{png}.png)" in text and (report / "plots" / f"{png}.png").is_file()
     assert main(args) == 2  # exists: kept unless --force
     assert "--force" in capsys.readouterr().err
@@ -174,10 +174,13 @@ def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
     sol = pd.read_parquet(out / "solutions" / "hold.parquet")
     at = truth.set_index(np.round(truth["t"], 6)).loc[np.round(sol["t"], 6)]
     v = at[["vn", "ve", "vd"]].to_numpy()
+    # rows matched by times rounded to the microsecond: with the body's vibration (some m/s^2)
+    # the truth moves by up to 1e-6 m/s within that rounding
     assert scores["hold"]["velocity"]["rms"] == pytest.approx(
-        np.sqrt(np.mean(np.sum(v**2, axis=1))), rel=1e-9)
+        np.sqrt(np.mean(np.sum(v**2, axis=1))), rel=1e-7)
+    # the held roll is the start's (the road's camber under the car), not zero
     assert scores["hold"]["attitude"]["roll_rms"] == pytest.approx(
-        np.degrees(np.sqrt(np.mean(at["roll"] ** 2))), rel=1e-9)
+        np.degrees(np.sqrt(np.mean((at["roll"] - truth["roll"].iloc[0]) ** 2))), rel=1e-7)
     assert scores["hold"]["horizontal"]["cep50"] > 100.0
     assert scores["hold"]["runtime"]["seconds"] > 0
     text = (out / "report.md").read_text()
@@ -188,6 +191,8 @@ def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
                  str(out / "solutions" / "hold.parquet"), "--json", str(tmp_path / "s.json")]) == 0
     again = _strict_json(tmp_path / "s.json")["hold"]
     scores["hold"].pop("runtime")
+    # the estimator used no GNSS: no outage scores, in the run and from the file it wrote
+    assert scores["hold"]["outages"] is None and scores["hold"]["degraded"] is None
     assert again == scores["hold"]
 
 

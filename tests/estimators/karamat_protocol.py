@@ -31,6 +31,10 @@ def short_scenario(seed: int, loops: int = 4, site_s: float | None = 390.0,
     the site ``site_s`` seconds into the loop (None: every window ending by ``end_s``, or none
     without it), no estimators."""
     data, _ = read_yaml(SCENARIO)
+    # the paper's figures are reproduced on a rigid body (issue 13): with the automotive body
+    # (suspension, side slip, roughness) one of the ten seeds leaves a 0.064 deg/s vertical-gyro
+    # bias error at 300 s, over the 0.05 of section 4.3.3
+    data["vehicle"] = "rigid"
     data["trajectory"]["segments"] = data["trajectory"]["segments"][:loops * LOOP_SEGMENTS]
     loop_s = build_truth(validate_data({**data, "faults": [], "estimators": []},
                                        str(SCENARIO))).duration_s / loops

@@ -34,7 +34,13 @@ def _garage_max(scored, events) -> float:
 def runs(request, tmp_path_factory) -> dict[str, np.ndarray]:
     entries = {"nhc": {"name": "ins_odo_ekf"},
                "no_nhc": {"name": "ins_odo_ekf", "config": {"nhc": False}}}
-    return paired_scores(request.param, entries, SEEDS, tmp_path_factory.mktemp("park"), (),
+    # on a rigid body, where the non-holonomic constraint holds exactly (issue 13). With the
+    # automotive body the IMU near the centre of gravity slips sideways by up to l_r / R (11 deg
+    # in the garage's 8 m turns) and the same filter measured a median horizontal RMS outside
+    # the outages of 15.9 m (15.1-17.4) and a median garage maximum of 66.9 m with the NHC
+    # against 61.2 m without (parking_garage.yaml): the constraint, violated, no longer helps
+    return paired_scores(request.param, entries, SEEDS, tmp_path_factory.mktemp("park"),
+                         ("vehicle=rigid",),
                          lambda s, ev: (_rms_outside_outages(s, ev), _garage_max(s, ev)))
 
 

@@ -63,8 +63,9 @@ def test_drive_is_ten_minutes_with_every_manoeuvre(drive):
 def test_strapdown_closure_ideal_increments(drive):
     """Issue 2's proof of the kinematics: a NED strapdown (Earth and transport rate, normal
     gravity) integrating the ideal 100 Hz IMU from truth stays within 1 m horizontally and
-    0.1 deg in yaw over the whole ten-minute drive. Measured: 1.3 cm and 6e-8 deg, so the
-    bounds asserted here are far stricter than the issue's."""
+    0.1 deg in yaw over the whole ten-minute drive. Measured: 1.3 cm and 6e-8 deg on the rigid
+    body; 1.2 cm and 8e-7 deg with the default automotive body on its class B road (issue 13),
+    so the bounds asserted here are far stricter than the issues'."""
     imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
                "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"]}))
     err = _closure(drive, as_frame(imu.generate(drive, None)["imu"]), increments=True)
@@ -97,8 +98,8 @@ def test_strapdown_closure_ideal_rates_smooth_drive():
     assert err["yaw_deg"] < 0.01
 
 
-def test_standstill_reads_gravity_and_earth_rate(drive):
-    table = drive.table(np.array([5.0]))
+def test_standstill_reads_gravity_and_earth_rate():
+    table = _drive(ten_minute_drive()[:2]).table(np.array([5.0]))
     row = table.iloc[0]
     lat = np.radians(row.lat)
     f = row[["fx", "fy", "fz"]].to_numpy(float)
@@ -110,7 +111,9 @@ def test_standstill_reads_gravity_and_earth_rate(drive):
 
 
 def _drive(segments, limits=None, **start):
-    data = scenario_data(segments, limits=limits or {})
+    """The truth of a rigid body on the segments: these tests check the road geometry itself
+    (the body's motion on it is tested in tests/vehicle/)."""
+    data = scenario_data(segments, limits=limits or {}, vehicle="rigid")
     data["start"].update(start)
     return build_truth(data)
 

@@ -47,7 +47,8 @@ IDEAL_IMU = {"preset": "ideal", "rate": 100.0, "output": "increment",
 
 @pytest.fixture(scope="module")
 def truth():
-    return build_truth(scenario_data(SEGMENTS))
+    # a rigid body: these tests check the reversing geometry and signs exactly
+    return build_truth(scenario_data(SEGMENTS, vehicle="rigid"))
 
 
 def _span(truth, name: str) -> tuple[float, float]:

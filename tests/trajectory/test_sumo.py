@@ -30,10 +30,12 @@ START = {"utc": "2024-05-01T08:00:00Z", "lat": 46.9480, "lon": 7.4474, "alt": 54
 
 
 def write_scenario(folder: Path, trajectory: dict, name: str = "drive") -> Path:
+    """A SUMO scenario with a rigid body: these tests hold the fitted road itself (its path,
+    grades, stops) against SUMO's and the networks' (the body on it: tests/vehicle/)."""
     path = folder / f"{name}.yaml"
     path.write_text(yaml.safe_dump({
         "name": name, "start": START, "trajectory": {"kind": "sumo", **trajectory},
-        "sensors": {"imu": {"preset": "ideal", "rate": 100}}}))
+        "vehicle": "rigid", "sensors": {"imu": {"preset": "ideal", "rate": 100}}}))
     return path
 
 
@@ -135,7 +137,11 @@ def test_standstill_yaw_rate_is_earth_rate(hilly_city):
     np.testing.assert_allclose(k["w_body"], expected, atol=1e-15)
     for start, end in _runs(table.speed.to_numpy() == 0.0, table.t.to_numpy()):
         stop = table[(table.t >= start) & (table.t <= end)]
-        assert np.ptp(stop.yaw) < 1e-12  # no heading change while stopped
+        # no heading change while stopped: at a stop's last sample the fitted distance may
+        # already differ by the rounding of its second differences (about 1e-7 m, fit.py),
+        # worth curvature x 1e-7 m of heading (1e-10 rad on this drive since issue 13's SUMO
+        # braking changed the run)
+        assert np.ptp(stop.yaw) < 1e-9
 
 
 def _runs(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:

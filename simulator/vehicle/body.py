@@ -1,0 +1,189 @@
+"""The body's motion relative to the road-following point: heave, pitch and roll from the
+full-car ride model (``suspension``) and the side slip from a linear bicycle model, each as a
+piecewise quintic of time that the exact kinematics differentiate.
+
+* Side slip at the centre of gravity: the steady-state linear bicycle model (Rajamani, *Vehicle
+  Dynamics and Control*, 2nd ed., Springer 2012, section 3.3, eq. 3.45 with the yaw rate of the
+  path):  beta = kappa (l_r - m l_f v^2 / (L C_r)),  with C_r the rear axle's cornering stiffness
+  (both tyres), l_f and l_r the distances of the centre of gravity from the front and rear
+  axles and L = l_f + l_r. At low speed it is the kinematic model's beta = l_r kappa (the rear
+  axle's velocity lies along the body, Rajamani eq. 2.29 for small angles); above the speed
+  sqrt(l_r L C_r / (m l_f)) (about 16 m/s for the automotive preset) the tyres' slip turns it
+  negative. Signs in FRD: kappa > 0 turns right; beta > 0 puts the velocity to the right of the
+  body's x axis, so the body's yaw is the path's heading minus beta. The steady state is used
+  throughout: the bicycle model's lateral and yaw modes settle within about 0.2 s, while every
+  curvature change of a drive (clothoids, lane changes, fitted paths) lasts a second or more.
+  Choice: beta is the same when reversing (at reversing speeds it is the kinematic l_r kappa).
+* Heave, pitch and roll: ``suspension.simulate`` on the grid of the truth, driven by the road
+  under the wheels (``road``) and by the longitudinal and lateral accelerations of the path.
+* Engine vibration: a vertical sine of rms ``engine_accel`` at ``engine_frequency`` added to the
+  heave (its phase drawn from the road's random stream).
+
+Each channel is known on the grid with its first and second derivatives; between grid points it
+is the quintic Hermite interpolant of those six values (``quintic_coefficients``), so the
+channels are C2 and exactly differentiable, and on the grid they equal the model's values.
+
+Public names
+------------
+BodyMotion, build_body, quintic_coefficients, side_slip, level_road.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from simulator.trajectory.piecewise import PiecewisePolynomial
+from simulator.trajectory.segments import RoadProfile
+from simulator.vehicle.params import ROUGHNESS_CLASSES
+from simulator.vehicle.road import RoadSurface, draw_roughness
+from simulator.vehicle.suspension import FullCar, axle_distances, simulate
+
+CHANNELS = ("heave", "pitch", "roll", "slip")
+
+
+def quintic_coefficients(h: np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
+                         y1: np.ndarray, dy1: np.ndarray, d2y1: np.ndarray) -> list[np.ndarray]:
+    """Coefficients a5 ... a0 (highest power first) of the quintic on an interval of length h
+    with the given value, first and second derivative at its two ends.
+
+    p = y0 + y0' dx + y0'' dx^2 / 2 + a3 dx^3 + a4 dx^4 + a5 dx^5, dx from the interval's start,
+    with a3..a5 from the conditions at its end (the residuals D0, D1 h, D2 h^2 of value, slope
+    and curvature of the quadratic part there): a3 = (10 D0 - 4 D1 h + D2 h^2 / 2) / h^3,
+    a4 = (-15 D0 + 7 D1 h - D2 h^2) / h^4, a5 = (6 D0 - 3 D1 h + D2 h^2 / 2) / h^5.
+    """
+    a1, a2 = dy0, 0.5 * d2y0
+    d0 = y1 - (y0 + h * (a1 + h * a2))
+    d1 = (dy1 - (a1 + 2 * a2 * h)) * h
+    d2 = (d2y1 - 2 * a2) * h * h
+    h3 = h**3
+    return [(6 * d0 - 3 * d1 + 0.5 * d2) / (h3 * h * h), (-15 * d0 + 7 * d1 - d2) / (h3 * h),
+            (10 * d0 - 4 * d1 + 0.5 * d2) / h3, a2, a1, y0]
+
+
+def side_slip(kappa: np.ndarray, dkappa: np.ndarray, d2kappa: np.ndarray, v: np.ndarray,
+              a: np.ndarray, jerk: np.ndarray, l_r: float,
+              gain: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """beta = kappa(s) (l_r - gain v^2) and its first two time derivatives (see the module doc;
+    gain = m l_f / (L C_r), s^2/m). kappa and its derivatives are along s (1/m, 1/m^2, 1/m^3);
+    v, a, jerk the path speed (>= 0) and its time derivatives."""
+    k_t = dkappa * v
+    k_tt = d2kappa * v * v + dkappa * a
+    g = l_r - gain * v * v
+    g_t = -2 * gain * v * a
+    g_tt = -2 * gain * (a * a + v * jerk)
+    return kappa * g, k_t * g + kappa * g_t, k_tt * g + 2 * k_t * g_t + kappa * g_tt
+
+
+def level_road(profile: RoadProfile) -> RoadProfile:
+    """The profile with its speed bumps taken out of the grade (the wheels ride over them
+    instead): the grade of every piece inside a bump is zero (a bump's road is level)."""
+    if not profile.bumps:
+        return profile
+    grade = profile.grade
+    mid = 0.5 * (grade.x[:-1] + grade.x[1:])
+    inside = np.zeros(len(mid), dtype=bool)
+    for start, length, _ in profile.bumps:
+        inside |= (mid > start) & (mid < start + length)
+    c = grade.c.copy()
+    c[:, inside] = 0.0
+    return replace(profile, grade=PiecewisePolynomial(c, grade.x))
+
+
+@dataclass
+class BodyMotion:
+    """Heave (m, up), suspension pitch (rad, nose up), suspension roll (rad, right side down)
+    and side slip (rad) of the body, each with its first and second time derivatives, on the
+    truth grid ``t`` (``nodes``, shape (12, n): the four channels' values, then their rates,
+    then their accelerations), and the truth's reference point from the centre of gravity
+    (m, FRD). Between grid times the channels are the quintic Hermite curves of the nodes
+    (``quintic_coefficients``), built interval by interval where asked."""
+
+    t: np.ndarray
+    nodes: np.ndarray
+    reference_point: np.ndarray
+
+    def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
+        """Each channel and its first and second time derivatives at t (1-D): keys ``heave``,
+        ``heave_rate``, ``heave_accel`` and so on. On grid times, the nodes themselves;
+        elsewhere the quintic of the interval, built from its two ends' nodes."""
+        h = self.t[1] - self.t[0]
+        n = len(self.t)
+        i = np.clip(np.floor(t / h).astype(np.intp), 0, n - 2)
+        on = t == self.t.take(i)
+        last = t == self.t[-1]  # the grid's last time closes the last interval
+        values = self.nodes.take(np.where(last, n - 1, i), axis=1)
+        off = np.flatnonzero(~(on | last))
+        if len(off):
+            j = i[off]
+            start, end = self.nodes.take(j, axis=1), self.nodes.take(j + 1, axis=1)
+            k = len(CHANNELS)
+            coeffs = quintic_coefficients(np.full(len(off), h), start[:k], start[k:2 * k],
+                                          start[2 * k:], end[:k], end[k:2 * k], end[2 * k:])
+            dx = t[off] - self.t.take(j)
+            for order in range(3):
+                acc = np.zeros((k, len(off)))
+                for power, c in enumerate(coeffs[:len(coeffs) - order]):
+                    degree = 5 - power
+                    factor = np.prod(np.arange(degree, degree - order, -1))
+                    acc = acc * dx + factor * c
+                values[order * k:(order + 1) * k, off] = acc
+        return {name + suffix: values[i + len(CHANNELS) * order]
+                for order, suffix in enumerate(("", "_rate", "_accel"))
+                for i, name in enumerate(CHANNELS)}
+
+    def breakpoints(self) -> np.ndarray:
+        return self.t
+
+
+def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
+               rng: np.random.Generator) -> BodyMotion:
+    """The body motion of a drive on its truth grid (see the module doc).
+
+    Parameters
+    ----------
+    profile : RoadProfile
+        The road and speed profile, bumps included (``profile.bumps``).
+    params : dict
+        Resolved vehicle parameters (``params.vehicle_parameters``).
+    t_grid : array, shape (n,)
+        The truth grid, uniform, from 0.
+    rng : numpy.random.Generator
+        The road's random stream (roughness, engine phase).
+    """
+    car = FullCar.from_parameters(params)
+    t = t_grid if len(t_grid) > 1 else np.array([0.0, profile.duration_s or 1.0])
+    h = t[1] - t[0]
+    s, v, a, jerk = profile.distance_of_time.evaluate(t, (0, 1, 2, 3))
+    np.maximum(v, 0.0, out=v)
+    d = profile.direction_at(t)
+    kappa, dkappa, d2kappa = profile.curvature.evaluate(s, (0, 1, 2))
+    # the road: roughness over the whole drive and a wheelbase either side
+    span = float(s[-1]) + 2 * params["wheelbase"] + 1.0
+    if params["roughness"] == "none":
+        tracks = None
+    else:
+        tracks = draw_roughness(span, ROUGHNESS_CLASSES[params["roughness"]], rng)
+    surface = RoadSurface(profile.bumps, tracks, -params["wheelbase"] - 0.5, params["camber"])
+    u = np.empty((6, len(t)))
+    u[:4] = surface.heights(s, car.corner_x, car.corner_y)
+    np.multiply(d, a, out=u[4])
+    np.multiply(d * kappa, v * v, out=u[5])
+    ride = simulate(car, u, h)  # z, theta, phi, then their rates and accelerations
+    omega = 2 * np.pi * params["engine_frequency"]
+    amplitude = params["engine_accel"] * np.sqrt(2.0) / omega**2
+    if amplitude > 0:
+        phase = omega * t + rng.uniform(0.0, 2 * np.pi)
+        sin = np.sin(phase)
+        ride[0] += amplitude * sin
+        ride[3] += amplitude * omega * np.cos(phase)
+        ride[6] -= amplitude * omega**2 * sin
+    l_f, l_r = axle_distances(params)
+    gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
+    slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
+    nodes = np.empty((3 * len(CHANNELS), len(t)))
+    for order in range(3):  # heave, pitch, roll, slip; then the rates, then the accelerations
+        nodes[4 * order:4 * order + 3] = ride[3 * order:3 * order + 3]
+        nodes[4 * order + 3] = slip[order]
+    return BodyMotion(t, nodes, np.asarray(params["imu_position"], dtype=float))

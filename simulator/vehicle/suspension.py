@@ -1,0 +1,197 @@
+"""The linear full-car ride model: body heave, pitch and roll on four suspension corners and four
+wheels on their tyres (seven degrees of freedom), driven by the road height under each wheel and
+by the pitch and roll moments of longitudinal and lateral acceleration.
+
+The model is the classical full-vehicle ride model (Gillespie, *Fundamentals of Vehicle
+Dynamics*, SAE 1992, ch. 5; Jazar, *Vehicle Dynamics: Theory and Application*, 3rd ed., Springer
+2017, section 15.4 "full car vibrating model", eq. 15.91 ff.):
+
+    M q'' + C q' + K q = F u,   q = [z, theta, phi, w_fl, w_fr, w_rl, w_rr]
+
+with z the body's heave (m, up), theta its pitch (rad, nose up), phi its roll (rad, right side
+down, as in FRD), w_i the wheels' heights (m, up) and u = [r_fl, r_fr, r_rl, r_rr, a_x, a_y] the
+road heights under the wheels (m) and the longitudinal and lateral accelerations (m/s^2, FRD).
+The corner i at (x_i, y_i) of the body moves by z + x_i theta - y_i phi; its spring and damper
+act on that minus w_i, the anti-roll bars on the difference of the left and right deflections
+(a roll stiffness split over the axles as the springs are), the tyre on w_i - r_i. The moments
+of the accelerations act on the sprung mass at ``cg_height`` above the axes: m h a_x nose up
+(the body squats when accelerating and dives when braking) and -m h a_y (it leans out of a
+turn). Corner springs follow from the ride frequencies on each axle's sprung load (Gillespie
+eq. 5-5), dampers from the damping ratio; the tyre is a spring (its damping is small).
+
+Integration: the state equation x' = A x + B u is diagonalised, A = V diag(lambda) V^-1; each
+mode is propagated exactly for an input linear between samples ("first-order hold"; the road
+heights at the wheels are sampled on the truth grid), y_k+1 = e^(lambda h) y_k + b (p u_k +
+q u_k+1). The recursion is evaluated in blocks with numpy (``_scan``), never sample by sample.
+
+Public names
+------------
+FullCar, axle_distances, corner_ride_rates, simulate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+N_BODY = 3  # heave, pitch, roll
+N_DOF = 7
+N_INPUT = 6  # four road heights, a_x, a_y
+
+
+def axle_distances(p: dict) -> tuple[float, float]:
+    """Distances l_f, l_r (m) of the centre of gravity from the front and rear axles: the
+    front axle carries ``front_weight`` of the weight, so l_r = front_weight x wheelbase."""
+    l_r = p["wheelbase"] * p["front_weight"]
+    return p["wheelbase"] - l_r, l_r
+
+
+def corner_ride_rates(p: dict) -> tuple[np.ndarray, np.ndarray]:
+    """Sprung mass on each corner (kg; front-left, front-right, rear-left, rear-right) and the
+    ride rate that gives its axle's ride frequency there, m (2 pi f)^2 (N/m; Gillespie eq.
+    5-5): the suspension spring in series with the tyre."""
+    sprung = p["mass"] - 4 * p["unsprung_mass"]
+    front = p["front_weight"]
+    corner_mass = np.array([front, front, 1 - front, 1 - front]) * sprung / 2
+    freq = np.array([p["front_frequency"]] * 2 + [p["rear_frequency"]] * 2)
+    return corner_mass, corner_mass * (2 * np.pi * freq) ** 2
+
+
+@dataclass
+class FullCar:
+    """The matrices of the full-car model (see the module doc) built from vehicle parameters.
+
+    ``corner_x`` and ``corner_y`` (m, FRD, from the centre of gravity) are the four corners in
+    the order front-left, front-right, rear-left, rear-right.
+    """
+
+    mass: np.ndarray  # (7, 7)
+    damping: np.ndarray  # (7, 7)
+    stiffness: np.ndarray  # (7, 7)
+    forcing: np.ndarray  # (7, 6)
+    corner_x: np.ndarray
+    corner_y: np.ndarray
+
+    @classmethod
+    def from_parameters(cls, p: dict) -> FullCar:
+        """Build the model from a resolved ``vehicle`` parameter mapping."""
+        m = p["mass"]
+        m_u = p["unsprung_mass"]
+        m_s = m - 4 * m_u
+        lf, lr = axle_distances(p)
+        half = p["track"] / 2
+        x = np.array([lf, lf, -lr, -lr])
+        y = np.array([-half, half, -half, half])
+        corner_mass, k_ride = corner_ride_rates(p)
+        # the ride rate is the spring in series with the tyre: k_s = k_ride k_t / (k_t - k_ride)
+        k_t = p["tyre_stiffness"]
+        k_s = k_ride * k_t / (k_t - k_ride)
+        c_s = 2 * p["damping"] * np.sqrt(k_ride * corner_mass)
+        # corners: deflection d = T q_body - w, T_i = [1, x_i, -y_i]
+        t_body = np.stack([np.ones(4), x, -y], axis=1)
+        g = np.hstack([t_body, -np.eye(4)])
+        k_defl = np.diag(k_s)
+        # anti-roll bars: (k_bar / t^2) (d_right - d_left)^2 / 2 per axle, the roll stiffness
+        # split over the axles in proportion to their springs' roll stiffness
+        axle_share = np.array([k_s[0], k_s[2]]) / (k_s[0] + k_s[2])
+        for axle, (left, right) in enumerate(((0, 1), (2, 3))):
+            k_bar = p["roll_stiffness"] * axle_share[axle] / (2 * half) ** 2
+            pair = np.array([left, right])
+            k_defl[np.ix_(pair, pair)] += k_bar * np.array([[1.0, -1.0], [-1.0, 1.0]])
+        stiffness = g.T @ k_defl @ g
+        stiffness[N_BODY:, N_BODY:] += k_t * np.eye(4)
+        damping = g.T @ np.diag(c_s) @ g
+        mass = np.diag([m_s, p["pitch_inertia"], p["roll_inertia"], m_u, m_u, m_u, m_u])
+        forcing = np.zeros((N_DOF, N_INPUT))
+        forcing[N_BODY:, :4] = k_t * np.eye(4)
+        forcing[1, 4] = m_s * p["cg_height"]  # accelerating pitches the nose up
+        forcing[2, 5] = -m_s * p["cg_height"]  # a turn to the right rolls the body left
+        return cls(mass, damping, stiffness, forcing, x, y)
+
+    def state_space(self) -> tuple[np.ndarray, np.ndarray]:
+        """A (14, 14) and B (14, 6) of x' = A x + B u, x = [q, q']."""
+        m_inv = np.linalg.inv(self.mass)
+        a = np.zeros((2 * N_DOF, 2 * N_DOF))
+        a[:N_DOF, N_DOF:] = np.eye(N_DOF)
+        a[N_DOF:, :N_DOF] = -m_inv @ self.stiffness
+        a[N_DOF:, N_DOF:] = -m_inv @ self.damping
+        b = np.zeros((2 * N_DOF, N_INPUT))
+        b[N_DOF:] = m_inv @ self.forcing
+        return a, b
+
+
+def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
+    """Body heave, pitch and roll and their first and second derivatives on a uniform grid.
+
+    Parameters
+    ----------
+    model : FullCar
+    u : array, shape (6, n)
+        Inputs at the grid times (see the module doc), one row per input, linear between
+        the grid times.
+    h : float
+        Grid spacing, s.
+
+    Returns
+    -------
+    array, shape (9, n)
+        z, theta, phi, z', theta', phi', z'', theta'', phi'' (m, rad, per s, per s^2). The model
+        starts at rest in the static equilibrium of the first input.
+
+    Every product with the (n,)-long series is a real matrix product of a few rows (the modal
+    matrices split into real and imaginary parts): complex products of that shape cost several
+    times more.
+    """
+    a, b = model.state_space()
+    lam, vec = np.linalg.eig(a)
+    vec_inv = np.linalg.inv(vec)
+    # one of each complex-conjugate pair (its partner adds the conjugate: twice the real part)
+    keep = lam.imag >= -1e-12 * np.abs(lam)
+    weight = np.where(np.abs(lam.imag) > 1e-12 * np.abs(lam), 2.0, 1.0)[keep]
+    lam, vec, vec_inv = lam[keep], vec[:, keep], vec_inv[keep]
+    modal_b = vec_inv @ b  # (modes, 6): y' = lam y + modal_b u
+    # exact propagation over h of y' = lam y + beta u(t), u linear: integrals of e^(lam (h-s))
+    # times 1 and s over [0, h]
+    e = np.exp(lam * h)
+    i0 = (e - 1) / lam
+    i1 = h * i0 - (h * e / lam - (e - 1) / lam**2)
+    now, after = (i0 - i1 / h)[:, None] * modal_b, (i1 / h)[:, None] * modal_b
+    forced = np.empty((len(lam), u.shape[1]), dtype=complex)
+    forced.real[:, 1:] = now.real @ u[:, :-1] + after.real @ u[:, 1:]
+    forced.imag[:, 1:] = now.imag @ u[:, :-1] + after.imag @ u[:, 1:]
+    forced[:, 0] = -(modal_b @ u[:, 0]) / lam  # the static equilibrium of u_0
+    y = _scan(e, forced)
+    # positions and rates of the body are states; accelerations are rows of A x + B u
+    rows = np.r_[0:N_BODY, N_DOF:N_DOF + N_BODY]
+    accel = slice(N_DOF, N_DOF + N_BODY)
+    gain = np.vstack([vec[rows], vec[accel] * lam]) * weight
+    out = gain.real @ y.real - gain.imag @ y.imag
+    out[2 * N_BODY:] += b[accel] @ u
+    return out
+
+
+def _scan(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
+    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode), vectorised.
+
+    Within blocks of ``b`` samples y = factor^j cumsum(factor^-j forced); the blocks' ends are
+    chained by a loop over blocks (not samples). ``b`` keeps |factor|^-b below 1e6, so the
+    scaled sums lose at most six digits of the double precision."""
+    k, n = forced.shape
+    decay = -np.log(np.abs(factor)).max()
+    b = int(np.clip(np.floor(np.log(1e6) / max(decay, 1e-300)), 1, 256))
+    n_blocks = -(-n // b)
+    padded = np.zeros((k, n_blocks * b), dtype=complex)
+    padded[:, :n] = forced
+    blocks = padded.reshape(k, n_blocks, b)
+    powers = factor[:, None] ** np.arange(b)[None, :]  # (k, b)
+    blocks *= (1 / powers)[:, None, :]
+    local = np.cumsum(blocks, axis=2, out=blocks)
+    local *= powers[:, None, :]  # each block from a zero start
+    ends = local[:, :, -1].T.copy()  # (n_blocks, k)
+    whole = factor**b
+    for i in range(1, n_blocks):
+        ends[i] += whole * ends[i - 1]
+    # the previous block's end carried to sample j: factor^(j+1)
+    local[:, 1:, :] += (powers * factor[:, None])[:, None, :] * ends[:-1].T[:, :, None]
+    return padded[:, :n]
