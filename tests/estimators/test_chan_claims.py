@@ -123,11 +123,11 @@ def _not_shown(measured: str) -> pytest.MarkDecorator:
 
 
 # (satellites, least cut %) of issue 15; the paper's Table 1: 54.4, 53.2, 52.6, 52.4 %
-SHORT_CLAIMS = [pytest.param(0, 40.0, marks=_not_shown("22.5 % with 0 satellites on the "
+SHORT_CLAIMS = [pytest.param(0, 40.0, marks=_not_shown("11.9 % with 0 satellites on the "
                                                        "shortened drive")),
                 (1, 25.0), (2, 25.0), (3, 25.0)]
 FULL_CLAIMS = [(0, 40.0), (1, 25.0), (2, 25.0),
-               pytest.param(3, 25.0, marks=_not_shown("19.9 % with 3 satellites"))]
+               pytest.param(3, 25.0, marks=_not_shown("17.8 % with 3 satellites"))]
 
 
 @pytest.mark.parametrize(("satellites", "least_cut"), SHORT_CLAIMS)
@@ -151,6 +151,8 @@ def test_nhc_cut_with_4_satellites_is_the_smallest_full_drive(full_table):
 
 
 @pytest.mark.slow
+@_not_shown("29.7 % on the automotive body, whose side slip in the 40 m loops breaks the "
+            "constraint (58.9 % on a rigid body)")
 def test_nhc_cut_in_complete_outages(tmp_path_factory):
     """Table 1's first row on the complete-outage drive (three 60 s outages per seed, straight
     and in loops): the NHC cuts the mean 3-D error over the outages by at least 40 %."""
