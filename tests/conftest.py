@@ -56,9 +56,11 @@ def scenario_data(segments: list[dict], **extra) -> dict:
 
 def build_drive(segments: list[dict], *, rate_hz: float = 100.0, start: dict | None = None,
                 utc: str = "2024-05-01T03:00:00Z", environment: dict | None = None,
-                limits: dict | None = None) -> Kinematics:
+                limits: dict | None = None, vehicle: str | dict = "rigid") -> Kinematics:
     """The one way tests build a drive: a segment scenario validated like a file, its drive
     built by ``simulator.drive`` (as ``landnav generate`` does), its truth kinematics returned.
+    The body is ``rigid`` unless ``vehicle`` says otherwise: sensor and GNSS models are tested
+    on the road's exact motion, the vehicle model in its own tests.
     No sensors, so any truth ``rate_hz`` is accepted; ``start`` (lat, lon in deg, alt in m,
     heading in deg) and ``environment`` replace the validated ones as given, so they may lie
     outside a scenario's limits (the magnetometer's check at 65 km, zones no segment has)."""
@@ -68,7 +70,7 @@ def build_drive(segments: list[dict], *, rate_hz: float = 100.0, start: dict | N
 
     data = scenario_data(segments, sensors={}, trajectory={
         "kind": "segments", "segments": segments, "rate": rate_hz},
-        start={"utc": utc, **DEFAULT_START},
+        start={"utc": utc, **DEFAULT_START}, vehicle=vehicle,
         **({"limits": limits} if limits is not None else {}))
     drive = drive_of(data)
     return dataclasses.replace(

@@ -15,7 +15,7 @@ from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
 from simulator.replay import read_solution
 from simulator.scenario import load_scenario
-from tests.estimators.test_baselines import horizontal_error
+from tests.scoring_helpers import horizontal_error
 from tests.synthetic import write_synthetic
 
 PLUGIN = "examples.my_estimator:MyEstimator"
