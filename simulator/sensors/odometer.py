@@ -12,24 +12,24 @@ Model (the multiplicative odometer error of Park et al. 2019, eq. 22: u_odo = s 
   and ``speed`` = ticks / (ticks_per_meter dt), the mean speed over the interval;
 * without ticks: ``speed`` = sf(t) d v(t - latency), the instantaneous signed speed.
 
-CAN wheel speed (``tooth_timing: true``), the way an ABS/ESC unit reports it: the ECU time-stamps
-each tooth edge of the tone wheel and reports the mean speed between the first and the last edge
-inside the last sample interval (the period-measurement method, Bosch *Automotive Handbook*,
-"wheel-speed sensors"): speed(t_k) = (j - i) / ``ticks_per_meter`` / (e_j - e_i), e_j the last
-edge at or before t_k and e_i the first edge after t_k - 1/rate (at least the edge before e_j).
-Edge times come from inverting the measured distance on a grid 4 times the sample rate (linear
-between grid points). The speed reads exactly 0 when no edge came within
-1 / (``ticks_per_meter`` ``min_speed``) seconds or the speed is below ``min_speed`` (the
-low-speed cut-off of real wheel-speed sensors: a passive sensor's signal vanishes near
-standstill). Then the speed is rounded to ``speed_resolution`` (the CAN signal's step, 0.01 km/h
-on the Toyota bus of the comma2k19 log). Without ``min_speed`` a stopped wheel keeps its last
-edge pair's speed forever, so the cut-off is required with tooth timing (a choice: the papers
-are silent; real units use 1.5-3 km/h).
+CAN wheel speed (``tooth_timing: true``), the way an ABS/ESC unit reports it: the ECU
+time-stamps each tooth edge of the tone wheel and reports the mean speed between the first and
+the last edge inside the last sample interval (the period-measurement method; the seed papers do
+not describe how a CAN speed is formed, so this is the implementer's choice): speed(t_k) = (j -
+i) / ``ticks_per_meter`` / (e_j - e_i), e_j the last edge at or before t_k and e_i the first
+edge after t_k - 1/rate (at least the edge before e_j). Edge times come from inverting the
+measured distance on a grid 4 times the sample rate (linear between grid points). The speed
+reads exactly 0 when no edge came within 1 / (``ticks_per_meter`` ``min_speed``) seconds or the
+speed is below ``min_speed`` (the low-speed cut-off of real wheel-speed sensors: a passive
+sensor's signal vanishes near standstill). Then the speed is rounded to ``speed_resolution``
+(the CAN signal's step, 0.01 km/h on the Toyota bus of the comma2k19 log). Without ``min_speed``
+a stopped wheel keeps its last edge pair's speed forever, so the cut-off is required with tooth
+timing (a choice: the papers are silent; real units use 1.5-3 km/h).
 
 Scale factor: sf(t) = ``scale_factor`` + ``scale_drift`` W(t) + ``speed_scale`` |v(t)|: the
 dynamic rolling radius of a radial tyre grows with speed (centrifugal growth of the tread); the
 seed papers give no value, so the ``automotive`` preset's 0.2 % at 30 m/s is an assumed order of
-magnitude, written down here and in docs/sensors.md.
+magnitude, written down here and in docs/odometer-and-barometer.md.
 
 Direction: a real car's bus carries the unsigned wheel speed and, separately, the gear (the
 direction). The ``direction`` column is that signal: +1 forward, -1 reversing, 0 standing still.
