@@ -26,10 +26,15 @@ sensor's signal vanishes near standstill). Then the speed is rounded to ``speed_
 a stopped wheel keeps its last edge pair's speed forever, so the cut-off is required with tooth
 timing (a choice: the papers are silent; real units use 1.5-3 km/h).
 
-Scale factor: sf(t) = ``scale_factor`` + ``scale_drift`` W(t) + ``speed_scale`` |v(t)|: the
-dynamic rolling radius of a radial tyre grows with speed (centrifugal growth of the tread); the
-seed papers give no value, so the ``automotive`` preset's 0.2 % at 30 m/s is an assumed order of
-magnitude, written down here and in docs/odometer-and-barometer.md.
+Scale factor: sf(t) = ``scale_factor`` + ``scale_drift`` W(t) + ``speed_scale`` |v(t)| +
+``slip_per_accel`` a(t): the dynamic rolling radius of a radial tyre grows with speed
+(centrifugal growth of the tread); the seed papers give no value, so the ``automotive`` preset's
+0.2 % at 30 m/s is an assumed order of magnitude, written down here and in
+docs/odometer-and-barometer.md. a is the acceleration along the path: a driven wheel turns
+faster than the car rolls while accelerating and slower while braking, by the longitudinal slip
+ratio, linear in the force for small slip (the linear range of the tyre's slip curve);
+``slip_per_accel`` (s^2/m) lumps mass, load and slip stiffness and is 0 in every preset (no
+sourced value yet); load and temperature are not modelled.
 
 Direction: a real car's bus carries the unsigned wheel speed and, separately, the gear (the
 direction). The ``direction`` column is that signal: +1 forward, -1 reversing, 0 standing still.
@@ -95,6 +100,8 @@ _FIELDS = {
     "speed_resolution": Number("m/s", None, min=0, doc="quantisation step of the reported "
                                                        "speed, e.g. '0.01 km/h'; 0: none"),
     "speed_scale": Number("s/m", None, doc="scale-factor change per m/s of speed (tyre growth)"),
+    "slip_per_accel": Number("s^2/m", None, doc="scale-factor change per m/s^2 of "
+                                                "acceleration along the path (tyre slip)"),
     "signed": Boolean(None, doc="speed and ticks signed (negative reversing); false: unsigned "
                                 "with the direction column"),
 }
@@ -150,8 +157,8 @@ class Odometer(PresetSensor):
         elif c["ticks_per_meter"] > 0:
             speed, table["ticks"] = self._counted_speed(truth, t_true, scale, rng)
         else:
-            speed = np.maximum(truth.profile.distance_of_time(t_true, 1), 0.0)
-            speed = (scale + c["speed_scale"] * speed) * speed
+            _, speed, sf = self._wheel_scale(truth, t_true, scale)
+            speed = sf * np.maximum(speed, 0.0)
             if c["min_speed"] > 0:
                 speed = np.where(speed < c["min_speed"], 0.0, speed)
             speed = speed * (truth.profile.direction_at(t_true) if c["signed"] else 1.0)
@@ -161,22 +168,22 @@ class Odometer(PresetSensor):
         table["direction"] = direction.astype(np.int8)
         return {"odometer": table}
 
-    def _scaled_increments(self, distance: np.ndarray, speed: np.ndarray,
-                           scale: np.ndarray) -> np.ndarray:
-        """Measured distance increments: sf (1 + ...) times the true ones, sf with the tyre growth
-        ``speed_scale`` |v| added."""
-        return (scale + self.config["speed_scale"] * np.abs(speed)) * np.diff(
-            distance, prepend=distance[0])
+    def _wheel_scale(self, truth: Kinematics, t_true: np.ndarray, scale: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The true distance s and speed v at ``t_true`` and the wheel's whole scale factor:
+        ``scale`` + ``speed_scale`` |v| + ``slip_per_accel`` a (module docstring)."""
+        c = self.config
+        s, v, a = truth.profile.distance_of_time.evaluate(t_true, (0, 1, 2))
+        return s, v, scale + c["speed_scale"] * np.abs(v) + c["slip_per_accel"] * a
 
     def _counted_speed(self, truth: Kinematics, t_true: np.ndarray, scale: np.ndarray,
                        rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
         """Ticks counted per interval and their mean speed (the up/down counter when signed)."""
         c = self.config
-        distance = truth.profile.net_distance(t_true)
-        if not c["signed"]:
-            distance = truth.profile.distance_of_time(t_true)
-        measured = np.cumsum(self._scaled_increments(
-            distance, truth.profile.distance_of_time(t_true, 1), scale))
+        distance, _, sf = self._wheel_scale(truth, t_true, scale)
+        if c["signed"]:
+            distance = truth.profile.net_distance(t_true)
+        measured = np.cumsum(sf * np.diff(distance, prepend=distance[0]))
         phase = float(rng.uniform())
         counts = np.floor(measured * c["ticks_per_meter"] + phase).astype(np.int64)
         ticks = np.diff(counts, prepend=counts[0])
@@ -190,10 +197,8 @@ class Odometer(PresetSensor):
         tpm, dt = c["ticks_per_meter"], 1.0 / self.rate_hz
         grid = np.linspace(0.0, t[-1], 4 * (len(t) - 1) + 1) if len(t) > 1 else t
         grid_true = np.clip(grid - c["latency"], 0.0, truth.duration_s)
-        grid_scale = np.interp(grid, t, scale)
-        measured = np.cumsum(self._scaled_increments(
-            truth.profile.distance_of_time(grid_true),
-            truth.profile.distance_of_time(grid_true, 1), grid_scale))
+        distance, _, sf = self._wheel_scale(truth, grid_true, np.interp(grid, t, scale))
+        measured = np.cumsum(sf * np.diff(distance, prepend=distance[0]))
         phase = float(rng.uniform())
         self.drawn["tick_phase"] = phase
         levels = (np.arange(np.ceil(phase), np.floor(measured[-1] * tpm + phase) + 1)

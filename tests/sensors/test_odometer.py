@@ -127,6 +127,22 @@ def test_tooth_timed_speed_is_exact_on_constant_speed():
     np.testing.assert_allclose(out["speed"].to_numpy()[cruise], 12.24, rtol=1e-9)
 
 
+def test_scale_factor_with_speed_and_slip():
+    """sf = scale_factor + speed_scale |v| + slip_per_accel a, analytic: accelerating at 1.5 m/s^2
+    with 0.01 s^2/m of slip the wheel reads 1.5 % fast on top of the speed term; at constant
+    speed only the speed term is left."""
+    truth = truth_from_segments([{"accelerate": {"to_speed": 12, "accel": 1.5}},
+                                 {"straight": {"length": 100}}])
+    odo = make({"rate": 50, "speed_scale": "0.001 s/m", "slip_per_accel": "0.01 s^2/m"})
+    out = as_frame(odo.generate(truth, np.random.default_rng(7))["odometer"])
+    inertial = truth.inertial(out["t"].to_numpy())
+    v, a = inertial["speed"], np.gradient(inertial["speed"], out["t"].to_numpy())
+    steady = np.isclose(a, 1.5, atol=1e-6) | np.isclose(a, 0.0, atol=1e-9)
+    assert steady.sum() > 200 and np.isclose(a, 1.5, atol=1e-6).sum() > 100
+    np.testing.assert_allclose(out["speed"].to_numpy()[steady],
+                               ((1 + 0.001 * v + 0.01 * np.round(a, 6)) * v)[steady], atol=1e-9)
+
+
 def test_unsigned_speed_with_direction():
     """signed: false gives |speed| and the gear direction -1 while reversing; signed: true (the
     default) gives the signed speed; direction is 0 at standstill."""
