@@ -38,8 +38,8 @@ SIS_CORRELATION_TIME_S = 3600.0  # broadcast orbit/clock errors change over an u
 IONO_CORRELATION_TIME_S = 1800.0  # residual of the Klobuchar model
 IONO_OWN_SHARE = 0.5  # 1-sigma of the per-signal iono residual relative to the common one
 # the code tracking error of a receiver that smooths its code with the carrier (Hatch filter):
-# correlated over the smoothing time constant, 100 s in RTCA DO-229 (SBAS receivers, section
-# 2.1.4.1.1) and in the GBAS ground and airborne receivers. The automotive preset uses it: the
+# correlated over the smoothing time constant, the 100 s of RTCA DO-229 (SBAS airborne
+# receivers) and DO-253 (GBAS airborne receivers). The automotive preset uses it: the
 # fix error of a mass-market receiver changes by centimetres per second while driving, e.g.
 # 0.036 m/s per axis in a u-blox log at 17.6 m/s (issue 19's measurement); a 1 m error
 # correlated over 100 s changes by 1 m x sqrt(2 (1 - exp(-1/100))) = 0.14 m in a second.
