@@ -8,6 +8,8 @@ ramp meets its ``rise`` exactly, which makes its road profile the costly part of
 Two figures: the library in-process (``landnav generate`` through ``simulator.cli.main``, the
 imports done beforehand), best of five after a warm-up run, and one whole ``landnav generate``
 process (best of three), beside the same figures for the no-helix hour of ``bench_truth.py``.
+A third drive gives each of the 28 helices its own rise (9.01 m, 9.02 m, ...), so that no
+grade solve is reused (a helix's solve is kept for the identical helices met again).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import yaml
 from bench_truth import hour_scenario, time_generate
 
 from simulator.cli import main as landnav
@@ -37,12 +40,24 @@ def time_in_process(scenario: Path, out: Path, runs: int = 5) -> list[float]:
     return times
 
 
+def distinct_helices(path: Path) -> None:
+    """``helix_hour.yaml`` with every helix's rise changed by a different centimetre count."""
+    data = yaml.safe_load((HERE / "helix_hour.yaml").read_text())
+    helices = [item["helix"] for item in data["trajectory"]["segments"] if "helix" in item]
+    for k, helix in enumerate(helices, start=1):
+        helix["rise"] += 0.01 * k if helix["rise"] > 0 else -0.01 * k
+    path.write_text(yaml.safe_dump(data))
+
+
 def main() -> None:
     with tempfile.TemporaryDirectory() as tmp, open(os.devnull, "w") as quiet:
         plain = Path(tmp) / "hour.yaml"
         hour_scenario(plain)
-        helix = HERE / "helix_hour.yaml"
-        for name, scenario in (("no-helix hour", plain), ("28-helix hour", helix)):
+        distinct = Path(tmp) / "distinct.yaml"
+        distinct_helices(distinct)
+        drives = (("no-helix hour", plain), ("28-helix hour", HERE / "helix_hour.yaml"),
+                  ("28 distinct helices", distinct))
+        for name, scenario in drives:
             stdout, sys.stdout = sys.stdout, quiet
             try:
                 inside = time_in_process(scenario, Path(tmp) / "out")

@@ -20,7 +20,9 @@ The replay (``simulator.replay``) builds it with its merged configuration, its i
 (``InitialState``: the truth at its start time perturbed by the scenario's ``init`` errors, or
 None) and the layout of the streams it receives, then calls ``setup()``. Each message goes to the
 method ``on_<stream>(t, row)``: ``row`` is a read-only float64 row of the stream's table whose
-column positions are ``self.columns[stream][column]`` (units in ``self.units[stream]``); a
+column positions are ``self.columns[stream][column]`` (units in ``self.units[stream]``;
+``self.imu_output`` says whether the IMU rows are rates, ``"rate"``, or increments over the
+interval before each sample, ``"increment"``, from the dataset's IMU stream description); a
 ``gnss_raw`` message is one whole epoch, a 2-D array with one row per satellite. After the
 messages of an output instant the replay calls ``solution(t)``, which returns the values of
 ``output_columns`` for time ``t`` (or None while the estimator has no solution yet).
@@ -95,11 +97,13 @@ class Estimator:
 
     def __init__(self, config: Mapping[str, Any] | None, initial: InitialState | None,
                  columns: Mapping[str, Mapping[str, int]],
-                 units: Mapping[str, Mapping[str, str]]):
+                 units: Mapping[str, Mapping[str, str]], *, imu_output: str | None = None):
         self.config = resolve_config(type(self), config)
         self.initial = initial
         self.columns = {k: dict(v) for k, v in columns.items()}
         self.units = {k: dict(v) for k, v in units.items()}
+        # "rate" or "increment" (None without an IMU stream): what the IMU rows hold
+        self.imu_output = imu_output
         self.setup()
 
     def setup(self) -> None:

@@ -14,6 +14,8 @@ get_estimator, list_estimators, entry_problems.
 from __future__ import annotations
 
 import importlib
+import os
+import sys
 from collections.abc import Mapping
 from typing import TYPE_CHECKING, Any
 
@@ -60,6 +62,10 @@ def _import_target(target: str, what: str) -> type:
     module_name, _, attr = target.partition(":")
     if not module_name or not attr:
         raise InputError(f"{what}: expected module:Class, got {target!r}")
+    # a module:Class of the user's own is found from the current directory, as `python -m`
+    # finds it (a console script's sys.path starts with its bin directory instead)
+    if os.getcwd() not in sys.path and "" not in sys.path:
+        sys.path.insert(0, os.getcwd())
     try:
         module = importlib.import_module(module_name)
     except Exception as exc:  # a plug-in's own failure, reported as its message

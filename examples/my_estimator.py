@@ -43,7 +43,7 @@ class MyEstimator(Estimator):
         self.speed = float(np.hypot(*self.initial.velocity[:2]))
         self.t = self.initial.t
         self.gz = self.columns["imu"]["gyro_z"]
-        self.increments = self.units["imu"]["gyro_z"] == "rad"
+        self.increments = self.imu_output == "increment"
         self.v = self.columns["odometer"]["speed"]
         if "gnss_fix" in self.columns:
             g = self.columns["gnss_fix"]
@@ -79,5 +79,7 @@ class MyEstimator(Estimator):
         lat, lon = np.degrees(np.array([self.lat0, self.lon0]) + self.x[:2] / self.m_per_rad)
         yaw = self.x[2]
         std = np.sqrt(np.diag(self.p))
+        # a 2-D filter: no roll or pitch estimate, so NaN (never a made-up 0)
         return [lat, lon, self.alt, self.speed * math.cos(yaw), self.speed * math.sin(yaw), 0.0,
-                0.0, 0.0, math.atan2(math.sin(yaw), math.cos(yaw)), std[0], std[1], std[2]]
+                math.nan, math.nan, math.atan2(math.sin(yaw), math.cos(yaw)), std[0], std[1],
+                std[2]]

@@ -1,5 +1,6 @@
-"""The ``landnav`` command line (SPEC section 3). Each command lives in its own module under
-``simulator/commands/`` with ``add_parser(subparsers)`` and ``run(args) -> int``.
+"""The ``landnav`` command line (its commands in README.md, its formats in docs/). Each command
+lives in its own module under ``simulator/commands/`` with ``add_parser(subparsers)`` and
+``run(args) -> int``.
 
 Bad input ends with one clear message per problem on stderr and exit code 2, never a traceback.
 """
@@ -30,7 +31,9 @@ Typical use:
   landnav generate scenarios/garage.yaml -o out/g --set sensors.imu.rate=200 --seed 3
   landnav campaign scenarios/karamat2015_partial_outages.yaml --runs 20 -o out/mc
 
-Run `landnav COMMAND --help` for each command's options.
+Run `landnav COMMAND --help` for each command's options. Reference documentation is in the
+repository's docs/ folder: scenario-reference.md (every scenario key, generated from the
+schema), dataset-format.md, solution-format.md, scores.md, faults.md, estimator_plugins.md.
 """
 
 

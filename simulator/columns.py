@@ -6,7 +6,8 @@ Parquet field metadata. Extra columns a model adds must be declared here too.
 Public names
 ------------
 TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV, BARO, MAG, EVENTS, TRUTH_GNSS, STREAMS,
-IMU_AXES, SOLUTION, SOLUTION_STD, DATASET_FORMAT, REQUIRED, TEXT_COLUMNS.
+IMU_AXES, SOLUTION, SOLUTION_STD, SENSOR_ERRORS, TRUTH_SENSORS, DATASET_FORMAT, REQUIRED,
+TEXT_COLUMNS.
 """
 
 from __future__ import annotations
@@ -83,6 +84,19 @@ SOLUTION_STD = {
     "std_roll": "rad", "std_pitch": "rad", "std_yaw": "rad",
 }
 
+# estimated sensor errors (SPEC section 7), the same names in a solution and in
+# truth_sensors.parquet: IMU errors on the unit's own axes (FRD), measured minus true; scale
+# factors are the dimensionless error (0 = perfect); the odometer scale factor is the ratio of
+# measured to true speed (1 = perfect); the receiver clock bias c dt_r and drift c d(dt_r)/dt
+SENSOR_ERRORS = {
+    **{f"gyro_bias_{a}": "rad/s" for a in "xyz"},
+    **{f"accel_bias_{a}": "m/s^2" for a in "xyz"},
+    **{f"gyro_scale_factor_{a}": "1" for a in "xyz"},
+    **{f"accel_scale_factor_{a}": "1" for a in "xyz"},
+    "odometer_scale_factor": "1", "clock_bias": "m", "clock_drift": "m/s",
+}
+TRUTH_SENSORS = {"t": "s", **SENSOR_ERRORS}
+
 # stream name -> (file name, columns); files whose name starts with "truth" and events.parquet
 # are for scoring only and never reach an estimator.
 STREAMS = {
@@ -96,8 +110,9 @@ STREAMS = {
     "mag": ("mag.parquet", MAG),
     "events": ("events.parquet", EVENTS),
     "truth_gnss": ("truth_gnss.parquet", TRUTH_GNSS),
+    "truth_sensors": ("truth_sensors.parquet", TRUTH_SENSORS),
 }
-SCORING_ONLY = ("truth", "truth_gnss", "events")
+SCORING_ONLY = ("truth", "truth_gnss", "truth_sensors", "events")
 
 # the columns a stream must have (SPEC section 5); an IMU needs ``t`` and at least one axis
 REQUIRED = {
@@ -115,5 +130,6 @@ REQUIRED = {
     "mag": ("t", "mag_x", "mag_y", "mag_z"),
     "events": tuple(EVENTS),
     "truth_gnss": ("t", "sv"),
+    "truth_sensors": ("t",),
 }
 TEXT_COLUMNS = ("zone", "kind", "detail")  # every other column of a stream is numeric

@@ -117,7 +117,8 @@ def run(scenario: Scenario, out_dir: str | Path, force: bool = False,
             if Path(label).name != label or label.startswith("."):
                 raise InputError([Problem(str(scenario.path), None, f"estimators.{i}.label",
                                           f"{label!r} cannot name a file; give a plain label")])
-            write_solution(solutions[label][0], tmp / "solutions" / f"{label}.parquet")
+            write_solution(solutions[label][0], tmp / "solutions" / f"{label}.parquet",
+                           uses_gnss=solutions[label][1]["uses_gnss"])
         evaluation = score(dataset, solutions)
         write_scores(evaluation.scores(), tmp / "scores.json")
         write_report(tmp, evaluation, f"{scenario.name} (seed {scenario.seed})",

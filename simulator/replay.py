@@ -17,7 +17,8 @@ roll/pitch/yaw added to the Euler angles, ``heading_error`` added to yaw).
 
 Public functions
 ----------------
-run_estimator, initial_state, merge_streams, output_times, write_solution, read_solution.
+run_estimator, initial_state, merge_streams, output_times, write_solution, read_solution,
+solution_problems.
 """
 
 from __future__ import annotations
@@ -187,9 +188,21 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
     return [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
 
 
+def imu_output(dataset: Dataset) -> str | None:
+    """What a dataset's IMU rows hold: ``"rate"`` or ``"increment"`` (None without an IMU), from
+    the IMU stream's description in the manifest (``imu_output``), else from the resolved
+    scenario's ``sensors.imu.output`` (datasets written before the field existed)."""
+    stream = dataset.manifest.get("streams", {}).get("imu")
+    if stream is None:
+        return None
+    imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
+    return stream.get("imu_output") or imu.get("output") or "rate"
+
+
 def _units(dataset: Dataset, name: str) -> dict[str, str]:
     """Column units of a stream; an IMU configured for increment output has rad and m/s
-    increments whatever its files say (the manifest's resolved scenario is authoritative)."""
+    increments whatever its files say (the manifest's resolved scenario is authoritative):
+    datasets written before the writer labelled increments say rad/s and m/s^2 there."""
     units = dataset.units(name)
     imu = (dataset.manifest.get("scenario") or {}).get("sensors", {}).get("imu") or {}
     if name == "imu" and imu.get("output") == "increment":
@@ -217,7 +230,8 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
         ``t`` (strictly increasing) and the estimator's ``output_columns`` (SPEC section 7).
     info : dict
         ``label``, ``name``, ``runtime_s`` (wall time of the estimator run, s) and
-        ``realtime_factor`` (data duration / runtime).
+        ``realtime_factor`` (data duration / runtime) and ``uses_gnss`` (whether a GNSS stream
+        reached the estimator).
 
     Raises
     ------
@@ -241,7 +255,7 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                 dataset.manifest.get("sensors"))
     with _plugin_call(cls, "setup"):
         estimator = cls(config, initial, {s.name: s.columns for s in streams},
-                        {s.name: s.units for s in streams})
+                        {s.name: s.units for s in streams}, imu_output=imu_output(dataset))
     gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
     out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
     out = np.full((len(out_t), len(cls.output_columns)), np.nan)
@@ -279,7 +293,8 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     frame.insert(0, "t", out_t[kept])
     duration = float(t[-1] - t[0])
     info = {"label": label, "name": name, "runtime_s": runtime,
-            "realtime_factor": duration / runtime if runtime > 0 else float("inf")}
+            "realtime_factor": duration / runtime if runtime > 0 else float("inf"),
+            "uses_gnss": bool(gnss)}
     return frame, info
 
 
@@ -337,7 +352,9 @@ def _solution_row(row: Any, cls: type, t: float) -> np.ndarray:
     return values
 
 
-def _solution_problems(frame: pd.DataFrame) -> list[str]:
+def solution_problems(frame: pd.DataFrame) -> list[str]:
+    """What makes a table not a solution (docs/solution-format.md): missing columns, t not
+    finite or not increasing; empty when it is one."""
     missing = [c for c in col.SOLUTION if c not in frame.columns]
     if missing:
         return [f"missing column(s) {', '.join(missing)} (a solution needs "
@@ -353,17 +370,23 @@ def _solution_problems(frame: pd.DataFrame) -> list[str]:
     return []
 
 
+USES_GNSS_KEY = "landnav.uses_gnss"  # Parquet schema metadata of a solution: "true" / "false"
+
+
 def write_solution(frame: pd.DataFrame, path: str | Path, force: bool = False,
-                   inputs: Iterable[Path | str] = ()) -> None:
-    """Write a solution table as Parquet (SPEC section 7), atomically; extra columns get unit
-    "". An existing file is replaced only with ``force``; a path inside one of ``inputs`` (the
-    dataset read) is refused."""
-    problems = _solution_problems(frame)
+                   inputs: Iterable[Path | str] = (), uses_gnss: bool | None = None) -> None:
+    """Write a solution table as Parquet (docs/solution-format.md), atomically; extra columns
+    get unit "". An existing file is replaced only with ``force``; a path inside one of
+    ``inputs`` (the dataset read) is refused. ``uses_gnss`` (whether the estimator had GNSS) is
+    kept in the schema metadata, so that scoring the file later leaves out the outage scores of
+    an estimator without GNSS, as scoring the run did."""
+    problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
-    units = {**col.SOLUTION, **col.SOLUTION_STD}
+    units = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
+    metadata = None if uses_gnss is None else {USES_GNSS_KEY: "true" if uses_gnss else "false"}
     with atomic_output_file(path, force, inputs) as tmp:
-        write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns})
+        write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns}, metadata)
 
 
 def read_solution(path: str | Path) -> pd.DataFrame:
@@ -376,7 +399,7 @@ def read_solution(path: str | Path) -> pd.DataFrame:
         increase.
     """
     frame = read_table(Path(path))
-    problems = _solution_problems(frame)
+    problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     return frame

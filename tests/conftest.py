@@ -1,10 +1,16 @@
-"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, drive builders."""
+"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, and the one drive
+builder (``build_drive``: segments to truth kinematics, through the scenario and the drive as
+``landnav generate`` builds them)."""
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
+
+if TYPE_CHECKING:
+    from simulator.trajectory.kinematics import Kinematics
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED = REPO.parent / "shared"
@@ -48,6 +54,31 @@ def scenario_data(segments: list[dict], **extra) -> dict:
     return validate_data(data, "test.yaml")
 
 
+def build_drive(segments: list[dict], *, rate_hz: float = 100.0, start: dict | None = None,
+                utc: str = "2024-05-01T03:00:00Z", environment: dict | None = None,
+                limits: dict | None = None) -> Kinematics:
+    """The one way tests build a drive: a segment scenario validated like a file, its drive
+    built by ``simulator.drive`` (as ``landnav generate`` does), its truth kinematics returned.
+    No sensors, so any truth ``rate_hz`` is accepted; ``start`` (lat, lon in deg, alt in m,
+    heading in deg) and ``environment`` replace the validated ones as given, so they may lie
+    outside a scenario's limits (the magnetometer's check at 65 km, zones no segment has)."""
+    import dataclasses
+
+    from simulator.drive import build_drive as drive_of
+
+    data = scenario_data(segments, sensors={}, trajectory={
+        "kind": "segments", "segments": segments, "rate": rate_hz},
+        start={"utc": utc, **DEFAULT_START},
+        **({"limits": limits} if limits is not None else {}))
+    drive = drive_of(data)
+    return dataclasses.replace(
+        drive, start={**drive.start, **(start or {})},
+        environment=drive.environment if environment is None else environment).truth
+
+
+DEFAULT_START = {"lat": 37.5, "lon": 127.0, "alt": 40.0, "heading": 30.0}
+
+
 def ten_minute_drive() -> list[dict]:
     """A ten-minute drive with turns, slopes, a helix, a speed bump and a lane change."""
     return [
@@ -71,3 +102,15 @@ def ten_minute_drive() -> list[dict]:
         {"accelerate": {"to_speed": 0.0, "accel": 2.0}},
         {"stop": {"duration": 20}},
     ]
+
+
+@pytest.fixture(scope="session")
+def quickstart(tmp_path_factory):
+    """The shipped quickstart scenario's dataset (seed 1), generated once per session."""
+    from simulator.dataset.generate import generate_dataset
+    from simulator.dataset.io import open_dataset
+    from simulator.scenario import load_scenario
+
+    out = tmp_path_factory.mktemp("quickstart") / "dataset"
+    return open_dataset(generate_dataset(load_scenario(REPO / "scenarios" / "quickstart.yaml"),
+                                         out, show_progress=False))

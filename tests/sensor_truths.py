@@ -1,13 +1,13 @@
-"""Small exact trajectories for the sensor tests (built without the scenario loader)."""
+"""Small exact trajectories for the sensor tests (built by ``conftest.build_drive``)."""
 
 from __future__ import annotations
 
 import datetime as dt
 from pathlib import Path
 
-from simulator.schema import Context
-from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile
-from simulator.trajectory.segments import LIMITS_FIELD, SEGMENT_FIELD, build_road_profile
+from conftest import build_drive
+
+from simulator.trajectory.kinematics import Kinematics
 
 SHARED = Path(__file__).resolve().parents[2] / "shared"
 
@@ -23,14 +23,11 @@ def truth_from_segments(segments: list[dict], rate_hz: float = 100.0,
                         start: dict | None = None,
                         utc: dt.datetime = dt.datetime(2020, 1, 1),
                         environment: dict | None = None) -> Kinematics:
-    ctx = Context("test")
-    limits = LIMITS_FIELD.check({}, ("limits",), ctx)
-    segs = [SEGMENT_FIELD.check(s, ("segments", i), ctx) for i, s in enumerate(segments)]
-    profile = build_road_profile(segs, limits, ctx)
-    assert not ctx.problems, ctx.problems
-    start = start or {"lat": 37.0, "lon": 127.0, "alt": 40.0, "heading": 30.0}
-    return kinematics_from_profile(profile, start, rate_hz, limits["roll_gradient"], utc,
-                                   environment)
+    """``conftest.build_drive`` with the sensor tests' start (37 N, 127 E, heading 30 deg) and
+    epoch (2020-01-01)."""
+    return build_drive(segments, rate_hz=rate_hz,
+                       start=start or {"lat": 37.0, "lon": 127.0, "alt": 40.0, "heading": 30.0},
+                       utc=utc.strftime("%Y-%m-%dT%H:%M:%SZ"), environment=environment)
 
 
 def static_truth(duration_s: float) -> Kinematics:

@@ -228,3 +228,24 @@ def test_sensor_error_priors_reach_the_initial_state():
     with pytest.raises(InputError, match="sensor_errors"):
         scenario_data(segments, estimators=[{"name": "gnss_only",
                                              "init": {"sensor_errors": "exact"}}])
+
+
+@pytest.mark.parametrize("output", ["rate", "increment"])
+def test_estimator_is_told_what_the_imu_rows_hold(tmp_path, output):
+    """``imu_output`` comes from the IMU stream's description in the manifest (written by the
+    generator), not from the units: the estimator sees the IMU's configured output."""
+    from simulator.dataset.generate import generate_dataset
+    from simulator.scenario import Scenario, validate_data
+    from tests.recording import Recorder
+
+    data = validate_data({"start": {"lat": 37.5, "lon": 127.0},
+                          "trajectory": {"kind": "segments",
+                                         "segments": [{"stop": {"duration": 2}}]},
+                          "sensors": {"imu": {"preset": "ideal", "rate": 100,
+                                              "output": output}}}, "s.yaml")
+    out = generate_dataset(Scenario(tmp_path / "s.yaml", data, []), tmp_path / "d",
+                           show_progress=False)
+    dataset = open_dataset(out)
+    assert dataset.manifest["streams"]["imu"]["imu_output"] == output
+    run_estimator(dataset, "tests.recording:Recorder", show_progress=False)
+    assert Recorder.last.imu_output == output

@@ -1,9 +1,13 @@
 """Baseline estimators, the floor of every comparison.
 
-* ``gnss_only`` holds the last GNSS fix: position and velocity of the fix, yaw from its course
-  over ground (held while the speed is below ``min_course_speed``), roll and pitch zero. It
-  initialises itself and reports nothing before the first fix. While the car reverses the
-  course points backwards, so this yaw is off by 180 deg: the floor cannot tell.
+* ``gnss_only`` is the receiver's own output between its fixes, as a receiver's 10 Hz output
+  would give it: the last valid fix's position extrapolated with the fix's velocity, p(t) =
+  p_fix + v_fix (t - t_fix) (the curvilinear position rates of Groves 2013 eq. 2.111, with the
+  radii of curvature at the fix; the height with -v_d), for at most
+  ``max_extrapolation`` seconds after the fix; later (a missed epoch, an outage) it reports
+  nothing, which the scores count against its coverage. It does not know the attitude: roll,
+  pitch and yaw are NaN (SPEC section 7). It initialises itself and reports nothing before the
+  first fix.
 * ``dead_reckoning`` is two-dimensional odometer/gyro dead reckoning with no GNSS (Groves 2013,
   section 6.3 (odometry, heading-and-distance form); the 2-D DR of Cho & Choi 2006,
   eqs. 24a-b and 24e, with the odometer giving the speed): the yaw integrates the z gyro,
@@ -11,8 +15,8 @@
   level vehicle (refreshed at each odometer sample); the distance between odometer samples
   comes from their speeds interpolated linearly in time, laid along the yaw history of the IMU
   samples. The odometer speed is signed (negative while reversing), so a reversing car moves
-  back along its heading. The height is held at its initial value, roll and pitch are reported
-  as zero.
+  back along its heading. The height is held at its initial value and the down velocity is
+  zero (it moves on the level of its start); roll and pitch, which it does not know, are NaN.
 
 Public classes
 --------------
@@ -36,32 +40,43 @@ from simulator.earth import (
 
 
 class GnssOnly(Estimator):
-    """Hold the last valid fix (``fix`` > 0) of the ``gnss_fix`` stream."""
+    """The last valid fix (``fix`` > 0) of the ``gnss_fix`` stream, extrapolated with its
+    velocity for up to ``max_extrapolation`` seconds."""
 
     name = "gnss_only"
     needs = ("gnss_fix",)
-    paper = "baseline: the receiver's own fixes, held between epochs"
+    paper = "baseline: the receiver's own fixes, extrapolated with their velocity between epochs"
     initialises_itself = True
-    defaults = {"min_course_speed": 1.0}  # m/s; below it the course is too noisy for yaw
+    # s after a fix during which it is extrapolated: bridges one missed epoch of a 1 Hz receiver
+    defaults = {"max_extrapolation": 2.0}
 
     def setup(self) -> None:
         c = self.columns["gnss_fix"]
         self._pos = [c["lat"], c["lon"], c["alt"]]
         self._vel = [c["vn"], c["ve"], c["vd"]]
-        self._fix, self._speed, self._course = c["fix"], c["speed"], c["course"]
-        self._state: list[float] | None = None
-        self._yaw = 0.0
+        self._fix = c["fix"]
+        self._t_fix: float | None = None
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        if not (row[self._fix] > 0 and math.isfinite(row[self._pos[0]])):
+        if not (row[self._fix] > 0 and all(math.isfinite(row[i]) for i in (*self._pos,
+                                                                              *self._vel))):
             return
-        if row[self._speed] >= self.config["min_course_speed"]:
-            self._yaw = float(wrap_angle(row[self._course]))
-        self._state = [*(float(row[i]) for i in self._pos), *(float(row[i]) for i in self._vel),
-                       0.0, 0.0, self._yaw]
+        self._t_fix = t
+        lat, lon, alt = (float(row[i]) for i in self._pos)
+        self._vn, self._ve, self._vd = (float(row[i]) for i in self._vel)
+        self._lat, self._lon, self._alt = math.radians(lat), math.radians(lon), alt
+        r_n, r_e = radii_of_curvature(self._lat)
+        # rad of latitude and longitude per second of the fix's north and east velocity
+        self._lat_rate = self._vn / (float(r_n) + alt)
+        self._lon_rate = self._ve / ((float(r_e) + alt) * math.cos(self._lat))
 
     def solution(self, t: float) -> list[float] | None:
-        return self._state
+        if self._t_fix is None or t - self._t_fix > self.config["max_extrapolation"]:
+            return None
+        dt = t - self._t_fix
+        return [math.degrees(self._lat + self._lat_rate * dt),
+                math.degrees(self._lon + self._lon_rate * dt), self._alt - self._vd * dt,
+                self._vn, self._ve, self._vd, math.nan, math.nan, math.nan]
 
 
 class DeadReckoning(Estimator):
@@ -83,7 +98,7 @@ class DeadReckoning(Estimator):
         self._speed = float(init.velocity[0] * math.cos(self._yaw)
                             + init.velocity[1] * math.sin(self._yaw))
         self._gz = self.columns["imu"]["gyro_z"]
-        self._increments = self.units["imu"].get("gyro_z") == "rad"
+        self._increments = self.imu_output == "increment"
         self._speed_col = self.columns["odometer"]["speed"]
         self._t_imu = init.t
         self._bias = 0.0  # yaw-gyro bias learned at standstill, rad/s
@@ -162,4 +177,4 @@ class DeadReckoning(Estimator):
         lat, lon = self._lat + d_lat, self._lon + d_lon
         return [math.degrees(lat), math.degrees(lon), self._alt,
                 self._speed * math.cos(self._yaw), self._speed * math.sin(self._yaw), 0.0,
-                0.0, 0.0, float(wrap_angle(self._yaw))]
+                math.nan, math.nan, float(wrap_angle(self._yaw))]

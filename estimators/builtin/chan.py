@@ -128,7 +128,7 @@ class _TightlyCoupled(Estimator):
         imu = self.columns["imu"]
         self._gyro_idx = [imu[c] for c in ("gyro_x", "gyro_y", "gyro_z")]
         self._accel_idx = [imu[c] for c in ("accel_x", "accel_y", "accel_z")]
-        self._increments = self.units["imu"].get("gyro_x") == "rad"
+        self._increments = self.imu_output == "increment"
         self._lever = np.asarray(cfg["lever_arm"], dtype=float)
         self._t_imu: float | None = None
         self._w_prev = np.zeros(3)

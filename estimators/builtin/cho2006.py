@@ -219,7 +219,7 @@ class _ChoDr(Estimator):
         self._g = float(normal_gravity(self._lat0, self._h0))
         imu = self.columns["imu"]
         self._cols = [imu[c] for c in self._imu_columns]
-        self._increment = self.units["imu"].get(self._imu_columns[-1]) in ("rad", "m/s")
+        self._increment = self.imu_output == "increment"
         fix = self.columns["gnss_fix"]
         self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
         self._s0 = self._s1 = self._s2 = 0.0  # the three inputs integrated over the DR step

@@ -54,7 +54,13 @@ persistent innovation with a huge azimuth correction). So the direction of the h
 velocity is propagated as eqs. 22 and 26 do (turned by dA/dt each step, corrected by the
 filter) and its magnitude is the odometer's, v_o cos p (eqs. 4-5); v_u is eq. 6. Integrating
 eqs. 22/26 fully instead lets the a_od corrections accumulate into a speed error no measurement
-anchors (1 m/s in a 60 s one-satellite window).
+anchors (1 m/s in a 60 s one-satellite window). The azimuth state is observed only through the
+acceleration terms of eqs. 24/28 and the gyro bias and drifted up to 17 deg from the direction
+of travel, so the direction of travel (the horizontal velocity's, against it while reversing)
+gives F's sin A, cos A and the reported yaw above 1 m/s. A wheel at a standstill reads zero
+whatever its scale error, so the speed is exactly zero while the odometer reads zero. The
+odometer's own speed noise (``odometer_speed_noise``) is in the mechanised velocity the rates
+are predicted from, so it enters the Doppler rows' R through the forward axis.
 
 Measurements: pseudoranges and pseudorange rates (eqs. 45-49; ``coupling: tight``), or the
 receiver's 3-D fixes (position and velocity; ``coupling: loose``; a loosely coupled filter has
@@ -90,38 +96,42 @@ from simulator.earth import (
     wrap_angle,
 )
 from simulator.errors import InputError
+from simulator.units import DEG, DEG_RT_H, MILLI_G
 
 STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
 _I = {name: i for i, name in enumerate(STATES)}
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
 
-DEG = math.pi / 180.0
-MG = 9.80665e-3
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
 # IMU300CC of the paper's Table 1: the gyro and accelerometer biases start at the Table 1
 # turn-on values (P0) and wander as a slow Gauss-Markov process whose noise equals an in-run
 # instability of 1 % (gyro) and 3 % (accelerometers) of them over 300 s; the tilt errors and
 # the odometer-derived acceleration error are short-correlated (a few seconds of vehicle
-# dynamics the accelerometer tilt of eqs. 2-3 cannot tell from gravity).
+# dynamics the accelerometer tilt of eqs. 2-3 cannot tell from gravity). The odometer-derived
+# acceleration's error was measured on the scenario's ABS wheel speed (difference of 1 s means):
+# std 0.04 m/s^2, correlated for less than 0.5 s, and its integral over 60 s only 0.014 m/s,
+# so its correlation time is one odometer step; a 10 s one (first tried) let the filter believe
+# the along-track velocity wanders by 1 m/s in 20 s, and single-satellite Doppler updates then
+# pushed it there.
 GM_PARAMETERS = {
     "bz": (0.02 * DEG * math.sqrt(3600.0 / 300.0), 3600.0),  # rad/s
-    "bx": (1.0 * MG * math.sqrt(3600.0 / 300.0), 3600.0),  # m/s^2
-    "by": (1.0 * MG * math.sqrt(3600.0 / 300.0), 3600.0),
-    "ao": (0.1, 10.0),  # m/s^2
+    "bx": (1.0 * MILLI_G * math.sqrt(3600.0 / 300.0), 3600.0),  # m/s^2
+    "by": (1.0 * MILLI_G * math.sqrt(3600.0 / 300.0), 3600.0),
+    "ao": (0.04, 0.1),  # m/s^2: measured on the derived a_od (std 0.04, correlated < 0.5 s)
     "r": (1.0 * DEG, 10.0),  # rad
     "p": (1.0 * DEG, 10.0),
 }
 _P0_SIGMA = {"N": 3.0, "E": 3.0, "h": 5.0, "ve": 0.3, "vn": 0.3, "vu": 0.3, "A": 1.0 * DEG,
              "ao": 0.1, "bz": 2.0 * DEG,  # Table 1: gyro bias 2 deg/s (data sheet)
              "cb": 30.0, "cd": 3.0, "r": 1.0 * DEG, "p": 1.0 * DEG,
-             "bx": 30.0 * MG, "by": 30.0 * MG,  # Table 1: accelerometer bias 30 mg
+             "bx": 30.0 * MILLI_G, "by": 30.0 * MILLI_G,  # Table 1: accelerometer bias 30 mg
              "vo": 0.2}
 # white-noise densities (per second) of the states without a Gauss-Markov model
 # (m/s)^2/s: unmodelled motion; v_u = v_o sin p (eq. 6) takes the noise of the accelerometer
 # pitch of eq. 2 directly (about 0.5 deg, 0.1 m/s at 14 m/s), which eq. 31 does not model
 _Q_WHITE = {"ve": 1e-4, "vn": 1e-4, "vu": 0.05,
-            "A": (2.25 * DEG / 60.0) ** 2,  # Table 1: gyro random walk 2.25 deg/sqrt(h)
+            "A": (2.25 * DEG_RT_H) ** 2,  # Table 1: gyro random walk 2.25 deg/sqrt(h)
             "vo": 1e-4}  # (m/s)^2/s
 
 
@@ -191,7 +201,7 @@ def riss_rates(x: np.ndarray, wz: float) -> np.ndarray:
     (the Gauss-Markov states enter as their mean dynamics -x / tau); ``wz`` is the up-axis gyro
     rate, rad/s.
     """
-    lat, _, h, ve, vn, _, az, ao, bz, _, cd, r, p, bx, by, _ = x
+    lat, _, h, ve, vn, _, az, ao, bz, _, cd, _, p, _, _, _ = x
     rm, rn = (float(v) for v in radii_of_curvature(lat))
     a_dot = -(wz - bz) + OMEGA_E_RAD_S * math.sin(lat) + ve * math.tan(lat) / (rn + h)
     out = np.zeros(len(STATES))
@@ -206,7 +216,6 @@ def riss_rates(x: np.ndarray, wz: float) -> np.ndarray:
     for name, (_, tau) in GM_PARAMETERS.items():
         out[_I[name]] = -x[_I[name]] / tau
     out[15] = ao
-    del r, bx, by
     return out
 
 
@@ -261,7 +270,7 @@ class RissTcEkf(Estimator):
         # sums over the IMU samples of the current odometer interval
         c = self.columns["imu"]
         self._col_gz, self._col_fx, self._col_fy = c["gyro_z"], c["accel_x"], c["accel_y"]
-        self._increments = self.units["imu"].get("gyro_z") == "rad"
+        self._increments = self.imu_output == "increment"
         self._t_imu = init.t
         self._sum_wz = self._sum_ffwd = self._sum_flat = self._sum_dt = 0.0
         self._n_imu = 0

@@ -42,10 +42,12 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   (eq. 39); the Jacobian has u cos(pitch) on ds and -s u sin(pitch) on the pitch error. Course
   is used only while moving forwards faster than ``course_min_speed`` (it is undefined at
   standstill and points backwards while reversing).
-* Barometer: its bias is removed "simply" with GPS height (section III-C): the offset
-  h_baro - h_GPS is averaged (first-order filter, ``baro_offset_time_constant``) over good 3-D
-  fixes (``gps_height_max_vdop``) and frozen without them; the barometer is used from the first
-  such fix on. GPS height enters step 2 only on such fixes.
+* Barometer: the ``altitude`` column of the ``baro`` stream (its standard-atmosphere pressure
+  altitude; a stream without it is not used). Its bias is removed "simply" with GPS height
+  (section III-C): the offset h_baro - h_GPS is averaged (first-order filter,
+  ``baro_offset_time_constant``) over good 3-D fixes (``gps_height_max_vdop``) and frozen
+  without them; the barometer is used from the first such fix on. GPS height enters step 2
+  only on such fixes.
 * Adaptation rules (section III-D), thresholds as printed: (1) | ||f|| - g | > 0.059 m/s^2
   inflates the tilt noise from ``tilt_sigma`` to ``tilt_sigma_inflated``; (2) a speed below
   5 m/s inflates the GPS speed and course noise to their ``*_inflated`` values; (3) a barometric
@@ -83,6 +85,7 @@ from numba import njit
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.gating import threshold_variance
+from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
 from simulator.earth import OMEGA_E_RAD_S, dcm_to_euler, normal_gravity, quat_to_dcm, wrap_angle
@@ -163,12 +166,12 @@ class _StepAccumulator:
     samples are integrated by the trapezoidal rule between consecutive samples (the first
     sample holds over the interval before it); increments are summed."""
 
-    def __init__(self, columns: dict[str, int], units: dict[str, str], t0: float):
+    def __init__(self, columns: dict[str, int], increments: bool, t0: float):
         # column of each axis, None for an axis the unit lacks (read as zero)
         self.cols = [columns.get(a) for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x",
                                               "accel_y", "accel_z")]
         self.has_accel = None not in self.cols[3:]
-        self.increments = units.get("gyro_z") == "rad"
+        self.increments = increments
         self.t = t0
         self.prev: list[float] | None = None
         self.reset()
@@ -255,7 +258,7 @@ class Dr3dEkf(Estimator):
         self._bias = np.zeros(3)  # gyro bias estimate, rad/s
         self._u = 0.0  # latest odometer reading, m/s
         self._zero3 = np.zeros(3)
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         self._baro_col = self.columns.get("baro", {}).get("altitude")
@@ -275,12 +278,16 @@ class Dr3dEkf(Estimator):
         self._still_steps = 0
         self._eye = np.eye(10)
         self._f = np.zeros((10, 10))  # eq. 30; the time-varying blocks are filled each step
-        self._f[3, 3] = -1.0 / c["scale_time_constant"]
-        self._f[7:10, 7:10] = -np.eye(3) / c["gyro_bias_time_constant"]
+        # eq. 29: first-order Gauss-Markov scale factor and gyro biases
+        f_gm, q_gm = gauss_markov_continuous(
+            [c["scale_time_constant"], *[c["gyro_bias_time_constant"]] * 3],
+            [c["scale_sigma"], *[c["gyro_bias_sigma"]] * 3])
+        self._f[3, 3] = f_gm[0]
+        self._f[7:10, 7:10] = np.diag(f_gm[1:])
         self._q_c = np.zeros(10)
-        self._q_c[3] = 2.0 * c["scale_sigma"] ** 2 / c["scale_time_constant"]
+        self._q_c[3] = q_gm[0]
         self._q_c[4:7] = c["gyro_noise_density"] ** 2
-        self._q_c[7:10] = 2.0 * c["gyro_bias_sigma"] ** 2 / c["gyro_bias_time_constant"]
+        self._q_c[7:10] = q_gm[1:]
 
     # -- messages ---------------------------------------------------------------------------
     def on_imu(self, t: float, row: np.ndarray) -> None:
@@ -446,21 +453,22 @@ class Dr2dOdoEkf(Estimator):
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
         self._u = 0.0
-        self._imu = _StepAccumulator(self.columns["imu"], self.units["imu"], init.t)
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
         self._odo = self.columns["odometer"]["speed"]
         self._fix = _FixColumns(self.columns["gnss_fix"])
         p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
                                                          c["heading_initial"] ** 2,
                                                          c["gyro_bias_initial"] ** 2])
         self._kf = ErrorState(p0)
-        self._q_c = np.array([0.0, 0.0,
-                              2.0 * c["speed_error_sigma"] ** 2 / c["speed_error_time_constant"],
-                              c["gyro_noise_density"] ** 2,
-                              2.0 * c["gyro_bias_sigma"] ** 2 / c["gyro_bias_time_constant"]])
+        # Gauss-Markov speed error and z-gyro bias
+        f_gm, q_gm = gauss_markov_continuous(
+            [c["speed_error_time_constant"], c["gyro_bias_time_constant"]],
+            [c["speed_error_sigma"], c["gyro_bias_sigma"]])
+        self._q_c = np.array([0.0, 0.0, q_gm[0], c["gyro_noise_density"] ** 2, q_gm[1]])
         self._f = np.zeros((5, 5))
-        self._f[2, 2] = -1.0 / c["speed_error_time_constant"]
-        self._f[3, 4] = -1.0
-        self._f[4, 4] = -1.0 / c["gyro_bias_time_constant"]
+        self._f[2, 2] = f_gm[0]
+        self._f[3, 4] = -1.0  # dpsi' = -(z-gyro bias error)
+        self._f[4, 4] = f_gm[1]
 
     def _speed(self) -> float:
         return self._u - self._speed_error if self._u != 0.0 else 0.0

@@ -68,9 +68,8 @@ class ParkInsOdometer(Estimator):
     ODOMETER_SCALE_SIGMA = 0.03  # unmodelled odometer scale-factor error, 1-sigma
 
     def setup(self) -> None:
-        imu_units = self.units["imu"]
-        self.ins = InsFilter(self.initial, self.columns["imu"],
-                             imu_units.get("gyro_x") == "rad", self.P0_SIGMA, self.NOISE)
+        self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
+                             self.P0_SIGMA, self.NOISE)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]

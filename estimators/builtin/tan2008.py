@@ -88,13 +88,12 @@ class TanLinearisedKF(Estimator):
     R_HEIGHT = np.array([[2.0**2]])  # m^2
     R_HEADING = np.array([[(2 * DEG) ** 2]])  # rad^2, magnetometer and GPS course
     R_ZUPT = np.eye(3) * 0.01**2  # (m/s)^2
-    R_ZARU = np.eye(3) * (0.01 * DEG) ** 2  # (rad/s)^2 (mean over a batch)
+    ZARU_FLOOR = 0.01 * DEG  # rad/s, added to the white noise of the batch-mean rate
     MAG_SOLVE_INTERVAL = 10.0  # s between re-solving the magnetometer calibration
     MOVING_SPEED = 0.5  # m/s: a GPS speed above it ends the initial standstill early
 
     def setup(self) -> None:
-        units = self.units["imu"]
-        self.ins = InsFilter(self.initial, self.columns["imu"], units.get("gyro_x") == "rad",
+        self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
                              self.P0_SIGMA, self.NOISE)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"]]
@@ -129,7 +128,9 @@ class TanLinearisedKF(Estimator):
         cfg = self.config
         if t < self._still_until:
             ins.update(*aiding.zero_velocity(ins.v), self.R_ZUPT)
-            ins.update(*aiding.zero_rate(ins.q, ins.pos[0], ins.mean_rate), self.R_ZARU)
+            if ins.mean_rate_dt > 0:  # the batch mean's noise: density^2 / duration
+                r = (self.NOISE.gyro_noise**2 / ins.mean_rate_dt + self.ZARU_FLOOR**2) * np.eye(3)
+                ins.update(*aiding.zero_rate(ins.q, ins.pos[0], ins.mean_rate), r)
             return
         mag = self._magnetometer()
         if not self._outage:

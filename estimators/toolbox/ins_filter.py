@@ -137,6 +137,7 @@ class InsFilter:
         self._prev = np.zeros(12)
         self._sums = np.zeros(7)
         self.mean_rate = np.zeros(3)  # compensated body angular rate over the last flush, rad/s
+        self.mean_rate_dt = 0.0  # the length of that flush, s
         # equal noise on the three axes: C Q C^T = Q, so G Q G^T does not depend on attitude
         self._gqg = noise_psd(np.eye(3), noise.accel_noise**2, noise.gyro_noise**2,
                               2 * noise.accel_bias_sigma**2 / noise.accel_bias_tau,
@@ -162,6 +163,7 @@ class InsFilter:
         if dt <= 0.0:
             return
         self.mean_rate = self._sums[3:6] / dt
+        self.mean_rate_dt = dt
         c_bn = quat_to_dcm(self.q)
         f_body = c_bn.T @ (self._sums[0:3] / dt)
         n = self.noise

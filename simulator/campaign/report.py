@@ -13,6 +13,7 @@ write_campaign_report.
 from __future__ import annotations
 
 import os
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
@@ -26,7 +27,9 @@ from simulator.scoring.report import PLOTS, format_number, markdown_table
 # (column, title) of the summary table and of the plots, in order
 _TABLE = [("horizontal.rms", "horizontal RMS (m)"), ("horizontal.cep95", "horizontal CEP95 (m)"),
           ("vertical.rms", "vertical RMS (m)"), ("attitude.yaw_rms", "yaw RMS (deg)"),
-          ("outages.end_horizontal", "outage end error (m)"), ("runtime.seconds", "runtime (s)")]
+          ("outages.end_horizontal", "outage end error (m)"),
+          ("degraded.end_horizontal", "degraded-window end error (m)"),
+          ("coverage.fraction", "coverage"), ("runtime.seconds", "runtime (s)")]
 _PLOTTED = [("horizontal.rms", "horizontal RMS (m)", "horizontal_rms"),
             ("outages.end_horizontal", "horizontal error at the end of GNSS outages (m)",
              "outage_end")]
@@ -85,14 +88,17 @@ def _box_plot(runs: pd.DataFrame, summary: dict, column: str, title: str, path: 
         values = runs.loc[at, column].to_numpy(dtype=float)
         names.append(_group_name(g))
         data.append(values[np.isfinite(values)])
-    fig = Figure(figsize=(max(5.0, 1.2 * len(names) + 2.0), 4.5), layout="constrained")
+    width_in, height_in = max(5.0, 1.2 * len(names) + 2.0), 4.5
+    fig = Figure(figsize=(width_in, height_in), layout="constrained")
     ax = fig.add_subplot()
     ax.boxplot(data, showfliers=False)
     for i, values in enumerate(data, start=1):  # every run as a point over its box
         ax.plot(np.full(values.size, i), values, "o", ms=3, alpha=0.5, color="tab:blue")
     ax.set_xticks(range(1, len(names) + 1), names, fontsize="small")
-    ax.set(xlabel=", ".join(["estimator", *summary["sweep"]]), ylabel=title,
-           title=f"{title} over the runs")
+    # wrapped to the figure (about 8 characters per inch of the default fonts), never clipped
+    ax.set(xlabel=", ".join(["estimator", *summary["sweep"]]),
+           ylabel=textwrap.fill(title, int(7 * height_in)),
+           title=textwrap.fill(f"{title} over the runs", int(8 * width_in)))
     ax.grid(axis="y", alpha=0.3)
     _replace(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
@@ -110,7 +116,8 @@ def write_campaign_report(directory: Path, runs: pd.DataFrame, summary: dict) ->
              f"estimator(s){sweep}: {ok} result(s) ok, {len(runs) - ok} failed.", "",
              "## Summary", "",
              "Each cell is mean / median / p95 over the runs that succeeded; metres, degrees, "
-             "seconds. Outage scores are each run's mean over its GNSS outages.", "",
+             "seconds. Outage (degraded-window) scores are each run's mean over its GNSS outages "
+             "(degraded windows); a solution without GNSS has none.", "",
              *_summary_lines(summary), "", "## Failed runs", "", *_failure_lines(runs, keys), ""]
     for column, title, name in _PLOTTED:
         if _has(summary, column):

@@ -26,12 +26,14 @@ from simulator.campaign.plan import RunTask, entry_labels
 STATUS_OK = "ok"
 STATUS_FAILED = "failed"
 RUN_COLUMNS = ("run_id", "seed", "label", "status")  # the leading columns of runs.parquet
-_SKIPPED = {"rows", "nees.expected", "outages.start"}  # bookkeeping, not performance
+# bookkeeping, not performance
+_SKIPPED = {"rows", "nees.expected", "outages.start", "degraded.start", "degraded.kind"}
 # unit of a flattened score column, by column or else by group (SPEC section 8)
 _UNITS = {"horizontal": "m", "vertical": "m", "velocity": "m/s", "attitude": "deg",
-          "runtime.seconds": "s", "outages.duration": "s", "outages.distance": "m",
-          "outages.max_horizontal": "m", "outages.end_horizontal": "m",
-          "outages.end_percent": "%"}
+          "runtime.seconds": "s", "coverage.longest_gap": "s",
+          **{f"{group}.{key}": unit for group in ("outages", "degraded")
+             for key, unit in (("duration", "s"), ("distance", "m"), ("max_horizontal", "m"),
+                               ("end_horizontal", "m"), ("end_percent", "%"))}}
 
 
 def _number(x: Any) -> float:
@@ -41,16 +43,21 @@ def _number(x: Any) -> float:
 def flatten_scores(scores: dict) -> dict[str, float]:
     """Scores of one solution (SPEC section 8) as ``{"horizontal.rms": value, ...}``.
 
-    Missing values are NaN. The ``outages`` list becomes ``outages.count`` and, for each
-    per-outage score, its mean over the outages that have it (NaN when none has).
+    Missing values are NaN. The ``outages`` and ``degraded`` lists become ``outages.count`` and,
+    for each per-window score, its mean over the windows that have it (NaN when none has); a
+    solution without GNSS has no outage columns. Nested groups (``sensor_errors``) flatten to
+    ``sensor_errors.gyro_bias_z.rms``.
     """
     out: dict[str, float] = {}
     for group, value in scores.items():
         if group in _SKIPPED:
             continue
         if isinstance(value, dict):
-            out.update({f"{group}.{k}": _number(v) for k, v in value.items()
-                        if f"{group}.{k}" not in _SKIPPED})
+            for k, v in value.items():
+                if isinstance(v, dict):
+                    out.update(flatten_scores({f"{group}.{k}": v}))
+                elif f"{group}.{k}" not in _SKIPPED:
+                    out[f"{group}.{k}"] = _number(v)
         elif isinstance(value, list):
             out[f"{group}.count"] = float(len(value))
             keys = dict.fromkeys(k for entry in value for k in entry)

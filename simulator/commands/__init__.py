@@ -13,4 +13,6 @@ SUMMARIES = {
     "run": "generate, run the scenario's estimators, score, write the report",
     "campaign": "Monte Carlo over seeds and sweeps, locally or on Dask; resumable",
     "export": "write a dataset's GNSS streams as RINEX 3.04 and NMEA 0183",
+    "schema": "print the JSON Schema of the scenario file (editor completion)",
+    "presets": "list the sensor presets with their parameters",
 }

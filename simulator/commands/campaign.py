@@ -1,5 +1,5 @@
 """``landnav campaign SCENARIO --runs N -o DIR``: Monte Carlo over seeds (and sweep points) of
-the scenario's estimators, in local processes or on a Dask cluster; resumable (SPEC section 3).
+the scenario's estimators, in local processes or on a Dask cluster; resumable.
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "estimate", help=SUMMARIES["estimate"],
         description="Replay a dataset into one estimator, message by message in time order "
                     "(the estimator never sees the truth), and write its solution as Parquet "
-                    "(SPEC section 7). The estimator starts from the truth at its first "
+                    "(docs/solution-format.md). The estimator starts from the truth at its first "
                     "message, perturbed by --init errors (unless it initialises itself).")
     p.add_argument("dataset", metavar="DATASET", help="dataset directory (landnav generate)")
     p.add_argument("-e", "--estimator", required=True, metavar="NAME",
@@ -78,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
     solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
-    write_solution(solution, args.output, args.force, [dataset.path])
+    write_solution(solution, args.output, args.force, [dataset.path],
+                   uses_gnss=info["uses_gnss"])
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
           f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")
     return 0

@@ -16,8 +16,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         "generate", help=SUMMARIES["generate"],
         description="Generate the dataset of a scenario: the exact truth trajectory, every "
                     "configured sensor's stream and the events table, as Parquet files with a "
-                    "manifest.json (SPEC section 5). The directory is written under a temporary "
-                    "name and renamed when complete; an existing one is kept unless --force.")
+                    "manifest.json (docs/dataset-format.md). The directory is written under a "
+                    "temporary name and renamed when complete; an existing one is kept unless "
+                    "--force.")
     p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="dataset directory")
     p.add_argument("--force", action="store_true", help="overwrite an existing DIR")

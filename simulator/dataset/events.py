@@ -17,8 +17,15 @@ _EVENT_TYPES = {"t_start": float, "t_end": float, "kind": str, "detail": str}
 
 
 def zone_events(zones: list[tuple[float, float, str]]) -> list[dict]:
-    """One ``zone`` row per zone interval of the drive."""
-    return [{"t_start": a, "t_end": b, "kind": "zone", "detail": name} for a, b, name in zones]
+    """One ``zone`` row per stretch of the drive in a zone: consecutive segments in the same
+    zone (a garage of fourteen segments) make one row, so that the stretch is one window."""
+    merged: list[list] = []
+    for a, b, name in sorted(zones, key=lambda z: z[0]):
+        if merged and merged[-1][2] == name and abs(a - merged[-1][1]) < 1e-9:
+            merged[-1][1] = b
+        else:
+            merged.append([a, b, name])
+    return [{"t_start": a, "t_end": b, "kind": "zone", "detail": name} for a, b, name in merged]
 
 
 def gnss_outage_intervals(epoch_t: np.ndarray, has_measurement: np.ndarray,

@@ -10,7 +10,7 @@ pandas.
 
 Public functions
 ----------------
-build_truth, sensor_rng, generate_streams, build_manifest, generate_dataset.
+build_truth, sensor_rng, generate_streams, build_manifest, stream_units, generate_dataset.
 """
 
 from __future__ import annotations
@@ -26,11 +26,13 @@ from pathlib import Path
 import numpy as np
 
 import simulator
+from simulator import columns as col
 from simulator.dataset.events import events_table, gnss_outage_intervals, zone_events
 from simulator.dataset.io import DatasetWriter
+from simulator.dataset.truth_sensors import truth_sensors_table
 from simulator.drive import build_drive
+from simulator.faults import FAULT_REGISTRY
 from simulator.faults.apply import apply_faults
-from simulator.faults.base import FAULT_REGISTRY
 from simulator.outputs import atomic_output_dir
 from simulator.progress import progress
 from simulator.scenario import Scenario
@@ -60,6 +62,8 @@ class Generated:
     truth: Kinematics
     streams: dict[str, Table]  # DataFrames unless generate_streams(frames=False)
     drawn: dict[str, dict] = field(default_factory=dict)
+    timing: dict[str, dict] = field(default_factory=dict)  # stream -> how it is stamped
+    truth_keys: dict[str, dict] = field(default_factory=dict)  # sensor -> {key: nominal}
 
 
 def generate_streams(scenario: Scenario | dict, show_progress: bool = True, frames: bool = True,
@@ -117,13 +121,22 @@ def generate_streams(scenario: Scenario | dict, show_progress: bool = True, fram
             for stream, table in made.items():
                 if on_final is not None and stream not in unsettled:
                     on_final(stream, table)
-    rows = zone_events(truth.profile.zones) + apply_faults(streams, scenario, truth)
+    fault_rows = apply_faults(streams, scenario, truth)
+    rows = zone_events(truth.profile.zones) + fault_rows
+    true_errors = {name: series for model in models.values()
+                   for name, series in getattr(model, "true_errors", {}).items()}
+    truth_sensors = truth_sensors_table(true_errors, truth.duration_s, fault_rows)
+    if truth_sensors is not None:
+        streams["truth_sensors"] = truth_sensors
     for t_start, t_end in _outages(streams, truth.duration_s):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
     if gnss is not None and "raw" not in gnss["outputs"]:
         streams.pop("gnss_raw", None)
     streams["events"] = events_table(rows)
-    return Generated(truth, as_frames(streams) if frames else streams, drawn)
+    timing = {stream: how for model in models.values() for stream, how in model.timing().items()
+              if stream in streams}
+    return Generated(truth, as_frames(streams) if frames else streams, drawn, timing,
+                     {name: dict(model.truth_keys) for name, model in models.items()})
 
 
 def _outages(streams: dict[str, Table], end_t: float) -> list[tuple[float, float]]:
@@ -151,11 +164,47 @@ def _versions(data: dict) -> dict[str, str]:
             **{name: importlib.import_module(name).__version__ for name in used}}
 
 
+# what a real user of the dataset would know, and what only the scorer may read
+KNOWLEDGE = {
+    "user": ["datasheet", "timing", "gps_time_start", "utc_start", "streams", "duration",
+             "software"],
+    "truth": ["scenario", "overrides", "sensors", "truth_parameters", "origin", "seed",
+              "truth*.parquet", "events.parquet"],
+}
+
+
+def _datasheet(data: dict, truth_keys: dict[str, dict]) -> tuple[dict, dict]:
+    """Each sensor's block as a user would know it (the true-value keys replaced by their
+    nominal values), and the true values replaced."""
+    datasheet, true_values = {}, {}
+    for name, block in data["sensors"].items():
+        if block is None:
+            continue
+        keys = truth_keys.get(name, {})
+        datasheet[name] = {k: keys.get(k, v) for k, v in block.items()}
+        if keys:
+            true_values[name] = {k: block[k] for k in keys if k in block}
+    return datasheet, true_values
+
+
 def build_manifest(scenario: Scenario, generated: Generated) -> dict:
-    """The manifest (SPEC section 5) without its ``streams`` block."""
+    """The manifest (SPEC section 5) without its ``streams`` block.
+
+    Besides the SPEC keys: ``datasheet`` (each sensor's parameters as a user knows them: the
+    datasheet and nominal values, with the scenario keys that set a true value, such as the
+    odometer's ``scale_factor``, replaced by the nominal value a user assumes), the values so
+    replaced in ``truth_parameters``, ``timing`` (how each stream is stamped and its effective
+    delay) and ``knowledge`` (which keys a real user would know, and which are truth that only
+    scoring may read: the resolved ``scenario``, the drawn ``sensors``, ...).
+    """
     data = scenario.data
     truth = generated.truth
+    datasheet, true_values = _datasheet(data, generated.truth_keys)
     return {
+        "knowledge": KNOWLEDGE,
+        "datasheet": datasheet,
+        "truth_parameters": true_values,
+        "timing": generated.timing,
         "scenario": data,
         "seed": data["seed"],
         "overrides": scenario.overrides,
@@ -169,14 +218,27 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
     }
 
 
+def stream_units(scenario: dict) -> dict[str, dict[str, str]]:
+    """Column units that differ from ``columns.STREAMS`` for this scenario: an IMU with
+    ``output: increment`` writes angle (rad) and velocity (m/s) increments over each sample
+    interval, so its file's ``unit`` metadata says so."""
+    imu = scenario["sensors"].get("imu")
+    if imu is not None and imu.get("output") == "increment":
+        return {"imu": dict(col.IMU_INCREMENT_UNITS)}
+    return {}
+
+
 def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
                      show_progress: bool = True) -> Path:
     """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
     ``force``). Returns ``out_dir``. Each stream no fault changes is written while the others are
     made."""
     out_dir = Path(out_dir)
-    with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp) as writer:
+    with (atomic_output_dir(out_dir, force) as tmp,
+          DatasetWriter(tmp, stream_units(scenario.data)) as writer):
         generated = generate_streams(scenario, show_progress, frames=False,
                                      on_final=writer.write)
-        writer.finish(build_manifest(scenario, generated), generated.streams)
+        imu = scenario.data["sensors"].get("imu")
+        described = {"imu": {"imu_output": imu["output"]}} if imu is not None else {}
+        writer.finish(build_manifest(scenario, generated), generated.streams, described)
     return out_dir

@@ -29,8 +29,10 @@ if TYPE_CHECKING:
     import pandas as pd
 
 
-def _units_for(name: str, table: Table) -> dict[str, str]:
+def _units_for(name: str, table: Table, overrides: dict[str, str] | None = None
+               ) -> dict[str, str]:
     declared = dict(col.STREAMS.get(name, (None, {}))[1])
+    declared.update(overrides or {})
     declared.update(getattr(table, "attrs", {}).get("units", {}))
     names = list(table)
     missing = [c for c in names if c not in declared]
@@ -63,8 +65,9 @@ class DatasetWriter:
     still being written.
     """
 
-    def __init__(self, directory: Path):
+    def __init__(self, directory: Path, units: dict[str, dict[str, str]] | None = None):
         self.directory = Path(directory)
+        self._units = units or {}  # stream -> column -> unit, over columns.STREAMS
         self._pool = ThreadPoolExecutor(max_workers=2)
         self._jobs: dict[str, Future] = {}
         # pyarrow loads in a writer thread while the caller starts making the streams
@@ -83,9 +86,12 @@ class DatasetWriter:
     def write(self, name: str, table: Table) -> None:
         self._jobs[name] = self._pool.submit(_write, table,
                                              self.directory / self.file_name(name),
-                                             _units_for(name, table))
+                                             _units_for(name, table, self._units.get(name)))
 
-    def finish(self, manifest: dict, streams: dict[str, Table]) -> None:
+    def finish(self, manifest: dict, streams: dict[str, Table],
+               described: dict[str, dict] | None = None) -> None:
+        """Write what is left, then the manifest with its ``streams`` block: each stream's file,
+        rows and rate, and the fields of ``described[name]`` (the IMU's ``imu_output``)."""
         manifest = dict(manifest)
         manifest["format"] = col.DATASET_FORMAT
         manifest["streams"] = {}
@@ -103,7 +109,7 @@ class DatasetWriter:
                 t = column(table, "t")
                 rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
             manifest["streams"][name] = {"file": self.file_name(name), "rows": rows,
-                                         "rate_hz": rate}
+                                         "rate_hz": rate, **(described or {}).get(name, {})}
         text = json.dumps(manifest, indent=2, sort_keys=True, default=str)
         (self.directory / "manifest.json").write_text(text + "\n", encoding="utf-8")
 

@@ -11,7 +11,7 @@ dataset writer's threads, so that a generation starts its work without waiting f
 
 Public functions
 ----------------
-write_table, read_table, read_units.
+write_table, read_table, read_units, read_metadata.
 """
 
 from __future__ import annotations
@@ -74,7 +74,8 @@ def _text_column(values: np.ndarray) -> pa.Array:
                                  null_count=null_count)
 
 
-def _arrow_table(table: Table, units: dict[str, str]) -> pa.Table:
+def _arrow_table(table: Table, units: dict[str, str], metadata: dict[str, str] | None = None
+                 ) -> pa.Table:
     """The Arrow table of a column table or DataFrame, each field with its unit and no
     schema-level metadata (no ``pandas`` key)."""
     if isinstance(table, dict):
@@ -83,14 +84,16 @@ def _arrow_table(table: Table, units: dict[str, str]) -> pa.Table:
         converted = pa.Table.from_pandas(table, preserve_index=False)
         names, arrays = converted.column_names, converted.columns
     schema = pa.schema([pa.field(name, array.type).with_metadata({"unit": units.get(name, "")})
-                        for name, array in zip(names, arrays, strict=True)], metadata={})
+                        for name, array in zip(names, arrays, strict=True)],
+                       metadata=metadata or {})
     return pa.Table.from_arrays(arrays, schema=schema)
 
 
-def write_table(frame: Table, path: Path, units: dict[str, str]) -> None:
+def write_table(frame: Table, path: Path, units: dict[str, str],
+                metadata: dict[str, str] | None = None) -> None:
     """Write one table (a column table or a DataFrame) as Parquet with each column's unit in its
-    field metadata."""
-    table = _arrow_table(frame, units)
+    field metadata, and ``metadata`` (none for dataset streams) as the schema's metadata."""
+    table = _arrow_table(frame, units, metadata)
     # dictionary encoding for text columns only (on floats it costs time and saves nothing);
     # floats byte-stream-split before zstd: smooth time series then compress about twice as
     # well, and faster; no column statistics (nothing here filters row groups by them)
@@ -111,6 +114,12 @@ def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
     except (pa.ArrowException, OSError) as exc:
         raise InputError([Problem(str(path), None, "", f"not a readable Parquet file: {exc}")]
                          ) from None
+
+
+def read_metadata(path: Path) -> dict[str, str]:
+    """The schema-level metadata of a Parquet file (text keys and values)."""
+    metadata = pq.read_schema(path).metadata or {}
+    return {k.decode(errors="replace"): v.decode(errors="replace") for k, v in metadata.items()}
 
 
 def read_units(path: Path) -> dict[str, str]:

@@ -31,4 +31,5 @@ ZONE_FIELD = Record(
 # zones a scenario uses without declaring them: these names have no sky, the others open sky
 COVERED_ZONE_NAMES = ("tunnel", "garage", "parking", "underground", "underpass")
 
-ENVIRONMENT_FIELD = Record({"zones": MapOf(ZONE_FIELD, {})}, default={})
+ENVIRONMENT_FIELD = Record({"zones": MapOf(ZONE_FIELD, {}, doc="what each named zone does to "
+                                                             "the sky")}, default={})

@@ -1,19 +1,24 @@
 """Faults: transformations of streams over intervals (outages, satellite limits, multipath,
 pressure jumps, wheel slip, bias steps, dropouts...), configured in the scenario's ``faults:``
-list. Each kind registers its schema and its transformation in ``FAULT_REGISTRY``; triggers
+list. Each kind is a ``FaultKind`` (its schema and its transformation) listed by name in
+``FAULT_REGISTRY``; triggers
 (start + duration, zone, distance range, random) are shared by all kinds.
 
 Public names
 ------------
-FAULT_KINDS, FAULT_FIELD, FAULT_STREAMS, check_faults.
+FAULT_REGISTRY, FAULT_KINDS, FAULT_FIELD, FAULT_STREAMS, check_faults.
 """
 
 from __future__ import annotations
 
-from simulator.faults import gnss_faults, sensor_faults  # noqa: F401  (register the kinds)
-from simulator.faults.base import FAULT_REGISTRY
+from simulator.faults.base import FaultKind
+from simulator.faults.gnss_faults import GNSS_FAULTS
+from simulator.faults.sensor_faults import SENSOR_FAULTS
 from simulator.faults.triggers import trigger_problems
 from simulator.schema import Context, Path, Record, Tagged
+
+# every fault kind by name: the one table the scenario, the generator and the faults read
+FAULT_REGISTRY: dict[str, FaultKind] = {kind.name: kind for kind in (*GNSS_FAULTS, *SENSOR_FAULTS)}
 
 FAULT_KINDS: dict[str, Record] = {name: kind.record for name, kind in FAULT_REGISTRY.items()}
 

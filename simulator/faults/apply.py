@@ -13,7 +13,8 @@ import zlib
 
 import numpy as np
 
-from simulator.faults.base import FAULT_REGISTRY, FaultContext
+from simulator.faults import FAULT_REGISTRY
+from simulator.faults.base import FaultContext
 from simulator.faults.triggers import TRIGGER_FIELDS, fault_intervals
 from simulator.tables import Table, as_frame
 

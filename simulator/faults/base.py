@@ -4,7 +4,7 @@ intervals stays byte-identical to the clean dataset.
 
 Public names
 ------------
-FaultKind, FaultContext, FAULT_REGISTRY, in_intervals, register.
+FaultKind, FaultContext, fault_kind, in_intervals.
 """
 
 from __future__ import annotations
@@ -55,16 +55,16 @@ class FaultKind:
         return self.streams + (("truth_gnss",) if gnss else ())
 
 
-FAULT_REGISTRY: dict[str, FaultKind] = {}
-
-
-def register(name: str, params: dict[str, Field], streams: tuple[str, ...], doc: str
-             ) -> Callable[[Apply], Apply]:
-    """Decorator registering a fault kind's parameters and its ``apply`` function."""
-    def wrap(apply: Apply) -> Apply:
-        FAULT_REGISTRY[name] = FaultKind(name, Record({**TRIGGER_FIELDS, **params}), apply,
-                                         streams, doc)
-        return apply
+def fault_kind(name: str, params: dict[str, Field], streams: tuple[str, ...], doc: str
+               ) -> Callable[[Apply], FaultKind]:
+    """Decorator making a fault kind of its ``apply`` function: its name, parameters (the
+    trigger fields added), the streams it acts on and a one-line description (also the
+    record's doc, which the scenario reference prints). The kinds are listed by name in
+    ``simulator.faults.FAULT_REGISTRY``."""
+    def wrap(apply: Apply) -> FaultKind:
+        record = Record({**TRIGGER_FIELDS, **params},
+                        doc=f"{doc} (acts on: {', '.join(streams)})")
+        return FaultKind(name, record, apply, streams, doc)
     return wrap
 
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from simulator.earth import geodetic_rates
-from simulator.faults.base import in_intervals, register
+from simulator.faults.base import fault_kind, in_intervals
 from simulator.gnss.fix import receiver_fixes
 from simulator.schema import Integer, ListOf, Number, Vector
 from simulator.stochastic import gauss_markov
@@ -32,7 +32,7 @@ def blank_fixes(fix, mask: np.ndarray) -> None:
         fix.loc[mask, "num_sats"] = 0
 
 
-@register("gnss_outage", {}, ("gnss_fix", "gnss_raw"),
+@fault_kind("gnss_outage", {}, ("gnss_fix", "gnss_raw"),
           "no GNSS measurement and no fix (a blocked sky, an antenna fault)")
 def _gnss_outage(streams, intervals, params, context) -> None:
     for name in ("gnss_raw", "truth_gnss"):
@@ -45,7 +45,7 @@ def _gnss_outage(streams, intervals, params, context) -> None:
         blank_fixes(fix, in_intervals(fix["t"].to_numpy(), intervals))
 
 
-@register("gnss_fix_jump", {"offset": Vector(3, Number("m"), doc="north, east, down step, m")},
+@fault_kind("gnss_fix_jump", {"offset": Vector(3, Number("m"), doc="north, east, down step, m")},
           ("gnss_fix",), "the position fixes jump by a fixed offset")
 def _gnss_fix_jump(streams, intervals, params, context) -> None:
     fix = streams["gnss_fix"]
@@ -58,7 +58,7 @@ def _gnss_fix_jump(streams, intervals, params, context) -> None:
     fix.loc[mask, "alt"] = alt + d_alt
 
 
-@register("gnss_latency", {"latency": Number("s", gt=0, doc="how late the fixes are")},
+@fault_kind("gnss_latency", {"latency": Number("s", gt=0, doc="how late the fixes are")},
           ("gnss_fix",), "fixes time-tagged late: each reports the epoch latency earlier")
 def _gnss_latency(streams, intervals, params, context) -> None:
     fix = streams["gnss_fix"]
@@ -73,7 +73,7 @@ def _gnss_latency(streams, intervals, params, context) -> None:
     blank_fixes(fix, np.isin(np.arange(len(fix)), rows[~valid]))
 
 
-@register("gnss_rate_drop", {"rate": Number("Hz", gt=0, doc="output rate during the fault")},
+@fault_kind("gnss_rate_drop", {"rate": Number("Hz", gt=0, doc="output rate during the fault")},
           ("gnss_fix", "gnss_raw"), "the receiver outputs epochs at a lower rate")
 def _gnss_rate_drop(streams, intervals, params, context) -> None:
     period = 1.0 / params["rate"]
@@ -119,7 +119,7 @@ def _set_tracked(streams, rows_dropped) -> None:
     truth.loc[key.isin(dropped), "tracked"] = 0
 
 
-@register("gnss_satellite_limit", {
+@fault_kind("gnss_satellite_limit", {
     "count": Integer(min=0, doc="satellites kept; the lowest are lost first"),
     "keep": ListOf(Integer(min=1), None, doc="or: the PRNs kept (the others are lost)"),
 }, ("gnss_fix", "gnss_raw"), "only a few satellites left (partial outage, Karamat et al. 2015)")
@@ -136,7 +136,7 @@ def _gnss_satellite_limit(streams, intervals, params, context) -> None:
     _refix(streams, intervals, context)
 
 
-@register("gnss_multipath", {
+@fault_kind("gnss_multipath", {
     "satellites": Integer(2, min=1, doc="how many satellites (the lowest at the start)"),
     "sigma": Number("m", 30.0, gt=0, doc="standard deviation of the multipath error"),
     "correlation_time": Number("s", 5.0, gt=0, doc="its Gauss-Markov correlation time"),
@@ -169,3 +169,7 @@ def _gnss_multipath(streams, intervals, params, context) -> None:
         truth["multipath"] = truth["multipath"].to_numpy() + extra.reindex(key).fillna(
             0.0).to_numpy()
     _refix(streams, intervals, context)
+
+
+GNSS_FAULTS = (_gnss_outage, _gnss_fix_jump, _gnss_latency, _gnss_rate_drop,
+               _gnss_satellite_limit, _gnss_multipath)

@@ -11,13 +11,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from simulator import columns as col
-from simulator.faults.base import in_intervals, register
+from simulator.faults.base import fault_kind, in_intervals
 from simulator.schema import ListOf, Number, Text
 
 if TYPE_CHECKING:
     import pandas as pd
 
-_AXES = ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1)
+_AXES = ListOf(Text(choices=list(col.IMU_AXES)), list(col.IMU_AXES), min_len=1,
+               doc="the IMU channels it acts on")
 
 
 def _imu_axes(imu: pd.DataFrame, axes: list[str], sensors: dict
@@ -29,7 +30,7 @@ def _imu_axes(imu: pd.DataFrame, axes: list[str], sensors: dict
     return [(a, a.split("_")[0], scale) for a in axes if a in imu]
 
 
-@register("imu_bias_step", {
+@fault_kind("imu_bias_step", {
     "axes": _AXES,
     "gyro": Number("rad/s", 0.0, doc="bias step of the gyros among axes"),
     "accel": Number("m/s^2", 0.0, doc="bias step of the accelerometers among axes"),
@@ -41,8 +42,9 @@ def _imu_bias_step(streams, intervals, params, context) -> None:
         imu.loc[mask, axis] = imu.loc[mask, axis].to_numpy() + params[group] * scale
 
 
-@register("imu_saturation_burst", {
+@fault_kind("imu_saturation_burst", {
     "axes": ListOf(Text(choices=list(col.IMU_AXES)), ["accel_x", "accel_y", "accel_z"],
+                   doc="the IMU channels it acts on",
                    min_len=1),
     "gyro_amplitude": Number("rad/s", 0.0, min=0, doc="shock oscillation on the gyros"),
     "accel_amplitude": Number("m/s^2", 0.0, min=0, doc="shock oscillation on the accels"),
@@ -63,7 +65,7 @@ def _imu_saturation_burst(streams, intervals, params, context) -> None:
         imu.loc[mask, axis] = values
 
 
-@register("odometer_slip", {"slip": Number("", min=-1.0, doc=(
+@fault_kind("odometer_slip", {"slip": Number("", min=-1.0, doc=(
     "speed error ratio: +0.2 spins the wheel 20 % fast, -1 locks it"))}, ("odometer",),
     "wheel spin or lock: the measured speed is off by a ratio")
 def _odometer_slip(streams, intervals, params, context) -> None:
@@ -75,14 +77,14 @@ def _odometer_slip(streams, intervals, params, context) -> None:
                                           * (1.0 + params["slip"]))
 
 
-@register("odometer_scale_change", {"scale_change": Number("", gt=-0.5, lt=0.5, doc=(
+@fault_kind("odometer_scale_change", {"scale_change": Number("", gt=-0.5, lt=0.5, doc=(
     "relative change of the scale factor, e.g. \"3 %\" after a tyre change"))},
     ("odometer",), "a tyre change: the odometer scale factor changes")
 def _odometer_scale_change(streams, intervals, params, context) -> None:
-    _odometer_slip(streams, intervals, {"slip": params["scale_change"]}, context)
+    _odometer_slip.apply(streams, intervals, {"slip": params["scale_change"]}, context)
 
 
-@register("baro_jump", {
+@fault_kind("baro_jump", {
     "delta_pa": Number("Pa", doc="pressure step (a window opened, a door closed)"),
     "recovery": Number("s", 5.0, min=0, doc="time over which the step decays at the end"),
 }, ("baro",), "a pressure step and its recovery")
@@ -98,10 +100,11 @@ def _baro_jump(streams, intervals, params, context) -> None:
         baro.loc[mask, "pressure"] = baro.loc[mask, "pressure"].to_numpy() + delta
 
 
-_STREAM = Text(choices=["imu", "odometer", "gnss_fix", "gnss_raw", "baro", "mag"])
+_STREAM = Text(choices=["imu", "odometer", "gnss_fix", "gnss_raw", "baro", "mag"],
+               doc="the stream it acts on")
 
 
-@register("sensor_dropout", {"stream": _STREAM}, ("imu", "odometer", "gnss_fix", "gnss_raw",
+@fault_kind("sensor_dropout", {"stream": _STREAM}, ("imu", "odometer", "gnss_fix", "gnss_raw",
                                                    "baro", "mag"),
           "a stream loses its samples")
 def _sensor_dropout(streams, intervals, params, context) -> None:
@@ -111,7 +114,7 @@ def _sensor_dropout(streams, intervals, params, context) -> None:
     streams[name] = frame.loc[keep].reset_index(drop=True)
 
 
-@register("timestamp_jitter", {
+@fault_kind("timestamp_jitter", {
     "stream": _STREAM,
     "sigma": Number("s", gt=0, doc="standard deviation of the time-tag error"),
 }, ("imu", "odometer", "gnss_fix", "gnss_raw", "baro", "mag"),
@@ -130,3 +133,7 @@ def _timestamp_jitter(streams, intervals, params, context) -> None:
     bound = 0.45 * spacing
     jitter = np.clip(context.rng.normal(0.0, params["sigma"], len(epochs)), -bound, bound)
     frame.loc[mask, "t"] = t[mask] + jitter[np.searchsorted(epochs, t[mask])]
+
+
+SENSOR_FAULTS = (_imu_bias_step, _imu_saturation_burst, _odometer_slip, _odometer_scale_change,
+                 _baro_jump, _sensor_dropout, _timestamp_jitter)

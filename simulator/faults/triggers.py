@@ -22,7 +22,8 @@ import numpy as np
 from simulator.schema import Context, Number, Path, Record, Text, Vector
 
 _DURATION_DISTRIBUTION = Record({
-    "distribution": Text("fixed", choices=["fixed", "uniform", "exponential"]),
+    "distribution": Text("fixed", choices=["fixed", "uniform", "exponential"],
+                         doc="how each event's duration is drawn"),
     "mean": Number("s", None, gt=0, doc="fixed value, or mean of the exponential"),
     "min": Number("s", None, min=0, doc="uniform: shortest"),
     "max": Number("s", None, gt=0, doc="uniform: longest"),
@@ -37,7 +38,8 @@ TRIGGER_FIELDS = {
         "rate": Number("1/s", gt=0, doc="events per unit time (\"3 /h\", or per second)"),
         "duration": _DURATION_DISTRIBUTION,
         "min_gap": Number("s", 1.0, min=0, doc="least time between two events"),
-    }, default=None),
+    }, default=None, doc="random events over the whole drive (a Poisson process of `rate`, "
+                         "durations drawn from `duration`)"),
 }
 
 

@@ -33,7 +33,7 @@ locations as of the epoch; the same values as the 3rd ed. (2001) Table 3-1) and 
 plan: e = 0, i = 55 deg, A = 26 559.7 km, RAAN rate -4.4874e-7 deg/s). The 5th ed. (2020) Tables
 3.2-1 and 3.2-2 restate the same slots at 2016-12-31 23:59:43 UTC (Greenwich hour angle
 100.765 deg): every RAAN +16.003 deg and argument of latitude -28.586 deg from the values here,
-the same ground-track equatorial crossings (see tests/test_gnss_constellation.py).
+the same ground-track equatorial crossings (see tests/gnss/test_gnss_constellation.py).
 """
 
 from __future__ import annotations

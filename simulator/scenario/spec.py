@@ -135,16 +135,22 @@ SCENARIO_FIELD = Record(
     {
         "name": SafeName(None, doc="the drive's name; `landnav run` without -o writes to "
                          "runs/<name>, so letters, digits, '.', '_' and '-' only"),
-        "description": Text(None),
-        "seed": Integer(0, min=0, max=2**63 - 1),
+        "description": Text(None, doc="free text"),
+        "seed": Integer(0, min=0, max=2**63 - 1,
+                        doc="determines every random draw (--seed overrides it)"),
         "start": START_FIELD,
         "limits": LIMITS_FIELD,
-        "trajectory": Tagged(TRAJECTORY_KINDS, what="trajectory kind"),
+        "trajectory": Tagged(TRAJECTORY_KINDS, what="trajectory kind",
+                             doc="the road and the speed: segments, a SUMO network or a "
+                                 "recorded drive"),
         "vehicle": VEHICLE_FIELD,
         "environment": ENVIRONMENT_FIELD,
-        "sensors": Record(SENSOR_FIELDS, default={}),
-        "faults": ListOf(FAULT_FIELD, []),
-        "estimators": ListOf(ESTIMATOR_ENTRY_FIELD, []),
+        "sensors": Record(SENSOR_FIELDS, default={},
+                          doc="the sensors the car carries; a sensor left out is absent"),
+        "faults": ListOf(FAULT_FIELD, [], doc="faults applied to the streams (docs/faults.md)"),
+        "estimators": ListOf(ESTIMATOR_ENTRY_FIELD, [],
+                             doc="what `landnav run` runs: a name, or {name, label, init, "
+                                 "config}"),
     },
     post=_check_whole,
 )

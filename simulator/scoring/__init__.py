@@ -1,4 +1,4 @@
-"""Truth-referenced scoring of navigation solutions (SPEC section 8) and the report.
+"""Truth-referenced scoring of navigation solutions (docs/scores.md) and the report.
 
 Modules
 -------

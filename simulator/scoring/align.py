@@ -11,13 +11,17 @@ truth's time span are dropped and counted):
   interpolates through 180 deg, not through 0.
 
 Position errors are the ECEF difference (solution minus truth) resolved in the NED frame at the
-interpolated true position (C_e^n, Groves eq. 2.150); velocity errors are NED differences;
-attitude errors are wrapped Euler-angle differences (solution minus truth), rad. NaN in a solution
-row propagates to the errors it feeds; the metrics skip those rows.
+interpolated true position (C_e^n, Groves eq. 2.150); a row without a height (NaN ``alt``, e.g. a
+bare NMEA GGA) is placed at the true height for its horizontal error and has a NaN down error;
+velocity errors are NED differences; attitude errors are wrapped Euler-angle differences
+(solution minus truth), rad. Estimated sensor errors (named as in docs/solution-format.md,
+``columns.SENSOR_ERRORS``) are compared with ``truth_sensors`` interpolated linearly at the
+solution times (``err_`` + the column name, solution minus truth, in the column's own unit). NaN
+in a solution row propagates to the errors it feeds; the metrics skip those rows.
 
 Public names
 ------------
-SolutionErrors, solution_errors, local_ned, ERR_POS, ERR_VEL, ERR_ATT, ERR_H.
+SolutionErrors, solution_errors, sensor_error_name, local_ned, ERR_POS, ERR_VEL, ERR_ATT, ERR_H.
 
 References
 ----------
@@ -53,7 +57,8 @@ class SolutionErrors:
     errors : DataFrame
         One row per solution row inside the truth span: ``t`` (s), ``err_n, err_e, err_d`` (m),
         ``err_h`` (m), ``err_vn, err_ve, err_vd`` (m/s), ``err_roll, err_pitch, err_yaw`` (rad),
-        and the solution's own ``std_*`` columns when it has them.
+        the solution's own ``std_*`` columns when it has them, and ``err_<name>`` for each
+        sensor-error column of the solution that the truth sensors table also has.
     total_rows : int
         Rows of the solution.
     outside_truth : int
@@ -86,7 +91,13 @@ def local_ned(frame: pd.DataFrame, origin: tuple[float, float, float]) -> np.nda
     return ecef_to_ned(_ecef(frame), np.radians(origin[0]), np.radians(origin[1]), origin[2])
 
 
-def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErrors:
+def sensor_error_name(column: str) -> str:
+    """The per-sample error column of an estimated sensor-error column."""
+    return f"err_{column}"
+
+
+def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame,
+                    truth_sensors: pd.DataFrame | None = None) -> SolutionErrors:
     """Errors of a solution against the truth interpolated at the solution times.
 
     Parameters
@@ -95,7 +106,9 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErro
         ``truth.parquet`` (at least ``t, lat, lon, alt, vn, ve, vd, roll, pitch, yaw``), t
         strictly increasing.
     solution : DataFrame
-        A solution table (SPEC section 7), t increasing.
+        A solution table (docs/solution-format.md), t increasing.
+    truth_sensors : DataFrame or None
+        ``truth_sensors.parquet`` (``t`` and true sensor-error columns), or None.
 
     Returns
     -------
@@ -114,15 +127,15 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErro
     # the NED frame of the interpolated true position (lat/lon interpolated only for the rotation)
     c_ne = ned_to_ecef_matrix(np.radians(interp(truth["lat"].to_numpy(float))),
                               np.radians(interp(truth["lon"].to_numpy(float))))
-    # a 2-D solution writes NaN height (SPEC section 7): its horizontal error is taken at the
-    # true height, and its vertical error stays NaN
-    no_height = ~np.isfinite(sol["alt"].to_numpy(float))
-    placed = sol
-    if no_height.any():
-        placed = sol[["lat", "lon", "alt"]].copy()
-        placed.loc[no_height, "alt"] = interp(truth["alt"].to_numpy(float))[no_height]
-    err_pos = np.einsum("kji,kj->ki", c_ne, _ecef(placed) - truth_ecef)
-    err_pos[no_height, 2] = np.nan
+    # a solution without a height (NaN alt) still has a horizontal error: its point is taken at
+    # the true height for that, and its down error stays NaN
+    alt = sol["alt"].to_numpy(float)
+    no_alt = ~np.isfinite(alt)
+    sol_ecef = geodetic_to_ecef(np.radians(sol["lat"].to_numpy(float)),
+                                np.radians(sol["lon"].to_numpy(float)),
+                                np.where(no_alt, interp(truth["alt"].to_numpy(float)), alt))
+    err_pos = np.einsum("kji,kj->ki", c_ne, sol_ecef - truth_ecef)
+    err_pos[no_alt, 2] = np.nan
     out = {"t": t}
     out.update(zip(ERR_POS, err_pos.T, strict=True))
     out[ERR_H] = np.hypot(err_pos[:, 0], err_pos[:, 1])
@@ -134,4 +147,11 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame) -> SolutionErro
     for name in col.SOLUTION_STD:
         if name in sol:
             out[name] = sol[name].to_numpy(float)
+    if truth_sensors is not None and len(truth_sensors):
+        t_sensors = truth_sensors["t"].to_numpy(float)
+        for name in col.SENSOR_ERRORS:
+            if name in sol and name in truth_sensors:
+                true_value = np.interp(t, t_sensors, truth_sensors[name].to_numpy(float),
+                                       left=np.nan, right=np.nan)
+                out[sensor_error_name(name)] = sol[name].to_numpy(float) - true_value
     return SolutionErrors(pd.DataFrame(out), len(solution), int((~inside).sum()))

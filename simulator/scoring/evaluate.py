@@ -1,9 +1,9 @@
 """Several solutions on one dataset: read the truth and events once, score each solution, and
-write the scores as JSON (SPEC section 8, keyed by label).
+write the scores as JSON (docs/scores.md, keyed by label).
 
 Public names
 ------------
-Scored, Evaluation, score_solutions, write_scores.
+Scored, Evaluation, score_solutions, canyon_zones, write_scores.
 """
 
 from __future__ import annotations
@@ -39,6 +39,8 @@ class Evaluation:
     truth: pd.DataFrame
     events: pd.DataFrame
     results: dict[str, Scored]
+    canyon_zones: frozenset[str] = frozenset()
+    dataset: Dataset | None = None  # for the report's GNSS plots
 
     def scores(self) -> dict[str, dict]:
         """The JSON-ready scores keyed by label."""
@@ -58,24 +60,43 @@ class Evaluation:
         return out
 
 
+def canyon_zones(manifest: dict) -> frozenset[str]:
+    """Names of the zones whose sky is an urban canyon in a dataset's resolved scenario."""
+    zones = ((manifest.get("scenario") or {}).get("environment") or {}).get("zones") or {}
+    return frozenset(name for name, zone in zones.items() if (zone or {}).get("sky") == "canyon")
+
+
 def score_solutions(dataset: Dataset,
                     solutions: dict[str, tuple[pd.DataFrame, dict | None]]) -> Evaluation:
     """Score solutions against a dataset's truth.
 
     Parameters
     ----------
-    dataset : the opened dataset (must have ``truth``; ``events`` is optional).
-    solutions : label -> (solution table, runtime info ``{"runtime_s", "realtime_factor"}`` or
-        None).
+    dataset : the opened dataset (must have ``truth``; ``events``, ``truth_sensors`` and
+        ``gnss_fix`` are used when present).
+    solutions : label -> (solution table, info or None). ``info`` of an estimator run inside
+        landnav (``simulator.replay.run_estimator``) gives ``runtime_s``, ``realtime_factor``
+        and ``uses_gnss``; a solution file gives ``{"uses_gnss": ...}`` as its reader found
+        (``simulator.scoring.readers``), and None is taken to use GNSS, so its outages are
+        scored.
     """
     truth = dataset.read("truth")
     events = (dataset.read("events") if dataset.has("events")
               else pd.DataFrame(columns=list(col.EVENTS)))
+    truth_sensors = dataset.read("truth_sensors") if dataset.has("truth_sensors") else None
+    gnss_fix = (dataset.read("gnss_fix", ["t", "num_sats"]) if dataset.has("gnss_fix")
+                else None)
+    canyons = canyon_zones(dataset.manifest)
     results = {}
-    for label, (frame, runtime) in solutions.items():
-        errors = solution_errors(truth, frame)
-        results[label] = Scored(label, frame, errors, score_errors(errors, truth, events, runtime))
-    return Evaluation(truth, events, results)
+    for label, (frame, info) in solutions.items():
+        errors = solution_errors(truth, frame, truth_sensors)
+        info = info or {}
+        runtime = info if "runtime_s" in info else None
+        scores = score_errors(errors, truth, events, runtime,
+                              uses_gnss=info.get("uses_gnss", True),
+                              canyon_zones=canyons, gnss_fix=gnss_fix)
+        results[label] = Scored(label, frame, errors, scores)
+    return Evaluation(truth, events, results, canyons, dataset)
 
 
 def write_scores(scores: dict, path: Path, force: bool = False,

@@ -47,12 +47,12 @@ BARO_PRESETS: dict[str, dict] = {
 }
 
 _FIELDS = {
-    "rate": Number("Hz", None, gt=0, max=1000),
+    "rate": Number("Hz", None, gt=0, max=1000, doc="sample rate"),
     "noise": Number("Pa", None, min=0, doc="white noise, 1-sigma"),
     "bias": Number("Pa", None, min=0, doc="bias, 1-sigma, drawn once per run"),
     "drift": Number("Pa/s", None, doc="sea-level pressure change (weather), e.g. '-1 hPa/h'"),
     "sea_level_pressure": Number("Pa", None, gt=0, doc="sea-level pressure at t = 0"),
-    "resolution": Number("Pa", None, min=0),
+    "resolution": Number("Pa", None, min=0, doc="quantisation step"),
     "range": Vector(2, Number("Pa", gt=0), None, doc="lowest and highest pressure measured"),
 }
 _DEFAULTS = {"rate": 10.0, "sea_level_pressure": P0_PA, "range": None}
@@ -72,6 +72,8 @@ class Barometer(PresetSensor):
     """A barometer built from its resolved scenario block (``sensors.baro``)."""
 
     name = "baro"
+    # the weather is truth: a user assumes the standard atmosphere, steady
+    truth_keys = {"sea_level_pressure": P0_PA, "drift": 0.0}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config

@@ -5,7 +5,8 @@ that turns the exact trajectory and a random generator into stream tables (colum
 
 Public names
 ------------
-SensorModel, sample_times, grid_index, grid_rows, truth_at, integrate_over_samples.
+SensorModel, TRUE_ERROR_RATE_HZ, sample_times, grid_index, grid_rows, truth_at,
+integrate_over_samples.
 """
 
 from __future__ import annotations
@@ -43,6 +44,12 @@ class SensorModel(Protocol):
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, Table]:
         ...
+
+
+# rate (Hz) at which sensors keep their true error values over time (``true_errors``, written
+# to truth_sensors.parquet): fast enough for a bias process seen by a 10 Hz solution, a tenth
+# of the IMU file at 100 Hz
+TRUE_ERROR_RATE_HZ = 10.0
 
 
 def sample_times(duration_s: float, rate_hz: float, first: int = 0) -> np.ndarray:

@@ -141,24 +141,29 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
 GNSS_FIELD = Record(
     {
         "preset": Text("automotive", doc="error preset: 'automotive' or 'ideal' (no errors)"),
-        "rate": Number("Hz", 1.0, gt=0, max=100),
-        "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1),
+        "rate": Number("Hz", 1.0, gt=0, max=100, doc="epoch rate"),
+        "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1,
+                          doc="streams written: gnss_fix and/or gnss_raw"),
         "constellation": Text("nominal-gps",
                               doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
         "expanded_slots": ListOf(Text(choices=list(EXPANDABLE_SLOTS)), [],
                                  doc="expandable slots of 'nominal-gps' split into their fore/aft "
                                      "pairs (SPS PS 2008 Table 3.4-2); [B1, D2, F2] = 27 slots"),
-        "elevation_mask": Number(angle=True, default=10.0, min=0, max=90),
-        "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0]),
+        "elevation_mask": Number(angle=True, default=10.0, min=0, max=90,
+                                 doc="satellites below it are not tracked"),
+        "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
+                                    doc="antenna position in the body frame (FRD) from the IMU"),
         **_ERROR_FIELDS,
-        "multipath_correlation_time": Number("s", 5.0, gt=0),
+        "multipath_correlation_time": Number("s", 5.0, gt=0,
+                                             doc="Gauss-Markov correlation time of multipath"),
         "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
         "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
         "cn0_threshold": Number("", 25.0, doc="tracking threshold, dB-Hz"),
-        "dll_bandwidth": Number("Hz", 0.5, gt=0),
+        "dll_bandwidth": Number("Hz", 0.5, gt=0, doc="code tracking loop (DLL) bandwidth"),
         "correlator_spacing": Number("", 0.5, gt=0, max=1, doc="early-late spacing, chips"),
         "fll_bandwidth": Number("Hz", 0.5, gt=0, doc="carrier (frequency) loop noise bandwidth"),
-        "integration_time": Number("s", 0.02, gt=0, max=0.02),
+        "integration_time": Number("s", 0.02, gt=0, max=0.02,
+                                   doc="coherent integration time of the correlators"),
         "smoothing": Number("s", 0.0, min=0, doc="fix smoothing time constant (0 = none)"),
         "dop_mask": Number("", 20.0, gt=0, doc="no fix when the HDOP is above this"),
     },
@@ -175,6 +180,18 @@ class Gnss(PresetSensor):
     def __init__(self, config: dict):
         super().__init__(config)
         self.drawn["constellation"] = config["constellation"]
+
+    def timing(self) -> dict[str, dict]:
+        """Epochs are stamped with the true GPS time of the measurement (the receiver's clock
+        error is in the measurements, not in ``t``); the fix of an epoch uses that epoch's
+        measurements only."""
+        stamp = "the true GPS time of the measurement epoch"
+        return {"gnss_fix": {"stamp": stamp, "delay_s": 0.0,
+                             "no_fix": "epochs without a fix are rows with fix = 0 and NaN "
+                                       "position and velocity"},
+                "gnss_raw": {"stamp": stamp, "delay_s": 0.0,
+                             "no_fix": "one row per tracked satellite; an epoch with no "
+                                       "satellite has no row"}}
 
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:
@@ -274,6 +291,7 @@ class Gnss(PresetSensor):
         # errors and measurements
         bias_s, drift_s_s, self.drawn["clock"] = draw_receiver_clock(rng, cfg["clock"], len(t),
                                                                       dt_s)
+        self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         err = draw_error_terms(rng, cfg, el, cn0, dt_s)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]

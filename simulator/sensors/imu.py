@@ -61,8 +61,12 @@ Misalignment is 1-sigma, a small angle in rad (strings such as "0.1 deg" or "1 m
 (Karamat 2015: vertical gyro, forward and lateral accelerometers), ``drm1`` (Cho 2006: two
 accelerometers and a yaw gyro) and ``drm2`` (Cho 2006: forward accelerometer, pitch and yaw gyros).
 The drawn values (turn-on biases, scale factors, misalignment and g-sensitivity matrices,
-temperature coefficients) are in ``drawn``. The ``ideal`` preset turns every error off: its rate
-output is the truth sampled at the IMU rate and its increment output the exact integral.
+temperature coefficients) are in ``drawn``; the true bias b0 + b_in + b_gm + b_rw + ramp + k_T dT
+(rad/s, m/s^2, white noise excluded) and diagonal scale-factor error s + s_T dT of every axis over
+time, at about ``TRUE_ERROR_RATE_HZ``, are in ``true_errors`` (written to truth_sensors.parquet;
+misalignment and g-sensitivity are constant and stay in ``drawn``). The ``ideal`` preset turns
+every error off: its rate output is the truth sampled at the IMU rate and its increment output the
+exact integral.
 
 Public names
 ------------
@@ -98,6 +102,7 @@ from simulator.schema import (
     Vector,
 )
 from simulator.sensors.base import (
+    TRUE_ERROR_RATE_HZ,
     grid_index,
     grid_rows,
     integrate_over_samples,
@@ -132,8 +137,8 @@ _LEVER_ARM_STEP_S = 1e-3  # central-difference step for the angular acceleration
 class AxisNumber(Field):
     """One number for all three axes, or a list of three (x, y, z), in ``unit``."""
 
-    def __init__(self, unit: str, default: Any = None, **limits: float):
-        super().__init__(default)
+    def __init__(self, unit: str, default: Any = None, doc: str = "", **limits: float):
+        super().__init__(default, doc)
         self.number = Number(unit, **limits)
         self.vector = Vector(3, self.number)
 
@@ -148,8 +153,8 @@ class DrawnOrFixed(Field):
     as ``{fixed: value}``, the true value itself (one number or three, any sign), for a paper's
     situation that fixes it (Cho & Choi 2006, eq. 36: scale factors 0.2, 0.1, -0.1)."""
 
-    def __init__(self, unit: str):
-        super().__init__(None)
+    def __init__(self, unit: str, doc: str = ""):
+        super().__init__(None, doc)
         self.sigma = AxisNumber(unit, min=0)
         self.fixed = Record({"fixed": AxisNumber(unit)})
 
@@ -170,24 +175,33 @@ def _constant(value: float | list[float] | dict | None, rng: np.random.Generator
 
 def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Field]:
     fields: dict[str, Field] = {
-        "bias": DrawnOrFixed(unit),
-        "bias_instability": AxisNumber(unit, min=0),
-        "bias_correlation_time": Number("s", None, gt=0),
-        "gauss_markov_sigma": AxisNumber(unit, min=0),
-        "gauss_markov_correlation_time": AxisNumber("s", min=0),
-        "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0),
-        "random_walk": AxisNumber(random_walk_unit, min=0),
-        "ramp": AxisNumber(f"{unit}/s", min=0),
-        "scale_factor": DrawnOrFixed(""),
-        "misalignment": AxisNumber("rad", min=0),
-        "range": AxisNumber(unit, gt=0),
-        "resolution": AxisNumber(unit, min=0),
-        "temperature_coefficient": AxisNumber(f"{unit}/K", min=0),
-        "scale_factor_temperature_coefficient": AxisNumber("1/K", min=0),
-        "bandwidth": AxisNumber("Hz", gt=0),
+        "bias": DrawnOrFixed(unit, doc="turn-on bias, 1-sigma, drawn once per run"),
+        "bias_instability": AxisNumber(unit, min=0, doc="bias instability B (Allan floor "
+                                                        "0.664 B), IEEE Std 952"),
+        "bias_correlation_time": Number("s", None, gt=0, doc="with it, the instability is a "
+                                        "Gauss-Markov bias; without, a flicker bias"),
+        "gauss_markov_sigma": AxisNumber(unit, min=0, doc="stationary std of an extra "
+                                                          "Gauss-Markov bias"),
+        "gauss_markov_correlation_time": AxisNumber("s", min=0,
+                                                    doc="its correlation time"),
+        "noise_density": AxisNumber(f"{unit}/sqrt(Hz)", min=0,
+                                    doc="white noise density (angle / velocity random walk)"),
+        "random_walk": AxisNumber(random_walk_unit, min=0, doc="bias random walk density"),
+        "ramp": AxisNumber(f"{unit}/s", min=0, doc="rate ramp, drawn sign"),
+        "scale_factor": DrawnOrFixed("", doc="scale-factor error, 1-sigma, drawn once"),
+        "misalignment": AxisNumber("rad", min=0, doc="axis misalignment / cross-coupling, "
+                                                     "1-sigma"),
+        "range": AxisNumber(unit, gt=0, doc="saturation limit"),
+        "resolution": AxisNumber(unit, min=0, doc="quantisation step"),
+        "temperature_coefficient": AxisNumber(f"{unit}/K", min=0,
+                                              doc="bias change per kelvin, 1-sigma"),
+        "scale_factor_temperature_coefficient": AxisNumber(
+            "1/K", min=0, doc="scale-factor change per kelvin, 1-sigma"),
+        "bandwidth": AxisNumber("Hz", gt=0, doc="first-order low-pass cut-off"),
     }
     if gyro:
-        fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0)
+        fields["g_sensitivity"] = Number("rad/s/(m/s^2)", None, min=0,
+                                         doc="gyro bias per specific force, 1-sigma")
     return fields
 
 
@@ -235,7 +249,8 @@ IMU_FIELD = Record(
         "preset": Text("ideal", doc="named parameter set; 'ideal' turns every error off"),
         "rate": Number("Hz", None, gt=0, max=10000, doc="sample rate (default: the preset's, "
                                                         "else 100 Hz)"),
-        "output": Text(None, choices=["rate", "increment"]),
+        "output": Text(None, choices=["rate", "increment"],
+                       doc="rates (rad/s, m/s^2) or increments over each sample (rad, m/s)"),
         "axes": Either(Text(choices=list(REDUCED_UNITS)),
                        ListOf(Text(choices=list(col.IMU_AXES)), min_len=1), default="full",
                        doc="channels of the unit, or a reduced unit: " + ", ".join(REDUCED_UNITS)),
@@ -274,7 +289,22 @@ class Imu:
         self.rate_hz = float(self.config["rate"])
         self.increment = self.config["output"] == "increment"
         self.drawn: dict = {"preset": self.config["preset"]}
+        # column (columns.SENSOR_ERRORS) -> (t, true value), filled by ``generate``
+        self.truth_keys: dict[str, float] = {}  # every key is a datasheet figure
+        self.true_errors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
         self._prepared: _Draws | None = None
+
+    def timing(self) -> dict[str, dict]:
+        """Rates are sampled at their stamp; increments cover (t - 1/rate, t], stamped at its
+        end (their mean is half a sample behind). A ``bandwidth`` low-pass delays the signal by
+        about 1/(2 pi bandwidth) at low frequencies (first-order filter)."""
+        bandwidth = [self.config[g]["bandwidth"] for g in ("gyro", "accel")]
+        delay = max((1.0 / (2 * np.pi * min(np.atleast_1d(b))) for b in bandwidth
+                     if b is not None), default=0.0)
+        if self.increment:
+            return {"imu": {"stamp": "the end of the integration interval (t - 1/rate, t]",
+                            "delay_s": 0.5 / self.rate_hz + delay}}
+        return {"imu": {"stamp": "the sampling instant", "delay_s": delay}}
 
     # -- the random part, drawn before the truth exists ---------------------------------------
     def prepare(self, duration_s: float, rng: np.random.Generator | None,
@@ -352,6 +382,13 @@ class Imu:
             additive += np.multiply.outer(t, ramp)
         if k_temp.any():
             additive += np.multiply.outer(d_temp, k_temp)
+        # the true bias and scale-factor error over time, before the white noise, at about
+        # TRUE_ERROR_RATE_HZ (every ``step``-th sample) for truth_sensors.parquet
+        step = max(1, round(self.rate_hz / TRUE_ERROR_RATE_HZ))
+        true_scale = np.broadcast_to(sf, (len(t[::step]), 3))
+        if k_sf_temp.any():
+            true_scale = true_scale + np.multiply.outer(d_temp[::step], k_sf_temp)
+        truth = {"t": t[::step], "bias": additive[::step].copy(), "scale_factor": true_scale}
         if self.increment:
             additive *= dt  # rate terms -> increment terms
         density = _per_axis(p["noise_density"])
@@ -359,7 +396,8 @@ class Imu:
             additive += white(n, dt, density, rng, increment=self.increment)
         return _GroupDraws(drawn, np.eye(3) + np.diag(sf) + mis,
                            d_temp[:, None] * k_sf_temp if k_sf_temp.any() else None,
-                           additive, g_matrix if g_matrix is not None and g_matrix.any() else None)
+                           additive, g_matrix if g_matrix is not None and g_matrix.any() else None,
+                           truth)
 
     # -- truth at the unit ------------------------------------------------------------------
     def _true_values(self, truth: Kinematics, t: np.ndarray,
@@ -428,6 +466,11 @@ class Imu:
             stepped *= q
             y = stepped if quantum.all() else np.where(quantum > 0, stepped, y)
         self.drawn[group] = draws.drawn
+        for i, axis in enumerate("xyz"):
+            if f"{group}_{axis}" in self.config["axes"]:
+                for kind in ("bias", "scale_factor"):
+                    self.true_errors[f"{group}_{kind}_{axis}"] = (draws.truth["t"],
+                                                                  draws.truth[kind][:, i])
         return y
 
     def generate(self, truth: Kinematics,
@@ -473,6 +516,7 @@ class _GroupDraws:
     sf_temperature: np.ndarray | None
     additive: np.ndarray
     g_matrix: np.ndarray | None
+    truth: dict[str, np.ndarray]  # t, bias (rate units) and scale_factor, decimated, (m, 3)
 
 
 @dataclass

@@ -38,7 +38,7 @@ Sources
   factor, which are left at zero (override them in the scenario).
 
   Largest misfit per axis (x, y, z), analytic fit over tau from 5 samples to 524 s (ADIS16448) or
-  1068 s (BMI160) / simulated curve against the real one in ``tests/test_imu_allan.py``
+  1068 s (BMI160) / simulated curve against the real one in ``tests/sensors/test_imu_allan.py``
   (one 40 min record, tau up to 40 s; ``--runslow``: four records of twice the longest real tau,
   tau up to a tenth of them); the presets are held to 25 %:
 

@@ -57,7 +57,7 @@ MAG_PRESETS: dict[str, dict] = {
 }
 
 _FIELDS = {
-    "rate": Number("Hz", None, gt=0, max=1000),
+    "rate": Number("Hz", None, gt=0, max=1000, doc="sample rate"),
     "noise": Number("T", None, min=0, doc="white noise per axis, 1-sigma"),
     "hard_iron": Number("T", None, min=0, doc="hard-iron offset per axis, 1-sigma"),
     "soft_iron": Number("", None, min=0, doc="soft-iron matrix elements, 1-sigma"),

@@ -49,7 +49,7 @@ ODOMETER_PRESETS: dict[str, dict] = {
 }
 
 _FIELDS = {
-    "rate": Number("Hz", None, gt=0, max=1000),
+    "rate": Number("Hz", None, gt=0, max=1000, doc="sample rate"),
     "scale_factor": Number("", None, gt=0, doc="measured / true distance at t = 0"),
     "scale_drift": Number("1/sqrt(s)", None, min=0,
                           doc="random-walk density of the scale factor"),
@@ -67,6 +67,17 @@ class Odometer(PresetSensor):
     """An odometer built from its resolved scenario block (``sensors.odometer``)."""
 
     name = "odometer"
+    truth_keys = {"scale_factor": 1.0}  # the true scale factor; a user assumes 1
+
+    def timing(self) -> dict[str, dict]:
+        """With ticks the speed is the count over the interval (t - 1/rate, t] divided by its
+        length: a mean, 0.5/rate behind its stamp, plus the latency."""
+        c = self.config
+        if c["ticks_per_meter"] > 0:
+            return {"odometer": {"stamp": "the end of the tick-counting interval; speed is the "
+                                          "mean over the interval",
+                                 "delay_s": c["latency"] + 0.5 / self.rate_hz}}
+        return {"odometer": {"stamp": "the sampling instant", "delay_s": c["latency"]}}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config
@@ -77,6 +88,7 @@ class Odometer(PresetSensor):
         scale = c["scale_factor"] + random_walk(len(t), dt, c["scale_drift"], rng)[:, 0]
         measured = np.cumsum(scale * np.diff(distance, prepend=distance[0]))
         self.drawn.update(scale_factor=float(scale[0]), scale_factor_end=float(scale[-1]))
+        self.true_errors["odometer_scale_factor"] = (t, scale)
         table = {"t": t}
         if c["ticks_per_meter"] > 0:
             phase = float(rng.uniform())

@@ -11,6 +11,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Any
 
+import numpy as np
+
 from simulator.schema import INVALID, Context, Field, Path, Record, Text
 
 
@@ -65,12 +67,23 @@ def preset_sensor_field(what: str, presets: dict[str, dict], fields: dict[str, F
 
 
 class PresetSensor:
-    """Base of the sensors built from a resolved preset block: keeps the block, the rate, and
-    the ``drawn`` record of the true error values (starting with the preset's name)."""
+    """Base of the sensors built from a resolved preset block: keeps the block, the rate, the
+    ``drawn`` record of the true error values (starting with the preset's name) and
+    ``true_errors``, the true values over time of the errors an estimator may estimate (column
+    of ``columns.SENSOR_ERRORS`` -> (t, values)), filled by ``generate``."""
 
     name = ""
+    # scenario keys that set a true value rather than a datasheet figure, with the nominal value
+    # a user would assume instead (the manifest's ``datasheet`` shows that one)
+    truth_keys: dict[str, float] = {}
 
     def __init__(self, config: dict):
         self.config = config
         self.rate_hz = float(config["rate"])
         self.drawn: dict = {"preset": config["preset"]}
+        self.true_errors: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+    def timing(self) -> dict[str, dict]:
+        """How each stream of the sensor is stamped (the manifest's ``timing``): stream ->
+        {stamp, delay_s (the effective delay of the value behind its stamp)}."""
+        return {self.name: {"stamp": "the sampling instant", "delay_s": 0.0}}

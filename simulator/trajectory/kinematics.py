@@ -451,7 +451,7 @@ class Kinematics:
         return {
             "t": k["t"],
             "lat": np.degrees(k["lat"]),
-            "lon": np.degrees(k["lon"]),
+            "lon": np.degrees(wrap_angle(k["lon"])),  # across the antimeridian too
             "alt": k["alt"],
             "vn": k["v_ned"][:, 0], "ve": k["v_ned"][:, 1], "vd": k["v_ned"][:, 2],
             "roll": wrap_angle(k["roll"]), "pitch": k["pitch"], "yaw": wrap_angle(k["yaw"]),

@@ -83,27 +83,51 @@ LIMITS_FIELD = Record(
     default={},
 )
 
-_speed = Number("m/s", None, min=0)
+_speed = Number("m/s", None, min=0, doc="speed through the segment (default: the current "
+                                        "speed; a different one is reached before it)")
 REVERSE_SPEED = 2.0  # default peak speed of a ``reverse``, m/s (a parking manoeuvre)
 SEGMENT_FIELD = OneKey(
     {
-        "stop": Record({"duration": Number("s", gt=0)}),
-        "accelerate": Record({"to_speed": Number("m/s", min=0),
-                              "accel": Number("m/s^2", gt=0)}),
-        "straight": Record({"length": Number("m", None, gt=0),
-                            "duration": Number("s", None, gt=0), "speed": _speed}),
-        "turn": Record({"angle": Number(angle=True), "radius": Number("m", gt=0),
+        "stop": Record({"duration": Number("s", gt=0, doc="time standing still (a stop "
+                                                         "reached while moving brakes first)")},
+                       doc="stand still"),
+        "accelerate": Record({"to_speed": Number("m/s", min=0, doc="speed at the end"),
+                              "accel": Number("m/s^2", gt=0, doc="peak acceleration "
+                                              "(jerk-limited by limits.jerk)")},
+                             doc="change speed along a straight road"),
+        "straight": Record({"length": Number("m", None, gt=0, doc="length (or give duration)"),
+                            "duration": Number("s", None, gt=0,
+                                               doc="time at the segment's speed (or give "
+                                                   "length)"),
+                            "speed": _speed}, doc="a straight level road"),
+        "turn": Record({"angle": Number(angle=True, doc="heading change, + to the right"),
+                        "radius": Number("m", gt=0, doc="radius of the circular arc between "
+                                                        "the transition curves"),
                         "speed": _speed, "bank": Number(default=0.0, angle=True,
-                                                        min=-45, max=45)}),
-        "slope": Record({"grade": Number(""), "length": Number("m", gt=0), "speed": _speed}),
-        "helix": Record({"turns": Number("", gt=0), "radius": Number("m", gt=0),
-                         "rise": Number("m"), "speed": _speed,
-                         "direction": Text("right", choices=["left", "right"]),
-                         "bank": Number(default=0.0, angle=True, min=-45, max=45)}),
-        "speed_bump": Record({"height": Number("m", gt=0, max=0.5),
-                              "length": Number("m", gt=0)}),
-        "lane_change": Record({"offset": Number("m"), "length": Number("m", gt=0),
-                               "speed": _speed}),
+                                                        min=-45, max=45,
+                                                        doc="road bank, + lowers the right "
+                                                            "side")},
+                       doc="a level turn entered and left through transition curves"),
+        "slope": Record({"grade": Number("", doc="rise over run, + climbs (at most "
+                                                 "limits.grade)"),
+                         "length": Number("m", gt=0, doc="length of the sloped road"),
+                         "speed": _speed},
+                        doc="climb or descend at a grade and return to level"),
+        "helix": Record({"turns": Number("", gt=0, doc="number of full turns"),
+                         "radius": Number("m", gt=0, doc="radius of the helix"),
+                         "rise": Number("m", doc="height change, + climbs (met exactly)"),
+                         "speed": _speed,
+                         "direction": Text("right", choices=["left", "right"],
+                                           doc="turning direction"),
+                         "bank": Number(default=0.0, angle=True, min=-45, max=45,
+                                        doc="road bank, + lowers the right side")},
+                        doc="a parking-ramp helix (grade from the rise over the turns)"),
+        "speed_bump": Record({"height": Number("m", gt=0, max=0.5, doc="bump height"),
+                              "length": Number("m", gt=0, doc="bump length along the road")},
+                             doc="a speed bump (a raised-cosine height profile)"),
+        "lane_change": Record({"offset": Number("m", doc="lateral offset, + to the right"),
+                               "length": Number("m", gt=0, doc="length of the manoeuvre"),
+                               "speed": _speed}, doc="move sideways by one lane"),
         "reverse": Record({"length": Number("m", gt=0, doc="distance backed up along the path"),
                            "angle": Number(default=0.0, angle=True,
                                            doc="steering direction and heading change: + "
@@ -114,7 +138,9 @@ SEGMENT_FIELD = OneKey(
                            "speed": Number("m/s", REVERSE_SPEED, gt=0,
                                            doc="peak reverse speed (magnitude)")}),
     },
-    shared={"zone": Text(None)},
+    shared={"zone": Text(None, doc="name of the zone the segment lies in (tunnel, garage, "
+                                   "parking, underground, underpass: no sky; others: "
+                                   "environment.zones)")},
     what="segment",
 )
 

@@ -95,60 +95,69 @@ def _maxima(protocol: dict, label: str, count: int) -> np.ndarray:
 
 def test_every_variant_is_a_working_filter(protocol):
     """All three variants stay bounded over the ten seeds (median window maxima measured: tight
-    8.9 / 7.8 / 28.0 / 11.5 m, loose 11.1 / 8.1 / 10.7 / 9.7 m, simplified 6.9 / 11.6 / 21.5 /
-    10.8 m at 3 / 2 / 1 / 0 satellites)."""
-    for label, bound in (("tight", 40.0), ("loose", 40.0), ("simplified", 60.0)):
+    3.5 / 3.9 / 4.6 / 7.3 m, loose 9.8 / 6.8 / 8.6 / 8.9 m, simplified 4.8 / 8.7 / 7.1 / 8.0 m
+    at 3 / 2 / 1 / 0 satellites)."""
+    for label in ("tight", "loose", "simplified"):
         for count in (3, 2, 1, 0):
-            assert np.median(_maxima(protocol, label, count)) < bound, (label, count)
+            assert np.median(_maxima(protocol, label, count)) < 20.0, (label, count)
 
 
-@pytest.mark.xfail(strict=True, reason="paper claim not reproduced (docs/reproduction_karamat"
-                   "2015.md): the means of the window maxima are 12.2, 11.2, 28.9, 11.9 m")
 def test_mean_window_maximum_under_12_m(protocol):
     """Karamat et al. section 4.3.1: 'on average, the maximum position error is always less
-    than 12 m, irrespective of the number of visible satellites'."""
+    than 12 m, irrespective of the number of visible satellites' (measured means: 3.0, 4.7,
+    9.8, 8.5 m at 3, 2, 1, 0 satellites)."""
     for count in (3, 2, 1, 0):
         assert _maxima(protocol, "tight", count).mean() < 12.0
 
 
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 13 of the 30 "
-                   "windows with 1-3 satellites (docs/reproduction_karamat2015.md)")
+@pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 23 of the 30 "
+                   "windows with 1-3 satellites, 77 % (docs/reproduction_karamat2015.md)")
 def test_tight_beats_loose_with_one_to_three_satellites(protocol):
     """Issue 15: the tight filter beats ``coupling: loose`` (which has no GNSS below four
-    satellites) in at least 80 % of the windows with 1-3 satellites, paired per seed."""
+    satellites) in at least 80 % of the windows with 1-3 satellites, paired per seed (measured:
+    8, 9 and 6 of 10 with 3, 2 and 1 satellites)."""
     wins = [(_maxima(protocol, "tight", c) < _maxima(protocol, "loose", c)) for c in (1, 2, 3)]
     assert np.concatenate(wins).mean() >= 0.8
 
 
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: the enhanced model gains 2 % with "
-                   "no satellite and loses 9 % over all windows (docs/reproduction_karamat2015.md)")
-def test_enhanced_model_gains_over_simplified(protocol):
-    """Karamat et al.: 16 % better than the earlier tightly coupled filter with no satellite
-    (section 4.3.1) and 40 % overall (section 5), here on the means of the window maxima (the
-    earlier model here is an EKF with the earlier states, the paper's comparison an LKF)."""
-    def gain(counts: tuple[int, ...]) -> float:
-        enhanced = np.mean([_maxima(protocol, "tight", c).mean() for c in counts])
-        simplified = np.mean([_maxima(protocol, "simplified", c).mean() for c in counts])
-        return 1.0 - enhanced / simplified
+def _gain(protocol: dict, counts: tuple[int, ...]) -> float:
+    """1 - enhanced / simplified, on the means of the window maxima over the seeds (the earlier
+    model here is an EKF with the earlier states, the paper's comparison an LKF)."""
+    enhanced = np.mean([_maxima(protocol, "tight", c).mean() for c in counts])
+    simplified = np.mean([_maxima(protocol, "simplified", c).mean() for c in counts])
+    return 1.0 - enhanced / simplified
 
-    assert gain((0,)) >= 0.16
-    assert gain((3, 2, 1, 0)) >= 0.40
+
+def test_enhanced_model_gains_16_percent_with_no_satellite(protocol):
+    """Karamat et al. section 4.3.1: 16 % better than the earlier tightly coupled filter in the
+    zero-satellite windows (measured: 20 %)."""
+    assert _gain(protocol, (0,)) >= 0.16
+
+
+@pytest.mark.xfail(strict=True, reason="claim not reproduced: the enhanced model gains 27 % over "
+                   "all windows (docs/reproduction_karamat2015.md)")
+def test_enhanced_model_gains_40_percent_overall(protocol):
+    """Karamat et al. section 5: 40 % better than the earlier tightly coupled filter in overall
+    maximum 2-D error (measured: 27 %; 40, 41, 20, 20 % at 3, 2, 1, 0 satellites)."""
+    assert _gain(protocol, (3, 2, 1, 0)) >= 0.40
 
 
 def test_gyro_bias_within_005_deg_s_by_300_s(protocol):
     """Karamat et al. section 4.3.3: the vertical-gyro bias converges in about 300 s (measured:
-    the error at 300 s is at most 0.036 deg/s over the ten seeds)."""
+    the error at 300 s is at most 0.037 deg/s over the ten seeds)."""
     errors = np.array([protocol[s]["tight"]["bias_error_300s"] for s in SEEDS])
     assert np.all(np.abs(errors) < 0.05)
 
 
 @pytest.mark.slow
 def test_full_drive_all_sites(tmp_path):
-    """The whole shipped scenario (nine sites, 36 windows, 1 h 53 min), seed 2015: the same
-    working-filter bounds and gyro-bias convergence as on site 1."""
+    """The whole shipped scenario (nine sites, 36 windows, 1 h 53 min), seed 2015: every variant
+    bounded and the gyro bias converged. Measured median window maxima at 3 / 2 / 1 / 0
+    satellites: tight 3.7 / 5.0 / 22.1 / 12.0 m, loose 21.9 / 20.2 / 15.9 / 21.8 m, simplified
+    5.1 / 9.2 / 24.9 / 13.8 m (sites 2-9 are harder to dead-reckon than site 1)."""
     data = short_scenario(2015, loops=13, site_s=None, end_s=1e9)
     result = run_protocol_dataset(generate(tmp_path / "full", data))
-    for label, bound in (("tight", 40.0), ("loose", 40.0), ("simplified", 60.0)):
+    for label in ("tight", "loose", "simplified"):
         for count in (3, 2, 1, 0):
-            assert np.median(result[label]["max"][count]) < bound, (label, count)
+            assert np.median(result[label]["max"][count]) < 40.0, (label, count)
     assert abs(result["tight"]["bias_error_300s"]) < 0.05

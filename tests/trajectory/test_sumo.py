@@ -23,9 +23,9 @@ from simulator.tables import as_frame
 from simulator.trajectory.sumo import place_drive, run_sumo
 from simulator.trajectory.sumo_network import prepare_network
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 NETWORKS = REPO / "scenarios" / "networks"
-ESMINI = Path(__file__).resolve().parents[2] / "shared" / "refdata" / "roads" / "esmini"
+ESMINI = Path(__file__).resolve().parents[3] / "shared" / "refdata" / "roads" / "esmini"
 START = {"utc": "2024-05-01T08:00:00Z", "lat": 46.9480, "lon": 7.4474, "alt": 540.0}
 
 

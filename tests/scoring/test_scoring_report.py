@@ -39,7 +39,8 @@ def test_report_has_every_plot_and_every_number(evaluation, tmp_path):
     path = write_report(tmp_path, evaluation, "quickstart")
     text = path.read_text()
     pngs = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
-    assert pngs == ["attitude_error.png", "horizontal_cdf.png", "horizontal_error.png", "map.png"]
+    assert pngs == ["altitude.png", "attitude_errors.png", "horizontal_cdf.png", "map.png",
+                    "map_windows.png", "nees.png", "position_errors.png"]
     assert sorted(re.findall(r"\]\(plots/([\w.]+)\)", text)) == pngs
     for png in pngs:
         assert (tmp_path / "plots" / png).read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

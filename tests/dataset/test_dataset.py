@@ -24,7 +24,7 @@ from simulator.errors import InputError
 from simulator.scenario import validate_data
 from simulator.tables import as_frame
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 QUICK = REPO / "scenarios" / "quickstart.yaml"
 
 
@@ -46,7 +46,7 @@ def test_layout_and_manifest(dataset):
     assert m["gps_time_start"] == {"week": 2312, "tow": pytest.approx(3 * 86400 + 3 * 3600 + 18)}
     assert m["origin"] == {"lat": 37.5665, "lon": 126.978, "alt": 40.0}
     assert set(m["streams"]) == {"truth", "imu", "odometer", "baro", "gnss_fix", "gnss_raw",
-                                 "gnss_nav", "truth_gnss", "events"}
+                                 "gnss_nav", "truth_gnss", "truth_sensors", "events"}
     assert m["streams"]["imu"]["rate_hz"] == pytest.approx(100.0)
     assert m["sensors"]["imu"]["preset"] == "bosch-smi130"
     truth = ds.read("truth")
@@ -59,7 +59,9 @@ def test_units_in_field_metadata(dataset):
     schema = pq.read_schema(dataset / "truth.parquet")
     units = {f.name: f.metadata[b"unit"].decode() for f in schema}
     assert units == col.TRUTH
-    assert open_dataset(dataset).units("imu")["gyro_x"] == "rad/s"
+    # the dataset's IMU writes increments: angle and velocity changes over each interval
+    assert open_dataset(dataset).units("imu")["gyro_x"] == "rad"
+    assert open_dataset(dataset).units("imu")["accel_x"] == "m/s"
 
 
 def test_same_seed_gives_identical_files(dataset, tmp_path):
@@ -68,7 +70,7 @@ def test_same_seed_gives_identical_files(dataset, tmp_path):
                  "--set", "sensors.imu.output=increment"]) == 0
     for name in ("truth.parquet", "imu.parquet", "odometer.parquet", "baro.parquet",
                  "gnss_fix.parquet", "gnss_raw.parquet", "truth_gnss.parquet", "events.parquet",
-                 "manifest.json"):
+                 "truth_sensors.parquet", "manifest.json"):
         assert (again / name).read_bytes() == (dataset / name).read_bytes(), name
 
 
@@ -144,7 +146,8 @@ def test_generate_without_gnss_and_faults_does_not_import_pandas(tmp_path):
                             cwd=REPO, env={**os.environ, "PYTHONPATH": str(REPO)}, check=True)
     assert result.stdout.splitlines()[-1] == "[]"
     ds = open_dataset(out)
-    assert set(ds.stream_names) == {"truth", "imu", "odometer", "baro", "mag", "events"}
+    assert set(ds.stream_names) == {"truth", "imu", "odometer", "baro", "mag", "events",
+                                    "truth_sensors"}
     assert list(ds.read("truth").columns) == list(col.TRUTH)
     assert set(ds.read("truth")["zone"]) == {"", "tunnel"}
     assert ds.read("odometer")["ticks"].dtype == np.int64

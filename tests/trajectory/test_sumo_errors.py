@@ -11,7 +11,7 @@ import yaml
 from simulator.cli import main
 from simulator.trajectory import sumo as sumo_source
 
-NETWORKS = Path(__file__).resolve().parents[1] / "scenarios" / "networks"
+NETWORKS = Path(__file__).resolve().parents[2] / "scenarios" / "networks"
 HILLS = {"nodes": str(NETWORKS / "hills.nod.xml"), "edges": str(NETWORKS / "hills.edg.xml")}
 
 

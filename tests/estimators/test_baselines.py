@@ -4,6 +4,7 @@ fixes it was handed."""
 from __future__ import annotations
 
 import numpy as np
+import pymap3d
 import pytest
 
 from simulator.dataset.io import open_dataset
@@ -84,19 +85,39 @@ def test_dead_reckoning_starts_from_the_perturbed_state(tmp_path):
     assert np.abs(error - 5.0).max() < 0.005
 
 
-def test_gnss_only_reproduces_the_fixes(tmp_path):
+def test_gnss_only_extrapolates_each_fix_with_its_velocity(tmp_path):
     ds = open_dataset(write_synthetic(tmp_path / "ds", streams=("gnss_fix",), gnss_sigma=3.0))
     fixes = ds.read("gnss_fix")
     fixes_t = fixes["t"].to_numpy()
     solution, _ = run_estimator(ds, "gnss_only", show_progress=False)
     assert np.allclose(np.diff(solution["t"])[:-1], 0.1)  # 10 Hz from 1 Hz fixes
-    # each row holds the latest fix at or before its time
-    latest = np.searchsorted(fixes_t, solution["t"].to_numpy() + 1e-9, side="right") - 1
-    for c in ("lat", "lon", "alt", "vn", "ve", "vd"):
-        np.testing.assert_array_equal(solution[c].to_numpy(), fixes[c].to_numpy()[latest])
-    moving = fixes["speed"].to_numpy()[latest] >= 1.0
-    np.testing.assert_allclose(solution["yaw"].to_numpy()[moving],
-                               fixes["course"].to_numpy()[latest][moving], atol=1e-12)
+    # each row is the latest fix at or before its time moved by its velocity (pymap3d's exact
+    # NED -> geodetic conversion as the independent reference)
+    t = solution["t"].to_numpy()
+    latest = np.searchsorted(fixes_t, t + 1e-9, side="right") - 1
+    f = fixes.iloc[latest]
+    dt = t - f["t"].to_numpy()
+    lat, lon, alt = pymap3d.ned2geodetic(f["vn"] * dt, f["ve"] * dt, f["vd"] * dt, f["lat"],
+                                         f["lon"], f["alt"])
+    assert dt.max() > 0.85 and np.abs(f["ve"]).max() > 5.0
+    ned = pymap3d.geodetic2ned(solution["lat"], solution["lon"], solution["alt"], lat, lon, alt)
+    assert np.abs(np.stack(ned)).max() < 1e-4
+    for c in ("vn", "ve", "vd"):
+        np.testing.assert_array_equal(solution[c].to_numpy(), f[c].to_numpy())
+    assert solution[["roll", "pitch", "yaw"]].isna().all().all()  # it knows no attitude
+
+
+def test_gnss_only_stops_reporting_after_max_extrapolation(tmp_path):
+    ds = open_dataset(write_synthetic(tmp_path / "ds", streams=("gnss_fix",), gnss_sigma=3.0))
+    fixes = ds.read("gnss_fix")
+    fixes.loc[(fixes["t"] >= 10.0) & (fixes["t"] < 20.0), ["fix", "lat"]] = [0, np.nan]
+    fixes.to_parquet(ds.path / ds.manifest["streams"]["gnss_fix"]["file"])
+    entry = {"name": "gnss_only", "config": {"max_extrapolation": 1.5}}
+    solution, _ = run_estimator(ds, entry, show_progress=False)
+    t = solution["t"].to_numpy()
+    # the last fix before the gap is at 9 s: rows up to 10.5 s, none again until 20 s
+    assert not ((t > 10.5 + 1e-9) & (t < 20.0)).any()
+    assert np.isclose(t, 10.5).any() and np.isclose(t, 20.0).any()
 
 
 def test_dead_reckoning_learns_the_gyro_bias_at_standstill(tmp_path):

@@ -99,7 +99,8 @@ def test_local_campaign_rows_seeds_and_summary(local):
     units = {f.name: f.metadata[b"unit"].decode()
              for f in pq.read_schema(out / "runs.parquet")}
     assert (units["horizontal.rms"], units["attitude.yaw_rms"], units["velocity.rms"],
-            units["runtime.seconds"], units["outages.count"]) == ("m", "deg", "m/s", "s", "")
+            units["runtime.seconds"], units["coverage.longest_gap"]
+            ) == ("m", "deg", "m/s", "s", "s")
     report = (out / "report.md").read_text()
     assert "| hold |" in report and "| shifted |" in report and "No run failed." in report
     assert (out / "plots" / "horizontal_rms.png").stat().st_size > 1000
@@ -116,7 +117,9 @@ def test_campaign_scores_equal_those_of_landnav_run(local, tmp_path):
         for group in ("horizontal", "vertical", "velocity", "attitude"):
             for key, value in expected[group].items():
                 assert row[f"{group}.{key}"] == pytest.approx(value, rel=1e-12, abs=1e-12)
-        assert row["outages.count"] == len(expected["outages"]) == 0
+        # neither estimator uses GNSS: no outage scores, full coverage
+        assert expected["outages"] is None and "outages.count" not in row
+        assert row["coverage.fraction"] == expected["coverage"]["fraction"] == 1.0
         assert row["runtime.seconds"] > 0
     assert runs.loc[runs["label"] == "shifted", "horizontal.rms"].iloc[0] != pytest.approx(
         runs.loc[runs["label"] == "hold", "horizontal.rms"].iloc[0])

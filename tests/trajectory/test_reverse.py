@@ -69,7 +69,7 @@ def _ned(truth, t: np.ndarray, t0: float) -> np.ndarray:
 
 
 def test_strapdown_closure_with_reversing(truth):
-    """The same bounds as the forward ten-minute drive (tests/test_kinematics.py): an
+    """The same bounds as the forward ten-minute drive (tests/trajectory/test_kinematics.py): an
     independent NED strapdown of the ideal IMU closes on the truth through four reverses."""
     imu = Imu(resolve_block("imu", IDEAL_IMU))
     err = _closure(truth, as_frame(imu.generate(truth, None)["imu"]), increments=True)

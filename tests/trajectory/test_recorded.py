@@ -17,7 +17,7 @@ from simulator.cli import main
 from simulator.dataset.generate import build_truth
 from simulator.scenario import load_scenario
 
-TURIN = (Path(__file__).resolve().parents[2] / "shared" / "refdata" / "vehicle"
+TURIN = (Path(__file__).resolve().parents[3] / "shared" / "refdata" / "vehicle"
          / "navego_ekinox_turin" / "ref.mat")
 
 

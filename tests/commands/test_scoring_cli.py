@@ -117,7 +117,7 @@ def test_score_report_is_written_atomically(dataset, shifted, tmp_path, capsys):
     assert main(args) == 0
     text = (report / "report.md").read_text()
     assert "shifted" in text and "5.000" in text and "20.000" in text
-    for png in ("map", "horizontal_error", "attitude_error", "horizontal_cdf"):
+    for png in ("map", "position_errors", "attitude_errors", "horizontal_cdf"):
         assert f"(plots/{png}.png)" in text and (report / "plots" / f"{png}.png").is_file()
     assert main(args) == 2  # exists: kept unless --force
     assert "--force" in capsys.readouterr().err
@@ -191,6 +191,8 @@ def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
                  str(out / "solutions" / "hold.parquet"), "--json", str(tmp_path / "s.json")]) == 0
     again = _strict_json(tmp_path / "s.json")["hold"]
     scores["hold"].pop("runtime")
+    # the estimator used no GNSS: no outage scores, in the run and from the file it wrote
+    assert scores["hold"]["outages"] is None and scores["hold"]["degraded"] is None
     assert again == scores["hold"]
 
 

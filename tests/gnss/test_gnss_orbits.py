@@ -17,7 +17,7 @@ from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, 
 from simulator.gnss.navfiles import read_navigation, read_rinex_nav, read_yuma
 from simulator.timebase import GPS_EPOCH
 
-SHARED = Path(__file__).resolve().parents[2] / "shared"
+SHARED = Path(__file__).resolve().parents[3] / "shared"
 REF = SHARED / "refdata"
 
 

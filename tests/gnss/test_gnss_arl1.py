@@ -25,7 +25,7 @@ from simulator.gnss.navfiles import read_rinex_nav
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
 from simulator.timebase import gps_to_utc
 
-FOLDER = Path(__file__).resolve().parents[2] / "shared" / "refdata" / "gnss" / \
+FOLDER = Path(__file__).resolve().parents[3] / "shared" / "refdata" / "gnss" / \
     "arl1_2015-07-19_gnsstk"
 ARL1_XYZ = np.array([-740289.9180, -5457071.7340, 3207245.5420])  # RINEX APPROX POSITION
 WEEK = 1854  # 2015-07-19 00:00 GPST = week 1854, TOW 0

@@ -15,8 +15,8 @@ from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
 from simulator.replay import read_solution
 from simulator.scenario import load_scenario
+from tests.estimators.test_baselines import horizontal_error
 from tests.synthetic import write_synthetic
-from tests.test_baselines import horizontal_error
 
 PLUGIN = "examples.my_estimator:MyEstimator"
 
@@ -126,14 +126,14 @@ def test_scenario_validation_checks_estimator_names(tmp_path):
         estimators:
           - dead_reckoning
           - kalmann
-          - {name: gnss_only, label: g, config: {min_course_speed: fast}}
+          - {name: gnss_only, label: g, config: {max_extrapolation: fast}}
           - {name: "no_such_module:Filter", label: x}
         """))
     with pytest.raises(InputError) as info:
         load_scenario(scenario)
     text = str(info.value)
     assert "s.yaml:5: estimators.1: unknown estimator 'kalmann'" in text
-    assert "estimators.2.config: config key 'min_course_speed'" in text
+    assert "estimators.2.config: config key 'max_extrapolation'" in text
     assert ("estimators.3.name: estimator 'no_such_module:Filter': cannot import module "
             "'no_such_module': ModuleNotFoundError") in text
     assert "dead_reckoning" not in text.split("known:")[0]

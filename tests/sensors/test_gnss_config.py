@@ -15,7 +15,7 @@ from simulator.schema import Context
 from simulator.sensors import SENSOR_FIELDS, SENSOR_MODELS
 from simulator.sensors.gnss import GNSS_FIELD, PRESETS, Gnss
 
-ALMANAC = Path(__file__).resolve().parents[2] / "shared" / "refdata" / "almanac" / \
+ALMANAC = Path(__file__).resolve().parents[3] / "shared" / "refdata" / "almanac" / \
     "maast_2020-01-01" / "almyuma_01jan2020.txt"
 
 

@@ -1,0 +1,314 @@
+"""The plots of the scoring report (matplotlib's Agg canvas, no display), one function per PNG.
+
+Every time plot shades the GNSS outages (red) and the degraded windows (orange: satellite
+limits, multipath, canyon zones) of the events table.
+
+* ``map``: the truth and every solution on a local map (east, north in m about the first truth
+  point), the outages drawn over the truth;
+* ``map_windows``: one panel per outage or degraded window (at most ``MAX_WINDOW_PANELS``, the
+  longest): the truth during the window and 10 s either side, or, where that path is over
+  ``ZOOM_RATIO`` times the largest error in the window, a zoom on the window's end, so that
+  metre errors show;
+* ``position_errors``: north, east and down errors against time, with the solution's +-3 sigma
+  (``std_n, std_e, std_d``) as a band where it has them;
+* ``attitude_errors``: roll, pitch and yaw errors (deg), +-3 sigma where ``std_roll...`` exist;
+* ``nees``: the per-epoch normalised estimation error squared of position (and of velocity and
+  attitude where the solution has their sigmas), log scale, with the two-sided 95 % bounds of
+  the chi-square distribution with 3 degrees of freedom (0.216, 9.35) that a consistent
+  estimator's NEES stays within 95 % of the time (Bar-Shalom, Li, Kirubarajan 2001, section
+  5.4.2);
+* ``altitude``: the altitude of the truth and of every solution against time (a parking helix
+  shows as its staircase of floors);
+* ``horizontal_cdf``: the empirical CDF of the horizontal error, logarithmic error axis;
+* ``gnss_sky`` (datasets with raw GNSS): a sky plot of the tracked satellites' tracks, and the
+  number of satellites, HDOP/VDOP and C/N0 against time, every other fault hatched grey.
+
+Public names
+------------
+MAX_WINDOW_PANELS, shaded_windows, has_std, and one ``plot_<name>(ev, path)`` per PNG.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from scipy.stats import chi2
+
+from simulator.scoring.align import ERR_ATT, ERR_H, ERR_POS, ERR_VEL, local_ned
+from simulator.scoring.evaluate import Evaluation
+from simulator.scoring.metrics import DEGRADED_KINDS, NEES_DOF, OUTAGE_KIND, degraded_windows
+
+MAX_WINDOW_PANELS = 6  # zoomed map panels, the longest windows first
+NEES_FLOOR = 1e-2  # lower end of the NEES plot's axis
+# a window's panel shows its whole path unless that is over ZOOM_RATIO times the largest error
+# in it; then it zooms on the window's end (+-3 times that error, at least 10 m)
+ZOOM_RATIO = 20.0
+_OUTAGE_COLOUR, _DEGRADED_COLOUR = "tab:red", "tab:orange"
+_DPI = 110
+_NEES_BOUNDS = chi2.ppf([0.025, 0.975], NEES_DOF)  # two-sided 95 % bounds of one epoch's NEES
+_STD_POS, _STD_VEL, _STD_ATT = ("std_n", "std_e", "std_d"), ("std_vn", "std_ve", "std_vd"), \
+    ("std_roll", "std_pitch", "std_yaw")
+
+
+def _gaps(t: np.ndarray, *values: np.ndarray) -> list[np.ndarray]:
+    """``t`` and ``values`` with a NaN inserted wherever the rows are more than three output
+    periods (median spacing) apart, so a line is not drawn across a stretch without rows."""
+    t = np.asarray(t, dtype=float)
+    out = [t, *(np.asarray(v, dtype=float) for v in values)]
+    if t.size < 3:
+        return out
+    step = np.diff(t)
+    breaks = np.flatnonzero(step > 3.0 * np.median(step)) + 1
+    return [np.insert(x, breaks, np.nan, axis=0) for x in out]
+
+
+def shaded_windows(ev: Evaluation) -> list[tuple[float, float, str]]:
+    """(start, end, label) of every outage and degraded window, label ``GNSS outage`` or the
+    degraded window's kind."""
+    out = ev.events.loc[ev.events["kind"] == OUTAGE_KIND]
+    windows = [(a, b, "GNSS outage") for a, b in zip(out["t_start"], out["t_end"], strict=True)]
+    deg = degraded_windows(ev.events, ev.canyon_zones)
+    windows += list(zip(deg["t_start"], deg["t_end"], deg["label"], strict=True))
+    return [(float(a), float(b), str(k)) for a, b, k in windows]
+
+
+def _shade(ax: Axes, ev: Evaluation, other_faults: bool = False) -> None:
+    """Shade the outages and degraded windows; with ``other_faults`` also every other fault
+    of the events table (grey, hatched), e.g. a fix jump or latency on a GNSS panel."""
+    seen: set[str] = set()
+    for a, b, kind in shaded_windows(ev):
+        colour = _OUTAGE_COLOUR if kind == "GNSS outage" else _DEGRADED_COLOUR
+        ax.axvspan(a, b, color=colour, alpha=0.15, lw=0, label=None if kind in seen else kind)
+        seen.add(kind)
+    if other_faults:
+        shown = {OUTAGE_KIND, "zone", *DEGRADED_KINDS}
+        rest = ev.events.loc[~ev.events["kind"].isin(shown)]
+        for a, b, kind in zip(rest["t_start"], rest["t_end"], rest["kind"], strict=True):
+            ax.axvspan(a, b, facecolor="none", edgecolor="grey", hatch="//", lw=0,
+                       label=None if kind in seen else kind)
+            seen.add(kind)
+
+
+def _save(fig: Figure, path: Path) -> None:
+    fig.savefig(path, dpi=_DPI)
+
+
+def _origin(ev: Evaluation) -> tuple[float, float, float]:
+    return tuple(float(x) for x in ev.truth[["lat", "lon", "alt"]].iloc[0])
+
+
+def plot_map(ev: Evaluation, path: Path) -> None:
+    truth = ev.truth
+    origin = _origin(ev)
+    ned = local_ned(truth, origin)
+    fig = Figure(figsize=(7, 6), layout="constrained")
+    ax = fig.add_subplot()
+    ax.plot(ned[:, 1], ned[:, 0], color="black", lw=2.0, label="truth")
+    t = truth["t"].to_numpy()
+    for i, (a, b, kind) in enumerate(w for w in shaded_windows(ev) if w[2] == "GNSS outage"):
+        inside = (t >= a) & (t <= b)
+        ax.plot(ned[inside, 1], ned[inside, 0], color=_OUTAGE_COLOUR, lw=5.0, alpha=0.5,
+                label=kind if i == 0 else None)
+    for label, r in ev.results.items():
+        _, sol = _gaps(r.solution["t"], local_ned(r.solution, origin))
+        ax.plot(sol[:, 1], sol[:, 0], lw=1.0, label=label)
+    ax.set(xlabel="east (m)", ylabel="north (m)", title="trajectories on a local map")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(loc="best", fontsize="small")
+    _save(fig, path)
+
+
+def plot_map_windows(ev: Evaluation, path: Path) -> None:
+    windows = sorted(shaded_windows(ev), key=lambda w: w[0] - w[1])[:MAX_WINDOW_PANELS]
+    windows.sort()
+    n = len(windows)
+    cols = min(n, 3)
+    rows = math.ceil(n / cols)
+    fig = Figure(figsize=(4.2 * cols, 4.0 * rows), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(rows, cols, squeeze=False)).ravel()
+    origin = _origin(ev)
+    truth_t = ev.truth["t"].to_numpy()
+    truth_ned = local_ned(ev.truth, origin)
+    for ax, (a, b, kind) in zip(axes, windows, strict=False):
+        span = (truth_t >= a - 10.0) & (truth_t <= b + 10.0)
+        inside = (truth_t >= a) & (truth_t <= b)
+        ax.plot(truth_ned[span, 1], truth_ned[span, 0], color="black", lw=2.0, label="truth")
+        colour = _OUTAGE_COLOUR if kind == "GNSS outage" else _DEGRADED_COLOUR
+        ax.plot(truth_ned[inside, 1], truth_ned[inside, 0], color=colour, lw=5.0, alpha=0.4,
+                label=kind)
+        for label, r in ev.results.items():
+            st = r.solution["t"].to_numpy()
+            rows_in = (st >= a - 10.0) & (st <= b + 10.0)
+            if rows_in.any():
+                _, sol = _gaps(st[rows_in], local_ned(r.solution.loc[rows_in], origin))
+                ax.plot(sol[:, 1], sol[:, 0], lw=1.0, marker=".", ms=2, label=label)
+        east, north = truth_ned[span, 1], truth_ned[span, 0]
+        extent = max(np.ptp(east), np.ptp(north))
+        worst = _worst_error(ev, a, b)
+        title = f"{kind} {a:.0f}-{b:.0f} s"
+        if extent > ZOOM_RATIO * max(worst, 1.0):  # the errors would not show: zoom on the end
+            half = max(10.0, 3.0 * worst)
+            centre = [np.interp(b, truth_t, truth_ned[:, i]) for i in (1, 0)]
+            ax.set_xlim(centre[0] - half, centre[0] + half)
+            ax.set_ylim(centre[1] - half, centre[1] + half)
+            title += ", its end"
+        else:  # a square around the window's path
+            half = 0.5 * extent + 10.0 + 0.1 * extent
+            mid_e, mid_n = 0.5 * (east.min() + east.max()), 0.5 * (north.min() + north.max())
+            ax.set_xlim(mid_e - half, mid_e + half)
+            ax.set_ylim(mid_n - half, mid_n + half)
+        ax.set_aspect("equal", adjustable="box")
+        ax.set(xlabel="east (m)", ylabel="north (m)", title=title)
+        ax.legend(loc="best", fontsize="x-small")
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    _save(fig, path)
+
+
+def _worst_error(ev: Evaluation, a: float, b: float) -> float:
+    """The largest horizontal error of any solution in [a, b) (0 without rows)."""
+    worst = 0.0
+    for r in ev.results.values():
+        e = r.errors.errors
+        h = e[ERR_H].to_numpy(float)[(e["t"] >= a) & (e["t"] < b)]
+        h = h[np.isfinite(h)]
+        if h.size:
+            worst = max(worst, float(h.max()))
+    return worst
+
+
+def _error_panels(ev: Evaluation, path: Path, names: tuple[str, ...], stds: tuple[str, ...],
+                  titles: tuple[str, ...], scale: float, unit: str, heading: str) -> None:
+    fig = Figure(figsize=(9, 7.5), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
+    colours = {label: f"C{i}" for i, label in enumerate(ev.results)}
+    for ax, name, std, title in zip(axes, names, stds, titles, strict=True):
+        _shade(ax, ev)
+        for label, r in ev.results.items():
+            e = r.errors.errors
+            sigma = e[std].to_numpy(float) if std in e else np.full(len(e), np.nan)
+            t, value, sigma = _gaps(e["t"], scale * e[name].to_numpy(float), sigma)
+            if not np.isfinite(value).any():
+                continue
+            ax.plot(t, value, lw=1.0, color=colours[label], label=label)
+            if np.isfinite(sigma).any():
+                bound = 3.0 * scale * sigma
+                ax.fill_between(t, -bound, bound, color=colours[label], alpha=0.15, lw=0,
+                                label=f"{label} ±3σ")
+        ax.set(ylabel=f"{title} ({unit})")
+        ax.grid(alpha=0.3)
+    axes[0].set_title(heading)
+    if axes[0].get_legend_handles_labels()[0]:  # nothing to list when no solution has the axis
+        axes[0].legend(loc="upper left", fontsize="x-small", ncol=3)
+    axes[-1].set_xlabel("t (s)")
+    _save(fig, path)
+
+
+def plot_position_errors(ev: Evaluation, path: Path) -> None:
+    _error_panels(ev, path, ERR_POS, _STD_POS, ("north error", "east error", "down error"), 1.0,
+                  "m", "position errors (solution - truth), ±3σ of the solution where given")
+
+
+def plot_attitude_errors(ev: Evaluation, path: Path) -> None:
+    _error_panels(ev, path, ERR_ATT, _STD_ATT, ("roll error", "pitch error", "yaw error"),
+                  180.0 / math.pi, "deg", "attitude errors (solution - truth), ±3σ where given")
+
+
+def has_std(ev: Evaluation) -> bool:
+    """Whether any solution has the three position standard deviations (a NEES plot)."""
+    return any(set(_STD_POS) <= set(r.errors.errors.columns) for r in ev.results.values())
+
+
+def plot_nees(ev: Evaluation, path: Path) -> None:
+    fig = Figure(figsize=(10, 4.5), layout="constrained")
+    ax = fig.add_subplot()
+    _shade(ax, ev)
+    for label, r in ev.results.items():
+        e = r.errors.errors
+        for group, errs, stds in (("position", ERR_POS, _STD_POS), ("velocity", ERR_VEL, _STD_VEL),
+                                  ("attitude", ERR_ATT, _STD_ATT)):
+            if not set(stds) <= set(e.columns):
+                continue
+            nees = np.sum((e[list(errs)].to_numpy(float) / e[list(stds)].to_numpy(float)) ** 2,
+                          axis=1)
+            ax.plot(*_gaps(e["t"], nees), lw=0.8, label=f"{label} {group}")
+    for bound in _NEES_BOUNDS:
+        ax.axhline(bound, color="black", ls="--", lw=1.0)
+    ax.set_yscale("log")
+    # an estimator started from the truth has NEES near 0 at first: the axis starts at 1e-2
+    ax.set_ylim(bottom=NEES_FLOOR)
+    ax.set(xlabel="t (s)", ylabel="NEES",
+           title=f"NEES per epoch; dashed: 95 % chi-square bounds, {NEES_DOF} dof "
+                 f"({_NEES_BOUNDS[0]:.3g}, {_NEES_BOUNDS[1]:.3g})")
+    fig.legend(loc="outside right upper", fontsize="x-small")
+    _save(fig, path)
+
+
+def plot_altitude(ev: Evaluation, path: Path) -> None:
+    fig = Figure(figsize=(9, 4), layout="constrained")
+    ax = fig.add_subplot()
+    _shade(ax, ev)
+    ax.plot(ev.truth["t"], ev.truth["alt"], color="black", lw=2.0, label="truth")
+    for label, r in ev.results.items():
+        ax.plot(*_gaps(r.solution["t"], r.solution["alt"]), lw=1.0, label=label)
+    ax.set(xlabel="t (s)", ylabel="altitude (m, ellipsoidal)", title="altitude")
+    ax.grid(alpha=0.3)
+    ax.legend(loc="best", fontsize="small")
+    _save(fig, path)
+
+
+def plot_horizontal_cdf(ev: Evaluation, path: Path) -> None:
+    fig = Figure(figsize=(6.5, 4), layout="constrained")
+    ax = fig.add_subplot()
+    for label, r in ev.results.items():
+        h = np.sort(r.errors.errors[ERR_H].to_numpy(float))
+        h = h[np.isfinite(h) & (h > 0)]
+        ax.step(h, np.arange(1, h.size + 1) / max(h.size, 1), where="post", label=label)
+    ax.set_xscale("log")
+    ax.set(xlabel="horizontal error (m, log scale)", ylabel="fraction of epochs",
+           ylim=(0, 1.02), title="CDF of horizontal error")
+    ax.grid(alpha=0.3, which="both")
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="lower right", fontsize="small")
+    _save(fig, path)
+
+
+def plot_gnss_sky(ev: Evaluation, path: Path, raw: pd.DataFrame,
+                  fix: pd.DataFrame | None) -> None:
+    fig = Figure(figsize=(11, 7.5), layout="constrained")
+    grid = fig.add_gridspec(3, 2, width_ratios=(1, 1.6))
+    sky = fig.add_subplot(grid[:, 0], projection="polar")
+    sky.set_theta_zero_location("N")
+    sky.set_theta_direction(-1)
+    for sv, track in raw.groupby("sv"):
+        sky.plot(track["azimuth"], 90.0 - np.degrees(track["elevation"]), ".", ms=1.5)
+        last = track.iloc[-1]
+        sky.annotate(f"G{int(sv):02d}", (last["azimuth"], 90.0 - math.degrees(last["elevation"])),
+                     fontsize="x-small")
+    sky.set_rlim(0, 90)
+    sky.set_yticks([0, 30, 60, 90], labels=["90", "60", "30", "0"])
+    sky.set_title("sky plot of tracked satellites (elevation deg)")
+    count, dop, cn0 = (fig.add_subplot(grid[i, 1]) for i in range(3))
+    per_epoch = raw.groupby("t")["sv"].count()
+    epochs = fix["t"] if fix is not None else per_epoch.index
+    tracked = per_epoch.reindex(epochs, fill_value=0)
+    count.step(tracked.index, tracked.to_numpy(), where="post", label="tracked")
+    if fix is not None:
+        count.step(fix["t"], fix["num_sats"], where="post", label="used in the fix")
+        dop.plot(fix["t"], fix["hdop"], lw=1.0, label="HDOP")
+        dop.plot(fix["t"], fix["vdop"], lw=1.0, label="VDOP")
+        dop.set_yscale("log")
+        dop.legend(loc="upper left", fontsize="x-small")
+    cn0.scatter(raw["t"], raw["cn0"], s=1, c=raw["sv"], cmap="tab20")
+    for ax, label in ((count, "satellites"), (dop, "DOP"), (cn0, "C/N0 (dB-Hz)")):
+        _shade(ax, ev, other_faults=True)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    count.legend(loc="lower left", fontsize="x-small")
+    cn0.set_xlabel("t (s)")
+    _save(fig, path)
