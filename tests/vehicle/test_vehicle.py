@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import scenario_data, ten_minute_drive
 
 from simulator import earth
 from simulator.dataset.generate import build_truth
@@ -15,6 +14,7 @@ from simulator.vehicle.body import BodyMotion
 from simulator.vehicle.params import ROUGHNESS_CLASSES, vehicle_parameters
 from simulator.vehicle.road import ISO_N0, draw_roughness
 from simulator.vehicle.suspension import FullCar, simulate
+from tests.conftest import scenario_data, ten_minute_drive
 
 G = earth.G0_M_S2
 # a smooth road and no engine: the responses to one input alone
@@ -250,11 +250,10 @@ def test_strapdown_closes_on_a_rough_road_with_an_suv():
     """Issue 13: an ideal 100 Hz IMU (increments) integrated by the independent strapdown of
     estimators/toolbox closes on the truth within 2 m and 0.2 deg of yaw after the ten-minute
     drive with bumps, helices and turns, here with the SUV on a class C road."""
-    from test_kinematics import _closure
-
     from simulator.sensors import resolve_block
     from simulator.sensors.imu import Imu
     from simulator.tables import as_frame
+    from tests.trajectory.test_kinematics import _closure
 
     truth = _truth(ten_minute_drive(), {"preset": "suv", "roughness": "C"})
     imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
