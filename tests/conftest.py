@@ -56,12 +56,14 @@ def scenario_data(segments: list[dict], **extra) -> dict:
 
 def build_drive(segments: list[dict], *, rate_hz: float = 100.0, start: dict | None = None,
                 utc: str = "2024-05-01T03:00:00Z", environment: dict | None = None,
-                limits: dict | None = None) -> Kinematics:
+                limits: dict | None = None, vehicle: str | dict = "rigid") -> Kinematics:
     """The one way tests build a drive: a segment scenario validated like a file, its drive
     built by ``simulator.drive`` (as ``landnav generate`` does), its truth kinematics returned.
     No sensors, so any truth ``rate_hz`` is accepted; ``start`` (lat, lon in deg, alt in m,
     heading in deg) and ``environment`` replace the validated ones as given, so they may lie
-    outside a scenario's limits (the magnetometer's check at 65 km, zones no segment has)."""
+    outside a scenario's limits (the magnetometer's check at 65 km, zones no segment has).
+    A rigid body by default: the sensor and GNSS tests hold each model against the exact motion
+    of a body that follows the road (the vehicle model's own tests are in tests/vehicle)."""
     import dataclasses
 
     from simulator.drive import build_drive as drive_of
@@ -69,7 +71,7 @@ def build_drive(segments: list[dict], *, rate_hz: float = 100.0, start: dict | N
     data = scenario_data(segments, sensors={}, trajectory={
         "kind": "segments", "segments": segments, "rate": rate_hz},
         start={"utc": utc, **DEFAULT_START},
-        **({"limits": limits} if limits is not None else {}))
+        vehicle=vehicle, **({"limits": limits} if limits is not None else {}))
     drive = drive_of(data)
     return dataclasses.replace(
         drive, start={**drive.start, **(start or {})},
