@@ -59,19 +59,19 @@ def build_drive(segments: list[dict], *, rate_hz: float = 100.0, start: dict | N
                 limits: dict | None = None, vehicle: str | dict = "rigid") -> Kinematics:
     """The one way tests build a drive: a segment scenario validated like a file, its drive
     built by ``simulator.drive`` (as ``landnav generate`` does), its truth kinematics returned.
+    The body is ``rigid`` unless ``vehicle`` says otherwise: sensor and GNSS models are tested
+    on the road's exact motion, the vehicle model in its own tests.
     No sensors, so any truth ``rate_hz`` is accepted; ``start`` (lat, lon in deg, alt in m,
     heading in deg) and ``environment`` replace the validated ones as given, so they may lie
-    outside a scenario's limits (the magnetometer's check at 65 km, zones no segment has).
-    A rigid body by default: the sensor and GNSS tests hold each model against the exact motion
-    of a body that follows the road (the vehicle model's own tests are in tests/vehicle)."""
+    outside a scenario's limits (the magnetometer's check at 65 km, zones no segment has)."""
     import dataclasses
 
     from simulator.drive import build_drive as drive_of
 
     data = scenario_data(segments, sensors={}, trajectory={
         "kind": "segments", "segments": segments, "rate": rate_hz},
-        start={"utc": utc, **DEFAULT_START},
-        vehicle=vehicle, **({"limits": limits} if limits is not None else {}))
+        start={"utc": utc, **DEFAULT_START}, vehicle=vehicle,
+        **({"limits": limits} if limits is not None else {}))
     drive = drive_of(data)
     return dataclasses.replace(
         drive, start={**drive.start, **(start or {})},

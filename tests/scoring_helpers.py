@@ -47,6 +47,15 @@ def offset_solution(truth: pd.DataFrame, dpos=(0.0, 0.0, 0.0), dvel=(0.0, 0.0, 0
     return sol.reset_index(drop=True)
 
 
+def horizontal_error(solution: pd.DataFrame, truth: pd.DataFrame) -> np.ndarray:
+    """Horizontal distance, m, between a solution and the truth interpolated to its times."""
+    lat = np.interp(solution["t"], truth["t"], truth["lat"])
+    lon = np.interp(solution["t"], truth["t"], truth["lon"])
+    rn, re = radii_of_curvature(np.radians(lat))
+    return np.hypot(np.radians(solution["lat"] - lat) * rn,
+                    np.radians(solution["lon"] - lon) * re * np.cos(np.radians(lat)))
+
+
 def events(*outages: tuple[float, float]) -> pd.DataFrame:
     """An events table with one ``gnss_outage`` row per (t_start, t_end) and a zone row."""
     rows = [{"t_start": a, "t_end": b, "kind": "gnss_outage", "detail": ""} for a, b in outages]

@@ -34,12 +34,17 @@ FLAT_LOOP = [  # a flat drive with left and right turns, about 2.2 km in 4 minut
 def scenario(segments: list[dict] | None = None, imu_output: str = "rate",
              vehicle: str | dict = "rigid") -> dict:
     """A resolved scenario; a rigid body by default, since the estimator tests built on it
-    check integration against a body that follows the road exactly (NHC exactly true)."""
+    check integration against a body that follows the road exactly (NHC exactly true). Rates
+    are point samples for the same reason (the exact truth at each stamp; the default interval
+    mean lags half a sample, tested in tests/trajectory/test_kinematics.py)."""
+    imu = {"preset": "ideal", "rate": 100, "output": imu_output}
+    if imu_output == "rate":
+        imu["rate_sampling"] = "point"
     data = {"name": "synthetic", "seed": 3, "vehicle": vehicle,
             "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5665, "lon": 126.978,
                       "alt": 40.0, "heading": 30.0},
             "trajectory": {"kind": "segments", "segments": segments or FLAT_LOOP},
-            "sensors": {"imu": {"preset": "ideal", "rate": 100, "output": imu_output}}}
+            "sensors": {"imu": imu}}
     return validate_data(data, "synthetic")
 
 

@@ -27,7 +27,8 @@ from typing import Any
 import yaml
 
 from simulator.errors import InputError, Problem
-from simulator.scenario import Scenario, load_scenario
+from simulator.pipeline import load_scenario
+from simulator.scenario import Scenario
 
 PLAN_FORMAT = "landnav-campaign/1"  # written into DIR/campaign.json
 _OPENING, _CLOSING = "[{(", "]})"
@@ -111,6 +112,8 @@ class CampaignPlan:
                 seed = self.base.seed + i
                 part = (f"sweep-{point.index:04d}-run-{i:06d}" if self.sweeps
                         else f"run-{i:06d}")
+                # the validated drive is kept: the road has its own seed (vehicle.road_seed),
+                # so every run of a sweep point drives the same road
                 run_scenario = dataclasses.replace(
                     scenario, data={**scenario.data, "seed": seed},
                     overrides=[*(o for o in scenario.overrides if not o.startswith("seed=")),

@@ -57,6 +57,7 @@ from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.constellation import EXPANDABLE_SLOTS, nominal_gps_navigation
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
 from simulator.gnss.errors import (
+    CARRIER_SMOOTHING_TIME_S,
     OSCILLATORS,
     draw_error_terms,
     draw_receiver_clock,
@@ -77,9 +78,10 @@ if TYPE_CHECKING:
 PRESETS: dict[str, dict] = {
     "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
                    "iono_residual": 0.2, "tropo_residual": 0.05, "sis_error": 0.5,
-                   "cn0_noise": 1.0},
+                   "cn0_noise": 1.0, "code_correlation_time": CARRIER_SMOOTHING_TIME_S},
     "ideal": {"clock": "ideal", "tracking_noise": 0.0, "multipath": 0.0, "iono_residual": 0.0,
-              "tropo_residual": 0.0, "sis_error": 0.0, "cn0_noise": 0.0},
+              "tropo_residual": 0.0, "sis_error": 0.0, "cn0_noise": 0.0,
+              "code_correlation_time": 0.0},
 }
 # broadcast ionosphere used with the nominal constellation: the coefficients of the IGS
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
@@ -100,6 +102,10 @@ _ERROR_FIELDS = {
     "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
     "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
     "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
+    "code_correlation_time": Number("s", None, min=0,
+                                    doc="correlation time of the code tracking error and "
+                                        "at least of the multipath (carrier-smoothed code; "
+                                        "0 = white per epoch)"),
 }
 
 
@@ -282,8 +288,8 @@ class Gnss(PresetSensor):
 
         # what the receiver tracks
         los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
-        cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss \
-            + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+        signal_cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
+        cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
         have = idx >= 0
         tracked = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos) \
             & (cn0 >= cfg["cn0_threshold"])
@@ -292,7 +298,9 @@ class Gnss(PresetSensor):
         bias_s, drift_s_s, self.drawn["clock"] = draw_receiver_clock(rng, cfg["clock"], len(t),
                                                                       dt_s)
         self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
-        err = draw_error_terms(rng, cfg, el, cn0, dt_s)
+        # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
+        # (which would otherwise make the error and the fix weights jump from epoch to epoch)
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]

@@ -50,6 +50,17 @@ increment``) integrates the truth exactly over each interval (anti-aliased, Gaus
 analytic kinematics); its error terms are the rate terms times dt, its saturation limit is
 range x dt and its quantum resolution x dt, with the rounding remainder carried to the next
 sample as integrating IMUs do (so the summed increments are exact to one quantum).
+Rate output (``output: rate``) is by default the interval mean (``rate_sampling:
+interval_mean``): the exact increment over (t - 1/rate, t] divided by 1/rate, as a unit whose
+output filter averages over the sample interval delivers it. This is a moving-average
+(sinc-shaped) anti-aliasing filter: content above the Nyquist frequency (a speed bump's jolt at
+100 Hz) no longer folds into the samples, and the group delay it adds is exactly half a sample
+(the mean of a linear signal over the interval is its value at t - 1/(2 rate)). The interval of
+the sample at t = 0 reaches before the drive, where the truth holds its starting state; the
+vibration is averaged over the interval too, and the white noise keeps sigma = N sqrt(rate), the
+interval mean of white noise of density N. ``rate_sampling: point`` is the truth at t (for tests
+of the error terms against the analytic truth; it aliases). A datasheet ``bandwidth`` low-pass
+applies on top of either.
 ``timestamp_jitter`` (1-sigma, s) samples the truth at t + e while the sample is stamped t (for
 increments: the interval ends move by e, to first order in e). On increment output the lever-arm
 term integrates to dw x r + the integral of w x (w x r) (the cubic rule on the truth grid,
@@ -65,8 +76,8 @@ temperature coefficients) are in ``drawn``; the true bias b0 + b_in + b_gm + b_r
 (rad/s, m/s^2, white noise excluded) and diagonal scale-factor error s + s_T dT of every axis over
 time, at about ``TRUE_ERROR_RATE_HZ``, are in ``true_errors`` (written to truth_sensors.parquet;
 misalignment and g-sensitivity are constant and stay in ``drawn``). The ``ideal`` preset turns
-every error off: its rate output is the truth sampled at the IMU rate and its increment output the
-exact integral.
+every error off: its rate output is the interval mean of the truth (with ``rate_sampling:
+point``, the truth sampled at the IMU rate) and its increment output the exact integral.
 
 Public names
 ------------
@@ -102,11 +113,13 @@ from simulator.schema import (
     Vector,
 )
 from simulator.sensors.base import (
+    TEMPERATURE_FIELD,
     TRUE_ERROR_RATE_HZ,
     grid_index,
     grid_rows,
     integrate_over_samples,
     sample_times,
+    temperature_change_k,
     truth_at,
 )
 from simulator.sensors.imu_presets import IMU_PRESETS
@@ -251,6 +264,10 @@ IMU_FIELD = Record(
                                                         "else 100 Hz)"),
         "output": Text(None, choices=["rate", "increment"],
                        doc="rates (rad/s, m/s^2) or increments over each sample (rad, m/s)"),
+        "rate_sampling": Text("interval_mean", choices=["interval_mean", "point"],
+                              doc="rate output: the mean over each sample interval (t - 1/rate, "
+                                  "t], anti-aliased, half a sample late) or the truth at t "
+                                  "(aliases content above the Nyquist frequency)"),
         "axes": Either(Text(choices=list(REDUCED_UNITS)),
                        ListOf(Text(choices=list(col.IMU_AXES)), min_len=1), default="full",
                        doc="channels of the unit, or a reduced unit: " + ", ".join(REDUCED_UNITS)),
@@ -259,11 +276,7 @@ IMU_FIELD = Record(
         "mounting": Vector(3, Number(angle=True), [0.0, 0.0, 0.0],
                            doc="roll, pitch, yaw of the unit in the vehicle"),
         "timestamp_jitter": Number("s", 0.0, min=0, doc="1-sigma sampling-time error"),
-        "temperature": Record({
-            "offset": Number("K", 0.0, doc="temperature at t = 0 minus calibration temperature"),
-            "warmup": Number("K", 0.0, doc="temperature rise during the warm-up"),
-            "warmup_time": Number("s", 600.0, gt=0, doc="time constant of the warm-up"),
-        }, default={}),
+        "temperature": TEMPERATURE_FIELD,
         "vibration": VIBRATION_FIELD,
         "gyro": Record(_GROUPS["gyro"], default=None),
         "accel": Record(_GROUPS["accel"], default=None),
@@ -288,6 +301,8 @@ class Imu:
         self.config = config
         self.rate_hz = float(self.config["rate"])
         self.increment = self.config["output"] == "increment"
+        # the truth integrated over each interval: increments, and rates as interval means
+        self.integrated = self.increment or self.config["rate_sampling"] == "interval_mean"
         self.drawn: dict = {"preset": self.config["preset"]}
         # column (columns.SENSOR_ERRORS) -> (t, true value), filled by ``generate``
         self.truth_keys: dict[str, float] = {}  # every key is a datasheet figure
@@ -295,13 +310,14 @@ class Imu:
         self._prepared: _Draws | None = None
 
     def timing(self) -> dict[str, dict]:
-        """Rates are sampled at their stamp; increments cover (t - 1/rate, t], stamped at its
-        end (their mean is half a sample behind). A ``bandwidth`` low-pass delays the signal by
-        about 1/(2 pi bandwidth) at low frequencies (first-order filter)."""
+        """Point rates are sampled at their stamp; increments and interval-mean rates cover
+        (t - 1/rate, t], stamped at its end (their mean is half a sample behind). A
+        ``bandwidth`` low-pass delays the signal by about 1/(2 pi bandwidth) at low frequencies
+        (first-order filter)."""
         bandwidth = [self.config[g]["bandwidth"] for g in ("gyro", "accel")]
         delay = max((1.0 / (2 * np.pi * min(np.atleast_1d(b))) for b in bandwidth
                      if b is not None), default=0.0)
-        if self.increment:
+        if self.integrated:
             return {"imu": {"stamp": "the end of the integration interval (t - 1/rate, t]",
                             "delay_s": 0.5 / self.rate_hz + delay}}
         return {"imu": {"stamp": "the sampling instant", "delay_s": delay}}
@@ -325,12 +341,12 @@ class Imu:
         run = pool.submit if pool is not None else _run_now
         jitter = float(self.config["timestamp_jitter"])
         # increments: the interval ends t - dt and t move; rates: the sampling instant moves
-        size = len(t) + 1 if self.increment else len(t)
+        size = len(t) + 1 if self.integrated else len(t)
         time_error = jitter * timing.standard_normal(size) if jitter > 0 else None
         vib = self.config["vibration"]
         shake = None
         if any(vib[k] > 0 for k in ("engine_accel", "engine_gyro", "road_accel", "road_gyro")):
-            shake = run(draw_vibration, t, dt, vib, self.increment, shaking)
+            shake = run(draw_vibration, t, dt, vib, self.integrated, shaking)
         self._prepared = _Draws(duration_s, t, time_error, shake,
                                 {group: run(self._draw_group, group, t, stream)
                                  for group, stream in zip(("gyro", "accel"), groups,
@@ -356,8 +372,7 @@ class Imu:
                  "ramp": ramp.tolist()}
         if g_matrix is not None:
             drawn["g_sensitivity"] = g_matrix.tolist()
-        temp = self.config["temperature"]
-        d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
+        d_temp = temperature_change_k(self.config["temperature"], t)
         processes = []  # the random processes of the bias, each (n, 3)
         instability = _per_axis(p["bias_instability"])
         if instability.any():
@@ -405,8 +420,8 @@ class Imu:
         """True rate and specific force (or their increments) at the unit, sensor frame."""
         dt = 1.0 / self.rate_hz
         lever = np.asarray(self.config["lever_arm"], dtype=float)
-        if self.increment:
-            k = integrate_over_samples(truth, t, dt)
+        if self.integrated:
+            k = _integrate(truth, t, dt)
             w, f = k["w_body"], k["f_body"]
             if time_error is not None or lever.any():
                 ends = truth_at(truth, np.concatenate([[t[0] - dt], t]))
@@ -419,6 +434,8 @@ class Imu:
             if lever.any():
                 dw = np.diff(ends["w_body"], axis=0)
                 f = f + np.cross(dw, lever) + _centripetal_increment(truth, t, dt, lever)
+            if not self.increment:  # the interval mean
+                w, f = w / dt, f / dt
         else:
             t_true = t + time_error if time_error is not None else t
             k = truth_at(truth, t_true)
@@ -485,10 +502,12 @@ class Imu:
         w, f = self._true_values(truth, t, draws.time_error)
         if draws.vibration is not None:
             dt = 1.0 / self.rate_hz
-            t_speed = t - dt / 2 if self.increment else t
+            t_speed = t - dt / 2 if self.integrated else t
             speed = np.maximum(truth.profile.distance_of_time(np.clip(t_speed, 0, None), 1), 0)
             shaking = vibration_at_speed(draws.vibration.result(), speed, dt,
-                                         self.config["vibration"], self.increment)
+                                         self.config["vibration"], self.integrated)
+            if self.integrated and not self.increment:  # the interval mean
+                shaking = {k: v / dt if v is not None else None for k, v in shaking.items()}
             if shaking["gyro"] is not None:
                 w = np.add(shaking["gyro"], w, out=shaking["gyro"])
             if shaking["accel"] is not None:
@@ -547,6 +566,17 @@ def _low_pass(y: np.ndarray, bandwidth_hz: np.ndarray, dt_s: float) -> np.ndarra
     a = np.exp(-2 * np.pi * np.asarray(bandwidth_hz, dtype=float) * dt_s)
     y[0] /= 1 - a  # (1 - a) x[0] + a y[-1] with y[-1] = x[0]: the first output is x[0]
     return ar1_filter(y, a, overwrite=True, gain_in=1 - a)
+
+
+def _integrate(truth: Kinematics, t_end: np.ndarray, dt_s: float) -> dict[str, np.ndarray]:
+    """``integrate_over_samples`` over (t - dt, t] for every t; an interval reaching before the
+    drive's start (the rate sample at t = 0) is integrated apart, so the others stay on the
+    truth's grid (the fast cubic rule). Before t = 0 the truth holds its starting state."""
+    if len(t_end) < 2 or t_end[0] >= dt_s - 1e-12:
+        return integrate_over_samples(truth, t_end, dt_s)
+    head = integrate_over_samples(truth, t_end[:1], dt_s)
+    rest = integrate_over_samples(truth, t_end[1:], dt_s)
+    return {key: np.concatenate([head[key], rest[key]]) for key in rest}
 
 
 def _centripetal(w: np.ndarray, lever_arm: np.ndarray) -> np.ndarray:

@@ -49,4 +49,6 @@ def test_datasheet_has_the_nominal_scale_factor_and_truth_the_drawn_one():
     assert manifest["datasheet"]["imu"] == data["sensors"]["imu"]
     assert {"scenario", "sensors", "truth_parameters"} <= set(manifest["knowledge"]["truth"])
     assert {"datasheet", "timing"} <= set(manifest["knowledge"]["user"])
-    assert manifest["timing"]["imu"] == {"stamp": "the sampling instant", "delay_s": 0.0}
+    # rates are interval means at 100 Hz: half a sample late
+    assert manifest["timing"]["imu"] == {
+        "stamp": "the end of the integration interval (t - 1/rate, t]", "delay_s": 0.005}

@@ -25,7 +25,7 @@ GROUP = {"bias": 0.01, "scale_factor": 0.002, "random_walk": 1e-4, "ramp": 1e-5,
 def _generated(output: str = "rate", faults: list | None = None):
     data = scenario_data(DRIVE, sensors={
         "imu": {"preset": "ideal", "rate": 100, "output": output, "gyro": GROUP,
-                "accel": GROUP},
+                "accel": GROUP, **({"rate_sampling": "point"} if output == "rate" else {})},
         "odometer": {"preset": "ideal", "rate": 10, "scale_factor": 1.02,
                      "scale_drift": 1e-3}}, faults=faults or [])
     return generate_streams(data, show_progress=False)

@@ -9,14 +9,13 @@ import json
 from pathlib import Path
 
 import numpy as np
-import pandas as pd
 
 from simulator.dataset.generate import build_truth, generate_dataset
 from simulator.dataset.io import open_dataset
-from simulator.earth import radii_of_curvature
 from simulator.replay import run_estimator
 from simulator.scenario import Scenario, validate_data
 from simulator.scenario.yamlio import read_yaml
+from tests.scoring_helpers import horizontal_error
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "karamat2015_partial_outages.yaml"
 VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model": "simplified"}}
@@ -54,14 +53,6 @@ def short_scenario(seed: int, loops: int = 4, site_s: float | None = 390.0,
 def generate(directory: Path, data: dict) -> Path:
     return generate_dataset(Scenario(SCENARIO, data, []), directory, force=True,
                             show_progress=False)
-
-
-def horizontal_error(solution: pd.DataFrame, truth: pd.DataFrame) -> np.ndarray:
-    lat = np.interp(solution["t"], truth["t"], truth["lat"])
-    lon = np.interp(solution["t"], truth["t"], truth["lon"])
-    rn, re = radii_of_curvature(np.radians(lat))
-    return np.hypot(np.radians(solution["lat"] - lat) * rn,
-                    np.radians(solution["lon"] - lon) * re * np.cos(np.radians(lat)))
 
 
 def true_gyro_bias_z(dataset_path: Path, t: np.ndarray, smooth_s: float = 20.0) -> np.ndarray:

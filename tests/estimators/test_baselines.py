@@ -11,17 +11,8 @@ from simulator.dataset.io import open_dataset
 from simulator.earth import radii_of_curvature
 from simulator.replay import run_estimator
 from simulator.scenario import validate_data
+from tests.scoring_helpers import horizontal_error
 from tests.synthetic import FLAT_LOOP, scenario, write_synthetic
-
-
-def horizontal_error(solution, truth) -> np.ndarray:
-    """Horizontal distance, m, between the solution and the truth at the solution times."""
-    lat = np.interp(solution["t"], truth["t"], truth["lat"])
-    lon = np.interp(solution["t"], truth["t"], truth["lon"])
-    rn, re = radii_of_curvature(np.radians(lat))
-    d_n = np.radians(solution["lat"] - lat) * rn
-    d_e = np.radians(solution["lon"] - lon) * re * np.cos(np.radians(lat))
-    return np.hypot(d_n, d_e)
 
 
 def _flat(roll_gradient: float | None, output: str) -> dict:

@@ -62,9 +62,8 @@ def test_error_model_predicts_the_growth_of_small_errors():
 @pytest.fixture(scope="module")
 def noise_free(tmp_path_factory):
     """The initial-error drive with an ideal IMU and error-free ranges, but a real TCXO
-    receiver clock (bias and drift to estimate)."""
-    # a rigid body: the noise-free case checks the filters' own integration (with the
-    # automotive body the yaw error reaches 0.73 deg against the 0.1 asserted)
+    receiver clock (bias and drift to estimate), on a rigid body (the constraint the filters
+    apply holds exactly there; the automotive body's side slip would break it)."""
     sc = load_scenario(REPO / "scenarios" / "chan_initial_error.yaml",
                        ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal",
                         "sensors.gnss.clock=tcxo", "vehicle=rigid"], seed=5)

@@ -36,7 +36,9 @@ def truth():
 
 
 def run(truth, block: dict, seed: int = 3):
-    imu = Imu(resolve(block))
+    """The unit's output; rates are point samples unless the block says otherwise, so each error
+    term is checked against the analytic truth at the sample time."""
+    imu = Imu(resolve({"rate_sampling": "point", **block}))
     return as_frame(imu.generate(truth, np.random.default_rng(seed))["imu"]), imu
 
 
@@ -80,11 +82,31 @@ def test_bad_input_named(block, message):
     assert found and any(message in p for p in found), found
 
 
-def test_ideal_rate_output_is_truth(truth):
+def test_ideal_point_rate_output_is_truth(truth):
     out, _ = run(truth, {"preset": "ideal", "rate": 50})
     k = truth.inertial(out["t"].to_numpy())
     np.testing.assert_array_equal(out[list(col.IMU_AXES[:3])].to_numpy(), k["w_body"])
     np.testing.assert_array_equal(out[list(col.IMU_AXES[3:])].to_numpy(), k["f_body"])
+
+
+def test_ideal_rate_output_is_interval_mean(truth):
+    # the default rate sampling: the mean over (t - dt, t] against adaptive quadrature
+    # (scipy.integrate.quad) of the analytic truth, on rows spread over the drive, the first
+    # (its interval starts before the drive, where the truth holds the start) among them
+    out, imu = run(truth, {"preset": "ideal", "rate": 50, "rate_sampling": "interval_mean"})
+    assert imu.timing()["imu"]["delay_s"] == pytest.approx(0.01)  # half a sample
+    assert out["t"].iloc[0] == 0.0
+    breaks = truth.breakpoints()
+    rows = np.unique(np.concatenate([np.searchsorted(out["t"], breaks[:6]),
+                                     np.linspace(0, len(out) - 1, 6).astype(int)]))
+    for i in rows:
+        t1 = out["t"].iloc[i]
+        for j, axis in enumerate(col.IMU_AXES):
+            key, comp = ("w_body", j) if j < 3 else ("f_body", j - 3)
+            exact, _ = quad(lambda s, key=key, comp=comp: truth.inertial(s)[key][0, comp],
+                            t1 - 0.02, t1, points=breaks[(breaks > t1 - 0.02) & (breaks < t1)],
+                            epsabs=1e-14, epsrel=1e-12)
+            assert out[axis].iloc[i] == pytest.approx(exact / 0.02, abs=1e-9)
 
 
 def test_ideal_increments_are_exact_integrals(truth):

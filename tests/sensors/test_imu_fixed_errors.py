@@ -13,7 +13,9 @@ from simulator.schema import Context
 from simulator.sensors.imu import IMU_FIELD, Imu
 from simulator.tables import as_frame
 
-EQ36 = {"gyro": {"scale_factor": {"fixed": [0.0, 0.1, -0.1]}, "noise_density": 1e-3},
+# point rate samples, so the output is checked against the analytic truth at each sample time
+EQ36 = {"rate_sampling": "point",
+        "gyro": {"scale_factor": {"fixed": [0.0, 0.1, -0.1]}, "noise_density": 1e-3},
         "accel": {"scale_factor": {"fixed": [0.2, 0.0, 0.0]}, "bias": {"fixed": 0.05}}}
 
 
@@ -40,7 +42,8 @@ def test_fixed_scale_factors_and_bias_are_applied_exactly(truth):
     accel = out[list(col.IMU_AXES[3:])].to_numpy()
     np.testing.assert_allclose(accel, k["f_body"] * [1.2, 1.0, 1.0] + 0.05, atol=1e-12)
     # the gyro noise is the same draw as with the scale factors drawn (zero 1-sigma)
-    drawn = {"gyro": {"scale_factor": 0.0, "noise_density": 1e-3}, "accel": EQ36["accel"]}
+    drawn = {"rate_sampling": "point", "gyro": {"scale_factor": 0.0, "noise_density": 1e-3},
+             "accel": EQ36["accel"]}
     ref = as_frame(Imu(_resolve(drawn)[0]).generate(truth, np.random.default_rng(5))["imu"])
     gyro = out[list(col.IMU_AXES[:3])].to_numpy()
     noise = ref[list(col.IMU_AXES[:3])].to_numpy() - k["w_body"]

@@ -8,9 +8,6 @@ import textwrap
 import numpy as np
 import pytest
 from conftest import scenario_data
-from test_baselines import horizontal_error
-from test_kinematics import _closure
-from test_odometer import make as make_odometer
 
 from simulator import earth
 from simulator.cli import main
@@ -20,7 +17,10 @@ from simulator.replay import run_estimator
 from simulator.sensors import resolve_block
 from simulator.sensors.imu import Imu
 from simulator.tables import as_frame
+from tests.scoring_helpers import horizontal_error
+from tests.sensors.test_odometer import make as make_odometer
 from tests.synthetic import scenario, write_synthetic
+from tests.trajectory.test_kinematics import _closure
 
 REVERSES = {"r1": 20.0, "r2": 15.0, "r3": 12.0, "r4": 4.0}
 SEGMENTS = [
