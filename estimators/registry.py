@@ -8,7 +8,7 @@ A third-party package registers an estimator in its ``pyproject.toml``::
 
 Public functions
 ----------------
-get_estimator, list_estimators, entry_problems.
+get_estimator, list_estimators, name_problems, entry_problems.
 """
 
 from __future__ import annotations
@@ -105,6 +105,23 @@ def get_estimator(name: str) -> type[Estimator]:
     if problems:
         raise InputError(problems[0] if len(problems) == 1 else "; ".join(problems))
     return cls
+
+
+def name_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:
+    """Problems of a scenario estimator entry's name, read from the name table alone (nothing
+    is imported): a built-in, an installed entry point, or a ``module:Class`` path."""
+    name = entry if isinstance(entry, str) else entry["name"]
+    if name in BUILTINS:
+        return []
+    if ":" in name:
+        module_name, _, attr = name.partition(":")
+        if module_name and attr:
+            return []
+        return [("name", f"estimator {name!r}: expected module:Class, got {name!r}")]
+    if name in _entry_points():
+        return []
+    return [("name", f"unknown estimator {name!r}; known: {', '.join(list_estimators())} "
+                     "(or give module:Class)")]
 
 
 def entry_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:

@@ -27,7 +27,7 @@ IMU_AXES = ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z")
 IMU = {"t": "s", **{a: "rad/s" for a in IMU_AXES[:3]}, **{a: "m/s^2" for a in IMU_AXES[3:]}}
 IMU_INCREMENT_UNITS = {**{a: "rad" for a in IMU_AXES[:3]}, **{a: "m/s" for a in IMU_AXES[3:]}}
 
-ODOMETER = {"t": "s", "speed": "m/s", "ticks": "1"}
+ODOMETER = {"t": "s", "speed": "m/s", "ticks": "1", "direction": "1"}
 
 GNSS_FIX = {
     "t": "s", "lat": "deg", "lon": "deg", "alt": "m",

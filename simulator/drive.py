@@ -22,12 +22,11 @@ from dataclasses import dataclass
 
 from simulator.errors import InputError
 from simulator.schema import Context
-from simulator.stochastic import stream_rng
 from simulator.timebase import parse_utc
 from simulator.trajectory import PROFILE_BUILDERS
 from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile, truth_grid
 from simulator.trajectory.segments import RoadProfile
-from simulator.vehicle import ROAD_STREAM, vehicle_body
+from simulator.vehicle import vehicle_body
 
 
 @dataclass(frozen=True)
@@ -44,7 +43,6 @@ class Drive:
     rate_hz: float  # of the truth grid
     roll_gradient: float  # rad per m/s^2 of lateral acceleration (``limits.roll_gradient``)
     vehicle: str | Mapping  # the resolved ``vehicle`` block: "rigid", a preset or parameters
-    seed: int  # the scenario's seed (the road's random stream)
 
     @property
     def duration_s(self) -> float:
@@ -52,11 +50,10 @@ class Drive:
 
     @functools.cached_property
     def truth(self) -> Kinematics:
-        """The exact truth trajectory (built once, on first use): the vehicle's body on the road
-        (its own random stream, ``ROAD_STREAM``), then the kinematics of both."""
+        """The exact truth trajectory (built once, on first use): the vehicle's body on the road,
+        then the kinematics of both."""
         profile, body = vehicle_body(self.profile, self.vehicle,
-                                     truth_grid(self.profile.duration_s, self.rate_hz),
-                                     stream_rng(self.seed, ROAD_STREAM))
+                                     truth_grid(self.profile.duration_s, self.rate_hz))
         return kinematics_from_profile(profile, self.start, self.rate_hz, self.roll_gradient,
                                        self.utc_start, self.environment, body)
 
@@ -80,4 +77,4 @@ def build_drive(scenario: dict, profile: RoadProfile | None = None) -> Drive:
                  environment=scenario["environment"],
                  rate_hz=scenario["trajectory"]["rate"],
                  roll_gradient=scenario["limits"]["roll_gradient"],
-                 vehicle=scenario["vehicle"], seed=scenario["seed"])
+                 vehicle=scenario["vehicle"])

@@ -30,12 +30,14 @@ from typing import Any
 
 import pandas as pd
 
+from estimators.registry import entry_problems
+from simulator import scenario as scenarios
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
 from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
-from simulator.scenario import Scenario, load_scenario
+from simulator.scenario import Scenario
 from simulator.scoring import report
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
 
@@ -48,6 +50,20 @@ Solutions = dict[str, tuple[pd.DataFrame, dict | None]]
 
 NO_ESTIMATOR = ("No estimator was named in the scenario (its `estimators:` list is empty): the "
                 "dataset was generated and nothing was scored.")
+
+
+def load_scenario(path: str | Path, overrides: list[str] | None = None,
+                  seed: int | None = None) -> Scenario:
+    """Read, override and validate a scenario file (``simulator.scenario.load_scenario``), then
+    check each estimator entry against its class: the class imports (through the registry) and
+    its ``config`` fits the class's defaults. Every problem is raised in one InputError."""
+    scenario = scenarios.load_scenario(path, overrides, seed)
+    problems = [Problem(str(scenario.path), None, f"estimators.{i}.{key}", message)
+                for i, entry in enumerate(scenario.data["estimators"])
+                for key, message in entry_problems(entry)]
+    if problems:
+        raise InputError(problems)
+    return scenario
 
 
 def generate(scenario: Scenario, out_dir: str | Path, force: bool = False,

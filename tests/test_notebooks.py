@@ -1,4 +1,5 @@
-"""The worked examples in notebooks/ run from top to bottom (their cells assert what they show)."""
+"""The worked examples in notebooks/ run from top to bottom (their cells assert what they show),
+render at least one plot, and leave nothing behind in the repository."""
 
 from __future__ import annotations
 
@@ -10,15 +11,23 @@ REPO = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
 
 
+def _entries() -> set[Path]:
+    """The repository's top-level entries and those of notebooks/ (where a notebook runs)."""
+    return {*REPO.iterdir(), *(REPO / "notebooks").iterdir()}
+
+
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_notebook_runs(path, monkeypatch):
     monkeypatch.setenv("MPLBACKEND", "Agg")
     nbformat = pytest.importorskip("nbformat")
     nbclient = pytest.importorskip("nbclient")
     notebook = nbformat.read(path, as_version=4)
+    before = _entries()
     client = nbclient.NotebookClient(notebook, timeout=300, kernel_name="python3",
                                      resources={"metadata": {"path": str(REPO)}})
     client.execute()
-    errors = [o for cell in notebook.cells if cell.cell_type == "code"
-              for o in cell.get("outputs", []) if o.get("output_type") == "error"]
-    assert not errors
+    outputs = [o for cell in notebook.cells if cell.cell_type == "code"
+               for o in cell.get("outputs", [])]
+    assert not [o for o in outputs if o.get("output_type") == "error"]
+    assert any("image/png" in o.get("data", {}) for o in outputs), "no plot was rendered"
+    assert _entries() <= before, f"left behind: {sorted(map(str, _entries() - before))}"

@@ -25,7 +25,9 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
 * Propagation (paper: each sigma point integrated through the noise-free dynamics with 10 RK4
   steps per GPS interval): every sigma point is integrated with one RK4 step of eqs. 1-3 per IMU
   interval (``strapdown.rk4_step``; rates at the interval's ends and their mean at its middle),
-  i.e. 100 steps per second at 100 Hz rather than 10, so that no IMU sample is skipped. The
+  i.e. 100 steps per second at 100 Hz rather than 10, so that no IMU sample is skipped (an
+  IMU that outputs increments gives the intervals' mean rates, used at the interval's end and,
+  from the interval before, at its start). The
   process noise is added to the propagated covariance (additive Q) and the points are drawn
   again from it before the measurement update.
 * Eq. 7 lacks the receiver position and prints "+" for a product: the model is
@@ -75,6 +77,7 @@ from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import (
     OMEGA_E_RAD_S,
     earth_rate_ned,
+    geodetic_rates,
     geodetic_to_ecef,
     ned_to_ecef_matrix,
     quat_multiply,
@@ -319,11 +322,9 @@ def boxplus(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
     position and attitude)."""
     if np.ndim(dx) == 1:
         return boxplus(x, dx[None, :])[0]
-    rm, rt = radii_of_curvature(x[0])
+    d_lat, d_lon, d_h = geodetic_rates(x[0], x[2], dx[:, 0:3])
     out = np.empty((len(dx), N_NOMINAL))
-    out[:, 0] = x[0] + dx[:, 0] / (rm + x[2])
-    out[:, 1] = x[1] + dx[:, 1] / ((rt + x[2]) * np.cos(x[0]))
-    out[:, 2] = x[2] - dx[:, 2]
+    out[:, 0], out[:, 1], out[:, 2] = x[0] + d_lat, x[1] + d_lon, x[2] + d_h
     out[:, VEL] = x[VEL] + dx[:, 3:6]
     out[:, QUAT] = quat_multiply(rotvec_to_quat(dx[:, 6:9]), x[QUAT])
     out[:, 10:] = x[10:] + dx[:, 9:]
@@ -425,6 +426,9 @@ class TcUkf(_TightlyCoupled):
         self.ukf.update(self._observe, z, r, ep, nhc)
 
     def solution(self, t: float) -> np.ndarray:
+        """The mean of the propagated points; the std columns are those of the covariance
+        formed at the last GPS or NHC update (the points' spread is formed only there, as in
+        the paper's step 3)."""
         self._flush()
         x = self.ukf.x
         return self._output(x[POS], x[VEL], x[QUAT], x[10:16], x[CLOCK], self.ukf.p)

@@ -27,7 +27,8 @@ from typing import Any
 import yaml
 
 from simulator.errors import InputError, Problem
-from simulator.scenario import Scenario, load_scenario
+from simulator.pipeline import load_scenario
+from simulator.scenario import Scenario
 
 PLAN_FORMAT = "landnav-campaign/1"  # written into DIR/campaign.json
 _OPENING, _CLOSING = "[{(", "]})"

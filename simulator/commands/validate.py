@@ -7,7 +7,7 @@ import sys
 
 from simulator.commands import SUMMARIES
 from simulator.errors import InputError
-from simulator.scenario import load_scenario
+from simulator.pipeline import load_scenario
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:

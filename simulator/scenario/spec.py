@@ -8,7 +8,7 @@ SCENARIO_FIELD, START_FIELD, ESTIMATOR_ENTRY_FIELD.
 
 from __future__ import annotations
 
-from estimators.registry import entry_problems
+from estimators.registry import name_problems
 from simulator.drive import build_profile
 from simulator.environment import COVERED_ZONE_NAMES, ENVIRONMENT_FIELD, ZONE_FIELD
 from simulator.faults import FAULT_FIELD, check_faults
@@ -89,7 +89,7 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
         if label in labels:
             ctx.error(path + ("estimators", i), f"label {label!r} is used twice; give a label")
         labels.add(label)
-        for key, message in entry_problems(entry):
+        for key, message in name_problems(entry):
             where = path + ("estimators", i) + (() if isinstance(entry, str) else (key,))
             ctx.error(where, message)
     zones = value["environment"]["zones"]

@@ -3,14 +3,27 @@ drifting sea-level pressure (weather), with bias, white noise, quantisation and 
 
 Model::
 
-    p(t) = p_std(h(t)) * p_sl(t) / 101325 Pa + b + n,   p_sl(t) = sea_level_pressure + drift t
+    p(t) = p_std(h(t)) * p_sl(t) / 101325 Pa + b + k_T dT(t) + n,
+    p_sl(t) = sea_level_pressure + (drift + r) t
 
 * p_std: the ICAO / U.S. 1976 standard atmosphere (``simulator.environment.atmosphere``) at the
   truth altitude h (the ellipsoidal height is used as height above sea level: the geoid
-  undulation is a constant offset, like the bias); a non-standard sea-level pressure scales the
-  whole column (the altimeter-setting convention);
+  undulation is a constant offset, like the bias: about 3 hPa at ARL1, issue 19. No geoid
+  model is used yet: the one PyPI package found that ships EGM96 data, egm96 0.3.0, needs
+  Python 3.12 and numpy 2.5, see docs/odometer-and-barometer.md); a non-standard sea-level
+  pressure scales the whole column (the altimeter-setting convention);
 * ``drift``: sea-level pressure change per hour (Pa/h, given, e.g. "-1 hPa/h" for a passing
   front);
+* r ~ N(0, ``weather_drift``^2), the weather's rate drawn once per run (``drawn["drift_rate"]``
+  holds drift + r). The ``bosch-bmp280`` preset draws it with 0.4 hPa/h, the rms change over
+  one hour of the real ARL1 met file of 2015-07-19 (refdata 1a, Vaisala PTU300 every 15 min:
+  0.41 hPa rms, at most 1.0 hPa in an hour, 3.8 hPa range over the day). A constant rate over
+  a run is the choice: drives last minutes to an hour, shorter than weather systems change;
+* k_T ~ N(0, ``temperature_coefficient``^2) drawn once per run, dT(t) the ``temperature``
+  block's profile (``simulator.sensors.base.temperature_change_k``, the IMU's convention). The
+  preset's 1.5 Pa/K is the BMP280's "temperature coefficient of offset" (data sheet Table 2,
+  +-1.5 Pa/K, 25-40 degC at 900 hPa), taken as the 1-sigma; with the default temperature
+  block (no change) it adds nothing until a profile is given;
 * b ~ N(0, ``bias``^2) drawn once per run; n white with 1-sigma ``noise`` (Pa);
 * then clipping to ``range`` [min, max] and rounding to ``resolution``.
 
@@ -34,7 +47,7 @@ import numpy as np
 
 from simulator.environment.atmosphere import P0_PA, pressure_altitude_m, pressure_pa
 from simulator.schema import Context, Number, Path, Vector
-from simulator.sensors.base import sample_times
+from simulator.sensors.base import TEMPERATURE_FIELD, sample_times, temperature_change_k
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
@@ -43,7 +56,8 @@ from simulator.units import HPA
 BARO_PRESETS: dict[str, dict] = {
     "ideal": {},
     "bosch-bmp280": {"rate": 20.0, "noise": 1.3, "bias": 1 * HPA, "resolution": 0.16,
-                     "range": [300 * HPA, 1100 * HPA]},
+                     "range": [300 * HPA, 1100 * HPA], "weather_drift": "0.4 hPa/h",
+                     "temperature_coefficient": "1.5 Pa/K"},
 }
 
 _FIELDS = {
@@ -51,6 +65,11 @@ _FIELDS = {
     "noise": Number("Pa", None, min=0, doc="white noise, 1-sigma"),
     "bias": Number("Pa", None, min=0, doc="bias, 1-sigma, drawn once per run"),
     "drift": Number("Pa/s", None, doc="sea-level pressure change (weather), e.g. '-1 hPa/h'"),
+    "weather_drift": Number("Pa/s", None, min=0, doc="1-sigma of the sea-level pressure rate "
+                                                      "drawn once per run, e.g. '0.4 hPa/h'"),
+    "temperature_coefficient": Number("Pa/K", None, min=0,
+                                      doc="1-sigma pressure offset per kelvin, drawn once per run"),
+    "temperature": TEMPERATURE_FIELD,
     "sea_level_pressure": Number("Pa", None, gt=0, doc="sea-level pressure at t = 0"),
     "resolution": Number("Pa", None, min=0, doc="quantisation step"),
     "range": Vector(2, Number("Pa", gt=0), None, doc="lowest and highest pressure measured"),
@@ -79,15 +98,20 @@ class Barometer(PresetSensor):
         c = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
         altitude = truth.position(t)[:, 2]
-        sea_level = c["sea_level_pressure"] + c["drift"] * t
         bias = c["bias"] * rng.standard_normal()
-        pressure = (pressure_pa(altitude) * sea_level / P0_PA + bias
-                    + c["noise"] * rng.standard_normal(len(t)))
+        noise = c["noise"] * rng.standard_normal(len(t))
+        rate = c["drift"] + c["weather_drift"] * rng.standard_normal()
+        k_temp = c["temperature_coefficient"] * rng.standard_normal()
+        sea_level = c["sea_level_pressure"] + rate * t
+        pressure = (pressure_pa(altitude) * sea_level / P0_PA + bias + noise
+                    + k_temp * temperature_change_k(c["temperature"], t))
         if c["range"] is not None:
             pressure = np.clip(pressure, *c["range"])
         if c["resolution"] > 0:
             pressure = np.round(pressure / c["resolution"]) * c["resolution"]
-        self.drawn.update(bias=float(bias), sea_level_pressure_start=float(sea_level[0]),
+        self.drawn.update(bias=float(bias), drift_rate=float(rate),
+                          temperature_coefficient=float(k_temp),
+                          sea_level_pressure_start=float(sea_level[0]),
                           sea_level_pressure_end=float(sea_level[-1]))
         return {"baro": {"t": t, "pressure": pressure,
                          "altitude": pressure_altitude_m(pressure)}}

@@ -5,8 +5,8 @@ that turns the exact trajectory and a random generator into stream tables (colum
 
 Public names
 ------------
-SensorModel, TRUE_ERROR_RATE_HZ, sample_times, grid_index, grid_rows, truth_at,
-integrate_over_samples.
+SensorModel, TRUE_ERROR_RATE_HZ, TEMPERATURE_FIELD, sample_times, grid_index, grid_rows, truth_at,
+integrate_over_samples, temperature_change_k.
 """
 
 from __future__ import annotations
@@ -15,6 +15,7 @@ from typing import Protocol
 
 import numpy as np
 
+from simulator.schema import Number, Record
 from simulator.tables import Table
 from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import (
@@ -50,6 +51,20 @@ class SensorModel(Protocol):
 # to truth_sensors.parquet): fast enough for a bias process seen by a 10 Hz solution, a tenth
 # of the IMU file at 100 Hz
 TRUE_ERROR_RATE_HZ = 10.0
+
+
+# a sensor's temperature profile (the IMU's and the barometer's ``temperature`` block)
+TEMPERATURE_FIELD = Record({
+    "offset": Number("K", 0.0, doc="temperature at t = 0 minus calibration temperature"),
+    "warmup": Number("K", 0.0, doc="temperature rise during the warm-up"),
+    "warmup_time": Number("s", 600.0, gt=0, doc="time constant of the warm-up"),
+}, default={})
+
+
+def temperature_change_k(block: dict, t: np.ndarray) -> np.ndarray:
+    """dT(t) = offset + warmup (1 - exp(-t / warmup_time)) (K from the calibration temperature),
+    the profile of a resolved ``TEMPERATURE_FIELD`` block: a first-order warm-up."""
+    return block["offset"] - block["warmup"] * np.expm1(-np.asarray(t) / block["warmup_time"])
 
 
 def sample_times(duration_s: float, rate_hz: float, first: int = 0) -> np.ndarray:

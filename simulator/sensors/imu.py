@@ -113,11 +113,13 @@ from simulator.schema import (
     Vector,
 )
 from simulator.sensors.base import (
+    TEMPERATURE_FIELD,
     TRUE_ERROR_RATE_HZ,
     grid_index,
     grid_rows,
     integrate_over_samples,
     sample_times,
+    temperature_change_k,
     truth_at,
 )
 from simulator.sensors.imu_presets import IMU_PRESETS
@@ -274,11 +276,7 @@ IMU_FIELD = Record(
         "mounting": Vector(3, Number(angle=True), [0.0, 0.0, 0.0],
                            doc="roll, pitch, yaw of the unit in the vehicle"),
         "timestamp_jitter": Number("s", 0.0, min=0, doc="1-sigma sampling-time error"),
-        "temperature": Record({
-            "offset": Number("K", 0.0, doc="temperature at t = 0 minus calibration temperature"),
-            "warmup": Number("K", 0.0, doc="temperature rise during the warm-up"),
-            "warmup_time": Number("s", 600.0, gt=0, doc="time constant of the warm-up"),
-        }, default={}),
+        "temperature": TEMPERATURE_FIELD,
         "vibration": VIBRATION_FIELD,
         "gyro": Record(_GROUPS["gyro"], default=None),
         "accel": Record(_GROUPS["accel"], default=None),
@@ -374,8 +372,7 @@ class Imu:
                  "ramp": ramp.tolist()}
         if g_matrix is not None:
             drawn["g_sensitivity"] = g_matrix.tolist()
-        temp = self.config["temperature"]
-        d_temp = temp["offset"] - temp["warmup"] * np.expm1(-t / temp["warmup_time"])
+        d_temp = temperature_change_k(self.config["temperature"], t)
         processes = []  # the random processes of the bias, each (n, 3)
         instability = _per_axis(p["bias_instability"])
         if instability.any():

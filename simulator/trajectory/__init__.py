@@ -13,14 +13,20 @@ from collections.abc import Callable
 
 from simulator.schema import Context, ListOf, Number, Record
 from simulator.trajectory.recorded import RECORDED_FIELD, build_recorded_profile
-from simulator.trajectory.segments import SEGMENT_FIELD, RoadProfile, build_road_profile
+from simulator.trajectory.segments import (
+    DRIVE_SEGMENT_FIELD,
+    RoadProfile,
+    build_road_profile,
+    expand_repeats,
+)
 from simulator.trajectory.sumo import SUMO_FIELD, build_sumo_profile
 
 _RATE = Number("Hz", None, gt=0, max=10000,
                doc="base rate of the truth table (default: the IMU rate, or 100 Hz)")
 
 TRAJECTORY_KINDS: dict[str, Record] = {
-    "segments": Record({"segments": ListOf(SEGMENT_FIELD, min_len=1), "rate": _RATE}),
+    "segments": Record({"segments": ListOf(DRIVE_SEGMENT_FIELD, min_len=1), "rate": _RATE},
+                       post=expand_repeats),
     "sumo": SUMO_FIELD,
     "recorded": RECORDED_FIELD,
 }

@@ -56,6 +56,8 @@ import numpy as np
 from simulator.earth import G0_M_S2
 from simulator.schema import (
     Context,
+    Integer,
+    ListOf,
     Number,
     OneKey,
     Path,
@@ -143,6 +145,39 @@ SEGMENT_FIELD = OneKey(
                                    "environment.zones)")},
     what="segment",
 )
+
+MAX_REPEAT = 1000  # times one ``repeat`` block may be driven
+MAX_SEGMENTS = 100_000  # segments of a drive once its repeats are written out
+
+DRIVE_SEGMENT_FIELD = OneKey(
+    {**SEGMENT_FIELD.variants,
+     "repeat": Record({"times": Integer(min=1, max=MAX_REPEAT,
+                                        doc="how many times the block is driven in a row"),
+                       "segments": ListOf(SEGMENT_FIELD, min_len=1,
+                                          doc="the segments of the block (any kind but repeat)")},
+                      doc="drive a block of segments several times in a row (a loop, a protocol "
+                          "repeated at the same place); a zone given here applies to the "
+                          "block's segments that name none")},
+    shared=SEGMENT_FIELD.shared, what="segment")
+
+
+def expand_repeats(value: dict, path: Path, ctx: Context) -> dict:
+    """Write every ``repeat`` block of a validated segment list out in place (post-check of the
+    ``segments`` trajectory), so the resolved scenario lists plain segments only."""
+    out: list[dict] = []
+    for item in value["segments"]:
+        (kind, body), = item.items()
+        if kind != "repeat":
+            out.append(item)
+            continue
+        block = [item_ if body.get("zone") is None or next(iter(item_.values())).get("zone")
+                 else {k: {**v, "zone": body["zone"]} for k, v in item_.items()}
+                 for item_ in body["segments"]]
+        out.extend(block * body["times"])
+    if len(out) > MAX_SEGMENTS:
+        return ctx.error(path + ("segments",), f"the repeats write out {len(out)} segments, "
+                                               f"more than {MAX_SEGMENTS}")
+    return {**value, "segments": out}
 
 
 @dataclass

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simulator.stochastic import stream_rng
 from simulator.trajectory.segments import RoadProfile
 from simulator.vehicle.body import BodyMotion, build_body, level_road
 from simulator.vehicle.params import VEHICLE_FIELD, vehicle_parameters
@@ -23,16 +24,17 @@ __all__ = ["ROAD_STREAM", "VEHICLE_FIELD", "vehicle_body"]
 ROAD_STREAM = "road"  # name of the road's random stream (roughness, engine phase)
 
 
-def vehicle_body(profile: RoadProfile, block: str | dict, t_grid: np.ndarray,
-                 rng: np.random.Generator) -> tuple[RoadProfile, BodyMotion | None]:
-    """The road profile the body follows and the body's motion for a resolved scenario: the
-    profile unchanged and None with ``vehicle: rigid``; else the profile without its speed bumps
-    in the grade (the wheels ride over them) and the body on its suspension.
+def vehicle_body(profile: RoadProfile, block: str | dict,
+                 t_grid: np.ndarray) -> tuple[RoadProfile, BodyMotion | None]:
+    """The road profile the body follows and the body's motion for a resolved ``vehicle``
+    block: the profile unchanged and None with ``vehicle: rigid``; else the profile without its
+    speed bumps in the grade (the wheels ride over them) and the body on its suspension.
 
-    ``block`` is the resolved ``vehicle`` block; ``rng`` the road's random stream (the dataset
-    generator keys it ``ROAD_STREAM`` among the sensors' streams, so that the road and the
-    sensors draw independently)."""
+    The road draws from its own random stream (``stochastic.stream_rng`` of ``road_seed``,
+    keyed ``ROAD_STREAM``): the road is part of the drive, like the trajectory, so it does not
+    change with the scenario's seed, which draws the sensors' errors."""
     params = vehicle_parameters(block)
     if params is None:
         return profile, None
+    rng = stream_rng(params["road_seed"], ROAD_STREAM)
     return level_road(profile), build_body(profile, params, t_grid, rng)

@@ -22,6 +22,7 @@ from simulator.schema import (
     INVALID,
     Context,
     Either,
+    Integer,
     Number,
     Path,
     Record,
@@ -101,6 +102,9 @@ _FIELDS = {
                      doc="road cross-slope (rise/run), + falling to the right"),
     "engine_frequency": Number("Hz", None, gt=0, doc="engine vibration frequency"),
     "engine_accel": Number("m/s^2", None, min=0, doc="engine vibration of the body, vertical rms"),
+    "road_seed": Integer(0, min=0, max=2**63 - 1,
+                         doc="seed of the road's roughness and the engine's phase: part of the "
+                             "drive, so a campaign's runs over seeds share one road"),
 }
 
 
@@ -112,8 +116,8 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
     preset = VEHICLE_PRESETS[value["preset"]]
     out = dict(value)
     for key, field in _FIELDS.items():
-        if out[key] is None:
-            out[key] = field.check(preset[key], path + (key,), ctx)
+        if out[key] is None:  # the preset's value, or the field's own default (road_seed)
+            out[key] = field.check(preset.get(key, field.default), path + (key,), ctx)
     if any(v is INVALID for v in out.values()):
         return INVALID
     if out["mass"] <= 4 * out["unsprung_mass"]:

@@ -22,7 +22,8 @@ eq. 5-5), dampers from the damping ratio; the tyre is a spring (its damping is s
 Integration: the state equation x' = A x + B u is diagonalised, A = V diag(lambda) V^-1; each
 mode is propagated exactly for an input linear between samples ("first-order hold"; the road
 heights at the wheels are sampled on the truth grid), y_k+1 = e^(lambda h) y_k + b (p u_k +
-q u_k+1). The recursion is evaluated in blocks with numpy (``_scan``), never sample by sample.
+q u_k+1). The recursion runs in blocks with numpy (``stochastic.ar1_filter`` on the modes turned
+into real factors, ``_modal_recursion``), never sample by sample.
 
 Public names
 ------------
@@ -34,6 +35,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+
+from simulator.stochastic import ar1_filter
 
 N_BODY = 3  # heave, pitch, roll
 N_DOF = 7
@@ -161,7 +164,7 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
     forced.real[:, 1:] = now.real @ u[:, :-1] + after.real @ u[:, 1:]
     forced.imag[:, 1:] = now.imag @ u[:, :-1] + after.imag @ u[:, 1:]
     forced[:, 0] = -(modal_b @ u[:, 0]) / lam  # the static equilibrium of u_0
-    y = _scan(e, forced)
+    y = _modal_recursion(e, forced)
     # positions and rates of the body are states; accelerations are rows of A x + B u
     rows = np.r_[0:N_BODY, N_DOF:N_DOF + N_BODY]
     accel = slice(N_DOF, N_DOF + N_BODY)
@@ -171,27 +174,15 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
     return out
 
 
-def _scan(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
-    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode), vectorised.
+def _modal_recursion(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
+    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode; |factor| < 1).
 
-    Within blocks of ``b`` samples y = factor^j cumsum(factor^-j forced); the blocks' ends are
-    chained by a loop over blocks (not samples). ``b`` keeps |factor|^-b below 1e6, so the
-    scaled sums lose at most six digits of the double precision."""
+    With factor = r e^(i theta), y_k = e^(i k theta) x_k where x_k = r x_k-1 + e^(-i k theta)
+    forced_k: a real first-order recursion on the rotated inputs' real and imaginary parts,
+    which ``stochastic.ar1_filter`` runs in blocks, without a loop over the samples."""
     k, n = forced.shape
-    decay = -np.log(np.abs(factor)).max()
-    b = int(np.clip(np.floor(np.log(1e6) / max(decay, 1e-300)), 1, 256))
-    n_blocks = -(-n // b)
-    padded = np.zeros((k, n_blocks * b), dtype=complex)
-    padded[:, :n] = forced
-    blocks = padded.reshape(k, n_blocks, b)
-    powers = factor[:, None] ** np.arange(b)[None, :]  # (k, b)
-    blocks *= (1 / powers)[:, None, :]
-    local = np.cumsum(blocks, axis=2, out=blocks)
-    local *= powers[:, None, :]  # each block from a zero start
-    ends = local[:, :, -1].T.copy()  # (n_blocks, k)
-    whole = factor**b
-    for i in range(1, n_blocks):
-        ends[i] += whole * ends[i - 1]
-    # the previous block's end carried to sample j: factor^(j+1)
-    local[:, 1:, :] += (powers * factor[:, None])[:, None, :] * ends[:-1].T[:, :, None]
-    return padded[:, :n]
+    turn = np.exp(1j * np.outer(np.angle(factor), np.arange(n)))  # e^(i k theta), (modes, n)
+    rotated = forced * turn.conj()
+    parts = np.ascontiguousarray(np.concatenate([rotated.real, rotated.imag]).T)  # (n, 2 modes)
+    x = ar1_filter(parts, np.tile(np.abs(factor), 2), overwrite=True)
+    return (x[:, :k] + 1j * x[:, k:]).T * turn

@@ -13,8 +13,8 @@ from estimators.registry import get_estimator, list_estimators
 from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
+from simulator.pipeline import load_scenario
 from simulator.replay import read_solution
-from simulator.scenario import load_scenario
 from tests.scoring_helpers import horizontal_error
 from tests.synthetic import write_synthetic
 
@@ -119,6 +119,8 @@ def test_bad_config_and_init(dataset, tmp_path, capsys):
 
 
 def test_scenario_validation_checks_estimator_names(tmp_path):
+    """The scenario checks names from the registry's name table (with their line); the
+    pipeline's loader then checks each entry against its class (import, config)."""
     scenario = tmp_path / "s.yaml"
     scenario.write_text(textwrap.dedent("""\
         start: {lat: 37.5, lon: 127.0, heading: 0}
@@ -133,10 +135,15 @@ def test_scenario_validation_checks_estimator_names(tmp_path):
         load_scenario(scenario)
     text = str(info.value)
     assert "s.yaml:5: estimators.1: unknown estimator 'kalmann'" in text
-    assert "estimators.2.config: config key 'max_extrapolation'" in text
-    assert ("estimators.3.name: estimator 'no_such_module:Filter': cannot import module "
-            "'no_such_module': ModuleNotFoundError") in text
     assert "dead_reckoning" not in text.split("known:")[0]
+    assert "estimators.2" not in text and "estimators.3" not in text  # names that exist
+    scenario.write_text(scenario.read_text().replace("  - kalmann\n", ""))
+    with pytest.raises(InputError) as info:
+        load_scenario(scenario)
+    text = str(info.value)
+    assert "estimators.1.config: config key 'max_extrapolation'" in text
+    assert ("estimators.2.name: estimator 'no_such_module:Filter': cannot import module "
+            "'no_such_module': ModuleNotFoundError") in text
 
 
 def test_incomplete_plugin_class_is_refused(dataset, tmp_path, capsys):

@@ -26,25 +26,28 @@ def error_3d(solution: pd.DataFrame, truth: pd.DataFrame) -> np.ndarray:
 
 
 def run(dataset: Dataset, name: str, **config) -> tuple[pd.DataFrame, np.ndarray]:
-    """Solution and its 3-D error of estimator ``name`` with ``config`` over the lever arm."""
-    entry = {"name": name, "config": {"lever_arm": LEVER_ARM, **config}}
+    """Solution and its 3-D error of estimator ``name`` with ``config`` over the lever arm
+    (``init``, if given, is the entry's initial errors rather than a config key)."""
     init = config.pop("init", None)
-    if init:
-        entry = {"name": name, "init": init, "config": {"lever_arm": LEVER_ARM, **config}}
+    entry = {"name": name, "init": init, "config": {"lever_arm": LEVER_ARM, **config}}
     solution, _ = run_estimator(dataset, entry, show_progress=False)
     return solution, error_3d(solution, dataset.read("truth"))
 
 
 def window_means(dataset: Dataset, solution: pd.DataFrame, error: np.ndarray
                  ) -> list[tuple[int, float]]:
-    """(satellites left, mean 3-D error over the window) of each degraded or outage window."""
+    """(satellites left, mean 3-D error over the window) of each satellite-limit window and
+    each complete outage of the events table (an outage inside a satellite-limit window with
+    count 0 is that window, counted once)."""
     events = dataset.read("events")
+    limits = events[events["kind"] == "gnss_satellite_limit"]
     t = solution["t"].to_numpy()
     out = []
     for row in events.itertuples():
         if row.kind == "gnss_satellite_limit":
             count = int(json.loads(row.detail)["count"])
-        elif row.kind == "gnss_outage":
+        elif row.kind == "gnss_outage" and not (
+                (limits["t_start"] < row.t_end) & (limits["t_end"] > row.t_start)).any():
             count = 0
         else:
             continue

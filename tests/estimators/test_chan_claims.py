@@ -123,11 +123,11 @@ def _not_shown(measured: str) -> pytest.MarkDecorator:
 
 
 # (satellites, least cut %) of issue 15; the paper's Table 1: 54.4, 53.2, 52.6, 52.4 %
-SHORT_CLAIMS = [pytest.param(0, 40.0, marks=_not_shown("22.5 % with 0 satellites on the "
+SHORT_CLAIMS = [pytest.param(0, 40.0, marks=_not_shown("11.9 % with 0 satellites on the "
                                                        "shortened drive")),
                 (1, 25.0), (2, 25.0), (3, 25.0)]
 FULL_CLAIMS = [(0, 40.0), (1, 25.0), (2, 25.0),
-               pytest.param(3, 25.0, marks=_not_shown("19.9 % with 3 satellites"))]
+               pytest.param(3, 25.0, marks=_not_shown("17.8 % with 3 satellites"))]
 
 
 @pytest.mark.parametrize(("satellites", "least_cut"), SHORT_CLAIMS)
@@ -148,6 +148,20 @@ def test_nhc_cut_as_table_1_full_drive(full_table, satellites, least_cut):
 @pytest.mark.slow
 def test_nhc_cut_with_4_satellites_is_the_smallest_full_drive(full_table):
     assert full_table[4]["cut"] < full_table[0]["cut"]
+
+
+@pytest.mark.slow
+@_not_shown("29.7 % on the automotive body, whose side slip in the 40 m loops breaks the "
+            "constraint (58.9 % on a rigid body)")
+def test_nhc_cut_in_complete_outages(tmp_path_factory):
+    """Table 1's first row on the complete-outage drive (three 60 s outages per seed, straight
+    and in loops): the NHC cuts the mean 3-D error over the outages by at least 40 %."""
+    rows = table1(window_errors(_datasets(tmp_path_factory, "chan_complete_outages", None)))
+    print(f"complete outages: {rows[0]['nhc_m']:.2f} vs {rows[0]['no_nhc_m']:.2f} m, cut "
+          f"{rows[0]['cut']:.1f} % (per seed median {rows[0]['median']:.1f}, "
+          f"[{rows[0]['min']:.1f}, {rows[0]['max']:.1f}])")
+    assert sorted(rows) == [0]
+    assert rows[0]["cut"] >= 40.0
 
 
 def settle_time(solution, error: np.ndarray, bound_m: float = 10.0) -> float:

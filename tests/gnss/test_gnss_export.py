@@ -4,6 +4,7 @@ valid checksums and carry the fixes."""
 
 from __future__ import annotations
 
+import json
 import warnings
 
 import numpy as np
@@ -12,7 +13,9 @@ import pytest
 import yaml
 
 from simulator.cli import main
+from simulator.dataset.export import export_nmea, export_rinex
 from simulator.dataset.io import open_dataset
+from simulator.errors import InputError
 from simulator.gnss.navfiles import read_rinex_nav
 from simulator.gnss.nmea import nmea_checksum
 
@@ -103,3 +106,33 @@ def test_nmea_sentences_parse_with_valid_checksums(exported):
     assert [r.status for r in rmc] == ["A" if f else "V" for f in with_fix]
     speed = np.array([r.spd if r.spd != "" else np.nan for r in rmc], dtype=float)
     np.testing.assert_allclose(speed[with_fix] * 1852 / 3600, fix["speed"][with_fix], atol=1e-3)
+
+
+def test_library_export_equals_the_command(exported, tmp_path):
+    """``simulator.dataset.export`` (what notebooks call) writes the files ``landnav export``
+    writes, byte for byte apart from the RINEX header's creation time; refuses to overwrite
+    without ``force``; names the caller's option for a dataset without the streams."""
+    root, dataset = exported
+    obs, nav = export_rinex(dataset, tmp_path)
+    assert (obs.name, nav.name) == ("ds.obs", "ds.nav")
+
+    def body(path):
+        return [line for line in path.read_text().splitlines() if "PGM / RUN BY" not in line]
+
+    assert body(obs) == body(root / "rinex" / "ds.obs")
+    assert body(nav) == body(root / "rinex" / "ds.nav")
+    nmea = export_nmea(dataset, tmp_path / "out.nmea")
+    assert nmea.read_text() == (root / "out.nmea").read_text()
+    with pytest.raises(InputError):
+        export_rinex(dataset, tmp_path)
+    assert export_rinex(dataset, tmp_path, force=True) == (obs, nav)
+    (tmp_path / "no_raw").mkdir()
+    for f in dataset.path.iterdir():
+        if f.name != "gnss_raw.parquet":
+            (tmp_path / "no_raw" / f.name).write_bytes(f.read_bytes())
+    manifest = tmp_path / "no_raw" / "manifest.json"
+    data = json.loads(manifest.read_text())
+    data["streams"].pop("gnss_raw")
+    manifest.write_text(json.dumps(data))
+    with pytest.raises(InputError, match="my_option needs the 'gnss_raw' stream"):
+        export_rinex(open_dataset(tmp_path / "no_raw"), tmp_path / "x", option="my_option")

@@ -16,22 +16,12 @@ import pyarrow.parquet as pq
 import pytest
 
 from simulator.cli import main
+from tests.reliability.drives import straight_drive
 
-SCENARIO = """\
-name: t
-start: {lat: 37.5, lon: 127.0}
-trajectory:
-  kind: segments
-  segments:
-    - accelerate: {to_speed: 10, accel: 1.5}
-    - straight: {length: 150}
-sensors:
-  imu: {preset: ideal, rate: 50}
-  odometer: {rate: 10}
-  gnss: {rate: 1, outputs: [fix, raw]}
-faults:
-  - {kind: gnss_outage, start: 8, duration: 3}
-"""
+SCENARIO = straight_drive(150, sensors="  imu: {preset: ideal, rate: 50}\n"
+                                       "  odometer: {rate: 10}\n"
+                                       "  gnss: {rate: 1, outputs: [fix, raw]}\n",
+                          tail="faults:\n  - {kind: gnss_outage, start: 8, duration: 3}\n")
 
 
 @pytest.fixture(scope="module")

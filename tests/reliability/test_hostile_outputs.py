@@ -15,20 +15,11 @@ from pathlib import Path
 import pytest
 
 from simulator.cli import main
+from tests.reliability.drives import straight_drive
 
 REPO = Path(__file__).resolve().parents[2]
-SCENARIO = """\
-name: t
-start: {lat: 37.5, lon: 127.0}
-trajectory:
-  kind: segments
-  segments:
-    - accelerate: {to_speed: 10, accel: 1.5}
-    - straight: {length: 200}
-sensors:
-  imu: {preset: ideal, rate: 50}
-  gnss: {rate: 1, outputs: [fix, raw]}
-"""
+SCENARIO = straight_drive(200, sensors="  imu: {preset: ideal, rate: 50}\n"
+                                       "  gnss: {rate: 1, outputs: [fix, raw]}\n")
 
 
 def _tree(root: Path) -> dict[str, tuple[int, int]]:

@@ -8,18 +8,9 @@ from pathlib import Path
 import pytest
 
 from simulator.cli import main
+from tests.reliability.drives import straight_drive
 
-SCENARIO = """\
-name: t
-start: {lat: 37.5, lon: 127.0}
-trajectory:
-  kind: segments
-  segments:
-    - accelerate: {to_speed: 10, accel: 1.5}
-    - straight: {length: 60}
-sensors:
-  imu: {preset: ideal, rate: 50}
-"""
+SCENARIO = straight_drive(60, sensors="  imu: {preset: ideal, rate: 50}\n")
 
 CASES = {
     "RaiseInSetup": "failed in setup(): RuntimeError: deliberate setup failure",

@@ -12,16 +12,9 @@ import pytest
 
 from simulator.cli import main
 from simulator.scenario.yamlio import MAX_DEPTH, apply_overrides, read_yaml
+from tests.reliability.drives import straight_drive
 
-GOOD_HEAD = """\
-name: t
-start: {lat: 37.5, lon: 127.0}
-trajectory:
-  kind: segments
-  segments:
-    - accelerate: {to_speed: 10, accel: 1.5}
-    - straight: {length: 100}
-"""
+GOOD_HEAD = straight_drive(100)
 
 
 def _alias_bomb(levels: int, fan: int) -> str:

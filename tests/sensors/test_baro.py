@@ -1,5 +1,6 @@
 """Standard atmosphere against the ICAO 1993 and U.S. 1976 tables; barometer noise, bias,
-weather drift, resolution and range; pressure altitude of the ideal barometer."""
+weather drift (default rate against the real ARL1 met file), temperature sensitivity, resolution
+and range; pressure altitude of the ideal barometer."""
 
 from __future__ import annotations
 
@@ -77,7 +78,10 @@ def test_bmp280_noise_bias_resolution():
     truth = static_truth(600.0)
     out = as_frame(baro.generate(truth, np.random.default_rng(4))["baro"])
     assert len(out) == 600 * 20 + 1
-    expected = pressure_pa(truth.position(out["t"])[:, 2]) + baro.drawn["bias"]
+    # the preset's weather drift (drawn rate) scales the column; the noise is what is left
+    sea_level = 101325.0 + baro.drawn["drift_rate"] * out["t"].to_numpy()
+    expected = (pressure_pa(truth.position(out["t"])[:, 2]) * sea_level / 101325.0
+                + baro.drawn["bias"])
     residual = out["pressure"].to_numpy() - expected
     assert np.std(residual) == pytest.approx(1.3, rel=0.05)
     assert abs(np.mean(residual)) < 0.1
@@ -98,10 +102,60 @@ def test_weather_drift_and_range():
     assert clipped["pressure"].max() == 100000.0
 
 
+def met_pressures_hpa() -> np.ndarray:
+    """PR column of the ARL1 whole-day met file (refdata 1a), every 15 min."""
+    path = SHARED / "refdata" / "gnss" / "arl1_2015-07-19_gnsstk" / "arlm2000.15m"
+    if not path.is_file():
+        pytest.skip(f"ARL1 met file not found: {path} (shared/refdata is missing)")
+    body = path.read_text().split("END OF HEADER")[1].split("\n")
+    return np.array([float(line.split()[6]) for line in body if line.strip()])
+
+
+def test_weather_drift_on_by_default_like_the_real_met_file():
+    """The bosch-bmp280 preset draws a sea-level pressure rate per run with 1-sigma 0.4 hPa/h:
+    the rms change over one hour of the real ARL1 met file (0.41 hPa, 96 records, 2015-07-19),
+    and the pressure of a static hour changes by that rate scaled to the altitude."""
+    hourly = np.diff(met_pressures_hpa()[::4])
+    real_rms_hpa_h = np.sqrt(np.mean(hourly ** 2))
+    baro = make({"preset": "bosch-bmp280", "noise": 0, "resolution": 0, "rate": 1})
+    assert baro.config["weather_drift"] * 3600 / 100 == pytest.approx(real_rms_hpa_h, rel=0.25)
+    truth = static_truth(3600.0)
+    rates = []
+    for seed in range(200):
+        out = as_frame(baro.generate(truth, np.random.default_rng(seed))["baro"])
+        p = out["pressure"].to_numpy()
+        rates.append(baro.drawn["drift_rate"])
+        p0 = pressure_pa(truth.position([0.0])[0, 2])
+        assert p[-1] - p[0] == pytest.approx(rates[-1] * 3600 * p0 / 101325.0, abs=1e-6)
+    assert np.std(rates) * 3600 / 100 == pytest.approx(0.4, rel=0.15)
+    assert make({}).config["weather_drift"] == 0.0  # ideal: no weather
+
+
+def test_temperature_sensitivity():
+    """BMP280 temperature coefficient of offset, 1.5 Pa/K (data sheet Table 2): with a 10 K
+    warm-up the pressure error is k_T dT(t) exactly, k_T drawn with 1-sigma 1.5 Pa/K."""
+    block = {"temperature_coefficient": "1.5 Pa/K",
+             "temperature": {"warmup": 10, "warmup_time": 300}}
+    baro = make(block)
+    truth = static_truth(1200.0)
+    ks = []
+    for seed in range(300):
+        out = as_frame(baro.generate(truth, np.random.default_rng(seed))["baro"])
+        t = out["t"].to_numpy()
+        error = out["pressure"].to_numpy() - pressure_pa(truth.position(t)[:, 2])
+        k = baro.drawn["temperature_coefficient"]
+        np.testing.assert_allclose(error, k * 10 * (1 - np.exp(-t / 300)), atol=1e-6)
+        ks.append(k)
+    assert np.std(ks) == pytest.approx(1.5, rel=0.12)
+    assert make({"preset": "bosch-bmp280"}).config["temperature_coefficient"] == 1.5
+
+
 @pytest.mark.parametrize("block, message", [
     ({"preset": "nope"}, "unknown barometer preset"),
     ({"noise": "1 m"}, "sensors.baro.noise"),
     ({"range": [110000, 30000]}, "must be below"),
+    ({"weather_drift": "-1 hPa/h"}, "below the minimum"),
+    ({"temperature_coefficient": "1 Pa"}, "sensors.baro.temperature_coefficient"),
 ])
 def test_bad_input_named(block, message):
     ctx = Context("test.yaml")
