@@ -112,11 +112,10 @@ class CampaignPlan:
                 seed = self.base.seed + i
                 part = (f"sweep-{point.index:04d}-run-{i:06d}" if self.sweeps
                         else f"run-{i:06d}")
-                # the drive's random road is the run's too: the validated profile is kept
-                drive = (None if scenario.drive is None
-                         else dataclasses.replace(scenario.drive, seed=seed))
+                # the validated drive is kept: the road has its own seed (vehicle.road_seed),
+                # so every run of a sweep point drives the same road
                 run_scenario = dataclasses.replace(
-                    scenario, data={**scenario.data, "seed": seed}, drive=drive,
+                    scenario, data={**scenario.data, "seed": seed},
                     overrides=[*(o for o in scenario.overrides if not o.startswith("seed=")),
                                f"seed={seed}"])
                 keep = None if keep_root is None else str(keep_root / part)

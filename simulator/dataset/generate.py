@@ -37,6 +37,7 @@ from simulator.outputs import atomic_output_dir
 from simulator.progress import progress
 from simulator.scenario import Scenario
 from simulator.sensors import SENSOR_MODELS
+from simulator.sensors.base import sample_times
 from simulator.stochastic import stream_rng
 from simulator.tables import Table, as_frames, column
 from simulator.trajectory.kinematics import Kinematics
@@ -128,7 +129,8 @@ def generate_streams(scenario: Scenario | dict, show_progress: bool = True, fram
     truth_sensors = truth_sensors_table(true_errors, truth.duration_s, fault_rows)
     if truth_sensors is not None:
         streams["truth_sensors"] = truth_sensors
-    for t_start, t_end in _outages(streams, truth.duration_s):
+    gnss_rate = None if gnss is None else gnss["rate"]
+    for t_start, t_end in _outages(streams, truth.duration_s, gnss_rate):
         rows.append({"t_start": t_start, "t_end": t_end, "kind": "gnss_outage", "detail": ""})
     if gnss is not None and "raw" not in gnss["outputs"]:
         streams.pop("gnss_raw", None)
@@ -139,16 +141,21 @@ def generate_streams(scenario: Scenario | dict, show_progress: bool = True, fram
                      {name: dict(model.truth_keys) for name, model in models.items()})
 
 
-def _outages(streams: dict[str, Table], end_t: float) -> list[tuple[float, float]]:
+def _outages(streams: dict[str, Table], end_t: float, gnss_rate_hz: float | None
+             ) -> list[tuple[float, float]]:
+    """The stretches of receiver epochs without a single measurement (SPEC section 5): epochs
+    from the fix stream, or the receiver's epoch grid when it outputs raw measurements only."""
     if "gnss_fix" in streams:
-        fix = streams["gnss_fix"]
-        epochs = column(fix, "t")
-        if "gnss_raw" in streams:
-            has = np.isin(epochs, column(streams["gnss_raw"], "t"))
-        else:
-            has = column(fix, "fix") > 0
-        return gnss_outage_intervals(epochs, has, end_t)
-    return []
+        epochs = column(streams["gnss_fix"], "t")
+    elif "gnss_raw" in streams and gnss_rate_hz:
+        epochs = sample_times(end_t, gnss_rate_hz)
+    else:
+        return []
+    if "gnss_raw" in streams:
+        has = np.isin(epochs, column(streams["gnss_raw"], "t"))
+    else:
+        has = column(streams["gnss_fix"], "fix") > 0
+    return gnss_outage_intervals(epochs, has, end_t)
 
 
 def _versions(data: dict) -> dict[str, str]:
