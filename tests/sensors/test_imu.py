@@ -89,30 +89,10 @@ def test_ideal_point_rate_output_is_truth(truth):
     np.testing.assert_array_equal(out[list(col.IMU_AXES[3:])].to_numpy(), k["f_body"])
 
 
-def test_ideal_rate_output_is_interval_mean(truth):
-    # the default rate sampling: the mean over (t - dt, t] against adaptive quadrature
-    # (scipy.integrate.quad) of the analytic truth, on rows spread over the drive, the first
-    # (its interval starts before the drive, where the truth holds the start) among them
-    out, imu = run(truth, {"preset": "ideal", "rate": 50, "rate_sampling": "interval_mean"})
-    assert imu.timing()["imu"]["delay_s"] == pytest.approx(0.01)  # half a sample
-    assert out["t"].iloc[0] == 0.0
-    breaks = truth.breakpoints()
-    rows = np.unique(np.concatenate([np.searchsorted(out["t"], breaks[:6]),
-                                     np.linspace(0, len(out) - 1, 6).astype(int)]))
-    for i in rows:
-        t1 = out["t"].iloc[i]
-        for j, axis in enumerate(col.IMU_AXES):
-            key, comp = ("w_body", j) if j < 3 else ("f_body", j - 3)
-            exact, _ = quad(lambda s, key=key, comp=comp: truth.inertial(s)[key][0, comp],
-                            t1 - 0.02, t1, points=breaks[(breaks > t1 - 0.02) & (breaks < t1)],
-                            epsabs=1e-14, epsrel=1e-12)
-            assert out[axis].iloc[i] == pytest.approx(exact / 0.02, abs=1e-9)
-
-
-def test_ideal_increments_are_exact_integrals(truth):
-    # against adaptive quadrature (scipy.integrate.quad) of the analytic body rate and specific
-    # force, on intervals spread over the drive (some hold a kinematic breakpoint)
-    out, _ = run(truth, {"preset": "ideal", "rate": 100, "output": "increment"})
+def _assert_interval_integrals(truth, out, dt: float, per_second: bool, abs_tol: float) -> None:
+    """Each row against adaptive quadrature (scipy.integrate.quad) of the analytic body rate and
+    specific force over (t - dt, t] (divided by dt when ``per_second``), on rows spread over the
+    drive: the first, and some whose interval holds a kinematic breakpoint."""
     breaks = truth.breakpoints()
     rows = np.unique(np.concatenate([np.searchsorted(out["t"], breaks[:6]),
                                      np.linspace(0, len(out) - 1, 8).astype(int)]))
@@ -121,9 +101,24 @@ def test_ideal_increments_are_exact_integrals(truth):
         for j, axis in enumerate(col.IMU_AXES):
             key, comp = ("w_body", j) if j < 3 else ("f_body", j - 3)
             exact, _ = quad(lambda s, key=key, comp=comp: truth.inertial(s)[key][0, comp],
-                            t1 - 0.01, t1, points=breaks[(breaks > t1 - 0.01) & (breaks < t1)],
+                            t1 - dt, t1, points=breaks[(breaks > t1 - dt) & (breaks < t1)],
                             epsabs=1e-14, epsrel=1e-12)
-            assert out[axis].iloc[i] == pytest.approx(exact, abs=1e-11)
+            assert out[axis].iloc[i] == pytest.approx(exact / dt if per_second else exact,
+                                                      abs=abs_tol)
+
+
+def test_ideal_rate_output_is_interval_mean(truth):
+    # the default rate sampling; the first row's interval starts before the drive, where the
+    # truth holds its starting state
+    out, imu = run(truth, {"preset": "ideal", "rate": 50, "rate_sampling": "interval_mean"})
+    assert imu.timing()["imu"]["delay_s"] == pytest.approx(0.01)  # half a sample
+    assert out["t"].iloc[0] == 0.0
+    _assert_interval_integrals(truth, out, 0.02, per_second=True, abs_tol=1e-9)
+
+
+def test_ideal_increments_are_exact_integrals(truth):
+    out, _ = run(truth, {"preset": "ideal", "rate": 100, "output": "increment"})
+    _assert_interval_integrals(truth, out, 0.01, per_second=False, abs_tol=1e-11)
 
 
 def test_scale_factor_and_misalignment_follow_drawn_matrix(truth):
