@@ -253,9 +253,14 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                       "stream; use an estimator that initialises itself")])
         initial = initial_state(dataset.read("truth"), float(t[0]), init,
                                 dataset.manifest.get("sensors"))
-    with _plugin_call(cls, "setup"):
+    try:
         estimator = cls(config, initial, {s.name: s.columns for s in streams},
                         {s.name: s.units for s in streams}, imu_output=imu_output(dataset))
+    except BaseException as exc:
+        failure = _plugin_failure(cls, "setup", None, exc)
+        if failure is None:
+            raise
+        raise failure from None
     gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
     out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
     out = np.full((len(out_t), len(cls.output_columns)), np.nan)
@@ -268,20 +273,27 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     start = time.perf_counter()
     k = 0
     asks = zip(out_t.tolist(), upto.tolist(), strict=True)
-    call = _Call(cls)
-    with call:
+    asking: float | None = None  # the solution time being asked for, else None (a message)
+    try:
         for j, (t_out, n_before) in enumerate(progress(asks, label, show_progress,
                                                        len(out_t))):
             while k < n_before:
                 s = sid_list[k]
-                call.at = (streams[s].name, t_list[k])
                 handlers[s](t_list[k], messages[s][idx_list[k]])
                 k += 1
-            call.at = ("solution", t_out)
+            asking = t_out
             row = solution(t_out)
+            asking = None
             if row is not None:
                 out[j] = _solution_row(row, cls, t_out)
                 kept[j] = True
+    except BaseException as exc:  # which call failed follows from where the loop stood
+        method, at = (("solution", asking) if asking is not None
+                      else (f"on_{streams[sid_list[k]].name}", t_list[k]))
+        failure = _plugin_failure(cls, method, at, exc)
+        if failure is None:
+            raise
+        raise failure from None
     runtime = time.perf_counter() - start
     position = out[kept][:, [cls.output_columns.index("lat"), cls.output_columns.index("lon")]]
     if not np.isfinite(position).all(axis=1).any():
@@ -302,37 +314,23 @@ def _where(cls: type) -> str:
     return f"estimator {cls.name!r} ({cls.__module__}.{cls.__qualname__})"
 
 
-class _Call:
-    """Turns anything a plug-in raises (``sys.exit`` included) into one ``InputError`` naming
-    the estimator, the call, the message time and the reason, with the line of the
-    estimator's code where it happened."""
-
-    def __init__(self, cls: type, at: tuple[str, float | None] = ("setup", None)):
-        self.cls, self.at = cls, at
-
-    def __enter__(self) -> _Call:
-        return self
-
-    def __exit__(self, kind: type | None, exc: BaseException | None, tb: Any) -> bool:
-        if exc is None or isinstance(exc, (InputError, KeyboardInterrupt, Terminated)):
-            return False
-        call, t = self.at
-        method = call if call in ("setup", "solution") else f"on_{call}"
-        when = "" if t is None else f" at t = {t:.6f} s"
-        if isinstance(exc, SystemExit):
-            reason = f"called sys.exit({exc.code!r}); an estimator must return, not exit"
-        else:
-            reason = f"{type(exc).__name__}: {exc}"
-            frames = [f for f in traceback.extract_tb(tb)
-                      if Path(f.filename).resolve() != Path(__file__).resolve()]
-            if frames:
-                reason += f" ({frames[-1].filename}:{frames[-1].lineno})"
-        raise InputError([Problem(_where(self.cls), None, "",
-                                  f"failed in {method}(){when}: {reason}")]) from None
-
-
-def _plugin_call(cls: type, method: str) -> _Call:
-    return _Call(cls, (method, None))
+def _plugin_failure(cls: type, method: str, t: float | None,
+                    exc: BaseException) -> InputError | None:
+    """What a plug-in raised (``sys.exit`` included) as one ``InputError`` naming the estimator,
+    the call, the message time and the reason, with the line of the estimator's code where it
+    happened; None for what must pass through (input errors, interruptions)."""
+    if isinstance(exc, (InputError, KeyboardInterrupt, Terminated)):
+        return None
+    when = "" if t is None else f" at t = {t:.6f} s"
+    if isinstance(exc, SystemExit):
+        reason = f"called sys.exit({exc.code!r}); an estimator must return, not exit"
+    else:
+        reason = f"{type(exc).__name__}: {exc}"
+        frames = [f for f in traceback.extract_tb(exc.__traceback__)
+                  if Path(f.filename).resolve() != Path(__file__).resolve()]
+        if frames:
+            reason += f" ({frames[-1].filename}:{frames[-1].lineno})"
+    return InputError([Problem(_where(cls), None, "", f"failed in {method}(){when}: {reason}")])
 
 
 def _solution_row(row: Any, cls: type, t: float) -> np.ndarray:
