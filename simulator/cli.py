@@ -149,8 +149,5 @@ def _run(args: argparse.Namespace) -> int:
             signal.signal(signum, handler)
 
 
-# the console script of installations made before 2026-11-24 calls ``program``
-program = main
-
 if __name__ == "__main__":
     sys.exit(main())
