@@ -208,7 +208,32 @@ class _StepAccumulator:
         self.dt += dt
 
 
-class Dr3dEkf(Estimator):
+class _OdometerDeadReckoning(Estimator):
+    """What both Park dead-reckoning filters take alike: IMU samples summed into steps of
+    ``config["step"]`` s (a step runs ``_step`` when complete), the latest odometer speed, and
+    the fix columns."""
+
+    def _take_inputs(self) -> None:
+        self._u = 0.0  # latest odometer reading, m/s
+        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment",
+                                     self.initial.t)
+        self._odo = self.columns["odometer"]["speed"]
+        self._fix = _FixColumns(self.columns["gnss_fix"])
+
+    def _step(self) -> None:
+        raise NotImplementedError
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        acc = self._imu
+        acc.add(t, row)
+        if acc.dt >= self.config["step"] - 1e-9:
+            self._step()
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        self._u = float(row[self._odo])
+
+
+class Dr3dEkf(_OdometerDeadReckoning):
     """Park et al. 2019 proposed 10-state 3-D DR/GPS EKF (eqs. 20-41, section III-D)."""
 
     name = "dr3d_ekf"
@@ -256,11 +281,8 @@ class Dr3dEkf(Estimator):
         self._v_ned = np.zeros(3)
         self._s = 1.0  # metres per odometer metre (eq. 20)
         self._bias = np.zeros(3)  # gyro bias estimate, rad/s
-        self._u = 0.0  # latest odometer reading, m/s
         self._zero3 = np.zeros(3)
-        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
-        self._odo = self.columns["odometer"]["speed"]
-        self._fix = _FixColumns(self.columns["gnss_fix"])
+        self._take_inputs()
         self._baro_col = self.columns.get("baro", {}).get("altitude")
         self._use_baro = bool(c["baro"]) and self._baro_col is not None
         self._baro_h = math.nan
@@ -290,15 +312,6 @@ class Dr3dEkf(Estimator):
         self._q_c[7:10] = q_gm[1:]
 
     # -- messages ---------------------------------------------------------------------------
-    def on_imu(self, t: float, row: np.ndarray) -> None:
-        acc = self._imu
-        acc.add(t, row)
-        if acc.dt >= self.config["step"] - 1e-9:
-            self._step()
-
-    def on_odometer(self, t: float, row: np.ndarray) -> None:
-        self._u = float(row[self._odo])
-
     def on_baro(self, t: float, row: np.ndarray) -> None:
         if self._baro_col is not None:
             self._baro_h = float(row[self._baro_col])
@@ -423,7 +436,7 @@ class Dr3dEkf(Estimator):
                 float(pitch), float(yaw), *std[0:3], *std_att, 1.0 / self._s, *self._bias]
 
 
-class Dr2dOdoEkf(Estimator):
+class Dr2dOdoEkf(_OdometerDeadReckoning):
     """Park et al. 2019 conventional 2-D DR/GPS with odometer (section II-B, eqs. 15-19)."""
 
     name = "dr2d_odo_ekf"
@@ -452,10 +465,7 @@ class Dr2dOdoEkf(Estimator):
         self._yaw = float(init.attitude[2])
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
-        self._u = 0.0
-        self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment", init.t)
-        self._odo = self.columns["odometer"]["speed"]
-        self._fix = _FixColumns(self.columns["gnss_fix"])
+        self._take_inputs()
         p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
                                                          c["heading_initial"] ** 2,
                                                          c["gyro_bias_initial"] ** 2])
@@ -472,15 +482,6 @@ class Dr2dOdoEkf(Estimator):
 
     def _speed(self) -> float:
         return self._u - self._speed_error if self._u != 0.0 else 0.0
-
-    def on_imu(self, t: float, row: np.ndarray) -> None:
-        acc = self._imu
-        acc.add(t, row)
-        if acc.dt >= self.config["step"] - 1e-9:
-            self._step()
-
-    def on_odometer(self, t: float, row: np.ndarray) -> None:
-        self._u = float(row[self._odo])
 
     def _step(self) -> None:
         """Heading (eq. 3 about the body z axis) and position (eqs. 15-16), covariance."""
