@@ -232,6 +232,16 @@ class _OdometerDeadReckoning(Estimator):
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         self._u = float(row[self._odo])
 
+    def _take_fix(self, row: np.ndarray) -> bool:
+        """Whether a fix epoch has a position; if so the dead reckoning is first brought up to
+        it (the part step since the last complete one)."""
+        fx = self._fix
+        if not (row[fx.fix] > 0 and math.isfinite(row[fx.lat])):
+            return False
+        if self._imu.dt > 0.0:
+            self._step()
+        return True
+
 
 class Dr3dEkf(_OdometerDeadReckoning):
     """Park et al. 2019 proposed 10-state 3-D DR/GPS EKF (eqs. 20-41, section III-D)."""
@@ -318,11 +328,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._baro_new = True
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        fx = self._fix
-        if not (row[fx.fix] > 0 and math.isfinite(row[fx.lat])):
+        if not self._take_fix(row):
             return
-        if self._imu.dt > 0.0:
-            self._step()
+        fx = self._fix
         c = self.config
         lat, lon, alt = math.radians(row[fx.lat]), math.radians(row[fx.lon]), float(row[fx.alt])
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
@@ -507,11 +515,9 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         """Eqs. 18-19: GPS north, east position and ground speed."""
-        fx = self._fix
-        if not (row[fx.fix] > 0 and math.isfinite(row[fx.lat])):
+        if not self._take_fix(row):
             return
-        if self._imu.dt > 0.0:
-            self._step()
+        fx = self._fix
         c = self.config
         # no lever arm: the attitude argument is not used
         dz, _ = gnss_position(_LEVEL, np.array([self._lat, self._lon, self._h]),
