@@ -21,6 +21,7 @@ import pytest
 
 from simulator.cli import main
 from simulator.dataset.io import open_dataset
+from simulator.pipeline import load_scenario
 
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
@@ -29,6 +30,12 @@ SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
 SHORTENED: dict[str, list[str]] = {
     "highway_long": ["trajectory.segments.3.repeat.times=1"],  # one lap of six (1 h -> 11 min)
     "sumo_city_canyon": ["trajectory.max_duration=150"],  # the first 150 s (6 min)
+}
+
+# zones a (shortened) run must pass through: the library scenarios are what their comments say
+EXPECTED_ZONES: dict[str, set[str]] = {
+    "highway_long": {"underpass", "tunnel"},
+    "sumo_city_canyon": {"downtown"},
 }
 
 
@@ -46,6 +53,7 @@ def test_shipped_scenario_runs(path, tmp_path):
     ds = open_dataset(out / "dataset")
     truth = ds.read("truth")
     assert truth.t.iloc[-1] == pytest.approx(ds.manifest["duration"], abs=0.02)
+    assert EXPECTED_ZONES.get(path.stem, set()) <= set(truth.zone)
     labels = [e if isinstance(e, str) else e["label"] or e["name"]
               for e in ds.manifest["scenario"]["estimators"]]
     scores = json.loads((out / "scores.json").read_text())
@@ -57,6 +65,22 @@ def test_shipped_scenario_runs(path, tmp_path):
     report = (out / "report.md").read_text()
     assert all(label in report for label in labels)
     assert not labels or any((out / "plots").glob("*.png"))
+
+
+def test_highway_long_is_an_hour_of_motorway():
+    """Whole (validation builds the road profile; nothing is generated): about an hour, 25-33 m/s
+    while moving (ramps aside), an overpass in each of the six laps and one tunnel of about 30 s."""
+    drive = load_scenario(REPO / "scenarios" / "highway_long.yaml").drive
+    assert 3300.0 < drive.duration_s < 3900.0
+    t = np.arange(0.0, drive.duration_s, 1.0)
+    speed = np.diff(drive.profile.distance_of_time(t))
+    moving = speed[speed > 1.0]
+    assert moving.max() <= 33.0 + 1e-6
+    assert np.mean((moving >= 25.0 - 1e-6) & (moving <= 33.0 + 1e-6)) > 0.95
+    zones = [(t0, t1, name) for t0, t1, name in drive.profile.zones]
+    assert [name for *_, name in zones].count("underpass") == 6
+    tunnels = [t1 - t0 for t0, t1, name in zones if name == "tunnel"]
+    assert len(tunnels) == 1 and 25.0 < tunnels[0] < 35.0
 
 
 def test_ruff_clean():
