@@ -285,10 +285,16 @@ class Gnss(PresetSensor):
                 ends = rng.standard_normal((el.shape[0], street.max() + 1, 2))[:, street]
                 facade_loss = np.maximum(zone["nlos_attenuation"] + zone["nlos_attenuation_spread"]
                                          * np.concatenate([sides, ends], axis=-1), 0.0)
-                z_los, z_nlos, z_extra, z_loss = canyon_reception(
-                    az[:, here], el[:, here], yaw[None, here], zone["building_height"],
-                    zone["street_width"], ahead[None, :], behind[None, :], facade_loss,
-                    LAMBDA_L1_M)
+                # traced only for the satellites above the horizon (about 40 % of them)
+                shape = el[:, here].shape
+                up = el[:, here] > 0
+                z_los, z_nlos = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
+                z_extra, z_loss = np.zeros(shape), np.zeros(shape)
+                z_los[up], z_nlos[up], z_extra[up], z_loss[up] = canyon_reception(
+                    az[:, here][up], el[:, here][up], np.broadcast_to(yaw[here], shape)[up],
+                    zone["building_height"], zone["street_width"],
+                    np.broadcast_to(ahead, shape)[up], np.broadcast_to(behind, shape)[up],
+                    facade_loss[up], LAMBDA_L1_M)
                 los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
                 loss[:, here] = z_loss
         return los, nlos, extra, loss
