@@ -29,6 +29,7 @@ from simulator.gnss.ephemeris import (
     select_ephemeris,
 )
 from simulator.gnss.navfiles import read_yuma
+from simulator.gnss.nmea import nmea_sentences
 from simulator.timebase import SECONDS_PER_WEEK, utc_to_gps
 
 REF = Path(__file__).resolve().parents[3] / "shared" / "refdata"
@@ -123,6 +124,12 @@ def test_unhealthy_satellite_is_tracked_flagged_and_left_out_of_the_fixes():
     healthy_per_epoch = raw[raw["health"] == 0].groupby("t").size()
     np.testing.assert_array_equal(fix.set_index("t")["num_sats"].loc[healthy_per_epoch.index],
                                   healthy_per_epoch.to_numpy())
+    # NMEA: GSV shows PRN 04 in view, GSA does not list it among the satellites used
+    week, tow = utc_to_gps(truth.utc_start)
+    lines = nmea_sentences(fix.iloc[:1], raw[raw["t"] == fix["t"].iloc[0]], week, tow)
+    gsa = next(x for x in lines if x.startswith("$GPGSA")).split("*")[0].split(",")[3:15]
+    gsv = [x.split("*")[0].split(",") for x in lines if x.startswith("$GPGSV")]
+    assert "04" in [f[k] for f in gsv for k in range(4, len(f), 4)] and "04" not in gsa
     # error-free measurements of the healthy satellites give the antenna exactly
     k = truth.inertial(fix["t"].to_numpy())
     assert (fix["fix"] == 2).all() and np.abs(fix["alt"] - k["alt"]).max() < 0.01
