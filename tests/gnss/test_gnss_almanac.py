@@ -162,3 +162,29 @@ def test_ephemeris_is_not_used_beyond_half_its_fit_interval():
     idx = select_ephemeris(eph, sv[:, None], t[None, :], healthy_only=False)
     assert EPHEMERIS_MAX_AGE_S == 7200.0
     assert (idx[:, 0] >= 0).all() and (idx[:, 1:] == -1).all()
+
+
+def test_satellite_limit_keeps_healthy_satellites():
+    """A ``gnss_satellite_limit`` of N leaves N usable satellites: PRN 04, unhealthy and the
+    sixth highest of ten over Seoul then, is lost with the low ones, not counted among the 6."""
+    from conftest import scenario_data
+
+    from simulator.dataset.generate import generate_streams
+
+    start = {"utc": "2026-05-04T04:40:00Z", "lat": 37.57, "lon": 126.98, "alt": 40.0,
+             "heading": 0.0}
+    sensors = {"imu": {"preset": "ideal", "rate": 10},
+               "gnss": {"preset": "ideal", "rate": 1, "outputs": ["fix", "raw"]}}
+    segments = [{"stop": {"duration": 60}}]
+    fault = {"kind": "gnss_satellite_limit", "start": 0, "duration": 60, "count": 6}
+    clean = generate_streams(scenario_data(segments, start=start, sensors=sensors),
+                             show_progress=False).streams["gnss_raw"]
+    cut = generate_streams(scenario_data(segments, start=start, sensors=sensors,
+                                         faults=[fault]), show_progress=False).streams
+    first = clean[clean["t"] == 10.0]
+    assert 4 in first.nlargest(6, "elevation")["sv"].tolist()  # PRN 04 is high in the sky
+    kept = cut["gnss_raw"][cut["gnss_raw"]["t"] == 10.0]
+    healthy = first[first["health"] == 0].nlargest(6, "elevation")
+    assert set(kept["sv"]) == set(healthy["sv"])
+    fix = cut["gnss_fix"][cut["gnss_fix"]["t"] < 60.0]  # the fault covers [0, 60) s
+    assert (fix["num_sats"] == 6).all() and (fix["fix"] == 2).all()
