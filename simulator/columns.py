@@ -45,6 +45,9 @@ GNSS_RAW = {
     "elevation": "rad", "azimuth": "rad",
     # the receiver's own 1-sigma estimates (as Android's ...UncertaintyMeters), for weighting
     "pseudorange_std": "m", "pseudorange_rate_std": "m/s",
+    # the satellite's broadcast health (IS-GPS-200 20.3.3.3.1.4; YUMA: the almanac's 6-bit
+    # code): 0 healthy; any other value is tracked and reported but not to be used
+    "health": "1",
 }
 
 # the true error terms of every signal above the horizon (tracked or not), so that

@@ -3,7 +3,9 @@ satellites in view, and the receiver's own fixes computed from them, so that a f
 exactly when and how the measurements do.
 
 Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
-``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac),
+``constellation`` (``gps-almanac``, the default: the real GPS constellation of the shipped
+2020-01-01 almanac re-epoched to the drive, ``simulator.gnss.constellation``; ``nominal-gps``;
+or a RINEX navigation file / YUMA almanac),
 ``expanded_slots`` (which expandable slots of ``nominal-gps`` are split into their fore/aft pairs:
 any of ``B1``, ``D2``, ``F2``; all three give the 27-slot constellation), ``elevation_mask``
 (deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
@@ -16,8 +18,9 @@ and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output,
 single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
 mass-market single-frequency receiver with a TCXO.
 
-Streams: ``gnss_raw`` (one row per tracked signal), ``gnss_fix`` (one row per epoch: 3D fix
-from four signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
+Streams: ``gnss_raw`` (one row per tracked signal, unhealthy satellites included with their
+``health`` code), ``gnss_fix`` (one row per epoch from the healthy signals: 3D fix from four
+signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
 elements used) and ``truth_gnss`` (the true error terms of every signal above the horizon).
 Epoch times ``t`` are true GPS time since the scenario start; the receiver clock error is in
 the measurements.
@@ -50,12 +53,22 @@ from simulator.earth import (
     ned_to_ecef_matrix,
 )
 from simulator.environment import ZONE_FIELD
-from simulator.environment.sky import canyon_visibility
+from simulator.environment.sky import canyon_reception
 from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
-from simulator.gnss.constellation import EXPANDABLE_SLOTS, nominal_gps_navigation
-from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
+from simulator.gnss.constellation import (
+    EXPANDABLE_SLOTS,
+    almanac_gps_navigation,
+    nominal_gps_navigation,
+)
+from simulator.gnss.ephemeris import (
+    EPHEMERIS_MAX_AGE_S,
+    ephemeris_arrays,
+    gather,
+    satellite_state,
+    select_ephemeris,
+)
 from simulator.gnss.errors import (
     CARRIER_SMOOTHING_TIME_S,
     OSCILLATORS,
@@ -87,6 +100,9 @@ PRESETS: dict[str, dict] = {
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
+# the constellations known by name (anything else names a file)
+CONSTELLATIONS = ("gps-almanac", "nominal-gps")
+ALMANAC_MAX_AGE_S = 7 * 86400.0  # a YUMA almanac file is used up to a week from its TOA
 # a zone the environment block does not describe, or describes in part: the schema's defaults
 _ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
 
@@ -120,20 +136,21 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
                                             f"{', '.join(sorted(OSCILLATORS))}")
     source = value["constellation"]
     expanded = value["expanded_slots"]
-    if expanded and source != "nominal-gps":
-        return ctx.error(path + ("expanded_slots",), "only applies to constellation "
-                                                     "'nominal-gps'")
     if len(set(expanded)) < len(expanded):
         return ctx.error(path + ("expanded_slots",), "names a slot more than once")
-    if source != "nominal-gps":
+    if expanded and source != "nominal-gps":
+        return ctx.error(path + ("expanded_slots",), "only applies to constellation "
+                                                     "'nominal-gps' (name it: the default is "
+                                                     "'gps-almanac')")
+    if source not in CONSTELLATIONS:
         candidates = [FilePath(source)]
         if ctx.file and not FilePath(source).is_absolute():
             candidates.insert(0, FilePath(ctx.file).resolve().parent / source)
         found = [c for c in candidates if c.is_file()]
         if not found:
             return ctx.error(path + ("constellation",),
-                             f"{source!r} is neither 'nominal-gps' nor an existing RINEX "
-                             "navigation or YUMA almanac file")
+                             f"{source!r} is neither 'gps-almanac', 'nominal-gps' nor an "
+                             "existing RINEX navigation or YUMA almanac file")
         value["constellation"] = str(found[0].resolve())
         try:
             read_navigation(found[0])
@@ -150,8 +167,11 @@ GNSS_FIELD = Record(
         "rate": Number("Hz", 1.0, gt=0, max=100, doc="epoch rate"),
         "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1,
                           doc="streams written: gnss_fix and/or gnss_raw"),
-        "constellation": Text("nominal-gps",
-                              doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
+        "constellation": Text("gps-almanac",
+                              doc="'gps-almanac' (the real GPS of the NAVCEN almanac of "
+                                  "2020-01-01, 31 satellites, re-epoched to the drive by whole "
+                                  "ground-track repeats), 'nominal-gps' (the 24 SPS slots) or a "
+                                  "RINEX navigation file or YUMA almanac"),
         "expanded_slots": ListOf(Text(choices=list(EXPANDABLE_SLOTS)), [],
                                  doc="expandable slots of 'nominal-gps' split into their fore/aft "
                                      "pairs (SPS PS 2008 Table 3.4-2); [B1, D2, F2] = 27 slots"),
@@ -164,7 +184,9 @@ GNSS_FIELD = Record(
                                              doc="Gauss-Markov correlation time of multipath"),
         "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
         "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
-        "cn0_threshold": Number("", 25.0, doc="tracking threshold, dB-Hz"),
+        "cn0_threshold": Number("", 17.0,
+                                doc="tracking threshold, dB-Hz (the weakest signal the "
+                                    "comma2k19 car's u-blox reports)"),
         "dll_bandwidth": Number("Hz", 0.5, gt=0, doc="code tracking loop (DLL) bandwidth"),
         "correlator_spacing": Number("", 0.5, gt=0, max=1, doc="early-late spacing, chips"),
         "fll_bandwidth": Number("Hz", 0.5, gt=0, doc="carrier (frequency) loop noise bandwidth"),
@@ -201,8 +223,12 @@ class Gnss(PresetSensor):
 
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:
-        """The navigation table used for the drive (nominal constellation or the named file)."""
+        """The navigation table used for the drive (a named constellation or the named file)."""
         week0, _ = utc_to_gps(truth.utc_start)
+        if self.config["constellation"] == "gps-almanac":
+            nav = almanac_gps_navigation(truth.utc_start, truth.duration_s)
+            nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
+            return nav
         if self.config["constellation"] == "nominal-gps":
             nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0,
                                          expanded=self.config["expanded_slots"])
@@ -224,12 +250,22 @@ class Gnss(PresetSensor):
         vel = np.einsum("nij,nj->ni", c_ne, v_ned)
         lat, lon, alt = ecef_to_geodetic(pos)
         return {"pos": pos, "vel": vel, "v_ned": v_ned, "lat": lat, "lon": lon, "alt": alt,
-                "yaw": k["yaw"]}
+                "yaw": k["yaw"], "distance": k["distance"]}
 
     def sky(self, truth: Kinematics, t: np.ndarray, az: np.ndarray, el: np.ndarray,
-            yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+            yaw: np.ndarray, distance: np.ndarray, rng: np.random.Generator
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Line of sight, NLOS, NLOS extra path (m) and C/N0 loss (dB) per satellite and epoch
-        from the environment zones (``sky``: open, none, canyon)."""
+        from the environment zones (``sky``: open, none, canyon).
+
+        A canyon (``simulator.environment.sky.canyon_reception``) is one street from where its
+        zone begins to where it ends along the drive (consecutive segments of the zone make one
+        street), closed at both ends by facades across it. Each facade's reflection loss is
+        drawn from N(``nlos_attenuation``, ``nlos_attenuation_spread``), floored at 0 dB, once
+        per satellite and building: side facades change every ``facade_length`` metres of the
+        distance driven (the building beside the antenna stands for the reflection point), the
+        end facades once per street. Draws are made only when the drive has a canyon, so open
+        drives' random streams are unchanged."""
         los = np.ones(el.shape, dtype=bool)
         nlos = np.zeros(el.shape, dtype=bool)
         extra = np.zeros(el.shape)
@@ -242,11 +278,25 @@ class Gnss(PresetSensor):
             if zone["sky"] == "none":
                 los[:, here] = False
             elif zone["sky"] == "canyon":
-                z_los, z_nlos, z_extra = canyon_visibility(
-                    az[:, here], el[:, here], yaw[None, here], zone["building_height"],
-                    zone["street_width"])
+                ahead, behind, street = _street_ends(truth, name, t[here], distance[here])
+                panel = np.floor(distance[here] / zone["facade_length"]).astype(int)
+                panel -= panel.min()
+                sides = rng.standard_normal((el.shape[0], panel.max() + 1, 2))[:, panel]
+                ends = rng.standard_normal((el.shape[0], street.max() + 1, 2))[:, street]
+                facade_loss = np.maximum(zone["nlos_attenuation"] + zone["nlos_attenuation_spread"]
+                                         * np.concatenate([sides, ends], axis=-1), 0.0)
+                # traced only for the satellites above the horizon (about 40 % of them)
+                shape = el[:, here].shape
+                up = el[:, here] > 0
+                z_los, z_nlos = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
+                z_extra, z_loss = np.zeros(shape), np.zeros(shape)
+                z_los[up], z_nlos[up], z_extra[up], z_loss[up] = canyon_reception(
+                    az[:, here][up], el[:, here][up], np.broadcast_to(yaw[here], shape)[up],
+                    zone["building_height"], zone["street_width"],
+                    np.broadcast_to(ahead, shape)[up], np.broadcast_to(behind, shape)[up],
+                    facade_loss[up], LAMBDA_L1_M)
                 los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
-                loss[:, here] = np.where(z_nlos, zone["nlos_attenuation"], 0.0)
+                loss[:, here] = z_loss
         return los, nlos, extra, loss
 
     def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
@@ -258,6 +308,7 @@ class Gnss(PresetSensor):
             raise InputError([Problem(
                 self.config["constellation"], None, "sensors.gnss.constellation",
                 f"fewer than four satellites have an ephemeris within {max_age_s / 3600:g} h "
+                "(half the broadcast fit interval; older records are not used) "
                 f"of the drive from t = {t[short][0]:g} s (the drive starts "
                 f"{truth.utc_start:%Y-%m-%d %H:%M:%S} UTC); use a navigation file of that "
                 "day or 'nominal-gps'")])
@@ -270,11 +321,15 @@ class Gnss(PresetSensor):
         week0, tow0 = utc_to_gps(truth.utc_start)
         nav = self.navigation(truth)
         eph = ephemeris_arrays(nav, week0)
-        # an almanac describes the orbits for days (coarsely); an ephemeris for its fit interval
-        max_age = 7 * 86400.0 if nav.attrs.get("kind") == "almanac" else 4 * 3600.0
+        # an almanac describes the orbits for days (coarsely); an ephemeris only within its fit
+        # interval. Unhealthy satellites are tracked and flagged; the fixes leave them out.
+        almanac = nav.attrs.get("kind") == "almanac"
+        max_age = ALMANAC_MAX_AGE_S if almanac else EPHEMERIS_MAX_AGE_S
         svs = np.unique(nav["sv"].to_numpy())
-        idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age)
+        idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
+                               healthy_only=False)
         self._check_coverage(idx, t, truth, max_age)
+        health = np.where(idx >= 0, gather(eph, idx)["health"], 0.0)
 
         # geometry: antenna, signal flight, look angles, broadcast delays (satellites x epochs)
         ant = self.antenna(truth, t)
@@ -287,7 +342,7 @@ class Gnss(PresetSensor):
         el, az = geo["elevation"], geo["azimuth"]
 
         # what the receiver tracks
-        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
+        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"], ant["distance"], rng)
         signal_cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
         cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
         have = idx >= 0
@@ -328,6 +383,7 @@ class Gnss(PresetSensor):
             "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": model["iono"],
             "tropo": model["tropo"], "elevation": el, "azimuth": az,
             "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
+            "health": health.astype(np.int64),
         })[list(col.GNSS_RAW)]
         truth_table = table(have & (el > 0), {
             "tracked": tracked.astype(np.int8), "los": los.astype(np.int8),
@@ -431,3 +487,23 @@ class _RowTable:
         for key, value in columns.items():
             out[key] = np.swapaxes(np.broadcast_to(value, mask.shape), 0, 1)[m]
         return pd.DataFrame(out)
+
+
+def _street_ends(truth: Kinematics, zone: str, t: np.ndarray, distance: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Distance to the end facade ahead and behind (along the drive) at epochs t inside
+    ``zone``, and the number of the street each epoch is in: consecutive stretches of the zone
+    (one segment's end is the next one's start) make one street."""
+    streets: list[list[float]] = []
+    for start, end, name in truth.profile.zones:  # one pass per zoned segment
+        if name != zone:
+            continue
+        if streets and abs(start - streets[-1][1]) < 1e-9:
+            streets[-1][1] = end
+        else:
+            streets.append([start, end])
+    bounds = np.asarray(streets, dtype=float).reshape(-1, 2)
+    street = np.clip(np.searchsorted(bounds[:, 0], t, side="right") - 1, 0, len(bounds) - 1)
+    at = truth.inertial(bounds.ravel())["distance"].reshape(-1, 2)
+    return (np.maximum(at[street, 1] - distance, 0.0), np.maximum(distance - at[street, 0], 0.0),
+            street)

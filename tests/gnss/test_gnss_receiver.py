@@ -206,8 +206,9 @@ def test_canyon_has_fewer_satellites_and_worse_dop(heading):
     assert (m.loc[m["nlos"] == 0, "nlos_delay"] == 0).all()
     nlos = m[m["nlos"] == 1]
     cfg = gnss.config
-    np.testing.assert_allclose(nlos["cn0"], cn0_model(nlos["elevation"], cfg["cn0_zenith"],
-                                                      cfg["cn0_horizon"]) - 10.0)
+    # they lose C/N0 (a reflection off a facade, or diffraction over its edge), never gain it
+    loss = cn0_model(nlos["elevation"], cfg["cn0_zenith"], cfg["cn0_horizon"]) - nlos["cn0"]
+    assert (loss > 0).all() and (nlos["cn0"] >= cfg["cn0_threshold"]).all()
 
 
 def test_three_satellites_give_a_2d_fix_and_two_give_none():
