@@ -33,7 +33,10 @@ Time behaviour (issue 19):
 - The true ionosphere is ``iono_scale`` times the Klobuchar delay (1.5 by default: the model
   leaves a residual of half its own value; Klobuchar 1987 designed it to remove about 50 % of
   the rms delay) times a slowly varying factor, 1 + ``iono_residual`` (c + 0.5 o), with c common
-  to all signals and o each signal's own, both Gauss-Markov over 30 min.
+  to all signals and o each signal's own, both Gauss-Markov over 30 min, drawn every 90 s and
+  interpolated linearly: smooth, as the ionosphere is (a Gauss-Markov process sampled every
+  epoch changes like a random walk from epoch to epoch, a rate the carrier smoothing would turn
+  into decimetres of code-carrier divergence error).
 
 Public names
 ------------
@@ -156,8 +159,12 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
 
     out = {"sis": cfg["sis_error"] * unit_gm(n_sat, SIS_CORRELATION_TIME_S)}
-    common = unit_gm(1, IONO_CORRELATION_TIME_S)
-    own = unit_gm(n_sat, IONO_CORRELATION_TIME_S)
+    # the ionosphere varies smoothly: a Gauss-Markov process drawn every 1/20 of its correlation
+    # time and interpolated, so that its rate (which the carrier smoothing's code-carrier
+    # divergence sees) stays at the mm/s of real ionospheric gradients
+    u_iono = np.arange(n_ep) * dt_s / IONO_CORRELATION_TIME_S
+    common = gauss_markov_along(u_iono, 1, rng)
+    own = gauss_markov_along(u_iono, n_sat, rng)
     out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"]
                                              * (common + IONO_OWN_SHARE * own))
     out["tropo_zenith"] = cfg["tropo_residual"] * rng.standard_normal()
