@@ -106,10 +106,11 @@ def test_raw_error_terms_add_up_to_the_measurement():
                + m["tropo_true"] + m["sis_error"] + m["multipath"] + m["nlos_delay"]
                + m["code_noise"])
     np.testing.assert_allclose(m["pseudorange"], rebuilt, rtol=0, atol=1e-6)
-    # the broadcast ionosphere leaves about half its own value (iono_scale 1.5 in the
-    # automotive preset, issue 19; was a 20 % residual about a ratio of 1 before)
-    iono_left = (m["iono_true"] - m["iono"]).abs().mean() / m["iono"].mean()
-    assert 0.25 < iono_left < 0.8
+    # the true ionosphere is iono_scale (1.5) x (1 + 0.2 x a slow variation) x the broadcast
+    # one (issue 19; was 1 + 0.2 x the variation before): one drive draws one common variation
+    # (here the ratio is 1.17), so the mean ratio over seeds is checked in test_gnss_errors
+    ratio = m["iono_true"] / m["iono"]
+    assert 0.5 < ratio.min() and ratio.max() < 2.5 and ratio.std() > 0.01
 
 
 def _budget_run(seed: int):
