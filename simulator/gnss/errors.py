@@ -245,14 +245,17 @@ def smooth_code_errors(cfg: dict, terms: dict[str, np.ndarray], iono_true_m: np.
     module docstring): ``code_noise`` = F(e_code) + F(2 I) - 2 I (the tracking noise and the
     ionosphere's code-carrier divergence), ``multipath`` = F(m_code). Untracked signals keep
     their raw values (nothing is smoothed there). Returns the updated copy of ``terms``."""
-    if cfg["carrier_smoothing"] <= 0:
+    rows = np.flatnonzero(tracked.any(axis=1))  # the satellites ever tracked
+    if cfg["carrier_smoothing"] <= 0 or rows.size == 0:
         return terms
-    stacked = np.stack([terms["code_noise"], terms["multipath"], 2.0 * iono_true_m])
-    smooth = hatch_filter(stacked, tracked, dt_s, cfg["carrier_smoothing"])
+    iono = iono_true_m[rows]
+    stacked = np.stack([terms["code_noise"][rows], terms["multipath"][rows], 2.0 * iono])
+    smooth = hatch_filter(stacked, tracked[rows], dt_s, cfg["carrier_smoothing"])
     out = dict(terms)
-    out["code_noise"] = np.where(tracked, smooth[0] + smooth[2] - 2.0 * iono_true_m,
-                                 terms["code_noise"])
-    out["multipath"] = np.where(tracked, smooth[1], terms["multipath"])
+    for key, value in (("code_noise", smooth[0] + smooth[2] - 2.0 * iono),
+                       ("multipath", smooth[1])):
+        out[key] = terms[key].copy()
+        out[key][rows] = np.where(tracked[rows], value, terms[key][rows])
     return out
 
 
