@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from gnss_helpers import drive, receiver
+from gnss_helpers import drive, pooled_autocorrelation, receiver
 
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import klobuchar_delay, tropo_delay, water_vapour_pressure
@@ -157,11 +157,8 @@ def autocorrelation(res: pd.DataFrame, lag_s: float) -> float:
     series about its own mean over the hour (so a constant per-satellite offset, e.g. a
     broadcast orbit error, does not count as correlation)."""
     wide = res.pivot(index="tow", columns="sv", values="pr_res")
-    wide = (wide - wide.mean()).to_numpy()
-    lag = int(round(lag_s / 30.0))  # the file's epochs are 30 s apart
-    a, b = wide[:-lag], wide[lag:]
-    both = np.isfinite(a) & np.isfinite(b)
-    return float(np.sum(a[both] * b[both]) / np.sqrt(np.sum(a[both] ** 2) * np.sum(b[both] ** 2)))
+    # the file's epochs are 30 s apart
+    return pooled_autocorrelation((wide - wide.mean()).to_numpy(), int(round(lag_s / 30.0)))
 
 
 def std_by_elevation(res: pd.DataFrame) -> np.ndarray:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from gnss_helpers import drive, receiver
+from gnss_helpers import drive, pooled_autocorrelation, receiver
 
 from simulator.gnss.errors import (
     gauss_markov_along,
@@ -76,10 +76,8 @@ def test_smoothing_lowers_white_noise_by_the_known_factor():
 
 
 def _pooled_autocorrelation(table, column: str, lag: int) -> float:
-    wide = table.pivot(index="t", columns="sv", values=column).to_numpy()
-    a, b = wide[:-lag], wide[lag:]
-    both = np.isfinite(a) & np.isfinite(b)
-    return float(np.sum(a[both] * b[both]) / np.sqrt(np.sum(a[both] ** 2) * np.sum(b[both] ** 2)))
+    return pooled_autocorrelation(table.pivot(index="t", columns="sv", values=column).to_numpy(),
+                                  lag)
 
 
 @pytest.mark.parametrize("rate, expected", [(10.0, np.exp(-0.1 / 0.5)), (1.0, np.exp(-1 / 0.5))])
