@@ -33,15 +33,14 @@ Time behaviour (issue 19):
 - The true ionosphere is ``iono_scale`` times the Klobuchar delay (1.5 by default: the model
   leaves a residual of half its own value; Klobuchar 1987 designed it to remove about 50 % of
   the rms delay) times a slowly varying factor, 1 + ``iono_residual`` (c + 0.5 o), with c common
-  to all signals and o each signal's own, both Gauss-Markov over 30 min, drawn every 90 s and
-  interpolated linearly: smooth, as the ionosphere is (a Gauss-Markov process sampled every
-  epoch changes like a random walk from epoch to epoch, a rate the carrier smoothing would turn
-  into decimetres of code-carrier divergence error).
+  to all signals and o each signal's own, both Gauss-Markov over 30 min, drawn every 30 min and
+  interpolated linearly: smooth, as the ionosphere is (``IONO_GRID_STEP``).
 
 Public names
 ------------
 OSCILLATORS, SIS_CORRELATION_TIME_S, IONO_CORRELATION_TIME_S, IONO_OWN_SHARE,
-REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, GRID_STEP, loop_time_constant_s,
+REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, GRID_STEP, IONO_GRID_STEP,
+loop_time_constant_s,
 decorrelation_coordinate, gauss_markov_along, draw_receiver_clock, draw_fading,
 draw_error_terms, hatch_filter, smoothed_variance_factor, smooth_code_errors,
 pseudorange_sigma.
@@ -79,6 +78,13 @@ REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it r
 # step of the grid (in correlation lengths of u) on which the motion-driven processes are drawn
 # before linear interpolation to the epochs: the interpolation keeps over 99 % of the variance
 GRID_STEP = 0.05
+# the ionosphere's variation is drawn once per correlation time (30 min) and interpolated: its
+# rate is then sigma x 1.1 / 30 min, about 1.5 mm/s on an 8 m delay with the default 1.5 x 0.2,
+# the rate of TEC of a quiet mid-latitude ionosphere (below 0.5 TECU/min = 1.35 mm/s on L1;
+# Pi et al., "Monitoring of global ionospheric irregularities using the worldwide GPS network",
+# Geophys. Res. Lett. 24(18), 1997); drawn every epoch, the process would change like a random
+# walk, some 10 mm/s, which the carrier smoothing turns into a metre of divergence error
+IONO_GRID_STEP = 1.0
 
 
 def loop_time_constant_s(bandwidth_hz: float) -> float:
@@ -94,15 +100,17 @@ def decorrelation_coordinate(t_s: np.ndarray, distance_m: np.ndarray, distance_s
     return np.asarray(distance_m) / distance_scale_m + np.asarray(t_s) / time_scale_s
 
 
-def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator) -> np.ndarray:
+def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator,
+                       step: float = GRID_STEP) -> np.ndarray:
     """Unit-variance processes with correlation exp(-|u_i - u_j|) at the points u (ascending,
     shape (n,)), one per row: shape (rows, n). Each is the exact Gauss-Markov process
-    (``simulator.stochastic.gauss_markov``, unit correlation length) on a grid of step
-    ``GRID_STEP`` in u, interpolated linearly at u."""
+    (``simulator.stochastic.gauss_markov``, unit correlation length) on a grid of ``step`` in
+    u, interpolated linearly at u (between grid points the variance falls to (1 + e^-step) / 2
+    at the middle: 0.99 for the default step, 0.68 for a step of 1)."""
     u = np.asarray(u, dtype=float)
-    grid = u[0] + np.arange(int(np.ceil((u[-1] - u[0]) / GRID_STEP)) + 2) * GRID_STEP
-    values = gauss_markov(len(grid), GRID_STEP, np.ones(rows), 1.0, rng)
-    pos = (u - grid[0]) / GRID_STEP
+    grid = u[0] + np.arange(int(np.ceil((u[-1] - u[0]) / step)) + 2) * step
+    values = gauss_markov(len(grid), step, np.ones(rows), 1.0, rng)
+    pos = (u - grid[0]) / step
     i = np.minimum(pos.astype(int), len(grid) - 2)
     w = pos - i
     return (values[i] * (1.0 - w)[:, None] + values[i + 1] * w[:, None]).T
@@ -159,12 +167,12 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
 
     out = {"sis": cfg["sis_error"] * unit_gm(n_sat, SIS_CORRELATION_TIME_S)}
-    # the ionosphere varies smoothly: a Gauss-Markov process drawn every 1/20 of its correlation
-    # time and interpolated, so that its rate (which the carrier smoothing's code-carrier
-    # divergence sees) stays at the mm/s of real ionospheric gradients
+    # the ionosphere varies smoothly: a Gauss-Markov process drawn once per correlation time
+    # and interpolated linearly, so that its rate (which the carrier smoothing's code-carrier
+    # divergence sees) stays at the mm/s of a quiet ionosphere
     u_iono = np.arange(n_ep) * dt_s / IONO_CORRELATION_TIME_S
-    common = gauss_markov_along(u_iono, 1, rng)
-    own = gauss_markov_along(u_iono, n_sat, rng)
+    common = gauss_markov_along(u_iono, 1, rng, IONO_GRID_STEP)
+    own = gauss_markov_along(u_iono, n_sat, rng, IONO_GRID_STEP)
     out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"]
                                              * (common + IONO_OWN_SHARE * own))
     out["tropo_zenith"] = cfg["tropo_residual"] * rng.standard_normal()

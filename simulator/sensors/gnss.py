@@ -358,7 +358,11 @@ class Gnss(PresetSensor):
         iono_true = model["iono"] * err["iono_ratio"]
         err = smooth_code_errors(cfg, err, iono_true, tracked, dt_s)
         tropo_true = model["tropo"] + err["tropo_zenith"] * mapping
-        iono_true_rate = model["iono_rate"] * err["iono_ratio"]
+        # the true ionosphere's rate: the broadcast model's along the geometry, times the ratio,
+        # plus the ratio's own (slow) change
+        ratio_rate = (np.gradient(err["iono_ratio"], dt_s, axis=1) if len(t) > 1
+                      else np.zeros_like(err["iono_ratio"]))
+        iono_true_rate = model["iono_rate"] * err["iono_ratio"] + model["iono"] * ratio_rate
         tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
         nlos_delay = np.where(nlos & ~los, extra, 0.0)
         sat_clock = C_M_S * geo["clock_s"]
