@@ -22,8 +22,8 @@ eq. 5-5), dampers from the damping ratio; the tyre is a spring (its damping is s
 Integration: the state equation x' = A x + B u is diagonalised, A = V diag(lambda) V^-1; each
 mode is propagated exactly for an input linear between samples ("first-order hold"; the road
 heights at the wheels are sampled on the truth grid), y_k+1 = e^(lambda h) y_k + b (p u_k +
-q u_k+1). The recursion runs in blocks with numpy (``stochastic.ar1_filter`` on the modes turned
-into real factors, ``_modal_recursion``), never sample by sample.
+q u_k+1). The recursion runs in blocks with numpy (``stochastic.ar1_filter`` with the modes'
+complex factors, ``_modal_recursion``), never sample by sample.
 
 Public names
 ------------
@@ -175,14 +175,7 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
 
 
 def _modal_recursion(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
-    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode; |factor| < 1).
-
-    With factor = r e^(i theta), y_k = e^(i k theta) x_k where x_k = r x_k-1 + e^(-i k theta)
-    forced_k: a real first-order recursion on the rotated inputs' real and imaginary parts,
-    which ``stochastic.ar1_filter`` runs in blocks, without a loop over the samples."""
-    k, n = forced.shape
-    turn = np.exp(1j * np.outer(np.angle(factor), np.arange(n)))  # e^(i k theta), (modes, n)
-    rotated = forced * turn.conj()
-    parts = np.ascontiguousarray(np.concatenate([rotated.real, rotated.imag]).T)  # (n, 2 modes)
-    x = ar1_filter(parts, np.tile(np.abs(factor), 2), overwrite=True)
-    return (x[:, :k] + 1j * x[:, k:]).T * turn
+    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode; |factor| < 1):
+    ``stochastic.ar1_filter`` with the complex factors, in blocks, without a loop over the
+    samples."""
+    return ar1_filter(np.ascontiguousarray(forced.T), factor, overwrite=True).T
