@@ -30,7 +30,7 @@ BodyMotion, build_body, quintic_coefficients, side_slip, level_road.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -43,7 +43,7 @@ from simulator.vehicle.suspension import FullCar, axle_distances, simulate
 CHANNELS = ("heave", "pitch", "roll", "slip")
 
 
-def quintic_coefficients(h: np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
+def quintic_coefficients(h: float | np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
                          y1: np.ndarray, dy1: np.ndarray, d2y1: np.ndarray) -> list[np.ndarray]:
     """Coefficients a5 ... a0 (highest power first) of the quintic on an interval of length h
     with the given value, first and second derivative at its two ends.
@@ -103,6 +103,7 @@ class BodyMotion:
     t: np.ndarray
     nodes: np.ndarray
     reference_point: np.ndarray
+    _by_sample: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Each channel and its first and second time derivatives at t (1-D): keys ``heave``,
@@ -113,13 +114,18 @@ class BodyMotion:
         i = np.clip(np.floor(t / h).astype(np.intp), 0, n - 2)
         on = t == self.t.take(i)
         last = t == self.t[-1]  # the grid's last time closes the last interval
-        values = self.nodes.take(np.where(last, n - 1, i), axis=1)
+        at = np.where(last, n - 1, i)
         off = np.flatnonzero(~(on | last))
+        if not len(off) and len(at) and at[-1] - at[0] == len(at) - 1:  # a run of grid times
+            values = self.nodes[:, at[0]:at[-1] + 1].copy()
+        else:
+            values = self.nodes.take(at, axis=1)
         if len(off):
             j = i[off]
-            start, end = self.nodes.take(j, axis=1), self.nodes.take(j + 1, axis=1)
+            rows = self._rows()  # the nodes sample by sample: a gather of whole rows
+            start, end = rows.take(j, axis=0).T, rows.take(j + 1, axis=0).T
             k = len(CHANNELS)
-            coeffs = quintic_coefficients(np.full(len(off), h), start[:k], start[k:2 * k],
+            coeffs = quintic_coefficients(float(h), start[:k], start[k:2 * k],
                                           start[2 * k:], end[:k], end[k:2 * k], end[2 * k:])
             dx = t[off] - self.t.take(j)
             for order in range(3):
@@ -135,6 +141,12 @@ class BodyMotion:
 
     def breakpoints(self) -> np.ndarray:
         return self.t
+
+    def _rows(self) -> np.ndarray:
+        """The nodes as (n, 12), C-ordered (kept once made)."""
+        if self._by_sample is None:
+            self._by_sample = np.ascontiguousarray(self.nodes.T)
+        return self._by_sample
 
 
 def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
