@@ -1,6 +1,6 @@
-"""The body's motion relative to the road-following point: heave, pitch and roll from the
-full-car ride model (``suspension``) and the side slip from a linear bicycle model, each as a
-piecewise quintic of time that the exact kinematics differentiate.
+"""The body's motion relative to the road-following point: heave, pitch, roll, surge and sway
+from the full-car ride model (``suspension``) and the side slip from a linear bicycle model,
+each as a piecewise quintic of time that the exact kinematics differentiate.
 
 * Side slip at the centre of gravity: the steady-state linear bicycle model (Rajamani, *Vehicle
   Dynamics and Control*, 2nd ed., Springer 2012, section 3.3, eq. 3.45 with the yaw rate of the
@@ -8,14 +8,15 @@ piecewise quintic of time that the exact kinematics differentiate.
   (both tyres), l_f and l_r the distances of the centre of gravity from the front and rear
   axles and L = l_f + l_r. At low speed it is the kinematic model's beta = l_r kappa (the rear
   axle's velocity lies along the body, Rajamani eq. 2.29 for small angles); above the speed
-  sqrt(l_r L C_r / (m l_f)) (about 16 m/s for the automotive preset) the tyres' slip turns it
+  sqrt(l_r L C_r / (m l_f)) (19.5 m/s for the automotive preset) the tyres' slip turns it
   negative. Signs in FRD: kappa > 0 turns right; beta > 0 puts the velocity to the right of the
   body's x axis, so the body's yaw is the path's heading minus beta. The steady state is used
   throughout: the bicycle model's lateral and yaw modes settle within about 0.2 s, while every
   curvature change of a drive (clothoids, lane changes, fitted paths) lasts a second or more.
   Choice: beta is the same when reversing (at reversing speeds it is the kinematic l_r kappa).
-* Heave, pitch and roll: ``suspension.simulate`` on the grid of the truth, driven by the road
-  under the wheels (``road``) and by the longitudinal and lateral accelerations of the path.
+* Heave, pitch, roll, surge and sway: ``suspension.simulate`` on the grid of the truth, driven
+  by the road's heights and slopes under the wheels (``road``) and by the longitudinal and
+  lateral accelerations of the path.
 * Engine vibration: a vertical sine of rms ``engine_accel`` at ``engine_frequency`` added to the
   heave (its phase drawn from the road's random stream).
 
@@ -40,7 +41,7 @@ from simulator.vehicle.params import ROUGHNESS_CLASSES
 from simulator.vehicle.road import RoadSurface, draw_roughness
 from simulator.vehicle.suspension import FullCar, axle_distances, simulate
 
-CHANNELS = ("heave", "pitch", "roll", "slip")
+CHANNELS = ("heave", "pitch", "roll", "slip", "surge", "sway")
 
 
 def quintic_coefficients(h: float | np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
@@ -93,10 +94,11 @@ def level_road(profile: RoadProfile) -> RoadProfile:
 
 @dataclass
 class BodyMotion:
-    """Heave (m, up), suspension pitch (rad, nose up), suspension roll (rad, right side down)
-    and side slip (rad) of the body, each with its first and second time derivatives, on the
-    truth grid ``t`` (``nodes``, shape (12, n): the four channels' values, then their rates,
-    then their accelerations), and the truth's reference point from the centre of gravity
+    """Heave (m, up), suspension pitch (rad, nose up), suspension roll (rad, right side down),
+    side slip (rad), surge (m, forward) and sway (m, right) of the body (``CHANNELS``), each
+    with its first and second time derivatives, on the truth grid ``t`` (``nodes``, shape (18,
+    n): the six channels' values, then their rates, then their accelerations), and the truth's
+    reference point from the centre of gravity
     (m, FRD). Between grid times the channels are the quintic Hermite curves of the nodes
     (``quintic_coefficients``), built interval by interval where asked."""
 
@@ -143,7 +145,7 @@ class BodyMotion:
         return self.t
 
     def _rows(self) -> np.ndarray:
-        """The nodes as (n, 12), C-ordered (kept once made)."""
+        """The nodes as (n, 18), C-ordered (kept once made)."""
         if self._by_sample is None:
             self._by_sample = np.ascontiguousarray(self.nodes.T)
         return self._by_sample
@@ -178,24 +180,26 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
     else:
         tracks = draw_roughness(span, ROUGHNESS_CLASSES[params["roughness"]], rng)
     surface = RoadSurface(profile.bumps, tracks, -params["wheelbase"] - 0.5, params["camber"])
-    u = np.empty((6, len(t)))
-    u[:4] = surface.heights(s, car.corner_x, car.corner_y)
+    u = np.empty((10, len(t)))
+    u[:4], u[6:] = surface.heights(s, car.corner_x, car.corner_y)
     np.multiply(d, a, out=u[4])
     np.multiply(d * kappa, v * v, out=u[5])
-    ride = simulate(car, u, h)  # z, theta, phi, then their rates and accelerations
+    ride = simulate(car, u, h)  # z, theta, phi, x, y, then their rates and accelerations
     omega = 2 * np.pi * params["engine_frequency"]
     amplitude = params["engine_accel"] * np.sqrt(2.0) / omega**2
     if amplitude > 0:
         phase = omega * t + rng.uniform(0.0, 2 * np.pi)
         sin = np.sin(phase)
         ride[0] += amplitude * sin
-        ride[3] += amplitude * omega * np.cos(phase)
-        ride[6] -= amplitude * omega**2 * sin
+        ride[5] += amplitude * omega * np.cos(phase)
+        ride[10] -= amplitude * omega**2 * sin
     l_f, l_r = axle_distances(params)
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
     slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
-    nodes = np.empty((3 * len(CHANNELS), len(t)))
-    for order in range(3):  # heave, pitch, roll, slip; then the rates, then the accelerations
-        nodes[4 * order:4 * order + 3] = ride[3 * order:3 * order + 3]
-        nodes[4 * order + 3] = slip[order]
+    k = len(CHANNELS)
+    nodes = np.empty((3 * k, len(t)))
+    for order in range(3):  # the channels; then their rates, then their accelerations
+        nodes[k * order:k * order + 3] = ride[5 * order:5 * order + 3]  # heave, pitch, roll
+        nodes[k * order + 3] = slip[order]
+        nodes[k * order + 4:k * order + 6] = ride[5 * order + 3:5 * order + 5]  # surge, sway
     return BodyMotion(t, nodes, np.asarray(params["imu_position"], dtype=float))
