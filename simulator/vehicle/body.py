@@ -15,8 +15,12 @@ each as a piecewise quintic of time that the exact kinematics differentiate.
   curvature change of a drive (clothoids, lane changes, fitted paths) lasts a second or more.
   Choice: beta is the same when reversing (at reversing speeds it is the kinematic l_r kappa).
 * Heave, pitch, roll, surge and sway: ``suspension.simulate`` on the grid of the truth, driven
-  by the road's heights and slopes under the wheels (``road``) and by the longitudinal and
-  lateral accelerations of the path.
+  by the road's heights and slopes under the wheels (``road``) and by the longitudinal, lateral
+  and vertical accelerations of the path. On a vertical curve (a grade change, dgamma/ds) the
+  road under wheel i lies dgamma/ds x_i^2 / 2 above the tangent plane at the centre of gravity
+  (the body follows the grade there), and the path accelerates by v^2 dgamma/ds normal to the
+  road: the body pitches and heaves at a crest or sag. The grade inside a speed bump is level
+  (``level_road``), so a bump is not counted twice.
 * Engine vibration: a vertical sine of rms ``engine_accel`` at ``engine_frequency`` added to the
   heave (its phase drawn from the road's random stream).
 
@@ -180,10 +184,15 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
     else:
         tracks = draw_roughness(span, ROUGHNESS_CLASSES[params["roughness"]], rng)
     surface = RoadSurface(profile.bumps, tracks, -params["wheelbase"] - 0.5, params["camber"])
-    u = np.empty((10, len(t)))
-    u[:4], u[6:] = surface.heights(s, car.corner_x, car.corner_y)
+    u = np.empty((11, len(t)))
+    u[:4], u[6:10] = surface.heights(s, car.corner_x, car.corner_y)
     np.multiply(d, a, out=u[4])
     np.multiply(d * kappa, v * v, out=u[5])
+    # a vertical curve: the road under wheel i lies dgamma/ds x_i^2 / 2 above the tangent plane
+    # at the centre of gravity, and the path accelerates by v^2 dgamma/ds normal to the road
+    dgamma = profile.grade.evaluate(s, (1,))[0]
+    u[:4] += np.multiply.outer(0.5 * car.corner_x**2, dgamma)
+    np.multiply(dgamma, v * v, out=u[10])
     ride = simulate(car, u, h)  # z, theta, phi, x, y, then their rates and accelerations
     omega = 2 * np.pi * params["engine_frequency"]
     amplitude = params["engine_accel"] * np.sqrt(2.0) / omega**2

@@ -12,8 +12,9 @@ Dynamics*, SAE 1992, ch. 5; Jazar, *Vehicle Dynamics: Theory and Application*, 3
 with z the body's heave (m, up), theta its pitch (rad, nose up), phi its roll (rad, right side
 down, as in FRD), x and y its surge and sway (m, forward and right, FRD) from the road-following
 point, w_i the wheels' heights (m, up) and u = [r_fl, r_fr, r_rl, r_rr, a_x, a_y, r'_fl, r'_fr,
-r'_rl, r'_rr] the road heights under the wheels (m), the longitudinal and lateral accelerations
-of the path (m/s^2, FRD) and the road's forward slopes under the wheels (dr/ds).
+r'_rl, r'_rr, a_v] the road heights under the wheels (m), the longitudinal and lateral
+accelerations of the path (m/s^2, FRD), the road's forward slopes under the wheels (dr/ds) and
+the path's acceleration normal to the road (m/s^2, up: v^2 dgamma/ds on a vertical curve).
 The corner i at (x_i, y_i) of the body moves by z + x_i theta - y_i phi; its spring and damper
 act on that minus w_i, the anti-roll bars on the difference of the left and right deflections
 (a roll stiffness split over the axles as the springs are), the tyre on w_i - r_i. The moments
@@ -32,7 +33,8 @@ cross-slope under an axle, (r_right - r_left) / track, adds -N_axle times it sid
 static wheel loads; the "effective road plane" of Pacejka, *Tire and Vehicle Dynamics*, 3rd ed.,
 Butterworth-Heinemann 2012, section 10.2, here without the tyre's enveloping filter). The
 path's accelerations add their inertial forces -m_s a_x, -m_s a_y (the tyres deflect under
-braking and cornering).
+braking and cornering) and -m a_v on the body and the wheels (the body sinks in a sag and
+rises over a crest).
 
 Integration: the state equation x' = A x + B u is diagonalised, A = V diag(lambda) V^-1; each
 mode is propagated exactly for an input linear between samples ("first-order hold"; the road
@@ -56,7 +58,7 @@ from simulator.stochastic import ar1_filter
 
 N_BODY = 5  # heave, pitch, roll, surge, sway
 N_DOF = 9
-N_INPUT = 10  # four road heights, a_x, a_y, four road slopes
+N_INPUT = 11  # four road heights, a_x, a_y, four road slopes, the path's vertical acceleration
 
 
 def axle_distances(p: dict) -> tuple[float, float]:
@@ -88,7 +90,7 @@ class FullCar:
     mass: np.ndarray  # (9, 9)
     damping: np.ndarray  # (9, 9)
     stiffness: np.ndarray  # (9, 9)
-    forcing: np.ndarray  # (9, 10)
+    forcing: np.ndarray  # (9, 11)
     corner_x: np.ndarray
     corner_y: np.ndarray
 
@@ -131,11 +133,14 @@ class FullCar:
         forcing[N_BODY:, :4] = k_t * np.eye(4)
         forcing[1, 4] = m_s * p["cg_height"]  # accelerating pitches the nose up
         forcing[2, 5] = -m_s * p["cg_height"]  # a turn to the right rolls the body left
-        forcing[3, 4] = forcing[4, 5] = -m_s  # the inertial forces of the path's accelerations
+        # the inertial forces of the path's accelerations, along the road and across it, and
+        # normal to it (a vertical curve: v^2 times the curvature of the road's profile)
+        forcing[3, 4] = forcing[4, 5] = forcing[0, 10] = -m_s
+        forcing[N_BODY:, 10] = -m_u
         # the contact forces along the road's normal: -N_i r'_i fore-aft, -N (r_right -
         # r_left) / track sideways per axle
         load = (corner_mass + m_u) * G0_M_S2
-        forcing[3, 6:] = -load
+        forcing[3, 6:10] = -load
         for left, right in ((0, 1), (2, 3)):
             axle_load = load[left] + load[right]
             forcing[4, left] += axle_load / (2 * half)
@@ -143,7 +148,7 @@ class FullCar:
         return cls(mass, damping, stiffness, forcing, x, y)
 
     def state_space(self) -> tuple[np.ndarray, np.ndarray]:
-        """A (18, 18) and B (18, 10) of x' = A x + B u, x = [q, q']."""
+        """A (18, 18) and B (18, 11) of x' = A x + B u, x = [q, q']."""
         m_inv = np.linalg.inv(self.mass)
         a = np.zeros((2 * N_DOF, 2 * N_DOF))
         a[:N_DOF, N_DOF:] = np.eye(N_DOF)
@@ -161,7 +166,7 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
     Parameters
     ----------
     model : FullCar
-    u : array, shape (10, n)
+    u : array, shape (11, n)
         Inputs at the grid times (see the module doc), one row per input, linear between
         the grid times.
     h : float

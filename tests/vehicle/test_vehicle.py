@@ -57,15 +57,16 @@ def test_body_channels_between_grid_times_are_c2_quintics_through_the_nodes():
 
 def test_suspension_integration_matches_runge_kutta():
     """The modal exact-hold integration against a fine classical Runge-Kutta integration of
-    the same state equations: a 5 cm step under the front-left wheel, a braking ramp and a road
-    slope ramping up under the rear-right wheel."""
+    the same state equations: a 5 cm step under the front-left wheel, a braking ramp, a road
+    slope ramping up under the rear-right wheel and a vertical acceleration ramp."""
     car = FullCar.from_parameters(vehicle_parameters("automotive"))
     a, b = car.state_space()
     h, n = 0.01, 400
-    u = np.zeros((n, 10))
+    u = np.zeros((n, 11))
     u[50:, 0] = 0.05
     u[100:, 4] = np.minimum(np.arange(n - 100) * h, 1.0) * -3.0
     u[150:, 9] = np.minimum(np.arange(n - 150) * h, 0.5) * 0.1
+    u[200:, 10] = np.minimum(np.arange(n - 200) * h, 0.5) * 1.0
     out = simulate(car, u.T, h)
     x = np.zeros(18)
     ref = np.empty((n, 15))
@@ -141,7 +142,8 @@ def test_braking_pitches_the_nose_down():
     assert pitch[-1] < -0.3 and pitch[-1] > -1.5
     p = vehicle_parameters("automotive")
     car = FullCar.from_parameters(p)
-    static = np.linalg.solve(car.stiffness, car.forcing @ [0, 0, 0, 0, -3.0, 0, 0, 0, 0, 0])[1]
+    static = np.linalg.solve(car.stiffness,
+                             car.forcing @ [0, 0, 0, 0, -3.0, 0, 0, 0, 0, 0, 0])[1]
     assert pitch[-1] == pytest.approx(np.degrees(static), rel=0.02)
 
 
@@ -342,6 +344,43 @@ def test_camber_rolls_the_body_by_the_cross_slope():
     segments = [{"accelerate": {"to_speed": 10.0, "accel": 1.0}}, {"straight": {"length": 100}}]
     table = _truth(segments, {**QUIET, "camber": 0.025}).table()
     np.testing.assert_allclose(table.roll, np.arctan(0.025), rtol=2e-3)
+
+
+def test_vertical_curves_load_the_suspension():
+    """Issue 13: a grade change loads the suspension. On a vertical curve of curvature
+    dgamma/ds the path accelerates by a_v = v^2 dgamma/ds normal to the road and the road under
+    axle i lies dgamma/ds x_i^2 / 2 above the tangent plane at the centre of gravity; with equal
+    front and rear ride frequencies f the quasi-static body heave is
+    -a_v / (2 pi f)^2 - a_v m_u / k_t (sprung mass on the ride rate, wheels on their tyres)
+    plus the axle heights interpolated at the centre of gravity, (l_r h_f + l_f h_r) / L, and
+    the pitch (h_f - h_r) / L. At 15 m/s over a 0.08 slope's crest and sag (a_v up to -+0.75
+    m/s^2): +8.5 / -8.5 mm of heave, the dynamics within 2 % of the quasi-static value."""
+    from simulator.vehicle import vehicle_body
+
+    equal = {**QUIET, "front_frequency": 1.3, "rear_frequency": 1.3}
+    segments = [{"accelerate": {"to_speed": 15.0, "accel": 1.5}}, {"straight": {"length": 100}},
+                {"slope": {"grade": 0.08, "length": 300}}, {"straight": {"length": 100}}]
+    truth = _truth(segments, equal)
+    p = {**vehicle_parameters("automotive"), **equal}
+    t = truth.t_grid
+    profile, body = vehicle_body(truth.profile, p, t)
+    motion = body.evaluate(t)
+    s, v = profile.distance_of_time.evaluate(t, (0, 1))
+    curvature = profile.grade.evaluate(s, (1,))[0]
+    a_v = v * v * curvature
+    length = p["wheelbase"]
+    l_r = length * p["front_weight"]
+    l_f = length - l_r
+    h_f, h_r = curvature * l_f**2 / 2, curvature * l_r**2 / 2
+    heave = (-a_v / (2 * np.pi * 1.3) ** 2 - a_v * p["unsprung_mass"] / p["tyre_stiffness"]
+             + (l_r * h_f + l_f * h_r) / length)
+    pitch = (h_f - h_r) / length
+    for k in (np.argmax(a_v), np.argmin(a_v)):  # the sag and the crest
+        assert abs(a_v[k]) > 0.7
+        assert motion["heave"][k] == pytest.approx(heave[k], rel=0.02)
+        assert motion["pitch"][k] == pytest.approx(pitch[k], rel=0.1)
+    level = np.abs(curvature) == 0.0
+    assert np.abs(motion["heave"][level & (t > 20.0)]).max() < 2e-3  # settled off the curves
 
 
 @pytest.mark.parametrize("block, where", [
