@@ -25,12 +25,12 @@ each as a piecewise quintic of time that the exact kinematics differentiate.
   heave (its phase drawn from the road's random stream).
 
 Each channel is known on the grid with its first and second derivatives; between grid points it
-is the quintic Hermite interpolant of those six values (``quintic_coefficients``), so the
+is the quintic Hermite interpolant of those six values (``quintic_hermite_basis``), so the
 channels are C2 and exactly differentiable, and on the grid they equal the model's values.
 
 Public names
 ------------
-BodyMotion, build_body, quintic_coefficients, side_slip, level_road.
+BodyMotion, build_body, quintic_hermite_basis, side_slip, level_road.
 """
 
 from __future__ import annotations
@@ -48,23 +48,39 @@ from simulator.vehicle.suspension import FullCar, axle_distances, simulate
 CHANNELS = ("heave", "pitch", "roll", "slip", "surge", "sway")
 
 
-def quintic_coefficients(h: float | np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
-                         y1: np.ndarray, dy1: np.ndarray, d2y1: np.ndarray) -> list[np.ndarray]:
-    """Coefficients a5 ... a0 (highest power first) of the quintic on an interval of length h
-    with the given value, first and second derivative at its two ends.
-
-    p = y0 + y0' dx + y0'' dx^2 / 2 + a3 dx^3 + a4 dx^4 + a5 dx^5, dx from the interval's start,
-    with a3..a5 from the conditions at its end (the residuals D0, D1 h, D2 h^2 of value, slope
-    and curvature of the quadratic part there): a3 = (10 D0 - 4 D1 h + D2 h^2 / 2) / h^3,
-    a4 = (-15 D0 + 7 D1 h - D2 h^2) / h^4, a5 = (6 D0 - 3 D1 h + D2 h^2 / 2) / h^5.
-    """
-    a1, a2 = dy0, 0.5 * d2y0
-    d0 = y1 - (y0 + h * (a1 + h * a2))
-    d1 = (dy1 - (a1 + 2 * a2 * h)) * h
-    d2 = (d2y1 - 2 * a2) * h * h
-    h3 = h**3
-    return [(6 * d0 - 3 * d1 + 0.5 * d2) / (h3 * h * h), (-15 * d0 + 7 * d1 - d2) / (h3 * h),
-            (10 * d0 - 4 * d1 + 0.5 * d2) / h3, a2, a1, y0]
+def quintic_hermite_basis(u: np.ndarray) -> np.ndarray:
+    """The quintic Hermite basis on [0, 1] and its first two derivatives at u (shape (m,)):
+    array (m, 3, 6), [:, order, b], b = 0 ... 5 the weights of y0, y0', y0'', y1, y1', y1''
+    (the derivatives scaled by the interval: h y', h^2 y''), so that on an interval of length h
+    p(u) = sum_b B[:, 0, b] c_b, p'(t) = sum_b B[:, 1, b] c_b / h, p''(t) = sum_b B[:, 2, b]
+    c_b / h^2 with c = (y0, h y0', h^2 y0'', y1, h y1', h^2 y1''). The polynomial matching value,
+    slope and curvature at both ends: H0 = 1 - 10 u^3 + 15 u^4 - 6 u^5, H1 = u - 6 u^3 + 8 u^4
+    - 3 u^5, H2 = (u^2 - 3 u^3 + 3 u^4 - u^5) / 2, H3 = 1 - H0, H4 = -4 u^3 + 7 u^4 - 3 u^5,
+    H5 = (u^3 - 2 u^4 + u^5) / 2."""
+    u2 = u * u
+    u3 = u2 * u
+    u4 = u3 * u
+    u5 = u4 * u
+    b = np.empty((len(u), 3, 6))
+    b[:, 0, 3] = 10 * u3 - 15 * u4 + 6 * u5
+    b[:, 0, 0] = 1.0 - b[:, 0, 3]
+    b[:, 0, 1] = u - 6 * u3 + 8 * u4 - 3 * u5
+    b[:, 0, 2] = 0.5 * (u2 - 3 * u3 + 3 * u4 - u5)
+    b[:, 0, 4] = -4 * u3 + 7 * u4 - 3 * u5
+    b[:, 0, 5] = 0.5 * (u3 - 2 * u4 + u5)
+    b[:, 1, 3] = 30 * (u2 - 2 * u3 + u4)
+    b[:, 1, 0] = -b[:, 1, 3]
+    b[:, 1, 1] = 1.0 - 18 * u2 + 32 * u3 - 15 * u4
+    b[:, 1, 2] = u - 4.5 * u2 + 6 * u3 - 2.5 * u4
+    b[:, 1, 4] = -12 * u2 + 28 * u3 - 15 * u4
+    b[:, 1, 5] = 1.5 * u2 - 4 * u3 + 2.5 * u4
+    b[:, 2, 3] = 60 * (u - 3 * u2 + 2 * u3)
+    b[:, 2, 0] = -b[:, 2, 3]
+    b[:, 2, 1] = -36 * u + 96 * u2 - 60 * u3
+    b[:, 2, 2] = 1.0 - 9 * u + 18 * u2 - 10 * u3
+    b[:, 2, 4] = -24 * u + 84 * u2 - 60 * u3
+    b[:, 2, 5] = 3 * u - 12 * u2 + 10 * u3
+    return b
 
 
 def side_slip(kappa: np.ndarray, dkappa: np.ndarray, d2kappa: np.ndarray, v: np.ndarray,
@@ -104,7 +120,7 @@ class BodyMotion:
     n): the six channels' values, then their rates, then their accelerations), and the truth's
     reference point from the centre of gravity
     (m, FRD). Between grid times the channels are the quintic Hermite curves of the nodes
-    (``quintic_coefficients``), built interval by interval where asked."""
+    (``quintic_hermite_basis``), built interval by interval where asked."""
 
     t: np.ndarray
     nodes: np.ndarray
@@ -124,23 +140,25 @@ class BodyMotion:
         off = np.flatnonzero(~(on | last))
         if not len(off) and len(at) and at[-1] - at[0] == len(at) - 1:  # a run of grid times
             values = self.nodes[:, at[0]:at[-1] + 1].copy()
+        elif len(off) == len(t):
+            values = np.empty((self.nodes.shape[0], len(t)))
         else:
             values = self.nodes.take(at, axis=1)
         if len(off):
             j = i[off]
             rows = self._rows()  # the nodes sample by sample: a gather of whole rows
-            start, end = rows.take(j, axis=0).T, rows.take(j + 1, axis=0).T
             k = len(CHANNELS)
-            coeffs = quintic_coefficients(float(h), start[:k], start[k:2 * k],
-                                          start[2 * k:], end[:k], end[k:2 * k], end[2 * k:])
-            dx = t[off] - self.t.take(j)
-            for order in range(3):
-                acc = np.zeros((k, len(off)))
-                for power, c in enumerate(coeffs[:len(coeffs) - order]):
-                    degree = 5 - power
-                    factor = np.prod(np.arange(degree, degree - order, -1))
-                    acc = acc * dx + factor * c
-                values[order * k:(order + 1) * k, off] = acc
+            scale = np.repeat([1.0, h, h * h], k)  # c = (y, h y', h^2 y'') at each end
+            ends = np.concatenate([rows.take(j, axis=0) * scale,
+                                   rows.take(j + 1, axis=0) * scale], axis=1)
+            basis = quintic_hermite_basis((t[off] - self.t.take(j)) / h)
+            out = basis @ ends.reshape(len(off), 6, k)  # (m, order, channel)
+            out[:, 1] /= h
+            out[:, 2] /= h * h
+            if len(off) == len(t):
+                values[:] = out.reshape(len(off), 3 * k).T
+            else:
+                values[:, off] = out.reshape(len(off), 3 * k).T
         return {name + suffix: values[i + len(CHANNELS) * order]
                 for order, suffix in enumerate(("", "_rate", "_accel"))
                 for i, name in enumerate(CHANNELS)}
