@@ -42,10 +42,14 @@ import numpy as np
 
 from estimators.base import Estimator
 from estimators.toolbox import aiding
+from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
+from estimators.toolbox.installation import Installation
+from simulator.errors import InputError
 
 G0 = 9.80665  # standard gravity, m/s^2 (datasheet mg)
 DEG = math.pi / 180.0
+NHC_POINTS = ("rear_axle", "imu")
 
 
 class ParkInsOdometer(Estimator):
@@ -54,7 +58,8 @@ class ParkInsOdometer(Estimator):
     name = "ins_odo_ekf"
     needs = ("imu", "odometer", "gnss_fix")
     paper = "Park et al. 2019 (IEEE Access), eqs. 1-14: INS/GPS/odometer EKF with NHC"
-    defaults = {"nhc": True}
+    defaults = {"nhc": True, "nhc_point": "rear_axle", "fix_error_states": False,
+                "odometer_scale_state": False}
     output_columns = SOLUTION_COLUMNS
 
     NOISE = InsNoise(accel_noise=0.19e-3 * G0, gyro_noise=0.02 * DEG,
@@ -63,21 +68,47 @@ class ParkInsOdometer(Estimator):
     P0_SIGMA = np.r_[[5.0, 5.0, 5.0], [0.5] * 3, [2 * DEG, 2 * DEG, 5 * DEG],
                      [70e-3 * G0] * 3, [1.0 * DEG] * 3]
     R_POSITION = np.diag([2.5, 2.5, 5.0]) ** 2  # m^2
+    FIX_SIGMA = np.array([2.5, 2.5, 5.0])  # correlated fix error, steady-state 1-sigma, m
+    R_POSITION_WHITE = np.diag([0.5, 0.5, 1.0]) ** 2  # m^2, its white remainder
     R_VELOCITY = np.diag([0.1, 0.1, 0.2]) ** 2  # (m/s)^2
     R_ODOMETER = 0.1**2  # (m/s)^2, each body axis: white noise
     ODOMETER_SCALE_SIGMA = 0.03  # unmodelled odometer scale-factor error, 1-sigma
 
     def setup(self) -> None:
+        if self.config["nhc_point"] not in NHC_POINTS:
+            raise InputError(f"ins_odo_ekf: config nhc_point must be one of "
+                             f"{', '.join(NHC_POINTS)}, got {self.config['nhc_point']!r}")
+        site = Installation.from_datasheet(self.datasheet)
+        # the receiver's fix error is correlated over its carrier-smoothing time (the datasheet's
+        # code_correlation_time): three Gauss-Markov states of that time constant
+        tau = float((self.datasheet.get("gnss") or {}).get("code_correlation_time") or 0.0)
+        self._fix_states = self.config["fix_error_states"] and tau > 0
+        sigma, taus = [], []
+        if self._fix_states:
+            sigma, taus = list(self.FIX_SIGMA), [tau] * 3
+        self._scale_col = None
+        if self.config["odometer_scale_state"]:  # a random constant (tau = inf)
+            self._scale_col = 15 + len(sigma)
+            sigma.append(self.ODOMETER_SCALE_SIGMA)
+            taus.append(np.inf)
+        markov = dict(extra_sigma=np.array(sigma), extra_tau=np.array(taus)) if sigma else {}
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
-                             self.P0_SIGMA, self.NOISE)
+                             self.P0_SIGMA, self.NOISE, mounting=site.mounting, **markov)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]
         self._speed = self.columns["odometer"]["speed"]
+        self._antenna = site.antenna
+        # the constraint where it holds: the rear axle, with the car's slip as its noise; at the
+        # IMU (a rigid body, or asked for) with the white 0.1 m/s of the paper's situation
+        self._rear = site.rear_axle if self.config["nhc_point"] == "rear_axle" else None
+        self._slip = (NonholonomicNoise(site.wheelbase or 2.7) if self._rear is not None
+                      else None)
         n_rows = 3 if self.config["nhc"] else 1
         self._r_odo = np.eye(n_rows) * self.R_ODOMETER
         self._r_fix = np.zeros((6, 6))
-        self._r_fix[:3, :3], self._r_fix[3:, 3:] = self.R_POSITION, self.R_VELOCITY
+        self._r_fix[:3, :3] = self.R_POSITION_WHITE if self._fix_states else self.R_POSITION
+        self._r_fix[3:, 3:] = self.R_VELOCITY
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         self.ins.add_imu(t, row)
@@ -89,17 +120,36 @@ class ParkInsOdometer(Estimator):
         ins = self.ins
         ins.flush()
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
-        dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos)
-        dz_v, h_v = aiding.gnss_velocity(ins.v, values[3:6])
+        n = ins.n_states
+        dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna, n)
+        if self._fix_states:  # the fix is the antenna plus its correlated error
+            dz_p += ins.extra[:3]
+            h_p[:, 15:18] = np.eye(3)
+        dz_v, h_v = aiding.gnss_velocity(ins.v, values[3:6], n, ins.q, ins.mean_rate,
+                                         self._antenna)
         ins.update(np.concatenate([dz_p, dz_v]), np.vstack([h_p, h_v]), self._r_fix)
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         ins = self.ins
         ins.flush()
         speed = float(row[self._speed])
-        dz, h = aiding.odometer(ins.q, ins.v, speed, self.config["nhc"])
-        self._r_odo[0, 0] = self.R_ODOMETER + (self.ODOMETER_SCALE_SIGMA * speed) ** 2
-        ins.update(dz, h, self._r_odo)
+        dz, h = aiding.odometer(ins.q, ins.v, speed, self.config["nhc"], ins.n_states,
+                                ins.mean_rate, self._rear)
+        r = self._r_odo
+        if self._scale_col is None:
+            r[0, 0] = self.R_ODOMETER + (self.ODOMETER_SCALE_SIGMA * speed) ** 2
+        else:  # the odometer reads (1 + k) v: dz = v_x - speed / (1 + k_est)
+            k = ins.extra[self._scale_col - 15]
+            dz[0] = dz[0] + speed - speed / (1.0 + k)
+            h[0, self._scale_col] = speed / (1.0 + k) ** 2
+            r[0, 0] = self.R_ODOMETER
+        if self._slip is not None and len(r) == 3:
+            # forward acceleration: specific force plus gravity's body-x part, g C_b^n[2, 0]
+            # = -g sin(pitch)
+            accel_x = ins.mean_force[0] + G0 * (2 * (ins.q[1] * ins.q[3] - ins.q[0] * ins.q[2]))
+            lateral, vertical = self._slip.sigma(speed, ins.mean_rate[2], accel_x)
+            r[1, 1], r[2, 2] = lateral * lateral, vertical * vertical
+        ins.update(dz, h, r)
 
     def solution(self, t: float) -> list[float]:
         self.ins.flush()
