@@ -9,6 +9,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from estimators.builtin.park2019_ins import ParkInsOdometer
+from simulator.errors import InputError
 from tests.estimators.paired_runs import paired_scores, spread
 
 SCENARIOS = ["scenarios/park2019_underground_garage.yaml", "scenarios/parking_garage.yaml"]
@@ -57,8 +59,5 @@ def test_nhc_is_used_in_the_garage(runs):
 
 
 def test_an_unknown_nhc_point_is_refused():
-    from estimators.builtin.park2019_ins import ParkInsOdometer
-    from simulator.errors import InputError
-
     with pytest.raises(InputError, match="nhc_point must be one of rear_axle, imu"):
         ParkInsOdometer({"nhc_point": "front_axle"}, None, {}, {})
