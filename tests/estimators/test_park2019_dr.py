@@ -113,6 +113,12 @@ DR2D_NOT_SHOWN = (
     "filters' heading error; without it dr3d_ekf wins 10/10 (docs/reproduction_park2019.md)")
 
 
+INS_NOT_SHOWN = (
+    "not shown since ins_odo_ekf applies its NHC at the rear axle (issue 14): dr3d_ekf beats it "
+    "in 6/10 seeds at the exit and 5/10 on the maximum (medians 11.9 m vs 19.7 m exit, 16.9 m "
+    "vs 21.3 m max); with the NHC at the IMU, violated by the car's slip, it won 10/10")
+
+
 def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
     """A filter as a test parameter: skipped when not registered, expected to fail with a
     reason (the measured figures) when ``xfail`` is given."""
@@ -124,7 +130,7 @@ def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
 
 
 @pytest.mark.parametrize("other", [_case("dr2d_odo_ekf", DR2D_NOT_SHOWN, strict=True),
-                                   _case("ins_odo_ekf")])
+                                   _case("ins_odo_ekf", INS_NOT_SHOWN, strict=True)])
 def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
     """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
     least 8 of 10 seeds (paired per seed)."""
