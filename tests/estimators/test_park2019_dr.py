@@ -79,9 +79,6 @@ SHORT = ["trajectory.segments.0.stop.duration=5", "trajectory.segments.2.straigh
          "trajectory.segments.4.straight.length=120", "trajectory.segments.6.straight.length=100",
          "trajectory.segments.17.stop.duration=5", "trajectory.segments.27.straight.length=60",
          "trajectory.segments.29.straight.length=60"]
-INS_FLAT = ("not shown against ins_odo_ekf (the INS engineer's filter, as merged): on the flat "
-            "garage dr3d_ekf's errors are still smaller (median ratio 0.66 exit, 0.28 max): "
-            "the INS velocity error from the accelerometer bias does not need ramps")
 
 
 @pytest.fixture(scope="module", params=["short", pytest.param("full", marks=pytest.mark.slow)])
@@ -139,10 +136,12 @@ def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
         assert wins.sum() >= 8, (key, wins.sum())
 
 
-@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf", INS_FLAT)])
+@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf")])
 def test_flat_garage_with_perfect_odometer_removes_the_advantage(flat_garage, other):
     """Without ramps and odometer scale-factor error, the median per-seed ratio of dr3d_ekf's
-    exit and maximum error to the baseline's lies between 0.7 and 1.3."""
+    exit and maximum error to the baseline's lies between 0.7 and 1.3. Against ins_odo_ekf
+    with its NHC at the rear axle (issue 14): 0.93 exit, 0.96 max (it was 0.66 and 0.28 with
+    the NHC at the IMU, an expected failure then)."""
     for key in ("exit_horizontal", "max_horizontal"):
         ratio = _column(flat_garage, "dr3d_ekf", key) / _column(flat_garage, other, key)
         assert 0.7 <= np.median(ratio) <= 1.3, (key, np.median(ratio))
