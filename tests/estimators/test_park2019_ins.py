@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from estimators.base import InitialState
 from estimators.builtin.park2019_ins import ParkInsOdometer
 from simulator.errors import InputError
 from tests.estimators.paired_runs import paired_scores, spread
@@ -61,3 +62,24 @@ def test_nhc_is_used_in_the_garage(runs):
 def test_an_unknown_nhc_point_is_refused():
     with pytest.raises(InputError, match="nhc_point must be one of rear_axle, imu"):
         ParkInsOdometer({"nhc_point": "front_axle"}, None, {}, {})
+
+
+def test_fix_error_states_take_the_receivers_carrier_smoothing_time():
+    """The options beyond the paper's 15 states: three fix-error states with the datasheet's
+    carrier-smoothing time (100 s for the automotive receiver), none when the receiver's
+    errors are white (``carrier_smoothing: 0``), and the odometer scale factor."""
+    initial = InitialState(0.0, np.array([0.6, 2.2, 40.0]), np.zeros(3), np.zeros(3))
+    columns = {"imu": {c: i + 1 for i, c in enumerate(
+                   ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"))},
+               "gnss_fix": {c: i + 1 for i, c in enumerate(
+                   ("lat", "lon", "alt", "vn", "ve", "vd", "fix"))},
+               "odometer": {"speed": 1}}
+    config = {"fix_error_states": True, "odometer_scale_state": True}
+
+    def states(smoothing: float) -> int:
+        sheet = {"gnss": {"carrier_smoothing": smoothing}}
+        est = ParkInsOdometer(config, initial, columns, {}, imu_output="rate", datasheet=sheet)
+        return est.ins.n_states
+
+    assert states(100.0) == 19 and states(0.0) == 16
+    assert ParkInsOdometer(None, initial, columns, {}, imu_output="rate").ins.n_states == 15
