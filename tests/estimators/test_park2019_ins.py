@@ -42,7 +42,7 @@ def runs(request, tmp_path_factory) -> dict[str, np.ndarray]:
     # RMS outside the outages median 2.77 m (1.64-3.02) on Park's garage, 3.29 m (2.48-3.85) on
     # parking_garage.yaml; garage maximum with the NHC 20.8 / 21.1 m against 43.9 / 44.6 m
     # without. At the IMU instead (nhc_point: imu), where the car slips sideways by up to 11 deg
-    # in the 8 m turns, it was 3.83 / 7.56 m and 73.3 / 48.2 m: the violated constraint hurt
+    # in the 8 m turns, it is 3.38 / 7.88 m and 72.0 / 48.7 m: the violated constraint hurts
     return paired_scores(request.param, entries, SEEDS, tmp_path_factory.mktemp("park"), (),
                          lambda s, ev: (_rms_outside_outages(s, ev), _garage_max(s, ev)))
 
