@@ -9,6 +9,7 @@ import textwrap
 from pathlib import Path
 
 from simulator.commands import SUMMARIES
+from simulator.commands.options import worker_problems
 from simulator.errors import InputError, Problem
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.runner import FULL_SEEDS, QUICK_SEEDS, reproduce
@@ -88,12 +89,7 @@ def _check(args: argparse.Namespace) -> int:
     if args.runs is not None and not 1 <= args.runs <= MAX_RUNS:
         problems.append(Problem("landnav reproduce", None, "--runs",
                                 f"must be between 1 and {MAX_RUNS}, got {args.runs}"))
-    if args.workers is not None and args.scheduler:
-        problems.append(Problem("landnav reproduce", None, "--workers", "a Dask cluster has "
-                                "its own workers: give --workers or --scheduler, not both"))
-    elif args.workers is not None and args.workers < 1:
-        problems.append(Problem("landnav reproduce", None, "--workers",
-                                f"must be at least 1, got {args.workers}"))
+    problems += worker_problems("reproduce", args.workers, args.scheduler)
     if problems:
         raise InputError(problems)
     return args.workers or os.cpu_count() or 1

@@ -1,7 +1,8 @@
 """Park et al. 2019 reproduced: the proposed 3-D DR/GPS (``dr3d_ekf``) against the 2-D DR/GPS
 (``dr2d_odo_ekf``) and the INS/GPS/odometer EKF (``ins_odo_ekf``) in an underground garage
 (Table 3, Fig. 19), the same garage made flat with a perfect odometer, the odometer scale
-factor at garage entry (Fig. 9), the open-sky blockage (Figs. 14-15), and the INS baseline on a
+factor at garage entry (Fig. 9), the open-sky blockage (Figs. 14-15), the multilevel garage
+(Table 3, area 2) and the curved tunnel (Fig. 18), and the INS baseline on a
 rigid body (a working filter that uses its NHC), with issue 14's criteria
 (docs/reproduction_park2019.md, docs/reproduction_park2019_ins.md).
 
@@ -18,8 +19,8 @@ from the scorer, ``simulator.reproduce.measures``):
 
 Public names
 ------------
-PAPER, GARAGE, FLAT, SCALE_097, OPEN_SKY, INS_PARK_GARAGE, INS_PARKING_GARAGE, PAPER_FILTERS,
-FLAT_PERFECT, SHORT, garage_figures.
+PAPER, GARAGE, FLAT, SCALE_097, OPEN_SKY, MULTILEVEL, TUNNEL, INS_PARK_GARAGE,
+INS_PARKING_GARAGE, PAPER_FILTERS, FLAT_PERFECT, SHORT, garage_figures.
 """
 
 from __future__ import annotations
@@ -105,6 +106,12 @@ SCALE_097 = Experiment(key="garage_scale_097", scenario="park2019_underground_ga
                        quick_overrides=SHORT)
 OPEN_SKY = Experiment(key="open_sky", scenario="park2019_open_sky_blockage.yaml",
                       entries={"dr3d_ekf": {"name": "dr3d_ekf"}}, measure=garage_figures)
+MULTILEVEL = Experiment(key="multilevel_garage", scenario="park2019_multilevel_garage.yaml",
+                        entries={name: {"name": name} for name in PAPER_FILTERS},
+                        measure=garage_figures)
+TUNNEL = Experiment(key="curved_tunnel", scenario="park2019_curved_tunnel.yaml",
+                    entries={name: {"name": name} for name in PAPER_FILTERS},
+                    measure=garage_figures)
 _INS_ENTRIES = {"nhc": {"name": "ins_odo_ekf"},
                 "no_nhc": {"name": "ins_odo_ekf", "config": {"nhc": False}}}
 INS_PARK_GARAGE = Experiment(key="ins_park_garage", scenario="park2019_underground_garage.yaml",
@@ -114,18 +121,21 @@ INS_PARKING_GARAGE = Experiment(key="ins_parking_garage", scenario="parking_gara
                                 entries=_INS_ENTRIES, measure=garage_figures, overrides=RIGID)
 
 
-def _beats(tables: Mapping[str, pd.DataFrame], other: str, analysis: str = "") -> Verdict:
+def _beats(tables: Mapping[str, pd.DataFrame], other: str, analysis: str = "",
+           experiment: str = "garage",
+           keys: tuple[str, ...] = ("exit_horizontal_m", "max_horizontal_m")) -> Verdict:
     parts, counts = [], []
-    for key in ("exit_horizontal_m", "max_horizontal_m"):
-        mine = m.column(tables, f"dr3d_ekf.{key}", "garage")
-        theirs = m.column(tables, f"{other}.{key}", "garage")
+    for key in keys:
+        mine = m.column(tables, f"dr3d_ekf.{key}", experiment)
+        theirs = m.column(tables, f"{other}.{key}", experiment)
         wins, n = m.paired_wins(mine, theirs)
         counts.append((wins, n))
         parts.append(f"{key.split('_')[0]}: {m.win_rate_text(wins, n, 'dr3d_ekf')}, dr3d_ekf "
                      f"{m.spread_text(mine, 'm')} vs {other} {m.spread_text(theirs, 'm')}")
     wins, n = min(counts)
+    what = " and ".join(k.split("_")[0] for k in keys)
     return m.count_verdict(wins, n, WIN_FRACTION, "; ".join(parts),
-                           f"dr3d_ekf beats {other} on both exit and maximum error", analysis)
+                           f"dr3d_ekf beats {other} on {what} error", analysis)
 
 
 def _flat(tables: Mapping[str, pd.DataFrame], other: str, analysis: str = "") -> Verdict:
@@ -142,6 +152,14 @@ def _flat(tables: Mapping[str, pd.DataFrame], other: str, analysis: str = "") ->
                        "odometer error the 3-D filter has no advantage")
     status = "partly" if any(inside) else "not shown"
     return Verdict(status, measured, f"a median ratio lies outside 0.7-1.3. {analysis}".strip())
+
+
+def _worst(*verdicts: Verdict) -> Verdict:
+    """Several verdicts of one claim as one: the worst word, every figure and reason."""
+    order = {"shown": 0, "partly": 1, "not shown": 2}
+    status = max((v.status for v in verdicts), key=order.__getitem__)
+    return Verdict(status, " / ".join(v.measured for v in verdicts),
+                   " / ".join(v.reason for v in verdicts))
 
 
 def _every_seed(values: np.ndarray, bound: float, measured: str, what: str,
@@ -161,8 +179,7 @@ def _judge_height(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 def _judge_scale(tables: Mapping[str, pd.DataFrame]) -> Verdict:
     per = {"1.03": m.column(tables, "dr3d_ekf.scale_at_entry", "garage"),
            "0.97": m.column(tables, "dr3d_ekf.scale_at_entry", "garage_scale_097")}
-    ok = min(int(np.sum(np.abs(v) < SCALE_TOLERANCE)) for v in per.values())
-    n = min(len(v) for v in per.values())
+    ok, n = m.least_count(per, lambda v: np.abs(v) < SCALE_TOLERANCE)
     measured = "; ".join(f"true {k}: relative error {m.spread_text(100 * v, '%')}"
                          for k, v in per.items())
     return m.count_verdict(ok, n, 1.0, measured, "the scale factor is within 0.5 % at entry "
@@ -171,8 +188,7 @@ def _judge_scale(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 
 def _judge_rms(tables: Mapping[str, pd.DataFrame]) -> Verdict:
     per = {name: m.column(tables, f"{name}.rms_outside_m", "garage") for name in PAPER_FILTERS}
-    ok = min(int(np.sum(v < RMS_OUTSIDE_M)) for v in per.values())
-    n = min(len(v) for v in per.values())
+    ok, n = m.least_count(per, lambda v: v < RMS_OUTSIDE_M)
     measured = "; ".join(f"{k} {m.spread_text(v, 'm')}" for k, v in per.items())
     return m.count_verdict(ok, n, 1.0, measured, "all three filters are under 5 m RMS outside "
                            "the outages (automotive body)",
@@ -222,6 +238,13 @@ DR2D_ANALYSIS = ("Both DR filters' heading error is dominated by the z-gyro scal
                  "(0.5 % 1-sigma, about 5 deg over the helix turns), which neither filter "
                  "estimates; with it set to zero as a diagnostic dr3d_ekf wins 10/10 "
                  "(docs/reproduction_park2019.md).")
+MULTILEVEL_ANALYSIS = ("Not analysed here: this garage has helices too, so the unestimated "
+                       "z-gyro scale factor found in the underground garage is the likely "
+                       "cause (not measured).")
+TUNNEL_ANALYSIS = ("Not analysed to the end: the tunnel has only 60 deg of turns, so the gyro "
+                   "scale factor is not the cause; part of the drift comes from the z-gyro's "
+                   "effective bias as estimated from about 100 s of GPS course before the "
+                   "tunnel (docs/reproduction_park2019.md).")
 INS_FLAT_ANALYSIS = ("Against ins_odo_ekf the 3-D DR keeps its advantage on flat ground too: "
                      "the INS velocity error from the accelerometer bias does not need ramps "
                      "(the paper's own argument in section I).")
@@ -230,7 +253,8 @@ PAPER = Paper(
     title="MEMS 3D DR/GPS Integrated System for Land Vehicle Application Robust to GPS Outages",
     citation="W. J. Park, J. W. Song, C. H. Kang, J. H. Lee, M. H. Seo, S. Y. Park, J. Y. Yeo, "
              "C. G. Park, IEEE Access 7, 2019 (seeds/004_45cf7e5461f4cee8)",
-    experiments=(GARAGE, FLAT, SCALE_097, OPEN_SKY, INS_PARK_GARAGE, INS_PARKING_GARAGE),
+    experiments=(GARAGE, FLAT, SCALE_097, OPEN_SKY, MULTILEVEL, TUNNEL, INS_PARK_GARAGE,
+                 INS_PARKING_GARAGE),
     claims=(
         Claim("garage_beats_2d",
               "Underground garage: dr3d_ekf beats dr2d_odo_ekf on exit and maximum horizontal "
@@ -275,6 +299,27 @@ PAPER = Paper(
               "ins_odo_ekf's NHC lowers its median garage error (rigid body, both garages)",
               "section II-A, eqs. 12-14: the NHC bounds the INS error (no number)",
               "vehicle: rigid", _judge_ins_nhc),
+        Claim("multilevel_beats_both",
+              "Multilevel garage (not an issue-14 criterion): dr3d_ekf beats dr2d_odo_ekf and "
+              "ins_odo_ekf on exit error in >= 8 of 10 seeds (paired)",
+              "Table 3, area 2 (182 s): INS/GPS/odometer 24.20 m, 2-D DR 9.60 m; the proposed "
+              "filter smaller (its column is lost from our copy)",
+              "simulated multilevel garage (four-floor helix up, rooftop lap, helix down; the "
+              "real geometry is not published), 203 s without GNSS instead of 182 s; sensors "
+              "as in the underground garage",
+              lambda t: _worst(_beats(t, "dr2d_odo_ekf", MULTILEVEL_ANALYSIS, "multilevel_garage",
+                                      ("exit_horizontal_m",)),
+                               _beats(t, "ins_odo_ekf", "", "multilevel_garage",
+                                      ("exit_horizontal_m",)))),
+        Claim("tunnel_beats_2d",
+              "Curved tunnel, 159 s without GNSS (not an issue-14 criterion): dr3d_ekf's error "
+              "at the exit is smaller than dr2d_odo_ekf's in >= 8 of 10 seeds (paired)",
+              "Fig. 18: error after the exit 1.91 m (3-D DR/GPS) vs 5.74 m (2-D DR/GPS)",
+              "simulated 2.6 km tunnel with a gentle S-curve and a 3 % climb (the real "
+              "geometry is not published); error at the last epoch before GNSS returns, "
+              "against the truth (the paper used a map)",
+              lambda t: _beats(t, "dr2d_odo_ekf", TUNNEL_ANALYSIS, "curved_tunnel",
+                               ("exit_horizontal_m",))),
         Claim("open_sky_bounded",
               "Open-sky 40 s blockage on an interchange ramp: dr3d_ekf's horizontal error stays "
               "under 7 m, every seed",
