@@ -164,20 +164,16 @@ def _judge_spkf_robust(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 
 
 def _judge_drm2_beats_drm1(tables: Mapping[str, pd.DataFrame]) -> Verdict:
-    drm1 = m.column(tables, "drm1.dr_error_m", "dr_outage")
-    drm2 = m.column(tables, "drm2.dr_error_m", "dr_outage")
-    wins, n = m.paired_wins(drm2, drm1)
-    measured = (f"{m.win_rate_text(wins, n, 'DRM2')}; DRM1 {m.spread_text(drm1, 'm')}; "
-                f"DRM2 {m.spread_text(drm2, 'm')}")
-    return m.count_verdict(wins, n, 0.8, measured, "DRM2 has the smaller error 120 s after "
-                           "the loss")
+    return m.paired_verdict(m.column(tables, "drm2.dr_error_m", "dr_outage"),
+                            m.column(tables, "drm1.dr_error_m", "dr_outage"),
+                            ("DRM2", "DRM1"), 0.8, "m",
+                            "DRM2 has the smaller error 120 s after the loss")
 
 
 def _judge_scale_factor(tables: Mapping[str, pd.DataFrame]) -> Verdict:
     per = {label: m.column(tables, f"{label}.z_scale_factor_error", "situation1")
            for label in ("ekf", "spkf")}
-    ok = min(int(np.sum(v < SCALE_TOLERANCE)) for v in per.values())
-    n = min(len(v) for v in per.values())
+    ok, n = m.least_count(per, lambda v: v < SCALE_TOLERANCE)
     measured = "; ".join(f"{label.upper()} largest error from 100 s {m.spread_text(v)}"
                          for label, v in per.items())
     return m.count_verdict(ok, n, 1.0, measured, "both filters hold the z-gyro scale factor "
@@ -185,15 +181,13 @@ def _judge_scale_factor(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 
 
 def _judge_situation3(tables: Mapping[str, pd.DataFrame]) -> Verdict:
-    ekf = m.column(tables, "ekf.outage_max_horizontal_m", "situation3")
-    spkf = m.column(tables, "spkf.outage_max_horizontal_m", "situation3")
-    wins, n = m.paired_wins(spkf, ekf)
-    measured = (f"largest horizontal error in the outage: EKF {m.spread_text(ekf, 'm')}, SPKF "
-                f"{m.spread_text(spkf, 'm')}; {m.win_rate_text(wins, n, 'SPKF')}")
-    return m.count_verdict(wins, n, 0.8, measured, "the SPKF's outage error is the smaller",
-                           "In a 15 s outage both filters stay within a few metres; the EKF "
-                           "linearises well once its heading has converged, so the SPKF has "
-                           "little to gain (docs/reproduction_cho2006.md).")
+    return m.paired_verdict(m.column(tables, "spkf.outage_max_horizontal_m", "situation3"),
+                            m.column(tables, "ekf.outage_max_horizontal_m", "situation3"),
+                            ("SPKF", "EKF"), 0.8, "m",
+                            "the SPKF's largest error in the outage is the smaller",
+                            "In a 15 s outage both filters stay within a few metres; the EKF "
+                            "linearises well once its heading has converged, so the SPKF has "
+                            "little to gain (docs/reproduction_cho2006.md).")
 
 
 CONDITIONS = ("simulated drive of about 165 s in the paper's spirit (its Fig. 6 profile is not "

@@ -20,14 +20,15 @@ Public names
 ------------
 errors, horizontal_error, outage_scores, moving_off, outages, longest_outage,
 inside_windows, at_time, spread_text, count_text, paired_wins, win_rate_text, count_verdict,
-median_verdict, needed_count, column, position_error_3d, satellite_windows, window_values.
+median_verdict, needed_count, column, least_count, paired_verdict, position_error_3d,
+satellite_windows, window_values.
 """
 
 from __future__ import annotations
 
 import json
 import math
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 
 import numpy as np
 import pandas as pd
@@ -39,9 +40,10 @@ from simulator.scoring.evaluate import score_solutions
 from simulator.scoring.metrics import OUTAGE_KIND
 
 __all__ = ["at_time", "column", "count_text", "count_verdict", "errors", "horizontal_error",
-           "inside_windows", "longest_outage", "median_verdict", "moving_off", "needed_count",
-           "outage_scores", "outages", "paired_wins", "position_error_3d", "satellite_windows",
-           "spread_text", "win_rate_text", "window_values"]
+           "inside_windows", "least_count", "longest_outage", "median_verdict", "moving_off",
+           "needed_count", "outage_scores", "outages", "paired_verdict", "paired_wins",
+           "position_error_3d", "satellite_windows", "spread_text", "win_rate_text",
+           "window_values"]
 
 
 # -- against the truth ----------------------------------------------------------------------
@@ -186,6 +188,24 @@ def outage_scores(dataset: Dataset, solution: pd.DataFrame) -> list[dict]:
     entry per GNSS outage of the dataset's events."""
     return score_solutions(dataset, {"solution": (solution, None)}).results["solution"] \
         .scores["outages"]
+
+
+def least_count(per: Mapping[str, np.ndarray], passes: Callable[[np.ndarray], np.ndarray]
+                ) -> tuple[int, int]:
+    """For a claim over several groups of per-seed values (filters, true values): the smallest
+    number of seeds passing ``passes`` in any group, and the smallest number of seeds."""
+    return (min(int(np.sum(passes(v))) for v in per.values()),
+            min(len(v) for v in per.values()))
+
+
+def paired_verdict(mine: np.ndarray, theirs: np.ndarray, names: tuple[str, str],
+                   fraction: float, unit: str, what: str, analysis: str = "") -> Verdict:
+    """The verdict on "``names[0]``'s figure is smaller than ``names[1]``'s in at least
+    ``fraction`` of the seeds" (paired per seed), with both spreads and the win rate."""
+    wins, n = paired_wins(mine, theirs)
+    measured = (f"{win_rate_text(wins, n, names[0])}; {names[0]} {spread_text(mine, unit)}; "
+                f"{names[1]} {spread_text(theirs, unit)}")
+    return count_verdict(wins, n, fraction, measured, what, analysis)
 
 
 # -- partial-outage windows (Chan, Karamat) ----------------------------------------------------

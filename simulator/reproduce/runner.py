@@ -30,6 +30,8 @@ import time
 import traceback
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as dist_version
 from pathlib import Path
 
 import pandas as pd
@@ -39,7 +41,8 @@ from simulator.outputs import atomic_output_dir
 from simulator.pipeline import estimate, generate, load_scenario
 from simulator.progress import progress
 from simulator.reproduce.paper import Experiment, Paper, Verdict
-from simulator.reproduce.papers import load_paper
+from simulator.reproduce.papers import load_paper, paper_keys
+from simulator.reproduce.report import write_report
 
 __all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings",
            "reproduce", "run_experiment", "seeds_of"]
@@ -156,9 +159,6 @@ def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict
 
 def version() -> str:
     """landnav's version and, in a git checkout, its commit."""
-    from importlib.metadata import PackageNotFoundError
-    from importlib.metadata import version as dist_version
-
     try:
         text = f"landnav {dist_version('landnav')}"
     except PackageNotFoundError:
@@ -186,9 +186,6 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
     InputError
         An unknown paper, ``out`` existing without ``force``, a scheduler that does not answer.
     """
-    from simulator.reproduce.papers import paper_keys
-    from simulator.reproduce.report import write_report
-
     loaded = [load_paper(key) for key in (papers or paper_keys())]
     seeds = seeds_of(runs or (QUICK_SEEDS if quick else FULL_SEEDS))
     tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)))
