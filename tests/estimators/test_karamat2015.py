@@ -2,7 +2,7 @@
 RISS mechanisation against the exact truth, and the paper's claims on its partial-outage
 protocol over ten seeds, computed by ``simulator/reproduce/karamat2015.py`` (what ``landnav
 reproduce karamat2015`` judges; figures in docs/reproduction_karamat2015.md). The protocol runs
-on a rigid body here, the paper's conditions (issue 13): with the automotive body one of the ten
+on a rigid body (the experiment's override, issue 13): with the automotive body one of the ten
 seeds leaves a 0.064 deg/s vertical-gyro bias error at 300 s, over the 0.05 of section 4.3.3."""
 
 from __future__ import annotations
@@ -100,7 +100,7 @@ SEEDS = range(1, 11)
 def protocol(tmp_path_factory):
     """The shortened protocol (site 1, loops 1-4) for ten seeds, three variants each."""
     return run_experiment(karamat.PROTOCOL, SEEDS, tmp_path_factory.mktemp("karamat"),
-                          quick=True, extra_overrides=RIGID)
+                          quick=True)
 
 
 def _maxima(protocol, label: str, count: int) -> np.ndarray:
@@ -157,15 +157,29 @@ def test_gyro_bias_within_005_deg_s_by_300_s(protocol):
     assert np.all(np.abs(errors) < 0.05)
 
 
+@pytest.fixture(scope="module")
+def full_drive(tmp_path_factory):
+    """The whole shipped scenario (ten sites, 40 windows, 2 h 20 min), seed 2015."""
+    return run_experiment(karamat.PROTOCOL, [2015], tmp_path_factory.mktemp("karamat_full"))
+
+
 @pytest.mark.slow
-def test_full_drive_all_sites(tmp_path):
-    """The whole shipped scenario (ten sites, 40 windows, 2 h 20 min), seed 2015: every variant
-    bounded and the gyro bias converged. Measured median window maxima at 3 / 2 / 1 / 0
-    satellites: see docs/reproduction_karamat2015.md."""
-    figures = run_experiment(karamat.PROTOCOL, [2015], tmp_path, extra_overrides=RIGID)
+def test_full_drive_all_sites(full_drive):
+    """Every variant bounded over the whole drive. Measured median window maxima at 3 / 2 / 1 /
+    0 satellites: tight 3.8 / 6.2 / 20.1 / 13.8 m, loose 21.8 / 23.1 / 23.1 / 22.1 m,
+    simplified 5.6 / 8.7 / 20.4 / 15.4 m (sites 2-10 are harder to dead-reckon than site 1)."""
     for label in ("tight", "loose", "simplified"):
         for count in (3, 2, 1, 0):
-            maxima = karamat.window_maxima(figures, label, count)
+            maxima = karamat.window_maxima(full_drive, label, count)
             assert len(maxima) == 10
             assert np.median(maxima) < 40.0, (label, count)
-    assert abs(figures["tight.gyro_bias_error_300s_deg_s"].iloc[0]) < 0.05
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="claim not reproduced: 0.0505 deg/s at 300 s on seed 2015 "
+                   "of the ten-site drive (0.033 on the nine-site drive of session 4, whose "
+                   "shorter duration drew the sensors' processes differently; "
+                   "docs/reproduction_karamat2015.md)")
+def test_full_drive_gyro_bias_converged(full_drive):
+    """Section 4.3.3 on the whole drive's seed: the bias error at 300 s below 0.05 deg/s."""
+    assert abs(full_drive["tight.gyro_bias_error_300s_deg_s"].iloc[0]) < 0.05
