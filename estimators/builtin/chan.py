@@ -34,18 +34,18 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   ``estimators.toolbox.gnss_model`` (range to r_ins + C_b^n l_b, with the Sagnac rotation).
 * NHC: the rows are the body y and z velocities (the paper's text says "x and y" once) of the
   point where the constraint holds on a car, the rear axle (the wheels there do not steer;
-  ``constraints.nonholonomic`` with the lever arm ``nhc_lever_arm``, by default the dataset's
-  ``datasheet.vehicle.rear_axle``, the IMU itself on a rigid body): v^b = C_n^b v^n + w x r with
-  w the compensated gyro rate. The paper says its R^v "depends on the noise of forward velocity
-  and misalignment angle" and prints no value; here its 1-sigma is the car's physics
-  (``constraints.NonholonomicNoise`` from the datasheet's wheelbase: the rear tyres' slip
-  growing with speed times lateral acceleration, the body's pitch on its springs, the road's
-  roughness, over a 0.1 m/s floor), evaluated at the filter's speed, yaw rate and forward
-  acceleration of each update; on a rigid body (no car in the datasheet) the floor, 0.1 m/s.
-  ``nhc_std`` (a number) fixes it instead. The UKF predicts the rows of every sigma point with
-  ``constraints.body_velocity_points``. It is stacked with the GPS measurements at each GPS
-  epoch and applied alone at 1 Hz when an expected GPS epoch has not come half an interval
-  after its time (complete outages).
+  ``constraints.nonholonomic`` with the lever arm of the datasheet's rear axle,
+  ``toolbox.installation``; at the IMU itself on a rigid body or with ``nhc_point: imu``):
+  v^b = C_n^b v^n + w x r with w the compensated gyro rate. The paper says its R^v "depends on
+  the noise of forward velocity and misalignment angle" and prints no value; here its 1-sigma
+  is the car's physics (``constraints.NonholonomicNoise`` from the datasheet's wheelbase: the
+  rear tyres' slip growing with speed times lateral acceleration, the body's pitch on its
+  springs, the road's roughness, over a 0.1 m/s floor), evaluated at the filter's speed, yaw
+  rate and forward acceleration of each update; at the IMU, the floor, 0.1 m/s (the value
+  chosen for a rigid body before). ``nhc_std`` (a number) fixes it instead. The UKF predicts
+  the rows of every sigma point with ``constraints.body_velocity_points``. It is stacked with
+  the GPS measurements at each GPS epoch and applied alone at 1 Hz when an expected GPS epoch
+  has not come half an interval after its time (complete outages).
 * Not printed: P0, Q, R. P0: ``initial_position_std`` per axis (10 m), 0.5 m/s, 1 deg roll and
   pitch, 3 deg yaw, the bias priors of an automotive MEMS IMU (10 mg, 0.2 deg/s), cb and d taken
   from the first GPS epoch's residuals with 30 m and 3 m/s. Q: white noise of the IMU (config
@@ -80,6 +80,7 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gnss_model, nav_error
+from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
@@ -98,6 +99,7 @@ from simulator.earth import (
     rotvec_to_quat,
     skew,
 )
+from simulator.errors import InputError
 from simulator.units import DEG_S, DEG_S_RT_HZ, MILLI_G, MILLI_G_RT_HZ
 
 N_STATES = 17  # [dr(3), dv(3), psi(3), ba(3), bg(3), cb, d]
@@ -107,12 +109,13 @@ PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Veh
          "(tightly coupled INS/GPS, UKF vs EKF, NHC)")
 COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
+NHC_POINTS = ("rear_axle", "imu")
 
 
 DEFAULTS = {
     "nhc": True,
     "nhc_std": None,  # m/s, body y and z velocity; None: from the car's physics (docstring)
-    "nhc_lever_arm": None,  # IMU to the NHC point, body FRD, m; None: the datasheet's rear axle
+    "nhc_point": "rear_axle",  # where the NHC holds: rear_axle (the datasheet's) or imu
     "nhc_rate": 1.0,  # Hz, NHC alone when GPS is missing
     "lever_arm": [0.0, 0.0, 0.0],  # IMU to GPS antenna, body FRD, m
     "initial_position_std": 10.0,  # m per axis
@@ -145,12 +148,14 @@ class _TightlyCoupled(Estimator):
         self._accel_idx = [imu[c] for c in ("accel_x", "accel_y", "accel_z")]
         self._increments = self.imu_output == "increment"
         self._lever = np.asarray(cfg["lever_arm"], dtype=float)
-        vehicle = self.datasheet.get("vehicle", {})
-        point = cfg["nhc_lever_arm"] if cfg["nhc_lever_arm"] is not None else vehicle.get(
-            "rear_axle")
-        self._nhc_point = None if point is None else np.asarray(point, dtype=float)
-        self._nhc_physics = (constraints.NonholonomicNoise(vehicle["wheelbase"])
-                             if cfg["nhc_std"] is None and "wheelbase" in vehicle else None)
+        if cfg["nhc_point"] not in NHC_POINTS:
+            raise InputError(f"config of {self.name}: nhc_point must be one of "
+                             f"{', '.join(NHC_POINTS)}, got {cfg['nhc_point']!r}")
+        site = Installation.from_datasheet(self.datasheet)
+        self._nhc_point = site.rear_axle if cfg["nhc_point"] == "rear_axle" else None
+        self._nhc_physics = (constraints.NonholonomicNoise(site.wheelbase or 2.7)
+                             if cfg["nhc_std"] is None and self._nhc_point is not None
+                             else None)
         self._t_imu: float | None = None
         self._w_prev = np.zeros(3)
         self._f_prev = np.zeros(3)

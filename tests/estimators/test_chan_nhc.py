@@ -16,6 +16,7 @@ from estimators.toolbox.constraints import (
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.earth import euler_to_dcm, euler_to_quat
+from simulator.errors import InputError
 from simulator.scenario import load_scenario
 from tests.conftest import REPO
 from tests.estimators.chan_helpers import run
@@ -94,6 +95,11 @@ def test_filters_follow_the_automotive_body_with_the_rear_axle_constraint(automo
         return np.abs(np.angle(np.exp(1j * (solution["yaw"] - yaw))))
 
     axle = yaw_error()
-    at_imu = yaw_error(nhc_lever_arm=[0.0, 0.0, 0.0], nhc_std=0.1)
+    at_imu = yaw_error(nhc_point="imu")
     assert axle.max() < np.radians(0.2)
     assert axle.max() < 0.5 * at_imu.max()
+
+
+def test_an_unknown_nhc_point_is_one_clear_error(automotive):
+    with pytest.raises(InputError, match="nhc_point must be one of rear_axle, imu"):
+        run(automotive, "tc_ukf", nhc_point="front")
