@@ -81,7 +81,9 @@ def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[
         _sentence("GPVTG", _num(course, 2), "T", "", "M", _num(knots, 3), "N",
                   _num(fix["speed"] * 3.6, 3), "K", mode),
     ]
-    used = [f"{int(sv):02d}" for sv in sats["sv"]][:12] if has_fix else []
+    # GSA lists the satellites the fix used: not the unhealthy ones GSV shows in view
+    healthy = sats[sats["health"] == 0] if "health" in sats else sats
+    used = [f"{int(sv):02d}" for sv in healthy["sv"]][:12] if has_fix else []
     out.append(_sentence("GPGSA", "A", {0: "1", 1: "2"}.get(int(fix["fix"]), "3"),
                          *(used + [""] * (12 - len(used))), _num(pdop, 1), _num(hdop, 1),
                          _num(vdop, 1)))
