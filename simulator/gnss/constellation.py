@@ -41,11 +41,12 @@ consistent real snapshot, and the elements are only shifted in time (toe, toc, w
 node's week-start longitude Omega_0, which carries the Earth's rotation; IS-GPS-200 Table
 20-IV), never propagated over years. They are written as a record per satellite every two hours,
 as broadcast ephemerides are (each the same orbit re-referenced to its toe), so that exported
-RINEX navigation files are accepted by receivers' and RTKLIB's age checks. Consequence: a 2026 scenario sees the 2020 constellation
-(its 31 satellites, PRNs and slots, the sidereal-time-of-day pattern of their passes), not the
-2026 one: satellites launched or retired since then are not there, and the real slow drift of
-the constellation along its tracks is not followed. Counts and geometry are those of a real
-31-satellite GPS (about 9-10 above 10 deg at mid latitudes); a scenario that must reproduce a
+RINEX navigation files are accepted by receivers' and RTKLIB's age checks. Consequence: a 2026
+scenario sees the 2020 constellation (its 31 satellites, PRNs and slots, the
+sidereal-time-of-day pattern of their passes), not the 2026 one: satellites launched or retired
+since then are not there, and the real slow drift of the constellation along its tracks is not
+followed. Counts and geometry are those of a real 31-satellite GPS (8.6-10.0 above 10 deg,
+averaged over a day, at seven sites from 34 S to 60 N); a scenario that must reproduce a
 particular day's sky names that day's navigation file.
 
 Public names
