@@ -55,6 +55,8 @@ GNSS_RAW = {
 #               + multipath + nlos_delay + code_noise
 # pseudorange_rate = range_rate + receiver_clock_drift - sat_clock_drift (1 - range_rate / c)
 #               + tropo_true_rate - iono_true_rate + rate_noise
+# (multipath and code_noise as the receiver delivers them, after its carrier smoothing;
+# code_noise then holds the smoothing's ionosphere divergence too: simulator.gnss.errors)
 TRUTH_GNSS = {
     "t": "s", "sv": "1", "tracked": "1", "los": "1", "nlos": "1",
     "elevation": "rad", "azimuth": "rad", "range": "m", "range_rate": "m/s",

@@ -9,14 +9,39 @@ or a RINEX navigation file / YUMA almanac),
 ``expanded_slots`` (which expandable slots of ``nominal-gps`` are split into their fore/aft pairs:
 any of ``B1``, ``D2``, ``F2``; all three give the 27-slot constellation), ``elevation_mask``
 (deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
-(body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
-DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative 1-sigma of the
-ionosphere the broadcast model misses (common to all signals, plus an independent part per
-signal of half that size), ``tropo_residual`` zenith 1-sigma, ``sis_error`` 1-sigma
-signal-in-space range error, ``cn0_noise``; see ``simulator.gnss.errors``), the tracking-loop
-and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
-single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
-mass-market single-frequency receiver with a TCXO.
+(body FRD, m, from the IMU), the error levels and their time behaviour (``tracking_noise`` scale
+of the C/N0-driven DLL/FLL jitter and the loops' bandwidths, ``carrier_smoothing`` Hatch filter,
+``multipath`` zenith 1-sigma with ``multipath_distance`` and ``multipath_correlation_time``,
+``cn0_fading``, ``iono_scale`` and ``iono_residual``, ``tropo_residual``, ``sis_error``,
+``cn0_noise``; see ``simulator.gnss.errors``), the C/N0 parameters and ``smoothing`` (time
+constant of the filtered fix output, 0 = raw single-epoch fixes). ``preset: ideal`` turns every
+error off; ``automotive`` (default) is a mass-market single-frequency receiver with a TCXO;
+``geodetic`` a static reference-station receiver.
+
+Presets (the figures they follow):
+
+- ``automotive``: DLL 0.5 Hz with 0.5-chip spacing and 100 s carrier smoothing (RTCA DO-229D
+  2.1.4.1.1, the 100 s Hatch filter; u-blox M8/F9 fixes change by centimetres per second while
+  driving: 0.036 m/s per axis in a u-blox log at 17.6 m/s, issue 19); FLL 2 Hz: pseudorange-rate
+  noise 0.024 / 0.04 / 0.08 m/s at 45 / 40 / 35 dB-Hz (Kaplan & Hegarty 2017 eq. 8.37), the
+  level of the u-blox NEO-M8 datasheet's 0.05 m/s velocity accuracy (UBX-15031086) and of the
+  0.097 m/s 1-sigma a u-blox M8 reports in comma2k19's log; multipath 0.3 m at zenith on the
+  DO-229D J.2.4 elevation shape (0.75 m at 10 deg; Braasch 1996 for code multipath of
+  mass-market antennas: metres near the horizon), decorrelating over 10 m travelled (the code
+  multipath of a moving antenna keeps the envelope set by reflectors metres to tens of metres
+  away; its phase rotates at v / lambda, far above the DLL bandwidth) and over 120 s standing
+  still (a quarter of the Georgiadou & Kleusberg 1988 period for a reflector 2 m away at 45 deg);
+  C/N0 fading 2 dB; TCXO.
+- ``geodetic``: a monitor-station receiver's raw code (RINEX observations are not smoothed):
+  narrow correlator 0.1 chip (Van Dierendonck, Fenton & Ford, "Theory and performance of narrow
+  correlator spacing in a GPS receiver", Navigation 39(3), 1992), carrier-aided DLL 0.2 Hz, FLL
+  0.5 Hz, multipath the DO-229D J.2.4 curve itself (0.13 m at zenith, 0.32 m at 10 deg: a
+  choke-ring antenna), C/N0 fading 0.5 dB, OCXO.
+- both: true ionosphere 1.5 x Klobuchar (Klobuchar 1987: the model removes about half of the
+  rms delay; issue 19: ARL1's true ionosphere was 1.3-1.8 x the broadcast model) with a 20 %
+  slow variation; signal-in-space error 0.5 m (the GPS SPS signal-in-space URE of the 2010s,
+  of order 0.5-1 m rms in the FAA GPS performance analysis reports); zenith troposphere
+  residual 5 cm.
 
 Streams: ``gnss_raw`` (one row per tracked signal, unhealthy satellites included with their
 ``health`` code), ``gnss_fix`` (one row per epoch from the healthy signals: 3D fix from four
@@ -70,11 +95,13 @@ from simulator.gnss.ephemeris import (
     select_ephemeris,
 )
 from simulator.gnss.errors import (
-    CARRIER_SMOOTHING_TIME_S,
     OSCILLATORS,
+    decorrelation_coordinate,
     draw_error_terms,
+    draw_fading,
     draw_receiver_clock,
     pseudorange_sigma,
+    smooth_code_errors,
 )
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
@@ -88,13 +115,23 @@ from simulator.trajectory.kinematics import Kinematics
 if TYPE_CHECKING:
     import pandas as pd
 
+# the receivers' error levels and loops; sources in the module docstring, "Presets"
+_LOOPS = {"dll_bandwidth": 0.5, "correlator_spacing": 0.5, "fll_bandwidth": 2.0}
+_ATMOSPHERE_AND_SKY = {"iono_scale": 1.5, "iono_residual": 0.2, "tropo_residual": 0.05,
+                       "sis_error": 0.5}
+_MULTIPATH_MOTION = {"multipath_distance": 10.0, "multipath_correlation_time": 120.0}
 PRESETS: dict[str, dict] = {
-    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
-                   "iono_residual": 0.2, "tropo_residual": 0.05, "sis_error": 0.5,
-                   "cn0_noise": 1.0, "code_correlation_time": CARRIER_SMOOTHING_TIME_S},
-    "ideal": {"clock": "ideal", "tracking_noise": 0.0, "multipath": 0.0, "iono_residual": 0.0,
-              "tropo_residual": 0.0, "sis_error": 0.0, "cn0_noise": 0.0,
-              "code_correlation_time": 0.0},
+    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, **_LOOPS, "carrier_smoothing": 100.0,
+                   "multipath": 0.3, **_MULTIPATH_MOTION, "cn0_fading": 2.0, "cn0_noise": 1.0,
+                   **_ATMOSPHERE_AND_SKY},
+    "geodetic": {"clock": "ocxo", "tracking_noise": 1.0, "dll_bandwidth": 0.2,
+                 "correlator_spacing": 0.1, "fll_bandwidth": 0.5, "carrier_smoothing": 0.0,
+                 "multipath": 0.13, **_MULTIPATH_MOTION, "cn0_fading": 0.5, "cn0_noise": 0.25,
+                 **_ATMOSPHERE_AND_SKY},
+    "ideal": {"clock": "ideal", "tracking_noise": 0.0, **_LOOPS, "carrier_smoothing": 0.0,
+              "multipath": 0.0, **_MULTIPATH_MOTION, "cn0_fading": 0.0, "cn0_noise": 0.0,
+              "iono_scale": 1.0, "iono_residual": 0.0, "tropo_residual": 0.0,
+              "sis_error": 0.0},
 }
 # broadcast ionosphere used with the nominal constellation: the coefficients of the IGS
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
@@ -112,16 +149,31 @@ _ERROR_FIELDS = {
     "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
     "tracking_noise": Number("", None, min=0,
                              doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
+    "dll_bandwidth": Number("Hz", None, gt=0,
+                            doc="code tracking loop (DLL) noise bandwidth; its time constant "
+                                "1 / (4 B) correlates the code noise"),
+    "correlator_spacing": Number("", None, gt=0, max=1, doc="early-late spacing, chips"),
+    "fll_bandwidth": Number("Hz", None, gt=0,
+                            doc="carrier (frequency) loop noise bandwidth: the Doppler noise"),
+    "carrier_smoothing": Number("s", None, min=0,
+                                doc="time constant of the Hatch filter smoothing the code with "
+                                    "the carrier (0 = raw code)"),
     "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
+    "multipath_distance": Number("m", None, gt=0,
+                                 doc="distance travelled over which multipath and C/N0 fading "
+                                     "decorrelate (1 / e)"),
+    "multipath_correlation_time": Number("s", None, gt=0,
+                                         doc="their correlation time standing still (the "
+                                             "satellites' motion)"),
+    "cn0_fading": Number("", None, min=0,
+                         doc="C/N0 fading 1-sigma, dB, correlated like the multipath"),
+    "cn0_noise": Number("", None, min=0, doc="C/N0 estimate noise 1-sigma, dB, white"),
+    "iono_scale": Number("", None, min=0,
+                         doc="mean true ionosphere / broadcast (Klobuchar) ionosphere"),
     "iono_residual": Number("", None, min=0,
-                            doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
+                            doc="1-sigma of the slow relative variation of that ratio"),
     "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
     "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
-    "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
-    "code_correlation_time": Number("s", None, min=0,
-                                    doc="correlation time of the code tracking error and "
-                                        "at least of the multipath (carrier-smoothed code; "
-                                        "0 = white per epoch)"),
 }
 
 
@@ -163,7 +215,8 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
 
 GNSS_FIELD = Record(
     {
-        "preset": Text("automotive", doc="error preset: 'automotive' or 'ideal' (no errors)"),
+        "preset": Text("automotive", doc="error preset: 'automotive', 'geodetic' or 'ideal' "
+                                         "(no errors)"),
         "rate": Number("Hz", 1.0, gt=0, max=100, doc="epoch rate"),
         "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1,
                           doc="streams written: gnss_fix and/or gnss_raw"),
@@ -180,16 +233,11 @@ GNSS_FIELD = Record(
         "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
                                     doc="antenna position in the body frame (FRD) from the IMU"),
         **_ERROR_FIELDS,
-        "multipath_correlation_time": Number("s", 5.0, gt=0,
-                                             doc="Gauss-Markov correlation time of multipath"),
         "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
         "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
         "cn0_threshold": Number("", 17.0,
                                 doc="tracking threshold, dB-Hz (the weakest signal the "
                                     "comma2k19 car's u-blox reports)"),
-        "dll_bandwidth": Number("Hz", 0.5, gt=0, doc="code tracking loop (DLL) bandwidth"),
-        "correlator_spacing": Number("", 0.5, gt=0, max=1, doc="early-late spacing, chips"),
-        "fll_bandwidth": Number("Hz", 0.5, gt=0, doc="carrier (frequency) loop noise bandwidth"),
         "integration_time": Number("s", 0.02, gt=0, max=0.02,
                                    doc="coherent integration time of the correlators"),
         "smoothing": Number("s", 0.0, min=0, doc="fix smoothing time constant (0 = none)"),
@@ -341,9 +389,13 @@ class Gnss(PresetSensor):
         geo = model = _signals_in_chunks(eph, idx, tow0 + t, ant, day_of_year, alpha, beta)
         el, az = geo["elevation"], geo["azimuth"]
 
-        # what the receiver tracks
+        # what the receiver tracks: the C/N0 fades with the motion (correlated like the
+        # multipath), the receiver's estimate of it adds white noise
+        u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
+                                     cfg["multipath_correlation_time"])
         los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"], ant["distance"], rng)
-        signal_cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
+        signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
+                      + draw_fading(rng, cfg, u, el.shape[0]))
         cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
         have = idx >= 0
         tracked = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos) \
@@ -355,12 +407,17 @@ class Gnss(PresetSensor):
         self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
         # (which would otherwise make the error and the fix weights jump from epoch to epoch)
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s)
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]
+        err = smooth_code_errors(cfg, err, iono_true, tracked, dt_s)
         tropo_true = model["tropo"] + err["tropo_zenith"] * mapping
-        iono_true_rate = model["iono_rate"] * err["iono_ratio"]
+        # the true ionosphere's rate: the broadcast model's along the geometry, times the ratio,
+        # plus the ratio's own (slow) change
+        ratio_rate = (np.gradient(err["iono_ratio"], dt_s, axis=1) if len(t) > 1
+                      else np.zeros_like(err["iono_ratio"]))
+        iono_true_rate = model["iono_rate"] * err["iono_ratio"] + model["iono"] * ratio_rate
         tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
         nlos_delay = np.where(nlos & ~los, extra, 0.0)
         sat_clock = C_M_S * geo["clock_s"]
@@ -371,7 +428,8 @@ class Gnss(PresetSensor):
                        + err["sis"] + err["multipath"] + nlos_delay + err["code_noise"])
         rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
                 + tropo_true_rate - iono_true_rate + err["rate_noise"])
-        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping)
+        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping, dt_s,
+                                             np.linalg.norm(ant["v_ned"], axis=1))
 
         table = _RowTable(t, svs)
         raw = table(tracked, {
