@@ -149,14 +149,16 @@ def geodetic_to_ecef(lat_rad: np.ndarray, lon_rad: np.ndarray, alt_m: np.ndarray
 def ecef_to_geodetic(xyz_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """ECEF (m), shape (..., 3), to geodetic latitude, longitude (rad) and height (m).
 
-    Uses pymap3d.ecef2geodetic (WGS-84).
+    Uses pymap3d.ecef2geodetic (WGS-84). The outputs have shape (...) always (pymap3d returns
+    the latitude of a single point, shape (1, 3), as a scalar).
     """
     xyz = np.asarray(xyz_m, dtype=float)
     pymap3d, wgs84 = _pymap3d()
     lat, lon, alt = pymap3d.ecef2geodetic(
         xyz[..., 0], xyz[..., 1], xyz[..., 2], ell=wgs84, deg=False
     )
-    return np.asarray(lat), np.asarray(lon), np.asarray(alt)
+    shape = xyz.shape[:-1]
+    return np.reshape(lat, shape), np.reshape(lon, shape), np.reshape(alt, shape)
 
 
 def ned_to_ecef_matrix(lat_rad: np.ndarray, lon_rad: np.ndarray) -> np.ndarray:
