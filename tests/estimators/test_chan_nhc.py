@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from tests.estimators.chan_helpers import run
 
 from estimators.toolbox.constraints import (
     NonholonomicNoise,
@@ -19,7 +20,6 @@ from simulator.earth import euler_to_dcm, euler_to_quat
 from simulator.errors import InputError
 from simulator.scenario import load_scenario
 from tests.conftest import REPO
-from tests.estimators.chan_helpers import run
 
 
 def test_points_form_is_the_jacobian_form_at_every_point():
