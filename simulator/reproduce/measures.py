@@ -20,11 +20,13 @@ Public names
 ------------
 errors, horizontal_error, outage_scores, moving_off, outages, longest_outage,
 inside_windows, at_time, spread_text, count_text, paired_wins, win_rate_text, count_verdict,
-median_verdict, needed_count, column, least_count, paired_verdict.
+median_verdict, needed_count, column, least_count, paired_verdict, position_error_3d,
+satellite_windows, window_values.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 
@@ -33,14 +35,15 @@ import pandas as pd
 
 from simulator.dataset.io import Dataset
 from simulator.reproduce.paper import Verdict
-from simulator.scoring.align import ERR_H, solution_errors
+from simulator.scoring.align import ERR_H, ERR_POS, solution_errors
 from simulator.scoring.evaluate import score_solutions
 from simulator.scoring.metrics import OUTAGE_KIND
 
 __all__ = ["at_time", "column", "count_text", "count_verdict", "errors", "horizontal_error",
            "inside_windows", "least_count", "longest_outage", "median_verdict", "moving_off",
            "needed_count", "outage_scores", "outages", "paired_verdict", "paired_wins",
-           "spread_text", "win_rate_text"]
+           "position_error_3d", "satellite_windows", "spread_text", "win_rate_text",
+           "window_values"]
 
 
 # -- against the truth ----------------------------------------------------------------------
@@ -203,3 +206,42 @@ def paired_verdict(mine: np.ndarray, theirs: np.ndarray, names: tuple[str, str],
     measured = (f"{win_rate_text(wins, n, names[0])}; {names[0]} {spread_text(mine, unit)}; "
                 f"{names[1]} {spread_text(theirs, unit)}")
     return count_verdict(wins, n, fraction, measured, what, analysis)
+
+
+# -- partial-outage windows (Chan, Karamat) ----------------------------------------------------
+
+SATELLITE_LIMIT_KIND = "gnss_satellite_limit"  # events.parquet kind of a partial outage
+
+
+def position_error_3d(dataset: Dataset, solution: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """Times (s) and 3-D position error (m, the norm of ``err_n/e/d``) of a solution's rows
+    inside the truth span."""
+    e = errors(dataset, solution)
+    return e["t"].to_numpy(), np.linalg.norm(e[list(ERR_POS)].to_numpy(), axis=1)
+
+
+def satellite_windows(events: pd.DataFrame) -> pd.DataFrame:
+    """The partial-outage windows of an events table with the satellites each leaves: every
+    ``gnss_satellite_limit`` row (its ``count``), and every GNSS outage that overlaps none of
+    them as a 0-satellite window (a limit to 0 satellites is also an outage row: counted once,
+    as the limit). Columns ``t_start``, ``t_end`` (s), ``satellites``; sorted by start."""
+    limits = events.loc[events["kind"] == SATELLITE_LIMIT_KIND]
+    rows = [(float(r.t_start), float(r.t_end), int(json.loads(r.detail)["count"]))
+            for r in limits.itertuples()]
+    for t0, t1 in outages(events):
+        if not ((limits["t_start"] < t1) & (limits["t_end"] > t0)).any():
+            rows.append((float(t0), float(t1), 0))
+    table = pd.DataFrame(rows, columns=["t_start", "t_end", "satellites"])
+    return table.sort_values("t_start", kind="stable").reset_index(drop=True)
+
+
+def window_values(t: np.ndarray, values: np.ndarray, windows: pd.DataFrame,
+                  reduce: Callable[[np.ndarray], float]) -> np.ndarray:
+    """``reduce`` (``np.mean``, ``np.max``, ...) of the ``values`` at times ``t`` inside each
+    [t_start, t_end) window of ``windows``, one per window (NaN for a window without a row)."""
+    out = np.full(len(windows), np.nan)
+    for k, (t0, t1) in enumerate(windows[["t_start", "t_end"]].to_numpy(float)):
+        inside = values[(t >= t0) & (t < t1)]
+        if inside.size:
+            out[k] = float(reduce(inside))
+    return out
