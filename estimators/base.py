@@ -22,7 +22,10 @@ None) and the layout of the streams it receives, then calls ``setup()``. Each me
 method ``on_<stream>(t, row)``: ``row`` is a read-only float64 row of the stream's table whose
 column positions are ``self.columns[stream][column]`` (units in ``self.units[stream]``;
 ``self.imu_output`` says whether the IMU rows are rates, ``"rate"``, or increments over the
-interval before each sample, ``"increment"``, from the dataset's IMU stream description); a
+interval before each sample, ``"increment"``, from the dataset's IMU stream description;
+``self.datasheet`` is the manifest's ``datasheet``, what a user knows of the sensors and the
+car: each sensor's parameters, the GNSS ``antenna_lever_arm``, the IMU ``mounting``, the
+``vehicle`` block with the rear axle from the IMU; empty when the dataset has none); a
 ``gnss_raw`` message is one whole epoch, a 2-D array with one row per satellite. After the
 messages of an output instant the replay calls ``solution(t)``, which returns the values of
 ``output_columns`` for time ``t`` (or None while the estimator has no solution yet).
@@ -97,13 +100,15 @@ class Estimator:
 
     def __init__(self, config: Mapping[str, Any] | None, initial: InitialState | None,
                  columns: Mapping[str, Mapping[str, int]],
-                 units: Mapping[str, Mapping[str, str]], *, imu_output: str | None = None):
+                 units: Mapping[str, Mapping[str, str]], *, imu_output: str | None = None,
+                 datasheet: Mapping[str, Any] | None = None):
         self.config = resolve_config(type(self), config)
         self.initial = initial
         self.columns = {k: dict(v) for k, v in columns.items()}
         self.units = {k: dict(v) for k, v in units.items()}
         # "rate" or "increment" (None without an IMU stream): what the IMU rows hold
         self.imu_output = imu_output
+        self.datasheet = copy.deepcopy(dict(datasheet or {}))
         self.setup()
 
     def setup(self) -> None:

@@ -255,7 +255,8 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                 dataset.manifest.get("sensors"))
     try:
         estimator = cls(config, initial, {s.name: s.columns for s in streams},
-                        {s.name: s.units for s in streams}, imu_output=imu_output(dataset))
+                        {s.name: s.units for s in streams}, imu_output=imu_output(dataset),
+                        datasheet=dataset.manifest.get("datasheet"))
     except BaseException as exc:
         failure = _plugin_failure(cls, "setup", None, exc)
         if failure is None:

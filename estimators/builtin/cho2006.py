@@ -35,10 +35,19 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   drawn at every GPS epoch and after each second of propagation without one, and the
   covariance (eq. 26) is formed from them before each draw.
 * Standstill gyro calibration (the paper: "the bias of a gyro can be calibrated during the
-  standing phase"): the run starts at rest; until the forward specific force moves more than
-  0.2 m/s^2 from its mean at rest, or a GPS fix reports more than 0.5 m/s, the filter holds
-  its state and averages the gyros; the averages are removed from every later sample and
-  written as ``gyro_bias_*``. ``standstill_calibration: false`` skips it.
+  standing phase"): at every standstill, the filter holds its state and averages the gyros; the
+  averages are removed from every later sample and written as ``gyro_bias_*``. The run starts
+  at rest; with an odometer stream (used when the dataset has one) every later stop counts too:
+  a standstill begins when the odometer reads zero (below 1 mm/s: a stopped wheel; a wheel-speed
+  sensor's reading below its cut-off speed, 2 km/h for CAN, counts as stopped, and the state
+  held over such a crawl moves the position by under 0.55 m/s times its length) and ends when
+  it reads a speed, or the forward specific force moves more than 0.2 m/s^2 from its mean at
+  rest, or a GPS fix reports more than 0.5 m/s. A stop's average replaces the calibration when
+  it lasted at least 2 s (the bias drifts in-run, so the latest stop is the best estimate;
+  shorter stops, whose 2 s average of the white noise would be no better than the calibration
+  held, are ignored). Without an odometer only the initial standstill is used (a stop cannot
+  be told from driving at a constant speed by the IMU alone). ``standstill_calibration:
+  false`` skips it.
 * DRM1's filter state is not printed: [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], the level-
   frame velocity of eq. 2 without its "+ g^n" (a typo: the horizontal components of g^n are
   zero) and the scale-factor model 2 of both accelerometers and the yaw gyro. P0 and Q follow
@@ -85,6 +94,8 @@ DR_STEP_S = 0.1  # the DR propagation interval (10 Hz, section III)
 DRAW_INTERVAL_S = 1.0  # longest SPKF propagation between sigma-point draws (the GPS period)
 MOVE_ACCEL_M_S2 = 0.2  # forward specific-force change that ends the initial standstill
 MOVE_SPEED_M_S = 0.5  # GPS speed that ends the initial standstill
+MIN_STOP_S = 2.0  # shortest stop whose gyro average replaces the calibration
+STOPPED_M_S = 1e-3  # odometer speed read as a stopped wheel (below any encoder's resolution)
 MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
 DEG = math.pi / 180.0
 
@@ -203,6 +214,7 @@ class _ChoDr(Estimator):
     (eq. 18), local north/east metres, the solution row."""
 
     needs = ("imu", "gnss_fix")
+    uses = ("odometer",)
     paper = PAPER
     output_rate_hz = 10.0
     defaults = {"standstill_calibration": True}
@@ -230,6 +242,8 @@ class _ChoDr(Estimator):
         self._still = bool(self.config["standstill_calibration"]) and speed < MOVE_SPEED_M_S
         self._still_sum = np.zeros(3)
         self._still_t = 0.0
+        self._first_stop = self._still  # the initial standstill: calibrated however short
+        self._odo_speed = self.columns.get("odometer", {}).get("speed")
         self._start_filter(self._initial_state(), self._p0.copy())
 
     # -- to be provided by the model and filter -------------------------------------------
@@ -290,10 +304,22 @@ class _ChoDr(Estimator):
 
     def _end_standstill(self) -> None:
         self._still = False
-        if self._still_t > 0.0:
+        if self._still_t > 0.0 and (self._first_stop or self._still_t >= MIN_STOP_S):
             mean = self._still_sum / self._still_t
             for i in self._gyro_channels:
                 self._bias[i] = mean[i]
+        self._first_stop = False
+
+    def on_odometer(self, t: float, row: np.ndarray) -> None:
+        """A stopped wheel starts a standstill; a speed ends it (module docstring)."""
+        stopped = abs(float(row[self._odo_speed])) < STOPPED_M_S
+        if stopped and not self._still and self.config["standstill_calibration"]:
+            self._step()  # the motion up to the stop
+            self._still = True
+            self._still_sum[:] = 0.0
+            self._still_t = 0.0
+        elif not stopped and self._still:
+            self._end_standstill()
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         fix, lat, lon, vn, ve = (float(row[i]) for i in self._fix_cols)

@@ -6,13 +6,17 @@ C_b^n(estimate) = (I + [psi x]) C_b^n(true)).
 * ``gnss_position``: receiver position, with the antenna lever arm l^b: r_a = r + C_b^n l^b, so
   H = [I, 0, -[(C_b^n l^b) x], 0, 0] (Park et al. 2019, eq. 8 without a lever arm; the lever-arm
   term as in Groves 2013, chapter 14);
-* ``gnss_velocity``: NED velocity, H = [0, I, 0, 0, 0] (Park et al. 2019, eq. 8);
+* ``gnss_velocity``: NED velocity, H = [0, I, 0, 0, 0] (Park et al. 2019, eq. 8); with the
+  lever arm the antenna moves at v_a = v + C_b^n (w^b x l^b), so H = [0, I, -[(C_b^n (w x l))
+  x], 0, C_b^n [l x]] (w the compensated body rate, the gyro-bias error entering through it;
+  Groves 2013, eq. 14.122, the Earth rate's part of w neglected);
 * ``ground_speed`` and ``course``: GNSS speed sqrt(vn^2 + ve^2) and course atan2(ve, vn) (Park
   et al. 2019, eqs. 38-41);
 * ``odometer``: body-frame velocity [v_odo, 0, 0] (Park et al. 2019, eqs. 10-14; the lateral and
   vertical rows are the non-holonomic constraint of ``constraints.nonholonomic``, dropped with
-  ``nhc=False``); Park's eq. 12 prints -C_n^b (v^n x) for an attitude error of the opposite sign
-  to ours, the same Jacobian;
+  ``nhc=False``), at the IMU or, with a lever arm, at the rear axle where the wheels measure and
+  the constraint holds (``constraints.body_velocity``); Park's eq. 12 prints -C_n^b (v^n x) for
+  an attitude error of the opposite sign to ours, the same Jacobian;
 * ``zero_velocity`` (ZUPT) and ``zero_rate`` (ZARU, the compensated gyro output equals the Earth
   rate at standstill; Groves 2013, chapter 15);
 * ``barometric_height``: the barometer's altitude minus its offset from the ellipsoidal height,
@@ -32,7 +36,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from estimators.toolbox.constraints import height, nonholonomic
+from estimators.toolbox.constraints import body_velocity, height
 from estimators.toolbox.ins_error import BG, N_STATES
 from simulator.earth import OMEGA_E_RAD_S, quat_to_dcm, radii_of_curvature, skew, wrap_angle
 
@@ -66,12 +70,24 @@ def gnss_position(q: np.ndarray, pos: np.ndarray, pos_gnss: np.ndarray,
     return dz, h_mat
 
 
-def gnss_velocity(v: np.ndarray, v_gnss: np.ndarray, n_states: int = N_STATES
-                  ) -> tuple[np.ndarray, np.ndarray]:
-    """NED velocity: dz = v - v_gnss (m/s), H = [0, I, 0 ...]."""
+def gnss_velocity(v: np.ndarray, v_gnss: np.ndarray, n_states: int = N_STATES,
+                  q: np.ndarray | None = None, rate_body: np.ndarray | None = None,
+                  lever_arm: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """NED velocity of the antenna: dz = v_a - v_gnss (m/s), H = [0, I, 0 ...] at the IMU; with
+    ``lever_arm`` (antenna from the IMU, body FRD, m; needs ``q`` and the compensated body rate
+    ``rate_body``, rad/s) the lever-arm terms of the module docstring."""
     h_mat = np.zeros((3, n_states))
     h_mat[:, 3:6] = np.eye(3)
-    return np.asarray(v, float) - np.asarray(v_gnss, float), h_mat
+    dz = np.asarray(v, float) - np.asarray(v_gnss, float)
+    if lever_arm is not None:
+        arm = np.asarray(lever_arm, dtype=float)
+        c_bn = quat_to_dcm(q)
+        turn_n = c_bn @ np.cross(rate_body, arm)
+        dz += turn_n
+        h_mat[:, 6:9] = -skew(turn_n)
+        if n_states > BG.start:
+            h_mat[:, BG] = c_bn @ skew(arm)
+    return dz, h_mat
 
 
 def ground_speed(v: np.ndarray, speed: float, n_states: int = N_STATES
@@ -95,22 +111,22 @@ def course(v: np.ndarray, course_rad: float, n_states: int = N_STATES
 
 
 def odometer(q: np.ndarray, v: np.ndarray, speed: float, nhc: bool = True,
-             n_states: int = N_STATES) -> tuple[np.ndarray, np.ndarray]:
-    """Odometer speed along body x, with the non-holonomic rows (Park et al. 2019, eqs. 13-14).
+             n_states: int = N_STATES, rate_body: np.ndarray | None = None,
+             lever_arm: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Odometer speed along body x, with the non-holonomic rows (Park et al. 2019, eqs. 13-14),
+    at the IMU or at the point ``lever_arm`` (from the IMU, body FRD, m; the rear axle) moving
+    with the compensated body rate ``rate_body`` (rad/s; ``constraints.body_velocity``).
 
     Returns
     -------
     dz : (3,) or (1,) estimated body velocity minus [speed, 0, 0], m/s; h : (3 or 1, n_states).
     """
-    c_nb = quat_to_dcm(q).T
-    h_x = np.zeros((1, n_states))
-    h_x[0, 3:6] = c_nb[0]
-    h_x[0, 6:9] = c_nb[0] @ skew(v)
-    dz_x = np.array([c_nb[0] @ v - speed])
+    bias = BG if n_states > BG.start else None
+    v_b, h = body_velocity(q, v, n_states, rate_body, lever_arm, bias)
+    v_b[0] -= speed
     if not nhc:
-        return dz_x, h_x
-    dz_yz, h_yz = nonholonomic(q, v, n_states)
-    return np.r_[dz_x, dz_yz], np.vstack([h_x, h_yz])
+        return v_b[:1], h[:1]
+    return v_b, h
 
 
 def zero_velocity(v: np.ndarray, n_states: int = N_STATES) -> tuple[np.ndarray, np.ndarray]:

@@ -10,6 +10,12 @@ the flushed interval with the mean specific force of the interval (the usual pra
 the covariance propagation slower than the mechanisation, Groves 2013, chapter 14). With a
 10 Hz solution rate the covariance is propagated at 10 Hz or faster.
 
+Optional extra states after the 15: first-order Gauss-Markov errors of an aid (``extra_sigma``,
+``extra_tau``; a GNSS receiver's correlated fix error, for example), x' = -x / tau + w with
+steady-state sigma (Brown & Hwang, 4th ed., section 2.9), appended to F and G Q G^T. Their
+current estimate ``extra`` is kept beside the nominal solution: fed back like the biases in
+closed loop, and decayed by exp(-dt / tau) between updates (the process's expected value).
+
 Public names
 ------------
 InsNoise, InsFilter.
@@ -25,7 +31,7 @@ from numba import njit
 
 from estimators.base import InitialState
 from estimators.toolbox import nav_error
-from estimators.toolbox.ins_error import BA, BG, discretise, noise_psd, system_matrix
+from estimators.toolbox.ins_error import BA, BG, N_STATES, discretise, noise_psd, system_matrix
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate
 from simulator.earth import quat_to_dcm, quat_to_euler
@@ -112,18 +118,33 @@ class InsFilter:
         Start in closed loop (True) or open loop.
     initial_biases : (6,), optional
         Initial accelerometer and gyro bias estimates.
+    extra_sigma, extra_tau : (k,), optional
+        Steady-state 1-sigma and correlation times (s) of k Gauss-Markov states after the 15
+        (module docstring); they start at zero with their steady-state covariance.
+    mounting : (3, 3), optional
+        C_s^v, the IMU's sensor frame to the vehicle frame (``installation.Installation``): the
+        samples are rotated into the vehicle frame before the strapdown, so that the filter
+        navigates the vehicle (the frame of the constraints and lever arms).
     """
 
     def __init__(self, initial: InitialState, imu_columns: Mapping[str, int], increments: bool,
                  p0_sigma: np.ndarray, noise: InsNoise, closed_loop: bool = True,
-                 initial_biases: np.ndarray | None = None, buffer_size: int = 512):
+                 initial_biases: np.ndarray | None = None, buffer_size: int = 512,
+                 mounting: np.ndarray | None = None, extra_sigma: np.ndarray | None = None,
+                 extra_tau: np.ndarray | None = None):
         self.t = float(initial.t)
         self.q = np.array(initial.quaternion, dtype=float)
         self.v = np.array(initial.velocity, dtype=float)
         self.pos = np.array(initial.position, dtype=float)
         biases = np.zeros(6) if initial_biases is None else np.asarray(initial_biases, float)
         self.ba, self.bg = biases[:3].copy(), biases[3:].copy()
-        self.kf = ErrorState(np.diag(np.asarray(p0_sigma, float) ** 2), closed_loop)
+        extra_sigma = np.zeros(0) if extra_sigma is None else np.asarray(extra_sigma, float)
+        self._extra_tau = np.broadcast_to(np.asarray(np.inf if extra_tau is None else extra_tau,
+                                                     dtype=float), extra_sigma.shape).copy()
+        self.extra = np.zeros(len(extra_sigma))  # estimate of the extra states
+        self.n_states = N_STATES + len(extra_sigma)
+        self.kf = ErrorState(np.diag(np.r_[np.asarray(p0_sigma, float), extra_sigma] ** 2),
+                             closed_loop)
         self.noise = noise
         missing = [c for c in IMU_AXES if c not in imu_columns]
         if missing:
@@ -138,10 +159,18 @@ class InsFilter:
         self._sums = np.zeros(7)
         self.mean_rate = np.zeros(3)  # compensated body angular rate over the last flush, rad/s
         self.mean_rate_dt = 0.0  # the length of that flush, s
+        self.mean_force = np.zeros(3)  # compensated specific force over it, body, m/s^2
+        self._mount = None if mounting is None else np.asarray(mounting, dtype=float)
         # equal noise on the three axes: C Q C^T = Q, so G Q G^T does not depend on attitude
-        self._gqg = noise_psd(np.eye(3), noise.accel_noise**2, noise.gyro_noise**2,
-                              2 * noise.accel_bias_sigma**2 / noise.accel_bias_tau,
-                              2 * noise.gyro_bias_sigma**2 / noise.gyro_bias_tau)
+        self._gqg = np.zeros((self.n_states, self.n_states))
+        self._gqg[:N_STATES, :N_STATES] = noise_psd(
+            np.eye(3), noise.accel_noise**2, noise.gyro_noise**2,
+            2 * noise.accel_bias_sigma**2 / noise.accel_bias_tau,
+            2 * noise.gyro_bias_sigma**2 / noise.gyro_bias_tau)
+        extra = np.arange(N_STATES, self.n_states)
+        self._gqg[extra, extra] = 2 * extra_sigma**2 / self._extra_tau
+        self._f = np.zeros((self.n_states, self.n_states))
+        self._f[extra, extra] = -1.0 / self._extra_tau
 
     def add_imu(self, t: float, row: np.ndarray) -> None:
         """Buffer one IMU sample (integrated at the next ``flush``)."""
@@ -156,6 +185,10 @@ class InsFilter:
         if self._n == 0:
             return
         self._sums[:] = 0.0
+        if self._mount is not None:
+            raw = self._buf[:self._n]
+            raw[:, 0:3] = raw[:, 0:3] @ self._mount.T
+            raw[:, 3:6] = raw[:, 3:6] @ self._mount.T
         self.t = _integrate(self._buf_t, self._buf, self._n, self._increments, self.t, self.q,
                             self.v, self.pos, self.ba, self.bg, self._prev, self._sums)
         self._n = 0
@@ -166,10 +199,13 @@ class InsFilter:
         self.mean_rate_dt = dt
         c_bn = quat_to_dcm(self.q)
         f_body = c_bn.T @ (self._sums[0:3] / dt)
+        self.mean_force = f_body
         n = self.noise
-        f = system_matrix(self.pos[0], self.pos[2], self.v, c_bn, f_body, n.accel_bias_tau,
-                          n.gyro_bias_tau)
-        self.kf.predict(*discretise(f, self._gqg, dt))
+        self._f[:N_STATES, :N_STATES] = system_matrix(self.pos[0], self.pos[2], self.v, c_bn,
+                                                      f_body, n.accel_bias_tau, n.gyro_bias_tau)
+        self.kf.predict(*discretise(self._f, self._gqg, dt))
+        if len(self.extra):
+            self.extra *= np.exp(-dt / self._extra_tau)
 
     def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> None:
         """Measurement update with dz = h(nominal) - z; in closed loop the errors are fed back."""
@@ -185,6 +221,7 @@ class InsFilter:
         self.q, self.v, self.pos = nav_error.correct(self.q, self.v, self.pos, dx[:9])
         self.ba -= dx[BA]
         self.bg -= dx[BG]
+        self.extra -= dx[N_STATES:]
 
     def corrected(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The best estimate (nominal minus the open-loop error estimate): q, v, pos and the

@@ -41,6 +41,8 @@ from simulator.sensors.base import sample_times
 from simulator.stochastic import stream_rng
 from simulator.tables import Table, as_frames, column
 from simulator.trajectory.kinematics import Kinematics
+from simulator.vehicle.params import vehicle_parameters
+from simulator.vehicle.suspension import axle_distances
 
 
 def build_truth(scenario: dict) -> Kinematics:
@@ -182,7 +184,8 @@ KNOWLEDGE = {
 
 def _datasheet(data: dict, truth_keys: dict[str, dict]) -> tuple[dict, dict]:
     """Each sensor's block as a user would know it (the true-value keys replaced by their
-    nominal values), and the true values replaced."""
+    nominal values), and the true values replaced; and the car's installation geometry
+    (``vehicle_datasheet``) under ``vehicle``."""
     datasheet, true_values = {}, {}
     for name, block in data["sensors"].items():
         if block is None:
@@ -191,7 +194,26 @@ def _datasheet(data: dict, truth_keys: dict[str, dict]) -> tuple[dict, dict]:
         datasheet[name] = {k: keys.get(k, v) for k, v in block.items()}
         if keys:
             true_values[name] = {k: block[k] for k in keys if k in block}
+    datasheet["vehicle"] = vehicle_datasheet(data["vehicle"])
     return datasheet, true_values
+
+
+def vehicle_datasheet(block: str | dict) -> dict:
+    """What a user measures on the car before a drive: its ``preset`` (``rigid``: the truth's
+    point follows the road, with nothing else), ``wheelbase`` (m), the truth's reference point
+    ``imu_position`` from the centre of gravity and ``rear_axle``, the point above the rear
+    axle's centre at the centre of gravity's height, from the IMU (both body FRD, m): there
+    the rear wheels roll without steering, so the non-holonomic constraint holds there (the
+    bicycle model's rear axle; ``estimators.toolbox.constraints``). The GNSS antenna's lever
+    arm from the IMU is the ``gnss`` block's ``antenna_lever_arm``, the IMU's mounting the
+    ``imu`` block's ``mounting``."""
+    params = vehicle_parameters(block)
+    if params is None:
+        return {"preset": "rigid"}
+    _, l_r = axle_distances(params)
+    imu = [float(x) for x in params["imu_position"]]
+    return {"preset": params["preset"], "wheelbase": float(params["wheelbase"]),
+            "imu_position": imu, "rear_axle": [-l_r - imu[0], -imu[1], -imu[2]]}
 
 
 def build_manifest(scenario: Scenario, generated: Generated) -> dict:

@@ -23,6 +23,7 @@ FULL_SEEDS.
 
 from __future__ import annotations
 
+import math
 import platform
 import subprocess
 import tempfile
@@ -73,7 +74,7 @@ def measure_seed(experiment: Experiment, seed: int, overrides: Sequence[str],
         dataset = generate(scenario, Path(tmp) / "dataset")
         solutions = {label: estimate(dataset, {**entry, "label": label})[0]
                      for label, entry in experiment.entries.items()}
-        return {name: float(value)
+        return {name: math.nan if value is None else float(value)  # None: the scorer's "none"
                 for name, value in experiment.measure(dataset, solutions).items()}
 
 

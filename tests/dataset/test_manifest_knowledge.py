@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from estimators.toolbox.installation import Installation
 from simulator.dataset.generate import build_manifest, generate_streams
 from simulator.scenario import Scenario
 from tests.conftest import scenario_data
@@ -52,3 +53,23 @@ def test_datasheet_has_the_nominal_scale_factor_and_truth_the_drawn_one():
     # rates are interval means at 100 Hz: half a sample late
     assert manifest["timing"]["imu"] == {
         "stamp": "the end of the integration interval (t - 1/rate, t]", "delay_s": 0.005}
+
+
+def test_datasheet_carries_the_installation_geometry():
+    """The car as its user measures it: the automotive preset's rear axle lies l_r = 0.57 x
+    2.7 m behind the centre of gravity, the IMU 0.2 m ahead of it and 0.1 m above, so the rear
+    axle is 1.739 m behind the IMU and 0.1 m below it; a rigid body has no rear axle. An
+    estimator reads it back with ``Installation``."""
+    data, g = _generated({"preset": "ideal"})
+    data = dict(data, vehicle="automotive")
+    sheet = build_manifest(Scenario(None, data, []), g)["datasheet"]
+    vehicle = sheet["vehicle"]
+    assert vehicle["preset"] == "automotive" and vehicle["wheelbase"] == 2.7
+    np.testing.assert_allclose(vehicle["imu_position"], [0.2, 0.0, -0.1])
+    np.testing.assert_allclose(vehicle["rear_axle"], [-0.57 * 2.7 - 0.2, 0.0, 0.1])
+    site = Installation.from_datasheet(sheet)
+    np.testing.assert_allclose(site.rear_axle, vehicle["rear_axle"])
+    assert site.wheelbase == 2.7 and site.antenna is None and site.mounting is None
+    rigid = build_manifest(Scenario(None, dict(data, vehicle="rigid"), []), g)["datasheet"]
+    assert rigid["vehicle"] == {"preset": "rigid"}
+    assert Installation.from_datasheet(rigid).rear_axle is None

@@ -228,3 +228,37 @@ def test_situation1_z_gyro_scale_factor_is_estimated_by_100_s(situation1, name):
     errors = situation1[f"{exp.SHORT[name]}.z_scale_factor_error"]
     for seed, error in errors.items():
         assert error < 0.02, seed
+
+
+
+@pytest.mark.parametrize("name", ["dr2d_drm2_ekf", "dr2d_drm1_ekf"])
+def test_every_stop_recalibrates_a_drifting_gyro_bias(tmp_path, name):
+    """A gyro whose bias ramps (2e-5 rad/s^2, drawn sign) and two stops, 110 s apart, seen by
+    the odometer: the calibration held between them is the first stop's, and after the second
+    it is that stop's bias (truth_sensors), the 2.2e-3 rad/s the bias moved in between
+    removed. The Earth rate's vertical part (4.3e-5 rad/s at 36 deg N) is in both."""
+    segments = [{"stop": {"duration": 10}}, {"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+                {"straight": {"length": 900}}, {"accelerate": {"to_speed": 0.0, "accel": 1.0}},
+                {"stop": {"duration": 10}}, {"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+                {"straight": {"length": 200}}]
+    data = {"name": "stops", "seed": 2, "vehicle": "rigid",
+            "start": {"utc": "2024-05-01T03:00:00Z", "lat": 36.35, "lon": 127.38, "alt": 60.0,
+                      "heading": 30.0},
+            "trajectory": {"kind": "segments", "segments": segments},
+            "sensors": {"imu": {"preset": "ideal", "rate": 100, "gyro": {"ramp": 2e-5}},
+                        "odometer": {"preset": "ideal", "rate": 10},
+                        "gnss": {"preset": "ideal", "rate": 1, "outputs": ["fix"]}}}
+    scenario = Scenario(tmp_path / "stops.yaml", validate_data(data, "stops.yaml"), [])
+    ds = open_dataset(generate_dataset(scenario, tmp_path / "stops", show_progress=False))
+    truth = ds.read("truth_sensors")
+    odo = ds.read("odometer")
+    stopped = odo["t"][(odo["speed"].abs() < 1e-3) & (odo["t"] > 20.0)].to_numpy()
+    first = truth.loc[truth["t"] < 10.0, "gyro_bias_z"].mean()
+    second = truth.loc[(truth["t"] > stopped[0]) & (truth["t"] < stopped[-1]),
+                       "gyro_bias_z"].mean()
+    assert abs(second - first) > 2e-3  # the ramp moved the bias between the stops
+    sol = _run(ds, name)
+    t = sol["t"].to_numpy()
+    between = sol["gyro_bias_z"].to_numpy()[(t > 20.0) & (t < stopped[0])]
+    assert np.allclose(between, first, atol=6e-5)
+    assert sol["gyro_bias_z"].iloc[-1] == pytest.approx(second, abs=6e-5)

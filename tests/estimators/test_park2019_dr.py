@@ -80,9 +80,6 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     assert abs(math.remainder(yaw - truth["yaw"].iloc[-1], 2 * math.pi)) < math.radians(0.01)
 
 
-INS_FLAT = ("not shown against ins_odo_ekf (the INS engineer's filter, as merged): on the flat "
-            "garage dr3d_ekf's errors are still smaller (median ratio 0.66 exit, 0.28 max): "
-            "the INS velocity error from the accelerometer bias does not need ramps")
 
 
 @pytest.fixture(scope="module", params=["short", pytest.param("full", marks=pytest.mark.slow)])
@@ -115,6 +112,12 @@ DR2D_NOT_SHOWN = (
     "filters' heading error; without it dr3d_ekf wins 10/10 (docs/reproduction_park2019.md)")
 
 
+INS_NOT_SHOWN = (
+    "not shown since ins_odo_ekf applies its NHC at the rear axle (issue 14): dr3d_ekf beats it "
+    "in 6/10 seeds at the exit and 5/10 on the maximum (medians 11.9 m vs 19.7 m exit, 16.9 m "
+    "vs 21.3 m max); with the NHC at the IMU, violated by the car's slip, it won 10/10")
+
+
 def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
     """A filter as a test parameter: skipped when not registered, expected to fail with a
     reason (the measured figures) when ``xfail`` is given."""
@@ -126,7 +129,7 @@ def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
 
 
 @pytest.mark.parametrize("other", [_case("dr2d_odo_ekf", DR2D_NOT_SHOWN, strict=True),
-                                   _case("ins_odo_ekf")])
+                                   _case("ins_odo_ekf", INS_NOT_SHOWN, strict=True)])
 def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
     """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
     least 8 of 10 seeds (paired per seed)."""
@@ -135,10 +138,12 @@ def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
         assert wins.sum() >= 8, (key, wins.sum())
 
 
-@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf", INS_FLAT)])
+@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf")])
 def test_flat_garage_with_perfect_odometer_removes_the_advantage(flat_garage, other):
     """Without ramps and odometer scale-factor error, the median per-seed ratio of dr3d_ekf's
-    exit and maximum error to the baseline's lies between 0.7 and 1.3."""
+    exit and maximum error to the baseline's lies between 0.7 and 1.3. Against ins_odo_ekf
+    with its NHC at the rear axle (issue 14): 0.93 exit, 0.96 max (it was 0.66 and 0.28 with
+    the NHC at the IMU, an expected failure then)."""
     for key in ("exit_horizontal_m", "max_horizontal_m"):
         ratio = _column(flat_garage, "dr3d_ekf", key) / _column(flat_garage, other, key)
         assert 0.7 <= np.median(ratio) <= 1.3, (key, np.median(ratio))

@@ -107,3 +107,27 @@ def test_magnetic_heading_calibration_recovers_heading_with_hard_iron_and_declin
         q = euler_to_quat(0.05, -0.04, yaw)
         m = quat_to_dcm(q).T @ b_ned + hard_iron
         assert cal.heading(m, q) == pytest.approx(yaw, abs=np.radians(0.5))
+
+
+def test_gnss_velocity_and_odometer_with_lever_arms_against_finite_differences():
+    """The antenna's velocity v + C_b^n (w x l) and the odometer at the rear axle, over the
+    navigation errors and the gyro-bias error (compensated rate w - dbg)."""
+    rate = np.array([0.02, -0.04, 0.3])
+    arm = np.array([0.5, -0.2, -1.4])
+    rear = np.array([-1.7, 0.0, 0.1])
+    fns = {
+        "velocity": lambda q, v, w: aiding.gnss_velocity(v, V_TRUE, 15, q, w, arm),
+        "odometer": lambda q, v, w: aiding.odometer(q, v, 10.0, True, 15, w, rear),
+    }
+    for fn in fns.values():
+        def measure(dx, fn=fn):
+            q, v, _ = perturb(Q_TRUE, V_TRUE, POS, dx[:9])
+            return fn(q, v, rate - dx[BG])[0]
+
+        eps = np.r_[EPS, [1e-7] * 6]
+        numeric = np.array([(measure(e) - measure(-e)) / (2 * e[i])
+                            for i, e in enumerate(np.diag(eps))]).T
+        np.testing.assert_allclose(fn(Q_TRUE, V_TRUE, rate)[1], numeric, rtol=1e-5, atol=1e-8)
+    c_bn = quat_to_dcm(Q_TRUE)
+    dz, _ = aiding.gnss_velocity(V_TRUE, V_TRUE, 15, Q_TRUE, rate, arm)
+    np.testing.assert_allclose(dz, c_bn @ np.cross(rate, arm), atol=1e-12)
