@@ -1,6 +1,8 @@
-"""Benchmark: one hour of 1 Hz GNSS raw measurements and receiver fixes from 31 satellites.
+"""Benchmark: one hour of 1 Hz (or 10 Hz) GNSS raw measurements and receiver fixes from 31
+satellites.
 
-Run:  python benchmarks/bench_gnss.py   (prints the figures recorded in BENCHMARKS.md, "GNSS")
+Run:  python benchmarks/bench_gnss.py [--rate 10]   (prints the figures recorded in
+BENCHMARKS.md, "GNSS")
 
 The receiver (automotive preset, every error on) drives the city loop of ``bench_truth.py``
 (21 rounds, about one hour) on 2010-07-01 with the IGS broadcast ephemeris brdc1820.10n of that
@@ -13,6 +15,7 @@ beforehand.
 
 from __future__ import annotations
 
+import argparse
 import datetime as dt
 import sys
 import time
@@ -37,6 +40,9 @@ NAV = HERE.parents[1] / "shared" / "refdata" / "gnss" / "igs_2010-07-01_rtklib" 
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--rate", type=float, default=1.0, help="epoch rate, Hz")
+    args = parser.parse_args()
     if not NAV.exists():
         sys.exit(f"needs {NAV} (the shared reference data beside the checkout)")
     ctx = Context("bench")
@@ -46,7 +52,7 @@ def main() -> None:
     truth = kinematics_from_profile(profile, {"lat": 37.5665, "lon": 126.978, "alt": 40.0,
                                               "heading": 0.0}, 10.0, limits["roll_gradient"],
                                     dt.datetime(2010, 7, 1, 6, 0))
-    config = GNSS_FIELD.check({"rate": 1, "constellation": str(NAV)}, ("gnss",), ctx)
+    config = GNSS_FIELD.check({"rate": args.rate, "constellation": str(NAV)}, ("gnss",), ctx)
     assert not ctx.problems, ctx.problems
     times, cpu = [], []
     for seed in range(3):

@@ -2,29 +2,36 @@
 default, ``automotive``) against the rigid body (``vehicle: rigid``). Issue 13's goal: at most 1.5
 times the rigid time.
 
-Run:  python benchmarks/bench_vehicle.py [increment|rate]   (the figures in BENCHMARKS.md)
+Run:  python benchmarks/bench_vehicle.py [increment|rate] [ROUNDS]   (figures in BENCHMARKS.md)
 
-Both are whole ``landnav generate`` processes (truth and the ideal 100 Hz IMU, as increments by
-default or as rate samples), best of five after a warm-up, as in ``bench_truth``; the two are
-interleaved run by run, so that a load on the shared machine hits both alike.
+Side by side in one process: each round loads the scenario (the drive) and generates the dataset
+(truth, the ideal 100 Hz IMU as increments by default or as rate samples, Parquet), rigid then
+automotive, after one warm-up round; the CPU time of the process over each generation (all
+threads) and its wall time, best of ROUNDS (default 5). Interleaving the two runs round by round
+makes a load on the shared machine hit both alike; the CPU time is the steadier figure.
 """
 
 from __future__ import annotations
 
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_truth import hour_scenario, time_generate  # noqa: E402
+from bench_truth import hour_scenario  # noqa: E402
+
+from simulator import pipeline  # noqa: E402
+
+VEHICLES = ("rigid", "automotive")
 
 
 def main(output: str = "increment", rounds: int = 5) -> None:
     with tempfile.TemporaryDirectory() as tmp:
         paths = {}
-        for vehicle in ("rigid", "automotive"):
+        for vehicle in VEHICLES:
             path = Path(tmp) / f"hour_{vehicle}.yaml"
             hour_scenario(path)
             data = yaml.safe_load(path.read_text())
@@ -32,19 +39,21 @@ def main(output: str = "increment", rounds: int = 5) -> None:
             data["sensors"]["imu"]["output"] = output
             path.write_text(yaml.safe_dump(data))
             paths[vehicle] = path
-        best: dict[str, list[float]] = {"rigid": [], "automotive": []}
-        cpu: dict[str, list[float]] = {"rigid": [], "automotive": []}
-        for _ in range(rounds):
+        wall: dict[str, list[float]] = {v: [] for v in VEHICLES}
+        cpu: dict[str, list[float]] = {v: [] for v in VEHICLES}
+        for round_ in range(rounds + 1):  # the first round warms up
             for vehicle, path in paths.items():
-                wall, used = time_generate(path, Path(tmp) / vehicle, runs=1)
-                best[vehicle] += wall
-                cpu[vehicle] += used
-        for vehicle in paths:
-            print(f"{vehicle:>10}: best {min(best[vehicle]):.2f} s wall of "
-                  f"{[round(x, 2) for x in best[vehicle]]}, CPU {min(cpu[vehicle]):.2f} s")
-        print(f"ratio (best wall): {min(best['automotive']) / min(best['rigid']):.2f}, "
-              f"(best CPU): {min(cpu['automotive']) / min(cpu['rigid']):.2f}")
+                start_cpu, start_wall = time.process_time(), time.perf_counter()
+                pipeline.generate(pipeline.load_scenario(path), Path(tmp) / vehicle, force=True)
+                if round_:
+                    cpu[vehicle].append(time.process_time() - start_cpu)
+                    wall[vehicle].append(time.perf_counter() - start_wall)
+        for vehicle in VEHICLES:
+            print(f"{vehicle:>10}: CPU best {min(cpu[vehicle]):.2f} s of "
+                  f"{[round(x, 2) for x in cpu[vehicle]]}, wall best {min(wall[vehicle]):.2f} s")
+        print(f"ratio (best CPU): {min(cpu['automotive']) / min(cpu['rigid']):.2f}, "
+              f"(best wall): {min(wall['automotive']) / min(wall['rigid']):.2f}")
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:2])
+    main(*sys.argv[1:2], *(int(x) for x in sys.argv[2:3]))

@@ -45,6 +45,9 @@ GNSS_RAW = {
     "elevation": "rad", "azimuth": "rad",
     # the receiver's own 1-sigma estimates (as Android's ...UncertaintyMeters), for weighting
     "pseudorange_std": "m", "pseudorange_rate_std": "m/s",
+    # the satellite's broadcast health (IS-GPS-200 20.3.3.3.1.4; YUMA: the almanac's 6-bit
+    # code): 0 healthy; any other value is tracked and reported but not to be used
+    "health": "1",
 }
 
 # the true error terms of every signal above the horizon (tracked or not), so that
@@ -52,6 +55,8 @@ GNSS_RAW = {
 #               + multipath + nlos_delay + code_noise
 # pseudorange_rate = range_rate + receiver_clock_drift - sat_clock_drift (1 - range_rate / c)
 #               + tropo_true_rate - iono_true_rate + rate_noise
+# (multipath and code_noise as the receiver delivers them, after its carrier smoothing;
+# code_noise then holds the smoothing's ionosphere divergence too: simulator.gnss.errors)
 TRUTH_GNSS = {
     "t": "s", "sv": "1", "tracked": "1", "los": "1", "nlos": "1",
     "elevation": "rad", "azimuth": "rad", "range": "m", "range_rate": "m/s",

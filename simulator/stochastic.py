@@ -130,7 +130,10 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False,
     over the samples.
 
     ``phi`` (0 <= phi <= 1) and the gains are one number, or one per column of a 2-D ``u`` (shape
-    (m,)). Blocks of L samples are solved in closed form, x[j] = phi^j (S[j] + phi c) with
+    (m,)). A complex ``phi`` (|phi| <= 1, a damped rotation: one mode of a linear system, such
+    as the ride model's, ``simulator.vehicle.suspension``) filters complex ``u`` the same way,
+    with complex powers phi^j.
+    Blocks of L samples are solved in closed form, x[j] = phi^j (S[j] + phi c) with
     S[j] = cumsum(phi^-i gain_in u[i]) and c the state at the end of the previous block (L
     chosen so that phi^-L stays below e^300 for every column, at most 4096; the rounding error
     stays that of the recursion, since each partial sum is scaled back by phi^j). The block-end
@@ -140,27 +143,28 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False,
     passes once phi^(2^p) underflows. With ``overwrite`` a C-contiguous float array ``u`` is
     filtered in place (no copy).
     """
-    in_place = overwrite and u.dtype == float and u.flags.c_contiguous  # blocks are views
-    x = u if in_place else np.array(u, dtype=float, order="C")
+    kind = complex if np.iscomplexobj(phi) or np.iscomplexobj(u) else float
+    in_place = overwrite and u.dtype == kind and u.flags.c_contiguous  # blocks are views
+    x = u if in_place else np.array(u, dtype=kind, order="C")
     flat = x.ndim == 1
     if flat:
         x = x[:, None]
     n, m = x.shape
-    phi = np.broadcast_to(np.asarray(phi, dtype=float), (m,))
+    phi = np.broadcast_to(np.asarray(phi, dtype=kind), (m,))
     gain_in = np.broadcast_to(np.asarray(gain_in, dtype=float), (m,))
     gain_out = np.broadcast_to(np.asarray(gain_out, dtype=float), (m,))
     if n == 0:
         return x[:, 0] if flat else x
     with np.errstate(divide="ignore"):
-        decay = -np.log(phi)  # |ln phi| per column, inf for phi = 0
-    fastest = float(decay.max())
+        decay = -np.log(phi)  # -ln phi per column (its real part |ln |phi||), inf for phi = 0
+    fastest = float(decay.real.max())
     length = min(n, _AR1_MAX_BLOCK)
     if fastest > _AR1_BLOCK_LOG_RANGE / length:
         length = int(_AR1_BLOCK_LOG_RANGE / fastest)
     if length < 2:
         x *= gain_in
         power, shift = phi.copy(), 1
-        while shift < n and np.any(power > 0.0):
+        while shift < n and np.any(np.abs(power) > 0.0):
             x[shift:] += power * x[:-shift]
             power, shift = power * power, shift * 2
         x *= gain_out

@@ -1,9 +1,11 @@
-"""Shared builders for the GNSS tests: short drives (``conftest.build_drive``) and receivers."""
+"""Shared builders for the GNSS tests: short drives (``conftest.build_drive``), receivers, and
+the pooled autocorrelation of per-satellite series."""
 
 from __future__ import annotations
 
 import datetime as dt
 
+import numpy as np
 from conftest import build_drive
 
 from simulator.schema import Context
@@ -26,3 +28,12 @@ def receiver(**config) -> Gnss:
     resolved = GNSS_FIELD.check(config, ("sensors", "gnss"), ctx)
     assert not ctx.problems, ctx.problems
     return Gnss(resolved)
+
+
+def pooled_autocorrelation(wide: np.ndarray, lag: int) -> float:
+    """Autocorrelation at ``lag`` samples of series held as the columns of ``wide`` (epochs x
+    satellites, NaN where a satellite has no value), pooled over every pair of epochs where both
+    values exist: sum x_k x_(k+lag) / sqrt(sum x_k^2 sum x_(k+lag)^2)."""
+    a, b = wide[:-lag], wide[lag:]
+    both = np.isfinite(a) & np.isfinite(b)
+    return float(np.sum(a[both] * b[both]) / np.sqrt(np.sum(a[both] ** 2) * np.sum(b[both] ** 2)))

@@ -29,7 +29,8 @@ PACKAGES = ("simulator", "estimators")
 LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("simulator", "simulator.earth", "simulator.units", "simulator.columns",
               "simulator.errors", "simulator.schema", "simulator.tables", "simulator.timebase",
-              "simulator.progress", "simulator.stochastic", "simulator.outputs")),
+              "simulator.progress", "simulator.stochastic", "simulator.outputs",
+              "simulator.geoid")),
     ("trajectory", ("simulator.trajectory", "simulator.vehicle", "simulator.environment")),
     ("drive", ("simulator.drive",)),
     ("gnss", ("simulator.gnss",)),
@@ -42,6 +43,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("scoring", ("simulator.scoring",)),
     ("pipeline", ("simulator.pipeline",)),
     ("campaign", ("simulator.campaign",)),
+    ("reproduce", ("simulator.reproduce",)),
     ("commands", ("simulator.commands", "simulator.cli")),
 ]
 ANYWHERE = {"estimators.registry"}  # the estimator name registry

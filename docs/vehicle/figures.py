@@ -1,6 +1,7 @@
 """The figures of docs/vehicle.md: the accelerometer's power spectral density on a class B road
-beside the real RAV4 log, and the distributions of speed, accelerations, yaw rate, pitch and roll
-of the shipped scenarios beside two real drives.
+beside the real RAV4 log (whole, and less the part its own rotation explains), and the
+distributions of speed, accelerations, yaw rate, pitch and roll of the shipped scenarios beside
+two real drives.
 
 Run from the checkout:  python docs/vehicle/figures.py [../shared]
 (needs the shared reference data; SUMO scenarios need SUMO; writes docs/vehicle/*.png and prints
@@ -18,7 +19,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from scipy.io import loadmat  # noqa: E402
-from scipy.signal import welch  # noqa: E402
+from scipy.signal import csd, welch  # noqa: E402
 
 from simulator import earth  # noqa: E402
 from simulator.dataset.generate import build_truth  # noqa: E402
@@ -43,10 +44,29 @@ def _cruise(vehicle: str | dict, speed: float = 15.0) -> dict:
     return {key: np.asarray(value)[keep] for key, value in truth.items()}
 
 
+def _not_from_rotation(accel: np.ndarray, gyro: np.ndarray, fs: float,
+                       nperseg: int) -> tuple[np.ndarray, np.ndarray]:
+    """PSD of one accelerometer axis less the part its three gyro axes explain (multiple
+    coherence: S_aa - S_ag S_gg^-1 S_ga per frequency), the vibration that is not the device's
+    rotation (a phone rocking on its windshield mount moves its accelerometer by the rotation
+    times its lever)."""
+    def cross(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        return csd(x, y, fs, nperseg=nperseg)[1]
+
+    f = csd(accel, accel, fs, nperseg=nperseg)[0]
+    s_gg = np.stack([np.stack([cross(gyro[:, i], gyro[:, j]) for j in range(3)], -1)
+                     for i in range(3)], -2)
+    s_ga = np.stack([cross(gyro[:, i], accel) for i in range(3)], -1)
+    explained = np.einsum("fi,fi->f", s_ga.conj(), np.linalg.solve(s_gg, s_ga[..., None])[..., 0])
+    return f, cross(accel, accel).real - explained.real
+
+
 def psd_figure(shared: Path) -> None:
     log = shared / COMMA / "processed_log"
     t = np.load(log / "IMU/accelerometer/t")
     real = np.load(log / "IMU/accelerometer/value")
+    gyro = np.load(log / "IMU/gyro/value")
+    real, gyro = real - real.mean(axis=0), gyro - gyro.mean(axis=0)
     fs_real = 1.0 / float(np.median(np.diff(t)))
     fig, axes = plt.subplots(1, 3, figsize=(13, 4), sharey=True)
     sims = {"automotive, class B": _cruise("automotive"),
@@ -58,6 +78,12 @@ def psd_figure(shared: Path) -> None:
         ax.semilogy(f, p, color="k", label="comma2k19 RAV4, 8-20 m/s (real)")
         band = (f >= 5) & (f <= 50)
         print(f"real accel_{name} rms 5-50 Hz: {np.sqrt(np.trapezoid(p[band], f[band])):.3f}")
+        f, p = _not_from_rotation(real[:, axis], gyro, fs_real, 256)
+        ax.semilogy(f, np.maximum(p, 1e-12), color="k", linestyle="--",
+                    label="the same, less what its rotation explains")
+        band = (f >= 5) & (f <= 50)
+        print(f"real accel_{name} less rotation rms 5-50 Hz: "
+              f"{np.sqrt(np.trapezoid(p[band], f[band])):.3f}")
         for label, truth in sims.items():
             x = truth["f" + name] - truth["f" + name].mean()
             f, p = welch(x, 100.0, nperseg=1024)

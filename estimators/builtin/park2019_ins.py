@@ -175,10 +175,8 @@ class ParkInsOdometer(Estimator):
             h[0, self._scale_col] = speed / (1.0 + k) ** 2
             r[0, 0] = self.R_ODOMETER
         if self._slip is not None and len(r) == 3:
-            # forward acceleration: specific force plus gravity's body-x part, g C_b^n[2, 0]
-            # = -g sin(pitch)
-            accel_x = ins.mean_force[0] + G0 * (2 * (ins.q[1] * ins.q[3] - ins.q[0] * ins.q[2]))
-            lateral, vertical = self._slip.sigma(speed, ins.mean_rate[2], accel_x)
+            lateral, vertical = self._slip.sigma_of_state(ins.q, ins.v, ins.mean_rate,
+                                                          ins.mean_force)
             r[1, 1], r[2, 2] = lateral * lateral, vertical * vertical
         ins.update(dz, h, r)
 

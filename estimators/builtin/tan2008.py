@@ -21,9 +21,15 @@ What the paper gives and what is chosen here:
   ``open_loop_outages: false`` stays closed through outages (not the paper's design; for
   comparison).
 * Velocity constraint, eqs. 6-7 (``nhc``): zero lateral and vertical body velocity. Eq. 6 prints
-  V_x^b = 0, which would stop the car: the lateral axis is y (V_y^b = 0, V_z^b = 0). 1-sigma
-  0.1 m/s (chosen). Used during outages only (section 5: "utilizes the vehicle motion
-  constraints and the magnetometer measurement during GPS outages").
+  V_x^b = 0, which would stop the car: the lateral axis is y (V_y^b = 0, V_z^b = 0). Used
+  during outages only (section 5: "utilizes the vehicle motion constraints and the
+  magnetometer measurement during GPS outages"). Applied where it holds, at the rear axle from
+  the datasheet's ``vehicle.rear_axle``, with the car's physics as its noise
+  (``constraints.NonholonomicNoise``, as ``ins_odo_ekf``; the forward speed is the INS's, Tan's
+  filter has no odometer); on a rigid body (no rear axle in the datasheet) at the IMU with
+  1-sigma 0.1 m/s (chosen).
+* GNSS antenna lever arm (``gnss.antenna_lever_arm``) in the position update, and the IMU's
+  ``mounting`` rotated out of the samples (``toolbox.installation``).
 * Height constraint, section 3.2 (``height_constraint``): the height stays at the last
   GPS-aided height through the outage, 1-sigma 2 m (the paper asks for "a realistic measurement
   uncertainty" and prints none).
@@ -57,9 +63,10 @@ import numpy as np
 
 from estimators.base import Estimator
 from estimators.toolbox import aiding
-from estimators.toolbox.constraints import height, nonholonomic
-from estimators.toolbox.ins_error import N_STATES
+from estimators.toolbox.constraints import NonholonomicNoise, height, nonholonomic
+from estimators.toolbox.ins_error import BG, N_STATES
 from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
+from estimators.toolbox.installation import Installation
 
 G0 = 9.80665  # standard gravity, m/s^2 (datasheet mg)
 DEG = math.pi / 180.0
@@ -93,8 +100,13 @@ class TanLinearisedKF(Estimator):
     MOVING_SPEED = 0.5  # m/s: a GPS speed above it ends the initial standstill early
 
     def setup(self) -> None:
+        site = Installation.from_datasheet(self.datasheet)
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
-                             self.P0_SIGMA, self.NOISE)
+                             self.P0_SIGMA, self.NOISE, mounting=site.mounting)
+        self._antenna = site.antenna
+        self._rear = site.rear_axle
+        self._slip = None if self._rear is None else NonholonomicNoise(site.wheelbase or 2.7)
+        self._r_nhc = self.R_NHC.copy()
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"]]
         self._fix, self._speed, self._course = c["fix"], c["speed"], c["course"]
@@ -142,8 +154,12 @@ class TanLinearisedKF(Estimator):
             return
         q = ins.corrected()[0]  # levels the magnetometer with the best roll and pitch
         if cfg["nhc"]:
-            dz, h = nonholonomic(ins.q, ins.v, N_STATES)
-            ins.update(dz, h, self.R_NHC)
+            dz, h = nonholonomic(ins.q, ins.v, N_STATES, ins.mean_rate, self._rear, BG)
+            if self._slip is not None:
+                lateral, vertical = self._slip.sigma_of_state(ins.q, ins.v, ins.mean_rate,
+                                                              ins.mean_force)
+                self._r_nhc[0, 0], self._r_nhc[1, 1] = lateral * lateral, vertical * vertical
+            ins.update(dz, h, self._r_nhc)
         if cfg["height_constraint"]:
             ins.update(*height(ins.pos[2], self._h_ref, N_STATES), self.R_HEIGHT)
         if cfg["mag_heading"] and mag is not None:
@@ -173,7 +189,7 @@ class TanLinearisedKF(Estimator):
             ins.set_closed_loop(True)
         values = row[self._fix_idx]
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
-        dz, h = aiding.gnss_position(ins.q, ins.pos, pos)
+        dz, h = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna)
         if math.isfinite(values[2]):
             ins.update(dz, h, self.R_POSITION)
         else:  # a 2-D fix: horizontal rows only

@@ -166,6 +166,15 @@ class NonholonomicNoise:
         half = 0.5 * self.wheelbase
         return self.cg_height / ((2 * math.pi * self.ride_frequency) ** 2 * half * half)
 
+    def sigma_of_state(self, q: np.ndarray, v_ned: np.ndarray, rate_body: np.ndarray,
+                       force_body: np.ndarray) -> tuple[float, float]:
+        """``sigma`` from a navigation state: the forward speed C_b^n[:, 0] . v^n, the body's
+        yaw rate, and the forward acceleration f_x + g C_b^n[2, 0] (the specific force plus
+        gravity's body-x part, -g sin(pitch); standard gravity is close enough for a sigma)."""
+        c_bn = quat_to_dcm(q)
+        return self.sigma(float(c_bn[:, 0] @ v_ned), float(rate_body[2]),
+                          float(force_body[0] + G0 * c_bn[2, 0]))
+
     def sigma(self, speed: float, yaw_rate: float, forward_accel: float) -> tuple[float, float]:
         """Lateral and vertical 1-sigma (m/s) at speed (m/s), yaw rate (rad/s) and forward
         acceleration (m/s^2)."""

@@ -80,7 +80,10 @@ class RawEpoch:
 
 def raw_epoch(block: np.ndarray, columns: Mapping[str, int]) -> RawEpoch:
     """Corrected measurements of a ``gnss_raw`` epoch block (rows = satellites) whose column
-    positions are ``columns`` (the replay's ``self.columns["gnss_raw"]``)."""
+    positions are ``columns`` (the replay's ``self.columns["gnss_raw"]``). Rows of unhealthy
+    satellites (``health`` not 0, where the stream has the column) are left out."""
+    if "health" in columns:
+        block = block[block[:, columns["health"]] == 0]
     def c(name: str) -> np.ndarray:
         return block[:, columns[name]]
 

@@ -19,11 +19,18 @@ ZONE_FIELD = Record(
         "sky": Text("open", choices=["open", "none", "canyon"],
                     doc="open sky, no sky (tunnel, garage: every satellite blocked), or an "
                         "urban canyon"),
-        "building_height": Number("m", 30.0, min=0, doc="canyon: height of the buildings"),
+        "building_height": Number("m", 30.0, min=0,
+                                  doc="canyon: height of the facades above the antenna"),
         "street_width": Number("m", 20.0, gt=0, doc="canyon: width between the facades"),
-        "nlos_attenuation": Number("", 10.0, min=0,
-                                   doc="canyon: C/N0 loss of a signal received only by "
-                                       "reflection, dB"),
+        "nlos_attenuation": Number("", 15.0, min=0,
+                                   doc="canyon: mean C/N0 loss of one reflection off a facade, "
+                                       "dB (Berlin u-blox log: NLOS 15.7 dB below LOS)"),
+        "nlos_attenuation_spread": Number("", 8.0, min=0,
+                                          doc="canyon: 1-sigma of the reflection loss from one "
+                                              "facade (building) to the next, dB"),
+        "facade_length": Number("m", 20.0, gt=0,
+                                doc="canyon: length of one building's facade along the street "
+                                    "(each draws its own reflection loss)"),
     },
     default={},
 )

@@ -1,62 +1,215 @@
-"""What the sky looks like from a road: which satellites are in line of sight, which arrive only
-by a reflection (non-line-of-sight, NLOS), and the extra path of the reflection.
+"""What the sky looks like from a road: through which path each satellite's signal reaches the
+antenna in an urban canyon (direct, diffracted over a roof edge, or reflected off facades), the
+extra path of that signal and its C/N0 loss.
 
-An urban canyon is modelled as an infinitely long street along the vehicle's heading with
-facades of height H on both sides at half the street width w/2 from the antenna (the vehicle is
-on the street's centre line). A satellite at azimuth az and elevation el, at angle
-alpha = az - heading to the street, is in line of sight when the ray clears the facade on its
-side: tan(el) >= H |sin alpha| / (w / 2). A blocked satellite is still received by specular
-reflection off the opposite facade when the reflected ray clears the facade on the satellite's
-side, i.e. when its image point, 3 w / 2 from that facade, sees over it:
-tan(el) >= H |sin alpha| / (3 w / 2). The reflection adds the path 2 (w / 2) cos(el) |sin alpha|
-(the classic image-antenna geometry of a vertical reflector, Groves 2013 section 10.4.2).
+The canyon is a street box around the antenna, in street axes (x along the vehicle's heading,
+y to its right, z up, the antenna at the origin on the street's centre line): facades of height
+H above the antenna on both sides at y = +-w/2 and, closing the street, facades across it at
+x = ``ahead`` and x = -``behind`` (a T-junction, an overpass: where the canyon zone ends). A
+satellite in direction u = (cos el cos a, cos el sin a, sin el), a = azimuth - heading, reaches
+the antenna along these paths, each traced as a ray from the antenna (image method, Groves 2013
+section 10.4.2; the street-canyon box of Bourdeau, Sahmoudi & Tourneret 2012):
 
-Public functions
-----------------
-canyon_visibility.
+- ``direct``: straight to the satellite; line of sight when it leaves the box over the edge of
+  the facade it meets (clearance >= 0), otherwise diffracted over that roof edge;
+- one specular reflection off either side facade or either end facade;
+- two reflections, right then left facade, or left then right.
+
+A reflection is possible when the ray meets the named facade first and below its top; every
+path's last leg leaves the box over an edge. Each path's C/N0 loss is the knife-edge diffraction
+loss J(nu) of that last edge (ITU-R P.526-15 eq. 31, nu = h sqrt(2 / (lambda d)) for a far
+transmitter, h the height of the edge above the ray, d the slant distance to it; 0 dB below
+nu = -0.78) plus the loss of every reflection (given by the caller: facades differ; about
+15 +- 8 dB, the C/N0 drop of NLOS against LOS signals in the Berlin u-blox log with NLOS labels,
+refdata 3d: 44.7 vs 29.1 dB-Hz, sd 8.2, and Hsu 2017/2018's urban NLOS measurements). The
+receiver tracks the strongest path (least loss), as its code loop locks onto the strongest
+correlation peak: it is line of sight when that is the direct path with clearance >= 0, NLOS
+otherwise (diffracted or reflected only). Its extra path is the length of the bent path minus
+the direct range: for legs ending at the last reflection point P (or the roof edge E of a
+diffracted leg) and a far satellite, sum(|legs|) - P . u. For one reflection off a side facade
+this is the image-antenna distance 2 (w/2) cos el |sin a| (Groves 2013 eq. 10.23 geometry); off
+the far end facade 2 ahead cos el cos a, which reaches hundreds of metres: the long tail of NLOS
+delays that Hsu 2018 reports, coming from geometry, not from a drawn distribution.
+
+Choices where the sources are silent: the antenna is on the centre line; the facades are
+continuous (no gaps, no cross streets) and equally high; the ground reflection and LOS
+multipath are left to the receiver's multipath error process; paths of three or more
+reflections are left out (they lose 45 dB and more).
+
+Public names
+------------
+PATHS, knife_edge_loss_db, trace_paths, canyon_reception.
 
 References
 ----------
 Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Systems*, 2nd ed.,
-2013, section 10.4.2 (non-line-of-sight reception, path delay of a reflection off a building).
+2013, section 10.4.2 (NLOS reception, path delay of a reflection off a building).
+Groves, "Shadow matching: a new GNSS positioning technique for urban canyons", J. Navigation
+64(3), 2011 (building edges decide which satellites are direct; diffraction near the edges).
+Bourdeau, Sahmoudi & Tourneret, "Tight integration of GNSS and a 3D city model for robust
+positioning in urban canyons", ION GNSS 2012 (street-canyon geometry, reflected signals' delays).
+Hsu, "Analysis and modeling GPS NLOS effect in highly urbanized area", GPS Solutions 22(1), 2018
+(NLOS delays and C/N0 of reflected signals in Hong Kong).
+ITU-R P.526-15, *Propagation by diffraction*, 2019, eq. 31 (single knife-edge loss J(nu)).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+# facades: 0 right side (y = +w/2), 1 left side, 2 far end ahead (x = ahead), 3 end behind
+RIGHT, LEFT, AHEAD, BEHIND = 0, 1, 2, 3
+# the paths traced: name -> facades met in order
+PATHS: dict[str, tuple[int, ...]] = {
+    "direct": (),
+    "right": (RIGHT,), "left": (LEFT,), "ahead": (AHEAD,), "behind": (BEHIND,),
+    "right_left": (RIGHT, LEFT), "left_right": (LEFT, RIGHT),
+}
+_NO_EDGE_NU = -0.78  # below it the knife-edge loss is zero (ITU-R P.526-15 eq. 31)
 
-def canyon_visibility(azimuth_rad: np.ndarray, elevation_rad: np.ndarray, heading_rad: np.ndarray,
-                      building_height_m: np.ndarray, street_width_m: np.ndarray
-                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Line-of-sight and NLOS masks and the NLOS extra path in a street canyon.
+
+def knife_edge_loss_db(nu: np.ndarray) -> np.ndarray:
+    """Single knife-edge diffraction loss, dB (ITU-R P.526-15 eq. 31):
+    J(nu) = 6.9 + 20 log10(sqrt((nu - 0.1)^2 + 1) + nu - 0.1) for nu > -0.78, else 0."""
+    nu = np.asarray(nu, dtype=float)
+    clipped = np.maximum(nu, _NO_EDGE_NU)  # far below the edge the formula cancels to log(0)
+    j = 6.9 + 20.0 * np.log10(np.sqrt((clipped - 0.1) ** 2 + 1.0) + clipped - 0.1)
+    return np.where(nu > _NO_EDGE_NU, j, 0.0)
+
+
+def _exit(p: np.ndarray, d: np.ndarray, half_width: np.ndarray, ahead: np.ndarray,
+          behind: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distance along the unit direction d (..., 3) from p (..., 3) to the facade the ray meets
+    first (horizontally: the box is convex), and that facade's number."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        sx = np.where(d[..., 0] > 0, (ahead - p[..., 0]) / d[..., 0],
+                      np.where(d[..., 0] < 0, (-behind - p[..., 0]) / d[..., 0], np.inf))
+        sy = np.where(d[..., 1] > 0, (half_width - p[..., 1]) / d[..., 1],
+                      np.where(d[..., 1] < 0, (-half_width - p[..., 1]) / d[..., 1], np.inf))
+    wall = np.where(sx < sy, np.where(d[..., 0] > 0, AHEAD, BEHIND),
+                    np.where(d[..., 1] > 0, RIGHT, LEFT))
+    return np.minimum(sx, sy), wall
+
+
+def _mirror(d: np.ndarray, wall: int) -> np.ndarray:
+    """Direction d after a specular reflection off facade ``wall`` (its normal component flips)."""
+    out = d.copy()
+    out[..., 0 if wall in (AHEAD, BEHIND) else 1] *= -1.0
+    return out
+
+
+def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np.ndarray,
+                ahead_m: np.ndarray, behind_m: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
+    """Trace every path of ``PATHS`` for satellite directions u in street axes.
 
     Parameters
     ----------
-    azimuth_rad, elevation_rad : array_like
-        Satellite direction seen from the antenna (azimuth from north, clockwise), rad.
-    heading_rad : array_like
-        Direction of the street (the vehicle heading), rad.
-    building_height_m, street_width_m : array_like
-        Facade height above the antenna and distance between the facades, m.
+    u : ndarray, shape (..., 3)
+        Unit vectors toward the satellites (x along the street ahead, y right, z up), z > 0.
+    building_height_m, street_width_m, ahead_m, behind_m : array_like, broadcast to u[..., 0]
+        Facade height above the antenna, distance between the side facades, distances to the
+        end facades ahead and behind (np.inf: open).
 
     Returns
     -------
-    los : ndarray of bool
-        Direct signal received.
-    nlos : ndarray of bool
-        Direct signal blocked, reflection off the opposite facade received.
-    extra_path_m : ndarray
-        Additional path length of the reflected signal (0 where not NLOS), m.
-
-    All arguments broadcast together.
+    dict
+        Path name -> {``possible`` (bool: every reflection meets its facade first, below the
+        top), ``clearance_m`` (height of the last leg above the edge it leaves over; < 0: it
+        passes below, diffracted), ``edge_distance_m`` (slant distance from the last
+        reflection point, or the antenna, to that edge), ``extra_path_m`` (length of the path
+        minus the direct range, over the roof edge where the last leg is diffracted),
+        ``hit_x_m`` (along-street coordinate of the first reflection; 0 for ``direct``)}.
     """
-    sin_alpha = np.abs(np.sin(np.asarray(azimuth_rad) - np.asarray(heading_rad)))
-    tan_el = np.tan(elevation_rad)
-    half = 0.5 * np.asarray(street_width_m, dtype=float)
-    height = np.asarray(building_height_m, dtype=float)
-    above = np.asarray(elevation_rad) > 0
-    los = above & (tan_el * half >= height * sin_alpha)
-    nlos = above & ~los & (tan_el * 3.0 * half >= height * sin_alpha)
-    extra = np.where(nlos, 2.0 * half * np.cos(elevation_rad) * sin_alpha, 0.0)
-    return los, nlos, extra
+    u = np.asarray(u, dtype=float)
+    shape = u.shape[:-1]
+    height = np.broadcast_to(np.asarray(building_height_m, dtype=float), shape)
+    half = np.broadcast_to(0.5 * np.asarray(street_width_m, dtype=float), shape)
+    ahead = np.broadcast_to(np.asarray(ahead_m, dtype=float), shape)
+    behind = np.broadcast_to(np.asarray(behind_m, dtype=float), shape)
+    out = {}
+    for name, walls in PATHS.items():  # seven paths
+        d = u
+        for wall in walls:
+            d = _mirror(d, wall)
+        p = np.zeros(u.shape)
+        possible = np.ones(shape, dtype=bool)
+        legs = np.zeros(shape)
+        hit_x = np.zeros(shape)
+        for n, wall in enumerate(walls):
+            s, met = _exit(p, d, half, ahead, behind)
+            possible &= np.isfinite(s)
+            s = np.where(np.isfinite(s), s, 0.0)
+            p = p + s[..., None] * d
+            possible &= (met == wall) & (p[..., 2] <= height)
+            legs = legs + s
+            if n == 0:
+                hit_x = p[..., 0]
+            d = _mirror(d, wall)
+        s, _ = _exit(p, d, half, ahead, behind)
+        s = np.where(np.isfinite(s), s, 1e9)  # an open street: no edge
+        edge = p + s[..., None] * d
+        clearance = edge[..., 2] - height
+        edge[..., 2] = np.maximum(edge[..., 2], height)  # the bent path goes over the edge
+        detour = np.linalg.norm(edge - p, axis=-1) - np.einsum("...k,...k->...", edge - p, u)
+        extra = legs - np.einsum("...k,...k->...", p, u) + np.where(clearance < 0, detour, 0.0)
+        out[name] = {"possible": possible, "clearance_m": clearance,
+                     "edge_distance_m": np.linalg.norm(edge - p, axis=-1),
+                     "extra_path_m": extra, "hit_x_m": hit_x}
+    return out
+
+
+def canyon_reception(azimuth_rad: np.ndarray, elevation_rad: np.ndarray, heading_rad: np.ndarray,
+                     building_height_m: np.ndarray, street_width_m: np.ndarray,
+                     ahead_m: np.ndarray, behind_m: np.ndarray,
+                     reflection_loss_db: np.ndarray, wavelength_m: float
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The strongest path of each satellite in a street canyon (module docstring).
+
+    Parameters
+    ----------
+    azimuth_rad, elevation_rad : ndarray, shape S
+        Satellite direction (azimuth from north, clockwise), rad.
+    heading_rad : array_like, broadcast to S
+        Direction of the street (the vehicle heading), rad.
+    building_height_m, street_width_m, ahead_m, behind_m : array_like, broadcast to S
+        As in ``trace_paths``.
+    reflection_loss_db : ndarray, shape S + (4,)
+        C/N0 loss of a reflection off each facade (right, left, ahead, behind), dB.
+    wavelength_m : float
+        Carrier wavelength (the diffraction parameter nu depends on it), m.
+
+    Returns
+    -------
+    los : ndarray of bool, S
+        The strongest path is the direct one and clears the roof edge.
+    nlos : ndarray of bool, S
+        Above the horizon and not ``los``: received by diffraction or reflection only.
+    extra_path_m : ndarray, S
+        Extra path of the tracked signal (0 where ``los``), m.
+    loss_db : ndarray, S
+        C/N0 loss of the tracked signal, dB (the caller applies its tracking threshold).
+    """
+    el = np.asarray(elevation_rad, dtype=float)
+    alpha = np.asarray(azimuth_rad, dtype=float) - np.asarray(heading_rad, dtype=float)
+    cos_el = np.cos(el)
+    u = np.stack(np.broadcast_arrays(cos_el * np.cos(alpha), cos_el * np.sin(alpha),
+                                     np.sin(np.maximum(el, 1e-6))), axis=-1)
+    paths = trace_paths(u, building_height_m, street_width_m, ahead_m, behind_m)
+    losses, extras = [], []
+    for name, walls in PATHS.items():
+        path = paths[name]
+        nu = -path["clearance_m"] * np.sqrt(2.0 / (wavelength_m
+                                                   * np.maximum(path["edge_distance_m"], 1e-3)))
+        loss = knife_edge_loss_db(nu)
+        for wall in walls:
+            loss = loss + reflection_loss_db[..., wall]
+        losses.append(np.where(path["possible"], loss, np.inf))
+        extras.append(path["extra_path_m"])
+    losses, extras = np.stack(losses), np.stack(extras)
+    best = np.argmin(losses, axis=0)
+    loss_db = np.take_along_axis(losses, best[None], axis=0)[0]
+    extra = np.take_along_axis(extras, best[None], axis=0)[0]
+    above = el > 0
+    los = above & (best == 0) & (paths["direct"]["clearance_m"] >= 0)
+    nlos = above & ~los
+    return los, nlos, np.where(los | ~above, 0.0, extra), loss_db

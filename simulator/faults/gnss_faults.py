@@ -120,7 +120,8 @@ def _set_tracked(streams, rows_dropped) -> None:
 
 
 @fault_kind("gnss_satellite_limit", {
-    "count": Integer(min=0, doc="satellites kept; the lowest are lost first"),
+    "count": Integer(min=0, doc="healthy satellites kept; the lowest are lost first, and "
+                                "unhealthy ones with them"),
     "keep": ListOf(Integer(min=1), None, doc="or: the PRNs kept (the others are lost)"),
 }, ("gnss_fix", "gnss_raw"), "only a few satellites left (partial outage, Karamat et al. 2015)")
 def _gnss_satellite_limit(streams, intervals, params, context) -> None:
@@ -129,8 +130,11 @@ def _gnss_satellite_limit(streams, intervals, params, context) -> None:
     if params["keep"] is not None:
         lost = inside & ~raw["sv"].isin(params["keep"]).to_numpy()
     else:
-        rank = raw.groupby("t")["elevation"].rank(ascending=False, method="first").to_numpy()
-        lost = inside & (rank > params["count"])
+        # ``count`` usable satellites: an unhealthy one (tracked, never used) is not one of them
+        healthy = (raw["health"] == 0).to_numpy() if "health" in raw else np.ones(len(raw), bool)
+        elevation = raw["elevation"].where(healthy, -np.inf)
+        rank = elevation.groupby(raw["t"]).rank(ascending=False, method="first").to_numpy()
+        lost = inside & ((rank > params["count"]) | ~healthy)
     _set_tracked(streams, raw.loc[lost, ["t", "sv"]])
     streams["gnss_raw"] = raw.loc[~lost].reset_index(drop=True)
     _refix(streams, intervals, context)

@@ -1,6 +1,7 @@
-"""The nominal GPS constellation: the 24 baseline slots of the GPS SPS Performance Standard,
-optionally with expandable slots split into their fore/aft pairs, as broadcast Keplerian elements
-(a navigation table), for any date.
+"""The GPS constellations landnav ships, as broadcast Keplerian elements (a navigation table)
+for any date: the real constellation of a broadcast almanac (the default sky,
+``almanac_gps_navigation``) and the nominal 24 baseline slots of the GPS SPS Performance
+Standard, optionally with expandable slots split into their fore/aft pairs.
 
 The Performance Standard defines each slot by its right ascension of the ascending node (RAAN)
 and argument of latitude at the epoch 1993-07-01 00:00 UT, when the Greenwich hour angle was
@@ -21,12 +22,38 @@ slots A1 ... F4 in order; an expanded slot's fore location keeps its slot's PRN 
 F2F 22) and its aft location takes a PRN of its own (B1A 25, D2A 26, F2A 27), whatever else is
 expanded.
 
+The real constellation (``almanac_gps_navigation``, scenario name ``gps-almanac``) is the YUMA
+almanac of week 38 (mod 1024, GPS week 2086), time of applicability 503808 s (2020-01-03
+19:56:48 GPST), as published for 2020-01-01 by the US Coast Guard Navigation Center (NAVCEN) and
+distributed with Stanford's MAAST toolset (``almyuma_01jan2020.txt``); US Government work, public
+domain. It is the newest real almanac this project can obtain (no package on PyPI ships one), and
+it is shipped as package data (``simulator/gnss/data/yuma_2020-01-01.txt``, byte-identical to the
+file of the reference data). 31 PRNs: 30 healthy and PRN 04 flagged unhealthy (health 63: GPS III
+SV01, launched December 2018, set healthy on 2020-01-13).
+
+A scenario at another date sees the almanac's sky re-epoched by a whole number k of ground-track
+repeat periods P (``REPEAT_PERIOD_S``, 86 155 s: two revolutions per sidereal day of the
+regressing orbit plane): the Earth-fixed positions at time t are those the almanac gives at
+t - k P, with k chosen so that t - k P lies within half a period of the time of applicability
+(where the almanac is accurate to a few kilometres). So every satellite keeps its plane's
+Earth-fixed node longitude and its place on its ground track, the whole constellation stays one
+consistent real snapshot, and the elements are only shifted in time (toe, toc, week and the
+node's week-start longitude Omega_0, which carries the Earth's rotation; IS-GPS-200 Table
+20-IV), never propagated over years. Consequence: a 2026 scenario sees the 2020 constellation
+(its 31 satellites, PRNs and slots, the sidereal-time-of-day pattern of their passes), not the
+2026 one: satellites launched or retired since then are not there, and the real slow drift of
+the constellation along its tracks is not followed. Counts and geometry are those of a real
+31-satellite GPS (about 9-10 above 10 deg at mid latitudes); a scenario that must reproduce a
+particular day's sky names that day's navigation file.
+
 Public names
 ------------
-NOMINAL_SLOTS, EXPANDABLE_SLOTS, AFT_PRN, nominal_slots, nominal_gps_navigation.
+NOMINAL_SLOTS, EXPANDABLE_SLOTS, AFT_PRN, ALMANAC_FILE, ALMANAC_WEEK, nominal_slots,
+nominal_gps_navigation, almanac_gps_navigation.
 
 References
 ----------
+IS-GPS-200N Table 20-VI (almanac parameters, evaluated with the Table 20-IV algorithm).
 GPS SPS Performance Standard, 4th ed. (2008), Table 3.4-1 (baseline 24-slot constellation, slot
 locations as of the epoch; the same values as the 3rd ed. (2001) Table 3-1) and Table 3.4-2
 (expandable 24-slot constellation definition); 3rd ed. (2001) Table A-2-1 (nominal constellation
@@ -40,12 +67,14 @@ from __future__ import annotations
 
 import datetime as dt
 from collections.abc import Iterable
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from simulator import columns as col
 from simulator.gnss.constants import MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, SECONDS_PER_WEEK
+from simulator.gnss.navfiles import read_yuma
 from simulator.timebase import GPS_EPOCH, utc_to_gps
 
 if TYPE_CHECKING:
@@ -160,4 +189,58 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     nav["m0"] = np.angle(np.exp(1j * arg_lat)).ravel()  # omega = 0: M0 is the arg. of latitude
     nav["omega_dot"] = RAAN_RATE_RAD_S
     nav = nav.astype({"sv": int, "week": int, "iode": int, "health": int})
+    return nav
+
+
+# the shipped real almanac (NAVCEN YUMA for 2020-01-01) and its full GPS week (YUMA's week 38)
+ALMANAC_FILE = Path(__file__).parent / "data" / "yuma_2020-01-01.txt"
+ALMANAC_WEEK = 2086
+TOE_GRID_S = 16.0  # broadcast toe values are multiples of 2^4 s (IS-GPS-200 Table 20-III)
+
+
+def almanac_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
+                           path: Path = ALMANAC_FILE, week: int = ALMANAC_WEEK) -> pd.DataFrame:
+    """The real GPS constellation of an almanac, re-epoched to ``utc`` by whole ground-track
+    repeat periods (module docstring): one record per satellite, valid over
+    [utc, utc + span_s].
+
+    Parameters
+    ----------
+    utc : datetime
+        Start of the drive (UTC).
+    span_s : float
+        Length of the drive, s; the shift is chosen for its middle.
+    path, week : the YUMA almanac and its full GPS week (default: the shipped 2020-01-01 one).
+
+    Returns
+    -------
+    pandas.DataFrame
+        The navigation table (``simulator.columns.GNSS_NAV``), unhealthy satellites included
+        with their health code; ``attrs``: ``kind`` = ``almanac``, ``source`` (the file's name)
+        and ``epoch_shift_s`` (k P, s).
+    """
+    nav = read_yuma(path, reference_week=week)
+    toa_abs = nav["week"].to_numpy() * SECONDS_PER_WEEK + nav["toe"].to_numpy()
+    start_week, start_tow = utc_to_gps(utc)
+    middle = start_week * SECONDS_PER_WEEK + start_tow + 0.5 * span_s
+    shift_s = round((middle - float(np.median(toa_abs))) / REPEAT_PERIOD_S) * REPEAT_PERIOD_S
+    # the new toe on the 16 s grid of broadcast toe values (IS-GPS-200 Table 20-VI scale
+    # factor 2^4), the elements carried over the remaining delta (< 8 s) exactly in two-body
+    # terms, so that the Earth-fixed orbit stays that of t - k P
+    exact = toa_abs + shift_s
+    new_abs = np.round(exact / TOE_GRID_S) * TOE_GRID_S
+    delta = new_abs - exact
+    new_week = np.floor(new_abs / SECONDS_PER_WEEK)
+    new_toe = new_abs - new_week * SECONDS_PER_WEEK
+    mean_motion = np.sqrt(MU_GPS_M3_S2 / nav["sqrt_a"].to_numpy() ** 6) + nav["delta_n"].to_numpy()
+    # Omega_k = Omega_0 + (Omega_dot - omega_e) t_k - omega_e toe: the same Earth-fixed node at
+    # the same time needs Omega_0 to take up the change of toe within its week
+    omega0 = (nav["omega0"].to_numpy() + OMEGA_E_DOT_RAD_S * (new_toe - nav["toe"].to_numpy())
+              + (nav["omega_dot"].to_numpy() - OMEGA_E_DOT_RAD_S) * delta)
+    nav["omega0"] = np.angle(np.exp(1j * omega0))
+    nav["m0"] = np.angle(np.exp(1j * (nav["m0"].to_numpy() + mean_motion * delta)))
+    nav["af0"] = nav["af0"].to_numpy() + nav["af1"].to_numpy() * delta
+    nav["week"] = new_week.astype(int)
+    nav["toe"] = nav["toc"] = new_toe
+    nav.attrs.update(kind="almanac", source=Path(path).name, epoch_shift_s=float(shift_s))
     return nav

@@ -5,9 +5,18 @@ Times are seconds relative to the start of a reference GPS week chosen by the ca
 (``ephemeris_arrays(nav, week0)``), so that differences such as t - toe stay small and exact in
 float64 and week crossovers need no special case.
 
-Public functions
-----------------
-ephemeris_arrays, select_ephemeris, gather, satellite_state.
+A broadcast ephemeris is a curve fit over its fit interval (IS-GPS-200 20.3.4.4: four hours,
+fit interval flag 0, with toe in its middle), so a record is used only within half that interval
+of its toe (``EPHEMERIS_MAX_AGE_S``, 2 h): beyond it the orbit error grows quickly, and a receiver
+would not use it. Unhealthy records are selected like healthy ones when asked (a receiver tracks
+an unhealthy satellite and reports it, it only leaves it out of its solution); a record without a
+usable orbit (square root of the semi-major axis below ``MIN_SQRT_A``, as some files write for
+satellites that are not transmitting) never is.
+
+Public names
+------------
+EPHEMERIS_FIT_INTERVAL_S, EPHEMERIS_MAX_AGE_S, MIN_SQRT_A, ephemeris_arrays, select_ephemeris,
+gather, satellite_state.
 
 References
 ----------
@@ -34,6 +43,9 @@ from simulator.gnss.constants import (
 if TYPE_CHECKING:
     import pandas as pd
 
+EPHEMERIS_FIT_INTERVAL_S = 4 * 3600.0  # IS-GPS-200 20.3.4.4, fit interval flag 0
+EPHEMERIS_MAX_AGE_S = 0.5 * EPHEMERIS_FIT_INTERVAL_S  # toe is in the middle of the fit interval
+MIN_SQRT_A = 4000.0  # m^0.5; GPS orbits have about 5153.6 (a = 26 560 km)
 _KEPLER_ITERATIONS = 8  # Newton steps on Kepler's equation: below 1e-15 rad for e < 0.1
 
 
@@ -49,8 +61,10 @@ def ephemeris_arrays(nav: pd.DataFrame, week0: int) -> dict[str, np.ndarray]:
 
 
 def select_ephemeris(eph: dict[str, np.ndarray], sv: np.ndarray, t_s: np.ndarray,
-                     max_age_s: float = 4 * 3600.0) -> np.ndarray:
-    """Index of the healthy ephemeris of satellite ``sv`` whose toe is nearest to ``t_s``.
+                     max_age_s: float = EPHEMERIS_MAX_AGE_S,
+                     healthy_only: bool = True) -> np.ndarray:
+    """Index of the ephemeris of satellite ``sv`` whose toe is nearest to ``t_s``: among the
+    healthy records, or (``healthy_only=False``) among all records with a usable orbit.
 
     Parameters
     ----------
@@ -59,14 +73,17 @@ def select_ephemeris(eph: dict[str, np.ndarray], sv: np.ndarray, t_s: np.ndarray
     sv, t_s : array_like, broadcast together
         Satellite numbers and times (s since the start of the reference week).
     max_age_s : float
-        Records with |t - toe| above this are not used (IS-GPS-200 fit interval: 4 h).
+        Records with |t - toe| above this are not used (default: half the 4 h fit interval).
+    healthy_only : bool
+        Leave out records whose health is not 0.
 
     Returns
     -------
     ndarray of int, the broadcast shape of sv and t_s; -1 where no record qualifies.
     """
     sv, t_s = np.broadcast_arrays(np.asarray(sv, dtype=int), np.asarray(t_s, dtype=float))
-    good = np.flatnonzero(eph["health"] == 0)
+    usable = eph["sqrt_a"] > MIN_SQRT_A
+    good = np.flatnonzero(usable & (eph["health"] == 0) if healthy_only else usable)
     span = 4.0 * SECONDS_PER_WEEK  # keys of different satellites never interleave
     key = eph["sv"][good] * span + eph["toe_s"][good]
     order = np.argsort(key, kind="stable")

@@ -1,22 +1,58 @@
 """The receiver's error budget: draws every error term of the raw measurements (receiver clock,
-signal-in-space error, ionosphere and troposphere residuals, multipath, code and carrier
-tracking noise) for satellites x epochs, and the 1-sigma the receiver reports for weighting.
+signal-in-space error, ionosphere and troposphere residuals, multipath, C/N0 fading, code and
+carrier tracking noise) for satellites x epochs, smooths the code with the carrier as the
+receiver does, and gives the 1-sigma the receiver reports for weighting.
 
-The processes themselves are in ``simulator.stochastic`` (Gauss-Markov) and
-``simulator.gnss.receiver`` (two-state clock, DLL/FLL jitter, multipath shape); this module sets
-how large each is and how they are shared.
+Time behaviour (issue 19):
+
+- The code tracking error is the DLL's thermal jitter (Kaplan & Hegarty 2017 eq. 8.51) shaped by
+  the loop: a first-order loop of noise bandwidth B_L passes white discriminator noise through
+  a low-pass of time constant 1 / (4 B_L) (Kaplan & Hegarty 2017 section 8.8; Groves 2013
+  section 9.3.3), so the error is a Gauss-Markov process of that correlation time sampled at
+  the output rate: a 0.5 Hz loop is correlated over 0.5 s, so consecutive 10 Hz samples are
+  (correlation 0.82), 1 Hz samples nearly not (0.14). The Doppler error is shaped likewise by
+  the frequency loop.
+- Carrier smoothing (Hatch 1982; RTCA DO-229D section 2.1.4.1.1 and DO-253C: a 100 s time
+  constant) filters the code-minus-carrier: smoothed = carrier + F(code - carrier), F the
+  first-order filter with weight 1 / min(n, N) for the n-th epoch of a tracking arc (a growing
+  average until N = T / dt epochs, then fixed). Since code - carrier = 2 I + e_code + m_code
+  (the carrier's own noise and multipath, millimetres, are left out), the smoothed pseudorange
+  error is F(e_code) + F(m_code) + F(2 I) - I: the noise and multipath are lowered and become
+  correlated over T, and the ionosphere's code-carrier divergence leaves a lag of about
+  -2 T dI/dt. Choice: the former "level kept" simplification (the smoothed error held at the
+  raw jitter's level, only its correlation changed) is dropped; the filter acts on the drawn
+  errors, so smoothing lowers them as receivers' do. An NLOS signal's extra path delays code
+  and carrier alike, so it passes the filter unchanged.
+- Multipath and C/N0 fading decorrelate with the antenna's motion relative to the reflectors
+  and, standing still, with the satellite's motion: Gauss-Markov processes in the coordinate
+  u = distance / D + t / T_static (D ``multipath_distance``, T_static
+  ``multipath_correlation_time``), so their correlation is exp(-|du|) (Braasch 1996,
+  *Multipath effects*, in Parkinson & Spilker vol. I ch. 14; the static period
+  lambda / (2 h cos(el) d el/dt) of Georgiadou & Kleusberg 1988 is minutes for reflectors
+  metres away).
+- The true ionosphere is ``iono_scale`` times the Klobuchar delay (1.5 by default: the model
+  leaves a residual of half its own value; Klobuchar 1987 designed it to remove about 50 % of
+  the rms delay) times a slowly varying factor, 1 + ``iono_residual`` (c + 0.5 o), with c common
+  to all signals and o each signal's own, both Gauss-Markov over 30 min, drawn every 30 min and
+  interpolated linearly: smooth, as the ionosphere is (``IONO_GRID_STEP``).
 
 Public names
 ------------
-OSCILLATORS, CARRIER_SMOOTHING_TIME_S, SIS_CORRELATION_TIME_S, IONO_CORRELATION_TIME_S,
-IONO_OWN_SHARE, REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, draw_receiver_clock,
-draw_error_terms, pseudorange_sigma.
+OSCILLATORS, SIS_CORRELATION_TIME_S, IONO_CORRELATION_TIME_S, IONO_OWN_SHARE,
+REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, GRID_STEP, IONO_GRID_STEP,
+loop_time_constant_s,
+decorrelation_coordinate, gauss_markov_along, draw_receiver_clock, draw_fading,
+draw_error_terms, hatch_filter, smoothed_variance_factor, smooth_code_errors,
+pseudorange_sigma.
 
 References
 ----------
 Brown & Hwang 2012, Table 9.1 (oscillator h-parameters). Kaplan & Hegarty 2017, section 10.2
-(the single-frequency error budget: satellite clock/ephemeris, ionosphere after the broadcast
-correction, troposphere, multipath, receiver noise).
+(the single-frequency error budget) and section 8.8 (loop noise bandwidth). Hatch, R., "The
+synergism of GPS code and carrier measurements", 3rd Int. Geodetic Symp. on Satellite Doppler
+Positioning, 1982. Klobuchar, J. A., "Ionospheric time-delay algorithm for single-frequency GPS
+users", IEEE Trans. AES 23(3), 325-331, 1987. Georgiadou, Y. & Kleusberg, A., "On carrier signal
+multipath effects in relative GPS positioning", Manuscripta Geodaetica 13, 172-179, 1988.
 """
 
 from __future__ import annotations
@@ -25,7 +61,7 @@ import numpy as np
 
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
-from simulator.stochastic import gauss_markov
+from simulator.stochastic import ar1_filter, gauss_markov
 
 # receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
 # crystal) and the 1-sigma spread of the clock state at switch-on
@@ -35,17 +71,49 @@ OSCILLATORS: dict[str, dict[str, float]] = {
     "ideal": {"h0": 0.0, "h_minus2": 0.0, "bias_s": 0.0, "drift_s_s": 0.0},
 }
 SIS_CORRELATION_TIME_S = 3600.0  # broadcast orbit/clock errors change over an upload cycle
-IONO_CORRELATION_TIME_S = 1800.0  # residual of the Klobuchar model
-IONO_OWN_SHARE = 0.5  # 1-sigma of the per-signal iono residual relative to the common one
-# the code tracking error of a receiver that smooths its code with the carrier (Hatch filter):
-# correlated over the smoothing time constant, the 100 s of RTCA DO-229 (SBAS airborne
-# receivers) and DO-253 (GBAS airborne receivers). The automotive preset uses it: the
-# fix error of a mass-market receiver changes by centimetres per second while driving, e.g.
-# 0.036 m/s per axis in a u-blox log at 17.6 m/s (issue 19's measurement); a 1 m error
-# correlated over 100 s changes by 1 m x sqrt(2 (1 - exp(-1/100))) = 0.14 m in a second.
-CARRIER_SMOOTHING_TIME_S = 100.0
+IONO_CORRELATION_TIME_S = 1800.0  # variations of the true/Klobuchar ratio
+IONO_OWN_SHARE = 0.5  # 1-sigma of the per-signal iono variation relative to the common one
 REPORTED_PR_STD_FLOOR_M = 0.1  # the smallest pseudorange 1-sigma the receiver reports
 REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it reports
+# step of the grid (in correlation lengths of u) on which the motion-driven processes are drawn
+# before linear interpolation to the epochs: the interpolation keeps over 99 % of the variance
+GRID_STEP = 0.05
+# the ionosphere's variation is drawn once per correlation time (30 min) and interpolated: its
+# rate is then sigma x 1.1 / 30 min, about 1.5 mm/s on an 8 m delay with the default 1.5 x 0.2,
+# the rate of TEC of a quiet mid-latitude ionosphere (below 0.5 TECU/min = 1.35 mm/s on L1;
+# Pi et al., "Monitoring of global ionospheric irregularities using the worldwide GPS network",
+# Geophys. Res. Lett. 24(18), 1997); drawn every epoch, the process would change like a random
+# walk, some 10 mm/s, which the carrier smoothing turns into a metre of divergence error
+IONO_GRID_STEP = 1.0
+
+
+def loop_time_constant_s(bandwidth_hz: float) -> float:
+    """Time constant of a first-order tracking loop of one-sided noise bandwidth B_L:
+    B_L = K / 4 for the loop gain K, so the loop low-passes with 1 / K = 1 / (4 B_L) (Kaplan &
+    Hegarty 2017 section 8.8, Table 8.23)."""
+    return 1.0 / (4.0 * bandwidth_hz)
+
+
+def decorrelation_coordinate(t_s: np.ndarray, distance_m: np.ndarray, distance_scale_m: float,
+                             time_scale_s: float) -> np.ndarray:
+    """u = distance / D + t / T: one unit of u decorrelates multipath and fading by 1 / e."""
+    return np.asarray(distance_m) / distance_scale_m + np.asarray(t_s) / time_scale_s
+
+
+def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator,
+                       step: float = GRID_STEP) -> np.ndarray:
+    """Unit-variance processes with correlation exp(-|u_i - u_j|) at the points u (ascending,
+    shape (n,)), one per row: shape (rows, n). Each is the exact Gauss-Markov process
+    (``simulator.stochastic.gauss_markov``, unit correlation length) on a grid of ``step`` in
+    u, interpolated linearly at u (between grid points the variance falls to (1 + e^-step) / 2
+    at the middle: 0.99 for the default step, 0.68 for a step of 1)."""
+    u = np.asarray(u, dtype=float)
+    grid = u[0] + np.arange(int(np.ceil((u[-1] - u[0]) / step)) + 2) * step
+    values = gauss_markov(len(grid), step, np.ones(rows), 1.0, rng)
+    pos = (u - grid[0]) / step
+    i = np.minimum(pos.astype(int), len(grid) - 2)
+    w = pos - i
+    return (values[i] * (1.0 - w)[:, None] + values[i + 1] * w[:, None]).T
 
 
 def draw_receiver_clock(rng: np.random.Generator, oscillator: str, n: int, dt_s: float
@@ -58,37 +126,38 @@ def draw_receiver_clock(rng: np.random.Generator, oscillator: str, n: int, dt_s:
     return bias, drift, {"oscillator": oscillator, "bias_s": bias0, "drift_s_s": drift0}
 
 
+def draw_fading(rng: np.random.Generator, cfg: dict, u: np.ndarray, n_sat: int) -> np.ndarray:
+    """C/N0 fading, dB, shape (n_sat, n_epoch): ``cn0_fading`` times a unit process correlated
+    in the motion coordinate ``u`` (``decorrelation_coordinate``), not white from epoch to
+    epoch: the fading comes from the same reflections as the multipath."""
+    if cfg["cn0_fading"] == 0:
+        return np.zeros((n_sat, len(u)))
+    return cfg["cn0_fading"] * gauss_markov_along(u, n_sat, rng)
+
+
 def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndarray,
-                     cn0_dbhz: np.ndarray, dt_s: float) -> dict[str, np.ndarray]:
-    """Every error term of the raw measurements, shape (n_sat, n_epoch) unless noted.
+                     cn0_dbhz: np.ndarray, dt_s: float, u: np.ndarray) -> dict[str, np.ndarray]:
+    """Every error term of the raw measurements before the receiver's carrier smoothing,
+    shape (n_sat, n_epoch) unless noted.
 
     Parameters
     ----------
     cfg : dict
         The resolved ``sensors.gnss`` block (error levels and tracking-loop parameters).
     elevation_rad, cn0_dbhz : ndarray, shape (n_sat, n_epoch)
-        Elevation and C/N0 of each signal.
+        Elevation and true C/N0 of each signal.
     dt_s : float
         Epoch interval.
+    u : ndarray, shape (n_epoch,)
+        The motion coordinate of multipath (``decorrelation_coordinate``).
 
     Returns
     -------
-    dict with ``sis`` (m); ``iono_ratio`` (true / broadcast ionosphere: the residual common to
-    all signals plus ``IONO_OWN_SHARE`` times an independent one per signal); ``tropo_zenith``
-    (scalar, m: the zenith troposphere the model misses, for the whole drive); ``multipath`` and
-    ``multipath_sigma`` (m); ``code_noise`` and ``code_sigma`` (m); ``rate_noise`` and
-    ``rate_sigma`` (m/s).
-
-    The code error keeps its 1-sigma (the DLL jitter for the signal's C/N0, Kaplan & Hegarty
-    2017 eq. 8.76 via ``dll_sigma_m``) and is, with ``code_correlation_time`` T > 0, a unit
-    first-order Gauss-Markov process times that sigma, correlated over T, as the code of a
-    carrier-smoothing receiver is; T = 0 draws it white per epoch. Choice: a Hatch filter of
-    time constant T would also lower the white jitter's variance by about dt / (2 T); the
-    preset's error level is kept instead (the ``tracking_noise`` scale describes the error the
-    receiver delivers), so the fix scatter stays that of the preset and only its time behaviour
-    changes. The multiplier on sigma(t) follows the C/N0 of each epoch. The code multipath goes
-    through the same smoothing, so its correlation time is the longer of
-    ``multipath_correlation_time`` and T (its level kept likewise).
+    dict with ``sis`` (m); ``iono_ratio`` (true / broadcast ionosphere, module docstring);
+    ``tropo_zenith`` (scalar, m: the zenith troposphere the model misses, for the whole drive);
+    ``multipath`` and ``multipath_sigma`` (m, correlated in u); ``code_noise`` and
+    ``code_sigma`` (m: the DLL jitter for the signal's C/N0, a Gauss-Markov process over the
+    loop's time constant); ``rate_noise`` and ``rate_sigma`` (m/s, the FLL's likewise).
     """
     shape = elevation_rad.shape
     n_sat, n_ep = shape
@@ -98,30 +167,115 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
 
     out = {"sis": cfg["sis_error"] * unit_gm(n_sat, SIS_CORRELATION_TIME_S)}
-    common = unit_gm(1, IONO_CORRELATION_TIME_S)
-    own = unit_gm(n_sat, IONO_CORRELATION_TIME_S)
-    out["iono_ratio"] = 1.0 + cfg["iono_residual"] * (common + IONO_OWN_SHARE * own)
+    # the ionosphere varies smoothly: a Gauss-Markov process drawn once per correlation time
+    # and interpolated linearly, so that its rate (which the carrier smoothing's code-carrier
+    # divergence sees) stays at the mm/s of a quiet ionosphere
+    u_iono = np.arange(n_ep) * dt_s / IONO_CORRELATION_TIME_S
+    common = gauss_markov_along(u_iono, 1, rng, IONO_GRID_STEP)
+    own = gauss_markov_along(u_iono, n_sat, rng, IONO_GRID_STEP)
+    out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"]
+                                             * (common + IONO_OWN_SHARE * own))
     out["tropo_zenith"] = cfg["tropo_residual"] * rng.standard_normal()
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
-    tau_code = cfg["code_correlation_time"]
-    tau_multipath = max(cfg["multipath_correlation_time"], tau_code)
-    out["multipath"] = out["multipath_sigma"] * unit_gm(n_sat, tau_multipath)
+    out["multipath"] = out["multipath_sigma"] * gauss_markov_along(u, n_sat, rng)
     out["code_sigma"] = scale * dll_sigma_m(cn0_dbhz, cfg["dll_bandwidth"],
                                             cfg["correlator_spacing"], cfg["integration_time"])
-    out["code_noise"] = out["code_sigma"] * (unit_gm(n_sat, tau_code) if tau_code > 0
-                                             else rng.standard_normal(shape))
+    out["code_noise"] = out["code_sigma"] * unit_gm(
+        n_sat, loop_time_constant_s(cfg["dll_bandwidth"]))
     out["rate_sigma"] = scale * LAMBDA_L1_M * fll_sigma_hz(cn0_dbhz, cfg["fll_bandwidth"],
                                                           cfg["integration_time"])
-    out["rate_noise"] = out["rate_sigma"] * rng.standard_normal(shape)
+    out["rate_noise"] = out["rate_sigma"] * unit_gm(
+        n_sat, loop_time_constant_s(cfg["fll_bandwidth"]))
+    return out
+
+
+def hatch_filter(x: np.ndarray, tracked: np.ndarray, dt_s: float, time_constant_s: float
+                 ) -> np.ndarray:
+    """The Hatch filter's response to x along the epochs (last axis), restarted at every
+    tracking arc: y_k = (1 - 1/n) y_{k-1} + x_k / n with n = min(epochs since the arc began,
+    N), N = T / dt (RTCA DO-229D 2.1.4.1.1); zero where not tracked.
+
+    Vectorised: the growing part is a running mean (cumulative sums restarted per arc), the
+    fixed part the recursion ``simulator.stochastic.ar1_filter`` run over the whole row with
+    zero input where not tracked, corrected at each arc by the state it inherited:
+    y_k = r_k + a^(k - k0 + 1) (mean_{k0-1} - r_{k0-1}) for k >= k0, the first epoch of the arc
+    with n = N, a = 1 - 1 / N, r the whole-row recursion.
+
+    Parameters
+    ----------
+    x : ndarray, shape (..., n_sat, n_epoch)
+    tracked : ndarray of bool, shape (n_sat, n_epoch)
+    """
+    x = np.where(tracked, x, 0.0)
+    n_window = time_constant_s / dt_s
+    if n_window <= 1.0:
+        return x
+    lead = x.shape[:-2]
+    n_sat, n_ep = tracked.shape
+    k = np.arange(n_ep)
+    starts = tracked & ~np.concatenate([np.zeros((n_sat, 1), bool), tracked[:, :-1]], axis=1)
+    arc_start = np.maximum.accumulate(np.where(starts, k, 0), axis=1)
+    pos = k - arc_start  # epochs since the arc began, 0 at its first
+    rows = np.arange(n_sat)[:, None]
+    total = np.cumsum(x, axis=-1)
+    before = np.where(arc_start > 0, total[..., rows, np.maximum(arc_start - 1, 0)], 0.0)
+    mean = (total - before) / (pos + 1)
+    a = 1.0 - 1.0 / n_window
+    flat = np.moveaxis(x, -1, 0).reshape(n_ep, -1)
+    run = np.moveaxis(ar1_filter(flat, a, gain_in=1.0 - a).reshape((n_ep,) + lead + (n_sat,)),
+                      0, -1)
+    first_fixed = int(np.ceil(n_window - 1.0))  # pos of k0
+    k0 = np.minimum(arc_start + first_fixed, n_ep - 1)
+    carried = mean[..., rows, k0 - 1] - run[..., rows, k0 - 1]
+    steps = np.maximum(pos - first_fixed + 1, 0)
+    fixed = run + np.power(a, steps) * carried
+    return np.where(tracked, np.where(pos < first_fixed, mean, fixed), 0.0)
+
+
+def smoothed_variance_factor(correlation_time_s: float | np.ndarray, dt_s: float,
+                             time_constant_s: float) -> np.ndarray:
+    """Steady-state variance of the Hatch filter's output per unit variance of a Gauss-Markov
+    input of correlation time tau sampled every dt: for the filter y_k = a y_{k-1} + (1 - a) x_k
+    and the input's correlation phi = exp(-dt / tau),
+    var = (1 - a)^2 (1 + a phi) / ((1 - a^2)(1 - a phi)) (the output of two first-order
+    recursions in cascade); 1 without smoothing."""
+    n_window = time_constant_s / dt_s
+    if n_window <= 1.0:
+        return np.ones_like(np.asarray(correlation_time_s, dtype=float))
+    a = 1.0 - 1.0 / n_window
+    phi = np.exp(-dt_s / np.asarray(correlation_time_s, dtype=float))
+    return (1.0 - a) ** 2 * (1.0 + a * phi) / ((1.0 - a * a) * (1.0 - a * phi))
+
+
+def smooth_code_errors(cfg: dict, terms: dict[str, np.ndarray], iono_true_m: np.ndarray,
+                       tracked: np.ndarray, dt_s: float) -> dict[str, np.ndarray]:
+    """The code error terms after the receiver's carrier smoothing (``carrier_smoothing`` T > 0;
+    module docstring): ``code_noise`` = F(e_code) + F(2 I) - 2 I (the tracking noise and the
+    ionosphere's code-carrier divergence), ``multipath`` = F(m_code). Untracked signals keep
+    their raw values (nothing is smoothed there). Returns the updated copy of ``terms``."""
+    rows = np.flatnonzero(tracked.any(axis=1))  # the satellites ever tracked
+    if cfg["carrier_smoothing"] <= 0 or rows.size == 0:
+        return terms
+    iono = iono_true_m[rows]
+    stacked = np.stack([terms["code_noise"][rows], terms["multipath"][rows], 2.0 * iono])
+    smooth = hatch_filter(stacked, tracked[rows], dt_s, cfg["carrier_smoothing"])
+    out = dict(terms)
+    for key, value in (("code_noise", smooth[0] + smooth[2] - 2.0 * iono),
+                       ("multipath", smooth[1])):
+        out[key] = terms[key].copy()
+        out[key][rows] = np.where(tracked[rows], value, terms[key][rows])
     return out
 
 
 def pseudorange_sigma(cfg: dict, terms: dict[str, np.ndarray], iono_m: np.ndarray,
-                      tropo_mapping: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+                      tropo_mapping: np.ndarray, dt_s: float, speed_m_s: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
     """The 1-sigma of each pseudorange (m) and pseudorange rate (m/s) the receiver reports:
-    the root sum of squares of the configured budget (code noise, multipath, ionosphere residual
-    common and own, troposphere zenith residual times the mapping, signal-in-space error), with
-    floors of 0.1 m and 0.01 m/s.
+    the root sum of squares of the configured budget (code noise and multipath after the carrier
+    smoothing, ``smoothed_variance_factor`` at the loop's and the multipath's correlation time
+    (the latter at the current speed); ionosphere residual (``iono_scale`` - 1 plus the
+    variations, common and own) times the broadcast delay; troposphere zenith residual times the
+    mapping; signal-in-space error), with floors of 0.1 m and 0.01 m/s.
 
     Parameters
     ----------
@@ -131,9 +285,19 @@ def pseudorange_sigma(cfg: dict, terms: dict[str, np.ndarray], iono_m: np.ndarra
         Broadcast ionosphere delay of each signal, m.
     tropo_mapping : ndarray
         Slant / zenith troposphere of each signal.
+    speed_m_s : ndarray, shape (n_epoch,)
+        Antenna speed (the multipath's correlation time falls with it).
     """
-    var = (terms["code_sigma"] ** 2 + terms["multipath_sigma"] ** 2
-           + (1.0 + IONO_OWN_SHARE**2) * (cfg["iono_residual"] * iono_m) ** 2
+    smoothing = cfg["carrier_smoothing"]
+    code_factor = smoothed_variance_factor(loop_time_constant_s(cfg["dll_bandwidth"]), dt_s,
+                                           smoothing)
+    mp_time = 1.0 / (speed_m_s / cfg["multipath_distance"]
+                     + 1.0 / cfg["multipath_correlation_time"])
+    mp_factor = smoothed_variance_factor(mp_time, dt_s, smoothing)[None, :]
+    iono_rel = (cfg["iono_scale"] - 1.0) ** 2 + (cfg["iono_scale"] * cfg["iono_residual"]) ** 2 \
+        * (1.0 + IONO_OWN_SHARE**2)
+    var = (code_factor * terms["code_sigma"] ** 2 + mp_factor * terms["multipath_sigma"] ** 2
+           + iono_rel * iono_m**2
            + (cfg["tropo_residual"] * tropo_mapping) ** 2 + cfg["sis_error"] ** 2)
     return (np.maximum(np.sqrt(var), REPORTED_PR_STD_FLOOR_M),
             np.maximum(terms["rate_sigma"], REPORTED_RATE_STD_FLOOR_M_S))

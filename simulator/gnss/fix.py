@@ -226,7 +226,8 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     t : ndarray, shape (n,)
         Fix epochs, s; every raw row's ``t`` must be one of them.
     raw : pandas.DataFrame
-        Rows of ``gnss_raw`` (with ``pseudorange_std`` and ``pseudorange_rate_std``).
+        Rows of ``gnss_raw`` (with ``pseudorange_std`` and ``pseudorange_rate_std``); rows whose
+        ``health`` is not 0 are left out.
     smoothing_time_constant_s : float
         0 for raw single-epoch fixes, else the time constant of ``smooth_positions``.
     dop_mask : float
@@ -236,6 +237,8 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     import pandas as pd
 
     n = len(t)
+    if "health" in raw:  # an unhealthy satellite is tracked and reported, never used
+        raw = raw[raw["health"].to_numpy() == 0]
     raw = raw.sort_values(["t", "sv"], kind="stable")
     epoch = np.searchsorted(t, raw["t"].to_numpy())
     sat_pos = raw[["sat_x", "sat_y", "sat_z"]].to_numpy()

@@ -2,9 +2,12 @@
 the ``gnss_fix`` and ``gnss_raw`` streams.
 
 Times are UTC (GPS time of the epoch minus the leap seconds); positions are the fix's WGS-84
-latitude and longitude; the GGA altitude is the fix's ellipsoidal height with a geoid
-separation of 0 (landnav has no geoid model). Epochs without a fix give GGA quality 0, RMC
-status V and empty position fields, as receivers do.
+latitude and longitude; GGA field 9 is the altitude above mean sea level (the geoid) and field
+11 the geoid separation N (geoid above the ellipsoid), as NMEA 0183 defines them, so that the
+ellipsoidal height is their sum. N is EGM96 at the fix's position (``simulator.geoid``, the
+barometer's geoid); a real receiver uses its own built-in geoid, often a coarser grid, so its N
+may differ by a metre or two. Epochs without a fix give GGA quality 0, RMC status V and empty
+position fields, as receivers do.
 
 Public functions
 ----------------
@@ -25,6 +28,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from simulator.geoid import geoid_undulation_m
 from simulator.timebase import gps_to_utc
 
 KNOTS_PER_M_S = 3600.0 / 1852.0  # international nautical mile, 1852 m
@@ -69,14 +73,17 @@ def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[
     mode = "A" if has_fix else "N"
     out = [
         _sentence("GPGGA", hms, lat, ns, lon, ew, "1" if has_fix else "0",
-                  f"{int(fix['num_sats']):02d}", _num(hdop, 1), _num(fix["alt"], 2), "M",
-                  "0.0" if has_fix else "", "M" if has_fix else "", "", ""),
+                  f"{int(fix['num_sats']):02d}", _num(hdop, 1),
+                  _num(fix["alt"] - fix["separation"], 2), "M", _num(fix["separation"], 2),
+                  "M" if has_fix else "", "", ""),
         _sentence("GPRMC", hms, "A" if has_fix else "V", lat, ns, lon, ew,
                   _num(knots, 3), _num(course, 2), stamp.strftime("%d%m%y"), "", "", mode),
         _sentence("GPVTG", _num(course, 2), "T", "", "M", _num(knots, 3), "N",
                   _num(fix["speed"] * 3.6, 3), "K", mode),
     ]
-    used = [f"{int(sv):02d}" for sv in sats["sv"]][:12] if has_fix else []
+    # GSA lists the satellites the fix used: not the unhealthy ones GSV shows in view
+    healthy = sats[sats["health"] == 0] if "health" in sats else sats
+    used = [f"{int(sv):02d}" for sv in healthy["sv"]][:12] if has_fix else []
     out.append(_sentence("GPGSA", "A", {0: "1", 1: "2"}.get(int(fix["fix"]), "3"),
                          *(used + [""] * (12 - len(used))), _num(pdop, 1), _num(hdop, 1),
                          _num(vdop, 1)))
@@ -104,6 +111,8 @@ def nmea_sentences(fix: pd.DataFrame, raw: pd.DataFrame, gps_week: int,
     by_epoch = dict(tuple(raw.groupby("t"))) if len(raw) else {}
     empty = pd.DataFrame(columns=["sv", "elevation", "azimuth", "cn0"])
     lines: list[str] = []
+    fix = fix.assign(separation=np.where(fix["fix"] > 0, geoid_undulation_m(fix["lat"], fix["lon"]),
+                                         np.nan))
     for rec in fix.to_dict("records"):
         stamp = gps_to_utc(gps_week, gps_tow_s + float(rec["t"]))
         lines += _epoch_sentences(stamp, rec, by_epoch.get(rec["t"], empty))

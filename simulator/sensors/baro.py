@@ -7,11 +7,13 @@ Model::
     p_sl(t) = sea_level_pressure + (drift + r) t
 
 * p_std: the ICAO / U.S. 1976 standard atmosphere (``simulator.environment.atmosphere``) at the
-  truth altitude h (the ellipsoidal height is used as height above sea level: the geoid
-  undulation is a constant offset, like the bias: about 3 hPa at ARL1, issue 19. No geoid
-  model is used yet: the one PyPI package found that ships EGM96 data, egm96 0.3.0, needs
-  Python 3.12 and numpy 2.5, see docs/odometer-and-barometer.md); a non-standard sea-level
-  pressure scales the whole column (the altimeter-setting convention);
+  truth's height above mean sea level H: with ``geoid: true`` (the ``bosch-bmp280`` preset) the
+  orthometric height H = h - N, N the EGM96 geoid undulation at the truth's position
+  (``simulator.geoid``; the atmosphere is layered on equipotential surfaces, so pressure
+  follows the geoid: at ARL1, N = -26.9 m, about 3 hPa); with ``geoid: false`` (the default
+  and ``preset: ideal``, unchanged) the ellipsoidal height h, so the ideal barometer's altitude
+  is the truth altitude. A non-standard sea-level pressure scales the whole column (the
+  altimeter-setting convention);
 * ``drift``: sea-level pressure change per hour (Pa/h, given, e.g. "-1 hPa/h" for a passing
   front);
 * r ~ N(0, ``weather_drift``^2), the weather's rate drawn once per run (``drawn["drift_rate"]``
@@ -28,7 +30,9 @@ Model::
 * then clipping to ``range`` [min, max] and rounding to ``resolution``.
 
 The ``altitude`` column is the pressure altitude of the measured pressure (standard atmosphere,
-101325 Pa at sea level), so the ideal barometer's altitude is the truth altitude.
+101325 Pa at sea level): with ``geoid: true`` an error-free barometer reads the orthometric
+height, which differs from the truth's ellipsoidal altitude by N (estimators calibrate the
+barometer's offset against GNSS heights, which absorbs it).
 
 Public names
 ------------
@@ -36,9 +40,10 @@ BARO_FIELD, BARO_PRESETS, Barometer.
 
 References
 ----------
-ICAO Doc 7488/3, *Manual of the ICAO Standard Atmosphere*, 1993. Park et al., IEEE Access 7,
-2019, Table 2 (Bosch BMP280: 300-1100 hPa, 1.3 Pa RMS noise, 20 Hz). Bosch Sensortec,
-*BMP280 data sheet* BST-BMP280-DS001 (absolute accuracy +-1 hPa, resolution 0.16 Pa).
+ICAO Doc 7488/3, *Manual of the ICAO Standard Atmosphere*, 1993. EGM96: Lemoine et al.,
+NASA/TP-1998-206861. Park et al., IEEE Access 7, 2019, Table 2 (Bosch BMP280: 300-1100 hPa,
+1.3 Pa RMS noise, 20 Hz). Bosch Sensortec, *BMP280 data sheet* BST-BMP280-DS001 (absolute
+accuracy +-1 hPa, resolution 0.16 Pa).
 """
 
 from __future__ import annotations
@@ -46,7 +51,8 @@ from __future__ import annotations
 import numpy as np
 
 from simulator.environment.atmosphere import P0_PA, pressure_altitude_m, pressure_pa
-from simulator.schema import Context, Number, Path, Vector
+from simulator.geoid import orthometric_height_m
+from simulator.schema import Boolean, Context, Number, Path, Vector
 from simulator.sensors.base import TEMPERATURE_FIELD, sample_times, temperature_change_k
 from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.tables import ColumnTable
@@ -57,7 +63,7 @@ BARO_PRESETS: dict[str, dict] = {
     "ideal": {},
     "bosch-bmp280": {"rate": 20.0, "noise": 1.3, "bias": 1 * HPA, "resolution": 0.16,
                      "range": [300 * HPA, 1100 * HPA], "weather_drift": "0.4 hPa/h",
-                     "temperature_coefficient": "1.5 Pa/K"},
+                     "temperature_coefficient": "1.5 Pa/K", "geoid": True},
 }
 
 _FIELDS = {
@@ -70,11 +76,13 @@ _FIELDS = {
     "temperature_coefficient": Number("Pa/K", None, min=0,
                                       doc="1-sigma pressure offset per kelvin, drawn once per run"),
     "temperature": TEMPERATURE_FIELD,
+    "geoid": Boolean(None, doc="pressure of the height above the EGM96 geoid (mean sea level); "
+                               "false: of the ellipsoidal height"),
     "sea_level_pressure": Number("Pa", None, gt=0, doc="sea-level pressure at t = 0"),
     "resolution": Number("Pa", None, min=0, doc="quantisation step"),
     "range": Vector(2, Number("Pa", gt=0), None, doc="lowest and highest pressure measured"),
 }
-_DEFAULTS = {"rate": 10.0, "sea_level_pressure": P0_PA, "range": None}
+_DEFAULTS = {"rate": 10.0, "sea_level_pressure": P0_PA, "range": None, "geoid": False}
 
 
 def _check_range(out: dict, path: Path, ctx: Context) -> dict:
@@ -97,7 +105,9 @@ class Barometer(PresetSensor):
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, ColumnTable]:
         c = self.config
         t = sample_times(truth.duration_s, self.rate_hz)
-        altitude = truth.position(t)[:, 2]
+        lat, lon, altitude = truth.position(t).T
+        if c["geoid"]:
+            altitude = orthometric_height_m(np.degrees(lat), np.degrees(lon), altitude)
         bias = c["bias"] * rng.standard_normal()
         noise = c["noise"] * rng.standard_normal(len(t))
         rate = c["drift"] + c["weather_drift"] * rng.standard_normal()

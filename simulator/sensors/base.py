@@ -21,6 +21,9 @@ from simulator.trajectory.kinematics import Kinematics
 from simulator.trajectory.quadrature import (
     GL_NODES,
     GL_WEIGHTS,
+    LOBATTO_END_WEIGHT,
+    LOBATTO_INNER_NODES,
+    LOBATTO_INNER_WEIGHTS,
     cubic_interval_integrals,
     cubic_rule_error,
 )
@@ -28,6 +31,9 @@ from simulator.trajectory.quadrature import (
 # largest error of the cubic rule accepted per interval before Gauss-Legendre takes over:
 # 1e-12 rad and 1e-11 m/s, so that a million samples cannot add up to a measurable drift
 CUBIC_RULE_TOLERANCE = {"w_body": 1e-12, "f_body": 1e-11}
+# a breakpoint closer than this share of the sample interval to an interval's end is taken to be
+# at the end (grid times and sample times ending on them differ by rounding, 1e-17 s)
+BREAK_SNAP = 1e-9
 
 
 class SensorModel(Protocol):
@@ -109,15 +115,19 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
 
     This is the anti-aliased increment an integrating IMU outputs. On the truth's own grid, the
     cubic rule on the cached grid samples (``simulator.trajectory.quadrature``) is used where its
-    estimated error is within ``CUBIC_RULE_TOLERANCE``. Every other interval is integrated with
-    three-point Gauss-Legendre (exact for polynomials up to degree 5) on the analytic
-    kinematics, split at the breakpoints of the piecewise kinematics so each piece is smooth.
+    estimated error is within ``CUBIC_RULE_TOLERANCE``; where it is not (a vibrating body), and
+    no breakpoint of the piecewise kinematics lies inside the interval, four-point Gauss-Lobatto
+    on the analytic kinematics, whose end nodes are the cached grid samples (two evaluations of
+    the truth per interval). Every other interval (off the grid, or holding a breakpoint) is
+    integrated with three-point Gauss-Legendre on the analytic kinematics, split at the
+    breakpoints so each piece is smooth. Both rules are exact for polynomials up to degree 5.
     """
     t_end = np.asarray(t_end, dtype=float)
     lo, hi = t_end - dt, t_end
     breaks = truth.breakpoints()
-    first = np.searchsorted(breaks, lo, side="right")
-    last = np.searchsorted(breaks, hi, side="left")
+    snap = BREAK_SNAP * dt
+    first = np.searchsorted(breaks, lo + snap, side="right")
+    last = np.searchsorted(breaks, hi - snap, side="left")
     out = {key: np.zeros((len(t_end), 3)) for key in keys}
     gauss = np.ones(len(t_end), dtype=bool)
 
@@ -128,9 +138,23 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
         grid = truth.grid_inertial()
         gauss = last > first
         interval = grid_rows(k_end - 1)  # the grid interval [t_k-1, t_k] of each sample
+        rough = np.zeros(len(t_end), dtype=bool)
         for key in keys:
             out[key] = cubic_interval_integrals(grid[key], dt)[interval]
-            gauss |= cubic_rule_error(grid[key], dt)[interval] > CUBIC_RULE_TOLERANCE[key]
+            rough |= cubic_rule_error(grid[key], dt)[interval] > CUBIC_RULE_TOLERANCE[key]
+        lobatto = np.flatnonzero(rough & ~gauss)
+        if len(lobatto):
+            k = k_end[lobatto]
+            nodes = (t_end[lobatto, None] - dt + dt * LOBATTO_INNER_NODES[None, :]).ravel()
+            values = truth.inertial(nodes)
+            for key in keys:
+                inner = values[key].reshape(len(k), len(LOBATTO_INNER_NODES), -1)
+                ends = grid[key].take(k - 1, axis=0)
+                ends += grid[key].take(k, axis=0)
+                ends *= LOBATTO_END_WEIGHT
+                ends += np.einsum("j,njk->nk", LOBATTO_INNER_WEIGHTS, inner)
+                ends *= dt
+                out[key][lobatto] = ends
     if not gauss.any():
         return out
     # intervals without a breakpoint are one piece; one holding c breakpoints (a few per

@@ -3,21 +3,49 @@ satellites in view, and the receiver's own fixes computed from them, so that a f
 exactly when and how the measurements do.
 
 Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
-``constellation`` (``nominal-gps`` or a RINEX navigation file / YUMA almanac),
+``constellation`` (``gps-almanac``, the default: the real GPS constellation of the shipped
+2020-01-01 almanac re-epoched to the drive, ``simulator.gnss.constellation``; ``nominal-gps``;
+or a RINEX navigation file / YUMA almanac),
 ``expanded_slots`` (which expandable slots of ``nominal-gps`` are split into their fore/aft pairs:
 any of ``B1``, ``D2``, ``F2``; all three give the 27-slot constellation), ``elevation_mask``
 (deg), ``clock`` (receiver oscillator: ``tcxo``, ``ocxo``, ``ideal``), ``antenna_lever_arm``
-(body FRD, m, from the IMU), the error levels (``tracking_noise`` scale of the C/N0-driven
-DLL/FLL jitter, ``multipath`` zenith 1-sigma, ``iono_residual`` relative 1-sigma of the
-ionosphere the broadcast model misses (common to all signals, plus an independent part per
-signal of half that size), ``tropo_residual`` zenith 1-sigma, ``sis_error`` 1-sigma
-signal-in-space range error, ``cn0_noise``; see ``simulator.gnss.errors``), the tracking-loop
-and C/N0 parameters and ``smoothing`` (time constant of the filtered fix output, 0 = raw
-single-epoch fixes). ``preset: ideal`` turns every error off; ``automotive`` (default) is a
-mass-market single-frequency receiver with a TCXO.
+(body FRD, m, from the IMU), the error levels and their time behaviour (``tracking_noise`` scale
+of the C/N0-driven DLL/FLL jitter and the loops' bandwidths, ``carrier_smoothing`` Hatch filter,
+``multipath`` zenith 1-sigma with ``multipath_distance`` and ``multipath_correlation_time``,
+``cn0_fading``, ``iono_scale`` and ``iono_residual``, ``tropo_residual``, ``sis_error``,
+``cn0_noise``; see ``simulator.gnss.errors``), the C/N0 parameters and ``smoothing`` (time
+constant of the filtered fix output, 0 = raw single-epoch fixes). ``preset: ideal`` turns every
+error off; ``automotive`` (default) is a mass-market single-frequency receiver with a TCXO;
+``geodetic`` a static reference-station receiver.
 
-Streams: ``gnss_raw`` (one row per tracked signal), ``gnss_fix`` (one row per epoch: 3D fix
-from four signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
+Presets (the figures they follow):
+
+- ``automotive``: DLL 0.5 Hz with 0.5-chip spacing and 100 s carrier smoothing (RTCA DO-229D
+  2.1.4.1.1, the 100 s Hatch filter; u-blox M8/F9 fixes change by centimetres per second while
+  driving: 0.036 m/s per axis in a u-blox log at 17.6 m/s, issue 19); FLL 2 Hz: pseudorange-rate
+  noise 0.024 / 0.04 / 0.08 m/s at 45 / 40 / 35 dB-Hz (Kaplan & Hegarty 2017 eq. 8.37), the
+  level of the u-blox NEO-M8 datasheet's 0.05 m/s velocity accuracy (UBX-15031086) and of the
+  0.097 m/s 1-sigma a u-blox M8 reports in comma2k19's log; multipath 0.3 m at zenith on the
+  DO-229D J.2.4 elevation shape (0.75 m at 10 deg; Braasch 1996 for code multipath of
+  mass-market antennas: metres near the horizon), decorrelating over 10 m travelled (the code
+  multipath of a moving antenna keeps the envelope set by reflectors metres to tens of metres
+  away; its phase rotates at v / lambda, far above the DLL bandwidth) and over 120 s standing
+  still (a quarter of the Georgiadou & Kleusberg 1988 period for a reflector 2 m away at 45 deg);
+  C/N0 fading 2 dB; TCXO.
+- ``geodetic``: a monitor-station receiver's raw code (RINEX observations are not smoothed):
+  narrow correlator 0.1 chip (Van Dierendonck, Fenton & Ford, "Theory and performance of narrow
+  correlator spacing in a GPS receiver", Navigation 39(3), 1992), carrier-aided DLL 0.2 Hz, FLL
+  0.5 Hz, multipath the DO-229D J.2.4 curve itself (0.13 m at zenith, 0.32 m at 10 deg: a
+  choke-ring antenna), C/N0 fading 0.5 dB, OCXO.
+- both: true ionosphere 1.5 x Klobuchar (Klobuchar 1987: the model removes about half of the
+  rms delay; issue 19: ARL1's true ionosphere was 1.3-1.8 x the broadcast model) with a 20 %
+  slow variation; signal-in-space error 0.5 m (the GPS SPS signal-in-space URE of the 2010s,
+  of order 0.5-1 m rms in the FAA GPS performance analysis reports); zenith troposphere
+  residual 5 cm.
+
+Streams: ``gnss_raw`` (one row per tracked signal, unhealthy satellites included with their
+``health`` code), ``gnss_fix`` (one row per epoch from the healthy signals: 3D fix from four
+signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
 elements used) and ``truth_gnss`` (the true error terms of every signal above the horizon).
 Epoch times ``t`` are true GPS time since the scenario start; the receiver clock error is in
 the measurements.
@@ -50,18 +78,30 @@ from simulator.earth import (
     ned_to_ecef_matrix,
 )
 from simulator.environment import ZONE_FIELD
-from simulator.environment.sky import canyon_visibility
+from simulator.environment.sky import canyon_reception
 from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
-from simulator.gnss.constellation import EXPANDABLE_SLOTS, nominal_gps_navigation
-from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
+from simulator.gnss.constellation import (
+    EXPANDABLE_SLOTS,
+    almanac_gps_navigation,
+    nominal_gps_navigation,
+)
+from simulator.gnss.ephemeris import (
+    EPHEMERIS_MAX_AGE_S,
+    ephemeris_arrays,
+    gather,
+    satellite_state,
+    select_ephemeris,
+)
 from simulator.gnss.errors import (
-    CARRIER_SMOOTHING_TIME_S,
     OSCILLATORS,
+    decorrelation_coordinate,
     draw_error_terms,
+    draw_fading,
     draw_receiver_clock,
     pseudorange_sigma,
+    smooth_code_errors,
 )
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
@@ -75,18 +115,31 @@ from simulator.trajectory.kinematics import Kinematics
 if TYPE_CHECKING:
     import pandas as pd
 
+# the receivers' error levels and loops; sources in the module docstring, "Presets"
+_LOOPS = {"dll_bandwidth": 0.5, "correlator_spacing": 0.5, "fll_bandwidth": 2.0}
+_ATMOSPHERE_AND_SKY = {"iono_scale": 1.5, "iono_residual": 0.2, "tropo_residual": 0.05,
+                       "sis_error": 0.5}
+_MULTIPATH_MOTION = {"multipath_distance": 10.0, "multipath_correlation_time": 120.0}
 PRESETS: dict[str, dict] = {
-    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, "multipath": 0.3,
-                   "iono_residual": 0.2, "tropo_residual": 0.05, "sis_error": 0.5,
-                   "cn0_noise": 1.0, "code_correlation_time": CARRIER_SMOOTHING_TIME_S},
-    "ideal": {"clock": "ideal", "tracking_noise": 0.0, "multipath": 0.0, "iono_residual": 0.0,
-              "tropo_residual": 0.0, "sis_error": 0.0, "cn0_noise": 0.0,
-              "code_correlation_time": 0.0},
+    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, **_LOOPS, "carrier_smoothing": 100.0,
+                   "multipath": 0.3, **_MULTIPATH_MOTION, "cn0_fading": 2.0, "cn0_noise": 1.0,
+                   **_ATMOSPHERE_AND_SKY},
+    "geodetic": {"clock": "ocxo", "tracking_noise": 1.0, "dll_bandwidth": 0.2,
+                 "correlator_spacing": 0.1, "fll_bandwidth": 0.5, "carrier_smoothing": 0.0,
+                 "multipath": 0.13, **_MULTIPATH_MOTION, "cn0_fading": 0.5, "cn0_noise": 0.25,
+                 **_ATMOSPHERE_AND_SKY},
+    "ideal": {"clock": "ideal", "tracking_noise": 0.0, **_LOOPS, "carrier_smoothing": 0.0,
+              "multipath": 0.0, **_MULTIPATH_MOTION, "cn0_fading": 0.0, "cn0_noise": 0.0,
+              "iono_scale": 1.0, "iono_residual": 0.0, "tropo_residual": 0.0,
+              "sis_error": 0.0},
 }
 # broadcast ionosphere used with the nominal constellation: the coefficients of the IGS
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
+# the constellations known by name (anything else names a file)
+CONSTELLATIONS = ("gps-almanac", "nominal-gps")
+ALMANAC_MAX_AGE_S = 7 * 86400.0  # a YUMA almanac file is used up to a week from its TOA
 # a zone the environment block does not describe, or describes in part: the schema's defaults
 _ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
 
@@ -96,16 +149,31 @@ _ERROR_FIELDS = {
     "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
     "tracking_noise": Number("", None, min=0,
                              doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
+    "dll_bandwidth": Number("Hz", None, gt=0,
+                            doc="code tracking loop (DLL) noise bandwidth; its time constant "
+                                "1 / (4 B) correlates the code noise"),
+    "correlator_spacing": Number("", None, gt=0, max=1, doc="early-late spacing, chips"),
+    "fll_bandwidth": Number("Hz", None, gt=0,
+                            doc="carrier (frequency) loop noise bandwidth: the Doppler noise"),
+    "carrier_smoothing": Number("s", None, min=0,
+                                doc="time constant of the Hatch filter smoothing the code with "
+                                    "the carrier (0 = raw code)"),
     "multipath": Number("m", None, min=0, doc="code multipath 1-sigma at zenith"),
+    "multipath_distance": Number("m", None, gt=0,
+                                 doc="distance travelled over which multipath and C/N0 fading "
+                                     "decorrelate (1 / e)"),
+    "multipath_correlation_time": Number("s", None, gt=0,
+                                         doc="their correlation time standing still (the "
+                                             "satellites' motion)"),
+    "cn0_fading": Number("", None, min=0,
+                         doc="C/N0 fading 1-sigma, dB, correlated like the multipath"),
+    "cn0_noise": Number("", None, min=0, doc="C/N0 estimate noise 1-sigma, dB, white"),
+    "iono_scale": Number("", None, min=0,
+                         doc="mean true ionosphere / broadcast (Klobuchar) ionosphere"),
     "iono_residual": Number("", None, min=0,
-                            doc="1-sigma of the true/broadcast ionosphere ratio minus 1"),
+                            doc="1-sigma of the slow relative variation of that ratio"),
     "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
     "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
-    "cn0_noise": Number("", None, min=0, doc="C/N0 measurement noise 1-sigma, dB"),
-    "code_correlation_time": Number("s", None, min=0,
-                                    doc="correlation time of the code tracking error and "
-                                        "at least of the multipath (carrier-smoothed code; "
-                                        "0 = white per epoch)"),
 }
 
 
@@ -120,20 +188,21 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
                                             f"{', '.join(sorted(OSCILLATORS))}")
     source = value["constellation"]
     expanded = value["expanded_slots"]
-    if expanded and source != "nominal-gps":
-        return ctx.error(path + ("expanded_slots",), "only applies to constellation "
-                                                     "'nominal-gps'")
     if len(set(expanded)) < len(expanded):
         return ctx.error(path + ("expanded_slots",), "names a slot more than once")
-    if source != "nominal-gps":
+    if expanded and source != "nominal-gps":
+        return ctx.error(path + ("expanded_slots",), "only applies to constellation "
+                                                     "'nominal-gps' (name it: the default is "
+                                                     "'gps-almanac')")
+    if source not in CONSTELLATIONS:
         candidates = [FilePath(source)]
         if ctx.file and not FilePath(source).is_absolute():
             candidates.insert(0, FilePath(ctx.file).resolve().parent / source)
         found = [c for c in candidates if c.is_file()]
         if not found:
             return ctx.error(path + ("constellation",),
-                             f"{source!r} is neither 'nominal-gps' nor an existing RINEX "
-                             "navigation or YUMA almanac file")
+                             f"{source!r} is neither 'gps-almanac', 'nominal-gps' nor an "
+                             "existing RINEX navigation or YUMA almanac file")
         value["constellation"] = str(found[0].resolve())
         try:
             read_navigation(found[0])
@@ -146,12 +215,16 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
 
 GNSS_FIELD = Record(
     {
-        "preset": Text("automotive", doc="error preset: 'automotive' or 'ideal' (no errors)"),
+        "preset": Text("automotive", doc="error preset: 'automotive', 'geodetic' or 'ideal' "
+                                         "(no errors)"),
         "rate": Number("Hz", 1.0, gt=0, max=100, doc="epoch rate"),
         "outputs": ListOf(Text(choices=["fix", "raw"]), ["fix", "raw"], min_len=1,
                           doc="streams written: gnss_fix and/or gnss_raw"),
-        "constellation": Text("nominal-gps",
-                              doc="'nominal-gps' or a RINEX navigation file or YUMA almanac"),
+        "constellation": Text("gps-almanac",
+                              doc="'gps-almanac' (the real GPS of the NAVCEN almanac of "
+                                  "2020-01-01, 31 satellites, re-epoched to the drive by whole "
+                                  "ground-track repeats), 'nominal-gps' (the 24 SPS slots) or a "
+                                  "RINEX navigation file or YUMA almanac"),
         "expanded_slots": ListOf(Text(choices=list(EXPANDABLE_SLOTS)), [],
                                  doc="expandable slots of 'nominal-gps' split into their fore/aft "
                                      "pairs (SPS PS 2008 Table 3.4-2); [B1, D2, F2] = 27 slots"),
@@ -160,14 +233,11 @@ GNSS_FIELD = Record(
         "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
                                     doc="antenna position in the body frame (FRD) from the IMU"),
         **_ERROR_FIELDS,
-        "multipath_correlation_time": Number("s", 5.0, gt=0,
-                                             doc="Gauss-Markov correlation time of multipath"),
         "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
         "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
-        "cn0_threshold": Number("", 25.0, doc="tracking threshold, dB-Hz"),
-        "dll_bandwidth": Number("Hz", 0.5, gt=0, doc="code tracking loop (DLL) bandwidth"),
-        "correlator_spacing": Number("", 0.5, gt=0, max=1, doc="early-late spacing, chips"),
-        "fll_bandwidth": Number("Hz", 0.5, gt=0, doc="carrier (frequency) loop noise bandwidth"),
+        "cn0_threshold": Number("", 17.0,
+                                doc="tracking threshold, dB-Hz (the weakest signal the "
+                                    "comma2k19 car's u-blox reports)"),
         "integration_time": Number("s", 0.02, gt=0, max=0.02,
                                    doc="coherent integration time of the correlators"),
         "smoothing": Number("s", 0.0, min=0, doc="fix smoothing time constant (0 = none)"),
@@ -201,8 +271,12 @@ class Gnss(PresetSensor):
 
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:
-        """The navigation table used for the drive (nominal constellation or the named file)."""
+        """The navigation table used for the drive (a named constellation or the named file)."""
         week0, _ = utc_to_gps(truth.utc_start)
+        if self.config["constellation"] == "gps-almanac":
+            nav = almanac_gps_navigation(truth.utc_start, truth.duration_s)
+            nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
+            return nav
         if self.config["constellation"] == "nominal-gps":
             nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0,
                                          expanded=self.config["expanded_slots"])
@@ -224,12 +298,22 @@ class Gnss(PresetSensor):
         vel = np.einsum("nij,nj->ni", c_ne, v_ned)
         lat, lon, alt = ecef_to_geodetic(pos)
         return {"pos": pos, "vel": vel, "v_ned": v_ned, "lat": lat, "lon": lon, "alt": alt,
-                "yaw": k["yaw"]}
+                "yaw": k["yaw"], "distance": k["distance"]}
 
     def sky(self, truth: Kinematics, t: np.ndarray, az: np.ndarray, el: np.ndarray,
-            yaw: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+            yaw: np.ndarray, distance: np.ndarray, rng: np.random.Generator
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Line of sight, NLOS, NLOS extra path (m) and C/N0 loss (dB) per satellite and epoch
-        from the environment zones (``sky``: open, none, canyon)."""
+        from the environment zones (``sky``: open, none, canyon).
+
+        A canyon (``simulator.environment.sky.canyon_reception``) is one street from where its
+        zone begins to where it ends along the drive (consecutive segments of the zone make one
+        street), closed at both ends by facades across it. Each facade's reflection loss is
+        drawn from N(``nlos_attenuation``, ``nlos_attenuation_spread``), floored at 0 dB, once
+        per satellite and building: side facades change every ``facade_length`` metres of the
+        distance driven (the building beside the antenna stands for the reflection point), the
+        end facades once per street. Draws are made only when the drive has a canyon, so open
+        drives' random streams are unchanged."""
         los = np.ones(el.shape, dtype=bool)
         nlos = np.zeros(el.shape, dtype=bool)
         extra = np.zeros(el.shape)
@@ -242,11 +326,25 @@ class Gnss(PresetSensor):
             if zone["sky"] == "none":
                 los[:, here] = False
             elif zone["sky"] == "canyon":
-                z_los, z_nlos, z_extra = canyon_visibility(
-                    az[:, here], el[:, here], yaw[None, here], zone["building_height"],
-                    zone["street_width"])
+                ahead, behind, street = _street_ends(truth, name, t[here], distance[here])
+                panel = np.floor(distance[here] / zone["facade_length"]).astype(int)
+                panel -= panel.min()
+                sides = rng.standard_normal((el.shape[0], panel.max() + 1, 2))[:, panel]
+                ends = rng.standard_normal((el.shape[0], street.max() + 1, 2))[:, street]
+                facade_loss = np.maximum(zone["nlos_attenuation"] + zone["nlos_attenuation_spread"]
+                                         * np.concatenate([sides, ends], axis=-1), 0.0)
+                # traced only for the satellites above the horizon (about 40 % of them)
+                shape = el[:, here].shape
+                up = el[:, here] > 0
+                z_los, z_nlos = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
+                z_extra, z_loss = np.zeros(shape), np.zeros(shape)
+                z_los[up], z_nlos[up], z_extra[up], z_loss[up] = canyon_reception(
+                    az[:, here][up], el[:, here][up], np.broadcast_to(yaw[here], shape)[up],
+                    zone["building_height"], zone["street_width"],
+                    np.broadcast_to(ahead, shape)[up], np.broadcast_to(behind, shape)[up],
+                    facade_loss[up], LAMBDA_L1_M)
                 los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
-                loss[:, here] = np.where(z_nlos, zone["nlos_attenuation"], 0.0)
+                loss[:, here] = z_loss
         return los, nlos, extra, loss
 
     def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
@@ -258,6 +356,7 @@ class Gnss(PresetSensor):
             raise InputError([Problem(
                 self.config["constellation"], None, "sensors.gnss.constellation",
                 f"fewer than four satellites have an ephemeris within {max_age_s / 3600:g} h "
+                "(half the broadcast fit interval; older records are not used) "
                 f"of the drive from t = {t[short][0]:g} s (the drive starts "
                 f"{truth.utc_start:%Y-%m-%d %H:%M:%S} UTC); use a navigation file of that "
                 "day or 'nominal-gps'")])
@@ -270,11 +369,15 @@ class Gnss(PresetSensor):
         week0, tow0 = utc_to_gps(truth.utc_start)
         nav = self.navigation(truth)
         eph = ephemeris_arrays(nav, week0)
-        # an almanac describes the orbits for days (coarsely); an ephemeris for its fit interval
-        max_age = 7 * 86400.0 if nav.attrs.get("kind") == "almanac" else 4 * 3600.0
+        # an almanac describes the orbits for days (coarsely); an ephemeris only within its fit
+        # interval. Unhealthy satellites are tracked and flagged; the fixes leave them out.
+        almanac = nav.attrs.get("kind") == "almanac"
+        max_age = ALMANAC_MAX_AGE_S if almanac else EPHEMERIS_MAX_AGE_S
         svs = np.unique(nav["sv"].to_numpy())
-        idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age)
+        idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
+                               healthy_only=False)
         self._check_coverage(idx, t, truth, max_age)
+        health = np.where(idx >= 0, gather(eph, idx)["health"], 0.0)
 
         # geometry: antenna, signal flight, look angles, broadcast delays (satellites x epochs)
         ant = self.antenna(truth, t)
@@ -286,9 +389,13 @@ class Gnss(PresetSensor):
         geo = model = _signals_in_chunks(eph, idx, tow0 + t, ant, day_of_year, alpha, beta)
         el, az = geo["elevation"], geo["azimuth"]
 
-        # what the receiver tracks
-        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"])
-        signal_cn0 = cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
+        # what the receiver tracks: the C/N0 fades with the motion (correlated like the
+        # multipath), the receiver's estimate of it adds white noise
+        u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
+                                     cfg["multipath_correlation_time"])
+        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"], ant["distance"], rng)
+        signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
+                      + draw_fading(rng, cfg, u, el.shape[0]))
         cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
         have = idx >= 0
         tracked = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos) \
@@ -300,12 +407,17 @@ class Gnss(PresetSensor):
         self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
         # (which would otherwise make the error and the fix weights jump from epoch to epoch)
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s)
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]
+        err = smooth_code_errors(cfg, err, iono_true, tracked, dt_s)
         tropo_true = model["tropo"] + err["tropo_zenith"] * mapping
-        iono_true_rate = model["iono_rate"] * err["iono_ratio"]
+        # the true ionosphere's rate: the broadcast model's along the geometry, times the ratio,
+        # plus the ratio's own (slow) change
+        ratio_rate = (np.gradient(err["iono_ratio"], dt_s, axis=1) if len(t) > 1
+                      else np.zeros_like(err["iono_ratio"]))
+        iono_true_rate = model["iono_rate"] * err["iono_ratio"] + model["iono"] * ratio_rate
         tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
         nlos_delay = np.where(nlos & ~los, extra, 0.0)
         sat_clock = C_M_S * geo["clock_s"]
@@ -316,7 +428,8 @@ class Gnss(PresetSensor):
                        + err["sis"] + err["multipath"] + nlos_delay + err["code_noise"])
         rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
                 + tropo_true_rate - iono_true_rate + err["rate_noise"])
-        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping)
+        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping, dt_s,
+                                             np.linalg.norm(ant["v_ned"], axis=1))
 
         table = _RowTable(t, svs)
         raw = table(tracked, {
@@ -328,6 +441,7 @@ class Gnss(PresetSensor):
             "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": model["iono"],
             "tropo": model["tropo"], "elevation": el, "azimuth": az,
             "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
+            "health": health.astype(np.int64),
         })[list(col.GNSS_RAW)]
         truth_table = table(have & (el > 0), {
             "tracked": tracked.astype(np.int8), "los": los.astype(np.int8),
@@ -431,3 +545,23 @@ class _RowTable:
         for key, value in columns.items():
             out[key] = np.swapaxes(np.broadcast_to(value, mask.shape), 0, 1)[m]
         return pd.DataFrame(out)
+
+
+def _street_ends(truth: Kinematics, zone: str, t: np.ndarray, distance: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Distance to the end facade ahead and behind (along the drive) at epochs t inside
+    ``zone``, and the number of the street each epoch is in: consecutive stretches of the zone
+    (one segment's end is the next one's start) make one street."""
+    streets: list[list[float]] = []
+    for start, end, name in truth.profile.zones:  # one pass per zoned segment
+        if name != zone:
+            continue
+        if streets and abs(start - streets[-1][1]) < 1e-9:
+            streets[-1][1] = end
+        else:
+            streets.append([start, end])
+    bounds = np.asarray(streets, dtype=float).reshape(-1, 2)
+    street = np.clip(np.searchsorted(bounds[:, 0], t, side="right") - 1, 0, len(bounds) - 1)
+    at = truth.inertial(bounds.ravel())["distance"].reshape(-1, 2)
+    return (np.maximum(at[street, 1] - distance, 0.0), np.maximum(distance - at[street, 0], 0.0),
+            street)

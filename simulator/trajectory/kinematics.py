@@ -19,9 +19,10 @@ by differencing samples:
   from the exact Euler-angle rates (Groves eq. 2.56 inverted).
 
 With a vehicle body (``simulator.vehicle``, issue 13) the road-following point above is the
-body's centre of gravity in its static position; the body then heaves, pitches and rolls on its
-suspension and yaws by the side slip beta relative to the path (``_with_body``), and the truth
-is the motion of its reference point (``BodyMotion.reference_point``) on the body.
+body's centre of gravity in its static position; the body then heaves, pitches, rolls, surges
+and sways on its suspension and tyres and yaws by the side slip beta relative to the path
+(``_with_body``), and the truth is the motion of its reference point
+(``BodyMotion.reference_point``) on the body.
 
 The truth table is ``Kinematics.columns`` (a column table of ``simulator.tables``, what the
 dataset writer takes, without pandas) or ``Kinematics.table`` (the same as a DataFrame).
@@ -179,10 +180,12 @@ class Kinematics:
 
         Attitude: roll = bank + body roll, pitch = grade + body pitch, yaw = path heading - side
         slip, each with its exact first and second time derivatives (the road curves' s
-        derivatives times v and a). The reference point sits at r' = r - z e_z from the centre
-        of gravity (FRD; r the reference point, z the heave), so relative to the road-following
-        point its velocity is C_b^n (w x r' - z' e_z) and its acceleration C_b^n (alpha x r' +
-        w x (w x r') - 2 z' w x e_z - z'' e_z), with w = w_nb^b from the Euler-angle rates
+        derivatives times v and a). The body's centre of gravity is displaced by
+        e = (x, y, -z) from the road-following point (FRD; surge x, sway y, heave z up) and the
+        reference point sits at r' = r + e from it (r the reference point), so relative to the
+        road-following point its velocity is C_b^n (w x r' + e') and its acceleration
+        C_b^n (alpha x r' + w x (w x r') + 2 w x e' + e''), with w = w_nb^b from the Euler-angle
+        rates
         (Groves eq. 2.56 inverted) and alpha its derivative. The rotation of the NED frame
         itself (the transport rate, below 1e-5 rad/s) is left out of these lever-arm terms: it
         moves the point by less than 1e-5 m/s x r. The road-following point's velocity is
@@ -211,18 +214,21 @@ class Kinematics:
               - yaw_rate * pitch_rate * sp * sr + yaw_rate * roll_rate * cp * cr)
         az = (-pitch_acc * sr - pitch_rate * roll_rate * cr + yaw_acc * cp * cr
               - yaw_rate * pitch_rate * sp * cr - yaw_rate * roll_rate * cp * sr)
-        rx, ry, r0 = self.body.reference_point
-        rz = r0 - b["heave"]
-        zd, zdd = b["heave_rate"], b["heave_accel"]
-        # w x r' - z' e_z, then alpha x r' + w x (w x r') - 2 z' (w x e_z) - z'' e_z
+        r0x, r0y, r0z = self.body.reference_point
+        rx, ry, rz = r0x + b["surge"], r0y + b["sway"], r0z - b["heave"]
+        ex, ey, ez = b["surge_rate"], b["sway_rate"], -b["heave_rate"]  # e'
+        # w x r' + e', then alpha x r' + w x (w x r') + 2 w x e' + e''
         ux = wy * rz - wz * ry
         uy = wz * rx - wx * rz
         uz = wx * ry - wy * rx
-        acc_x = ay * rz - az * ry + (wy * uz - wz * uy) - 2 * zd * wy
-        acc_y = az * rx - ax * rz + (wz * ux - wx * uz) + 2 * zd * wx
-        acc_z = ax * ry - ay * rx + (wx * uy - wy * ux) - zdd
+        acc_x = (ay * rz - az * ry + (wy * uz - wz * uy) + 2 * (wy * ez - wz * ey)
+                 + b["surge_accel"])
+        acc_y = (az * rx - ax * rz + (wz * ux - wx * uz) + 2 * (wz * ex - wx * ez)
+                 + b["sway_accel"])
+        acc_z = (ax * ry - ay * rx + (wx * uy - wy * ux) + 2 * (wx * ey - wy * ex)
+                 - b["heave_accel"])
         trig = (cr, sr, cp, sp, cy, sy)
-        v_ned = road["v_ned"].T + body_to_ned_components(*trig, ux, uy, uz - zd)
+        v_ned = road["v_ned"].T + body_to_ned_components(*trig, ux + ex, uy + ey, uz + ez)
         a_ned = road["a_ned"].T + body_to_ned_components(*trig, acc_x, acc_y, acc_z)
         offset = body_to_ned_components(*trig, rx, ry, rz)
         return dict(s=road["s"], v=speed, roll=roll, pitch=pitch, yaw=yaw, roll_rate=roll_rate,

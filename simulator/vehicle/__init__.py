@@ -37,4 +37,5 @@ def vehicle_body(profile: RoadProfile, block: str | dict,
     if params is None:
         return profile, None
     rng = stream_rng(params["road_seed"], ROAD_STREAM)
-    return level_road(profile), build_body(profile, params, t_grid, rng)
+    level = level_road(profile)  # keeps ``bumps``, which the wheels ride over
+    return level, build_body(level, params, t_grid, rng)

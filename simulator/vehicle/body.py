@@ -1,6 +1,6 @@
-"""The body's motion relative to the road-following point: heave, pitch and roll from the
-full-car ride model (``suspension``) and the side slip from a linear bicycle model, each as a
-piecewise quintic of time that the exact kinematics differentiate.
+"""The body's motion relative to the road-following point: heave, pitch, roll, surge and sway
+from the full-car ride model (``suspension``) and the side slip from a linear bicycle model,
+each as a piecewise quintic of time that the exact kinematics differentiate.
 
 * Side slip at the centre of gravity: the steady-state linear bicycle model (Rajamani, *Vehicle
   Dynamics and Control*, 2nd ed., Springer 2012, section 3.3, eq. 3.45 with the yaw rate of the
@@ -8,29 +8,34 @@ piecewise quintic of time that the exact kinematics differentiate.
   (both tyres), l_f and l_r the distances of the centre of gravity from the front and rear
   axles and L = l_f + l_r. At low speed it is the kinematic model's beta = l_r kappa (the rear
   axle's velocity lies along the body, Rajamani eq. 2.29 for small angles); above the speed
-  sqrt(l_r L C_r / (m l_f)) (about 16 m/s for the automotive preset) the tyres' slip turns it
+  sqrt(l_r L C_r / (m l_f)) (19.5 m/s for the automotive preset) the tyres' slip turns it
   negative. Signs in FRD: kappa > 0 turns right; beta > 0 puts the velocity to the right of the
   body's x axis, so the body's yaw is the path's heading minus beta. The steady state is used
   throughout: the bicycle model's lateral and yaw modes settle within about 0.2 s, while every
   curvature change of a drive (clothoids, lane changes, fitted paths) lasts a second or more.
   Choice: beta is the same when reversing (at reversing speeds it is the kinematic l_r kappa).
-* Heave, pitch and roll: ``suspension.simulate`` on the grid of the truth, driven by the road
-  under the wheels (``road``) and by the longitudinal and lateral accelerations of the path.
+* Heave, pitch, roll, surge and sway: ``suspension.simulate`` on the grid of the truth, driven
+  by the road's heights and slopes under the wheels (``road``) and by the longitudinal, lateral
+  and vertical accelerations of the path. On a vertical curve (a grade change, dgamma/ds) the
+  road under wheel i lies dgamma/ds x_i^2 / 2 above the tangent plane at the centre of gravity
+  (the body follows the grade there), and the path accelerates by v^2 dgamma/ds normal to the
+  road: the body pitches and heaves at a crest or sag. The grade inside a speed bump is level
+  (``level_road``), so a bump is not counted twice.
 * Engine vibration: a vertical sine of rms ``engine_accel`` at ``engine_frequency`` added to the
   heave (its phase drawn from the road's random stream).
 
 Each channel is known on the grid with its first and second derivatives; between grid points it
-is the quintic Hermite interpolant of those six values (``quintic_coefficients``), so the
+is the quintic Hermite interpolant of those six values (``quintic_hermite_basis``), so the
 channels are C2 and exactly differentiable, and on the grid they equal the model's values.
 
 Public names
 ------------
-BodyMotion, build_body, quintic_coefficients, side_slip, level_road.
+BodyMotion, build_body, quintic_hermite_basis, side_slip, level_road.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -40,26 +45,42 @@ from simulator.vehicle.params import ROUGHNESS_CLASSES
 from simulator.vehicle.road import RoadSurface, draw_roughness
 from simulator.vehicle.suspension import FullCar, axle_distances, simulate
 
-CHANNELS = ("heave", "pitch", "roll", "slip")
+CHANNELS = ("heave", "pitch", "roll", "slip", "surge", "sway")
 
 
-def quintic_coefficients(h: np.ndarray, y0: np.ndarray, dy0: np.ndarray, d2y0: np.ndarray,
-                         y1: np.ndarray, dy1: np.ndarray, d2y1: np.ndarray) -> list[np.ndarray]:
-    """Coefficients a5 ... a0 (highest power first) of the quintic on an interval of length h
-    with the given value, first and second derivative at its two ends.
-
-    p = y0 + y0' dx + y0'' dx^2 / 2 + a3 dx^3 + a4 dx^4 + a5 dx^5, dx from the interval's start,
-    with a3..a5 from the conditions at its end (the residuals D0, D1 h, D2 h^2 of value, slope
-    and curvature of the quadratic part there): a3 = (10 D0 - 4 D1 h + D2 h^2 / 2) / h^3,
-    a4 = (-15 D0 + 7 D1 h - D2 h^2) / h^4, a5 = (6 D0 - 3 D1 h + D2 h^2 / 2) / h^5.
-    """
-    a1, a2 = dy0, 0.5 * d2y0
-    d0 = y1 - (y0 + h * (a1 + h * a2))
-    d1 = (dy1 - (a1 + 2 * a2 * h)) * h
-    d2 = (d2y1 - 2 * a2) * h * h
-    h3 = h**3
-    return [(6 * d0 - 3 * d1 + 0.5 * d2) / (h3 * h * h), (-15 * d0 + 7 * d1 - d2) / (h3 * h),
-            (10 * d0 - 4 * d1 + 0.5 * d2) / h3, a2, a1, y0]
+def quintic_hermite_basis(u: np.ndarray) -> np.ndarray:
+    """The quintic Hermite basis on [0, 1] and its first two derivatives at u (shape (m,)):
+    array (m, 3, 6), [:, order, b], b = 0 ... 5 the weights of y0, y0', y0'', y1, y1', y1''
+    (the derivatives scaled by the interval: h y', h^2 y''), so that on an interval of length h
+    p(u) = sum_b B[:, 0, b] c_b, p'(t) = sum_b B[:, 1, b] c_b / h, p''(t) = sum_b B[:, 2, b]
+    c_b / h^2 with c = (y0, h y0', h^2 y0'', y1, h y1', h^2 y1''). The polynomial matching value,
+    slope and curvature at both ends: H0 = 1 - 10 u^3 + 15 u^4 - 6 u^5, H1 = u - 6 u^3 + 8 u^4
+    - 3 u^5, H2 = (u^2 - 3 u^3 + 3 u^4 - u^5) / 2, H3 = 1 - H0, H4 = -4 u^3 + 7 u^4 - 3 u^5,
+    H5 = (u^3 - 2 u^4 + u^5) / 2."""
+    u2 = u * u
+    u3 = u2 * u
+    u4 = u3 * u
+    u5 = u4 * u
+    b = np.empty((len(u), 3, 6))
+    b[:, 0, 3] = 10 * u3 - 15 * u4 + 6 * u5
+    b[:, 0, 0] = 1.0 - b[:, 0, 3]
+    b[:, 0, 1] = u - 6 * u3 + 8 * u4 - 3 * u5
+    b[:, 0, 2] = 0.5 * (u2 - 3 * u3 + 3 * u4 - u5)
+    b[:, 0, 4] = -4 * u3 + 7 * u4 - 3 * u5
+    b[:, 0, 5] = 0.5 * (u3 - 2 * u4 + u5)
+    b[:, 1, 3] = 30 * (u2 - 2 * u3 + u4)
+    b[:, 1, 0] = -b[:, 1, 3]
+    b[:, 1, 1] = 1.0 - 18 * u2 + 32 * u3 - 15 * u4
+    b[:, 1, 2] = u - 4.5 * u2 + 6 * u3 - 2.5 * u4
+    b[:, 1, 4] = -12 * u2 + 28 * u3 - 15 * u4
+    b[:, 1, 5] = 1.5 * u2 - 4 * u3 + 2.5 * u4
+    b[:, 2, 3] = 60 * (u - 3 * u2 + 2 * u3)
+    b[:, 2, 0] = -b[:, 2, 3]
+    b[:, 2, 1] = -36 * u + 96 * u2 - 60 * u3
+    b[:, 2, 2] = 1.0 - 9 * u + 18 * u2 - 10 * u3
+    b[:, 2, 4] = -24 * u + 84 * u2 - 60 * u3
+    b[:, 2, 5] = 3 * u - 12 * u2 + 10 * u3
+    return b
 
 
 def side_slip(kappa: np.ndarray, dkappa: np.ndarray, d2kappa: np.ndarray, v: np.ndarray,
@@ -93,16 +114,18 @@ def level_road(profile: RoadProfile) -> RoadProfile:
 
 @dataclass
 class BodyMotion:
-    """Heave (m, up), suspension pitch (rad, nose up), suspension roll (rad, right side down)
-    and side slip (rad) of the body, each with its first and second time derivatives, on the
-    truth grid ``t`` (``nodes``, shape (12, n): the four channels' values, then their rates,
-    then their accelerations), and the truth's reference point from the centre of gravity
+    """Heave (m, up), suspension pitch (rad, nose up), suspension roll (rad, right side down),
+    side slip (rad), surge (m, forward) and sway (m, right) of the body (``CHANNELS``), each
+    with its first and second time derivatives, on the truth grid ``t`` (``nodes``, shape (18,
+    n): the six channels' values, then their rates, then their accelerations), and the truth's
+    reference point from the centre of gravity
     (m, FRD). Between grid times the channels are the quintic Hermite curves of the nodes
-    (``quintic_coefficients``), built interval by interval where asked."""
+    (``quintic_hermite_basis``), built interval by interval where asked."""
 
     t: np.ndarray
     nodes: np.ndarray
     reference_point: np.ndarray
+    _by_sample: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Each channel and its first and second time derivatives at t (1-D): keys ``heave``,
@@ -113,28 +136,41 @@ class BodyMotion:
         i = np.clip(np.floor(t / h).astype(np.intp), 0, n - 2)
         on = t == self.t.take(i)
         last = t == self.t[-1]  # the grid's last time closes the last interval
-        values = self.nodes.take(np.where(last, n - 1, i), axis=1)
+        at = np.where(last, n - 1, i)
         off = np.flatnonzero(~(on | last))
+        if not len(off) and len(at) and at[-1] - at[0] == len(at) - 1:  # a run of grid times
+            values = self.nodes[:, at[0]:at[-1] + 1].copy()
+        elif len(off) == len(t):
+            values = np.empty((self.nodes.shape[0], len(t)))
+        else:
+            values = self.nodes.take(at, axis=1)
         if len(off):
             j = i[off]
-            start, end = self.nodes.take(j, axis=1), self.nodes.take(j + 1, axis=1)
+            rows = self._rows()  # the nodes sample by sample: a gather of whole rows
             k = len(CHANNELS)
-            coeffs = quintic_coefficients(np.full(len(off), h), start[:k], start[k:2 * k],
-                                          start[2 * k:], end[:k], end[k:2 * k], end[2 * k:])
-            dx = t[off] - self.t.take(j)
-            for order in range(3):
-                acc = np.zeros((k, len(off)))
-                for power, c in enumerate(coeffs[:len(coeffs) - order]):
-                    degree = 5 - power
-                    factor = np.prod(np.arange(degree, degree - order, -1))
-                    acc = acc * dx + factor * c
-                values[order * k:(order + 1) * k, off] = acc
+            scale = np.repeat([1.0, h, h * h], k)  # c = (y, h y', h^2 y'') at each end
+            ends = np.concatenate([rows.take(j, axis=0) * scale,
+                                   rows.take(j + 1, axis=0) * scale], axis=1)
+            basis = quintic_hermite_basis((t[off] - self.t.take(j)) / h)
+            out = basis @ ends.reshape(len(off), 6, k)  # (m, order, channel)
+            out[:, 1] /= h
+            out[:, 2] /= h * h
+            if len(off) == len(t):
+                values[:] = out.reshape(len(off), 3 * k).T
+            else:
+                values[:, off] = out.reshape(len(off), 3 * k).T
         return {name + suffix: values[i + len(CHANNELS) * order]
                 for order, suffix in enumerate(("", "_rate", "_accel"))
                 for i, name in enumerate(CHANNELS)}
 
     def breakpoints(self) -> np.ndarray:
         return self.t
+
+    def _rows(self) -> np.ndarray:
+        """The nodes as (n, 18), C-ordered (kept once made)."""
+        if self._by_sample is None:
+            self._by_sample = np.ascontiguousarray(self.nodes.T)
+        return self._by_sample
 
 
 def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
@@ -166,24 +202,31 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
     else:
         tracks = draw_roughness(span, ROUGHNESS_CLASSES[params["roughness"]], rng)
     surface = RoadSurface(profile.bumps, tracks, -params["wheelbase"] - 0.5, params["camber"])
-    u = np.empty((6, len(t)))
-    u[:4] = surface.heights(s, car.corner_x, car.corner_y)
+    u = np.empty((11, len(t)))
+    u[:4], u[6:10] = surface.heights(s, car.corner_x, car.corner_y)
     np.multiply(d, a, out=u[4])
     np.multiply(d * kappa, v * v, out=u[5])
-    ride = simulate(car, u, h)  # z, theta, phi, then their rates and accelerations
+    # a vertical curve: the road under wheel i lies dgamma/ds x_i^2 / 2 above the tangent plane
+    # at the centre of gravity, and the path accelerates by v^2 dgamma/ds normal to the road
+    dgamma = profile.grade.evaluate(s, (1,))[0]
+    u[:4] += np.multiply.outer(0.5 * car.corner_x**2, dgamma)
+    np.multiply(dgamma, v * v, out=u[10])
+    ride = simulate(car, u, h)  # z, theta, phi, x, y, then their rates and accelerations
     omega = 2 * np.pi * params["engine_frequency"]
     amplitude = params["engine_accel"] * np.sqrt(2.0) / omega**2
     if amplitude > 0:
         phase = omega * t + rng.uniform(0.0, 2 * np.pi)
         sin = np.sin(phase)
         ride[0] += amplitude * sin
-        ride[3] += amplitude * omega * np.cos(phase)
-        ride[6] -= amplitude * omega**2 * sin
+        ride[5] += amplitude * omega * np.cos(phase)
+        ride[10] -= amplitude * omega**2 * sin
     l_f, l_r = axle_distances(params)
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
     slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
-    nodes = np.empty((3 * len(CHANNELS), len(t)))
-    for order in range(3):  # heave, pitch, roll, slip; then the rates, then the accelerations
-        nodes[4 * order:4 * order + 3] = ride[3 * order:3 * order + 3]
-        nodes[4 * order + 3] = slip[order]
+    k = len(CHANNELS)
+    nodes = np.empty((3 * k, len(t)))
+    for order in range(3):  # the channels; then their rates, then their accelerations
+        nodes[k * order:k * order + 3] = ride[5 * order:5 * order + 3]  # heave, pitch, roll
+        nodes[k * order + 3] = slip[order]
+        nodes[k * order + 4:k * order + 6] = ride[5 * order + 3:5 * order + 5]  # surge, sway
     return BodyMotion(t, nodes, np.asarray(params["imu_position"], dtype=float))

@@ -7,7 +7,12 @@ tracks and centre-of-gravity heights are typical of their class (Gillespie, *Fun
 Vehicle Dynamics*, SAE 1992, Table 5.1 and ch. 5: sprung-mass ride frequencies of 1-1.5 Hz,
 damping ratios of 0.2-0.4, wheel-hop near 10 Hz); cornering stiffnesses are those of passenger-car
 tyres (Rajamani, *Vehicle Dynamics and Control*, 2nd ed., Springer 2012, ch. 2-3: some 60-100
-kN/rad per tyre). The ``automotive`` preset is the default (``default_vehicle``).
+kN/rad per tyre). The corners' horizontal stiffnesses follow from the tyre's relaxation length
+sigma, the ratio of its slip stiffness to its carcass stiffness (Pacejka, *Tire and Vehicle
+Dynamics*, 3rd ed., 2012, ch. 7: sigma = C / c): sideways the cornering stiffness of one tyre
+over sigma_y = 0.5 m, fore-aft a longitudinal slip stiffness of about 60 kN over sigma_x =
+0.2 m (chosen values of a passenger-car tyre; the suspension's bushings, several times stiffer,
+are left out of the series). The ``automotive`` preset is the default (``default_vehicle``).
 
 Public names
 ------------
@@ -42,6 +47,7 @@ VEHICLE_PRESETS: dict[str, dict[str, Any]] = {
         pitch_inertia=2400.0, roll_inertia=550.0, unsprung_mass=40.0,
         front_frequency=1.2, rear_frequency=1.35, damping=0.3,
         tyre_stiffness=2.2e5, roll_stiffness=5.0e4,
+        tyre_longitudinal_stiffness=3.0e5, tyre_lateral_stiffness=1.5e5,
         front_cornering=1.4e5, rear_cornering=1.6e5,
         imu_position=[0.2, 0.0, -0.1], roughness="B", camber=0.02,
         engine_frequency=28.0, engine_accel=0.05),
@@ -51,6 +57,7 @@ VEHICLE_PRESETS: dict[str, dict[str, Any]] = {
         pitch_inertia=1500.0, roll_inertia=380.0, unsprung_mass=33.0,
         front_frequency=1.3, rear_frequency=1.45, damping=0.3,
         tyre_stiffness=1.9e5, roll_stiffness=3.5e4,
+        tyre_longitudinal_stiffness=2.6e5, tyre_lateral_stiffness=1.3e5,
         front_cornering=1.1e5, rear_cornering=1.25e5,
         imu_position=[0.2, 0.0, -0.1], roughness="B", camber=0.02,
         engine_frequency=30.0, engine_accel=0.06),
@@ -60,6 +67,7 @@ VEHICLE_PRESETS: dict[str, dict[str, Any]] = {
         pitch_inertia=3800.0, roll_inertia=850.0, unsprung_mass=50.0,
         front_frequency=1.3, rear_frequency=1.45, damping=0.3,
         tyre_stiffness=2.6e5, roll_stiffness=7.0e4,
+        tyre_longitudinal_stiffness=3.5e5, tyre_lateral_stiffness=1.8e5,
         front_cornering=1.7e5, rear_cornering=1.9e5,
         imu_position=[0.2, 0.0, -0.15], roughness="B", camber=0.02,
         engine_frequency=25.0, engine_accel=0.05),
@@ -89,6 +97,12 @@ _FIELDS = {
     "tyre_stiffness": Number("N/m", None, gt=0, doc="vertical stiffness of one tyre"),
     "roll_stiffness": Number("N*m/rad", None, min=0,
                              doc="anti-roll bars, front and rear together"),
+    "tyre_longitudinal_stiffness": Number("N/m", None, gt=0,
+                                          doc="fore-aft stiffness of one corner (tyre carcass "
+                                              "in series with the suspension's compliance)"),
+    "tyre_lateral_stiffness": Number("N/m", None, gt=0,
+                                     doc="sideways stiffness of one corner (tyre carcass in "
+                                         "series with the suspension's compliance)"),
     "front_cornering": Number("N/rad", None, gt=0,
                               doc="cornering stiffness of the front axle (both tyres)"),
     "rear_cornering": Number("N/rad", None, gt=0,

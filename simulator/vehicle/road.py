@@ -72,11 +72,14 @@ class RoadSurface:
     track_start: float
     camber: float
 
-    def heights(self, s: np.ndarray, corner_x: np.ndarray, corner_y: np.ndarray) -> np.ndarray:
+    def heights(self, s: np.ndarray, corner_x: np.ndarray,
+                corner_y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Road height (m, up) under each corner (x_i forward, y_i right of the reference point,
-        m) when the reference point is at distance s (non-decreasing) along the road; shape
-        (corners, len(s))."""
+        m) when the reference point is at distance s (non-decreasing) along the road, and the
+        road's forward slope there (dz/ds: the linear interpolation's cell slope, the bump's
+        derivative); each of shape (corners, len(s))."""
         z = np.empty((len(corner_x), len(s)))
+        slope = np.zeros_like(z)
         grid_start, n_grid = self.track_start, 0 if self.tracks is None else self.tracks.shape[1]
         for i, (x, y) in enumerate(zip(corner_x, corner_y, strict=True)):
             if self.tracks is None:
@@ -86,10 +89,13 @@ class RoadSurface:
                 cell = np.clip(at.astype(np.intp), 0, n_grid - 2)
                 track = self.tracks[int(y > 0)]
                 left = track.take(cell)
-                z[i] = left + (at - cell) * (track.take(cell + 1) - left)
+                np.subtract(track.take(cell + 1), left, out=slope[i])
+                z[i] = left + (at - cell) * slope[i]
+                slope[i] /= GRID_M
             z[i] -= self.camber * y
             for start, length, height in self.bumps:  # a bump's rows are a run (s increases)
                 rows = slice(*np.searchsorted(s, [start - x, start + length - x]))
                 u = np.clip((s[rows] + x - start) / length, 0.0, 1.0)
                 z[i, rows] += height * 64.0 * (u * (1 - u)) ** 3
-        return z
+                slope[i, rows] += height * 192.0 * (u * (1 - u)) ** 2 * (1 - 2 * u) / length
+        return z, slope

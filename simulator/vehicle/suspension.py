@@ -1,16 +1,20 @@
 """The linear full-car ride model: body heave, pitch and roll on four suspension corners and four
-wheels on their tyres (seven degrees of freedom), driven by the road height under each wheel and
-by the pitch and roll moments of longitudinal and lateral acceleration.
+wheels on their tyres, and the body's fore-aft and sideways motion on the horizontal compliance
+of tyres and suspension (nine degrees of freedom), driven by the road height and slope under
+each wheel and by the inertial forces and moments of longitudinal and lateral acceleration.
 
-The model is the classical full-vehicle ride model (Gillespie, *Fundamentals of Vehicle
+The vertical part is the classical full-vehicle ride model (Gillespie, *Fundamentals of Vehicle
 Dynamics*, SAE 1992, ch. 5; Jazar, *Vehicle Dynamics: Theory and Application*, 3rd ed., Springer
 2017, section 15.4 "full car vibrating model", eq. 15.91 ff.):
 
-    M q'' + C q' + K q = F u,   q = [z, theta, phi, w_fl, w_fr, w_rl, w_rr]
+    M q'' + C q' + K q = F u,   q = [z, theta, phi, x, y, w_fl, w_fr, w_rl, w_rr]
 
 with z the body's heave (m, up), theta its pitch (rad, nose up), phi its roll (rad, right side
-down, as in FRD), w_i the wheels' heights (m, up) and u = [r_fl, r_fr, r_rl, r_rr, a_x, a_y] the
-road heights under the wheels (m) and the longitudinal and lateral accelerations (m/s^2, FRD).
+down, as in FRD), x and y its surge and sway (m, forward and right, FRD) from the road-following
+point, w_i the wheels' heights (m, up) and u = [r_fl, r_fr, r_rl, r_rr, a_x, a_y, r'_fl, r'_fr,
+r'_rl, r'_rr, a_v] the road heights under the wheels (m), the longitudinal and lateral
+accelerations of the path (m/s^2, FRD), the road's forward slopes under the wheels (dr/ds) and
+the path's acceleration normal to the road (m/s^2, up: v^2 dgamma/ds on a vertical curve).
 The corner i at (x_i, y_i) of the body moves by z + x_i theta - y_i phi; its spring and damper
 act on that minus w_i, the anti-roll bars on the difference of the left and right deflections
 (a roll stiffness split over the axles as the springs are), the tyre on w_i - r_i. The moments
@@ -19,11 +23,24 @@ of the accelerations act on the sprung mass at ``cg_height`` above the axes: m h
 turn). Corner springs follow from the ride frequencies on each axle's sprung load (Gillespie
 eq. 5-5), dampers from the damping ratio; the tyre is a spring (its damping is small).
 
+Fore-aft and sideways: the sprung mass sits on the horizontal stiffness of its four corners
+(``tyre_longitudinal_stiffness``, ``tyre_lateral_stiffness``: the tyre carcass in series with
+the suspension's fore-aft and lateral compliance), damped with the ride modes' ratio (the
+rolling tyres' slip damping, C / v per tyre, gives a ratio of that order at 10-20 m/s), and
+is pushed by the road: a tyre rolling over unevenness feels its contact force along the local
+road normal, so the road's forward slope under wheel i adds -N_i r'_i fore-aft and the road's
+cross-slope under an axle, (r_right - r_left) / track, adds -N_axle times it sideways (N the
+static wheel loads; the "effective road plane" of Pacejka, *Tire and Vehicle Dynamics*, 3rd ed.,
+Butterworth-Heinemann 2012, section 10.2, here without the tyre's enveloping filter). The
+path's accelerations add their inertial forces -m_s a_x, -m_s a_y (the tyres deflect under
+braking and cornering) and -m a_v on the body and the wheels (the body sinks in a sag and
+rises over a crest).
+
 Integration: the state equation x' = A x + B u is diagonalised, A = V diag(lambda) V^-1; each
 mode is propagated exactly for an input linear between samples ("first-order hold"; the road
 heights at the wheels are sampled on the truth grid), y_k+1 = e^(lambda h) y_k + b (p u_k +
-q u_k+1). The recursion runs in blocks with numpy (``stochastic.ar1_filter`` on the modes turned
-into real factors, ``_modal_recursion``), never sample by sample.
+q u_k+1). The recursion runs in blocks with numpy (``stochastic.ar1_filter`` with the modes'
+complex factors, ``_modal_recursion``), never sample by sample.
 
 Public names
 ------------
@@ -36,11 +53,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from simulator.earth import G0_M_S2
 from simulator.stochastic import ar1_filter
 
-N_BODY = 3  # heave, pitch, roll
-N_DOF = 7
-N_INPUT = 6  # four road heights, a_x, a_y
+N_BODY = 5  # heave, pitch, roll, surge, sway
+N_DOF = 9
+N_INPUT = 11  # four road heights, a_x, a_y, four road slopes, the path's vertical acceleration
 
 
 def axle_distances(p: dict) -> tuple[float, float]:
@@ -69,10 +87,10 @@ class FullCar:
     the order front-left, front-right, rear-left, rear-right.
     """
 
-    mass: np.ndarray  # (7, 7)
-    damping: np.ndarray  # (7, 7)
-    stiffness: np.ndarray  # (7, 7)
-    forcing: np.ndarray  # (7, 6)
+    mass: np.ndarray  # (9, 9)
+    damping: np.ndarray  # (9, 9)
+    stiffness: np.ndarray  # (9, 9)
+    forcing: np.ndarray  # (9, 11)
     corner_x: np.ndarray
     corner_y: np.ndarray
 
@@ -91,8 +109,8 @@ class FullCar:
         k_t = p["tyre_stiffness"]
         k_s = k_ride * k_t / (k_t - k_ride)
         c_s = 2 * p["damping"] * np.sqrt(k_ride * corner_mass)
-        # corners: deflection d = T q_body - w, T_i = [1, x_i, -y_i]
-        t_body = np.stack([np.ones(4), x, -y], axis=1)
+        # corners: deflection d = T q_body - w, T_i = [1, x_i, -y_i, 0, 0]
+        t_body = np.stack([np.ones(4), x, -y, np.zeros(4), np.zeros(4)], axis=1)
         g = np.hstack([t_body, -np.eye(4)])
         k_defl = np.diag(k_s)
         # anti-roll bars: (k_bar / t^2) (d_right - d_left)^2 / 2 per axle, the roll stiffness
@@ -105,15 +123,32 @@ class FullCar:
         stiffness = g.T @ k_defl @ g
         stiffness[N_BODY:, N_BODY:] += k_t * np.eye(4)
         damping = g.T @ np.diag(c_s) @ g
-        mass = np.diag([m_s, p["pitch_inertia"], p["roll_inertia"], m_u, m_u, m_u, m_u])
+        # fore-aft and sideways on the four corners' horizontal stiffness, damped as the ride
+        for dof, key in ((3, "tyre_longitudinal_stiffness"), (4, "tyre_lateral_stiffness")):
+            stiffness[dof, dof] = 4 * p[key]
+            damping[dof, dof] = 2 * p["damping"] * np.sqrt(4 * p[key] * m_s)
+        mass = np.diag([m_s, p["pitch_inertia"], p["roll_inertia"], m_s, m_s,
+                        m_u, m_u, m_u, m_u])
         forcing = np.zeros((N_DOF, N_INPUT))
         forcing[N_BODY:, :4] = k_t * np.eye(4)
         forcing[1, 4] = m_s * p["cg_height"]  # accelerating pitches the nose up
         forcing[2, 5] = -m_s * p["cg_height"]  # a turn to the right rolls the body left
+        # the inertial forces of the path's accelerations, along the road and across it, and
+        # normal to it (a vertical curve: v^2 times the curvature of the road's profile)
+        forcing[3, 4] = forcing[4, 5] = forcing[0, 10] = -m_s
+        forcing[N_BODY:, 10] = -m_u
+        # the contact forces along the road's normal: -N_i r'_i fore-aft, -N (r_right -
+        # r_left) / track sideways per axle
+        load = (corner_mass + m_u) * G0_M_S2
+        forcing[3, 6:10] = -load
+        for left, right in ((0, 1), (2, 3)):
+            axle_load = load[left] + load[right]
+            forcing[4, left] += axle_load / (2 * half)
+            forcing[4, right] -= axle_load / (2 * half)
         return cls(mass, damping, stiffness, forcing, x, y)
 
     def state_space(self) -> tuple[np.ndarray, np.ndarray]:
-        """A (14, 14) and B (14, 6) of x' = A x + B u, x = [q, q']."""
+        """A (18, 18) and B (18, 11) of x' = A x + B u, x = [q, q']."""
         m_inv = np.linalg.inv(self.mass)
         a = np.zeros((2 * N_DOF, 2 * N_DOF))
         a[:N_DOF, N_DOF:] = np.eye(N_DOF)
@@ -125,12 +160,13 @@ class FullCar:
 
 
 def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
-    """Body heave, pitch and roll and their first and second derivatives on a uniform grid.
+    """Body heave, pitch, roll, surge and sway and their first and second derivatives on a
+    uniform grid.
 
     Parameters
     ----------
     model : FullCar
-    u : array, shape (6, n)
+    u : array, shape (11, n)
         Inputs at the grid times (see the module doc), one row per input, linear between
         the grid times.
     h : float
@@ -138,9 +174,9 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
 
     Returns
     -------
-    array, shape (9, n)
-        z, theta, phi, z', theta', phi', z'', theta'', phi'' (m, rad, per s, per s^2). The model
-        starts at rest in the static equilibrium of the first input.
+    array, shape (15, n)
+        z, theta, phi, x, y, then their first and then their second derivatives (m, rad, per
+        s, per s^2). The model starts at rest in the static equilibrium of the first input.
 
     Every product with the (n,)-long series is a real matrix product of a few rows (the modal
     matrices split into real and imaginary parts): complex products of that shape cost several
@@ -175,14 +211,7 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
 
 
 def _modal_recursion(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
-    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode; |factor| < 1).
-
-    With factor = r e^(i theta), y_k = e^(i k theta) x_k where x_k = r x_k-1 + e^(-i k theta)
-    forced_k: a real first-order recursion on the rotated inputs' real and imaginary parts,
-    which ``stochastic.ar1_filter`` runs in blocks, without a loop over the samples."""
-    k, n = forced.shape
-    turn = np.exp(1j * np.outer(np.angle(factor), np.arange(n)))  # e^(i k theta), (modes, n)
-    rotated = forced * turn.conj()
-    parts = np.ascontiguousarray(np.concatenate([rotated.real, rotated.imag]).T)  # (n, 2 modes)
-    x = ar1_filter(parts, np.tile(np.abs(factor), 2), overwrite=True)
-    return (x[:, :k] + 1j * x[:, k:]).T * turn
+    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode; |factor| < 1):
+    ``stochastic.ar1_filter`` with the complex factors, in blocks, without a loop over the
+    samples."""
+    return ar1_filter(np.ascontiguousarray(forced.T), factor, overwrite=True).T

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
-from gnss_helpers import drive, receiver
+from gnss_helpers import drive, pooled_autocorrelation, receiver
 
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import klobuchar_delay, tropo_delay, water_vapour_pressure
@@ -93,7 +93,7 @@ def _real_observations() -> pd.DataFrame:
                          "doppler": frame["D1"].to_numpy(), "cn0": frame["S1"].to_numpy()})
 
 
-def _simulated(preset: str) -> pd.DataFrame:
+def _simulated(preset: str, seed: int = 2015) -> pd.DataFrame:
     lat, lon, alt = ecef_to_geodetic(ARL1_XYZ)
     start = {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": float(alt),
              "heading": 0.0}
@@ -101,7 +101,7 @@ def _simulated(preset: str) -> pd.DataFrame:
     assert utc == dt.datetime(2015, 7, 18, 23, 59, 43)
     truth = drive([{"stop": {"duration": 3570}}], start=start, utc=utc, rate_hz=1.0)
     gnss = receiver(preset=preset, rate=1 / 30, constellation=str(FOLDER / "arlm200a.15n"))
-    raw = gnss.generate(truth, np.random.default_rng(2015))["gnss_raw"]
+    raw = gnss.generate(truth, np.random.default_rng(seed))["gnss_raw"]
     return pd.DataFrame({"tow": raw["t"].to_numpy(), "sv": raw["sv"].to_numpy(),
                          "pseudorange": raw["pseudorange"].to_numpy(),
                          "doppler": raw["doppler"].to_numpy(), "cn0": raw["cn0"].to_numpy()})
@@ -147,3 +147,73 @@ def test_cn0_against_elevation_beside_the_real_arl1_receiver():
         means[name] = r.groupby(band, observed=False)["cn0"].mean()
     print(pd.DataFrame(means))
     assert np.abs(means["real"] - means["sim"]).max() < 1.5
+
+
+ELEVATION_BINS_DEG = [10, 20, 30, 45, 90]
+
+
+def autocorrelation(res: pd.DataFrame, lag_s: float) -> float:
+    """Pooled autocorrelation at ``lag_s`` of the pseudorange residuals, each satellite's
+    series about its own mean over the hour (so a constant per-satellite offset, e.g. a
+    broadcast orbit error, does not count as correlation)."""
+    wide = res.pivot(index="tow", columns="sv", values="pr_res")
+    # the file's epochs are 30 s apart
+    return pooled_autocorrelation((wide - wide.mean()).to_numpy(), int(round(lag_s / 30.0)))
+
+
+def std_by_elevation(res: pd.DataFrame) -> np.ndarray:
+    band = pd.cut(np.degrees(res["elevation"]), ELEVATION_BINS_DEG)
+    return res.groupby(band, observed=False)["pr_res"].std().to_numpy()
+
+
+SEEDS = range(2015, 2019)
+
+
+def test_static_hour_time_behaviour_and_ionosphere_beside_arl1():
+    """Issue 19, the static hour at ARL1's position and date with the real broadcast file: the
+    pseudorange residual autocorrelation at 30 s lies in 0.3-0.8 for the geodetic preset (the
+    mean over four seeds; one hour of about nine satellites gives a single seed's figure a
+    spread of about 0.05) as for the real receiver, and the true ionosphere is 1.2-2.2 x
+    Klobuchar in every seed. Measured: real 0.59 at 30 s, 0.49 at 60 s; geodetic 0.65, 0.68,
+    0.76, 0.68 at 30 s (mean 0.69) and 0.59-0.71 at 60 s: more correlated than the real
+    receiver, whose residual holds more of a fast part; ionosphere 1.23-1.70 x Klobuchar."""
+    nav = _nav()
+    real = residuals(_real_observations(), nav, ARL1_XYZ)
+    sims = [residuals(_simulated("geodetic", seed), nav, ARL1_XYZ) for seed in SEEDS]
+    figures = {"real": [autocorrelation(real, 30), autocorrelation(real, 60)]}
+    for seed, sim in zip(SEEDS, sims, strict=True):
+        figures[f"geodetic {seed}"] = [autocorrelation(sim, 30), autocorrelation(sim, 60)]
+    print("\nautocorrelation at 30 s / 60 s:", {k: np.round(v, 2).tolist()
+                                                 for k, v in figures.items()})
+    assert 0.3 < figures["real"][0] < 0.8
+    assert 0.3 < np.mean([figures[f"geodetic {seed}"][0] for seed in SEEDS]) < 0.8
+
+    lat, lon, alt = ecef_to_geodetic(ARL1_XYZ)
+    start = {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": float(alt),
+             "heading": 0.0}
+    truth = drive([{"stop": {"duration": 3570}}], start=start, utc=gps_to_utc(WEEK, 0.0),
+                  rate_hz=1.0)
+    gnss = receiver(preset="geodetic", rate=1 / 30, constellation=str(FOLDER / "arlm200a.15n"))
+    ratios = []
+    for seed in SEEDS:
+        out = gnss.generate(truth, np.random.default_rng(seed))
+        both = out["gnss_raw"].merge(out["truth_gnss"], on=["t", "sv"])
+        ratios.append(both["iono_true"].sum() / both["iono"].sum())
+    print("true / Klobuchar ionosphere:", np.round(ratios, 2))
+    assert all(1.2 < r < 2.2 for r in ratios)
+
+
+@pytest.mark.xfail(strict=True, reason=(
+    "not shown: geodetic-preset residual std by elevation band 10-20/20-30/30-45/45-90 deg is "
+    "1.15/0.72/0.81/0.69 m (mean of four seeds) against ARL1's 1.26/0.96/0.47/0.37 m: above "
+    "30 deg the per-signal ionosphere variation (0.5-0.9 m) and the 0.5 m signal-in-space "
+    "error alone exceed the real file's whole residual; levels set from published figures, "
+    "not fitted"))
+def test_residual_std_by_elevation_within_30_percent_of_arl1():
+    nav = _nav()
+    real = std_by_elevation(residuals(_real_observations(), nav, ARL1_XYZ))
+    sims = np.array([std_by_elevation(residuals(_simulated("geodetic", seed), nav, ARL1_XYZ))
+                     for seed in SEEDS])
+    print("\nresidual std by elevation band, real:", np.round(real, 2), "geodetic:",
+          np.round(sims, 2))
+    assert np.all(np.abs(sims.mean(axis=0) / real - 1.0) < 0.3)

@@ -16,6 +16,7 @@ from simulator.cli import main
 from simulator.dataset.export import export_nmea, export_rinex
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
+from simulator.geoid import geoid_undulation_m
 from simulator.gnss.navfiles import read_rinex_nav
 from simulator.gnss.nmea import nmea_checksum
 
@@ -102,6 +103,11 @@ def test_nmea_sentences_parse_with_valid_checksums(exported):
     np.testing.assert_allclose(lat[with_fix], fix["lat"][with_fix], atol=2e-8)
     np.testing.assert_allclose(lon[with_fix], fix["lon"][with_fix], atol=2e-8)
     assert [g.quality for g in gga] == [1 if f else 0 for f in with_fix]
+    # altitude above the geoid plus the EGM96 separation is the fix's ellipsoidal height
+    sep = np.array([g.sep if g.quality else np.nan for g in gga], dtype=float)
+    alt = np.array([g.alt if g.quality else np.nan for g in gga], dtype=float)
+    np.testing.assert_allclose(sep[with_fix], geoid_undulation_m(lat, lon)[with_fix], atol=0.006)
+    np.testing.assert_allclose((alt + sep)[with_fix], fix["alt"][with_fix], atol=0.011)
     assert [g.numSV for g in gga] == fix["num_sats"].tolist()
     assert [r.status for r in rmc] == ["A" if f else "V" for f in with_fix]
     speed = np.array([r.spd if r.spd != "" else np.nan for r in rmc], dtype=float)

@@ -1,14 +1,12 @@
 """Receiver error processes against their defining statistics: the two-state clock against the
-Allan variance of its h-parameters (computed by allantools, an independent implementation), the
-tracking-noise formulas against their limiting forms, and the canyon geometry against
-hand-solvable cases."""
+Allan variance of its h-parameters (computed by allantools, an independent implementation) and the
+tracking-noise formulas against their limiting forms (the canyon geometry: tests/environment)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from simulator.environment.sky import canyon_visibility
 from simulator.gnss.constants import CHIP_L1CA_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz
 
@@ -38,16 +36,3 @@ def test_tracking_noise_limits():
         np.sqrt(4 * 2.0 / cn0) / (2 * np.pi * 0.02), rel=1e-3)
     # weaker signals are noisier, and a 10 dB loss is more than sqrt(10) times the noise
     assert dll_sigma_m(30.0, 0.5, 0.5, 0.02) > np.sqrt(10) * dll_sigma_m(40.0, 0.5, 0.5, 0.02)
-
-
-def test_canyon_geometry():
-    street = np.radians(0.0)  # a north-south street, 20 m facades, 20 m wide
-    el = np.radians([80.0, 40.0, 40.0, 10.0, 5.0])
-    az = np.radians([90.0, 0.0, 90.0, 90.0, 90.0])
-    los, nlos, extra = canyon_visibility(az, el, street, 20.0, 20.0)
-    # along the street: visible at any height; across: needs tan(el) >= 20 / 10
-    assert los.tolist() == [True, True, False, False, False]
-    # reflected by the opposite facade when tan(el) >= 20 / 30 (el >= 33.7 deg)
-    assert nlos.tolist() == [False, False, True, False, False]
-    assert extra[2] == pytest.approx(2 * 10.0 * np.cos(np.radians(40.0)))
-    assert (extra[~nlos] == 0).all()

@@ -106,19 +106,23 @@ def test_raw_error_terms_add_up_to_the_measurement():
                + m["tropo_true"] + m["sis_error"] + m["multipath"] + m["nlos_delay"]
                + m["code_noise"])
     np.testing.assert_allclose(m["pseudorange"], rebuilt, rtol=0, atol=1e-6)
-    # the broadcast models remove most, not all, of the atmosphere
-    iono_left = (m["iono_true"] - m["iono"]).abs().mean() / m["iono"].mean()
-    assert 0.02 < iono_left < 0.5
+    # the true ionosphere is iono_scale (1.5) x (1 + 0.2 x a slow variation) x the broadcast
+    # one (issue 19; was 1 + 0.2 x the variation before): one drive draws one common variation
+    # (here the ratio is 1.17), so the mean ratio over seeds is checked in test_gnss_errors
+    ratio = m["iono_true"] / m["iono"]
+    assert 0.5 < ratio.min() and ratio.max() < 2.5 and ratio.std() > 0.01
 
 
 def _budget_run(seed: int):
-    """Static receiver, 10 min at 1 Hz, automotive errors: the actual NED fix errors, and the
-    covariance the configured error budget predicts for each epoch's weighted least squares,
-    G R G^T with G = (H^T W H)^-1 H^T W, W the receiver's weights and R the configured
-    measurement error covariance (independent terms on the diagonal, plus the ionosphere and
-    troposphere residuals common to every signal)."""
+    """Static receiver, 10 min at 1 Hz, automotive errors on the raw code (no carrier smoothing,
+    whose growing window at each arc's start this budget does not describe): the actual NED fix
+    errors, and the covariance the configured error budget predicts for each epoch's weighted
+    least squares, G R G^T with G = (H^T W H)^-1 H^T W, W the receiver's weights and R the
+    configured measurement error covariance (independent terms on the diagonal, plus the
+    ionosphere and troposphere residuals common to every signal: the ionosphere's mean excess
+    (iono_scale - 1) I and its common variation iono_scale iono_residual I both lie along I)."""
     truth = drive([{"stop": {"duration": 600}}], rate_hz=1.0)
-    gnss = receiver()
+    gnss = receiver(carrier_smoothing=0.0)
     cfg = gnss.config
     out = gnss.generate(truth, np.random.default_rng(seed))
     raw, fix = out["gnss_raw"], out["gnss_fix"]
@@ -130,9 +134,11 @@ def _budget_run(seed: int):
     el, az = raw["elevation"].to_numpy(), raw["azimuth"].to_numpy()
     code = dll_sigma_m(raw["cn0"].to_numpy(), cfg["dll_bandwidth"], cfg["correlator_spacing"],
                        cfg["integration_time"]) * cfg["tracking_noise"]
+    iono = raw["iono"].to_numpy()
+    variation = cfg["iono_scale"] * cfg["iono_residual"]
     own = (code**2 + multipath_sigma_m(el, cfg["multipath"]) ** 2 + cfg["sis_error"] ** 2
-           + (IONO_OWN_SHARE * cfg["iono_residual"] * raw["iono"].to_numpy()) ** 2)
-    iono_common = cfg["iono_residual"] * raw["iono"].to_numpy()
+           + (IONO_OWN_SHARE * variation * iono) ** 2)
+    iono_common = np.hypot(variation, cfg["iono_scale"] - 1.0) * iono
     zenith = np.add(*saastamoinen_zenith(k["lat"][0], k["alt"][0]))
     tropo_common = cfg["tropo_residual"] * raw["tropo"].to_numpy() / zenith
     u = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), -np.sin(el)], axis=1)
@@ -206,8 +212,9 @@ def test_canyon_has_fewer_satellites_and_worse_dop(heading):
     assert (m.loc[m["nlos"] == 0, "nlos_delay"] == 0).all()
     nlos = m[m["nlos"] == 1]
     cfg = gnss.config
-    np.testing.assert_allclose(nlos["cn0"], cn0_model(nlos["elevation"], cfg["cn0_zenith"],
-                                                      cfg["cn0_horizon"]) - 10.0)
+    # they lose C/N0 (a reflection off a facade, or diffraction over its edge), never gain it
+    loss = cn0_model(nlos["elevation"], cfg["cn0_zenith"], cfg["cn0_horizon"]) - nlos["cn0"]
+    assert (loss > 0).all() and (nlos["cn0"] >= cfg["cn0_threshold"]).all()
 
 
 def test_three_satellites_give_a_2d_fix_and_two_give_none():
@@ -233,9 +240,13 @@ def test_three_satellites_give_a_2d_fix_and_two_give_none():
 
 
 def test_smoothed_fixes_are_quieter_and_follow_the_motion():
+    """The fix-output filter (``smoothing``) on the raw code (no carrier smoothing, which would
+    already have made consecutive fixes nearly equal)."""
     static = drive([{"stop": {"duration": 300}}], rate_hz=1.0)
-    raw_fix = receiver().generate(static, np.random.default_rng(10))["gnss_fix"]
-    smooth = receiver(smoothing=20.0).generate(static, np.random.default_rng(10))["gnss_fix"]
+    raw_fix = receiver(carrier_smoothing=0.0).generate(static, np.random.default_rng(10))[
+        "gnss_fix"]
+    smooth = receiver(carrier_smoothing=0.0, smoothing=20.0).generate(
+        static, np.random.default_rng(10))["gnss_fix"]
     jitter = [np.std(np.diff(f["lat"].to_numpy())) for f in (raw_fix, smooth)]
     assert jitter[1] < 0.5 * jitter[0]
     moving = drive(DRIVE)
@@ -296,45 +307,34 @@ def _fix_errors_ned(truth, fix) -> np.ndarray:
 
 
 def test_10hz_fix_errors_change_slowly_while_driving():
-    """Issue 19: a 10 Hz receiver's fix errors change by under 0.2 m per second per axis in
-    open sky while driving (real: 0.036 m/s, u-blox at 17.6 m/s), at the preset's error level.
-    The automotive preset's code error is correlated over the 100 s of carrier smoothing
-    (RTCA DO-229); drawn white per epoch (code_correlation_time 0, the former model) the fix
-    jumps by about a metre from one fix to the next. Measured over 4 x 290 s: per-second change
-    0.16 / 0.11 m north / east (vertical 0.38 m), horizontal rms equal within 10 % to the white
-    model's."""
+    """Issue 19: a 10 Hz receiver's fix errors change by under 0.2 m per second per axis (north,
+    east and vertical) in open sky while driving (real: 0.036 m/s, u-blox at 17.6 m/s). The
+    automotive preset smooths the code with the carrier (Hatch filter, 100 s, RTCA DO-229);
+    its raw code (carrier_smoothing 0: DLL noise correlated over 0.5 s only) jumps by a metre
+    and more from one second to the next, and smoothing lowers the level. Measured over
+    3 x 290 s at 15 m/s: per-second change 0.06 / 0.03 / 0.14 m north / east / down (raw code
+    1.5 / 1.0 / 3.7 m); was 0.16 / 0.11 / 0.38 m with the former 100 s Gauss-Markov code error.
+    Averaging one second of fixes leaves the scatter as it is (real receivers: little gain; the
+    white model went from 1.09 to 0.49 m)."""
     truth = drive([{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
                    {"straight": {"length": 2000}}, {"turn": {"angle": 90, "radius": 50}},
                    {"straight": {"length": 2000}}], rate_hz=10.0)
-    assert receiver().config["code_correlation_time"] == 100.0
+    assert receiver().config["carrier_smoothing"] == 100.0
     errors = {}
-    for name, extra in (("smoothed", {}), ("white", {"code_correlation_time": 0.0})):
+    for name, extra in (("smoothed", {}), ("raw code", {"carrier_smoothing": 0.0})):
         runs = [_fix_errors_ned(truth, receiver(rate=10, **extra).generate(
             truth, np.random.default_rng(seed))["gnss_fix"]) for seed in range(3)]
         per_second = np.concatenate([e[10:] - e[:-10] for e in runs])
+        # averaging each second's ten fixes: little gain when they are correlated (issue 19)
+        averaged = np.concatenate([e[:len(e) // 10 * 10].reshape(-1, 10, 3).mean(axis=1)
+                                   for e in runs])
         errors[name] = (np.sqrt(np.mean(per_second**2, axis=0)),
-                        np.sqrt(np.mean(np.concatenate(runs)[:, :2] ** 2)))
-    change, level = errors["smoothed"]
-    white_change, white_level = errors["white"]
-    assert np.all(change[:2] < 0.2), change
-    assert np.all(white_change[:2] > 0.5), white_change
-    assert 0.75 < level / white_level < 1.33
-
-
-def test_code_error_is_gauss_markov_over_the_smoothing_time():
-    """The automotive code error is a first-order Gauss-Markov process of correlation time
-    100 s: its autocorrelation is exp(-lag / 100 s), 0.99 at 1 s and 0.74 at 30 s (pooled over
-    the satellites of a static hour at 1 Hz); drawn white it is uncorrelated from epoch to epoch."""
-    truth = drive([{"stop": {"duration": 3600}}], rate_hz=1.0)
-
-    def autocorrelation(lag: int, **extra) -> float:
-        out = receiver(outputs=["raw"], **extra).generate(truth, np.random.default_rng(4))
-        noise = out["truth_gnss"].pivot(index="t", columns="sv", values="code_noise").to_numpy()
-        a, b = noise[:-lag], noise[lag:]
-        both = np.isfinite(a) & np.isfinite(b)
-        return float(np.sum(a[both] * b[both]) / np.sqrt(np.sum(a[both] ** 2)
-                                                          * np.sum(b[both] ** 2)))
-
-    assert autocorrelation(1) == pytest.approx(np.exp(-0.01), abs=0.01)
-    assert autocorrelation(30) == pytest.approx(np.exp(-0.3), abs=0.1)
-    assert abs(autocorrelation(1, code_correlation_time=0.0)) < 0.05
+                        np.sqrt(np.mean(np.concatenate(runs) ** 2, axis=0)),
+                        np.sqrt(np.mean(averaged**2, axis=0)))
+    print({name: [np.round(v, 3).tolist() for v in value] for name, value in errors.items()})
+    change, level, averaged = errors["smoothed"]
+    raw_change, raw_level, _ = errors["raw code"]
+    assert np.all(change < 0.2), change
+    assert np.all(raw_change > 0.5), raw_change
+    assert np.all(level < raw_level)
+    assert np.all(averaged > 0.95 * level)

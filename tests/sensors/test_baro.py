@@ -4,10 +4,12 @@ and range; pressure altitude of the ideal barometer."""
 
 from __future__ import annotations
 
+import datetime as dt
+
 import numpy as np
 import pandas as pd
 import pytest
-from sensor_truths import SHARED, drive_truth, static_truth
+from sensor_truths import SHARED, drive_truth, static_truth, truth_from_segments
 
 from simulator.environment.atmosphere import (
     R0_M,
@@ -16,6 +18,7 @@ from simulator.environment.atmosphere import (
     pressure_pa,
     temperature_k,
 )
+from simulator.geoid import geoid_undulation_m, orthometric_height_m
 from simulator.schema import Context
 from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.baro import BARO_FIELD, Barometer
@@ -29,6 +32,13 @@ def table(name: str) -> pd.DataFrame:
     if not path.is_file():
         pytest.skip(f"reference table not found: {path} (shared/refdata is missing)")
     return pd.read_csv(path, comment="#")
+
+
+def msl_height(truth, t) -> np.ndarray:
+    """The truth's height above the EGM96 geoid, m, which the bosch-bmp280 preset's pressure
+    follows (``geoid: true``)."""
+    lat, lon, h = truth.position(np.asarray(t, dtype=float)).T
+    return orthometric_height_m(np.degrees(lat), np.degrees(lon), h)
 
 
 def make(block: dict) -> Barometer:
@@ -80,7 +90,7 @@ def test_bmp280_noise_bias_resolution():
     assert len(out) == 600 * 20 + 1
     # the preset's weather drift (drawn rate) scales the column; the noise is what is left
     sea_level = 101325.0 + baro.drawn["drift_rate"] * out["t"].to_numpy()
-    expected = (pressure_pa(truth.position(out["t"])[:, 2]) * sea_level / 101325.0
+    expected = (pressure_pa(msl_height(truth, out["t"])) * sea_level / 101325.0
                 + baro.drawn["bias"])
     residual = out["pressure"].to_numpy() - expected
     assert np.std(residual) == pytest.approx(1.3, rel=0.05)
@@ -125,7 +135,7 @@ def test_weather_drift_on_by_default_like_the_real_met_file():
         out = as_frame(baro.generate(truth, np.random.default_rng(seed))["baro"])
         p = out["pressure"].to_numpy()
         rates.append(baro.drawn["drift_rate"])
-        p0 = pressure_pa(truth.position([0.0])[0, 2])
+        p0 = pressure_pa(msl_height(truth, [0.0])[0])
         assert p[-1] - p[0] == pytest.approx(rates[-1] * 3600 * p0 / 101325.0, abs=1e-6)
     assert np.std(rates) * 3600 / 100 == pytest.approx(0.4, rel=0.15)
     assert make({}).config["weather_drift"] == 0.0  # ideal: no weather
@@ -161,3 +171,38 @@ def test_bad_input_named(block, message):
     ctx = Context("test.yaml")
     BARO_FIELD.check(block, ("sensors", "baro"), ctx)
     assert any(message in str(p) for p in ctx.problems), ctx.problems
+
+
+# ARL1 (refdata 1a): RINEX header position, 30.383664 N, 97.725413 W, 217.6 m ellipsoidal
+ARL1 = {"lat": 30.383664, "lon": -97.725413, "alt": 217.6, "heading": 0.0}
+
+
+def test_pressure_at_arl1_follows_the_geoid():
+    """Issue 19: the BMP280 preset at ARL1 reads the standard atmosphere at the orthometric
+    height H = h - N (EGM96 N = -26.9 m there), not at the ellipsoidal height (about 3 hPa
+    higher): error-free to its resolution, and with the preset's drawn errors (bias 1 hPa
+    1-sigma, weather, noise) centred within 1 hPa of it over 200 runs."""
+    truth = truth_from_segments([{"stop": {"duration": 60.0}}], rate_hz=1.0, start=ARL1,
+                                utc=dt.datetime(2015, 7, 19))
+    big_h = ARL1["alt"] - float(geoid_undulation_m(ARL1["lat"], ARL1["lon"]))
+    p_orthometric, p_ellipsoidal = pressure_pa(big_h), pressure_pa(ARL1["alt"])
+    assert p_ellipsoidal - p_orthometric > 250.0  # the geoid matters here: about 3 hPa
+    exact = make({"preset": "bosch-bmp280", "bias": 0, "noise": 0, "weather_drift": 0,
+                  "temperature_coefficient": 0})
+    p = as_frame(exact.generate(truth, np.random.default_rng(0))["baro"])["pressure"]
+    assert np.abs(p - p_orthometric).max() <= 0.08 + 1e-9  # half the 0.16 Pa resolution
+    preset = make({"preset": "bosch-bmp280"})
+    means = [as_frame(preset.generate(truth, np.random.default_rng(s))["baro"])["pressure"].mean()
+             for s in range(200)]
+    assert abs(np.median(means) - p_orthometric) < 100.0  # 1 hPa
+    assert np.median(np.abs(np.array(means) - p_orthometric)) < 100.0
+
+
+def test_ideal_barometer_keeps_the_ellipsoidal_height():
+    """``preset: ideal`` (geoid: false) is unchanged: its altitude is the truth's; geoid: true
+    without errors reads the orthometric height."""
+    truth = truth_from_segments([{"stop": {"duration": 10.0}}], rate_hz=1.0, start=ARL1)
+    ideal = as_frame(make({}).generate(truth, np.random.default_rng(0))["baro"])
+    np.testing.assert_allclose(ideal["altitude"], ARL1["alt"], atol=1e-6)
+    msl = as_frame(make({"geoid": True}).generate(truth, np.random.default_rng(0))["baro"])
+    np.testing.assert_allclose(msl["altitude"], msl_height(truth, msl["t"]), atol=1e-6)

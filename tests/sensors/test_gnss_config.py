@@ -43,7 +43,7 @@ def test_registered_and_defaults_filled_from_the_preset():
     ({"preset": "survey"}, "sensors.gnss.preset: unknown GNSS preset 'survey'"),
     ({"clock": "rubidium"}, "sensors.gnss.clock: unknown oscillator 'rubidium'"),
     ({"constellation": "no/such/file.nav"}, "sensors.gnss.constellation: 'no/such/file.nav' is "
-                                            "neither 'nominal-gps' nor an existing"),
+                                            "neither 'gps-almanac', 'nominal-gps' nor an existing"),
     ({"elevation_mask": 95}, "sensors.gnss.elevation_mask"),
     ({"outputs": ["position"]}, "sensors.gnss.outputs.0"),
     ({"multipath": "3 s"}, "sensors.gnss.multipath"),
@@ -62,8 +62,10 @@ def test_bad_configuration_is_reported_with_its_key(config, fragment):
 def test_expanded_slots_add_their_aft_satellites_to_the_receiver():
     truth = drive([{"stop": {"duration": 600}}], rate_hz=1.0)
     rng = np.random.default_rng(3)
-    base = receiver(preset="ideal").generate(truth, rng)
-    full = receiver(preset="ideal", expanded_slots=["B1", "D2", "F2"]).generate(truth, rng)
+    # the 24-slot constellation is named: the default sky is the real almanac's
+    base = receiver(preset="ideal", constellation="nominal-gps").generate(truth, rng)
+    full = receiver(preset="ideal", constellation="nominal-gps",
+                    expanded_slots=["B1", "D2", "F2"]).generate(truth, rng)
     assert set(base["gnss_nav"]["sv"]) == set(range(1, 25))
     assert set(full["gnss_nav"]["sv"]) == set(range(1, 28))
     n_base, n_full = base["gnss_fix"]["num_sats"], full["gnss_fix"]["num_sats"]

@@ -303,3 +303,17 @@ def test_ar1_filter_gains_match_scipy_lfilter(n):
                          gain_out=gain_out[1:])
         np.testing.assert_allclose(out, expected[:, 1:], rtol=1e-9,
                                    atol=1e-9 * np.abs(expected).max())
+
+
+def test_ar1_filter_complex_factors_match_scipy_lfilter():
+    """Complex factors (damped rotations, the ride model's modes) over many blocks, one factor
+    per column, against scipy's direct recursion."""
+    from scipy.signal import lfilter
+
+    from simulator.stochastic import ar1_filter
+
+    phi = np.array([0.999 * np.exp(0.3j), 0.5 * np.exp(2.5j), 0.9999 * np.exp(-0.01j)])
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal((20_000, 3)) + 1j * rng.standard_normal((20_000, 3))
+    expected = np.stack([lfilter([1.0], [1.0, -f], u[:, j]) for j, f in enumerate(phi)], axis=1)
+    np.testing.assert_allclose(ar1_filter(u, phi), expected, rtol=1e-9, atol=1e-9)

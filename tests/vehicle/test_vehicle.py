@@ -42,7 +42,7 @@ def test_body_channels_between_grid_times_are_c2_quintics_through_the_nodes():
     t = np.linspace(0.0, 2.0, 41)
     w = 3.0
     rows = [np.sin(w * t), w * np.cos(w * t), -w * w * np.sin(w * t)]
-    nodes = np.vstack([np.tile(row, (4, 1)) for row in rows])
+    nodes = np.vstack([np.tile(row, (6, 1)) for row in rows])
     body = BodyMotion(t, nodes, np.zeros(3))
     fine = np.linspace(0.0, 2.0, 4001)
     got = body.evaluate(fine)
@@ -57,20 +57,23 @@ def test_body_channels_between_grid_times_are_c2_quintics_through_the_nodes():
 
 def test_suspension_integration_matches_runge_kutta():
     """The modal exact-hold integration against a fine classical Runge-Kutta integration of
-    the same state equations: a 5 cm step under the front-left wheel and a braking ramp."""
+    the same state equations: a 5 cm step under the front-left wheel, a braking ramp, a road
+    slope ramping up under the rear-right wheel and a vertical acceleration ramp."""
     car = FullCar.from_parameters(vehicle_parameters("automotive"))
     a, b = car.state_space()
     h, n = 0.01, 400
-    u = np.zeros((n, 6))
+    u = np.zeros((n, 11))
     u[50:, 0] = 0.05
     u[100:, 4] = np.minimum(np.arange(n - 100) * h, 1.0) * -3.0
+    u[150:, 9] = np.minimum(np.arange(n - 150) * h, 0.5) * 0.1
+    u[200:, 10] = np.minimum(np.arange(n - 200) * h, 0.5) * 1.0
     out = simulate(car, u.T, h)
-    x = np.zeros(14)
-    ref = np.empty((n, 9))
+    x = np.zeros(18)
+    ref = np.empty((n, 15))
     sub = 50
     for k in range(n):
-        ref[k, :3], ref[k, 3:6] = x[:3], x[7:10]
-        ref[k, 6:] = (a @ x + b @ u[k])[7:10]
+        ref[k, :5], ref[k, 5:10] = x[:5], x[9:14]
+        ref[k, 10:] = (a @ x + b @ u[k])[9:14]
         if k + 1 < n:
             for j in range(sub):
                 def uu(frac, k=k, j=j):
@@ -82,8 +85,8 @@ def test_suspension_integration_matches_runge_kutta():
                 k4 = a @ (x + dt * k3) + b @ uu(1.0)
                 x = x + dt / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     out = out.T
-    np.testing.assert_allclose(out[:, :6], ref[:, :6], atol=1e-10)
-    np.testing.assert_allclose(out[:, 6:], ref[:, 6:], atol=1e-8)
+    np.testing.assert_allclose(out[:, :10], ref[:, :10], atol=1e-10)
+    np.testing.assert_allclose(out[:, 10:], ref[:, 10:], atol=1e-8)
 
 
 def test_ride_modes_lie_at_the_preset_frequencies():
@@ -139,7 +142,8 @@ def test_braking_pitches_the_nose_down():
     assert pitch[-1] < -0.3 and pitch[-1] > -1.5
     p = vehicle_parameters("automotive")
     car = FullCar.from_parameters(p)
-    static = np.linalg.solve(car.stiffness, car.forcing @ [0, 0, 0, 0, -3.0, 0])[1]
+    static = np.linalg.solve(car.stiffness,
+                             car.forcing @ [0, 0, 0, 0, -3.0, 0, 0, 0, 0, 0, 0])[1]
     assert pitch[-1] == pytest.approx(np.degrees(static), rel=0.02)
 
 
@@ -226,24 +230,84 @@ def _band_rms(x: np.ndarray, dt: float, low: float, high: float) -> np.ndarray:
     return np.sqrt((np.abs(spectrum[band]) ** 2).sum(axis=0) * 2 / len(x) ** 2)
 
 
-def test_vibration_at_15_m_s_on_a_class_b_road(shared_dir):
-    """Issue 13: accelerometer rms in 5-50 Hz at 15 m/s on an ISO class B road between 0.1 and
-    1 m/s^2 (vertical axis) with the automotive preset; the real RAV4 log of comma2k19 at
-    8-20 m/s on a Californian highway (refdata 3a) reads 0.3-0.5 m/s^2 per axis there, and the
-    simulated vertical vibration is within a factor of three of the real one."""
+RAV4_IMU = "refdata/vehicle/comma2k19_rav4_2018-08-02_seg40/processed_log/IMU"
+
+
+def _cruise_vibration() -> tuple[np.ndarray, np.ndarray]:
+    """Accelerometer and gyro rms in 5-50 Hz per axis (FRD) of the automotive preset cruising
+    at 15 m/s on an ISO class B road (the truth's specific force and rate, 100 Hz)."""
     segments = [{"accelerate": {"to_speed": 15.0, "accel": 1.5}},
                 {"straight": {"duration": 60}}]
-    truth = _truth(segments)
-    table = truth.table()
+    table = _truth(segments).table()
     cruise = table.t.to_numpy() > table.t.iloc[-1] - 55.0
-    f = table[["fx", "fy", "fz"]].to_numpy()[cruise]
-    sim = _band_rms(f, 0.01, 5.0, 50.0)
-    assert 0.1 < sim[2] < 1.0
-    log = shared_dir / "refdata/vehicle/comma2k19_rav4_2018-08-02_seg40/processed_log/IMU"
-    t = np.load(log / "accelerometer/t")
-    real = _band_rms(np.load(log / "accelerometer/value"), float(np.median(np.diff(t))),
-                     5.0, 50.0)
-    assert real[2] / 3 < sim[2] < 3 * real[2]
+    return (_band_rms(table[["fx", "fy", "fz"]].to_numpy()[cruise], 0.01, 5.0, 50.0),
+            _band_rms(table[["wx", "wy", "wz"]].to_numpy()[cruise], 0.01, 5.0, 50.0))
+
+
+def _rav4_band_rms(shared_dir, stream: str) -> np.ndarray:
+    log = shared_dir / RAV4_IMU / stream
+    t = np.load(log / "t")
+    return _band_rms(np.load(log / "value"), float(np.median(np.diff(t))), 5.0, 50.0)
+
+
+def test_vibration_at_15_m_s_on_a_class_b_road(shared_dir):
+    """Issue 13: accelerometer rms in 5-50 Hz at 15 m/s on an ISO class B road between 0.1 and
+    1 m/s^2 (vertical axis) with the automotive preset (measured 0.24); the real RAV4 log of
+    comma2k19 at 8-20 m/s on a Californian highway (refdata 3a) reads 0.49 m/s^2 vertically,
+    within a factor of three. Fore-aft and sideways the body now moves on its tyres, pushed by
+    the road's slopes (``suspension``): 0.052 and 0.059 m/s^2 (0.018 and 0.047 before, from
+    pitch and roll alone), at least twice what pitch and roll give without those forces."""
+    accel, _ = _cruise_vibration()
+    assert 0.1 < accel[2] < 1.0
+    real = _rav4_band_rms(shared_dir, "accelerometer")
+    assert real[2] / 3 < accel[2] < 3 * real[2]
+    assert accel[0] > 0.04 and accel[1] > 0.04
+
+
+@pytest.mark.xfail(strict=True, reason="not shown: fore-aft 0.052 and sideways 0.059 m/s^2 "
+                                       "against the log's 0.54 and 0.36 (vertical 0.24 "
+                                       "against 0.49): see the docstring")
+def test_vibration_per_axis_within_a_factor_two_of_the_rav4_log(shared_dir):
+    """Issue 13's check: per-axis accelerometer rms in 5-50 Hz of the automotive preset at 15
+    m/s on class B within a factor of two of the real RAV4 log's (comma2k19, refdata 3a: x
+    0.54, y 0.36, z 0.49 m/s^2, device axes forward, right, down). Measured: 0.052, 0.059,
+    0.24. Not shown, and not tuned: the log's fore-aft and sideways vibration is mostly the
+    device rocking on its windshield mount, not the car body translating. Its x
+    accelerometer is coherent with its pitch rate (0.90 in 40-52 Hz, 0.77 in 10-20 Hz) and its
+    y accelerometer with its roll rate (0.75, 0.51); the three gyro axes explain (multiple
+    coherence, 256-sample Welch segments) 0.52 of the 0.54 m/s^2 fore-aft and 0.32 of the
+    0.36 sideways, leaving 0.15 and 0.16 m/s^2 (0.31 of 0.49 vertically): a pitch rate of
+    0.014 rad/s at 45 Hz times a 9 cm lever gives the 0.38 m/s^2 of x there, while a car body's
+    pitch modes lie near 1.5 Hz. The model's body is within a factor of three of that
+    remainder fore-aft and sideways; a mount model (a sensor's, not the car's) is not built."""
+    accel, _ = _cruise_vibration()
+    real = _rav4_band_rms(shared_dir, "accelerometer")
+    assert np.all((accel > real / 2) & (accel < 2 * real))
+
+
+def test_the_road_pushes_the_body_along_its_normal_and_the_tyres_deflect():
+    """Fore-aft and sideways on the tyres (``suspension``), static cases: on a camber c the
+    contact forces along the road's normal push the body downhill (right) by m g c / (4 k_y)
+    (the tyres' lateral deflection, 0.61 mm for the automotive preset at 2.5 %); braking at
+    3 m/s^2 carries it forward by m_s a / (4 k_x) on the tyres' fore-aft stiffness."""
+    from simulator.vehicle import vehicle_body
+
+    p = vehicle_parameters("automotive")
+    segments = [{"accelerate": {"to_speed": 20.0, "accel": 2.0}}, {"straight": {"length": 200}},
+                {"accelerate": {"to_speed": 0.0, "accel": 3.0}}, {"stop": {"duration": 3}}]
+    truth = _truth(segments, {**QUIET, "camber": 0.025})
+    t = truth.t_grid
+    _, body = vehicle_body(truth.profile, {**p, **QUIET, "camber": 0.025}, t)
+    motion = body.evaluate(t)
+    cruising = (t > 12.0) & (t < 15.0)  # at 20 m/s, settled
+    np.testing.assert_allclose(motion["sway"][cruising],
+                               p["mass"] * G * 0.025 / (4 * p["tyre_lateral_stiffness"]),
+                               rtol=1e-3)
+    speed = truth.table().speed.to_numpy()
+    braking = np.flatnonzero(np.abs(np.diff(speed, prepend=np.nan) * 100.0 + 3.0) < 1e-6)
+    sprung = p["mass"] - 4 * p["unsprung_mass"]
+    assert motion["surge"][braking[-1]] == pytest.approx(
+        sprung * 3.0 / (4 * p["tyre_longitudinal_stiffness"]), rel=0.02)
 
 
 def test_strapdown_closes_on_a_rough_road_with_an_suv():
@@ -282,6 +346,43 @@ def test_camber_rolls_the_body_by_the_cross_slope():
     np.testing.assert_allclose(table.roll, np.arctan(0.025), rtol=2e-3)
 
 
+def test_vertical_curves_load_the_suspension():
+    """Issue 13: a grade change loads the suspension. On a vertical curve of curvature
+    dgamma/ds the path accelerates by a_v = v^2 dgamma/ds normal to the road and the road under
+    axle i lies dgamma/ds x_i^2 / 2 above the tangent plane at the centre of gravity; with equal
+    front and rear ride frequencies f the quasi-static body heave is
+    -a_v / (2 pi f)^2 - a_v m_u / k_t (sprung mass on the ride rate, wheels on their tyres)
+    plus the axle heights interpolated at the centre of gravity, (l_r h_f + l_f h_r) / L, and
+    the pitch (h_f - h_r) / L. At 15 m/s over a 0.08 slope's crest and sag (a_v up to -+0.75
+    m/s^2): +8.5 / -8.5 mm of heave, the dynamics within 2 % of the quasi-static value."""
+    from simulator.vehicle import vehicle_body
+
+    equal = {**QUIET, "front_frequency": 1.3, "rear_frequency": 1.3}
+    segments = [{"accelerate": {"to_speed": 15.0, "accel": 1.5}}, {"straight": {"length": 100}},
+                {"slope": {"grade": 0.08, "length": 300}}, {"straight": {"length": 100}}]
+    truth = _truth(segments, equal)
+    p = {**vehicle_parameters("automotive"), **equal}
+    t = truth.t_grid
+    profile, body = vehicle_body(truth.profile, p, t)
+    motion = body.evaluate(t)
+    s, v = profile.distance_of_time.evaluate(t, (0, 1))
+    curvature = profile.grade.evaluate(s, (1,))[0]
+    a_v = v * v * curvature
+    length = p["wheelbase"]
+    l_r = length * p["front_weight"]
+    l_f = length - l_r
+    h_f, h_r = curvature * l_f**2 / 2, curvature * l_r**2 / 2
+    heave = (-a_v / (2 * np.pi * 1.3) ** 2 - a_v * p["unsprung_mass"] / p["tyre_stiffness"]
+             + (l_r * h_f + l_f * h_r) / length)
+    pitch = (h_f - h_r) / length
+    for k in (np.argmax(a_v), np.argmin(a_v)):  # the sag and the crest
+        assert abs(a_v[k]) > 0.7
+        assert motion["heave"][k] == pytest.approx(heave[k], rel=0.02)
+        assert motion["pitch"][k] == pytest.approx(pitch[k], rel=0.1)
+    level = np.abs(curvature) == 0.0
+    assert np.abs(motion["heave"][level & (t > 20.0)]).max() < 2e-3  # settled off the curves
+
+
 @pytest.mark.parametrize("block, where", [
     ({"damping": -0.2}, "vehicle.damping"),
     ({"preset": "truck"}, "vehicle.preset"),
@@ -299,19 +400,23 @@ def test_bad_vehicle_values_name_the_key(block, where):
 
 def test_wheels_meet_the_bump_one_wheelbase_apart_and_the_grade_loses_it():
     """The road under each corner: the segment's bump shape H 64 u^3 (1 - u)^3 at s + x_i, the
-    camber's -c y_i, and the level road keeps no bump in its grade (the rigid body's 8 cm climb
-    is gone from the altitude; the body heaves by about the bump instead)."""
+    camber's -c y_i, the forward slope its derivative, and the level road keeps no bump in its
+    grade (the rigid body's 8 cm climb is gone from the altitude; the body heaves by about the
+    bump instead)."""
     from simulator.vehicle.body import level_road
     from simulator.vehicle.road import RoadSurface
 
     surface = RoadSurface([(10.0, 1.0, 0.08)], None, 0.0, 0.02)
     x, y = np.array([1.2, 1.2, -1.5, -1.5]), np.array([-0.8, 0.8, -0.8, 0.8])
     s = np.linspace(0.0, 20.0, 2001)
-    z = surface.heights(s, x, y)
+    z, slope = surface.heights(s, x, y)
+    ahead, behind = surface.heights(s + 1e-6, x, y)[0], surface.heights(s - 1e-6, x, y)[0]
     for i in range(4):
         u = np.clip((s + x[i] - 10.0), 0.0, 1.0)
         np.testing.assert_allclose(z[i], 0.08 * 64 * (u * (1 - u)) ** 3 - 0.02 * y[i],
                                    atol=1e-15)
+        # the slope against the central difference of the heights (step 1 um)
+        np.testing.assert_allclose(slope[i], (ahead[i] - behind[i]) / 2e-6, atol=1e-8)
     segments = [{"accelerate": {"to_speed": 4.0, "accel": 1.0}}, {"straight": {"length": 20}},
                 {"speed_bump": {"height": 0.08, "length": 1.0}}, {"straight": {"length": 20}}]
     rigid = _truth(segments, "rigid")

@@ -132,3 +132,15 @@ def test_nonholonomic_noise_follows_the_bicycle_model():
     # class B road at 10 m/s through 10 Hz: 4 pi^2 64e-6 0.01 10 10 = 2.53e-3 (m/s)^2
     _, vertical = noise.sigma(10.0, 0.0, 0.0)
     assert vertical**2 == pytest.approx(0.01 + 4 * np.pi**2 * 64e-6 * 0.01 * 100, rel=1e-9)
+
+
+def test_nonholonomic_noise_of_a_state_reads_speed_yaw_rate_and_forward_acceleration():
+    """Pitched up 0.1 rad at rest on a slope: the accelerometer reads g sin(0.1) forward and
+    the forward acceleration is zero; moving at 10 m/s along the body with a 0.3 rad/s yaw
+    rate it is the ``sigma`` of those."""
+    noise = NonholonomicNoise(wheelbase=2.7)
+    q = euler_to_quat(0.0, 0.1, 0.4)
+    v = 10.0 * np.array([np.cos(0.1) * np.cos(0.4), np.cos(0.1) * np.sin(0.4), -np.sin(0.1)])
+    force = np.array([9.80665 * np.sin(0.1), 0.0, -9.80665 * np.cos(0.1)])
+    rate = np.array([0.0, 0.0, 0.3])
+    assert noise.sigma_of_state(q, v, rate, force) == pytest.approx(noise.sigma(10.0, 0.3, 0.0))
