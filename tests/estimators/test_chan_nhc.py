@@ -17,9 +17,19 @@ from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.earth import euler_to_dcm, euler_to_quat
 from simulator.errors import InputError
+from simulator.replay import run_estimator
+from simulator.reproduce.chan import LEVER_ARM
+from simulator.reproduce.measures import position_error_3d
 from simulator.scenario import load_scenario
 from tests.conftest import REPO
-from tests.estimators.chan_helpers import run
+
+
+def run(dataset, name: str, **config):
+    """Solution of a filter with the Chan scenarios' antenna lever arm, and its 3-D error."""
+    solution, _ = run_estimator(dataset, {"name": name,
+                                          "config": {"lever_arm": LEVER_ARM, **config}},
+                                show_progress=False)
+    return solution, position_error_3d(dataset, solution)[1]
 
 
 def test_points_form_is_the_jacobian_form_at_every_point():
