@@ -53,7 +53,12 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   preset), small bias random walks, and the receiver-clock model of a TCXO
   (``gnss_model.clock_noise``). R: the receiver's reported pseudorange and pseudorange-rate
   1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``); the config's
-  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them.
+  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them; white,
+  as the paper treats them, unless ``pseudorange_correlation_time`` (s) names the correlation
+  time of the pseudorange errors, which scales their sigma by
+  ``gnss_model.correlated_noise_inflation`` (a receiver's errors are correlated over its carrier
+  smoothing and longer: with white R the filters' position NEES is 40-90 on open sky,
+  docs/reproduction_chan.md).
 * The EKF (eqs. 4-6): position error rate dr' = dv as printed (eq. 4), velocity and attitude error
   equations in the psi convention of ``nav_error`` (eq. 5: -[f^n x] psi - C_b^n dba
   - (2 w_ie + w_en) x dv - (2 dw_ie + dw_en) x v; eq. 6: psi' = -w_in x psi - C_b^n dbg - dw_in,
