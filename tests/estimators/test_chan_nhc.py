@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests.estimators.chan_helpers import run
 
 from estimators.toolbox.constraints import (
     NonholonomicNoise,
