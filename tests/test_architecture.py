@@ -43,6 +43,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("scoring", ("simulator.scoring",)),
     ("pipeline", ("simulator.pipeline",)),
     ("campaign", ("simulator.campaign",)),
+    ("reproduce", ("simulator.reproduce",)),
     ("commands", ("simulator.commands", "simulator.cli")),
 ]
 ANYWHERE = {"estimators.registry"}  # the estimator name registry

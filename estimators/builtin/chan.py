@@ -32,11 +32,20 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   again from it before the measurement update.
 * Eq. 7 lacks the receiver position and prints "+" for a product: the model is
   ``estimators.toolbox.gnss_model`` (range to r_ins + C_b^n l_b, with the Sagnac rotation).
-* NHC: the rows are the body y and z velocities (the paper's text says "x and y" once), noise
-  ``nhc_std`` (0.1 m/s, covering the road's bumps and a small mounting misalignment; the paper
-  prints no value). It is stacked with the GPS measurements at each GPS epoch and applied alone at
-  1 Hz when an expected GPS epoch has not come half an interval after its time (complete
-  outages).
+* NHC: the rows are the body y and z velocities (the paper's text says "x and y" once) of the
+  point where the constraint holds on a car, the rear axle (the wheels there do not steer;
+  ``constraints.nonholonomic`` with the lever arm of the datasheet's rear axle,
+  ``toolbox.installation``; at the IMU itself on a rigid body or with ``nhc_point: imu``):
+  v^b = C_n^b v^n + w x r with w the compensated gyro rate. The paper says its R^v "depends on
+  the noise of forward velocity and misalignment angle" and prints no value; here its 1-sigma
+  is the car's physics (``constraints.NonholonomicNoise`` from the datasheet's wheelbase: the
+  rear tyres' slip growing with speed times lateral acceleration, the body's pitch on its
+  springs, the road's roughness, over a 0.1 m/s floor), evaluated at the filter's speed, yaw
+  rate and forward acceleration of each update; at the IMU, the floor, 0.1 m/s (the value
+  chosen for a rigid body before). ``nhc_std`` (a number) fixes it instead. The UKF predicts
+  the rows of every sigma point with ``constraints.body_velocity_points``. It is stacked with
+  the GPS measurements at each GPS epoch and applied alone at 1 Hz when an expected GPS epoch
+  has not come half an interval after its time (complete outages).
 * Not printed: P0, Q, R. P0: ``initial_position_std`` per axis (10 m), 0.5 m/s, 1 deg roll and
   pitch, 3 deg yaw, the bias priors of an automotive MEMS IMU (10 mg, 0.2 deg/s), cb and d taken
   from the first GPS epoch's residuals with 30 m and 3 m/s. Q: white noise of the IMU (config
@@ -44,7 +53,12 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   preset), small bias random walks, and the receiver-clock model of a TCXO
   (``gnss_model.clock_noise``). R: the receiver's reported pseudorange and pseudorange-rate
   1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``); the config's
-  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them.
+  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them; white,
+  as the paper treats them, unless ``pseudorange_correlation_time`` (s) names the correlation
+  time of the pseudorange errors, which scales their sigma by
+  ``gnss_model.correlated_noise_inflation`` (a receiver's errors are correlated over its carrier
+  smoothing and longer: with white R the filters' position NEES is 40-90 on open sky,
+  docs/reproduction_chan.md).
 * The EKF (eqs. 4-6): position error rate dr' = dv as printed (eq. 4), velocity and attitude error
   equations in the psi convention of ``nav_error`` (eq. 5: -[f^n x] psi - C_b^n dba
   - (2 w_ie + w_en) x dv - (2 dw_ie + dw_en) x v; eq. 6: psi' = -w_in x psi - C_b^n dbg - dw_in,
@@ -71,15 +85,18 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gnss_model, nav_error
+from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import (
     OMEGA_E_RAD_S,
+    dcm_to_euler,
     earth_rate_ned,
     geodetic_rates,
     geodetic_to_ecef,
     ned_to_ecef_matrix,
+    normal_gravity,
     quat_multiply,
     quat_to_dcm,
     quat_to_euler,
@@ -87,6 +104,7 @@ from simulator.earth import (
     rotvec_to_quat,
     skew,
 )
+from simulator.errors import InputError
 from simulator.units import DEG_S, DEG_S_RT_HZ, MILLI_G, MILLI_G_RT_HZ
 
 N_STATES = 17  # [dr(3), dv(3), psi(3), ba(3), bg(3), cb, d]
@@ -96,11 +114,13 @@ PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Veh
          "(tightly coupled INS/GPS, UKF vs EKF, NHC)")
 COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
+NHC_POINTS = ("rear_axle", "imu")
 
 
 DEFAULTS = {
     "nhc": True,
-    "nhc_std": 0.1,  # m/s, body y and z velocity
+    "nhc_std": None,  # m/s, body y and z velocity; None: from the car's physics (docstring)
+    "nhc_point": "rear_axle",  # where the NHC holds: rear_axle (the datasheet's) or imu
     "nhc_rate": 1.0,  # Hz, NHC alone when GPS is missing
     "lever_arm": [0.0, 0.0, 0.0],  # IMU to GPS antenna, body FRD, m
     "initial_position_std": 10.0,  # m per axis
@@ -114,6 +134,9 @@ DEFAULTS = {
     "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
     "pseudorange_std": 3.0,  # m, when the stream reports none
     "range_rate_std": 0.1,  # m/s, when the stream reports none
+    # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
+    "pseudorange_correlation_time": 0.0,
+    "gnss_interval": 1.0,  # s, the epoch interval the correlation is counted in
 }
 
 
@@ -133,6 +156,16 @@ class _TightlyCoupled(Estimator):
         self._accel_idx = [imu[c] for c in ("accel_x", "accel_y", "accel_z")]
         self._increments = self.imu_output == "increment"
         self._lever = np.asarray(cfg["lever_arm"], dtype=float)
+        self._pr_inflation = gnss_model.correlated_noise_inflation(
+            cfg["pseudorange_correlation_time"], cfg["gnss_interval"])
+        if cfg["nhc_point"] not in NHC_POINTS:
+            raise InputError(f"config of {self.name}: nhc_point must be one of "
+                             f"{', '.join(NHC_POINTS)}, got {cfg['nhc_point']!r}")
+        site = Installation.from_datasheet(self.datasheet)
+        self._nhc_point = site.rear_axle if cfg["nhc_point"] == "rear_axle" else None
+        self._nhc_physics = (constraints.NonholonomicNoise(site.wheelbase or 2.7)
+                             if cfg["nhc_std"] is None and self._nhc_point is not None
+                             else None)
         self._t_imu: float | None = None
         self._w_prev = np.zeros(3)
         self._f_prev = np.zeros(3)
@@ -172,12 +205,27 @@ class _TightlyCoupled(Estimator):
         q[15:17, 15:17] = gnss_model.clock_noise(dt)
         return q
 
-    def _measurement_noise(self, ep: gnss_model.RawEpoch, with_nhc: bool) -> np.ndarray:
+    def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         cfg = self.config
         pr = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std, cfg["pseudorange_std"])
+        pr = pr * self._pr_inflation
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
-        nhc = [cfg["nhc_std"]] * 2 if with_nhc else []
-        return np.diag(np.concatenate([pr, rr, nhc]) ** 2)
+        return np.diag(np.concatenate([pr, rr]) ** 2)
+
+    def _nhc_noise(self, c_bn: np.ndarray, v: np.ndarray, rate: np.ndarray, f: np.ndarray,
+                   pos: np.ndarray) -> np.ndarray:
+        """R of the two NHC rows (module docstring) at the estimate's attitude C_b^n, NED
+        velocity, compensated body rate and specific force (rad/s, m/s^2) and position."""
+        if self._nhc_physics is None:
+            sigma = self.config["nhc_std"]
+            if sigma is None:
+                sigma = constraints.NonholonomicNoise.floor
+            return np.eye(2) * sigma**2
+        pitch = dcm_to_euler(c_bn)[1]
+        forward_accel = f[0] - float(normal_gravity(pos[0], pos[2])) * np.sin(pitch)
+        lateral, vertical = self._nhc_physics.sigma(float((c_bn.T @ v)[0]), float(rate[2]),
+                                                    float(forward_accel))
+        return np.diag([lateral**2, vertical**2])
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         w, f, dt = self._imu_sample(t, row)
@@ -243,6 +291,17 @@ def _antenna_ecef(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, lever: np.nd
     c_ne = ned_to_ecef_matrix(lat, lon)
     r = geodetic_to_ecef(lat, lon, pos[..., 2]) + np.einsum("...ij,...j->...i", c_ne, off)
     return r, np.einsum("...ij,...j->...i", c_ne, v + voff), c_ne
+
+
+def _block_diagonal(blocks: list[np.ndarray]) -> np.ndarray:
+    """The block-diagonal matrix of square blocks."""
+    n = sum(len(b) for b in blocks)
+    out = np.zeros((n, n))
+    i = 0
+    for b in blocks:
+        out[i:i + len(b), i:i + len(b)] = b
+        i += len(b)
+    return out
 
 
 def _earth_rate_body(c_bn: np.ndarray, lat: np.ndarray) -> np.ndarray:
@@ -411,17 +470,24 @@ class TcUkf(_TightlyCoupled):
                                              pts[:, 17])
             parts += [pr, rate]
         if nhc:
-            parts.append(np.einsum("kji,kj->ki", c_bn, pts[:, VEL])[:, 1:3])
+            rate = self._w_prev[None, :] - pts[:, BG]
+            v_b = constraints.body_velocity_points(c_bn, pts[:, VEL], rate, self._nhc_point)
+            parts.append(v_b[:, 1:3])
         return np.concatenate(parts, axis=1)
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         nhc = bool(self.config["nhc"])
+        if ep is None and not nhc:
+            return
         self._predict(t)
-        if ep is None:
-            z, r = np.zeros(2), np.eye(2) * self.config["nhc_std"] ** 2
-        else:
-            z = np.concatenate([ep.pseudorange, ep.range_rate] + ([np.zeros(2)] if nhc else []))
-            r = self._measurement_noise(ep, nhc)
+        blocks = [] if ep is None else [self._measurement_noise(ep)]
+        z = [] if ep is None else [ep.pseudorange, ep.range_rate]
+        if nhc:
+            x = self.ukf.x
+            blocks.append(self._nhc_noise(quat_to_dcm(x[QUAT]), x[VEL], self._w_prev - x[BG],
+                                          self._f_prev - x[BA], x[POS]))
+            z.append(np.zeros(2))
+        z, r = np.concatenate(z), _block_diagonal(blocks)
         # the driver draws the points of N(x_bar, P^xx + Q), P^xy without R, P -= K P^yy K^T
         self.ukf.update(self._observe, z, r, ep, nhc)
 
@@ -554,20 +620,18 @@ class TcEkf(_TightlyCoupled):
             h_rr[:, 16] = 1.0
             dz += [pr - ep.pseudorange, rate - ep.range_rate]
             rows += [h_pr, h_rr]
-            noise.append(self._measurement_noise(ep, False))
+            noise.append(self._measurement_noise(ep))
         if nhc:
-            z_nhc, h_nhc = constraints.nonholonomic(self._q, self._v, N_STATES)
+            rate = self._w_prev - self._bg
+            z_nhc, h_nhc = constraints.nonholonomic(self._q, self._v, N_STATES, rate,
+                                                    self._nhc_point, slice(12, 15))
             dz.append(z_nhc)
             rows.append(h_nhc)
-            noise.append(np.eye(2) * self.config["nhc_std"] ** 2)
+            noise.append(self._nhc_noise(c_bn, self._v, rate, self._f_prev - self._ba,
+                                         self._pos))
         if not dz:
             return
-        r_all = np.zeros((sum(len(x) for x in dz),) * 2)
-        i = 0
-        for block in noise:
-            r_all[i:i + len(block), i:i + len(block)] = block
-            i += len(block)
-        self._err.update(np.concatenate(dz), np.vstack(rows), r_all)
+        self._err.update(np.concatenate(dz), np.vstack(rows), _block_diagonal(noise))
         dx = self._err.feedback()
         self._q, self._v, self._pos = nav_error.correct(self._q, self._v, self._pos, dx[0:9])
         self._ba = self._ba - dx[9:12]

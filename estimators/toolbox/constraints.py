@@ -26,7 +26,7 @@ Each function returns dz = h(estimate) - z, ready for ``kalman.ErrorState.update
 
 Public names
 ------------
-body_velocity, nonholonomic, NonholonomicNoise, height.
+body_velocity, body_velocity_points, nonholonomic, NonholonomicNoise, height.
 """
 
 from __future__ import annotations
@@ -75,6 +75,29 @@ def body_velocity(q: np.ndarray, v_ned: np.ndarray, n_states: int = 9,
         if gyro_bias is not None:
             h[:, gyro_bias] = skew(r)
     return v_b, h
+
+
+def body_velocity_points(c_bn: np.ndarray, v_ned: np.ndarray, rate_body: np.ndarray | None = None,
+                         lever_arm: np.ndarray | None = None) -> np.ndarray:
+    """``body_velocity``'s value for a set of states at once (the sigma points of an unscented
+    filter, which needs no Jacobian): C_n^b v^n + w^b x r.
+
+    Parameters
+    ----------
+    c_bn : (k, 3, 3) body-to-NED rotations; v_ned : (k, 3) NED velocities of the IMU, m/s.
+    rate_body : (k, 3), optional
+        Bias-compensated body rates, rad/s (needed with ``lever_arm``).
+    lever_arm : (3,), optional
+        The point from the IMU, body FRD, m; None: the IMU itself.
+
+    Returns
+    -------
+    v : (k, 3) the point's body-frame velocity of each state, m/s.
+    """
+    v_b = np.einsum("kji,kj->ki", c_bn, v_ned)
+    if lever_arm is not None:
+        v_b = v_b + np.cross(rate_body, np.asarray(lever_arm, dtype=float))
+    return v_b
 
 
 def nonholonomic(q: np.ndarray, v_ned: np.ndarray, n_states: int = 9,

@@ -12,6 +12,7 @@ SUMMARIES = {
     "score": "score solutions against a dataset's truth (table, JSON, report)",
     "run": "generate, run the scenario's estimators, score, write the report",
     "campaign": "Monte Carlo over seeds and sweeps, locally or on Dask; resumable",
+    "reproduce": "run the seed papers' experiments over seeds, judge each claim, report",
     "export": "write a dataset's GNSS streams as RINEX 3.04 and NMEA 0183",
     "schema": "print the JSON Schema of the scenario file (editor completion)",
     "presets": "list the sensor presets with their parameters",

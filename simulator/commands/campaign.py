@@ -9,7 +9,7 @@ import os
 from pathlib import Path
 
 from simulator.commands import SUMMARIES
-from simulator.commands.options import add_scenario_options
+from simulator.commands.options import add_scenario_options, worker_problems
 from simulator.errors import InputError, Problem
 
 
@@ -62,12 +62,7 @@ def _check_counts(args: argparse.Namespace) -> int:
         problems.append(Problem("landnav campaign", None, "--runs",
                                 f"must be between 1 and {MAX_RUNS:,}, got {args.runs:,}; "
                                 "split a larger study into campaigns"))
-    if args.workers is not None and args.scheduler:
-        problems.append(Problem("landnav campaign", None, "--workers", "a Dask cluster has its "
-                                "own workers: give --workers or --scheduler, not both"))
-    elif args.workers is not None and args.workers < 1:
-        problems.append(Problem("landnav campaign", None, "--workers",
-                                f"must be at least 1, got {args.workers}"))
+    problems += worker_problems("campaign", args.workers, args.scheduler)
     if args.scheduler_timeout <= 0:
         problems.append(Problem("landnav campaign", None, "--scheduler-timeout",
                                 f"must be positive, got {args.scheduler_timeout}"))

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from simulator.errors import Problem
+
 
 def add_scenario_options(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=None,
@@ -13,3 +15,15 @@ def add_scenario_options(parser: argparse.ArgumentParser) -> None:
                         help="override any scenario value, e.g. --set sensors.imu.rate=200 or "
                              "--set trajectory.segments.2.straight.length=500 (repeatable; "
                              "validated like the file and recorded in the manifest)")
+
+
+def worker_problems(command: str, workers: int | None, scheduler: str | None) -> list[Problem]:
+    """The problems of ``--workers`` and ``--scheduler`` (campaign, reproduce): both given, or
+    fewer than one worker."""
+    if workers is not None and scheduler:
+        return [Problem(f"landnav {command}", None, "--workers", "a Dask cluster has its own "
+                        "workers: give --workers or --scheduler, not both")]
+    if workers is not None and workers < 1:
+        return [Problem(f"landnav {command}", None, "--workers",
+                        f"must be at least 1, got {workers}")]
+    return []

@@ -15,9 +15,9 @@ from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.earth import euler_to_quat, quat_multiply, quat_to_dcm, radii_of_curvature
 from simulator.errors import InputError
+from simulator.reproduce.chan import run_filter
 from simulator.scenario import load_scenario
 from tests.conftest import REPO
-from tests.estimators.chan_helpers import run
 
 
 def _tangent_error(x_est: np.ndarray, x_true: np.ndarray) -> np.ndarray:
@@ -73,7 +73,7 @@ def noise_free(tmp_path_factory):
 
 @pytest.mark.parametrize("name", ["tc_ekf", "tc_ukf"])
 def test_noise_free_drive_gives_the_truth_and_the_receiver_clock(noise_free, name):
-    solution, error = run(noise_free, name)
+    solution, error = run_filter(noise_free, name)
     assert error.max() < 0.3
     truth = noise_free.read("truth")
     yaw = np.interp(solution["t"], truth["t"], np.unwrap(truth["yaw"]))

@@ -1,8 +1,8 @@
 """Cho & Choi 2006 estimators: the transition matrices against finite differences and the
 paper's eq. 17, the standstill gyro calibration against fixed biases, an error-free drive, and
 the issue's claims over ten seeds of the shipped scenarios, paired per seed
-(tests/estimators/cho2006_experiments.py measures them; docs/reproduction_cho2006.md lists
-the figures beside the paper's)."""
+(``simulator.reproduce.cho2006`` measures them, as ``landnav reproduce cho2006`` does;
+docs/reproduction_cho2006.md lists the figures beside the paper's)."""
 
 from __future__ import annotations
 
@@ -19,16 +19,33 @@ from estimators.builtin.cho2006 import (
 )
 from estimators.registry import get_estimator
 from simulator.dataset.generate import generate_dataset
-from simulator.dataset.io import open_dataset
+from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError
+from simulator.pipeline import estimate, generate, load_scenario
+from simulator.reproduce import cho2006 as exp
+from simulator.reproduce.measures import moving_off
+from simulator.reproduce.runner import SCENARIOS, run_experiment
 from simulator.scenario import Scenario, validate_data
-from tests.estimators import cho2006_experiments as exp
 from tests.synthetic import FLAT_LOOP
+
+SEEDS = range(1, 11)
 
 G = 9.8
 U2 = np.array([0.7, 0.05, -0.2])  # f_x, w_y, w_z
 U1 = np.array([0.7, 2.1, -0.2])  # f_x, f_y, w_z
 X = np.array([3.0, -4.0, 12.0, 0.05, 2.5, 0.02, -0.03, 0.05])
+
+
+def _dataset(name: str, seed: int, root, overrides: list[str] | None = None) -> Dataset:
+    """scenarios/<name>.yaml generated with ``seed`` under ``root`` (reused if present)."""
+    out = root / f"{name}-{seed}"
+    if not out.exists():
+        generate(load_scenario(SCENARIOS / f"{name}.yaml", overrides, seed), out)
+    return open_dataset(out)
+
+
+def _run(ds: Dataset, name: str, config: dict | None = None):
+    return estimate(ds, {"name": name, "label": None, "init": None, "config": config})[0]
 
 
 def _numeric_jacobian(f, x: np.ndarray, step: float = 1e-6) -> np.ndarray:
@@ -84,14 +101,14 @@ def test_standstill_calibration_finds_fixed_gyro_biases(root, name):
     """Gyro biases fixed at 0.01, 0.02, -0.03 rad/s, no other IMU error: the 10 s standstill
     returns them plus the Earth rate on the body axes (< 6e-5 rad/s at 36 deg N)."""
     bias = [0.01, 0.02, -0.03]
-    ds = exp.dataset("cho2006_situation2", 1, root / "bias", [
+    ds = _dataset("cho2006_situation2", 1, root / "bias", [
         "sensors.imu.preset=ideal", f"sensors.imu.gyro.bias={{fixed: {bias}}}".replace(" ", ""),
     ])
-    sol = exp.run(ds, name)
+    sol = _run(ds, name)
     assert sol["gyro_bias_z"].iloc[-1] == pytest.approx(bias[2], abs=6e-5)
     if "gyro_bias_y" in sol:
         assert sol["gyro_bias_y"].iloc[-1] == pytest.approx(bias[1], abs=6e-5)
-    off = exp.run(ds, name, config={"standstill_calibration": False})
+    off = _run(ds, name, config={"standstill_calibration": False})
     assert np.all(off["gyro_bias_z"] == 0.0)
 
 
@@ -104,14 +121,14 @@ def test_error_free_sensors_track_the_drive(root):
     # a rigid body: the error-free case checks the filters' own integration (on the automotive
     # body, which rolls, pitches and slips where the planar model assumes a level body without
     # slip, the EKF's error is 2.2 m)
-    ds = exp.dataset("cho2006_situation2", 1, root / "ideal",
+    ds = _dataset("cho2006_situation2", 1, root / "ideal",
                      ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal", "vehicle=rigid"])
-    t, horizontal, d_yaw = exp.errors(ds, exp.run(ds, "dr2d_drm2_ekf"))
+    t, horizontal, d_yaw = exp.track_errors(ds, _run(ds, "dr2d_drm2_ekf"))
     assert horizontal.max() < 0.5
     assert np.abs(d_yaw).max() < 0.3
     assert t[-1] > 150.0
-    t, horizontal, d_yaw = exp.errors(ds, exp.run(ds, "dr2d_drm2_spkf"))
-    late = t >= exp.moving_off(ds) + exp.SETTLE_S
+    t, horizontal, d_yaw = exp.track_errors(ds, _run(ds, "dr2d_drm2_spkf"))
+    late = t >= moving_off(ds.read("truth")) + exp.SETTLE_S
     assert horizontal[late].max() < 2.0
     assert np.abs(d_yaw[late]).max() < 1.0
 
@@ -128,7 +145,7 @@ def test_drm1_follows_a_flat_drive_with_error_free_sensors(tmp_path):
                         "gnss": {"preset": "ideal", "rate": 1, "outputs": ["fix"]}}}
     scenario = Scenario(tmp_path / "flat.yaml", validate_data(data, "flat.yaml"), [])
     ds = open_dataset(generate_dataset(scenario, tmp_path / "flat", show_progress=False))
-    t, horizontal, d_yaw = exp.errors(ds, exp.run(ds, "dr2d_drm1_ekf"))
+    t, horizontal, d_yaw = exp.track_errors(ds, _run(ds, "dr2d_drm1_ekf"))
     assert horizontal.max() < 0.5
     assert np.abs(d_yaw).max() < 0.5
 
@@ -137,14 +154,14 @@ def test_increment_output_gives_the_rate_output_solution(root):
     """The IMU samples are averaged over each 0.1 s step from rates or from increments alike."""
     # rigid, as the error-free case above (same dataset); on the automotive body the two
     # outputs differ by 0.09 m, the vibration's share of averaging rates against increments
-    rates = exp.dataset("cho2006_situation2", 1, root / "ideal",
+    rates = _dataset("cho2006_situation2", 1, root / "ideal",
                         ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal",
                          "vehicle=rigid"])
-    increments = exp.dataset("cho2006_situation2", 1, root / "increments",
+    increments = _dataset("cho2006_situation2", 1, root / "increments",
                              ["sensors.imu.preset=ideal", "sensors.gnss.preset=ideal",
                               "sensors.imu.output=increment", "vehicle=rigid"])
-    _, h_rate, yaw_rate = exp.errors(rates, exp.run(rates, "dr2d_drm2_ekf"))
-    _, h_inc, yaw_inc = exp.errors(increments, exp.run(increments, "dr2d_drm2_ekf"))
+    _, h_rate, yaw_rate = exp.track_errors(rates, _run(rates, "dr2d_drm2_ekf"))
+    _, h_inc, yaw_inc = exp.track_errors(increments, _run(increments, "dr2d_drm2_ekf"))
     assert h_inc.max() < 0.5 and np.abs(yaw_inc).max() < 0.3
     assert abs(h_inc.max() - h_rate.max()) < 0.1
 
@@ -152,20 +169,21 @@ def test_increment_output_gives_the_rate_output_solution(root):
 @pytest.mark.parametrize("config, key", [({"alpha": 0.0}, "alpha"), ({"alpha": 1.5}, "alpha"),
                                          ({"w0": 1.0}, "w0"), ({"beta": -1.0}, "beta")])
 def test_spkf_refuses_parameters_outside_their_ranges(root, config, key):
-    ds = exp.dataset("cho2006_situation2", 1, root)
+    ds = _dataset("cho2006_situation2", 1, root)
     with pytest.raises(InputError, match=f"'{key}' of estimator dr2d_drm2_spkf"):
-        exp.run(ds, "dr2d_drm2_spkf", config=config)
+        _run(ds, "dr2d_drm2_spkf", config=config)
 
 
 # -- the claims of issue 14, ten seeds each --------------------------------------------------
 
 @pytest.fixture(scope="module")
 def situation2(root):
-    return [exp.dataset("cho2006_situation2", s, root) for s in exp.SEEDS]
+    """Situation II over ten seeds: every filter from every initial heading error."""
+    return run_experiment(exp.SITUATION2, SEEDS, root)
 
 
-def _converged(datasets, name: str, angle: float) -> list[bool]:
-    return [exp.heading_rms(ds, name, angle) < exp.CONVERGED_DEG for ds in datasets]
+def _converged(table, name: str, angle: float) -> list[bool]:
+    return list(table[f"{exp.heading_label(name, angle)}.heading_rms_deg"] < exp.CONVERGED_DEG)
 
 
 def test_spkf_converges_from_minus_140_deg(situation2):
@@ -193,20 +211,24 @@ def test_spkf_converges_at_least_as_often_as_the_ekf_at_large_errors(situation2)
 def test_drm2_dead_reckoning_beats_drm1_after_gnss_loss(root):
     """Paper, section II and Fig. 12: DRM2 reflects the rotary motion; DRM1 does not. Paired
     per seed, horizontal error 120 s after the loss on the curved drive."""
-    wins = 0
-    for seed in exp.SEEDS:
-        ds = exp.dataset("cho2006_dr_outage", seed, root)
-        wins += exp.dr_error(ds, "dr2d_drm2_ekf") < exp.dr_error(ds, "dr2d_drm1_ekf")
+    table = run_experiment(exp.DR_OUTAGE, SEEDS, root)
+    wins = int((table["drm2.dr_error_m"] < table["drm1.dr_error_m"]).sum())
     assert wins >= 8
 
 
+@pytest.fixture(scope="module")
+def situation1(root):
+    return run_experiment(exp.SITUATION1, SEEDS, root)
+
+
 @pytest.mark.parametrize("name", ["dr2d_drm2_ekf", "dr2d_drm2_spkf"])
-def test_situation1_z_gyro_scale_factor_is_estimated_by_100_s(root, name):
+def test_situation1_z_gyro_scale_factor_is_estimated_by_100_s(situation1, name):
     """Situation I (eq. 36, Fig. 7(d)): the z-gyro scale factor -0.1 is within 0.02 from
     100 s on."""
-    for seed in exp.SEEDS:
-        ds = exp.dataset("cho2006_situation1", seed, root)
-        assert exp.z_scale_factor_error(ds, name) < 0.02, seed
+    errors = situation1[f"{exp.SHORT[name]}.z_scale_factor_error"]
+    for seed, error in errors.items():
+        assert error < 0.02, seed
+
 
 
 @pytest.mark.parametrize("name", ["dr2d_drm2_ekf", "dr2d_drm1_ekf"])
@@ -235,7 +257,7 @@ def test_every_stop_recalibrates_a_drifting_gyro_bias(tmp_path, name):
     second = truth.loc[(truth["t"] > stopped[0]) & (truth["t"] < stopped[-1]),
                        "gyro_bias_z"].mean()
     assert abs(second - first) > 2e-3  # the ramp moved the bias between the stops
-    sol = exp.run(ds, name)
+    sol = _run(ds, name)
     t = sol["t"].to_numpy()
     between = sol["gyro_bias_z"].to_numpy()[(t > 20.0) & (t < stopped[0])]
     assert np.allclose(between, first, atol=6e-5)

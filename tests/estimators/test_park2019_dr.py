@@ -1,17 +1,22 @@
 """Park et al. 2019 dead-reckoning filters (``dr2d_odo_ekf``, ``dr3d_ekf``): the navigation
 processor against exact kinematics, the error model's Jacobians against finite differences, and
-the paper's garage claims over ten seeds (figures in docs/reproduction_park2019.md)."""
+the paper's garage claims over ten seeds (figures in docs/reproduction_park2019.md), computed
+by ``simulator.reproduce.park2019`` (what ``landnav reproduce park2019`` runs)."""
 
 from __future__ import annotations
 
 import math
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from estimators.builtin.park2019_dr import _dr3d_navigate, euler_error_jacobian
+from estimators.registry import BUILTINS
 from simulator.earth import dcm_to_euler, euler_to_dcm, euler_to_quat, radii_of_curvature, skew
-from tests.estimators import park2019_compare as cmp
+from simulator.pipeline import generate, load_scenario
+from simulator.reproduce import park2019
+from simulator.reproduce.runner import SCENARIOS, run_experiment
 
 SEEDS = list(range(1, 11))
 
@@ -42,8 +47,10 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     integration leaves 0.8 m horizontal and 4 m height error (a finding noted in the docs)."""
     # a rigid body: the speed used is the truth's along-body speed, which only a rigid body's
     # velocity equals (the automotive body slips and heaves: 3.4 m after the drive)
-    ds = cmp.generate_garage(tmp_path / "g", 1, ["sensors.imu.preset=ideal",
-                                                 "trajectory.rate=200", "vehicle=rigid"])
+    scenario = load_scenario(SCENARIOS / park2019.GARAGE.scenario,
+                             ["sensors.imu.preset=ideal", "trajectory.rate=200", "vehicle=rigid"],
+                             1)
+    ds = generate(scenario, tmp_path / "g")
     truth = ds.read("truth")
     t = truth["t"].to_numpy()
     rates = truth[["wx", "wy", "wz"]].to_numpy()
@@ -73,35 +80,30 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     assert abs(math.remainder(yaw - truth["yaw"].iloc[-1], 2 * math.pi)) < math.radians(0.01)
 
 
-# the CI length of the garage: the open road before it and after it shorter, the parking stop
-# shorter; the garage's helices, ramps and laps unchanged (425 s -> about 300 s)
-SHORT = ["trajectory.segments.0.stop.duration=5", "trajectory.segments.2.straight.length=120",
-         "trajectory.segments.4.straight.length=120", "trajectory.segments.6.straight.length=100",
-         "trajectory.segments.17.stop.duration=5", "trajectory.segments.27.straight.length=60",
-         "trajectory.segments.29.straight.length=60"]
 
 
 @pytest.fixture(scope="module", params=["short", pytest.param("full", marks=pytest.mark.slow)])
-def length(request) -> list[str]:
-    """Overrides of the drive length: the shortened CI drive, or the scenario as shipped."""
-    return SHORT if request.param == "short" else []
+def quick(request) -> bool:
+    """The drive length: the shortened CI drive (``park2019.SHORT``, the experiments' quick
+    overrides: 425 s -> about 300 s, the garage unchanged), or the scenario as shipped."""
+    return request.param == "short"
 
 
 @pytest.fixture(scope="module")
-def garage(length, tmp_path_factory) -> dict:
-    """The garage (true odometer scale factor 1.03) over ten seeds, every registered filter."""
-    return cmp.compare_seeds(SEEDS, length, work=tmp_path_factory.mktemp("garage"))
+def garage(quick, tmp_path_factory) -> pd.DataFrame:
+    """The garage (true odometer scale factor 1.03) over ten seeds, the paper's three filters."""
+    return run_experiment(park2019.GARAGE, SEEDS, tmp_path_factory.mktemp("garage"), quick)
 
 
 @pytest.fixture(scope="module")
-def flat_garage(length, tmp_path_factory) -> dict:
-    """The same garage made flat with a perfect odometer, ten seeds."""
-    return cmp.compare_seeds(SEEDS, [*cmp.FLAT_PERFECT, *length],
-                             work=tmp_path_factory.mktemp("flat"))
+def flat_garage(quick, tmp_path_factory) -> pd.DataFrame:
+    """The same garage made flat with a perfect odometer (``park2019.FLAT_PERFECT``), ten
+    seeds."""
+    return run_experiment(park2019.FLAT, SEEDS, tmp_path_factory.mktemp("flat"), quick)
 
 
-def _column(results: dict, name: str, key: str) -> np.ndarray:
-    return np.array([results[s][name][key] for s in SEEDS])
+def _column(table: pd.DataFrame, name: str, key: str) -> np.ndarray:
+    return table[f"{name}.{key}"].to_numpy()
 
 
 DR2D_NOT_SHOWN = (
@@ -119,7 +121,7 @@ INS_NOT_SHOWN = (
 def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
     """A filter as a test parameter: skipped when not registered, expected to fail with a
     reason (the measured figures) when ``xfail`` is given."""
-    marks = [pytest.mark.skipif(name not in cmp.registered_filters(),
+    marks = [pytest.mark.skipif(name not in BUILTINS,
                                 reason=f"{name} is not registered")]
     if xfail:
         marks.append(pytest.mark.xfail(strict=strict, reason=xfail))
@@ -131,7 +133,7 @@ def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
 def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
     """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
     least 8 of 10 seeds (paired per seed)."""
-    for key in ("exit_horizontal", "max_horizontal"):
+    for key in ("exit_horizontal_m", "max_horizontal_m"):
         wins = _column(garage, "dr3d_ekf", key) < _column(garage, other, key)
         assert wins.sum() >= 8, (key, wins.sum())
 
@@ -142,7 +144,7 @@ def test_flat_garage_with_perfect_odometer_removes_the_advantage(flat_garage, ot
     exit and maximum error to the baseline's lies between 0.7 and 1.3. Against ins_odo_ekf
     with its NHC at the rear axle (issue 14): 0.93 exit, 0.96 max (it was 0.66 and 0.28 with
     the NHC at the IMU, an expected failure then)."""
-    for key in ("exit_horizontal", "max_horizontal"):
+    for key in ("exit_horizontal_m", "max_horizontal_m"):
         ratio = _column(flat_garage, "dr3d_ekf", key) / _column(flat_garage, other, key)
         assert 0.7 <= np.median(ratio) <= 1.3, (key, np.median(ratio))
 
@@ -150,19 +152,18 @@ def test_flat_garage_with_perfect_odometer_removes_the_advantage(flat_garage, ot
 def test_dr3d_height_change_through_the_garage(garage):
     """Park Fig. 19: the height change from garage entry to exit within 2 m of the truth
     (paper: 1.22 m change for the 3-D DR, 22.34 m for INS/GPS/odometer), every seed."""
-    err = _column(garage, "dr3d_ekf", "height_change_error")
+    err = _column(garage, "dr3d_ekf", "height_change_error_m")
     assert np.all(err < 2.0), err
 
 
 @pytest.mark.parametrize("scale", [1.03, 0.97])
-def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, length, scale):
+def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, quick, scale):
     """Park section III-E, Fig. 9: the odometer scale factor (true 1.03 and 0.97) estimated
     within 0.5 % when GNSS is lost at the garage entry, every seed."""
     if scale == 1.03:
         rel = _column(garage, "dr3d_ekf", "scale_at_entry")
     else:
-        runs = cmp.compare_seeds(SEEDS, [f"sensors.odometer.scale_factor={scale}", *length],
-                                 names=["dr3d_ekf"], work=tmp_path)
+        runs = run_experiment(park2019.SCALE_097, SEEDS, tmp_path, quick)
         rel = _column(runs, "dr3d_ekf", "scale_at_entry")
     assert np.all(np.abs(rel) < 0.005), rel
 
@@ -170,14 +171,13 @@ def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, length, scale):
 @pytest.mark.parametrize("name", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf"), "dr3d_ekf"])
 def test_filters_work_outside_the_outages(garage, name):
     """Horizontal RMS outside the GNSS outages under 5 m, every seed."""
-    rms = _column(garage, name, "rms_outside")
+    rms = _column(garage, name, "rms_outside_m")
     assert np.all(rms < 5.0), rms
 
 
 def test_open_sky_blockage_stays_bounded(tmp_path):
     """Park Figs. 14-15: GNSS blocked for 40 s on an interchange ramp in open sky, the 3-D
     DR/GPS's horizontal error stays under 7 m, every seed (measured: at most 4.0 m)."""
-    scenario = cmp.REPO / "scenarios" / "park2019_open_sky_blockage.yaml"
-    runs = cmp.compare_seeds(SEEDS, names=["dr3d_ekf"], work=tmp_path, scenario=scenario)
-    worst = _column(runs, "dr3d_ekf", "max_horizontal")
+    runs = run_experiment(park2019.OPEN_SKY, SEEDS, tmp_path)
+    worst = _column(runs, "dr3d_ekf", "max_horizontal_m")
     assert np.all(worst < 7.0), worst

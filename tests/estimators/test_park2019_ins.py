@@ -12,39 +12,27 @@ import pytest
 from estimators.base import InitialState
 from estimators.builtin.park2019_ins import ParkInsOdometer
 from simulator.errors import InputError
-from tests.estimators.paired_runs import paired_scores, spread
+from simulator.reproduce import park2019
+from simulator.reproduce.measures import spread_text as spread
+from simulator.reproduce.runner import run_experiment
 
-SCENARIOS = ["scenarios/park2019_underground_garage.yaml", "scenarios/parking_garage.yaml"]
+EXPERIMENTS = [park2019.INS_PARK_GARAGE, park2019.INS_PARKING_GARAGE]
 SEEDS = range(1, 11)
 
 
-def _rms_outside_outages(scored, events) -> float:
-    e = scored.errors.errors
-    t = e["t"].to_numpy()
-    inside = np.zeros(len(t), dtype=bool)
-    for t0, t1 in events.loc[events["kind"] == "gnss_outage", ["t_start", "t_end"]].to_numpy():
-        inside |= (t >= t0) & (t < t1)
-    h = e["err_h"].to_numpy()[~inside]
-    return float(np.sqrt(np.nanmean(h**2)))
-
-
-def _garage_max(scored, events) -> float:
-    (outage,) = scored.scores["outages"]
-    return outage["max_horizontal"]
-
-
-@pytest.fixture(scope="module", params=SCENARIOS)
+@pytest.fixture(scope="module", params=EXPERIMENTS, ids=lambda e: e.scenario)
 def runs(request, tmp_path_factory) -> dict[str, np.ndarray]:
-    entries = {"nhc": {"name": "ins_odo_ekf"},
-               "no_nhc": {"name": "ins_odo_ekf", "config": {"nhc": False}}}
+    """label -> per seed (horizontal RMS outside the outages, largest error in the garage's
+    outage), figures of ``simulator.reproduce.park2019``, full-length drives."""
     # on the default automotive body: the constraint at the rear axle (from the datasheet's
     # installation geometry), its noise from the bicycle model's tyre slip. Measured, ten seeds:
     # RMS outside the outages median 2.77 m (1.64-3.02) on Park's garage, 3.29 m (2.48-3.85) on
     # parking_garage.yaml; garage maximum with the NHC 20.8 / 21.1 m against 43.9 / 44.6 m
     # without. At the IMU instead (nhc_point: imu), where the car slips sideways by up to 11 deg
     # in the 8 m turns, it is 3.38 / 7.88 m and 72.0 / 48.7 m: the violated constraint hurts
-    return paired_scores(request.param, entries, SEEDS, tmp_path_factory.mktemp("park"), (),
-                         lambda s, ev: (_rms_outside_outages(s, ev), _garage_max(s, ev)))
+    table = run_experiment(request.param, SEEDS, tmp_path_factory.mktemp("park"))
+    return {label: table[[f"{label}.rms_outside_m", f"{label}.max_horizontal_m"]].to_numpy()
+            for label in request.param.entries}
 
 
 def test_horizontal_rms_outside_outages_is_under_5_m(runs):

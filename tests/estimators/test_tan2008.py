@@ -10,23 +10,19 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from tests.estimators.paired_runs import paired_scores, spread
+from simulator.reproduce import tan2008
+from simulator.reproduce.measures import spread_text as spread
+from simulator.reproduce.runner import run_experiment
 
-SCENARIO = "scenarios/tan2008_outage.yaml"
 SEEDS = range(1, 11)
-ENTRIES = {
-    "full": {"name": "ins_lkf"},
-    "constraints": {"name": "ins_lkf", "config": {"mag_heading": False}},
-    "free": {"name": "ins_lkf",
-             "config": {"nhc": False, "height_constraint": False, "mag_heading": False}},
-}
-# the last straight (segment 16) shortened: the drive ends about 20 s after the outage
-SHORT = ["trajectory.segments.16.straight.length=200"]
 
 
-def _outage_end(scored, events) -> float:
-    (outage,) = scored.scores["outages"]
-    return outage["end_horizontal"]
+def _end_errors(quick: bool, work) -> dict[str, np.ndarray]:
+    """The outage-end error of each configuration per seed (``simulator.reproduce.tan2008``;
+    ``quick``: the drive cut 20 s after the outage)."""
+    table = run_experiment(tan2008.OUTAGE, SEEDS, work, quick=quick)
+    return {label: table[f"{label}.end_horizontal_m"].to_numpy() for label in
+            tan2008.OUTAGE.entries}
 
 
 def _check(end: dict[str, np.ndarray]) -> None:
@@ -41,8 +37,7 @@ def _check(end: dict[str, np.ndarray]) -> None:
 
 @pytest.fixture(scope="module")
 def short_runs(tmp_path_factory) -> dict[str, np.ndarray]:
-    return paired_scores(SCENARIO, ENTRIES, SEEDS, tmp_path_factory.mktemp("tan"), SHORT,
-                         _outage_end)
+    return _end_errors(True, tmp_path_factory.mktemp("tan"))
 
 
 def test_constraints_and_magnetometer_on_the_70_s_outage(short_runs):
@@ -57,4 +52,4 @@ def test_outage_error_is_that_of_the_open_loop_ins_without_aiding(short_runs):
 
 @pytest.mark.slow
 def test_constraints_and_magnetometer_full_length(tmp_path):
-    _check(paired_scores(SCENARIO, ENTRIES, SEEDS, tmp_path, (), _outage_end))
+    _check(_end_errors(False, tmp_path))

@@ -1,0 +1,111 @@
+"""``landnav reproduce [PAPER...] -o DIR``: run the seed papers' experiments over seeds, judge
+every claim, write report.md and a self-contained report.html (``simulator.reproduce``)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import textwrap
+from pathlib import Path
+
+from simulator.commands import SUMMARIES
+from simulator.commands.options import worker_problems
+from simulator.errors import InputError, Problem
+from simulator.reproduce.papers import load_paper, paper_keys
+from simulator.reproduce.runner import FULL_SEEDS, QUICK_SEEDS, reproduce
+
+MAX_RUNS = 1000  # seeds per experiment
+
+
+def _papers_help() -> str:
+    lines = []
+    for key in paper_keys():
+        paper = load_paper(key)
+        scenarios = sorted({e.scenario for e in paper.experiments})
+        lines.append(f"  {key:12s} {paper.title}")
+        for name, items in (("claims", [c.key for c in paper.claims]),
+                            ("scenarios", scenarios)):
+            lines.append(textwrap.fill(f"{name}: {', '.join(items)}", 78,
+                                       initial_indent=" " * 15, subsequent_indent=" " * 17))
+    return "\n".join(lines)
+
+
+def _wrap(text: str) -> str:
+    """Each paragraph of ``text`` filled to 78 columns; indented lines kept as they are."""
+    return "\n\n".join(p if p.startswith(("  ", "Papers", "Examples")) else textwrap.fill(p, 78)
+                       for p in text.split("\n\n"))
+
+
+def add_parser(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "reproduce", help=SUMMARIES["reproduce"],
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+        description=_wrap(
+            "Reproduce the seed papers' claims. Each paper's experiments (a shipped scenario "
+            "and the estimators the paper compares) run over seeds 1..N; every estimator "
+            "replays the same dataset of a seed, so comparisons are paired per seed. Every "
+            "claim is then judged from the figures over seeds with one word (shown, partly, "
+            "not shown) and the reason, beside the paper's own figure and the conditions that "
+            "differ.\n\n"
+            "Writes DIR/report.md (with DIR/plots/), DIR/report.html (self-contained: plots "
+            "embedded), DIR/figures/PAPER/EXPERIMENT.parquet (index seed, one column per "
+            "figure) and DIR/failures.parquet when a run failed (the others go on; the report "
+            "names the seed and the error). Nothing is written until the run is complete.\n\n"
+            f"Papers (all when none is named):\n{_papers_help()}\n\n"
+            "Examples:\n"
+            "  landnav reproduce --quick -o out/repro          every paper, 3 seeds, short "
+            "drives\n"
+            "  landnav reproduce cho2006 tan2008 --runs 10 --workers 2 -o out/repro-ct\n"
+            "  landnav reproduce park2019 --scheduler tcp://10.0.0.5:8786 -o out/park"))
+    p.add_argument("papers", nargs="*", metavar="PAPER",
+                   help="paper keys (default: every registered paper)")
+    p.add_argument("--runs", type=int, default=None, metavar="N",
+                   help=f"seeds 1..N per experiment (default {FULL_SEEDS}; {QUICK_SEEDS} with "
+                        "--quick)")
+    p.add_argument("--quick", action="store_true",
+                   help="shortened drives (each experiment's quick overrides) and 3 seeds "
+                        "unless --runs says otherwise: a check in minutes, not the paper's "
+                        "full protocol")
+    p.add_argument("-o", "--output", required=True, metavar="DIR", help="report folder")
+    p.add_argument("--workers", type=int, default=None, metavar="W",
+                   help="local worker processes (default: the CPU count)")
+    p.add_argument("--scheduler", metavar="ADDRESS",
+                   help="run on the Dask cluster of this scheduler (tcp://host:port) instead of "
+                        "local processes; its workers need landnav and its scenarios/")
+    p.add_argument("--force", action="store_true",
+                   help="replace DIR if it exists and is not empty")
+    p.set_defaults(run=run)
+
+
+def _check(args: argparse.Namespace) -> int:
+    """The number of local workers; refuses unknown papers, N and W out of range, --workers
+    with --scheduler."""
+    problems = []
+    known = paper_keys()
+    for key in args.papers:
+        if key not in known:
+            problems.append(Problem("landnav reproduce", None, "PAPER",
+                                    f"unknown paper {key!r}; known: {', '.join(known)}"))
+    if args.runs is not None and not 1 <= args.runs <= MAX_RUNS:
+        problems.append(Problem("landnav reproduce", None, "--runs",
+                                f"must be between 1 and {MAX_RUNS}, got {args.runs}"))
+    problems += worker_problems("reproduce", args.workers, args.scheduler)
+    if problems:
+        raise InputError(problems)
+    return args.workers or os.cpu_count() or 1
+
+
+def run(args: argparse.Namespace) -> int:
+    workers = _check(args)
+    out = Path(args.output)
+    empty_dir = out.is_dir() and not out.is_symlink() and not any(out.iterdir())
+    results = reproduce(args.papers, args.runs, args.quick, out, workers, args.scheduler,
+                        show_progress=True, force=args.force or empty_dir)
+    for r in results:
+        words = [v.status for v in r.verdicts.values()]
+        failed = sum(len(e.failures) for e in r.experiments.values())
+        print(f"{r.paper.key}: {len(words)} claims: {words.count('shown')} shown, "
+              f"{words.count('partly')} partly, {words.count('not shown')} not shown"
+              + (f"; {failed} run(s) failed" if failed else ""))
+    print(f"report: {out / 'report.md'} and {out / 'report.html'}")
+    return 0

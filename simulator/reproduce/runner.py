@@ -1,0 +1,231 @@
+"""Reproduce papers: every experiment of every paper over seeds, on the campaign executor (local
+processes or a Dask scheduler, ``simulator.campaign.execute``), then every claim judged and the
+report written.
+
+One task is one (paper, experiment, seed): the seed's dataset is generated in a temporary folder,
+every entry of the experiment replays it (``simulator.pipeline.estimate``), the experiment's
+``measure`` turns the solutions into that seed's figures, and the dataset is deleted. A task that
+raises is recorded with its seed and error and the others go on; a claim whose figures are
+missing is judged on the seeds that have them (and says so).
+
+The output folder (written under a temporary name and renamed when complete,
+``simulator.outputs.atomic_output_dir``)::
+
+    DIR/report.md, DIR/report.html
+    DIR/figures/PAPER/EXPERIMENT.parquet   index seed, one column per figure
+    DIR/failures.parquet                    paper, experiment, seed, error (failed tasks only)
+
+Public names
+------------
+Settings, ExperimentResult, PaperResult, run_experiment, reproduce, seeds_of, QUICK_SEEDS,
+FULL_SEEDS.
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+import subprocess
+import tempfile
+import time
+import traceback
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from importlib.metadata import PackageNotFoundError
+from importlib.metadata import version as dist_version
+from pathlib import Path
+
+import pandas as pd
+
+from simulator.campaign.execute import completed, open_executor
+from simulator.outputs import atomic_output_dir
+from simulator.pipeline import estimate, generate, load_scenario
+from simulator.progress import progress
+from simulator.reproduce.paper import Experiment, Paper, Verdict
+from simulator.reproduce.papers import load_paper, paper_keys
+from simulator.reproduce.report import write_report
+
+__all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings",
+           "reproduce", "run_experiment", "seeds_of"]
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+FULL_SEEDS = 10  # seeds of a full run unless --runs says otherwise (issue 14: ten seeds)
+QUICK_SEEDS = 3  # seeds of --quick (issue 16: at least 3)
+SCHEDULER_TIMEOUT_S = 10.0
+
+
+def seeds_of(runs: int) -> list[int]:
+    """The seeds of a run: 1..runs."""
+    return list(range(1, runs + 1))
+
+
+def experiment_overrides(experiment: Experiment, quick: bool,
+                         extra: Sequence[str] = ()) -> list[str]:
+    """The --set overrides of an experiment: its own, then the quick ones, then ``extra``."""
+    return [*experiment.overrides, *(experiment.quick_overrides if quick else ()), *extra]
+
+
+def measure_seed(experiment: Experiment, seed: int, overrides: Sequence[str],
+                 work: Path) -> dict[str, float]:
+    """One seed of an experiment in-process: generate the dataset under ``work``, replay every
+    entry, measure, delete the dataset; the seed's figures."""
+    scenario = load_scenario(SCENARIOS / experiment.scenario, list(overrides), seed)
+    with tempfile.TemporaryDirectory(dir=work, prefix=f"{experiment.key}-{seed}-") as tmp:
+        dataset = generate(scenario, Path(tmp) / "dataset")
+        solutions = {label: estimate(dataset, {**entry, "label": label})[0]
+                     for label, entry in experiment.entries.items()}
+        return {name: math.nan if value is None else float(value)  # None: the scorer's "none"
+                for name, value in experiment.measure(dataset, solutions).items()}
+
+
+def run_experiment(experiment: Experiment, seeds: Sequence[int], work: Path,
+                   quick: bool = False, extra_overrides: Sequence[str] = ()) -> pd.DataFrame:
+    """An experiment over ``seeds`` in this process (the claim tests use it): a table with index
+    ``seed`` and one column per figure. Errors propagate."""
+    overrides = experiment_overrides(experiment, quick, extra_overrides)
+    rows = {seed: measure_seed(experiment, seed, overrides, work) for seed in seeds}
+    return _table(rows)
+
+
+def _table(rows: Mapping[int, Mapping[str, float]]) -> pd.DataFrame:
+    table = pd.DataFrame.from_dict(dict(rows), orient="index").sort_index()
+    table.index.name = "seed"
+    return table
+
+
+@dataclass(frozen=True)
+class _Task:
+    paper: str
+    experiment: str
+    seed: int
+    overrides: tuple[str, ...]
+
+
+def _execute(task: _Task) -> tuple[dict[str, float] | None, str | None, float]:
+    """A task on a worker: (figures, None, CPU seconds) or (None, the error's traceback, ...)."""
+    start = time.process_time()
+    try:
+        paper = load_paper(task.paper)
+        experiment = next(e for e in paper.experiments if e.key == task.experiment)
+        with tempfile.TemporaryDirectory(prefix="landnav-reproduce-") as work:
+            figures = measure_seed(experiment, task.seed, task.overrides, Path(work))
+        return figures, None, time.process_time() - start
+    except Exception:  # reported per seed in the report, the run goes on
+        return None, traceback.format_exc(limit=8), time.process_time() - start
+
+
+@dataclass
+class ExperimentResult:
+    """An experiment's figures over seeds and its failed seeds (seed -> error)."""
+
+    experiment: Experiment
+    table: pd.DataFrame
+    failures: dict[int, str] = field(default_factory=dict)
+
+
+@dataclass
+class PaperResult:
+    """A paper, its experiments' results and the verdict on each claim (claim key ->)."""
+
+    paper: Paper
+    experiments: dict[str, ExperimentResult]
+    verdicts: dict[str, Verdict]
+
+
+@dataclass(frozen=True)
+class Settings:
+    """What the report says about the run."""
+
+    seeds: tuple[int, ...]
+    quick: bool
+    workers: int | None
+    scheduler: str | None
+    wall_time_s: float
+    cpu_time_s: float
+    version: str
+
+
+def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict]:
+    """Every claim of a paper judged on its experiments' tables; a judge that raises (figures
+    missing because seeds failed) gives ``not shown`` with the error as its reason."""
+    out = {}
+    for claim in paper.claims:
+        try:
+            out[claim.key] = claim.judge(tables)
+        except Exception as exc:  # noqa: BLE001 - the report says why, the others are judged
+            out[claim.key] = Verdict("not shown", "no figure",
+                                     f"could not be judged: {type(exc).__name__}: {exc}")
+    return out
+
+
+def version() -> str:
+    """landnav's version and, in a git checkout, its commit."""
+    try:
+        text = f"landnav {dist_version('landnav')}"
+    except PackageNotFoundError:
+        text = "landnav (not installed)"
+    try:
+        commit = subprocess.run(["git", "-C", str(SCENARIOS.parent), "rev-parse", "--short",
+                                 "HEAD"], capture_output=True, text=True, timeout=10,
+                                check=True).stdout.strip()
+        text += f", commit {commit}"
+    except (OSError, subprocess.SubprocessError):
+        pass
+    return f"{text}, Python {platform.python_version()}"
+
+
+def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | str,
+              workers: int, scheduler: str | None = None, show_progress: bool = False,
+              force: bool = False) -> list[PaperResult]:
+    """Reproduce ``papers`` (keys of ``simulator.reproduce.papers.PAPERS``; all when empty) over
+    seeds 1..``runs`` (default 10, or 3 with ``quick``, which also shortens each experiment's
+    drive by its ``quick_overrides``), on ``workers`` local processes or the Dask
+    ``scheduler``; write the figures and the report into ``out`` (module docstring).
+
+    Raises
+    ------
+    InputError
+        An unknown paper, ``out`` existing without ``force``, a scheduler that does not answer.
+    """
+    loaded = [load_paper(key) for key in (papers or paper_keys())]
+    seeds = seeds_of(runs or (QUICK_SEEDS if quick else FULL_SEEDS))
+    tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)))
+             for p in loaded for e in p.experiments for seed in seeds]
+    figures: dict[tuple[str, str], dict[int, dict[str, float]]] = {}
+    failures: dict[tuple[str, str], dict[int, str]] = {}
+    start, cpu = time.monotonic(), 0.0
+    with atomic_output_dir(Path(out), force) as tmp:
+        with open_executor(workers, scheduler, SCHEDULER_TIMEOUT_S) as (executor, in_flight):
+            for task, future in progress(completed(executor, in_flight, _execute, tasks),
+                                         "reproduce", show_progress, total=len(tasks)):
+                key = (task.paper, task.experiment)
+                try:
+                    result, error, task_cpu = future.result()
+                except Exception as exc:  # a worker that died: this seed failed
+                    result, error, task_cpu = None, f"{type(exc).__name__}: {exc}", 0.0
+                cpu += task_cpu
+                if result is None:
+                    failures.setdefault(key, {})[task.seed] = error or "unknown error"
+                else:
+                    figures.setdefault(key, {})[task.seed] = result
+        results = []
+        for paper in loaded:
+            experiments = {}
+            for experiment in paper.experiments:
+                key = (paper.key, experiment.key)
+                table = _table(figures.get(key, {}))
+                experiments[experiment.key] = ExperimentResult(experiment, table,
+                                                               failures.get(key, {}))
+                path = tmp / "figures" / paper.key / f"{experiment.key}.parquet"
+                path.parent.mkdir(parents=True, exist_ok=True)
+                table.to_parquet(path)
+            verdicts = judge(paper, {k: r.table for k, r in experiments.items()})
+            results.append(PaperResult(paper, experiments, verdicts))
+        failed = [{"paper": p, "experiment": e, "seed": s, "error": err}
+                  for (p, e), per_seed in failures.items() for s, err in per_seed.items()]
+        if failed:
+            pd.DataFrame(failed).to_parquet(tmp / "failures.parquet")
+        settings = Settings(tuple(seeds), quick, None if scheduler else workers, scheduler,
+                            time.monotonic() - start, cpu, version())
+        write_report(tmp, results, settings)
+    return results

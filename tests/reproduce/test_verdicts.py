@@ -1,0 +1,138 @@
+"""The verdict logic of ``simulator.reproduce.measures`` and the paper modules' judges on
+synthetic per-seed figures: a claim is judged shown, partly or not shown as the criterion says."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from simulator.reproduce import cho2006, park2019, tan2008
+from simulator.reproduce import measures as m
+from simulator.reproduce.papers import PAPERS, load_paper, paper_keys
+from simulator.reproduce.runner import SCENARIOS, judge
+
+
+@pytest.mark.parametrize("fraction, n, need", [(0.9, 10, 9), (0.8, 10, 8), (0.9, 3, 3),
+                                               (0.8, 3, 3), (1.0, 7, 7), (0.5, 4, 2)])
+def test_needed_count_scales_the_criterion_to_the_seeds_run(fraction, n, need):
+    assert m.needed_count(fraction, n) == need
+
+
+@pytest.mark.parametrize("successes, status", [(10, "shown"), (9, "shown"), (8, "partly"),
+                                               (5, "partly"), (4, "not shown"), (0, "not shown")])
+def test_count_verdict_words(successes, status):
+    verdict = m.count_verdict(successes, 10, 0.9, "measured", "converges", "why not")
+    assert verdict.status == status
+    assert verdict.measured == "measured"
+    assert f"{successes}/10" in verdict.reason
+    assert ("why not" in verdict.reason) == (status != "shown")
+
+
+def test_count_verdict_without_seeds_is_not_shown():
+    assert m.count_verdict(0, 0, 0.9, "no figure", "converges").status == "not shown"
+
+
+@pytest.mark.parametrize("values, status", [([0.5, 0.4, 0.8], "shown"),
+                                            ([0.1, 0.2, 0.25], "partly"),
+                                            ([-0.1, 0.0, -0.3], "not shown"),
+                                            ([np.nan, np.nan], "not shown")])
+def test_median_verdict_above_a_bound(values, status):
+    assert m.median_verdict(values, 0.3, "above", 0.0, "x", "cut").status == status
+
+
+def test_median_verdict_below_a_bound():
+    assert m.median_verdict([0.9, 1.0, 1.2], 1.1, "below", 1.1, "x", "ratio").status == "shown"
+    assert m.median_verdict([1.2, 1.3], 1.1, "below", 1.1, "x", "ratio").status == "not shown"
+
+
+def test_paired_wins_leave_out_seeds_missing_either_figure():
+    a = np.array([1.0, 5.0, np.nan, 2.0])
+    b = np.array([2.0, 4.0, 1.0, np.nan])
+    assert m.paired_wins(a, b) == (1, 2)
+    assert m.win_rate_text(1, 2, "a") == "a better in 1/2 seeds (50 %)"
+
+
+def test_spread_text_gives_median_iqr_and_range():
+    text = m.spread_text([1.0, 2.0, 3.0, 4.0, 5.0], "m")
+    assert text == "median 3 m (IQR 2-4, range 1-5; 5 seeds)"
+    assert m.spread_text([np.nan]) == "no figure (every seed failed)"
+
+
+def test_windows_from_the_events_table():
+    events = pd.DataFrame({"t_start": [10.0, 50.0, 30.0], "t_end": [20.0, 110.0, 35.0],
+                           "kind": ["gnss_outage", "gnss_outage", "zone"],
+                           "detail": ["", "", "tunnel"]})
+    assert m.longest_outage(events) == (50.0, 110.0)
+    t = np.array([5.0, 10.0, 19.9, 20.0, 60.0, 110.0])
+    np.testing.assert_array_equal(m.inside_windows(t, m.outages(events)),
+                                  [False, True, True, False, True, False])
+
+
+def _cho_tables(spkf_rms: list[float], ekf_rms: list[float]) -> dict[str, pd.DataFrame]:
+    seeds = pd.Index(range(1, len(spkf_rms) + 1), name="seed")
+    columns = {}
+    for angle in (*cho2006.ANGLES_EKF, *cho2006.ANGLES_LARGE):
+        columns[f"{cho2006.heading_label('dr2d_drm2_spkf', angle)}.heading_rms_deg"] = spkf_rms
+        columns[f"{cho2006.heading_label('dr2d_drm2_ekf', angle)}.heading_rms_deg"] = ekf_rms
+    return {"situation2": pd.DataFrame(columns, index=seeds)}
+
+
+def test_cho_judges_on_synthetic_heading_errors():
+    """Ten seeds: the SPKF converged in 9 (shown from -140), the EKF in 7 at every angle (partly
+    from -45/-90; the SPKF more robust: shown)."""
+    spkf = [0.5] * 9 + [10.0]
+    ekf = [0.5] * 7 + [20.0] * 3
+    tables = _cho_tables(spkf, ekf)
+    assert cho2006.PAPER.claims[0].judge(tables).status == "shown"
+    moderate = next(c for c in cho2006.PAPER.claims if c.key == "ekf_converges_moderate")
+    assert moderate.judge(tables).status == "partly"
+    robust = next(c for c in cho2006.PAPER.claims if c.key == "spkf_more_robust")
+    verdict = robust.judge(tables)
+    assert verdict.status == "shown" and "-140 deg 9/7" in verdict.measured
+    assert robust.judge(_cho_tables(ekf, spkf)).status == "not shown"
+    assert robust.judge(_cho_tables(spkf, spkf)).status == "partly"
+
+
+def test_tan_judges_on_synthetic_outage_errors():
+    seeds = pd.Index([1, 2, 3], name="seed")
+    table = pd.DataFrame({"free.end_horizontal_m": [100.0, 200.0, 300.0],
+                          "constraints.end_horizontal_m": [50.0, 160.0, 270.0],
+                          "full.end_horizontal_m": [60.0, 200.0, 300.0]}, index=seeds)
+    verdicts = judge(tan2008.PAPER, {"outage": table})
+    # cuts 50 %, 20 %, 10 %: median 20 %, short of 30 % but an effect
+    assert verdicts["constraints_cut_outage_error"].status == "partly"
+    # ratios 1.2, 1.25, 1.11: worse by more than 10 %
+    assert verdicts["magnetometer_no_worse"].status == "not shown"
+
+
+def test_park_flat_ratio_judge():
+    seeds = pd.Index([1, 2, 3], name="seed")
+    flat = pd.DataFrame({"dr3d_ekf.exit_horizontal_m": [10.0, 10.0, 10.0],
+                         "dr3d_ekf.max_horizontal_m": [10.0, 10.0, 10.0],
+                         "dr2d_odo_ekf.exit_horizontal_m": [9.0, 11.0, 10.0],
+                         "dr2d_odo_ekf.max_horizontal_m": [20.0, 20.0, 20.0]}, index=seeds)
+    claim = next(c for c in park2019.PAPER.claims if c.key == "flat_no_advantage_2d")
+    assert claim.judge({"flat_garage": flat}).status == "partly"  # exit 1.0, max 0.5
+    flat["dr2d_odo_ekf.max_horizontal_m"] = 11.0
+    assert claim.judge({"flat_garage": flat}).status == "shown"
+
+
+def test_a_judge_without_its_figures_is_not_shown_with_the_reason():
+    verdicts = judge(tan2008.PAPER, {"outage": pd.DataFrame(index=pd.Index([], name="seed"))})
+    assert all(v.status == "not shown" for v in verdicts.values())
+    assert all("could not be judged" in v.reason for v in verdicts.values())
+
+
+def test_every_registered_paper_loads_with_unique_keys_and_module_level_measures():
+    assert set(paper_keys()) <= set(PAPERS)
+    assert {"cho2006", "tan2008", "park2019"} <= set(paper_keys())
+    for key in paper_keys():
+        paper = load_paper(key)
+        assert paper.key == key
+        assert len({e.key for e in paper.experiments}) == len(paper.experiments)
+        assert len({c.key for c in paper.claims}) == len(paper.claims)
+        for e in paper.experiments:
+            # picklable by reference: a module-level function
+            assert e.measure.__qualname__ == e.measure.__name__
+            assert (SCENARIOS / e.scenario).is_file(), e.scenario
