@@ -6,15 +6,21 @@ shipped with the Park DR estimators) and ``parking_garage.yaml`` (100 Hz IMU).""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
 from estimators.base import InitialState
 from estimators.builtin.park2019_ins import ParkInsOdometer
+from simulator.dataset.generate import generate_dataset
+from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
+from simulator.replay import run_estimator
 from simulator.reproduce import park2019
 from simulator.reproduce.measures import spread_text as spread
 from simulator.reproduce.runner import run_experiment
+from simulator.scenario import Scenario, validate_data
 
 EXPERIMENTS = [park2019.INS_PARK_GARAGE, park2019.INS_PARKING_GARAGE]
 SEEDS = range(1, 11)
@@ -71,3 +77,39 @@ def test_fix_error_states_take_the_receivers_carrier_smoothing_time():
 
     assert states(100.0) == 19 and states(0.0) == 16
     assert ParkInsOdometer(None, initial, columns, {}, imu_output="rate").ins.n_states == 15
+
+
+def test_the_antenna_lever_arm_is_taken_from_the_datasheet(tmp_path):
+    """Error-free IMU, odometer and receiver on a rigid body with the antenna 1.5 m ahead of the
+    IMU and 1.2 m above it: the filter that reads the lever arm from the datasheet follows the
+    IMU's truth within a decimetre (measured 0.007 m rms); told the antenna sits on the IMU (the
+    datasheet's lever arm zeroed), it is pulled towards the antenna (1.39 m rms)."""
+    segments = [{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+                {"turn": {"angle": 90, "radius": 40}}, {"straight": {"length": 200}},
+                {"turn": {"angle": -90, "radius": 40}}, {"straight": {"length": 200}}]
+    data = {"name": "arm", "seed": 1, "vehicle": "rigid",
+            "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5, "lon": 127.0, "alt": 40.0,
+                      "heading": 30.0},
+            "trajectory": {"kind": "segments", "segments": segments},
+            "sensors": {"imu": {"preset": "ideal", "rate": 100, "output": "increment"},
+                        "odometer": {"preset": "ideal", "rate": 10},
+                        "gnss": {"preset": "ideal", "rate": 1, "outputs": ["fix"],
+                                 "antenna_lever_arm": [1.5, 0.0, -1.2]}}}
+    scenario = Scenario(tmp_path / "arm.yaml", validate_data(data, "arm.yaml"), [])
+    folder = generate_dataset(scenario, tmp_path / "arm", show_progress=False)
+    errors = []
+    for zeroed in (False, True):
+        if zeroed:
+            manifest = json.loads((folder / "manifest.json").read_text())
+            manifest["datasheet"]["gnss"]["antenna_lever_arm"] = [0.0, 0.0, 0.0]
+            (folder / "manifest.json").write_text(json.dumps(manifest))
+        ds = open_dataset(folder)
+        solution, _ = run_estimator(ds, "ins_odo_ekf", show_progress=False)
+        truth = ds.read("truth")
+        t = solution["t"].to_numpy()
+        d_n = np.radians(solution["lat"] - np.interp(t, truth["t"], truth["lat"])) * 6.36e6
+        d_e = (np.radians(solution["lon"] - np.interp(t, truth["t"], truth["lon"]))
+               * 6.39e6 * np.cos(np.radians(37.5)))
+        errors.append(float(np.sqrt(np.mean(d_n**2 + d_e**2))))
+    print(f"horizontal RMS with the lever arm {errors[0]:.3f} m, without {errors[1]:.3f} m")
+    assert errors[0] < 0.1 and errors[1] > 0.5, errors
