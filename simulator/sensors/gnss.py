@@ -100,6 +100,7 @@ from simulator.gnss.errors import (
     draw_error_terms,
     draw_fading,
     draw_receiver_clock,
+    pierce_points_km,
     pseudorange_sigma,
     smooth_code_errors,
 )
@@ -407,7 +408,9 @@ class Gnss(PresetSensor):
         self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
         # (which would otherwise make the error and the fix weights jump from epoch to epoch)
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u)
+        # (below the horizon, where nothing is tracked, the pierce point of the horizon)
+        pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]
