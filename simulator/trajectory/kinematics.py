@@ -237,7 +237,7 @@ class Kinematics:
         offset = body_to_ned_components(*trig, rx, ry, rz)
         return dict(s=road["s"], v=speed, roll=roll, pitch=pitch, yaw=yaw, roll_rate=roll_rate,
                     pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
-                    cos_pitch=cp, sin_pitch=sp, cos_yaw=cy, sin_yaw=sy,
+                    cos_pitch=cp, sin_pitch=sp, cos_yaw=cy, sin_yaw=sy, cos_roll=cr, sin_roll=sr,
                     v_road=road["v_ned"].T, offset=offset)
 
     # -- position ---------------------------------------------------------------------------
@@ -395,8 +395,10 @@ class Kinematics:
         f_n = a[:, 0] + (ce * vd - cd * ve)
         f_e = a[:, 1] + (cd * vn - cn * vd)
         f_d = a[:, 2] + (cn * ve - ce * vn - normal_gravity_from_sin(sin_lat, alt))
-        roll = m["roll"]
-        sr, cr = np.sin(roll), np.cos(roll)
+        if "cos_roll" in m:  # the body's roll, whose sine and cosine ``_with_body`` took
+            sr, cr = m["sin_roll"], m["cos_roll"]
+        else:
+            sr, cr = np.sin(m["roll"]), np.cos(m["roll"])
         sp, cp = m["sin_pitch"], m["cos_pitch"]
         trig = (cr, sr, cp, sp, m["cos_yaw"], m["sin_yaw"])
         f_body = ned_to_body_components(*trig, f_n, f_e, f_d)
