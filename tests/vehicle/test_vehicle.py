@@ -488,3 +488,7 @@ def test_rates_inside_grid_intervals_are_the_truth_there():
     np.testing.assert_allclose(got["w_body"], ref["w_body"], rtol=0, atol=1e-12)
     np.testing.assert_allclose(got["f_body"], ref["f_body"], rtol=0, atol=1e-11)
     assert np.ptp(ref["f_body"][:, 2]) > 1.0  # the body vibrates
+    rigid = _truth(ten_minute_drive(), "rigid")
+    got, ref = rigid.rates_inside(j[::5], u), rigid.inertial(rigid.t_grid[j[::5]] + u * h)
+    for key in ("w_body", "f_body"):  # without a body, the very same operations
+        np.testing.assert_array_equal(got[key], ref[key])
