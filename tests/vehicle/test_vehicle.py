@@ -492,3 +492,45 @@ def test_rates_inside_grid_intervals_are_the_truth_there():
     got, ref = rigid.rates_inside(j[::5], u), rigid.inertial(rigid.t_grid[j[::5]] + u * h)
     for key in ("w_body", "f_body"):  # without a body, the very same operations
         np.testing.assert_array_equal(got[key], ref[key])
+
+
+def test_ideal_increments_on_the_vibrating_body_are_the_exact_integrals():
+    """Where the body vibrates (roughness, engine), every IMU increment comes from the Lobatto
+    rule on ``rates_inside`` and the grid samples: each checked against adaptive quadrature
+    (scipy.integrate.quad) of the analytic truth over its interval, on rows spread over a
+    drive with a turn and braking. The bound is four times the largest difference measured
+    between two degree-5 rules (Lobatto and Gauss-Legendre, 5e-11 m/s and 2e-13 rad per
+    sample, BENCHMARKS.md)."""
+    from scipy.integrate import quad
+
+    from simulator import columns as col
+    from simulator.sensors import resolve_block
+    from simulator.sensors.imu import Imu
+
+    truth = _truth([{"stop": {"duration": 2}}, {"accelerate": {"to_speed": 12.0, "accel": 2.0}},
+                    {"turn": {"angle": 90, "radius": 40}},
+                    {"accelerate": {"to_speed": 0.0, "accel": 3.0}}])
+    imu = Imu(resolve_block("imu", {"preset": "ideal", "rate": 100.0, "output": "increment",
+                                    "axes": ["gyro_x", "gyro_y", "gyro_z", "accel_x",
+                                             "accel_y", "accel_z"]}))
+    out = imu.generate(truth, None)["imu"]
+    breaks = truth.breakpoints()
+    dt = 0.01
+    grid = truth.grid_inertial()
+    bounds = {"w_body": 1e-12, "f_body": 2e-10}
+    checked = 0
+    for i in np.linspace(300, len(out["t"]) - 2, 7).astype(int):
+        t1 = out["t"][i]
+        if ((breaks > t1 - dt) & (breaks < t1)).any():
+            continue  # such an interval is split at its breakpoint: checked for the rigid body
+        k = int(round(t1 / dt))
+        for j, axis in enumerate(col.IMU_AXES):
+            key, comp = ("w_body", j) if j < 3 else ("f_body", j - 3)
+            exact, _ = quad(lambda s, key=key, comp=comp: truth.inertial(s)[key][0, comp],
+                            t1 - dt, t1, epsabs=1e-15, epsrel=1e-13, limit=200)
+            assert abs(out[axis][i] - exact) < bounds[key], (i, axis, out[axis][i] - exact)
+            if axis == "accel_z":  # the grid samples alone (trapezoid) would miss it by far more
+                trapezoid = 0.5 * dt * (grid[key][k - 1, comp] + grid[key][k, comp])
+                assert abs(trapezoid - exact) > 100 * bounds[key]
+        checked += 1
+    assert checked >= 5
