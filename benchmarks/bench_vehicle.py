@@ -2,7 +2,8 @@
 default, ``automotive``) against the rigid body (``vehicle: rigid``). Issue 13's goal: at most 1.5
 times the rigid time.
 
-Run:  python benchmarks/bench_vehicle.py [increment|rate] [ROUNDS]   (figures in BENCHMARKS.md)
+Run:  python benchmarks/bench_vehicle.py [increment|rate] [ROUNDS] [process]
+(figures in BENCHMARKS.md)
 
 Two datasets of the same drive, side by side in one process:
 
@@ -17,6 +18,10 @@ Each round loads the scenario (the drive) and generates the dataset, every case 
 automotive, after one warm-up round; the CPU time of the process over each generation (all
 threads) and its wall time, best of ROUNDS (default 5). Interleaving the runs round by round
 makes a load on the shared machine hit them alike; the CPU time is the steadier figure.
+
+With ``process``: each case as whole ``landnav generate`` processes instead
+(``bench_truth.time_generate``: one warm-up, then ROUNDS runs; the best CPU time of the child
+processes), interpreter start and imports included.
 """
 
 from __future__ import annotations
@@ -29,7 +34,7 @@ from pathlib import Path
 import yaml
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_truth import hour_scenario  # noqa: E402
+from bench_truth import hour_scenario, time_generate  # noqa: E402
 
 from simulator import pipeline  # noqa: E402
 
@@ -46,18 +51,41 @@ def case_sensors(case: str, output: str) -> dict:
     return sensors
 
 
-def main(output: str = "increment", rounds: int = 5) -> None:
+def write_scenarios(tmp: str, output: str) -> dict[tuple[str, str], Path]:
+    """The hour drive's scenario for each case and vehicle, written into ``tmp``."""
+    paths = {}
+    for case in ("imu", "dataset"):
+        for vehicle in VEHICLES:
+            path = Path(tmp) / f"hour_{case}_{vehicle}.yaml"
+            hour_scenario(path)
+            data = yaml.safe_load(path.read_text())
+            data["vehicle"] = vehicle
+            data["sensors"] = case_sensors(case, output)
+            path.write_text(yaml.safe_dump(data))
+            paths[case, vehicle] = path
+    return paths
+
+
+def processes(output: str, rounds: int) -> None:
+    """Each case as whole ``landnav generate`` processes (see the module doc)."""
     with tempfile.TemporaryDirectory() as tmp:
-        paths = {}
+        best = {}
+        for key, path in write_scenarios(tmp, output).items():
+            _, cpu = time_generate(path, Path(tmp) / "_".join(key), runs=rounds)
+            best[key] = min(cpu)
+            print(f"{key[0]:>8} {key[1]:>10}: process CPU best {best[key]:.2f} s of "
+                  f"{[round(x, 2) for x in cpu]}")
         for case in ("imu", "dataset"):
-            for vehicle in VEHICLES:
-                path = Path(tmp) / f"hour_{case}_{vehicle}.yaml"
-                hour_scenario(path)
-                data = yaml.safe_load(path.read_text())
-                data["vehicle"] = vehicle
-                data["sensors"] = case_sensors(case, output)
-                path.write_text(yaml.safe_dump(data))
-                paths[case, vehicle] = path
+            print(f"{case:>8} ratio (best process CPU): "
+                  f"{best[case, 'automotive'] / best[case, 'rigid']:.2f}")
+
+
+def main(output: str = "increment", rounds: int = 5, mode: str = "in-process") -> None:
+    if mode == "process":
+        processes(output, rounds)
+        return
+    with tempfile.TemporaryDirectory() as tmp:
+        paths = write_scenarios(tmp, output)
         wall: dict[tuple[str, str], list[float]] = {key: [] for key in paths}
         cpu: dict[tuple[str, str], list[float]] = {key: [] for key in paths}
         for round_ in range(rounds + 1):  # the first round warms up
@@ -79,4 +107,4 @@ def main(output: str = "increment", rounds: int = 5) -> None:
 
 
 if __name__ == "__main__":
-    main(*sys.argv[1:2], *(int(x) for x in sys.argv[2:3]))
+    main(*sys.argv[1:2], *(int(x) for x in sys.argv[2:3]), *sys.argv[3:4])
