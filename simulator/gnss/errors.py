@@ -150,7 +150,7 @@ def pierce_points_km(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.n
     signals' ionospheric pierce points (``klobuchar_pierce_point``) on the shell of radius
     ``IONO_SHELL_RADIUS_KM``: the field is defined in space, so no map projection distorts the
     distances (the chord between two pierce points is their distance along the shell within
-    0.2 % up to 1000 km, 0.7 % at 2000 km)."""
+    0.1 % up to 1000 km, 0.4 % at 2000 km)."""
     phi_i, lam_i = klobuchar_pierce_point(lat_rad, lon_rad, azimuth_rad, elevation_rad)
     phi, lam = phi_i * np.pi, lam_i * np.pi
     return IONO_SHELL_RADIUS_KM * np.stack([np.cos(phi) * np.cos(lam),
@@ -172,8 +172,8 @@ def iono_field(rng: np.random.Generator, pierce_km: np.ndarray, t_s: np.ndarray
     ``iono_field_correlation`` (d the chord): g(x, t) = sqrt(2 / M) sum_m a_m(t)
     cos(k_m . x + p_m), M ``IONO_FIELD_WAVES`` plane waves in space (random Fourier features,
     Rahimi & Recht 2007: for wave numbers k_m ~ N(0, I3 / L^2), the spectrum of the Gaussian
-    correlation, and phases p_m
-    uniform, E[g(x) g(x')] = E[cos(k . (x - x'))] = exp(-|x - x'|^2 / (2 L^2))), the amplitudes
+    correlation, and phases p_m uniform, E[g(x) g(x')] = E[cos(k . (x - x'))]
+    = exp(-|x - x'|^2 / (2 L^2))), the amplitudes
     a_m unit-variance Gauss-Markov processes over ``IONO_CORRELATION_TIME_S`` drawn every
     ``IONO_GRID_STEP`` correlation times and interpolated. A sum of 64 waves is Gaussian to a
     good approximation; each drive draws its own waves.
