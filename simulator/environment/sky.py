@@ -55,6 +55,8 @@ ITU-R P.526-15, *Propagation by diffraction*, 2019, eq. 31 (single knife-edge lo
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 # facades: 0 right side (y = +w/2), 1 left side, 2 far end ahead (x = ahead), 3 end behind
@@ -77,10 +79,96 @@ def knife_edge_loss_db(nu: np.ndarray) -> np.ndarray:
     return np.where(nu > _NO_EDGE_NU, j, 0.0)
 
 
+@dataclass(frozen=True)
+class Buildings:
+    """The buildings along both sides of a drive's canyon streets, in the distance driven.
+
+    Side ``k`` (0 right, 1 left) has buildings ``start_m[k][i] <= s < end_m[k][i]`` (sorted, not
+    overlapping; s the along-street coordinate, the distance driven) of height ``height_m[k][i]``
+    above the antenna; between them are gaps and cross streets. ``street_start_m`` are the
+    distances where the streets begin (each closed at both ends by an end facade of
+    ``end_height_m``). Facade numbers (for the reflection losses): the right side's buildings
+    first, then the left side's, then each street's end facades, ahead and behind."""
+
+    start_m: tuple[np.ndarray, np.ndarray]
+    end_m: tuple[np.ndarray, np.ndarray]
+    height_m: tuple[np.ndarray, np.ndarray]
+    street_start_m: np.ndarray
+    end_height_m: float
+
+    @property
+    def count(self) -> int:
+        """Number of facades: every building, and two end facades per street."""
+        return len(self.start_m[0]) + len(self.start_m[1]) + 2 * len(self.street_start_m)
+
+
+def street_buildings(rng: np.random.Generator, streets_m: np.ndarray, block_length_m: float,
+                     cross_street_width_m: float, building_length_m: float,
+                     building_gap_m: float, height_m: float, height_spread_m: float
+                     ) -> Buildings:
+    """Lay out the buildings of canyon streets, block by block, with drawn heights.
+
+    Each street (rows of ``streets_m``: start and end in the distance driven) begins at an
+    intersection: blocks of ``block_length_m`` alternate with cross streets of
+    ``cross_street_width_m``, at the same places on both sides (intersections). Along a block,
+    buildings of ``building_length_m`` frontage follow each other ``building_gap_m`` apart (0: the
+    closed perimeter block of European city centres); the last one ends with the block. Each
+    building's height above the antenna is drawn once from N(``height_m``,
+    ``height_spread_m``), floored at 0, independently per building (the city model of Wang,
+    Groves & Ziebart 2013 gives every building its own height). The end facades closing each
+    street are ``height_m`` high. A street shorter than a block (a zone driven over no
+    distance: the car stands in it) gets one block from its start."""
+    starts, ends = [], []
+    for first, end in np.asarray(streets_m, dtype=float).reshape(-1, 2):
+        last = max(end, first + block_length_m)  # a street stood in (no length): one block
+        block = np.arange(first, last, block_length_m + cross_street_width_m)
+        pitch = building_length_m + building_gap_m
+        per_block = int(np.ceil(block_length_m / pitch)) if block_length_m > 0 else 0
+        b0 = (block[:, None] + pitch * np.arange(per_block)[None, :]).ravel()
+        b1 = np.minimum(b0 + building_length_m, np.repeat(block + block_length_m, per_block))
+        keep = (b1 > b0) & (b0 < last)
+        starts.append(b0[keep])
+        ends.append(np.minimum(b1[keep], last))
+    start = np.concatenate(starts) if starts else np.zeros(0)
+    end = np.concatenate(ends) if ends else np.zeros(0)
+    heights = np.maximum(height_m + height_spread_m * rng.standard_normal((2, len(start))), 0.0)
+    return Buildings((start, start.copy()), (end, end.copy()), (heights[0], heights[1]),
+                     np.asarray(streets_m, dtype=float).reshape(-1, 2)[:, 0], float(height_m))
+
+
+def _side_facade(buildings: Buildings | None, side: int, s: np.ndarray, height: np.ndarray
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The building at along-street coordinate s on ``side``: whether there is one, its height
+    and its facade number (``np.searchsorted`` over the sorted buildings)."""
+    if buildings is None:
+        return np.ones(s.shape, dtype=bool), height, np.full(s.shape, side)
+    start, end = buildings.start_m[side], buildings.end_m[side]
+    i = np.searchsorted(start, s, side="right") - 1
+    j = np.maximum(i, 0)
+    inside = (i >= 0) & (s < end[j])
+    number = j + (len(buildings.start_m[0]) if side == LEFT else 0)
+    return inside, np.where(inside, buildings.height_m[side][j], 0.0), number
+
+
+def _gap_wall(buildings: Buildings, side: int, s: np.ndarray, forward: np.ndarray
+              ) -> tuple[np.ndarray, np.ndarray]:
+    """The building side wall that bounds the gap or cross street at s, in the direction the ray
+    runs along the street (``forward``: toward larger s): its along-street coordinate (+-inf if
+    none) and its height."""
+    start, end, height = buildings.start_m[side], buildings.end_m[side], buildings.height_m[side]
+    i = np.searchsorted(start, s, side="right")  # the next building starts at start[i]
+    n = len(start)
+    nxt = np.where(i < n, start[np.minimum(i, n - 1)], np.inf)
+    prev = np.where(i > 0, end[np.maximum(i - 1, 0)], -np.inf)
+    h_next = np.where(i < n, height[np.minimum(i, n - 1)], 0.0)
+    h_prev = np.where(i > 0, height[np.maximum(i - 1, 0)], 0.0)
+    return np.where(forward, nxt, prev), np.where(forward, h_next, h_prev)
+
+
 def _exit(p: np.ndarray, d: np.ndarray, half_width: np.ndarray, ahead: np.ndarray,
           behind: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distance along the unit direction d (..., 3) from p (..., 3) to the facade the ray meets
-    first (horizontally: the box is convex), and that facade's number."""
+    """Distance along the unit direction d (..., 3) from p (..., 3) to the facade line the ray
+    meets first (horizontally: the box is convex), and that facade's wall number."""
     with np.errstate(divide="ignore", invalid="ignore"):
         sx = np.where(d[..., 0] > 0, (ahead - p[..., 0]) / d[..., 0],
                       np.where(d[..., 0] < 0, (-behind - p[..., 0]) / d[..., 0], np.inf))
@@ -98,8 +186,58 @@ def _mirror(d: np.ndarray, wall: int) -> np.ndarray:
     return out
 
 
+def _end_number(buildings: Buildings | None, along: np.ndarray, wall: int) -> np.ndarray:
+    """Facade number of the end facade ``wall`` (AHEAD or BEHIND) of the street at ``along``."""
+    if buildings is None:
+        return np.full(along.shape, wall)
+    street = np.maximum(np.searchsorted(buildings.street_start_m, along, side="right") - 1, 0)
+    return (len(buildings.start_m[0]) + len(buildings.start_m[1]) + 2 * street
+            + (wall - AHEAD))
+
+
+def _leave(p: np.ndarray, d: np.ndarray, half: np.ndarray, ahead: np.ndarray,
+           behind: np.ndarray, along: np.ndarray, height: np.ndarray, end_height: np.ndarray,
+           buildings: Buildings | None) -> tuple[np.ndarray, np.ndarray]:
+    """Where the leg from p along d leaves the street, and its clearance there.
+
+    It crosses the facade line of a side or an end. An end facade, or a side building at the
+    crossing's along-street coordinate, is passed over its roof edge (clearance: height of the
+    ray above it). Where the crossing falls in a gap or a cross street, the ray runs on between
+    the side walls of the buildings bounding it (walls as deep as the block) and leaves over the
+    edge of the one it runs toward (a ray square to the street leaves freely). Returns the edge
+    point (its height raised to the edge where the ray passes below: the bent path's corner;
+    far away for an open street) and the clearance (< 0: diffracted)."""
+    s, met = _exit(p, d, half, ahead, behind)
+    s = np.where(np.isfinite(s), s, 1e9)  # an open street: no edge
+    edge = p + s[..., None] * d
+    side = (met == RIGHT) | (met == LEFT)
+    top = np.where(side, 0.0, end_height)
+    for wall in (RIGHT, LEFT):
+        there = met == wall
+        if not there.any():
+            continue
+        inside, h, _ = _side_facade(buildings, wall, along[there] + edge[there, 0],
+                                    height[there])
+        top_w, edge_w = np.where(inside, h, 0.0), edge[there]
+        gap = ~inside & (d[there, 0] != 0)
+        if gap.any():
+            assert buildings is not None  # a continuous facade has no gaps
+            dg, eg = d[there][gap], edge_w[gap]
+            wall_s, wall_h = _gap_wall(buildings, wall, along[there][gap] + eg[:, 0],
+                                       dg[:, 0] > 0)
+            k = np.where(np.isfinite(wall_s), (wall_s - along[there][gap] - eg[:, 0]) / dg[:, 0],
+                         1e9)
+            edge_w[gap] = eg + k[:, None] * dg
+            top_w[gap] = np.where(np.isfinite(wall_s), wall_h, 0.0)
+        top[there], edge[there] = top_w, edge_w
+    clearance = edge[..., 2] - top
+    edge[..., 2] = np.maximum(edge[..., 2], top)  # the bent path goes over the edge
+    return edge, clearance
+
+
 def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np.ndarray,
-                ahead_m: np.ndarray, behind_m: np.ndarray) -> dict[str, dict[str, np.ndarray]]:
+                ahead_m: np.ndarray, behind_m: np.ndarray, along_m: np.ndarray = 0.0,
+                buildings: Buildings | None = None) -> dict[str, dict[str, np.ndarray]]:
     """Trace every path of ``PATHS`` for satellite directions u in street axes.
 
     Parameters
@@ -107,18 +245,25 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
     u : ndarray, shape (..., 3)
         Unit vectors toward the satellites (x along the street ahead, y right, z up), z > 0.
     building_height_m, street_width_m, ahead_m, behind_m : array_like, broadcast to u[..., 0]
-        Facade height above the antenna, distance between the side facades, distances to the
-        end facades ahead and behind (np.inf: open).
+        Facade height above the antenna (of continuous facades, and of the end facades where
+        ``buildings`` is None), distance between the side facades, distances to the end facades
+        ahead and behind (np.inf: open).
+    along_m : array_like, broadcast to u[..., 0]
+        The antenna's along-street coordinate (distance driven) in ``buildings``' terms.
+    buildings : Buildings or None
+        The buildings along the sides (``street_buildings``); None: continuous facades of
+        ``building_height_m`` (the special case with no gaps), numbered as the walls.
 
     Returns
     -------
     dict
-        Path name -> {``possible`` (bool: every reflection meets its facade first, below the
-        top), ``clearance_m`` (height of the last leg above the edge it leaves over; < 0: it
-        passes below, diffracted), ``edge_distance_m`` (slant distance from the last
+        Path name -> {``possible`` (bool: every reflection meets a building of its facade first,
+        below its top), ``clearance_m`` (height of the last leg above the edge it leaves over;
+        < 0: it passes below, diffracted), ``edge_distance_m`` (slant distance from the last
         reflection point, or the antenna, to that edge), ``extra_path_m`` (length of the path
         minus the direct range, over the roof edge where the last leg is diffracted),
-        ``hit_x_m`` (along-street coordinate of the first reflection; 0 for ``direct``)}.
+        ``hit_x_m`` (along-street coordinate of the first reflection; 0 for ``direct``),
+        ``facades`` (facade number of each reflection, shape (len(walls),) + u.shape[:-1])}.
     """
     u = np.asarray(u, dtype=float)
     shape = u.shape[:-1]
@@ -126,6 +271,8 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
     half = np.broadcast_to(0.5 * np.asarray(street_width_m, dtype=float), shape)
     ahead = np.broadcast_to(np.asarray(ahead_m, dtype=float), shape)
     behind = np.broadcast_to(np.asarray(behind_m, dtype=float), shape)
+    along = np.broadcast_to(np.asarray(along_m, dtype=float), shape)
+    end_height = height if buildings is None else np.full(shape, buildings.end_height_m)
     out = {}
     for name, walls in PATHS.items():  # seven paths
         d = u
@@ -135,33 +282,37 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
         possible = np.ones(shape, dtype=bool)
         legs = np.zeros(shape)
         hit_x = np.zeros(shape)
+        facades = np.zeros((len(walls),) + shape, dtype=int)
         for n, wall in enumerate(walls):
             s, met = _exit(p, d, half, ahead, behind)
             possible &= np.isfinite(s)
             s = np.where(np.isfinite(s), s, 0.0)
             p = p + s[..., None] * d
-            possible &= (met == wall) & (p[..., 2] <= height)
+            if wall in (RIGHT, LEFT):  # the image method per building: one must be there
+                there, top, facades[n] = _side_facade(buildings, wall, along + p[..., 0], height)
+            else:
+                there, top, facades[n] = True, end_height, _end_number(buildings, along, wall)
+            possible &= (met == wall) & there & (p[..., 2] <= top)
             legs = legs + s
             if n == 0:
                 hit_x = p[..., 0]
             d = _mirror(d, wall)
-        s, _ = _exit(p, d, half, ahead, behind)
-        s = np.where(np.isfinite(s), s, 1e9)  # an open street: no edge
-        edge = p + s[..., None] * d
-        clearance = edge[..., 2] - height
-        edge[..., 2] = np.maximum(edge[..., 2], height)  # the bent path goes over the edge
+        edge, clearance = _leave(p, d, half, ahead, behind, along, height, end_height,
+                                 buildings)
         detour = np.linalg.norm(edge - p, axis=-1) - np.einsum("...k,...k->...", edge - p, u)
         extra = legs - np.einsum("...k,...k->...", p, u) + np.where(clearance < 0, detour, 0.0)
         out[name] = {"possible": possible, "clearance_m": clearance,
                      "edge_distance_m": np.linalg.norm(edge - p, axis=-1),
-                     "extra_path_m": extra, "hit_x_m": hit_x}
+                     "extra_path_m": extra, "hit_x_m": hit_x, "facades": facades}
     return out
 
 
 def canyon_reception(azimuth_rad: np.ndarray, elevation_rad: np.ndarray, heading_rad: np.ndarray,
                      building_height_m: np.ndarray, street_width_m: np.ndarray,
                      ahead_m: np.ndarray, behind_m: np.ndarray,
-                     reflection_loss_db: np.ndarray, wavelength_m: float
+                     reflection_loss_db: np.ndarray, wavelength_m: float,
+                     along_m: np.ndarray = 0.0, buildings: Buildings | None = None,
+                     satellite: np.ndarray | None = None
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The strongest path of each satellite in a street canyon (module docstring).
 
@@ -173,10 +324,15 @@ def canyon_reception(azimuth_rad: np.ndarray, elevation_rad: np.ndarray, heading
         Direction of the street (the vehicle heading), rad.
     building_height_m, street_width_m, ahead_m, behind_m : array_like, broadcast to S
         As in ``trace_paths``.
-    reflection_loss_db : ndarray, shape S + (4,)
-        C/N0 loss of a reflection off each facade (right, left, ahead, behind), dB.
+    reflection_loss_db : ndarray, shape S + (F,), or (number of satellites, F) with ``satellite``
+        C/N0 loss of a reflection off each facade, dB, by facade number (``Buildings``; for
+        continuous facades F = 4: right, left, ahead, behind).
     wavelength_m : float
         Carrier wavelength (the diffraction parameter nu depends on it), m.
+    along_m, buildings : as in ``trace_paths``
+    satellite : ndarray of int, shape S, optional
+        Row of ``reflection_loss_db`` of each sample's satellite (the loss of a building is drawn
+        once per satellite, not per sample).
 
     Returns
     -------
@@ -194,15 +350,19 @@ def canyon_reception(azimuth_rad: np.ndarray, elevation_rad: np.ndarray, heading
     cos_el = np.cos(el)
     u = np.stack(np.broadcast_arrays(cos_el * np.cos(alpha), cos_el * np.sin(alpha),
                                      np.sin(np.maximum(el, 1e-6))), axis=-1)
-    paths = trace_paths(u, building_height_m, street_width_m, ahead_m, behind_m)
+    paths = trace_paths(u, building_height_m, street_width_m, ahead_m, behind_m, along_m,
+                        buildings)
+    table = np.asarray(reflection_loss_db, dtype=float)
+    if satellite is None:
+        table = np.broadcast_to(table, u.shape[:-1] + table.shape[-1:])
     losses, extras = [], []
-    for name, walls in PATHS.items():
-        path = paths[name]
+    for path in paths.values():
         nu = -path["clearance_m"] * np.sqrt(2.0 / (wavelength_m
                                                    * np.maximum(path["edge_distance_m"], 1e-3)))
         loss = knife_edge_loss_db(nu)
-        for wall in walls:
-            loss = loss + reflection_loss_db[..., wall]
+        for facade in path["facades"]:
+            loss = loss + (table[satellite, facade] if satellite is not None else
+                           np.take_along_axis(table, facade[..., None], axis=-1)[..., 0])
         losses.append(np.where(path["possible"], loss, np.inf))
         extras.append(path["extra_path_m"])
     losses, extras = np.stack(losses), np.stack(extras)

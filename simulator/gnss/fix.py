@@ -67,11 +67,18 @@ def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
     return mask, packed
 
 
-def _solve(normal: np.ndarray, rhs: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Batched solve of normal equations; singular epochs (not ok) get an identity system."""
+def _solve(normal: np.ndarray, rhs: np.ndarray, ok: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Batched solve of normal equations; epochs not ok get an identity system. An epoch whose
+    system is singular although it has the equations (the iteration diverged: far from the
+    Earth every satellite lies in one direction, as four NLOS satellites can make it) is no
+    longer ok. Returns the steps and the updated ok."""
     eye = np.eye(normal.shape[-1])
-    normal = np.where(ok[:, None, None], normal, eye)
-    return np.linalg.solve(normal, rhs[..., None])[..., 0]
+    try:
+        return np.linalg.solve(np.where(ok[:, None, None], normal, eye), rhs[..., None])[..., 0], ok
+    except np.linalg.LinAlgError:  # rare: find the singular epochs only then
+        ok = ok & (np.linalg.matrix_rank(normal) == normal.shape[-1])
+        return np.linalg.solve(np.where(ok[:, None, None], normal, eye), rhs[..., None])[..., 0], ok
 
 
 def _up_ecef(pos_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -130,7 +137,7 @@ def solve_position(pr_m: np.ndarray, sat_pos_m: np.ndarray, weight: np.ndarray,
             row = np.concatenate([up, np.zeros((len(up), 1))], axis=1)
             normal[held] += row[:, :, None] * row[:, None, :]
             rhs[held] += row * (height_m[held] - alt)[:, None]
-        dx = _solve(normal, rhs, ok)
+        dx, ok = _solve(normal, rhs, ok)
         x = x + np.where(ok[:, None], dx, 0.0)
     pos = np.where(ok[:, None], x[:, :3], np.nan)
     return pos, np.where(ok, x[:, 3], np.nan), ok
@@ -168,7 +175,7 @@ def solve_velocity(rate_m_s: np.ndarray, sat_pos_m: np.ndarray, sat_vel_m_s: np.
         _, up = _up_ecef(rx[held])
         row = np.concatenate([up, np.zeros((len(up), 1))], axis=1)
         normal[held] += row[:, :, None] * row[:, None, :]
-    x = _solve(normal, np.einsum("nki,nk->ni", hw, y), ok)
+    x, ok = _solve(normal, np.einsum("nki,nk->ni", hw, y), ok)
     x = np.where(ok[:, None], x, np.nan)
     return x[:, :3], x[:, 3]
 
