@@ -3,20 +3,31 @@ antenna in an urban canyon (direct, diffracted over a roof edge, or reflected of
 extra path of that signal and its C/N0 loss.
 
 The canyon is a street box around the antenna, in street axes (x along the vehicle's heading,
-y to its right, z up, the antenna at the origin on the street's centre line): facades of height
-H above the antenna on both sides at y = +-w/2 and, closing the street, facades across it at
-x = ``ahead`` and x = -``behind`` (a T-junction, an overpass: where the canyon zone ends). A
-satellite in direction u = (cos el cos a, cos el sin a, sin el), a = azimuth - heading, reaches
-the antenna along these paths, each traced as a ray from the antenna (image method, Groves 2013
-section 10.4.2; the street-canyon box of Bourdeau, Sahmoudi & Tourneret 2012):
+y to its right, z up, the antenna at the origin on the street's centre line): the facade lines
+of both sides at y = +-w/2 and, closing the street, facades across it at x = ``ahead`` and
+x = -``behind`` (a T-junction, an overpass: where the canyon zone ends). Along the side facade
+lines stand buildings (``Buildings``, laid out by ``street_buildings``): blocks between cross
+streets, buildings of one frontage with gaps between them, each with its own height, as a 3D
+city model gives them (Groves 2011; Wang, Groves & Ziebart 2013); every lookup of "the building
+at this along-street coordinate" is a ``np.searchsorted`` over them, vectorised over satellites
+and epochs. A satellite in direction u = (cos el cos a, cos el sin a, sin el),
+a = azimuth - heading, reaches the antenna along these paths, each traced as a ray from the
+antenna (image method, Groves 2013 section 10.4.2; the street-canyon box of Bourdeau, Sahmoudi &
+Tourneret 2012):
 
-- ``direct``: straight to the satellite; line of sight when it leaves the box over the edge of
-  the facade it meets (clearance >= 0), otherwise diffracted over that roof edge;
+- ``direct``: straight to the satellite; line of sight when it leaves the box over the edge it
+  meets (clearance >= 0), otherwise diffracted over that edge;
 - one specular reflection off either side facade or either end facade;
 - two reflections, right then left facade, or left then right.
 
-A reflection is possible when the ray meets the named facade first and below its top; every
-path's last leg leaves the box over an edge. Each path's C/N0 loss is the knife-edge diffraction
+A reflection is possible when the ray meets the named facade line first, at an along-street
+coordinate where a building stands, below that building's top (the image method per facade
+segment: a reflection point on a gap or a cross street reflects nothing). Every path's last leg
+leaves the box where it crosses a facade line: over the roof edge of the building standing there
+(its own height: a lower building lets a ray through that a taller one would stop), or, where
+the crossing falls in a gap or a cross street, between the side walls of the buildings bounding
+it (taken as deep as the block), over the edge of the wall it runs toward; a ray square to the
+street leaves a gap freely. Each path's C/N0 loss is the knife-edge diffraction
 loss J(nu) of that last edge (ITU-R P.526-15 eq. 31, nu = h sqrt(2 / (lambda d)) for a far
 transmitter, h the height of the edge above the ray, d the slant distance to it; 0 dB below
 nu = -0.78) plus the loss of every reflection (given by the caller: facades differ; about
@@ -31,14 +42,18 @@ this is the image-antenna distance 2 (w/2) cos el |sin a| (Groves 2013 eq. 10.23
 the far end facade 2 ahead cos el cos a, which reaches hundreds of metres: the long tail of NLOS
 delays that Hsu 2018 reports, coming from geometry, not from a drawn distribution.
 
-Choices where the sources are silent: the antenna is on the centre line; the facades are
-continuous (no gaps, no cross streets) and equally high; the ground reflection and LOS
-multipath are left to the receiver's multipath error process; paths of three or more
-reflections are left out (they lose 45 dB and more).
+Choices where the sources are silent: the antenna is on the centre line; the street is
+straight along the vehicle's heading with the distance driven as its along-street coordinate;
+the end facades are ``building_height`` high; only the buildings along the street are modelled
+(beyond a roof or a gap's side walls the sky is open); diffraction round a building's vertical
+corner edges, the ground reflection and LOS multipath are left out (the last two to the
+receiver's multipath error process); paths of three or more reflections are left out (they lose
+45 dB and more). Continuous facades of one height (``buildings`` None) are the special case of
+closed blocks with no cross streets and no height spread.
 
 Public names
 ------------
-PATHS, knife_edge_loss_db, trace_paths, canyon_reception.
+PATHS, Buildings, street_buildings, knife_edge_loss_db, trace_paths, canyon_reception.
 
 References
 ----------
@@ -46,6 +61,9 @@ Groves, *Principles of GNSS, Inertial, and Multisensor Integrated Navigation Sys
 2013, section 10.4.2 (NLOS reception, path delay of a reflection off a building).
 Groves, "Shadow matching: a new GNSS positioning technique for urban canyons", J. Navigation
 64(3), 2011 (building edges decide which satellites are direct; diffraction near the edges).
+Wang, Groves & Ziebart, "GNSS shadow matching: improving urban positioning accuracy using a 3D
+city model with optimized visibility scoring scheme", NAVIGATION 60(3), 2013 (buildings as blocks
+of their own heights, the city model a satellite's visibility is decided against).
 Bourdeau, Sahmoudi & Tourneret, "Tight integration of GNSS and a 3D city model for robust
 positioning in urban canyons", ION GNSS 2012 (street-canyon geometry, reflected signals' delays).
 Hsu, "Analysis and modeling GPS NLOS effect in highly urbanized area", GPS Solutions 22(1), 2018
