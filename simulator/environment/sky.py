@@ -154,33 +154,50 @@ def street_buildings(rng: np.random.Generator, streets_m: np.ndarray, block_leng
                      np.asarray(streets_m, dtype=float).reshape(-1, 2)[:, 0], float(height_m))
 
 
-def _side_facade(buildings: Buildings | None, side: int, s: np.ndarray, height: np.ndarray
+# the left side's buildings are looked up beyond the right side's, shifted by this much (far
+# beyond any drive), so that both sides are one sorted array and one ``np.searchsorted``
+_LEFT_SHIFT_M = 1e12
+
+
+def _sorted_sides(buildings: Buildings) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Both sides' starts, ends and heights as one sorted array (the left side shifted by
+    ``_LEFT_SHIFT_M``: an index into it is the facade number), and the right side's count."""
+    return (np.concatenate([buildings.start_m[0], buildings.start_m[1] + _LEFT_SHIFT_M]),
+            np.concatenate([buildings.end_m[0], buildings.end_m[1] + _LEFT_SHIFT_M]),
+            np.concatenate(buildings.height_m), len(buildings.start_m[0]))
+
+
+def _side_facade(sides: tuple | None, left: np.ndarray, s: np.ndarray, height: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The building at along-street coordinate s on ``side``: whether there is one, its height
-    and its facade number (``np.searchsorted`` over the sorted buildings)."""
-    if buildings is None:
-        return np.ones(s.shape, dtype=bool), height, np.full(s.shape, side)
-    start, end = buildings.start_m[side], buildings.end_m[side]
-    i = np.searchsorted(start, s, side="right") - 1
+    """The building at along-street coordinate s on the left (``left`` true) or right side:
+    whether there is one, its height and its facade number (``np.searchsorted`` over the sorted
+    buildings, ``_sorted_sides``; None: continuous facades of ``height``, numbered 0 right,
+    1 left)."""
+    if sides is None:
+        return (np.ones(s.shape, dtype=bool), height,
+                np.broadcast_to(left, s.shape).astype(int))
+    start, end, tops, n_right = sides
+    key = s + np.where(left, _LEFT_SHIFT_M, 0.0)
+    i = np.searchsorted(start, key, side="right") - 1
     j = np.maximum(i, 0)
-    inside = (i >= 0) & (s < end[j])
-    number = j + (len(buildings.start_m[0]) if side == LEFT else 0)
-    return inside, np.where(inside, buildings.height_m[side][j], 0.0), number
+    inside = (i >= np.where(left, n_right, 0)) & (key < end[j])
+    return inside, np.where(inside, tops[j], 0.0), j
 
 
-def _gap_wall(buildings: Buildings, side: int, s: np.ndarray, forward: np.ndarray
+def _gap_wall(sides: tuple, left: np.ndarray, s: np.ndarray, forward: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray]:
     """The building side wall that bounds the gap or cross street at s, in the direction the ray
     runs along the street (``forward``: toward larger s): its along-street coordinate (+-inf if
-    none) and its height."""
-    start, end, height = buildings.start_m[side], buildings.end_m[side], buildings.height_m[side]
-    i = np.searchsorted(start, s, side="right")  # the next building starts at start[i]
-    n = len(start)
-    nxt = np.where(i < n, start[np.minimum(i, n - 1)], np.inf)
-    prev = np.where(i > 0, end[np.maximum(i - 1, 0)], -np.inf)
-    h_next = np.where(i < n, height[np.minimum(i, n - 1)], 0.0)
-    h_prev = np.where(i > 0, height[np.maximum(i - 1, 0)], 0.0)
-    return np.where(forward, nxt, prev), np.where(forward, h_next, h_prev)
+    none on that side) and its height."""
+    start, end, tops, n_right = sides
+    first, last = np.where(left, n_right, 0), np.where(left, len(start), n_right)
+    shift = np.where(left, _LEFT_SHIFT_M, 0.0)
+    i = np.searchsorted(start, s + shift, side="right")  # the next building starts at start[i]
+    k = np.clip(np.where(forward, i, i - 1), 0, len(start) - 1)
+    there = np.where(forward, i < last, i - 1 >= first)
+    wall = np.where(forward, start[k], end[k]) - shift
+    return (np.where(there, wall, np.where(forward, np.inf, -np.inf)),
+            np.where(there, tops[k], 0.0))
 
 
 def _exit(p: np.ndarray, d: np.ndarray, half_width: np.ndarray, ahead: np.ndarray,
@@ -215,7 +232,7 @@ def _end_number(buildings: Buildings | None, along: np.ndarray, wall: int) -> np
 
 def _leave(p: np.ndarray, d: np.ndarray, half: np.ndarray, ahead: np.ndarray,
            behind: np.ndarray, along: np.ndarray, height: np.ndarray, end_height: np.ndarray,
-           buildings: Buildings | None) -> tuple[np.ndarray, np.ndarray]:
+           sides: tuple | None) -> tuple[np.ndarray, np.ndarray]:
     """Where the leg from p along d leaves the street, and its clearance there.
 
     It crosses the facade line of a side or an end. An end facade, or a side building at the
@@ -229,25 +246,16 @@ def _leave(p: np.ndarray, d: np.ndarray, half: np.ndarray, ahead: np.ndarray,
     s = np.where(np.isfinite(s), s, 1e9)  # an open street: no edge
     edge = p + s[..., None] * d
     side = (met == RIGHT) | (met == LEFT)
-    top = np.where(side, 0.0, end_height)
-    for wall in (RIGHT, LEFT):
-        there = met == wall
-        if not there.any():
-            continue
-        inside, h, _ = _side_facade(buildings, wall, along[there] + edge[there, 0],
-                                    height[there])
-        top_w, edge_w = np.where(inside, h, 0.0), edge[there]
-        gap = ~inside & (d[there, 0] != 0)
-        if gap.any():
-            assert buildings is not None  # a continuous facade has no gaps
-            dg, eg = d[there][gap], edge_w[gap]
-            wall_s, wall_h = _gap_wall(buildings, wall, along[there][gap] + eg[:, 0],
-                                       dg[:, 0] > 0)
-            k = np.where(np.isfinite(wall_s), (wall_s - along[there][gap] - eg[:, 0]) / dg[:, 0],
-                         1e9)
-            edge_w[gap] = eg + k[:, None] * dg
-            top_w[gap] = np.where(np.isfinite(wall_s), wall_h, 0.0)
-        top[there], edge[there] = top_w, edge_w
+    inside, top, _ = _side_facade(sides, met == LEFT, along + edge[..., 0], height)
+    top = np.where(side, top, end_height)
+    gap = side & ~inside & (d[..., 0] != 0)
+    if gap.any():  # only where buildings are laid out: continuous facades have no gaps
+        wall_s, wall_h = _gap_wall(sides, met[gap] == LEFT, along[gap] + edge[gap][:, 0],
+                                   d[gap][:, 0] > 0)
+        open_run = ~np.isfinite(wall_s)
+        k = np.where(open_run, 1e9, (wall_s - along[gap] - edge[gap][:, 0]) / d[gap][:, 0])
+        edge[gap] = edge[gap] + k[:, None] * d[gap]
+        top[gap] = np.where(open_run, 0.0, wall_h)
     clearance = edge[..., 2] - top
     edge[..., 2] = np.maximum(edge[..., 2], top)  # the bent path goes over the edge
     return edge, clearance
@@ -291,6 +299,7 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
     behind = np.broadcast_to(np.asarray(behind_m, dtype=float), shape)
     along = np.broadcast_to(np.asarray(along_m, dtype=float), shape)
     end_height = height if buildings is None else np.full(shape, buildings.end_height_m)
+    sides = None if buildings is None else _sorted_sides(buildings)
     out = {}
     for name, walls in PATHS.items():  # seven paths
         d = u
@@ -307,7 +316,8 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
             s = np.where(np.isfinite(s), s, 0.0)
             p = p + s[..., None] * d
             if wall in (RIGHT, LEFT):  # the image method per building: one must be there
-                there, top, facades[n] = _side_facade(buildings, wall, along + p[..., 0], height)
+                there, top, facades[n] = _side_facade(sides, np.bool_(wall == LEFT),
+                                                      along + p[..., 0], height)
             else:
                 there, top, facades[n] = True, end_height, _end_number(buildings, along, wall)
             possible &= (met == wall) & there & (p[..., 2] <= top)
@@ -315,8 +325,7 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
             if n == 0:
                 hit_x = p[..., 0]
             d = _mirror(d, wall)
-        edge, clearance = _leave(p, d, half, ahead, behind, along, height, end_height,
-                                 buildings)
+        edge, clearance = _leave(p, d, half, ahead, behind, along, height, end_height, sides)
         detour = np.linalg.norm(edge - p, axis=-1) - np.einsum("...k,...k->...", edge - p, u)
         extra = legs - np.einsum("...k,...k->...", p, u) + np.where(clearance < 0, detour, 0.0)
         out[name] = {"possible": possible, "clearance_m": clearance,
