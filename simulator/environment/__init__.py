@@ -20,7 +20,9 @@ ZONE_FIELD = Record(
                     doc="open sky, no sky (tunnel, garage: every satellite blocked), or an "
                         "urban canyon"),
         "building_height": Number("m", 30.0, min=0,
-                                  doc="canyon: height of the facades above the antenna"),
+                                  doc="canyon: mean height of the buildings above the antenna "
+                                      "(each drawn with building_height_spread); the end "
+                                      "facades' height"),
         "street_width": Number("m", 20.0, gt=0, doc="canyon: width between the facades"),
         "nlos_attenuation": Number("", 15.0, min=0,
                                    doc="canyon: mean C/N0 loss of one reflection off a facade, "
