@@ -134,14 +134,16 @@ def street_buildings(rng: np.random.Generator, streets_m: np.ndarray, block_leng
     building's height above the antenna is drawn once from N(``height_m``,
     ``height_spread_m``), floored at 0, independently per building (the city model of Wang,
     Groves & Ziebart 2013 gives every building its own height). The end facades closing each
-    street are ``height_m`` high. A street shorter than a block (a zone driven over no
-    distance: the car stands in it) gets one block from its start."""
+    street are ``height_m`` high. A street of no length (a zone the car stands in) gets one
+    block from its start, up to the next street's start."""
+    streets = np.asarray(streets_m, dtype=float).reshape(-1, 2)
+    following = np.append(streets[1:, 0], np.inf)
+    pitch = building_length_m + building_gap_m
+    per_block = int(np.ceil(block_length_m / pitch))
     starts, ends = [], []
-    for first, end in np.asarray(streets_m, dtype=float).reshape(-1, 2):
-        last = max(end, first + block_length_m)  # a street stood in (no length): one block
+    for (first, end), next_first in zip(streets, following, strict=True):  # one pass per street
+        last = end if end > first else min(first + block_length_m, next_first)
         block = np.arange(first, last, block_length_m + cross_street_width_m)
-        pitch = building_length_m + building_gap_m
-        per_block = int(np.ceil(block_length_m / pitch)) if block_length_m > 0 else 0
         b0 = (block[:, None] + pitch * np.arange(per_block)[None, :]).ravel()
         b1 = np.minimum(b0 + building_length_m, np.repeat(block + block_length_m, per_block))
         keep = (b1 > b0) & (b0 < last)
@@ -151,7 +153,7 @@ def street_buildings(rng: np.random.Generator, streets_m: np.ndarray, block_leng
     end = np.concatenate(ends) if ends else np.zeros(0)
     heights = np.maximum(height_m + height_spread_m * rng.standard_normal((2, len(start))), 0.0)
     return Buildings((start, start.copy()), (end, end.copy()), (heights[0], heights[1]),
-                     np.asarray(streets_m, dtype=float).reshape(-1, 2)[:, 0], float(height_m))
+                     streets[:, 0], float(height_m))
 
 
 # the left side's buildings are looked up beyond the right side's, shifted by this much (far

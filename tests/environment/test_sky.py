@@ -237,3 +237,15 @@ def test_street_layout_blocks_and_heights_are_reproducible():
     assert abs(heights.mean() - 22.0) < 4 * 3.0 / np.sqrt(heights.size)
     assert heights.std() == pytest.approx(3.0, rel=0.05)
     assert abs(np.corrcoef(many.height_m[0], many.height_m[1])[0, 1]) < 0.05
+
+
+def test_a_street_stood_in_gets_a_block_that_stops_at_the_next_street():
+    # a zone the car stands in (no length) at s = 0, the next stretch of it from s = 50 m: one
+    # block from 0, cut where the next street begins, and the buildings stay sorted
+    buildings = street_buildings(np.random.default_rng(3), np.array([[0.0, 0.0], [50.0, 300.0]]),
+                                 110.0, 20.0, 20.0, 0.0, 22.0, 3.0)
+    start, end = buildings.start_m[0], buildings.end_m[0]
+    np.testing.assert_allclose(start[:4], [0.0, 20.0, 40.0, 50.0])
+    np.testing.assert_allclose(end[:3], [20.0, 40.0, 50.0])
+    assert (np.diff(start) > 0).all() and (start[1:] >= end[:-1]).all()
+    assert buildings.count == 2 * len(start) + 4
