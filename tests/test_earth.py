@@ -163,3 +163,15 @@ def test_quat_to_rotvec_inverts_rotvec_to_quat():
     long_way = axis[4] * (2 * np.pi - 0.5)
     np.testing.assert_allclose(earth.quat_to_rotvec(earth.rotvec_to_quat(long_way)),
                                -axis[4] * 0.5, rtol=1e-9)
+
+
+@pytest.mark.parametrize("shape", [(), (1,), (2,), (2, 3)])
+def test_ecef_to_geodetic_keeps_the_input_shape(shape):
+    """One position in a one-row array gives one-row arrays (pymap3d returns a scalar
+    latitude for it, which broke the receiver's 2-D fix when a single epoch held its height)."""
+    lat, lon, alt = np.radians(37.5), np.radians(127.0), 40.0
+    xyz = np.broadcast_to(earth.geodetic_to_ecef(lat, lon, alt).reshape(3), shape + (3,))
+    out = earth.ecef_to_geodetic(xyz)
+    assert all(v.shape == shape for v in out)
+    np.testing.assert_allclose(out[0], lat, atol=1e-12)
+    np.testing.assert_allclose(out[2], alt, atol=1e-6)
