@@ -17,19 +17,9 @@ from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.earth import euler_to_dcm, euler_to_quat
 from simulator.errors import InputError
-from simulator.replay import run_estimator
-from simulator.reproduce.chan import LEVER_ARM
-from simulator.reproduce.measures import position_error_3d
+from simulator.reproduce.chan import run_filter
 from simulator.scenario import load_scenario
 from tests.conftest import REPO
-
-
-def run(dataset, name: str, **config):
-    """Solution of a filter with the Chan scenarios' antenna lever arm, and its 3-D error."""
-    solution, _ = run_estimator(dataset, {"name": name,
-                                          "config": {"lever_arm": LEVER_ARM, **config}},
-                                show_progress=False)
-    return solution, position_error_3d(dataset, solution)[1]
 
 
 def test_points_form_is_the_jacobian_form_at_every_point():
@@ -99,7 +89,7 @@ def test_filters_follow_the_automotive_body_with_the_rear_axle_constraint(automo
     truth = automotive.read("truth")
 
     def yaw_error(**config) -> np.ndarray:
-        solution, error = run(automotive, name, **config)
+        solution, error = run_filter(automotive, name, **config)
         assert error.max() < 0.1  # m; the ranges hold the position (measured 0.04 m)
         yaw = np.interp(solution["t"], truth["t"], np.unwrap(truth["yaw"]))
         return np.abs(np.angle(np.exp(1j * (solution["yaw"] - yaw))))
@@ -112,4 +102,4 @@ def test_filters_follow_the_automotive_body_with_the_rear_axle_constraint(automo
 
 def test_an_unknown_nhc_point_is_one_clear_error(automotive):
     with pytest.raises(InputError, match="nhc_point must be one of rear_axle, imu"):
-        run(automotive, "tc_ukf", nhc_point="front")
+        run_filter(automotive, "tc_ukf", nhc_point="front")
