@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
+_MAX_CONDITION = 1e12  # a normal matrix beyond this is singular in float64 (no fix)
 
 
 def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
@@ -69,16 +70,15 @@ def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
 
 def _solve(normal: np.ndarray, rhs: np.ndarray, ok: np.ndarray
            ) -> tuple[np.ndarray, np.ndarray]:
-    """Batched solve of normal equations; epochs not ok get an identity system. An epoch whose
-    system is singular although it has the equations (the iteration diverged: far from the
-    Earth every satellite lies in one direction, as four NLOS satellites can make it) is no
-    longer ok. Returns the steps and the updated ok."""
+    """Batched solve of normal equations. Epochs not ``ok``, or whose system is numerically
+    singular (condition number above ``_MAX_CONDITION``: satellites in a degenerate geometry,
+    or an iteration gone far from the Earth), get an identity system and come back not
+    solvable. Returns the solutions and the solvable flags."""
     eye = np.eye(normal.shape[-1])
-    try:
-        return np.linalg.solve(np.where(ok[:, None, None], normal, eye), rhs[..., None])[..., 0], ok
-    except np.linalg.LinAlgError:  # rare: find the singular epochs only then
-        ok = ok & (np.linalg.matrix_rank(normal) == normal.shape[-1])
-        return np.linalg.solve(np.where(ok[:, None, None], normal, eye), rhs[..., None])[..., 0], ok
+    normal = np.where(ok[:, None, None], normal, eye)
+    solvable = ok & (np.linalg.cond(normal) < _MAX_CONDITION)
+    normal = np.where(solvable[:, None, None], normal, eye)
+    return np.linalg.solve(normal, rhs[..., None])[..., 0], solvable
 
 
 def _up_ecef(pos_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
