@@ -67,8 +67,12 @@ def test_canyon_fixes_have_a_plausible_cep50(canyon_figures):
     assert 5.0 <= canyon_figures["cep50"] <= 20.0  # measured 8.5-9.7 m per seed
 
 
-@pytest.mark.xfail(strict=True, reason="measured 6.94 tracked satellites on average over "
-                                       "seeds 1-3 (6.85-7.25 per seed over 1-5; goal 7): see the "
-                                       "module docstring")
+# not strict: the measured mean sits 0.06 satellite below the goal, within what any change
+# of the GNSS error draws moves it, so a pass here must not fail the suite; the figure is
+# printed either way
+@pytest.mark.xfail(strict=False, reason="measured 6.94 tracked satellites on average over "
+                                        "seeds 1-3 (6.85-7.25 per seed over 1-5; goal 7): see "
+                                        "the module docstring")
 def test_canyon_keeps_at_least_seven_tracked_satellites(canyon_figures):
+    print(f"tracked satellites in the canyon, mean: {canyon_figures['tracked']:.2f}")
     assert canyon_figures["tracked"] >= 7.0
