@@ -19,8 +19,9 @@ Claims and verdicts (issue 15's criteria decide "shown"):
 * Table 1: the NHC cuts the mean 3-D error over the windows (``table1``: one minus the ratio of
   the means over all seeds, as the paper's "average reduction") by >= 40 % with 0 satellites,
   >= 25 % with 1, 2 and 3, and with 4 by less than with 0 (paper: 54.4, 53.2, 52.6, 52.4,
-  22.6 %). "partly" when the constraint still cuts the error (a positive cut, and a positive
-  cut in more than half of the seeds) but by less than the criterion; "not shown" otherwise.
+  22.6 %). "partly" when the constraint still cuts the error (a positive pooled cut, and a
+  positive cut in at least half of the seeds, as ``measures.count_verdict`` asks of a count)
+  but by less than the criterion; "not shown" otherwise.
 * Figure 2: from 100 m per axis both filters are below 10 m within 10 s and the UKF no later
   than the EKF + 1 s, in every seed ("partly": both settle within 10 s in every seed but the UKF
   is later in some, or both conditions hold in more than half of the seeds).
@@ -36,7 +37,7 @@ Public names
 ------------
 PAPER, PARTIAL_OUTAGES, COMPLETE_OUTAGES, INITIAL_ERROR, LEVER_ARM, short_partial_overrides,
 short_complete_overrides, measure_windows, measure_initial_error, table1, judge_cut,
-settle_time, initial_error_figures.
+settle_time, initial_error_figures, run_filter.
 """
 
 from __future__ import annotations
@@ -51,12 +52,14 @@ import pandas as pd
 import yaml
 
 from simulator.dataset.io import Dataset
+from simulator.replay import run_estimator
 from simulator.reproduce import measures as m
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict
 
 __all__ = ["COMPLETE_OUTAGES", "INITIAL_ERROR", "LEVER_ARM", "PAPER", "PARTIAL_OUTAGES",
            "initial_error_figures", "judge_cut", "measure_initial_error", "measure_windows",
-           "settle_time", "short_complete_overrides", "short_partial_overrides", "table1"]
+           "run_filter", "settle_time", "short_complete_overrides", "short_partial_overrides",
+           "table1"]
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 LEVER_ARM = [0.5, 0.0, -1.2]  # the Chan scenarios' antenna lever arm (body FRD), m
@@ -79,6 +82,13 @@ INITIAL_ERROR_ENTRIES = {
     "tc_ukf": _entry("tc_ukf"),
     "tc_ekf": _entry("tc_ekf"),
 }
+
+
+def run_filter(dataset: Dataset, name: str, **config) -> tuple[pd.DataFrame, np.ndarray]:
+    """One replay of ``name`` (``tc_ukf``, ``tc_ekf``) with the Chan scenarios' lever arm and
+    ``config``: its solution and the 3-D position error of each row (m)."""
+    solution, _ = run_estimator(dataset, _entry(name, **config), show_progress=False)
+    return solution, m.position_error_3d(dataset, solution)[1]
 
 
 def short_partial_overrides(seed: int) -> list[str]:
@@ -170,8 +180,8 @@ def _cut_words(row: dict[str, float]) -> str:
 def judge_cut(figures: Mapping[str, pd.DataFrame], experiment: str, count: int, least: float,
               why: str) -> Verdict:
     """The verdict on "the NHC cuts the mean 3-D error with ``count`` satellites by at least
-    ``least`` %" on the pooled cut of ``table1`` (module docstring); ``why`` is the analysis
-    given when it does not show."""
+    ``least`` %" on the pooled cut of ``table1`` and the seeds it cuts in (module docstring);
+    ``why`` is the analysis given when it does not show."""
     rows = table1(figures[experiment])
     if count not in rows:
         return Verdict("not shown", "no window with this count", "the drive has none")
@@ -179,7 +189,7 @@ def judge_cut(figures: Mapping[str, pd.DataFrame], experiment: str, count: int, 
     measured = _cut_words(row)
     if row["cut"] >= least:
         return Verdict("shown", measured, f"the pooled cut is at least {least:.0f} %")
-    if row["cut"] > 0.0:
+    if row["cut"] > 0.0 and row["positive"] >= 0.5:
         return Verdict("partly", measured, f"the constraint cuts the error, by less than "
                        f"{least:.0f} %: {why}")
     return Verdict("not shown", measured, f"the constraint does not cut the error: {why}")
@@ -191,8 +201,8 @@ WHY_ALONG = ("with few satellites the remaining error is mostly along track, fro
 WHY_GEOMETRY = ("with three pseudoranges and range rates the filter already bounds most of the "
                 "drift, and the satellites kept are the highest (poor horizontal geometry; "
                 "docs/reproduction_chan.md)")
-WHY_SLIP = ("the automotive body's side slip in the 40 m loops breaks the constraint, whose "
-            "noise was sized for a rigid body (docs/reproduction_chan.md)")
+WHY_SLIP = ("in the 40 m loops at 10 m/s the car's side slip is largest, and the constraint "
+            "holds least there (docs/reproduction_chan.md)")
 
 
 def judge_four_smaller(figures: Mapping[str, pd.DataFrame]) -> Verdict:

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from tests.estimators.chan_helpers import run
 
 from estimators.toolbox.constraints import (
     NonholonomicNoise,
@@ -18,6 +17,7 @@ from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.earth import euler_to_dcm, euler_to_quat
 from simulator.errors import InputError
+from simulator.reproduce.chan import run_filter
 from simulator.scenario import load_scenario
 from tests.conftest import REPO
 
@@ -89,7 +89,7 @@ def test_filters_follow_the_automotive_body_with_the_rear_axle_constraint(automo
     truth = automotive.read("truth")
 
     def yaw_error(**config) -> np.ndarray:
-        solution, error = run(automotive, name, **config)
+        solution, error = run_filter(automotive, name, **config)
         assert error.max() < 0.1  # m; the ranges hold the position (measured 0.04 m)
         yaw = np.interp(solution["t"], truth["t"], np.unwrap(truth["yaw"]))
         return np.abs(np.angle(np.exp(1j * (solution["yaw"] - yaw))))
@@ -102,4 +102,4 @@ def test_filters_follow_the_automotive_body_with_the_rear_axle_constraint(automo
 
 def test_an_unknown_nhc_point_is_one_clear_error(automotive):
     with pytest.raises(InputError, match="nhc_point must be one of rear_axle, imu"):
-        run(automotive, "tc_ukf", nhc_point="front")
+        run_filter(automotive, "tc_ukf", nhc_point="front")

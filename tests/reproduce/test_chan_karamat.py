@@ -126,12 +126,14 @@ def _table1_frame(nhc: dict[int, list[float]], no_nhc: dict[int, list[float]]) -
 
 @pytest.mark.parametrize("with_nhc, status", [([5.0, 4.0, 6.0], "shown"),   # cut 50 %
                                               ([7.0, 7.0, 7.0], "partly"),  # cut 30 %
+                                              ([1.0, 11.0, 11.0], "not shown"),  # 1/3 seeds
                                               ([11.0, 9.0, 12.0], "not shown")])
 def test_chan_table1_words(with_nhc, status):
     frame = _table1_frame({0: with_nhc, 4: [9.0, 9.0, 9.0]}, {0: [10.0] * 3, 4: [10.0] * 3})
     verdict = chan.judge_cut({"partial_outages": frame}, "partial_outages", 0, 40.0, "why")
     assert verdict.status == status
     assert f"{100 * (1 - np.mean(with_nhc) / 10.0):.1f} %" in verdict.measured
+    assert f"{np.sum(np.array(with_nhc) < 10.0)}/3 seeds cut" in verdict.measured
     four = chan.judge_four_smaller({"partial_outages": frame})
     assert four.status == ("shown" if np.mean(with_nhc) < 9.0 else "not shown")
 
