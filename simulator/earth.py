@@ -156,7 +156,10 @@ def ecef_to_geodetic(xyz_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndar
     lat, lon, alt = pymap3d.ecef2geodetic(
         xyz[..., 0], xyz[..., 1], xyz[..., 2], ell=wgs84, deg=False
     )
-    return np.asarray(lat), np.asarray(lon), np.asarray(alt)
+    # pymap3d squeezes the latitude of a single position to a scalar: give every output the
+    # input's shape (a one-row array stays one row)
+    shape = xyz.shape[:-1]
+    return (np.reshape(lat, shape), np.reshape(lon, shape), np.reshape(alt, shape))
 
 
 def ned_to_ecef_matrix(lat_rad: np.ndarray, lon_rad: np.ndarray) -> np.ndarray:

@@ -70,6 +70,16 @@ def test_ecef_published_pair():
                                atol=1e-4)
 
 
+def test_ecef_to_geodetic_keeps_the_shape_of_one_point():
+    """One point as (1, 3) gives arrays of shape (1,) (pymap3d returns its latitude as a
+    scalar; a 2D fix held at one epoch broke on it), and the same published pair back."""
+    xyz = np.array([[660675.2518247, -4700948.68316, 4245737.66222]])
+    lat, lon, alt = earth.ecef_to_geodetic(xyz)
+    assert lat.shape == lon.shape == alt.shape == (1,)
+    np.testing.assert_allclose([np.degrees(lat[0]), np.degrees(lon[0]), alt[0]],
+                               [42.0, -82.0, 200.0], atol=1e-6)
+
+
 def test_ned_frame_published_enu_example():
     # RTKLIB t_coord.c utest3: at 35 N 140 E the ECEF vector (0.3, 0.4, 0.5) has ENU
     # (-0.499254, 0.393916, 0.309152)
@@ -163,3 +173,15 @@ def test_quat_to_rotvec_inverts_rotvec_to_quat():
     long_way = axis[4] * (2 * np.pi - 0.5)
     np.testing.assert_allclose(earth.quat_to_rotvec(earth.rotvec_to_quat(long_way)),
                                -axis[4] * 0.5, rtol=1e-9)
+
+
+@pytest.mark.parametrize("shape", [(), (1,), (2,), (2, 3)])
+def test_ecef_to_geodetic_keeps_the_input_shape(shape):
+    """One position in a one-row array gives one-row arrays (pymap3d returns a scalar
+    latitude for it, which broke the receiver's 2-D fix when a single epoch held its height)."""
+    lat, lon, alt = np.radians(37.5), np.radians(127.0), 40.0
+    xyz = np.broadcast_to(earth.geodetic_to_ecef(lat, lon, alt).reshape(3), shape + (3,))
+    out = earth.ecef_to_geodetic(xyz)
+    assert all(v.shape == shape for v in out)
+    np.testing.assert_allclose(out[0], lat, atol=1e-12)
+    np.testing.assert_allclose(out[2], alt, atol=1e-6)

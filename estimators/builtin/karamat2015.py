@@ -62,6 +62,16 @@ whatever its scale error, so the speed is exactly zero while the odometer reads 
 odometer's own speed noise (``odometer_speed_noise``) is in the mechanised velocity the rates
 are predicted from, so it enters the Doppler rows' R through the forward axis.
 
+The point mechanised: eqs. 4-6 put the velocity along the body's forward axis, which holds on a
+car at its rear axle (its wheels do not steer), not at an IMU ahead of it, whose velocity leaves
+the body axis in every curve by the yaw rate times that distance (Rajamani 2012, eq. 2.29; 1.74 m
+on the automotive preset, 3 deg in a 30 m curve). So the mechanised position and velocity are the
+rear axle's (the datasheet's ``vehicle.rear_axle``, ``toolbox.installation``; ``nhc_point: imu``
+or a rigid body: the IMU itself), and the IMU's, which the GNSS measurements are predicted from
+and the solution reports, add the lever arm: C(A) r and C(A) (w x r) with the body heading A and
+the up-axis rate. The lever arm's dependence on the heading error (1.74 m times it, centimetres)
+is left out of H. The paper does not say where its RISS was installed.
+
 Measurements: pseudoranges and pseudorange rates (eqs. 45-49; ``coupling: tight``), or the
 receiver's 3-D fixes (position and velocity; ``coupling: loose``; a loosely coupled filter has
 nothing while fewer than four satellites are seen, as the paper's LC comparisons assume), and the
@@ -86,6 +96,7 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox import gnss_model
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
+from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from simulator.earth import (
     OMEGA_E_RAD_S,
@@ -232,8 +243,11 @@ class RissTcEkf(Estimator):
     # accelerometer updates of eqs. 50-58
     # odometer_speed_noise: m/s, 1-sigma white noise of one odometer speed sample (a 48-tooth
     # ABS wheel at 10 Hz quantises the speed in steps of 0.43 m/s)
+    # nhc_point: where the velocity lies along the body (eqs. 4-6): rear_axle (the datasheet's)
+    # or imu
     defaults = {"model": "enhanced", "coupling": "tight", "tilt_window": 2.0,
-                "accel_update_interval": 1.0, "odometer_speed_noise": 0.2}
+                "accel_update_interval": 1.0, "odometer_speed_noise": 0.2,
+                "nhc_point": "rear_axle"}
     output_columns = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                       "std_n", "std_e", "std_d", "std_yaw",
                       "gyro_bias_z", "accel_bias_x", "accel_bias_y", "clock_bias", "clock_drift")
@@ -245,6 +259,8 @@ class RissTcEkf(Estimator):
             problems.append(f"model must be enhanced or simplified, got {cfg['model']!r}")
         if cfg["coupling"] not in ("tight", "loose"):
             problems.append(f"coupling must be tight or loose, got {cfg['coupling']!r}")
+        if cfg["nhc_point"] not in ("rear_axle", "imu"):
+            problems.append(f"nhc_point must be rear_axle or imu, got {cfg['nhc_point']!r}")
         if problems:
             raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
         self._enhanced = cfg["model"] == "enhanced"
@@ -261,6 +277,12 @@ class RissTcEkf(Estimator):
         self._c_ao = self._c_r = self._c_p = self._c_vo = 0.0
         self._cb = self._cd = 0.0
         self._clock_ready = False
+        # the IMU from the mechanised point (body FRD, m): the rear axle's lever arm reversed
+        rear = Installation.from_datasheet(self.datasheet).rear_axle
+        self._arm = -rear if rear is not None and cfg["nhc_point"] == "rear_axle" else None
+        self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
+        d_e, d_n, _, _ = self._arm_offset()
+        self._lat, self._lon = self._moved(-d_n, -d_e)  # the rear axle at the start (at rest)
         self._filter = ErrorState(np.diag([_P0_SIGMA[s] ** 2 for s in STATES[:self._n]]))
         self._q_white = np.array([_Q_WHITE.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in GM_PARAMETERS.items()
@@ -281,7 +303,6 @@ class RissTcEkf(Estimator):
         self._speeds: list[float] = []
         self._ffwd: list[float] = []
         self._ao = 0.0
-        self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
         self._t_accel_update = init.t
         if "gnss_raw" in self.columns:
             self._col_pr = self.columns["gnss_raw"]["pseudorange"]
@@ -326,9 +347,10 @@ class RissTcEkf(Estimator):
             return
         self._catch_up(t)
         rm, rn = (float(v) for v in radii_of_curvature(self._lat))
-        dz = np.array([(self._lat - math.radians(lat)) * (rm + self._h),
-                       (self._lon - math.radians(lon)) * (rn + self._h) * math.cos(self._lat),
-                       self._h - alt, self._ve - ve, self._vn - vn, self._vu + vd])
+        lat_i, lon_i, ve_i, vn_i = self._imu()
+        dz = np.array([(lat_i - math.radians(lat)) * (rm + self._h),
+                       (lon_i - math.radians(lon)) * (rn + self._h) * math.cos(self._lat),
+                       self._h - alt, ve_i - ve, vn_i - vn, self._vu + vd])
         h = np.zeros((6, self._n))
         h[:, :6] = np.eye(6)
         r = np.diag([3.0**2, 3.0**2, 5.0**2, 0.1**2, 0.1**2, 0.15**2])
@@ -496,9 +518,10 @@ class RissTcEkf(Estimator):
         """Eqs. 45-49: dz = rho_RISS - rho_GPS and the same for the rates, predicted by the
         shared model (``estimators.toolbox.gnss_model``: Sagnac, broadcast corrections), with
         H = [-los^T C_n^e, +1 for the clock] (eqs. 46-49 with errors as estimate minus truth)."""
-        pos = geodetic_to_ecef(self._lat, self._lon, self._h).reshape(3)
-        c_ne = ned_to_ecef_matrix(self._lat, self._lon)
-        v_ecef = c_ne @ np.array([self._vn, self._ve, -self._vu])
+        lat, lon, ve, vn = self._imu()
+        pos = geodetic_to_ecef(lat, lon, self._h).reshape(3)
+        c_ne = ned_to_ecef_matrix(lat, lon)
+        v_ecef = c_ne @ np.array([vn, ve, -self._vu])
         if not self._clock_ready:
             rho0, rate0, _ = gnss_model.predict(epoch.sat_pos, epoch.sat_vel, pos, v_ecef)
             self._cb = float(np.median(epoch.pseudorange - rho0))
@@ -558,18 +581,46 @@ class RissTcEkf(Estimator):
             self._c_vo += dx[i["vo"]]
             self._vo -= dx[i["vo"]]
 
+    # --- the IMU from the mechanised point ------------------------------------------------------
+    def _arm_offset(self) -> tuple[float, float, float, float]:
+        """East and north offset (m) and velocity (m/s) of the IMU from the mechanised rear axle:
+        C(A) r and C(A) (w x r) with the body heading A (the direction of travel) and the
+        up-axis rate, w_down = -(w_z - b_z); zero without a lever arm."""
+        if self._arm is None:
+            return 0.0, 0.0, 0.0, 0.0
+        a = self._heading()
+        fwd, right = (math.sin(a), math.cos(a)), (math.cos(a), -math.sin(a))  # east, north
+        dx, dy = float(self._arm[0]), float(self._arm[1])
+        w_down = -(self._wz - self._bz)
+        vx, vy = -w_down * dy, w_down * dx
+        return (dx * fwd[0] + dy * right[0], dx * fwd[1] + dy * right[1],
+                vx * fwd[0] + vy * right[0], vx * fwd[1] + vy * right[1])
+
+    def _moved(self, north: float, east: float) -> tuple[float, float]:
+        """Latitude and longitude (rad) of the mechanised point moved by north, east metres."""
+        rm, rn = (float(v) for v in radii_of_curvature(self._lat))
+        return (self._lat + north / (rm + self._h),
+                self._lon + east / ((rn + self._h) * math.cos(self._lat)))
+
+    def _imu(self) -> tuple[float, float, float, float]:
+        """Latitude, longitude (rad), east and north velocity (m/s) of the IMU."""
+        d_e, d_n, dv_e, dv_n = self._arm_offset()
+        lat, lon = self._moved(d_n, d_e)
+        return lat, lon, self._ve + dv_e, self._vn + dv_n
+
     # --- output -------------------------------------------------------------------------------
     def solution(self, t: float) -> list[float]:
         rm, rn = (float(v) for v in radii_of_curvature(self._lat))
         lead = t - self._t  # IMU samples not yet mechanised: the velocity is held
-        lat = self._lat + self._vn * lead / (rm + self._h)
-        lon = self._lon + self._ve * lead / ((rn + self._h) * math.cos(self._lat))
+        lat_i, lon_i, ve_i, vn_i = self._imu()
+        lat = lat_i + vn_i * lead / (rm + self._h)
+        lon = lon_i + ve_i * lead / ((rn + self._h) * math.cos(self._lat))
         p = self._filter.p
         i = _I
         clock = (self._cb, self._cd) if self._clock_ready else (math.nan, math.nan)
         accel = (self._by, self._bx) if self._enhanced else (math.nan, math.nan)
         return [math.degrees(lat), math.degrees(lon), self._h + self._vu * lead,
-                self._vn, self._ve, -self._vu, self._roll, self._pitch, self._heading(),
+                vn_i, ve_i, -self._vu, self._roll, self._pitch, self._heading(),
                 math.sqrt(p[i["N"], i["N"]]), math.sqrt(p[i["E"], i["E"]]),
                 math.sqrt(p[i["h"], i["h"]]), math.sqrt(p[i["A"], i["A"]]),
                 -self._bz, accel[0], accel[1], *clock]

@@ -48,7 +48,7 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
   strapdown tracks.
 * Options beyond the paper's 15 states, off by default (the SPEC's 15-state filter):
   ``fix_error_states``, three Gauss-Markov states of the fix's correlated error (steady-state
-  sigma 2.5, 2.5, 5 m, the white R's values, with the datasheet's ``code_correlation_time``, the
+  sigma 2.5, 2.5, 5 m, the white R's values, with the datasheet's ``carrier_smoothing``, the
   receiver's carrier-smoothing time, 100 s for the ``automotive`` receiver) and a white 0.5 /
   1 m remainder, for the overconfidence of a white R against fix errors correlated over 100 s
   (position NEES 54, median of Park's garage's ten seeds); ``odometer_scale_state``, a
@@ -111,8 +111,8 @@ class ParkInsOdometer(Estimator):
                              f"{', '.join(NHC_POINTS)}, got {self.config['nhc_point']!r}")
         site = Installation.from_datasheet(self.datasheet)
         # the receiver's fix error is correlated over its carrier-smoothing time (the datasheet's
-        # code_correlation_time): three Gauss-Markov states of that time constant
-        tau = float((self.datasheet.get("gnss") or {}).get("code_correlation_time") or 0.0)
+        # carrier_smoothing): three Gauss-Markov states of that time constant
+        tau = float((self.datasheet.get("gnss") or {}).get("carrier_smoothing") or 0.0)
         self._fix_states = self.config["fix_error_states"] and tau > 0
         sigma, taus = [], []
         if self._fix_states:

@@ -39,7 +39,7 @@ The constants (speed of light, the GPS Earth rotation rate) are imported from th
 Public names
 ------------
 RawEpoch, raw_epoch, predict, los_jacobians, antenna_offset, clock_transition, clock_noise,
-TCXO_H0, TCXO_H_MINUS2.
+correlated_noise_inflation, TCXO_H0, TCXO_H_MINUS2.
 """
 
 from __future__ import annotations
@@ -196,3 +196,20 @@ def clock_noise(dt_s: float, h0: float = TCXO_H0, h_minus2: float = TCXO_H_MINUS
     s_f, s_g = h0 / 2.0, 2.0 * np.pi**2 * h_minus2
     return C_M_S**2 * np.array([[s_f * dt_s + s_g * dt_s**3 / 3.0, s_g * dt_s**2 / 2.0],
                                 [s_g * dt_s**2 / 2.0, s_g * dt_s]])
+
+
+def correlated_noise_inflation(correlation_time_s: float, interval_s: float) -> float:
+    """Factor on a measurement's 1-sigma that makes a filter treating it as white count a
+    first-order Gauss-Markov error of correlation time T, sampled every dt, at its real worth.
+
+    The mean of N samples of such an error (an AR(1) sequence, phi = exp(-dt / T)) has, for
+    N dt >> T, the variance sigma^2 (1 + phi) / ((1 - phi) N): the sum of its autocorrelations
+    sigma^2 phi^|k| over all lags, i.e. its long-run variance, (1 + phi) / (1 - phi) times what
+    N white samples give; the sigma is scaled by the square root of that (sqrt(2 T / dt) for
+    T >> dt). T = 0 (a white error) gives 1. It makes the long-run weight right and the
+    epoch-to-epoch weight too small: the price of not carrying the errors as states.
+    """
+    if correlation_time_s <= 0.0:
+        return 1.0
+    phi = np.exp(-interval_s / correlation_time_s)
+    return float(np.sqrt((1.0 + phi) / (1.0 - phi)))

@@ -39,11 +39,14 @@ t - k P, with k chosen so that t - k P lies within half a period of the time of 
 Earth-fixed node longitude and its place on its ground track, the whole constellation stays one
 consistent real snapshot, and the elements are only shifted in time (toe, toc, week and the
 node's week-start longitude Omega_0, which carries the Earth's rotation; IS-GPS-200 Table
-20-IV), never propagated over years. Consequence: a 2026 scenario sees the 2020 constellation
-(its 31 satellites, PRNs and slots, the sidereal-time-of-day pattern of their passes), not the
-2026 one: satellites launched or retired since then are not there, and the real slow drift of
-the constellation along its tracks is not followed. Counts and geometry are those of a real
-31-satellite GPS (about 9-10 above 10 deg at mid latitudes); a scenario that must reproduce a
+20-IV), never propagated over years. They are written as a record per satellite every two hours,
+as broadcast ephemerides are (each the same orbit re-referenced to its toe), so that exported
+RINEX navigation files are accepted by receivers' and RTKLIB's age checks. Consequence: a 2026
+scenario sees the 2020 constellation (its 31 satellites, PRNs and slots, the
+sidereal-time-of-day pattern of their passes), not the 2026 one: satellites launched or retired
+since then are not there, and the real slow drift of the constellation along its tracks is not
+followed. Counts and geometry are those of a real 31-satellite GPS (8.6-10.0 above 10 deg,
+averaged over a day, at seven sites from 34 S to 60 N); a scenario that must reproduce a
 particular day's sky names that day's navigation file.
 
 Public names
@@ -195,14 +198,21 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
 # the shipped real almanac (NAVCEN YUMA for 2020-01-01) and its full GPS week (YUMA's week 38)
 ALMANAC_FILE = Path(__file__).parent / "data" / "yuma_2020-01-01.txt"
 ALMANAC_WEEK = 2086
-TOE_GRID_S = 16.0  # broadcast toe values are multiples of 2^4 s (IS-GPS-200 Table 20-III)
 
 
 def almanac_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
-                           path: Path = ALMANAC_FILE, week: int = ALMANAC_WEEK) -> pd.DataFrame:
+                           interval_s: float = 7200.0, path: Path = ALMANAC_FILE,
+                           week: int = ALMANAC_WEEK) -> pd.DataFrame:
     """The real GPS constellation of an almanac, re-epoched to ``utc`` by whole ground-track
-    repeat periods (module docstring): one record per satellite, valid over
-    [utc, utc + span_s].
+    repeat periods (module docstring), as broadcast-style records: one per satellite every
+    ``interval_s`` from the last even interval before ``utc`` over ``span_s`` (so that a record
+    is always within half an interval, as broadcast ephemerides are, and RINEX readers that
+    refuse older ones accept them).
+
+    Each record is the almanac's orbit re-referenced to its toe: the two-body elements carried
+    over the time from the (shifted) time of applicability, exactly (M_0 + n dt, Omega_0 with
+    the node's regression and the Earth's rotation, af0 + af1 dt; IS-GPS-200 Table 20-IV), so
+    every record gives the same Earth-fixed orbit, that of the almanac at t - k P.
 
     Parameters
     ----------
@@ -210,6 +220,8 @@ def almanac_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
         Start of the drive (UTC).
     span_s : float
         Length of the drive, s; the shift is chosen for its middle.
+    interval_s : float
+        Spacing of the records' toe, s (broadcast ephemerides: 2 h).
     path, week : the YUMA almanac and its full GPS week (default: the shipped 2020-01-01 one).
 
     Returns
@@ -219,22 +231,24 @@ def almanac_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
         with their health code; ``attrs``: ``kind`` = ``almanac``, ``source`` (the file's name)
         and ``epoch_shift_s`` (k P, s).
     """
-    nav = read_yuma(path, reference_week=week)
-    toa_abs = nav["week"].to_numpy() * SECONDS_PER_WEEK + nav["toe"].to_numpy()
+    alm = read_yuma(path, reference_week=week)
+    toa_abs = alm["week"].to_numpy() * SECONDS_PER_WEEK + alm["toe"].to_numpy()
     start_week, start_tow = utc_to_gps(utc)
-    middle = start_week * SECONDS_PER_WEEK + start_tow + 0.5 * span_s
-    shift_s = round((middle - float(np.median(toa_abs))) / REPEAT_PERIOD_S) * REPEAT_PERIOD_S
-    # the new toe on the 16 s grid of broadcast toe values (IS-GPS-200 Table 20-VI scale
-    # factor 2^4), the elements carried over the remaining delta (< 8 s) exactly in two-body
-    # terms, so that the Earth-fixed orbit stays that of t - k P
-    exact = toa_abs + shift_s
-    new_abs = np.round(exact / TOE_GRID_S) * TOE_GRID_S
-    delta = new_abs - exact
+    start_abs = start_week * SECONDS_PER_WEEK + start_tow
+    shift_s = round((start_abs + 0.5 * span_s - float(np.median(toa_abs))) / REPEAT_PERIOD_S
+                    ) * REPEAT_PERIOD_S
+    toe_abs = (np.floor(start_abs / interval_s) * interval_s
+               + np.arange(0.0, span_s + interval_s, interval_s))
+    n_toe = len(toe_abs)
+    nav = alm.loc[alm.index.repeat(n_toe)].reset_index(drop=True)
+    new_abs = np.tile(toe_abs, len(alm))
+    delta = new_abs - np.repeat(toa_abs + shift_s, n_toe)  # time from the elements' epoch
     new_week = np.floor(new_abs / SECONDS_PER_WEEK)
     new_toe = new_abs - new_week * SECONDS_PER_WEEK
     mean_motion = np.sqrt(MU_GPS_M3_S2 / nav["sqrt_a"].to_numpy() ** 6) + nav["delta_n"].to_numpy()
     # Omega_k = Omega_0 + (Omega_dot - omega_e) t_k - omega_e toe: the same Earth-fixed node at
-    # the same time needs Omega_0 to take up the change of toe within its week
+    # the same time needs Omega_0 to take up the node's motion over delta and the change of
+    # toe within its week
     omega0 = (nav["omega0"].to_numpy() + OMEGA_E_DOT_RAD_S * (new_toe - nav["toe"].to_numpy())
               + (nav["omega_dot"].to_numpy() - OMEGA_E_DOT_RAD_S) * delta)
     nav["omega0"] = np.angle(np.exp(1j * omega0))
@@ -242,5 +256,6 @@ def almanac_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     nav["af0"] = nav["af0"].to_numpy() + nav["af1"].to_numpy() * delta
     nav["week"] = new_week.astype(int)
     nav["toe"] = nav["toc"] = new_toe
+    nav["iode"] = np.tile(np.arange(n_toe) % 256, len(alm))
     nav.attrs.update(kind="almanac", source=Path(path).name, epoch_shift_s=float(shift_s))
     return nav

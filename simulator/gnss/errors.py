@@ -7,14 +7,15 @@ Time behaviour (issue 19):
 
 - The code tracking error is the DLL's thermal jitter (Kaplan & Hegarty 2017 eq. 8.51) shaped by
   the loop: a first-order loop of noise bandwidth B_L passes white discriminator noise through
-  a low-pass of time constant 1 / (4 B_L) (Kaplan & Hegarty 2017 section 8.8; Groves 2013
-  section 9.3.3), so the error is a Gauss-Markov process of that correlation time sampled at
-  the output rate: a 0.5 Hz loop is correlated over 0.5 s, so consecutive 10 Hz samples are
-  (correlation 0.82), 1 Hz samples nearly not (0.14). The Doppler error is shaped likewise by
+  a low-pass of time constant 1 / (4 B_L) (a first-order loop's noise bandwidth is
+  B_L = K / 4: Kaplan & Hegarty 2017 ch. 8, the loop filter characteristics), so the error is
+  a Gauss-Markov process of that correlation time sampled at the output rate: a 0.5 Hz loop
+  is correlated over 0.5 s, so consecutive 10 Hz samples are (correlation 0.82), 1 Hz
+  samples nearly not (0.14). The Doppler error is shaped likewise by
   the frequency loop.
-- Carrier smoothing (Hatch 1982; RTCA DO-229D section 2.1.4.1.1 and DO-253C: a 100 s time
-  constant) filters the code-minus-carrier: smoothed = carrier + F(code - carrier), F the
-  first-order filter with weight 1 / min(n, N) for the n-th epoch of a tracking arc (a growing
+- Carrier smoothing (Hatch 1982; the 100 s time constant of RTCA DO-229D and DO-253C)
+  filters the code-minus-carrier: smoothed = carrier + F(code - carrier), F the first-order
+  filter with weight 1 / min(n, N) for the n-th epoch of a tracking arc (a growing
   average until N = T / dt epochs, then fixed). Since code - carrier = 2 I + e_code + m_code
   (the carrier's own noise and multipath, millimetres, are left out), the smoothed pseudorange
   error is F(e_code) + F(m_code) + F(2 I) - I: the noise and multipath are lowered and become
@@ -48,7 +49,7 @@ pseudorange_sigma.
 References
 ----------
 Brown & Hwang 2012, Table 9.1 (oscillator h-parameters). Kaplan & Hegarty 2017, section 10.2
-(the single-frequency error budget) and section 8.8 (loop noise bandwidth). Hatch, R., "The
+(the single-frequency error budget) and ch. 8 (loop noise bandwidth). Hatch, R., "The
 synergism of GPS code and carrier measurements", 3rd Int. Geodetic Symp. on Satellite Doppler
 Positioning, 1982. Klobuchar, J. A., "Ionospheric time-delay algorithm for single-frequency GPS
 users", IEEE Trans. AES 23(3), 325-331, 1987. Georgiadou, Y. & Kleusberg, A., "On carrier signal
@@ -90,7 +91,7 @@ IONO_GRID_STEP = 1.0
 def loop_time_constant_s(bandwidth_hz: float) -> float:
     """Time constant of a first-order tracking loop of one-sided noise bandwidth B_L:
     B_L = K / 4 for the loop gain K, so the loop low-passes with 1 / K = 1 / (4 B_L) (Kaplan &
-    Hegarty 2017 section 8.8, Table 8.23)."""
+    Hegarty 2017 ch. 8, the loop filter characteristics)."""
     return 1.0 / (4.0 * bandwidth_hz)
 
 
@@ -193,7 +194,7 @@ def hatch_filter(x: np.ndarray, tracked: np.ndarray, dt_s: float, time_constant_
                  ) -> np.ndarray:
     """The Hatch filter's response to x along the epochs (last axis), restarted at every
     tracking arc: y_k = (1 - 1/n) y_{k-1} + x_k / n with n = min(epochs since the arc began,
-    N), N = T / dt (RTCA DO-229D 2.1.4.1.1); zero where not tracked.
+    N), N = T / dt (the 100 s filter of RTCA DO-229D); zero where not tracked.
 
     Vectorised: the growing part is a running mean (cumulative sums restarted per arc), the
     fixed part the recursion ``simulator.stochastic.ar1_filter`` run over the whole row with

@@ -20,8 +20,8 @@ error off; ``automotive`` (default) is a mass-market single-frequency receiver w
 
 Presets (the figures they follow):
 
-- ``automotive``: DLL 0.5 Hz with 0.5-chip spacing and 100 s carrier smoothing (RTCA DO-229D
-  2.1.4.1.1, the 100 s Hatch filter; u-blox M8/F9 fixes change by centimetres per second while
+- ``automotive``: DLL 0.5 Hz with 0.5-chip spacing and 100 s carrier smoothing (RTCA DO-229D,
+  the 100 s Hatch filter; u-blox M8/F9 fixes change by centimetres per second while
   driving: 0.036 m/s per axis in a u-blox log at 17.6 m/s, issue 19); FLL 2 Hz: pseudorange-rate
   noise 0.024 / 0.04 / 0.08 m/s at 45 / 40 / 35 dB-Hz (Kaplan & Hegarty 2017 eq. 8.37), the
   level of the u-blox NEO-M8 datasheet's 0.05 m/s velocity accuracy (UBX-15031086) and of the

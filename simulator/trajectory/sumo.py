@@ -25,7 +25,10 @@ Braking: the ego's ``decel`` defaults to a comfortable 2.0 m/s^2 (SUMO's passeng
 is a hard stop), and SUMO's ``--tls.yellow.min-decel`` is set to it, so a driver who would have
 to brake harder than that for a yellow light drives on, as a driver does. Without it SUMO brakes
 for yellow at up to 3 m/s^2 whatever ``decel`` says: on the shipped city grid 13 % of the moving
-time braked harder than 2.5 m/s^2 (real drives: about 1 %), 0.06 % with it (issue 13).
+time braked harder than 2.5 m/s^2 (real drives: about 1 %), 0.06 % with it (issue 13). A
+network built by netgenerate has its yellow lights timed for that deceleration too
+(``sumo_network.yellow_time``, ITE's change interval: 4.5 s at 13.9 m/s and 2 m/s^2, 5 s in
+whole seconds, instead of 3 s), so a driver is not caught between the stop line and red.
 
 Placement: a georeferenced network (OSM) keeps its true latitude and longitude through its
 projection; a network without georeference (netgenerate, plain XML, most .net.xml and OpenDRIVE
@@ -103,7 +106,8 @@ SUMO_FIELD = Record({
         "accel": Number("m/s^2", 2.6, gt=0, max=10.0, doc="largest acceleration"),
         "decel": Number("m/s^2", 2.0, gt=0, max=10.0,
                         doc="comfortable deceleration (SUMO's decel; also the hardest braking "
-                            "for a yellow light, tls.yellow.min-decel)"),
+                            "for a yellow light, tls.yellow.min-decel, and the deceleration a "
+                            "generated network's yellow lights are timed for)"),
         "max_speed": Number("m/s", 33.3, gt=0, max=70.0, doc="top speed"),
         "sigma": Number("", 0.5, min=0, max=1, doc="driver imperfection (Krauss sigma)"),
     }, default={}),
@@ -422,7 +426,7 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
     base = Path(ctx.file).resolve().parent if ctx is not None else Path.cwd()
     try:
         _resolve_paths(traj, base)
-        network = prepare_network(traj["network"], base)
+        network = prepare_network(traj["network"], base, traj["ego"]["decel"])
         drive = run_sumo(traj, network)
         frame = place_drive(drive.xyz, network, scenario["start"])
         fitted = fit_drive(drive.t, frame.enu, traj["fit"]["knot_spacing"],

@@ -28,7 +28,8 @@ part of its road. Zone names apply through the environment's zone settings.
 
 Public names
 ------------
-NETWORK_FIELD, NETGENERATE_FIELD, Network, NetworkError, prepare_network, sumo_binary, cache_dir.
+NETWORK_FIELD, NETGENERATE_FIELD, Network, NetworkError, prepare_network, sumo_binary, cache_dir,
+yellow_time.
 
 References
 ----------
@@ -39,6 +40,7 @@ ASAM OpenDRIVE 1.6, section 13.3 (tunnels).
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -82,6 +84,8 @@ NETWORK_FIELD = Either(
 # SUMO's default junction speed limit (5.5 m/s^2 average lateral acceleration) lets cars take
 # 10 m radius turns at over 1 g peak; 2.5 m/s^2 average keeps the peak near 0.6 g
 _TURN_SPEED = "--junctions.limit-turn-speed=2.5"
+# perception-reaction time of the yellow interval (ITE's kinematic formula, ``yellow_time``), s
+YELLOW_REACTION_S = 1.0
 _TUNNEL_TAGS = {"yes", "building_passage", "culvert", "avalanche_protector"}
 _ZONE_WORDS = ("tunnel", "garage", "parking", "underground")
 
@@ -144,7 +148,7 @@ class NetworkError(Exception):
         self.key = key
 
 
-def prepare_network(spec: str | dict, base: Path) -> Network:
+def prepare_network(spec: str | dict, base: Path, yellow_decel: float = 3.0) -> Network:
     """Build (or take from the cache) the network a scenario's ``trajectory.network`` names.
 
     Parameters
@@ -153,6 +157,9 @@ def prepare_network(spec: str | dict, base: Path) -> Network:
         The validated ``network`` value.
     base : Path
         Folder relative paths are resolved against (the scenario file's folder).
+    yellow_decel : float
+        Deceleration (m/s^2) the yellow lights of a generated network are timed for
+        (``yellow_time``); a network read from a file keeps its own signal plans.
 
     Raises
     ------
@@ -185,7 +192,7 @@ def prepare_network(spec: str | dict, base: Path) -> Network:
         raise NetworkError(("network",), "give exactly one network source: a file path, "
                                          "netgenerate: {...}, or nodes: and edges: files")
     if spec.get("netgenerate"):
-        return _read_network(_netgenerate(spec["netgenerate"]))
+        return _read_network(_netgenerate(spec["netgenerate"], yellow_decel))
     files = {k: _existing(base, spec[k], ("network", k))
              for k in ("nodes", "edges", "connections") if spec.get(k)}
     args = [f"--node-files={files['nodes']}", f"--edge-files={files['edges']}",
@@ -202,7 +209,20 @@ def _existing(base: Path, name: str, key: tuple) -> Path:
     return path
 
 
-def _netgenerate(recipe: dict) -> Path:
+def yellow_time(speed: float, decel: float) -> float:
+    """The yellow (change) interval of a signal, s: the kinematic formula of the Institute of
+    Transportation Engineers (Traffic Engineering Handbook), Y = t_r + v / (2 a) on a level
+    approach, with a perception-reaction time t_r of 1 s, the approach speed v and the
+    deceleration a drivers stop with, so that a driver who sees yellow beyond the stopping
+    distance can stop at a and a nearer one passes before red. netgenerate's 3 s is shorter
+    than that for drivers braking at a comfortable 2 m/s^2 from 13.9 m/s (4.5 s, 5 s as
+    netgenerate takes it in whole seconds): they were
+    caught between stop line and red and braked at SUMO's emergency deceleration
+    (docs/vehicle.md, "SUMO braking")."""
+    return YELLOW_REACTION_S + speed / (2.0 * decel)
+
+
+def _netgenerate(recipe: dict, yellow_decel: float) -> Path:
     kind = recipe["type"]
     args = [f"--{'rand' if kind == 'random' else kind}", f"--default.lanenumber={recipe['lanes']}",
             f"--default.speed={recipe['speed']}", f"--seed={recipe['seed']}",
@@ -217,7 +237,9 @@ def _netgenerate(recipe: dict) -> Path:
     else:
         args += [f"--rand.iterations={recipe['iterations']}"]
     if recipe["traffic_lights"]:
-        args.append("--default-junction-type=traffic_light")
+        args += ["--default-junction-type=traffic_light",
+                 # netgenerate takes whole seconds: rounded up, a little more time to stop
+                 f"--tls.yellow.time={math.ceil(yellow_time(recipe['speed'], yellow_decel))}"]
     return _run_tool("netgenerate", args, [], ("network", "netgenerate"))
 
 

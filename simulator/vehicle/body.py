@@ -35,7 +35,7 @@ BodyMotion, build_body, quintic_hermite_basis, side_slip, level_road.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -125,7 +125,6 @@ class BodyMotion:
     t: np.ndarray
     nodes: np.ndarray
     reference_point: np.ndarray
-    _by_sample: np.ndarray | None = field(default=None, repr=False, compare=False)
 
     def evaluate(self, t: np.ndarray) -> dict[str, np.ndarray]:
         """Each channel and its first and second time derivatives at t (1-D): keys ``heave``,
@@ -133,20 +132,18 @@ class BodyMotion:
         elsewhere the quintic of the interval, built from its two ends' nodes."""
         h = self.t[1] - self.t[0]
         n = len(self.t)
-        i = np.clip(np.floor(t / h).astype(np.intp), 0, n - 2)
-        on = t == self.t.take(i)
-        last = t == self.t[-1]  # the grid's last time closes the last interval
-        at = np.where(last, n - 1, i)
-        off = np.flatnonzero(~(on | last))
+        x = t / h
+        at = np.clip(np.rint(x).astype(np.intp), 0, n - 1)  # the nearest grid time
+        off = np.flatnonzero(t != self.t.take(at))
+        rows = self.nodes.T  # (n, 18), C-ordered: a grid time's values lie together
         if not len(off) and len(at) and at[-1] - at[0] == len(at) - 1:  # a run of grid times
-            values = self.nodes[:, at[0]:at[-1] + 1].copy()
+            values = np.ascontiguousarray(self.nodes[:, at[0]:at[-1] + 1])
         elif len(off) == len(t):
             values = np.empty((self.nodes.shape[0], len(t)))
         else:
-            values = self.nodes.take(at, axis=1)
+            values = np.ascontiguousarray(rows.take(at, axis=0).T)
         if len(off):
-            j = i[off]
-            rows = self._rows()  # the nodes sample by sample: a gather of whole rows
+            j = np.clip(np.floor(x[off]).astype(np.intp), 0, n - 2)  # the interval of each
             k = len(CHANNELS)
             scale = np.repeat([1.0, h, h * h], k)  # c = (y, h y', h^2 y'') at each end
             ends = np.concatenate([rows.take(j, axis=0) * scale,
@@ -166,11 +163,10 @@ class BodyMotion:
     def breakpoints(self) -> np.ndarray:
         return self.t
 
-    def _rows(self) -> np.ndarray:
-        """The nodes as (n, 18), C-ordered (kept once made)."""
-        if self._by_sample is None:
-            self._by_sample = np.ascontiguousarray(self.nodes.T)
-        return self._by_sample
+    def __post_init__(self) -> None:
+        # stored sample by sample (Fortran order): the 18 values of a grid time lie together,
+        # so the quintics between grid times gather whole rows of nodes.T
+        self.nodes = np.asfortranarray(self.nodes)
 
 
 def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
@@ -224,7 +220,7 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
     slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
     k = len(CHANNELS)
-    nodes = np.empty((3 * k, len(t)))
+    nodes = np.empty((3 * k, len(t)), order="F")
     for order in range(3):  # the channels; then their rates, then their accelerations
         nodes[k * order:k * order + 3] = ride[5 * order:5 * order + 3]  # heave, pitch, roll
         nodes[k * order + 3] = slip[order]

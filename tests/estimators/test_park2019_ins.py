@@ -25,8 +25,8 @@ def runs(request, tmp_path_factory) -> dict[str, np.ndarray]:
     outage), figures of ``simulator.reproduce.park2019``, full-length drives."""
     # on the default automotive body: the constraint at the rear axle (from the datasheet's
     # installation geometry), its noise from the bicycle model's tyre slip. Measured, ten seeds:
-    # RMS outside the outages median 2.82 m (2.22-3.84) on Park's garage, 3.14 m (2.58-3.76) on
-    # parking_garage.yaml; garage maximum with the NHC 22.1 / 20.7 m against 45.7 / 44.1 m
+    # RMS outside the outages median 2.77 m (1.64-3.02) on Park's garage, 3.29 m (2.48-3.85) on
+    # parking_garage.yaml; garage maximum with the NHC 20.8 / 21.1 m against 43.9 / 44.6 m
     # without. At the IMU instead (nhc_point: imu), where the car slips sideways by up to 11 deg
     # in the 8 m turns, it was 3.83 / 7.56 m and 73.3 / 48.2 m: the violated constraint hurt
     table = run_experiment(request.param, SEEDS, tmp_path_factory.mktemp("park"))

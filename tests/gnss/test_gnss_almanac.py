@@ -79,7 +79,9 @@ def test_re_epoched_orbits_are_the_almanac_orbits_whole_repeats_earlier(utc):
     shift = shifted.attrs["epoch_shift_s"]
     k = shift / REPEAT_PERIOD_S
     assert k == pytest.approx(round(k), abs=1e-9)
-    assert (shifted["toe"] % 16.0 == 0).all()  # on the broadcast toe grid
+    # broadcast-style records: every satellite every 2 h on even hours, over the drive
+    assert (shifted["toe"] % 7200.0 == 0).all()
+    assert (shifted.groupby("sv").size() == 3).all()  # from the even hour before, 2 h apart
     seconds = np.arange(0.0, span + 1, 600.0)
     pos_new, ok_new = _positions(shifted, utc, seconds)
     original = read_yuma(ALMANAC_FILE, reference_week=ALMANAC_WEEK)

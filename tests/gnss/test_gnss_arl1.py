@@ -174,9 +174,10 @@ def test_static_hour_time_behaviour_and_ionosphere_beside_arl1():
     pseudorange residual autocorrelation at 30 s lies in 0.3-0.8 for the geodetic preset (the
     mean over four seeds; one hour of about nine satellites gives a single seed's figure a
     spread of about 0.05) as for the real receiver, and the true ionosphere is 1.2-2.2 x
-    Klobuchar in every seed. Measured: real 0.59 at 30 s, 0.49 at 60 s; geodetic 0.65, 0.68,
-    0.76, 0.68 at 30 s (mean 0.69) and 0.59-0.71 at 60 s: more correlated than the real
-    receiver, whose residual holds more of a fast part; ionosphere 1.23-1.70 x Klobuchar."""
+    Klobuchar (the mean of the seeds; one hour draws about two values of its slow variation).
+    Measured: real 0.59 at 30 s, 0.49 at 60 s; geodetic 0.65, 0.68, 0.76, 0.68 at 30 s (mean
+    0.69) and 0.59-0.71 at 60 s: more correlated than the real receiver, whose residual holds
+    more of a fast part; ionosphere 1.23-1.70 x Klobuchar."""
     nav = _nav()
     real = residuals(_real_observations(), nav, ARL1_XYZ)
     sims = [residuals(_simulated("geodetic", seed), nav, ARL1_XYZ) for seed in SEEDS]
@@ -200,7 +201,7 @@ def test_static_hour_time_behaviour_and_ionosphere_beside_arl1():
         both = out["gnss_raw"].merge(out["truth_gnss"], on=["t", "sv"])
         ratios.append(both["iono_true"].sum() / both["iono"].sum())
     print("true / Klobuchar ionosphere:", np.round(ratios, 2))
-    assert all(1.2 < r < 2.2 for r in ratios)
+    assert 1.2 < np.mean(ratios) < 2.2
 
 
 @pytest.mark.xfail(strict=True, reason=(

@@ -88,8 +88,11 @@ def test_code_noise_is_correlated_over_the_dll_time_constant(rate, expected):
     truth = drive([{"stop": {"duration": 300}}], rate_hz=10.0)
     out = receiver(rate=rate, carrier_smoothing=0.0, outputs=["raw"]).generate(
         truth, np.random.default_rng(5))
-    tracked = out["truth_gnss"].query("tracked == 1")
-    assert _pooled_autocorrelation(tracked, "code_noise", 1) == pytest.approx(expected, abs=0.05)
+    tracked = out["truth_gnss"].query("tracked == 1").copy()
+    # each satellite's series in units of its own spread, so the weakest signals (noisiest by
+    # far near the 17 dB-Hz threshold) do not make the pooled figure theirs alone
+    tracked["unit"] = tracked["code_noise"] / tracked.groupby("sv")["code_noise"].transform("std")
+    assert _pooled_autocorrelation(tracked, "unit", 1) == pytest.approx(expected, abs=0.05)
 
 
 def test_carrier_smoothing_correlates_the_code_error_over_its_time_constant():
@@ -180,14 +183,17 @@ def test_doppler_noise_at_the_level_of_mass_market_receivers():
 
 
 def test_true_ionosphere_is_one_and_a_half_klobuchar_by_default():
-    """iono_scale 1.5: over ten seeds the hour's mean true/broadcast ratio stays within the
-    1.2-2.2 of issue 19 in every one, and averages 1.5."""
+    """iono_scale 1.5 with a 20 % slow variation: over twenty 10-minute drives the mean
+    true/broadcast ratio is 1.5 (within 3 standard errors, 0.2) and most drives (the model
+    expects 83 %; at least 75 % asserted) lie within the 1.2-2.2 of issue 19 (the variation is
+    common to the signals over 30 min, so one short drive draws one ratio)."""
     truth = drive([{"stop": {"duration": 600}}], rate_hz=1.0)
     ratios = []
-    for seed in range(10):
+    for seed in range(20):
         out = receiver(outputs=["raw"], rate=0.1).generate(truth, np.random.default_rng(seed))
         both = out["gnss_raw"].merge(out["truth_gnss"], on=["t", "sv"])
         ratios.append(both["iono_true"].sum() / both["iono"].sum())
+    ratios = np.array(ratios)
     print("\ntrue / Klobuchar ionosphere by seed:", np.round(ratios, 2))
-    assert all(1.2 < r < 2.2 for r in ratios)
-    assert np.mean(ratios) == pytest.approx(1.5, abs=0.15)
+    assert np.mean(ratios) == pytest.approx(1.5, abs=0.2)
+    assert np.mean((ratios > 1.2) & (ratios < 2.2)) >= 0.75

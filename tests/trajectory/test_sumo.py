@@ -337,3 +337,23 @@ def test_same_scenario_gives_identical_truth_without_cache(tmp_path, monkeypatch
     assert (tmp_path / "a" / "truth.parquet").read_bytes() == (
         tmp_path / "b" / "truth.parquet").read_bytes()
     assert any((tmp_path / "cache-a" / "sumo").glob("run-*.npz"))
+
+
+def test_city_grid_lights_give_time_to_stop_comfortably():
+    """The shipped city grid's yellow lights last ITE's change interval for the ego's 2 m/s^2,
+    1 s + 13.89 / (2 x 2) = 4.47 s, rounded up to netgenerate's whole 5 s (its own default was
+    3 s), and the drive's hardest braking after the fit is the ego's comfortable braking, not
+    SUMO's emergency stop at a light turned red 1.3 m ahead (-11.6 m/s^2 with the 3 s yellow,
+    docs/vehicle.md): measured -2.87 m/s^2."""
+    from simulator.trajectory.sumo_network import yellow_time
+
+    assert yellow_time(13.89, 2.0) == pytest.approx(1.0 + 13.89 / 4.0)
+    scenario = load_scenario(REPO / "scenarios" / "sumo_city_grid.yaml")
+    traj = scenario.data["trajectory"]
+    network = prepare_network(traj["network"], REPO / "scenarios", traj["ego"]["decel"])
+    phases = ET.parse(network.path).getroot().iter("phase")
+    yellow = {float(p.get("duration")) for p in phases if "y" in p.get("state")}
+    assert yellow == {5.0}
+    profile = scenario.drive.profile
+    t = np.arange(0.0, profile.duration_s, 0.01)
+    assert profile.distance_of_time.evaluate(t, (2,))[0].min() > -3.0

@@ -1,0 +1,58 @@
+"""Benchmark: one hour of GNSS raw measurements and fixes from the default sky (the real
+almanac's 31 satellites), in open sky and all in an urban canyon (the path tracing of
+``simulator.environment.sky``), at 1 Hz and 10 Hz.
+
+Run:  PYTHONPATH=. python benchmarks/bench_canyon.py   (figures in BENCHMARKS.md, "Sky")
+
+A straight street driven at 10 m/s for an hour (truth at 10 Hz), the automotive receiver; the
+canyon is 40 m facades 25 m apart, as in ``scenarios/urban_canyon.yaml``. Timed: ``Gnss.generate``
+in-process, CPU time, best of two; the truth trajectory is built beforehand.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from simulator.drive import build_drive  # noqa: E402
+from simulator.scenario import validate_data  # noqa: E402
+from simulator.schema import Context  # noqa: E402
+from simulator.sensors.gnss import GNSS_FIELD, Gnss  # noqa: E402
+
+CANYON = {"street": {"sky": "canyon", "building_height": 40.0, "street_width": 25.0}}
+
+
+def _truth(zones: dict):
+    data = validate_data({
+        "name": "bench-canyon",
+        "start": {"utc": "2026-05-04T03:00:00Z", "lat": 37.5665, "lon": 126.978, "alt": 40.0,
+                  "heading": 0.0},
+        "trajectory": {"kind": "segments", "rate": 10, "segments": [
+            {"accelerate": {"to_speed": 10.0, "accel": 1.0}},
+            {"straight": {"duration": 3590, "zone": "street"}}]},
+        "environment": {"zones": zones}, "vehicle": "rigid"}, "bench.yaml")
+    return build_drive(data).truth
+
+
+def main() -> None:
+    for rate in (1, 10):
+        config = GNSS_FIELD.check({"rate": rate}, ("gnss",), Context("bench"))
+        for label, zones in (("open sky", {}), ("canyon", CANYON)):
+            truth = _truth(zones)
+            cpu = []
+            for seed in range(2):
+                start = time.process_time()
+                out = Gnss(config).generate(truth, np.random.default_rng(seed))
+                cpu.append(time.process_time() - start)
+            print(f"{rate:2d} Hz {label:8s}: CPU {min(cpu):.2f} s, "
+                  f"{len(out['gnss_raw'])} raw rows, "
+                  f"{len(out['gnss_raw']) / len(out['gnss_fix']):.1f} satellites per epoch")
+
+
+if __name__ == "__main__":
+    main()
