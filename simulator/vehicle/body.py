@@ -13,7 +13,10 @@ each as a piecewise quintic of time that the exact kinematics differentiate.
   body's x axis, so the body's yaw is the path's heading minus beta. The steady state is used
   throughout: the bicycle model's lateral and yaw modes settle within about 0.2 s, while every
   curvature change of a drive (clothoids, lane changes, fitted paths) lasts a second or more.
-  Choice: beta is the same when reversing (at reversing speeds it is the kinematic l_r kappa).
+  Reversing (d = -1): the rear axle still rolls without sliding sideways, but the velocity at
+  the centre of gravity is now -v along the path, so the same geometry gives beta = d kappa
+  (l_r - m l_f v^2 / (L C_r)): the kinematic -l_r kappa at reversing speeds (the whole
+  expression times d; d is constant between standstills, so its rates are d times those).
 * Heave, pitch, roll, surge and sway: ``suspension.simulate`` on the grid of the truth, driven
   by the road's heights and slopes under the wheels (``road``) and by the longitudinal, lateral
   and vertical accelerations of the path. On a vertical curve (a grade change, dgamma/ds) the
@@ -218,7 +221,7 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
         ride[10] -= amplitude * omega**2 * sin
     l_f, l_r = axle_distances(params)
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
-    slip = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
+    slip = [d * x for x in side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)]
     k = len(CHANNELS)
     nodes = np.empty((3 * k, len(t)), order="F")
     for order in range(3):  # the channels; then their rates, then their accelerations

@@ -114,8 +114,8 @@ DR2D_NOT_SHOWN = (
 
 INS_NOT_SHOWN = (
     "not shown since ins_odo_ekf applies its NHC at the rear axle (issue 14): dr3d_ekf beats it "
-    "in 6/10 seeds at the exit and 5/10 on the maximum (medians 11.9 m vs 19.7 m exit, 16.9 m "
-    "vs 21.3 m max); with the NHC at the IMU, violated by the car's slip, it won 10/10")
+    "in 7/10 seeds at the exit and 5/10 on the maximum (medians 10.3 m vs 18.6 m exit, 16.8 m "
+    "vs 20.2 m max); with the NHC at the IMU, violated by the car's slip, it won 10/10")
 
 
 def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:

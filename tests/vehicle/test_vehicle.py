@@ -193,6 +193,29 @@ def test_low_speed_slip_is_the_kinematic_geometry():
     np.testing.assert_allclose(beta, l_r / 8.0, rtol=0.01)
 
 
+def test_reversing_keeps_the_rear_axle_from_sliding_sideways():
+    """Backing into a bay on a 5 m radius: on the arc the rear axle's lateral velocity (the
+    kinematic bicycle's no-slip condition, v_lat(cg) - yaw rate x l_r = 0) is near zero, as
+    when driving forward (what is left is the tyres' slip term, under 1 % of the speed), and
+    the slip at the centre of gravity is -l_r / R (its sign follows the direction). With the
+    forward slip kept when reversing, the rear axle slid sideways at 0.9 m/s here."""
+    segments = [{"stop": {"duration": 1.0}},
+                {"reverse": {"length": 12.0, "angle": 90, "radius": 5.0, "speed": 1.5}}]
+    vehicle = {**QUIET, "imu_position": [0.0, 0.0, 0.0]}
+    table = _truth(segments, vehicle).table()
+    v_body = _body_velocity(table)
+    wz = table.wz.to_numpy()
+    p = vehicle_parameters("automotive")
+    l_r = p["wheelbase"] * p["front_weight"]
+    speed = np.hypot(v_body[:, 0], v_body[:, 1])
+    on_arc = (speed > 1.0) & (np.abs(np.abs(wz) * 5.0 - speed) < 0.01)
+    assert on_arc.sum() > 100 and np.all(v_body[on_arc, 0] < 0)
+    rear_lateral = v_body[on_arc, 1] - wz[on_arc] * l_r  # v + w x r, r = (-l_r, 0, 0)
+    assert np.abs(rear_lateral).max() < 0.01 * np.abs(v_body[on_arc, 0]).max()
+    beta = np.arctan2(v_body[on_arc, 1], v_body[on_arc, 0])  # the velocity against body x
+    np.testing.assert_allclose(np.abs(np.pi - np.abs(beta)), l_r / 5.0, rtol=0.05)
+
+
 def test_body_velocity_at_the_imu_is_no_longer_along_x():
     """Issue 13: body-frame lateral and vertical velocity at the IMU are no longer zero (a
     rigid body: exactly zero, the non-holonomic constraint holds perfectly)."""
