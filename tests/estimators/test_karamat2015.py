@@ -166,8 +166,8 @@ def full_drive(tmp_path_factory):
 @pytest.mark.slow
 def test_full_drive_all_sites(full_drive):
     """Every variant bounded over the whole drive. Measured median window maxima at 3 / 2 / 1 /
-    0 satellites: tight 3.8 / 6.2 / 20.1 / 13.8 m, loose 21.8 / 23.1 / 23.1 / 22.1 m,
-    simplified 5.6 / 8.7 / 20.4 / 15.4 m (sites 2-10 are harder to dead-reckon than site 1)."""
+    0 satellites: tight 3.7 / 7.6 / 23.0 / 20.1 m, loose 22.0 / 23.2 / 22.8 / 21.4 m,
+    simplified 5.3 / 9.5 / 24.7 / 21.1 m (sites 2-10 are harder to dead-reckon than site 1)."""
     for label in ("tight", "loose", "simplified"):
         for count in (3, 2, 1, 0):
             maxima = karamat.window_maxima(full_drive, label, count)
@@ -176,8 +176,8 @@ def test_full_drive_all_sites(full_drive):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: 0.0505 deg/s at 300 s on seed 2015 "
-                   "of the ten-site drive (0.033 on the nine-site drive of session 4, whose "
+@pytest.mark.xfail(strict=True, reason="claim not reproduced: 0.05003 deg/s at 300 s on seed 2015 "
+                   "of the ten-site drive (0.033 on the nine-site drive, whose "
                    "shorter duration drew the sensors' processes differently; "
                    "docs/reproduction_karamat2015.md)")
 def test_full_drive_gyro_bias_converged(full_drive):
