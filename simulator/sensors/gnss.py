@@ -39,9 +39,13 @@ Presets (the figures they follow):
   choke-ring antenna), C/N0 fading 0.5 dB, OCXO.
 - both: true ionosphere 1.5 x Klobuchar (Klobuchar 1987: the model removes about half of the
   rms delay; issue 19: ARL1's true ionosphere was 1.3-1.8 x the broadcast model) with a 20 %
-  slow variation; signal-in-space error 0.5 m (the GPS SPS signal-in-space URE of the 2010s,
-  of order 0.5-1 m rms in the FAA GPS performance analysis reports); zenith troposphere
-  residual 5 cm.
+  variation that is a smooth field over the pierce points (1000 km, 30 min;
+  ``simulator.gnss.errors``); signal-in-space error 0.5 m (the GPS SPS signal-in-space URE of
+  the 2010s: a global average SISRE of 0.7 m over 2013/2014, Montenbruck, Steigenberger &
+  Hauschild, "Broadcast versus precise ephemerides: a multi-GNSS perspective", GPS Solutions
+  19, 321-333, 2015, falling since as Block IIF/III satellites replaced older ones; kept at
+  0.5 m, not fitted to the ARL1 hour, whose high satellites agree within 0.2 m:
+  docs/gnss-errors.md); zenith troposphere residual 5 cm.
 
 Streams: ``gnss_raw`` (one row per tracked signal, unhealthy satellites included with their
 ``health`` code), ``gnss_fix`` (one row per epoch from the healthy signals: 3D fix from four
@@ -100,6 +104,7 @@ from simulator.gnss.errors import (
     draw_error_terms,
     draw_fading,
     draw_receiver_clock,
+    pierce_points_km,
     pseudorange_sigma,
     smooth_code_errors,
 )
@@ -171,7 +176,8 @@ _ERROR_FIELDS = {
     "iono_scale": Number("", None, min=0,
                          doc="mean true ionosphere / broadcast (Klobuchar) ionosphere"),
     "iono_residual": Number("", None, min=0,
-                            doc="1-sigma of the slow relative variation of that ratio"),
+                            doc="1-sigma of the relative variation of that ratio, a field "
+                                "smooth over the pierce points (1000 km) and in time (30 min)"),
     "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
     "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
 }
@@ -413,7 +419,9 @@ class Gnss(PresetSensor):
         self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
         # (which would otherwise make the error and the fix weights jump from epoch to epoch)
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u)
+        # (below the horizon, where nothing is tracked, the pierce point of the horizon)
+        pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]
