@@ -158,7 +158,8 @@ def _html_table(header: list[str], rows: list[list[str]]) -> str:
         escaped = html.escape(str(text))
         # **word** -> <b>word</b>, the one markup the cells use
         parts = escaped.split("**")
-        escaped = "".join(f"<b>{p}</b>" if i % 2 else p for i, p in enumerate(parts))
+        escaped = "".join(f"<b{_STATUS_CLASS.get(p, '')}>{p}</b>" if i % 2 else p
+                          for i, p in enumerate(parts))
         return f"<{tag}>{escaped}</{tag}>"
 
     head = "".join(cell(h, "th") for h in header)
@@ -166,7 +167,10 @@ def _html_table(header: list[str], rows: list[list[str]]) -> str:
     return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
 
 
-_STYLE = """body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;}
+_STATUS_CLASS = {"shown": " class='shown'", "partly": " class='partly'",
+                 "not shown": " class='not-shown'"}  # the verdict words, coloured
+_STYLE = """.shown{color:#1b6e20;} .partly{color:#a65f00;} .not-shown{color:#b00020;}
+body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;}
 table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em;}
 td,th{border:1px solid #bbb;padding:4px 6px;vertical-align:top;text-align:left;}
 th{background:#eee;} img{max-width:100%;}"""

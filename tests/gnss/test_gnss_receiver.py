@@ -11,10 +11,15 @@ from gnss_helpers import drive, receiver
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import saastamoinen_zenith
-from simulator.gnss.constants import LAMBDA_L1_M
+from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.errors import iono_field_correlation, pierce_points_km
 from simulator.gnss.fix import pack_epochs, receiver_fixes, solve_position
-from simulator.gnss.receiver import cn0_model, dll_sigma_m, multipath_sigma_m
+from simulator.gnss.receiver import (
+    cn0_model,
+    dll_sigma_m,
+    multipath_sigma_m,
+    rotate_to_reception_frame,
+)
 
 DRIVE = [{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
          {"turn": {"angle": 90, "radius": 50}}, {"straight": {"length": 200}}]
@@ -342,3 +347,24 @@ def test_10hz_fix_errors_change_slowly_while_driving():
     assert np.all(raw_change > 0.5), raw_change
     assert np.all(level < raw_level)
     assert np.all(averaged > 0.95 * level)
+
+
+def test_degenerate_geometry_gives_no_fix_rather_than_an_error():
+    """Four satellites of which three sit at one place: the normal matrix is singular, so that
+    epoch has no fix (NaN, not solvable), while a good epoch beside it is solved to the
+    receiver's true position (found by a Chan experiment with randomly kept satellites, where
+    generation stopped on numpy's LinAlgError)."""
+    rx = geodetic_to_ecef(np.radians(48.0), np.radians(11.0), 500.0)
+    up = rx / np.linalg.norm(rx)
+    east = np.cross([0.0, 0.0, 1.0], up)
+    east /= np.linalg.norm(east)
+    north = np.cross(up, east)
+    good = np.stack([rx + 2.2e7 * d / np.linalg.norm(d) for d in
+                     (up, up + east, up - east + 0.3 * north, up + north - 0.5 * east)])
+    sats = np.stack([good, np.stack([good[0], good[0], good[0], good[1]])])
+    geometric = np.linalg.norm(sats - rx, axis=-1)
+    pr = np.linalg.norm(rotate_to_reception_frame(sats, geometric / C_M_S) - rx, axis=-1)
+    pos, _, ok = solve_position(pr, sats, np.ones((2, 4)), np.ones((2, 4), dtype=bool))
+    assert ok.tolist() == [True, False]
+    np.testing.assert_allclose(pos[0], rx, atol=1e-3)
+    assert np.isnan(pos[1]).all()

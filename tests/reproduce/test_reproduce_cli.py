@@ -4,12 +4,15 @@ end to end."""
 
 from __future__ import annotations
 
+import html
+
 import pandas as pd
 import pytest
 
 from simulator.cli import main
+from simulator.reproduce import tan2008
 from simulator.reproduce.papers import load_paper, paper_keys
-from simulator.reproduce.runner import _execute, _Task
+from simulator.reproduce.runner import _execute, _Task, run_experiment
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -55,7 +58,7 @@ def test_quick_run_of_every_paper(tmp_path, capsys):
     page = (out / "report.html").read_text()
     for key in paper_keys():
         paper = load_paper(key)
-        assert paper.title in md and paper.title in page
+        assert paper.title in md and html.escape(paper.title) in page
         for experiment in paper.experiments:
             table = pd.read_parquet(out / "figures" / key / f"{experiment.key}.parquet")
             assert list(table.index) == [1, 2, 3], (key, experiment.key)
@@ -74,3 +77,18 @@ def test_help_lists_the_papers(capsys):
     for key in paper_keys():
         assert key in text
         assert load_paper(key).claims[0].key in text
+
+
+def test_on_a_dask_cluster_the_figures_are_those_of_an_in_process_run(tmp_path):
+    """Tan's outage, 2 seeds, shortened drive, on a loopback Dask cluster: the figures stored
+    equal those of ``run_experiment`` in this process (same scenario and seed, same numbers)."""
+    distributed = pytest.importorskip("distributed")
+    out = tmp_path / "dask"
+    with distributed.LocalCluster(host="127.0.0.1", n_workers=2, threads_per_worker=1,
+                                  processes=True, dashboard_address=None) as cluster:
+        assert main(["reproduce", "tan2008", "--quick", "--runs", "2", "--scheduler",
+                     cluster.scheduler_address, "-o", str(out)]) == 0
+    stored = pd.read_parquet(out / "figures" / "tan2008" / "outage.parquet")
+    expected = run_experiment(tan2008.OUTAGE, [1, 2], tmp_path, quick=True)
+    pd.testing.assert_frame_equal(stored, expected, check_exact=False, rtol=1e-12)
+    assert "Dask scheduler" in (out / "report.md").read_text()
