@@ -124,12 +124,12 @@ def test_mean_window_maximum_under_12_m(protocol):
         assert _maxima(protocol, "tight", count).mean() < 12.0
 
 
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 23 of the 30 "
-                   "windows with 1-3 satellites, 77 % (docs/reproduction_karamat2015.md)")
 def test_tight_beats_loose_with_one_to_three_satellites(protocol):
     """Issue 15: the tight filter beats ``coupling: loose`` (which has no GNSS below four
     satellites) in at least 80 % of the windows with 1-3 satellites, paired per seed (measured:
-    8, 9 and 6 of 10 with 3, 2 and 1 satellites)."""
+    8, 9 and 7 of 10 with 3, 2 and 1 satellites, 24 of 30: exactly the 80 %, one window from
+    failing; 8, 9 and 6 before the ionosphere became a field over the pierce points, which
+    changed every GNSS draw)."""
     wins, windows = karamat.window_wins(protocol, "tight", "loose", (1, 2, 3))
     assert windows == 3 * len(SEEDS)
     assert wins >= 0.8 * windows
