@@ -176,7 +176,9 @@ def test_full_drive_all_sites(full_drive):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: 0.05003 deg/s at 300 s on seed 2015 "
+# not strict: the figure is 0.00003 deg/s above the bound, within what any change to the
+# random draws moves it
+@pytest.mark.xfail(strict=False, reason="claim not reproduced: 0.05003 deg/s at 300 s on seed 2015 "
                    "of the ten-site drive (0.033 on the nine-site drive, whose "
                    "shorter duration drew the sensors' processes differently; "
                    "docs/reproduction_karamat2015.md)")
