@@ -2,7 +2,7 @@
 scenario's estimators, scores, report); the code base stays ruff-clean.
 
 Long drives run shortened here with ``--set`` (table below; each scenario's comment says so too)
-and whole in ``benchmarks/bench_shipped.py``. This file takes 82 s of CPU (user + system, one
+and whole in ``benchmarks/bench_shipped.py``. This file takes 65 s of CPU (user + system, one
 process, so about that long on a quiet machine; BENCHMARKS.md, "Shipped scenarios"), under the
 3 minutes issue 16 allows.
 """
@@ -22,14 +22,17 @@ import pytest
 from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.pipeline import load_scenario
+from simulator.reproduce.karamat2015 import protocol_overrides as karamat_overrides
 
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
 
-# scenario -> the --set overrides that shorten it for CI (the whole drive in brackets)
+# scenario -> the --set overrides that shorten it for CI (the whole drive in the comment)
 SHORTENED: dict[str, list[str]] = {
-    "highway_long": ["trajectory.segments.3.repeat.times=1"],  # one lap of six (1 h -> 11 min)
-    "sumo_city_canyon": ["trajectory.max_duration=150"],  # the first 150 s (6 min)
+    "highway_long": ["trajectory.segments.3.repeat.times=1"],  # one lap of six (1 h -> 12.5 min)
+    "sumo_city_canyon": ["trajectory.max_duration=150"],  # 150 s after the initial stop (6 min)
+    # two loops of sixteen with the four windows that end in them (2 h 20 min -> 17.5 min)
+    "karamat2015_partial_outages": karamat_overrides(2),
 }
 
 # zones a (shortened) run must pass through: the library scenarios are what their comments say

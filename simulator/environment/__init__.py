@@ -20,7 +20,9 @@ ZONE_FIELD = Record(
                     doc="open sky, no sky (tunnel, garage: every satellite blocked), or an "
                         "urban canyon"),
         "building_height": Number("m", 30.0, min=0,
-                                  doc="canyon: height of the facades above the antenna"),
+                                  doc="canyon: mean height of the buildings above the antenna "
+                                      "(each drawn with building_height_spread); the end "
+                                      "facades' height"),
         "street_width": Number("m", 20.0, gt=0, doc="canyon: width between the facades"),
         "nlos_attenuation": Number("", 15.0, min=0,
                                    doc="canyon: mean C/N0 loss of one reflection off a facade, "
@@ -29,8 +31,22 @@ ZONE_FIELD = Record(
                                           doc="canyon: 1-sigma of the reflection loss from one "
                                               "facade (building) to the next, dB"),
         "facade_length": Number("m", 20.0, gt=0,
-                                doc="canyon: length of one building's facade along the street "
-                                    "(each draws its own reflection loss)"),
+                                doc="canyon: frontage of one building along the street (each has "
+                                    "its own height and draws its own reflection loss; Berlin's "
+                                    "perimeter-block plots are about 20 m wide)"),
+        "building_height_spread": Number("m", 3.0, min=0,
+                                         doc="canyon: 1-sigma of the buildings' heights about "
+                                             "building_height, drawn per building (about one "
+                                             "storey)"),
+        "block_length": Number("m", 110.0, gt=0,
+                               doc="canyon: length of a block between cross streets (European "
+                                   "city centres 50-150 m; Barcelona's Eixample 113 m)"),
+        "cross_street_width": Number("m", 20.0, min=0,
+                                     doc="canyon: width of the cross streets between blocks, where "
+                                         "the facades open on both sides (0: none)"),
+        "building_gap": Number("m", 0.0, min=0,
+                               doc="canyon: gap between neighbouring buildings of a block (0: the "
+                                   "closed perimeter block)"),
     },
     default={},
 )

@@ -3,8 +3,9 @@ ionosphere and the Saastamoinen troposphere with the Niell mapping functions.
 
 Public functions
 ----------------
-klobuchar_delay, default_weather, water_vapour_pressure, saastamoinen_zenith,
-saastamoinen_delay, niell_mapping, tropo_delay, broadcast_delays.
+klobuchar_pierce_point, klobuchar_obliquity, klobuchar_delay, default_weather,
+water_vapour_pressure, saastamoinen_zenith, saastamoinen_delay, niell_mapping, tropo_delay,
+broadcast_delays.
 
 References
 ----------
@@ -26,6 +27,26 @@ from simulator.gnss.constants import C_M_S
 SECONDS_PER_DAY = 86400.0
 
 
+def klobuchar_pierce_point(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.ndarray,
+                           elevation_rad: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Latitude and longitude (semicircles) of the broadcast model's ionospheric pierce point
+    (IS-GPS-200 Figure 20-4): the Earth-centred angle psi = 0.0137 / (E + 0.11) - 0.022
+    (E the elevation in semicircles; the model's approximation of a thin shell 350 km up)
+    along the azimuth, the latitude clipped to +-0.416. Arguments in rad, broadcast together."""
+    az = np.asarray(azimuth_rad, dtype=float)
+    el_sc = np.asarray(elevation_rad, dtype=float) / np.pi  # semicircles
+    psi = 0.0137 / (el_sc + 0.11) - 0.022  # Earth-centred angle to the pierce point
+    phi_i = np.clip(np.asarray(lat_rad, dtype=float) / np.pi + psi * np.cos(az), -0.416, 0.416)
+    lam_i = np.asarray(lon_rad, dtype=float) / np.pi + psi * np.sin(az) / np.cos(phi_i * np.pi)
+    return phi_i, lam_i
+
+
+def klobuchar_obliquity(elevation_rad: np.ndarray) -> np.ndarray:
+    """The broadcast model's slant / vertical delay, F = 1 + 16 (0.53 - E)^3 (E the elevation
+    in semicircles; IS-GPS-200 Figure 20-4)."""
+    return 1.0 + 16.0 * (0.53 - np.asarray(elevation_rad, dtype=float) / np.pi) ** 3
+
+
 def klobuchar_delay(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.ndarray,
                     elevation_rad: np.ndarray, gps_tow_s: np.ndarray,
                     alpha: np.ndarray, beta: np.ndarray) -> np.ndarray:
@@ -44,14 +65,10 @@ def klobuchar_delay(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.nd
 
     All array arguments broadcast together; the result has their broadcast shape.
     """
-    az = np.asarray(azimuth_rad, dtype=float)
-    el_sc = np.asarray(elevation_rad, dtype=float) / np.pi  # semicircles
-    psi = 0.0137 / (el_sc + 0.11) - 0.022  # Earth-centred angle to the pierce point
-    phi_i = np.clip(np.asarray(lat_rad, dtype=float) / np.pi + psi * np.cos(az), -0.416, 0.416)
-    lam_i = np.asarray(lon_rad, dtype=float) / np.pi + psi * np.sin(az) / np.cos(phi_i * np.pi)
+    phi_i, lam_i = klobuchar_pierce_point(lat_rad, lon_rad, azimuth_rad, elevation_rad)
     phi_m = phi_i + 0.064 * np.cos((lam_i - 1.617) * np.pi)  # geomagnetic latitude
     t = np.mod(4.32e4 * lam_i + np.asarray(gps_tow_s, dtype=float), SECONDS_PER_DAY)  # local time
-    slant = 1.0 + 16.0 * (0.53 - el_sc) ** 3  # obliquity factor F
+    slant = klobuchar_obliquity(elevation_rad)
     powers = phi_m[..., None] ** np.arange(4)
     amp = np.maximum(powers @ np.asarray(alpha, dtype=float), 0.0)
     per = np.maximum(powers @ np.asarray(beta, dtype=float), 72000.0)

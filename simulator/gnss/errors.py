@@ -33,16 +33,30 @@ Time behaviour (issue 19):
   metres away).
 - The true ionosphere is ``iono_scale`` times the Klobuchar delay (1.5 by default: the model
   leaves a residual of half its own value; Klobuchar 1987 designed it to remove about 50 % of
-  the rms delay) times a slowly varying factor, 1 + ``iono_residual`` (c + 0.5 o), with c common
-  to all signals and o each signal's own, both Gauss-Markov over 30 min, drawn every 30 min and
-  interpolated linearly: smooth, as the ionosphere is (``IONO_GRID_STEP``).
+  the rms delay) times 1 + ``iono_residual`` g, g a smooth random field over the ionospheric
+  pierce points (the broadcast model's own thin-shell geometry,
+  ``simulator.gnss.atmosphere.klobuchar_pierce_point``) and time: the vertical delay error is
+  ``iono_scale`` ``iono_residual`` g times the model's vertical delay at the pierce point, and
+  the slant error that times the model's obliquity factor. So signals close in the sky share
+  their residual; what differs between them is what the pierce points' separation gives,
+  not an independent draw per signal. g has unit variance and the correlation
+  exp(-|dt| / 30 min) exp(-d^2 / (2 L^2)) at pierce points d apart, L = 1000 km (choice: the
+  error of a broadcast or global ionosphere model is a regional structure; the WAAS and GIM
+  vertical-delay variograms decorrelate over hundreds to a thousand kilometres: Blanch 2002,
+  Sparks et al. 2011, and the 5 deg x 2.5 deg grid of the IGS maps resolves it, Hernandez-
+  Pajares et al. 2009). g is drawn as a sum of random plane waves (``iono_field``; Rahimi &
+  Recht 2007): wave numbers drawn from the Gaussian correlation's spectrum, amplitudes slowly
+  varying Gauss-Markov processes: smooth in space and time (a wave shorter than a few hundred
+  kilometres is unlikely, so the ionosphere's rate stays at the mm/s of a quiet ionosphere).
 
 Public names
 ------------
-OSCILLATORS, SIS_CORRELATION_TIME_S, IONO_CORRELATION_TIME_S, IONO_OWN_SHARE,
+OSCILLATORS, SIS_CORRELATION_TIME_S, IONO_CORRELATION_TIME_S, IONO_CORRELATION_LENGTH_KM,
+IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S,
 REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, GRID_STEP, IONO_GRID_STEP,
 loop_time_constant_s,
-decorrelation_coordinate, gauss_markov_along, draw_receiver_clock, draw_fading,
+decorrelation_coordinate, gauss_markov_along, pierce_points_km, iono_field_correlation,
+iono_field, iono_field_at_epochs, draw_receiver_clock, draw_fading,
 draw_error_terms, hatch_filter, smoothed_variance_factor, smooth_code_errors,
 pseudorange_sigma.
 
@@ -52,7 +66,12 @@ Brown & Hwang 2012, Table 9.1 (oscillator h-parameters). Kaplan & Hegarty 2017, 
 (the single-frequency error budget) and ch. 8 (loop noise bandwidth). Hatch, R., "The
 synergism of GPS code and carrier measurements", 3rd Int. Geodetic Symp. on Satellite Doppler
 Positioning, 1982. Klobuchar, J. A., "Ionospheric time-delay algorithm for single-frequency GPS
-users", IEEE Trans. AES 23(3), 325-331, 1987. Georgiadou, Y. & Kleusberg, A., "On carrier signal
+users", IEEE Trans. AES 23(3), 325-331, 1987. Blanch, J., "An ionosphere estimation algorithm
+for WAAS based on kriging", ION GPS 2002. Sparks, L., Blanch, J. & Pandya, N., "Estimating
+ionospheric delay using kriging: 1. Methodology", Radio Sci. 46, RS0D21, 2011. Hernandez-Pajares,
+M. et al., "The IGS VTEC maps: a reliable source of ionospheric information since 1998",
+J. Geodesy 83, 263-275, 2009. Rahimi, A. & Recht, B., "Random features for large-scale kernel
+machines", NIPS 2007. Georgiadou, Y. & Kleusberg, A., "On carrier signal
 multipath effects in relative GPS positioning", Manuscripta Geodaetica 13, 172-179, 1988.
 """
 
@@ -60,6 +79,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
 from simulator.stochastic import ar1_filter, gauss_markov
@@ -73,14 +93,21 @@ OSCILLATORS: dict[str, dict[str, float]] = {
 }
 SIS_CORRELATION_TIME_S = 3600.0  # broadcast orbit/clock errors change over an upload cycle
 IONO_CORRELATION_TIME_S = 1800.0  # variations of the true/Klobuchar ratio
-IONO_OWN_SHARE = 0.5  # 1-sigma of the per-signal iono variation relative to the common one
+IONO_CORRELATION_LENGTH_KM = 1000.0  # L of the field's correlation exp(-d^2 / (2 L^2))
+IONO_FIELD_WAVES = 64  # plane waves summed to draw the field (its variance is exact)
+IONO_SHELL_RADIUS_KM = 6371.0 + 350.0  # Klobuchar's shell: mean Earth radius + 350 km
+# the field is evaluated every 10 s and interpolated linearly between: a pierce point moves by
+# under 2 km in 10 s (a satellite's at about 0.1 km/s, a car's at its speed), 1/500 of L, so
+# the interpolation changes the field by under 1e-5 of its sigma
+IONO_FIELD_STEP_S = 10.0
 REPORTED_PR_STD_FLOOR_M = 0.1  # the smallest pseudorange 1-sigma the receiver reports
 REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it reports
 # step of the grid (in correlation lengths of u) on which the motion-driven processes are drawn
 # before linear interpolation to the epochs: the interpolation keeps over 99 % of the variance
 GRID_STEP = 0.05
-# the ionosphere's variation is drawn once per correlation time (30 min) and interpolated: its
-# rate is then sigma x 1.1 / 30 min, about 1.5 mm/s on an 8 m delay with the default 1.5 x 0.2,
+# the amplitudes of the ionosphere field's waves are drawn once per correlation time (30 min)
+# and interpolated: their rate is then sigma x 1.1 / 30 min, about 1.5 mm/s on an 8 m delay
+# with the default 1.5 x 0.2,
 # the rate of TEC of a quiet mid-latitude ionosphere (below 0.5 TECU/min = 1.35 mm/s on L1;
 # Pi et al., "Monitoring of global ionospheric irregularities using the worldwide GPS network",
 # Geophys. Res. Lett. 24(18), 1997); drawn every epoch, the process would change like a random
@@ -117,6 +144,75 @@ def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator,
     return (values[i] * (1.0 - w)[:, None] + values[i + 1] * w[:, None]).T
 
 
+def pierce_points_km(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.ndarray,
+                     elevation_rad: np.ndarray) -> np.ndarray:
+    """Earth-centred coordinates (km, shape (3,) + the arguments' broadcast shape) of the
+    signals' ionospheric pierce points (``klobuchar_pierce_point``) on the shell of radius
+    ``IONO_SHELL_RADIUS_KM``: the field is defined in space, so no map projection distorts the
+    distances (the chord between two pierce points is their distance along the shell within
+    0.1 % up to 1000 km, 0.4 % at 2000 km)."""
+    phi_i, lam_i = klobuchar_pierce_point(lat_rad, lon_rad, azimuth_rad, elevation_rad)
+    phi, lam = phi_i * np.pi, lam_i * np.pi
+    return IONO_SHELL_RADIUS_KM * np.stack([np.cos(phi) * np.cos(lam),
+                                            np.cos(phi) * np.sin(lam), np.sin(phi)])
+
+
+def iono_field_correlation(distance_km: np.ndarray, lag_s: np.ndarray = 0.0) -> np.ndarray:
+    """Correlation of the ionosphere field ``iono_field`` between pierce points ``distance_km``
+    apart and ``lag_s`` apart in time: exp(-d^2 / (2 L^2)) exp(-|lag| / T) (L
+    ``IONO_CORRELATION_LENGTH_KM``, T ``IONO_CORRELATION_TIME_S``; the time part is that of the
+    amplitudes' Gauss-Markov processes, exact at the grid points they are drawn on)."""
+    d = np.asarray(distance_km, dtype=float) / IONO_CORRELATION_LENGTH_KM
+    return np.exp(-0.5 * d**2 - np.abs(np.asarray(lag_s, dtype=float)) / IONO_CORRELATION_TIME_S)
+
+
+def iono_field(rng: np.random.Generator, pierce_km: np.ndarray, t_s: np.ndarray
+               ) -> np.ndarray:
+    """A unit-variance random field over the pierce points with the correlation
+    ``iono_field_correlation`` (d the chord): g(x, t) = sqrt(2 / M) sum_m a_m(t)
+    cos(k_m . x + p_m), M ``IONO_FIELD_WAVES`` plane waves in space (random Fourier features,
+    Rahimi & Recht 2007: for wave numbers k_m ~ N(0, I3 / L^2), the spectrum of the Gaussian
+    correlation, and phases p_m uniform, E[g(x) g(x')] = E[cos(k . (x - x'))]
+    = exp(-|x - x'|^2 / (2 L^2))), the amplitudes
+    a_m unit-variance Gauss-Markov processes over ``IONO_CORRELATION_TIME_S`` drawn every
+    ``IONO_GRID_STEP`` correlation times and interpolated. A sum of 64 waves is Gaussian to a
+    good approximation; each drive draws its own waves.
+
+    Parameters
+    ----------
+    pierce_km : ndarray, shape (3, n_sat, n_epoch)
+        Pierce points (``pierce_points_km``).
+    t_s : ndarray, shape (n_epoch,)
+        Epoch times, ascending.
+    """
+    waves = IONO_FIELD_WAVES
+    k = rng.standard_normal((waves, 3)) / IONO_CORRELATION_LENGTH_KM
+    phase = rng.uniform(0.0, 2.0 * np.pi, waves)
+    amp = gauss_markov_along(np.asarray(t_s, dtype=float) / IONO_CORRELATION_TIME_S, waves,
+                             rng, IONO_GRID_STEP)
+    x, y, z = pierce_km
+    out = np.zeros(np.shape(x))
+    for m in range(waves):  # a loop over the waves; each is vectorised over signals x epochs
+        out += amp[m] * np.cos(k[m, 0] * x + k[m, 1] * y + k[m, 2] * z + phase[m])
+    return np.sqrt(2.0 / waves) * out
+
+
+def iono_field_at_epochs(rng: np.random.Generator, pierce_km: np.ndarray, dt_s: float
+                          ) -> np.ndarray:
+    """``iono_field`` at every epoch (dt_s apart) of the pierce points (3, n_sat, n_epoch),
+    evaluated every ``IONO_FIELD_STEP_S`` (and at the last epoch) and interpolated linearly."""
+    n_ep = pierce_km.shape[-1]
+    step = max(1, int(IONO_FIELD_STEP_S / dt_s))
+    coarse = np.unique(np.append(np.arange(0, n_ep, step), n_ep - 1))
+    values = iono_field(rng, pierce_km[..., coarse], coarse * dt_s)
+    if len(coarse) == n_ep:
+        return values
+    k = np.arange(n_ep)
+    i = np.minimum(np.searchsorted(coarse, k, side="right") - 1, len(coarse) - 2)
+    w = (k - coarse[i]) / (coarse[i + 1] - coarse[i])
+    return values[:, i] * (1.0 - w) + values[:, i + 1] * w
+
+
 def draw_receiver_clock(rng: np.random.Generator, oscillator: str, n: int, dt_s: float
                         ) -> tuple[np.ndarray, np.ndarray, dict]:
     """Receiver clock bias (s) and drift (s/s) at n epochs, and the drawn initial state."""
@@ -137,7 +233,8 @@ def draw_fading(rng: np.random.Generator, cfg: dict, u: np.ndarray, n_sat: int) 
 
 
 def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndarray,
-                     cn0_dbhz: np.ndarray, dt_s: float, u: np.ndarray) -> dict[str, np.ndarray]:
+                     cn0_dbhz: np.ndarray, dt_s: float, u: np.ndarray,
+                     pierce_km: np.ndarray) -> dict[str, np.ndarray]:
     """Every error term of the raw measurements before the receiver's carrier smoothing,
     shape (n_sat, n_epoch) unless noted.
 
@@ -151,6 +248,8 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         Epoch interval.
     u : ndarray, shape (n_epoch,)
         The motion coordinate of multipath (``decorrelation_coordinate``).
+    pierce_km : ndarray, shape (3, n_sat, n_epoch)
+        The signals' ionospheric pierce points (``pierce_points_km``).
 
     Returns
     -------
@@ -168,14 +267,12 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
 
     out = {"sis": cfg["sis_error"] * unit_gm(n_sat, SIS_CORRELATION_TIME_S)}
-    # the ionosphere varies smoothly: a Gauss-Markov process drawn once per correlation time
-    # and interpolated linearly, so that its rate (which the carrier smoothing's code-carrier
-    # divergence sees) stays at the mm/s of a quiet ionosphere
-    u_iono = np.arange(n_ep) * dt_s / IONO_CORRELATION_TIME_S
-    common = gauss_markov_along(u_iono, 1, rng, IONO_GRID_STEP)
-    own = gauss_markov_along(u_iono, n_sat, rng, IONO_GRID_STEP)
-    out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"]
-                                             * (common + IONO_OWN_SHARE * own))
+    # the ionosphere's error: a field smooth over the pierce points and in time (module
+    # docstring), so that nearby signals share it and its rate (which the carrier smoothing's
+    # code-carrier divergence sees) stays at the mm/s of a quiet ionosphere
+    field = (iono_field_at_epochs(rng, pierce_km, dt_s) if cfg["iono_residual"] > 0
+             else np.zeros(shape))
+    out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"] * field)
     out["tropo_zenith"] = cfg["tropo_residual"] * rng.standard_normal()
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
     out["multipath"] = out["multipath_sigma"] * gauss_markov_along(u, n_sat, rng)
@@ -275,7 +372,7 @@ def pseudorange_sigma(cfg: dict, terms: dict[str, np.ndarray], iono_m: np.ndarra
     the root sum of squares of the configured budget (code noise and multipath after the carrier
     smoothing, ``smoothed_variance_factor`` at the loop's and the multipath's correlation time
     (the latter at the current speed); ionosphere residual (``iono_scale`` - 1 plus the
-    variations, common and own) times the broadcast delay; troposphere zenith residual times the
+    field's variation) times the broadcast delay; troposphere zenith residual times the
     mapping; signal-in-space error), with floors of 0.1 m and 0.01 m/s.
 
     Parameters
@@ -295,8 +392,7 @@ def pseudorange_sigma(cfg: dict, terms: dict[str, np.ndarray], iono_m: np.ndarra
     mp_time = 1.0 / (speed_m_s / cfg["multipath_distance"]
                      + 1.0 / cfg["multipath_correlation_time"])
     mp_factor = smoothed_variance_factor(mp_time, dt_s, smoothing)[None, :]
-    iono_rel = (cfg["iono_scale"] - 1.0) ** 2 + (cfg["iono_scale"] * cfg["iono_residual"]) ** 2 \
-        * (1.0 + IONO_OWN_SHARE**2)
+    iono_rel = (cfg["iono_scale"] - 1.0) ** 2 + (cfg["iono_scale"] * cfg["iono_residual"]) ** 2
     var = (code_factor * terms["code_sigma"] ** 2 + mp_factor * terms["multipath_sigma"] ** 2
            + iono_rel * iono_m**2
            + (cfg["tropo_residual"] * tropo_mapping) ** 2 + cfg["sis_error"] ** 2)

@@ -35,6 +35,7 @@ if TYPE_CHECKING:
     import pandas as pd
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
+_MAX_CONDITION = 1e12  # a normal matrix beyond this is singular in float64 (no fix)
 
 
 def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
@@ -67,11 +68,17 @@ def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
     return mask, packed
 
 
-def _solve(normal: np.ndarray, rhs: np.ndarray, ok: np.ndarray) -> np.ndarray:
-    """Batched solve of normal equations; singular epochs (not ok) get an identity system."""
+def _solve(normal: np.ndarray, rhs: np.ndarray, ok: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray]:
+    """Batched solve of normal equations. Epochs not ``ok``, or whose system is numerically
+    singular (condition number above ``_MAX_CONDITION``: satellites in a degenerate geometry,
+    or an iteration gone far from the Earth), get an identity system and come back not
+    solvable. Returns the solutions and the solvable flags."""
     eye = np.eye(normal.shape[-1])
     normal = np.where(ok[:, None, None], normal, eye)
-    return np.linalg.solve(normal, rhs[..., None])[..., 0]
+    solvable = ok & (np.linalg.cond(normal) < _MAX_CONDITION)
+    normal = np.where(solvable[:, None, None], normal, eye)
+    return np.linalg.solve(normal, rhs[..., None])[..., 0], solvable
 
 
 def _up_ecef(pos_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -130,7 +137,7 @@ def solve_position(pr_m: np.ndarray, sat_pos_m: np.ndarray, weight: np.ndarray,
             row = np.concatenate([up, np.zeros((len(up), 1))], axis=1)
             normal[held] += row[:, :, None] * row[:, None, :]
             rhs[held] += row * (height_m[held] - alt)[:, None]
-        dx = _solve(normal, rhs, ok)
+        dx, ok = _solve(normal, rhs, ok)
         x = x + np.where(ok[:, None], dx, 0.0)
     pos = np.where(ok[:, None], x[:, :3], np.nan)
     return pos, np.where(ok, x[:, 3], np.nan), ok
@@ -168,7 +175,7 @@ def solve_velocity(rate_m_s: np.ndarray, sat_pos_m: np.ndarray, sat_vel_m_s: np.
         _, up = _up_ecef(rx[held])
         row = np.concatenate([up, np.zeros((len(up), 1))], axis=1)
         normal[held] += row[:, :, None] * row[:, None, :]
-    x = _solve(normal, np.einsum("nki,nk->ni", hw, y), ok)
+    x, ok = _solve(normal, np.einsum("nki,nk->ni", hw, y), ok)
     x = np.where(ok[:, None], x, np.nan)
     return x[:, :3], x[:, 3]
 

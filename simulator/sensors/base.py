@@ -118,7 +118,8 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
     estimated error is within ``CUBIC_RULE_TOLERANCE``; where it is not (a vibrating body), and
     no breakpoint of the piecewise kinematics lies inside the interval, four-point Gauss-Lobatto
     on the analytic kinematics, whose end nodes are the cached grid samples (two evaluations of
-    the truth per interval). Every other interval (off the grid, or holding a breakpoint) is
+    the truth per interval, ``Kinematics.rates_inside``: at a fixed fraction of every grid
+    interval). Every other interval (off the grid, or holding a breakpoint) is
     integrated with three-point Gauss-Legendre on the analytic kinematics, split at the
     breakpoints so each piece is smooth. Both rules are exact for polynomials up to degree 5.
     """
@@ -145,14 +146,13 @@ def integrate_over_samples(truth: Kinematics, t_end: np.ndarray, dt: float,
         lobatto = np.flatnonzero(rough & ~gauss)
         if len(lobatto):
             k = k_end[lobatto]
-            nodes = (t_end[lobatto, None] - dt + dt * LOBATTO_INNER_NODES[None, :]).ravel()
-            values = truth.inertial(nodes)
+            inner = [truth.rates_inside(k - 1, u) for u in LOBATTO_INNER_NODES]
             for key in keys:
-                inner = values[key].reshape(len(k), len(LOBATTO_INNER_NODES), -1)
                 ends = grid[key].take(k - 1, axis=0)
                 ends += grid[key].take(k, axis=0)
                 ends *= LOBATTO_END_WEIGHT
-                ends += np.einsum("j,njk->nk", LOBATTO_INNER_WEIGHTS, inner)
+                for weight, values in zip(LOBATTO_INNER_WEIGHTS, inner, strict=True):
+                    ends += weight * values[key]
                 ends *= dt
                 out[key][lobatto] = ends
     if not gauss.any():

@@ -39,9 +39,13 @@ Presets (the figures they follow):
   choke-ring antenna), C/N0 fading 0.5 dB, OCXO.
 - both: true ionosphere 1.5 x Klobuchar (Klobuchar 1987: the model removes about half of the
   rms delay; issue 19: ARL1's true ionosphere was 1.3-1.8 x the broadcast model) with a 20 %
-  slow variation; signal-in-space error 0.5 m (the GPS SPS signal-in-space URE of the 2010s,
-  of order 0.5-1 m rms in the FAA GPS performance analysis reports); zenith troposphere
-  residual 5 cm.
+  variation that is a smooth field over the pierce points (1000 km, 30 min;
+  ``simulator.gnss.errors``); signal-in-space error 0.5 m (the GPS SPS signal-in-space URE of
+  the 2010s: a global average SISRE of 0.7 m over 2013/2014, Montenbruck, Steigenberger &
+  Hauschild, "Broadcast versus precise ephemerides: a multi-GNSS perspective", GPS Solutions
+  19, 321-333, 2015, falling since as Block IIF/III satellites replaced older ones; kept at
+  0.5 m, not fitted to the ARL1 hour, whose high satellites agree within 0.2 m:
+  docs/gnss-errors.md); zenith troposphere residual 5 cm.
 
 Streams: ``gnss_raw`` (one row per tracked signal, unhealthy satellites included with their
 ``health`` code), ``gnss_fix`` (one row per epoch from the healthy signals: 3D fix from four
@@ -78,7 +82,7 @@ from simulator.earth import (
     ned_to_ecef_matrix,
 )
 from simulator.environment import ZONE_FIELD
-from simulator.environment.sky import canyon_reception
+from simulator.environment.sky import canyon_reception, street_buildings
 from simulator.errors import InputError, Problem
 from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
@@ -100,6 +104,7 @@ from simulator.gnss.errors import (
     draw_error_terms,
     draw_fading,
     draw_receiver_clock,
+    pierce_points_km,
     pseudorange_sigma,
     smooth_code_errors,
 )
@@ -171,7 +176,8 @@ _ERROR_FIELDS = {
     "iono_scale": Number("", None, min=0,
                          doc="mean true ionosphere / broadcast (Klobuchar) ionosphere"),
     "iono_residual": Number("", None, min=0,
-                            doc="1-sigma of the slow relative variation of that ratio"),
+                            doc="1-sigma of the relative variation of that ratio, a field "
+                                "smooth over the pierce points (1000 km) and in time (30 min)"),
     "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
     "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
 }
@@ -308,12 +314,15 @@ class Gnss(PresetSensor):
 
         A canyon (``simulator.environment.sky.canyon_reception``) is one street from where its
         zone begins to where it ends along the drive (consecutive segments of the zone make one
-        street), closed at both ends by facades across it. Each facade's reflection loss is
-        drawn from N(``nlos_attenuation``, ``nlos_attenuation_spread``), floored at 0 dB, once
-        per satellite and building: side facades change every ``facade_length`` metres of the
-        distance driven (the building beside the antenna stands for the reflection point), the
-        end facades once per street. Draws are made only when the drive has a canyon, so open
-        drives' random streams are unchanged."""
+        street), closed at both ends by facades across it. Its buildings are laid out block by
+        block with drawn heights (``street_buildings``: blocks of ``block_length``, cross streets
+        of ``cross_street_width``, buildings of ``facade_length`` ``building_gap`` apart, heights
+        from N(``building_height``, ``building_height_spread``)); the along-street coordinate
+        is the antenna's distance driven. Each facade's reflection loss is drawn from
+        N(``nlos_attenuation``, ``nlos_attenuation_spread``), floored at 0 dB, once per
+        satellite and building (each end facade counts as one), and applied where that building
+        is the reflection point. Draws are made only when the drive has a canyon, so open drives'
+        random streams are unchanged."""
         los = np.ones(el.shape, dtype=bool)
         nlos = np.zeros(el.shape, dtype=bool)
         extra = np.zeros(el.shape)
@@ -326,23 +335,26 @@ class Gnss(PresetSensor):
             if zone["sky"] == "none":
                 los[:, here] = False
             elif zone["sky"] == "canyon":
-                ahead, behind, street = _street_ends(truth, name, t[here], distance[here])
-                panel = np.floor(distance[here] / zone["facade_length"]).astype(int)
-                panel -= panel.min()
-                sides = rng.standard_normal((el.shape[0], panel.max() + 1, 2))[:, panel]
-                ends = rng.standard_normal((el.shape[0], street.max() + 1, 2))[:, street]
+                ahead, behind, streets = _street_ends(truth, name, t[here], distance[here])
+                buildings = street_buildings(
+                    rng, streets, zone["block_length"], zone["cross_street_width"],
+                    zone["facade_length"], zone["building_gap"], zone["building_height"],
+                    zone["building_height_spread"])
                 facade_loss = np.maximum(zone["nlos_attenuation"] + zone["nlos_attenuation_spread"]
-                                         * np.concatenate([sides, ends], axis=-1), 0.0)
+                                         * rng.standard_normal((el.shape[0], buildings.count)),
+                                         0.0)
                 # traced only for the satellites above the horizon (about 40 % of them)
                 shape = el[:, here].shape
                 up = el[:, here] > 0
+                satellite = np.broadcast_to(np.arange(shape[0])[:, None], shape)[up]
                 z_los, z_nlos = np.zeros(shape, dtype=bool), np.zeros(shape, dtype=bool)
                 z_extra, z_loss = np.zeros(shape), np.zeros(shape)
                 z_los[up], z_nlos[up], z_extra[up], z_loss[up] = canyon_reception(
                     az[:, here][up], el[:, here][up], np.broadcast_to(yaw[here], shape)[up],
                     zone["building_height"], zone["street_width"],
                     np.broadcast_to(ahead, shape)[up], np.broadcast_to(behind, shape)[up],
-                    facade_loss[up], LAMBDA_L1_M)
+                    facade_loss, LAMBDA_L1_M, np.broadcast_to(distance[here], shape)[up],
+                    buildings, satellite)
                 los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
                 loss[:, here] = z_loss
         return los, nlos, extra, loss
@@ -407,7 +419,9 @@ class Gnss(PresetSensor):
         self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
         # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
         # (which would otherwise make the error and the fix weights jump from epoch to epoch)
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u)
+        # (below the horizon, where nothing is tracked, the pierce point of the horizon)
+        pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]
@@ -550,8 +564,8 @@ class _RowTable:
 def _street_ends(truth: Kinematics, zone: str, t: np.ndarray, distance: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Distance to the end facade ahead and behind (along the drive) at epochs t inside
-    ``zone``, and the number of the street each epoch is in: consecutive stretches of the zone
-    (one segment's end is the next one's start) make one street."""
+    ``zone``, and each street's start and end in the distance driven (rows): consecutive
+    stretches of the zone (one segment's end is the next one's start) make one street."""
     streets: list[list[float]] = []
     for start, end, name in truth.profile.zones:  # one pass per zoned segment
         if name != zone:
@@ -564,4 +578,4 @@ def _street_ends(truth: Kinematics, zone: str, t: np.ndarray, distance: np.ndarr
     street = np.clip(np.searchsorted(bounds[:, 0], t, side="right") - 1, 0, len(bounds) - 1)
     at = truth.inertial(bounds.ravel())["distance"].reshape(-1, 2)
     return (np.maximum(at[street, 1] - distance, 0.0), np.maximum(distance - at[street, 0], 0.0),
-            street)
+            at)

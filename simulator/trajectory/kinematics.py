@@ -127,7 +127,10 @@ class Kinematics:
             return self._motion_piece(t)
         return _by_pieces(lambda rows: self._motion_piece(t[rows]), len(t))
 
-    def _motion_piece(self, t: np.ndarray) -> dict[str, np.ndarray]:
+    def _motion_piece(self, t: np.ndarray,
+                      body: dict[str, np.ndarray] | None = None) -> dict[str, np.ndarray]:
+        """``_motion`` of one piece; ``body``: the body's channels at t when already known
+        (``BodyMotion.inside``), else evaluated here."""
         p = self.profile
         s, v, a = p.distance_of_time.evaluate(t, (0, 1, 2))
         np.maximum(v, 0.0, out=v)
@@ -168,15 +171,17 @@ class Kinematics:
             road = dict(s=s, v=v, a=a, psi=psi, kappa=kappa, dkappa=dkappa, gamma=gamma,
                         dgamma=dgamma, d2gamma=d2gamma[0], bank=bank, dbank=dbank,
                         d2bank=d2bank[0], v_ned=v_ned, a_ned=a_ned)
-            return self._with_body(t, road, dv + 0.0)
+            return self._with_body(road, dv + 0.0,
+                                   self.body.evaluate(t) if body is None else body)
         # + 0.0: a reversing car at rest reads 0.0, not -0.0
         return dict(s=s, v=dv + 0.0, roll=roll, pitch=gamma, yaw=psi, roll_rate=roll_rate,
                     pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned.T, a_ned=a_ned.T,
                     cos_pitch=cg, sin_pitch=sg, cos_yaw=cp, sin_yaw=sp)
 
-    def _with_body(self, t: np.ndarray, road: dict[str, np.ndarray],
-                   speed: np.ndarray) -> dict[str, np.ndarray]:
-        """``_motion_piece`` with the body: attitude, rates and the reference point's motion.
+    def _with_body(self, road: dict[str, np.ndarray], speed: np.ndarray,
+                   b: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """``_motion_piece`` with the body (its channels ``b``, ``BodyMotion.evaluate``):
+        attitude, rates and the reference point's motion.
 
         Attitude: roll = bank + body roll, pitch = grade + body pitch, yaw = path heading - side
         slip, each with its exact first and second time derivatives (the road curves' s
@@ -191,7 +196,6 @@ class Kinematics:
         moves the point by less than 1e-5 m/s x r. The road-following point's velocity is
         kept as ``v_road`` for the position integration, the displacement as ``offset``.
         """
-        b = self.body.evaluate(t)
         v, a = road["v"], road["a"]
         v2 = v * v
         roll = road["bank"] + b["roll"]
@@ -233,7 +237,7 @@ class Kinematics:
         offset = body_to_ned_components(*trig, rx, ry, rz)
         return dict(s=road["s"], v=speed, roll=roll, pitch=pitch, yaw=yaw, roll_rate=roll_rate,
                     pitch_rate=pitch_rate, yaw_rate=yaw_rate, v_ned=v_ned, a_ned=a_ned,
-                    cos_pitch=cp, sin_pitch=sp, cos_yaw=cy, sin_yaw=sy,
+                    cos_pitch=cp, sin_pitch=sp, cos_yaw=cy, sin_yaw=sy, cos_roll=cr, sin_roll=sr,
                     v_road=road["v_ned"].T, offset=offset)
 
     # -- position ---------------------------------------------------------------------------
@@ -326,15 +330,17 @@ class Kinematics:
             return pos
         return _displaced(pos, self._motion(np.clip(t, 0.0, self.duration_s))["offset"])
 
-    def _road_position(self, t: np.ndarray) -> np.ndarray:
-        """``position`` of the road-following point."""
+    def _road_position(self, t: np.ndarray, i: np.ndarray | None = None) -> np.ndarray:
+        """``position`` of the road-following point; ``i``: the integration interval of each
+        time when known (else searched)."""
         nodes = self._t_int
         t = np.clip(np.atleast_1d(np.asarray(t, float)), 0.0, nodes[-1])
         out = np.empty((3,) + t.shape)  # component by component, handed out as (n, 3)
         if len(nodes) == 1:
             out[:] = [[values[0]] for values in self._lla]
             return out.T
-        i = np.clip(np.searchsorted(nodes, t, side="right") - 1, 0, len(nodes) - 2)
+        if i is None:
+            i = np.clip(np.searchsorted(nodes, t, side="right") - 1, 0, len(nodes) - 2)
         start = nodes.take(i)
         h = nodes.take(i + 1) - start
         u = (t - start) / h
@@ -389,8 +395,10 @@ class Kinematics:
         f_n = a[:, 0] + (ce * vd - cd * ve)
         f_e = a[:, 1] + (cd * vn - cn * vd)
         f_d = a[:, 2] + (cn * ve - ce * vn - normal_gravity_from_sin(sin_lat, alt))
-        roll = m["roll"]
-        sr, cr = np.sin(roll), np.cos(roll)
+        if "cos_roll" in m:  # the body's roll, whose sine and cosine ``_with_body`` took
+            sr, cr = m["sin_roll"], m["cos_roll"]
+        else:
+            sr, cr = np.sin(m["roll"]), np.cos(m["roll"])
         sp, cp = m["sin_pitch"], m["cos_pitch"]
         trig = (cr, sr, cp, sp, m["cos_yaw"], m["sin_yaw"])
         f_body = ned_to_body_components(*trig, f_n, f_e, f_d)
@@ -399,6 +407,31 @@ class Kinematics:
         w_body[:, 1] += m["pitch_rate"] * cr + m["yaw_rate"] * cp * sr
         w_body[:, 2] += -m["pitch_rate"] * sr + m["yaw_rate"] * cp * cr
         return {"w_body": w_body, "f_body": f_body}
+
+    def rates_inside(self, j: np.ndarray, u: float) -> dict[str, np.ndarray]:
+        """w_ib^b and f_ib^b (``inertial``'s ``w_body``, ``f_body``, shape (m, 3)) at
+        t_j + u h for the base grid's intervals j (indices, shape (m,)) at one fraction u of
+        the interval: the inner nodes of a quadrature rule over grid intervals.
+
+        The same truth as ``inertial``, computed piece by piece straight to the two vectors
+        (the motion, the place and the body vectors of a piece are never assembled for the
+        whole series), with the body's channels from ``BodyMotion.inside`` (one linear map of
+        the interval's end nodes for all points) and the position from the interval's own
+        integration nodes (no search)."""
+        j = np.asarray(j, dtype=np.intp)
+        h = 1.0 / self.rate_hz
+
+        def piece(rows: slice) -> dict[str, np.ndarray]:
+            jj = j[rows]
+            t = np.minimum(self.t_grid.take(jj) + u * h, self.duration_s)
+            body = None if self.body is None else self.body.inside(jj, u)
+            motion = self._motion_piece(t, body)
+            pos = self._road_position(t, jj)
+            if self.body is not None:
+                pos = _displaced(pos, motion["offset"])
+            return self._body_vectors(motion, _place(pos))
+
+        return _by_pieces(piece, len(j))
 
     def grid_inertial(self) -> dict[str, np.ndarray]:
         """``inertial`` on the base grid, cached: the truth table and the sensors sampling at

@@ -163,6 +163,35 @@ class BodyMotion:
                 for order, suffix in enumerate(("", "_rate", "_accel"))
                 for i, name in enumerate(CHANNELS)}
 
+    def inside(self, j: np.ndarray | slice, u: float) -> dict[str, np.ndarray]:
+        """``evaluate`` at t_j + u h for the grid intervals j (an index array or a slice of
+        them) at one fraction u of the interval (0 < u < 1), as a quadrature rule asks for.
+
+        With u fixed, the quintic Hermite basis is a constant: every channel, rate and
+        acceleration there is one linear map of the two ends' 18 nodes, values = N_j W_0 +
+        N_j+1 W_1 with W_e[(d, c), (o, c)] = B[o, 3 e + d] h^(d - o) (d the order of the node,
+        o that of the value, c the channel; ``quintic_hermite_basis``), two matrix products
+        over the intervals instead of a basis and a small product per point. The same
+        polynomials as ``evaluate``, so the same values to rounding."""
+        h = self.t[1] - self.t[0]
+        basis = quintic_hermite_basis(np.array([float(u)]))[0]  # (order, 6)
+        k = len(CHANNELS)
+        power = np.arange(3)[:, None] - np.arange(3)[None, :]  # d - o
+        weights = [np.kron(basis[:, 3 * end:3 * end + 3].T * h ** power, np.eye(k))
+                   for end in (0, 1)]
+        rows = self.nodes.T  # (n, 18), C-ordered
+        if isinstance(j, slice):
+            start, stop, _ = j.indices(len(self.t) - 1)
+            values = rows[start:stop] @ weights[0]
+            values += rows[start + 1:stop + 1] @ weights[1]
+        else:
+            values = rows.take(j, axis=0) @ weights[0]
+            values += rows.take(j + 1, axis=0) @ weights[1]
+        values = values.T
+        return {name + suffix: values[i + k * order]
+                for order, suffix in enumerate(("", "_rate", "_accel"))
+                for i, name in enumerate(CHANNELS)}
+
     def breakpoints(self) -> np.ndarray:
         return self.t
 

@@ -8,7 +8,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from simulator.environment.sky import canyon_reception, knife_edge_loss_db, trace_paths
+from simulator.environment.sky import (
+    Buildings,
+    canyon_reception,
+    knife_edge_loss_db,
+    street_buildings,
+    trace_paths,
+)
 
 LAMBDA_M = 0.1903  # GPS L1 wavelength
 H, W = 20.0, 20.0  # facades 20 m above the antenna, 20 m apart
@@ -117,3 +123,129 @@ def test_the_strongest_path_is_tracked():
     # over the right roof edge E = (0, W / 2, H): the bent path's extra |E| - E . u
     edge, u = np.array([0.0, W / 2, H]), _u(90.0, 45.0)
     assert extra == pytest.approx(np.linalg.norm(edge) - edge @ u, rel=1e-12)
+
+
+# -- buildings with gaps, cross streets and their own heights ---------------------------------
+
+def _buildings(right: list[tuple[float, float, float]], left: list[tuple[float, float, float]],
+               end_height: float = H) -> Buildings:
+    """Buildings from (start, end, height) rows per side, one street from s = -1000 m."""
+    r, lft = np.array(right, dtype=float), np.array(left, dtype=float)
+    return Buildings((r[:, 0], lft[:, 0]), (r[:, 1], lft[:, 1]), (r[:, 2], lft[:, 2]),
+                     np.array([-1000.0]), end_height)
+
+
+# both sides: a block [0, 100), a cross street [100, 120), a block [120, 220), 20 m high
+BLOCKS = [(0.0, 100.0, H), (120.0, 220.0, H)]
+
+
+def test_a_ray_through_a_cross_street_is_line_of_sight():
+    # across the street at 30 deg: in front of a building its ray meets the facade 5.8 m up
+    # (blocked); standing in the intersection the same ray leaves along the cross street
+    for along, expected in ((50.0, False), (110.0, True)):
+        path = trace_paths(_u(90.0, 30.0), H, W, np.inf, np.inf, along, _buildings(BLOCKS, BLOCKS))
+        assert (path["direct"]["clearance_m"] >= 0) == expected
+    # 30 deg off the normal (a = 60 deg) from s = 105: the ray crosses the facade line at
+    # s = 105 + (W / 2) / tan(a), in the cross street, and runs on to the next block's corner
+    # wall at s = 120, 15 / cos(a) m of horizontal distance away: clearance 30 tan(el) - H
+    for el in (30.0, 40.0):
+        path = trace_paths(_u(60.0, el), H, W, np.inf, np.inf, 105.0,
+                           _buildings(BLOCKS, BLOCKS))["direct"]
+        expected = 15.0 / np.cos(np.radians(60.0)) * np.tan(np.radians(el)) - H
+        assert path["clearance_m"] == pytest.approx(expected, rel=1e-12)
+    # a building lower than the ray lets it through: the building in its way decides
+    low = [(0.0, 100.0, 5.0), (120.0, 220.0, H)]
+    assert trace_paths(_u(90.0, 30.0), H, W, np.inf, np.inf, 50.0,
+                       _buildings(low, BLOCKS))["direct"]["clearance_m"] >= 0
+
+
+def test_a_reflection_point_on_a_gap_gives_no_reflection():
+    # right side continuous, the left side with a gap [100, 120). A satellite at a = 60 deg,
+    # 45 deg up, is hidden by the right facade (met 11.5 m up); its reflection off the left
+    # facade is met at x = (W / 2) / tan(a) = 5.77 m ahead, 11.5 m up
+    right = [(0.0, 220.0, H)]
+    u = _u(60.0, 45.0)
+    on_building = trace_paths(u, H, W, np.inf, np.inf, 80.0, _buildings(right, BLOCKS))
+    on_gap = trace_paths(u, H, W, np.inf, np.inf, 100.0, _buildings(right, BLOCKS))
+    assert on_building["direct"]["clearance_m"] < 0 and on_gap["direct"]["clearance_m"] < 0
+    assert on_building["left"]["possible"] and not on_gap["left"]["possible"]
+    assert on_building["left"]["hit_x_m"] == pytest.approx((W / 2) / np.tan(np.radians(60.0)))
+    # the image method: the extra path is still the mirrored antenna's W cos(el) sin(a)
+    assert on_building["left"]["extra_path_m"] == pytest.approx(W * u[1], rel=1e-12)
+    # a building too low for the point (11.5 m) reflects nothing either
+    low_left = [(0.0, 100.0, 10.0), (120.0, 220.0, H)]
+    assert not trace_paths(u, H, W, np.inf, np.inf, 80.0,
+                           _buildings(right, low_left))["left"]["possible"]
+
+
+def test_the_reflecting_building_gives_its_own_loss():
+    # as above, from s = 80: the reflection point is on the left side's first building
+    # (facade number 1: the right side's one building is 0); its loss is the one applied
+    buildings = _buildings([(0.0, 220.0, H)], BLOCKS)
+    table = np.array([[60.0, 7.0, 12.0, 60.0, 60.0]])  # right, left x2, the street's two ends
+    los, nlos, _, loss = canyon_reception(
+        np.radians([60.0]), np.radians([45.0]), 0.0, H, W, np.inf, np.inf, table, LAMBDA_M,
+        80.0, buildings, np.array([0]))
+    assert nlos[0] and loss[0] == pytest.approx(7.0, abs=1e-9)
+    # from s = 130 the point is on the second left building (number 2)
+    *_, loss = canyon_reception(np.radians([60.0]), np.radians([45.0]), 0.0, H, W, np.inf,
+                                np.inf, table, LAMBDA_M, 130.0, buildings, np.array([0]))
+    assert loss[0] == pytest.approx(12.0, abs=1e-9)
+
+
+def test_closed_blocks_of_one_height_are_the_continuous_facade():
+    """With no cross streets, no gaps and no height spread, the laid-out street traces exactly
+    as the continuous facades (the special case the analytic tests above use)."""
+    buildings = street_buildings(np.random.default_rng(1), np.array([[0.0, 400.0]]), 110.0, 0.0,
+                                 20.0, 0.0, 30.0, 0.0)
+    gen = np.random.default_rng(2)
+    az, el = gen.uniform(0, 2 * np.pi, 500), gen.uniform(0.05, 1.5, 500)
+    u = np.stack([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)], axis=-1)
+    along = gen.uniform(0.0, 400.0, 500)
+    ahead, behind = 400.0 - along, along
+    laid = trace_paths(u, 30.0, W, ahead, behind, along, buildings)
+    plain = trace_paths(u, 30.0, W, ahead, behind)
+    for name in laid:
+        for key in ("possible", "clearance_m", "extra_path_m"):
+            np.testing.assert_allclose(laid[name][key], plain[name][key], rtol=1e-12, atol=1e-9)
+
+
+def test_street_layout_blocks_and_heights_are_reproducible():
+    args = (np.array([[100.0, 460.0]]), 110.0, 20.0, 20.0, 2.0, 22.0, 3.0)
+    one = street_buildings(np.random.default_rng(5), *args)
+    again = street_buildings(np.random.default_rng(5), *args)
+    other = street_buildings(np.random.default_rng(6), *args)
+    for side in (0, 1):
+        np.testing.assert_array_equal(one.height_m[side], again.height_m[side])
+        assert not np.array_equal(one.height_m[side], other.height_m[side])
+        np.testing.assert_array_equal(one.start_m[side], other.start_m[side])
+    # blocks of 110 m from the street's start every 130 m (20 m cross streets); buildings of
+    # 20 m frontage 2 m apart (five fit in a block); the street's end cuts the last one
+    starts, ends = one.start_m[0], one.end_m[0]
+    np.testing.assert_allclose(starts[:6], [100.0, 122.0, 144.0, 166.0, 188.0, 230.0])
+    np.testing.assert_allclose(ends[:6], [120.0, 142.0, 164.0, 186.0, 208.0, 250.0])
+    np.testing.assert_allclose(starts[-1], 100.0 + 2 * 130.0 + 88.0)
+    assert ends[-1] == pytest.approx(460.0) and one.count == 2 * len(starts) + 2
+    # a block's end cuts its last building: 25 m frontages in a 110 m block end at 110 m
+    cut = street_buildings(np.random.default_rng(5), np.array([[0.0, 300.0]]), 110.0, 20.0,
+                           25.0, 0.0, 22.0, 3.0)
+    np.testing.assert_allclose(cut.end_m[1][:6], [25.0, 50.0, 75.0, 100.0, 110.0, 155.0])
+    # the heights: N(22, 3) per building, independently on both sides
+    many = street_buildings(np.random.default_rng(7), np.array([[0.0, 2e5]]), 110.0, 20.0,
+                            20.0, 0.0, 22.0, 3.0)
+    heights = np.concatenate(many.height_m)
+    assert abs(heights.mean() - 22.0) < 4 * 3.0 / np.sqrt(heights.size)
+    assert heights.std() == pytest.approx(3.0, rel=0.05)
+    assert abs(np.corrcoef(many.height_m[0], many.height_m[1])[0, 1]) < 0.05
+
+
+def test_a_street_stood_in_gets_a_block_that_stops_at_the_next_street():
+    # a zone the car stands in (no length) at s = 0, the next stretch of it from s = 50 m: one
+    # block from 0, cut where the next street begins, and the buildings stay sorted
+    buildings = street_buildings(np.random.default_rng(3), np.array([[0.0, 0.0], [50.0, 300.0]]),
+                                 110.0, 20.0, 20.0, 0.0, 22.0, 3.0)
+    start, end = buildings.start_m[0], buildings.end_m[0]
+    np.testing.assert_allclose(start[:4], [0.0, 20.0, 40.0, 50.0])
+    np.testing.assert_allclose(end[:3], [20.0, 40.0, 50.0])
+    assert (np.diff(start) > 0).all() and (start[1:] >= end[:-1]).all()
+    assert buildings.count == 2 * len(start) + 4

@@ -68,7 +68,7 @@ SHORT_CLAIMS = [pytest.param(0, 40.0, marks=_not_shown("19.5 % with 0 satellites
                                                        "shortened drive")),
                 (1, 25.0), (2, 25.0), (3, 25.0)]
 FULL_CLAIMS = [(0, 40.0), (1, 25.0), (2, 25.0),
-               pytest.param(3, 25.0, marks=_not_shown("12.8 % with 3 satellites"))]
+               pytest.param(3, 25.0, marks=_not_shown("19.4 % with 3 satellites"))]
 
 
 @pytest.mark.parametrize(("satellites", "least_cut"), SHORT_CLAIMS)
@@ -92,11 +92,10 @@ def test_nhc_cut_with_4_satellites_is_the_smallest_full_drive(full_table):
 
 
 @pytest.mark.slow
-@_not_shown("29.7 % on the automotive body, whose side slip in the 40 m loops breaks the "
-            "constraint (58.9 % on a rigid body)")
 def test_nhc_cut_in_complete_outages(tmp_path_factory):
     """Table 1's first row on the complete-outage drive (three 60 s outages per seed, straight
-    and in loops): the NHC cuts the mean 3-D error over the outages by at least 40 %."""
+    and in loops): the NHC cuts the mean 3-D error over the outages by at least 40 % (measured
+    54.8 % with the constraint at the rear axle, 5.70 vs 12.62 m; 29.7 % with it at the IMU)."""
     rows = chan.table1(run_experiment(chan.COMPLETE_OUTAGES, SEEDS,
                                       tmp_path_factory.mktemp("chan_complete")))
     print(f"complete outages: {rows[0]['nhc_m']:.2f} vs {rows[0]['no_nhc_m']:.2f} m, cut "

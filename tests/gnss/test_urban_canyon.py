@@ -1,17 +1,21 @@
-"""The shipped urban canyon (scenarios/urban_canyon.yaml: a 1 km street between 40 m facades,
-25 m apart) under the physical NLOS model: how many satellites the receiver keeps there, how
-many of them arrive by reflection or diffraction only, and how good its fixes are.
+"""The shipped urban canyon (scenarios/urban_canyon.yaml: 1 km of a Berlin centre street, eaves
+22 m high, 22 m wide, closed perimeter blocks of 20 m plots with 22 m cross streets every 110 m,
+building heights spread 3 m; sources in the scenario's comment) under the physical NLOS model:
+how many satellites the receiver keeps there, how many of them arrive by reflection or
+diffraction only, and how good its fixes are.
 
 Issue 19 asks for at least 7 tracked satellites on average with at least 30 % of them NLOS and a
 CEP50 of 5-20 m (the Berlin u-blox log of refdata 3d: 9.9 GPS satellites tracked, 53 % NLOS).
-Measured over seeds 1-5 (``PYTHONPATH=. python -m simulator.cli generate
-scenarios/urban_canyon.yaml -o OUT --seed N``): 5.4-5.9 tracked of the 9 above the mask,
-66-68 % NLOS (95 % of them reflected, 5 % diffracted only), CEP50 8.5-11.6 m. The count falls
-short: with continuous facades 1.6 times as high as the street is wide, a satellite across the
-street needs 47 deg of elevation even to be reflected (tan(el) >= H / (1.5 w)); below that both
-the direct and the reflected path are diffracted deep into the roof's shadow (over 25 dB).
-Berlin's streets are about as wide as their eaves are high and have gaps and cross streets; this
-model has neither (the scenario was not changed to make the figure appear)."""
+Measured per seed (``PYTHONPATH=. python -m simulator.cli generate scenarios/urban_canyon.yaml
+-o OUT --seed N``; figures inside the ``downtown`` zone), seeds 1-5: 6.85-7.25 tracked of the 10
+above the mask (mean 7.01; 6.94 over this test's seeds 1-3), 42-44 % NLOS, CEP50 8.5-9.7 m.
+The count sits at the goal's edge and misses it over the seeds tested here. What the street's
+parts do (seeds 1-3): the same street with continuous facades of one height (no cross streets,
+no height spread) keeps 6.73-7.00 with 45-47 % NLOS and CEP50 10.9-11.9 m, so the cross streets
+add about 0.1 satellite and take 2 m off CEP50; the former street (40 m facades 25 m apart, in
+Seoul) with 110 m blocks and 20 m cross streets keeps 5.6-6.0 (5.4-5.9 with continuous
+facades). The shallower street, Berlin's eaves as high as the street is wide, is what brings the
+count near 7 (a satellite across it is reflected from 31 deg of elevation instead of 47 deg)."""
 
 from __future__ import annotations
 
@@ -56,15 +60,19 @@ def canyon_figures(tmp_path_factory):
 
 
 def test_canyon_keeps_many_satellites_as_nlos_only(canyon_figures):
-    assert canyon_figures["nlos"] >= 0.30  # measured 0.66-0.68
+    assert canyon_figures["nlos"] >= 0.30  # measured 0.42-0.44
 
 
 def test_canyon_fixes_have_a_plausible_cep50(canyon_figures):
-    assert 5.0 <= canyon_figures["cep50"] <= 20.0  # measured 8.5-11.6 m per seed
+    assert 5.0 <= canyon_figures["cep50"] <= 20.0  # measured 8.5-9.7 m per seed
 
 
-@pytest.mark.xfail(strict=True, reason="measured 5.4-5.9 tracked satellites on average (goal "
-                                       "7): continuous facades 1.6 times the street's width; "
-                                       "see the module docstring")
+# not strict: the measured mean sits 0.06 satellite below the goal, within what any change
+# of the GNSS error draws moves it, so a pass here must not fail the suite; the figure is
+# printed either way
+@pytest.mark.xfail(strict=False, reason="measured 6.94 tracked satellites on average over "
+                                        "seeds 1-3 (6.85-7.25 per seed over 1-5; goal 7): see "
+                                        "the module docstring")
 def test_canyon_keeps_at_least_seven_tracked_satellites(canyon_figures):
+    print(f"tracked satellites in the canyon, mean: {canyon_figures['tracked']:.2f}")
     assert canyon_figures["tracked"] >= 7.0
