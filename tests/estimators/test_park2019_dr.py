@@ -113,9 +113,10 @@ DR2D_NOT_SHOWN = (
 
 
 INS_NOT_SHOWN = (
-    "not shown since ins_odo_ekf applies its NHC at the rear axle (issue 14): dr3d_ekf beats it "
-    "in 7/10 seeds at the exit and 5/10 on the maximum (medians 10.3 m vs 18.6 m exit, 16.8 m "
-    "vs 20.2 m max); with the NHC at the IMU, violated by the car's slip, it won 10/10")
+    "not shown on the shortened CI drive since ins_odo_ekf applies its NHC at the rear axle "
+    "(issue 14): dr3d_ekf beats it in 7/10 seeds at the exit and 5/10 on the maximum (medians "
+    "10.3 m vs 18.6 m exit, 16.8 m vs 20.2 m max); on the full drive it does (10/10, 9/10 in "
+    "the session-5 reproduce run)")
 
 
 def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
@@ -129,10 +130,13 @@ def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
 
 
 @pytest.mark.parametrize("other", [_case("dr2d_odo_ekf", DR2D_NOT_SHOWN, strict=True),
-                                   _case("ins_odo_ekf", INS_NOT_SHOWN, strict=True)])
-def test_dr3d_beats_the_baselines_in_the_garage(garage, other):
+                                   _case("ins_odo_ekf")])
+def test_dr3d_beats_the_baselines_in_the_garage(garage, quick, other, request):
     """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
-    least 8 of 10 seeds (paired per seed)."""
+    least 8 of 10 seeds (paired per seed). Against ins_odo_ekf an expected failure on the
+    shortened drive only (its short open-road stretches leave the INS less to drift over)."""
+    if other == "ins_odo_ekf" and quick:
+        request.applymarker(pytest.mark.xfail(strict=True, reason=INS_NOT_SHOWN))
     for key in ("exit_horizontal_m", "max_horizontal_m"):
         wins = _column(garage, "dr3d_ekf", key) < _column(garage, other, key)
         assert wins.sum() >= 8, (key, wins.sum())
