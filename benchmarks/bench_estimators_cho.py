@@ -16,7 +16,6 @@ shared, so wall time varies several-fold), ours including the replay's reading o
 
 from __future__ import annotations
 
-import argparse
 import math
 import tempfile
 import time
@@ -24,6 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
+from benchmarks.arguments import hours_and_repeat
 from estimators.builtin.cho2006 import (
     DR_STEP_S,
     P0_DRM2,
@@ -96,10 +96,7 @@ def run_peer(kind: str, u: np.ndarray, z: np.ndarray, g: float) -> float:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--hours", type=float, default=1.0)
-    parser.add_argument("--repeat", type=int, default=3)
-    args = parser.parse_args()
+    args = hours_and_repeat(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         base = load_scenario(SCENARIO)
         data = {k: v for k, v in base.data.items() if k in ("name", "seed", "start", "limits")}

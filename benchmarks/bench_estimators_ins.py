@@ -15,7 +15,6 @@ shared machine.
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -23,6 +22,7 @@ from pathlib import Path
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 
+from benchmarks.arguments import hours_and_repeat
 from estimators.builtin.park2019_ins import ParkInsOdometer
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
@@ -121,10 +121,7 @@ def _best(dataset, entry: str, repeat: int) -> tuple[float, float, object]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--hours", type=float, default=1.0)
-    parser.add_argument("--repeat", type=int, default=3)
-    args = parser.parse_args()
+    args = hours_and_repeat(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         data = validate_data(scenario(args.hours), "bench-ins")
         generate_dataset(Scenario(Path(tmp) / "bench.yaml", data, []), Path(tmp) / "d",

@@ -16,7 +16,6 @@ Needs ``filterpy`` (``pip install -e .[bench]``).
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -24,6 +23,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from benchmarks.arguments import hours_and_repeat
 from estimators.builtin.park2019_dr import Dr3dEkf
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
@@ -101,10 +101,7 @@ def _time(ds, entry, repeat: int) -> tuple[float, float, float, object]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--hours", type=float, default=1.0)
-    parser.add_argument("--repeat", type=int, default=3)
-    args = parser.parse_args()
+    args = hours_and_repeat(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         warm = generate_dataset(load_scenario(GARAGE, [], 1), tmp / "warm")

@@ -9,7 +9,6 @@ times matter here), with a 100 Hz truth table for the initial state.
 
 from __future__ import annotations
 
-import argparse
 import tempfile
 import time
 from pathlib import Path
@@ -17,6 +16,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from benchmarks.arguments import hours_and_repeat
 from estimators.base import Estimator
 from simulator import columns as col
 from simulator.dataset.io import open_dataset, write_dataset
@@ -63,10 +63,7 @@ def make_dataset(path: Path, hours: float) -> None:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--hours", type=float, default=1.0)
-    parser.add_argument("--repeat", type=int, default=3)
-    args = parser.parse_args()
+    args = hours_and_repeat(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
         make_dataset(Path(tmp), args.hours)
         dataset = open_dataset(tmp)
