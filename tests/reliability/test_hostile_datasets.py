@@ -16,7 +16,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from simulator.cli import main
-from tests.reliability.drives import straight_drive
+from tests.reliability.drives import generated_dataset, straight_drive
 
 SCENARIO = straight_drive(150, sensors="  imu: {preset: ideal, rate: 50}\n"
                                        "  odometer: {rate: 10}\n"
@@ -26,10 +26,7 @@ SCENARIO = straight_drive(150, sensors="  imu: {preset: ideal, rate: 50}\n"
 
 @pytest.fixture(scope="module")
 def pristine(tmp_path_factory) -> Path:
-    root = tmp_path_factory.mktemp("hostile_ds")
-    (root / "s.yaml").write_text(SCENARIO)
-    assert main(["generate", str(root / "s.yaml"), "-o", str(root / "ds")]) == 0
-    return root / "ds"
+    return generated_dataset(tmp_path_factory.mktemp("hostile_ds"), SCENARIO)
 
 
 def _rewrite(path: Path, change: Callable[[pa.Table], pa.Table]) -> None:

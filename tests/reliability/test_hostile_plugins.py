@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from simulator.cli import main
-from tests.reliability.drives import straight_drive
+from tests.reliability.drives import generated_dataset, straight_drive
 
 SCENARIO = straight_drive(60, sensors="  imu: {preset: ideal, rate: 50}\n")
 
@@ -30,10 +30,7 @@ CASES = {
 
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory) -> Path:
-    root = tmp_path_factory.mktemp("plugins")
-    (root / "s.yaml").write_text(SCENARIO)
-    assert main(["generate", str(root / "s.yaml"), "-o", str(root / "ds")]) == 0
-    return root / "ds"
+    return generated_dataset(tmp_path_factory.mktemp("plugins"), SCENARIO)
 
 
 @pytest.mark.parametrize("cls", list(CASES))
