@@ -30,6 +30,11 @@ ZONE_FIELD = Record(
         "nlos_attenuation_spread": Number("", 8.0, min=0,
                                           doc="canyon: 1-sigma of the reflection loss from one "
                                               "facade (building) to the next, dB"),
+        "scattering_coefficient": Number("", 0.4, min=0, max=1,
+                                         doc="canyon: S of the facades' diffuse scattering (the "
+                                             "Lambertian effective-roughness model, Degli-Esposti "
+                                             "et al. 2007: about 0.4 for building walls); 0: "
+                                             "specular reflections and diffraction only"),
         "facade_length": Number("m", 20.0, gt=0,
                                 doc="canyon: frontage of one building along the street (each has "
                                     "its own height and draws its own reflection loss; Berlin's "

@@ -67,6 +67,7 @@ signal, error and fix models.
 from __future__ import annotations
 
 import datetime as dt
+from collections.abc import Callable
 from pathlib import Path as FilePath
 from typing import TYPE_CHECKING
 
@@ -307,7 +308,8 @@ class Gnss(PresetSensor):
                 "yaw": k["yaw"], "distance": k["distance"]}
 
     def sky(self, truth: Kinematics, t: np.ndarray, az: np.ndarray, el: np.ndarray,
-            yaw: np.ndarray, distance: np.ndarray, rng: np.random.Generator
+            yaw: np.ndarray, distance: np.ndarray, rng: np.random.Generator,
+            antenna_gain_db: Callable[[np.ndarray], np.ndarray] | None = None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Line of sight, NLOS, NLOS extra path (m) and C/N0 loss (dB) per satellite and epoch
         from the environment zones (``sky``: open, none, canyon).
@@ -321,8 +323,11 @@ class Gnss(PresetSensor):
         is the antenna's distance driven. Each facade's reflection loss is drawn from
         N(``nlos_attenuation``, ``nlos_attenuation_spread``), floored at 0 dB, once per
         satellite and building (each end facade counts as one), and applied where that building
-        is the reflection point. Draws are made only when the drive has a canyon, so open drives'
-        random streams are unchanged."""
+        is the reflection point. Diffuse scattering off the facade across the street
+        (``scattering_coefficient``) arrives from that facade, where the antenna's gain
+        (``antenna_gain_db`` against elevation) differs from its gain toward the satellite.
+        Draws are made only when the drive has a canyon, so open drives' random streams are
+        unchanged."""
         los = np.ones(el.shape, dtype=bool)
         nlos = np.zeros(el.shape, dtype=bool)
         extra = np.zeros(el.shape)
@@ -354,7 +359,7 @@ class Gnss(PresetSensor):
                     zone["building_height"], zone["street_width"],
                     np.broadcast_to(ahead, shape)[up], np.broadcast_to(behind, shape)[up],
                     facade_loss, LAMBDA_L1_M, np.broadcast_to(distance[here], shape)[up],
-                    buildings, satellite)
+                    buildings, satellite, zone["scattering_coefficient"], antenna_gain_db)
                 los[:, here], nlos[:, here], extra[:, here] = z_los, z_nlos, z_extra
                 loss[:, here] = z_loss
         return los, nlos, extra, loss
@@ -405,7 +410,9 @@ class Gnss(PresetSensor):
         # multipath), the receiver's estimate of it adds white noise
         u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
                                      cfg["multipath_correlation_time"])
-        los, nlos, extra, loss = self.sky(truth, t, az, el, ant["yaw"], ant["distance"], rng)
+        los, nlos, extra, loss = self.sky(
+            truth, t, az, el, ant["yaw"], ant["distance"], rng,
+            lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
         signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
                       + draw_fading(rng, cfg, u, el.shape[0]))
         cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)

@@ -1,7 +1,8 @@
 """The street-canyon sky against hand-solvable geometry: a satellite along the street is in line
 of sight, one across the street below the facades' angle is blocked or reflected, a reflection's
 extra path is the image-antenna distance (one and two side facades, the end facade), diffraction
-over a roof edge follows the knife-edge loss of ITU-R P.526."""
+over a roof edge follows the knife-edge loss of ITU-R P.526, diffuse scattering off the lit
+facade across the street is the Lambertian integral over it (patch by patch, by quadrature)."""
 
 from __future__ import annotations
 
@@ -12,6 +13,8 @@ from simulator.environment.sky import (
     Buildings,
     canyon_reception,
     knife_edge_loss_db,
+    lit_strip_solid_angle,
+    scattered_path,
     street_buildings,
     trace_paths,
 )
@@ -249,3 +252,89 @@ def test_a_street_stood_in_gets_a_block_that_stops_at_the_next_street():
     np.testing.assert_allclose(end[:3], [20.0, 40.0, 50.0])
     assert (np.diff(start) > 0).all() and (start[1:] >= end[:-1]).all()
     assert buildings.count == 2 * len(start) + 4
+
+
+# diffuse scattering (the Lambertian effective-roughness model, Degli-Esposti et al. 2007)
+
+S = 0.4
+
+
+def _lambertian_fraction_by_quadrature(u: np.ndarray, low: float, high: float,
+                                       half_width: float) -> float:
+    """Scattered power over direct power at the antenna from a lit strip of the facade across
+    the street (y = -half_width for a satellite on the right), summed patch by patch:
+    S^2 cos(theta_i) dA cos(theta_s) / (pi r^2), by numerical quadrature over the facade."""
+    from scipy.integrate import dblquad
+
+    cos_i = abs(u[1])
+
+    def patch(z: float, x: float) -> float:
+        r2 = x * x + half_width**2 + z * z
+        cos_s = half_width / np.sqrt(r2)
+        return S**2 * cos_i * cos_s / (np.pi * r2)
+
+    total = 0.0
+    for a, b in ((-np.inf, -50.0), (-50.0, 50.0), (50.0, np.inf)):
+        total += dblquad(patch, a, b, low, high, epsabs=1e-12, epsrel=1e-9)[0]
+    return total
+
+
+@pytest.mark.parametrize("az, el", [(90.0, 15.0), (90.0, 25.0), (60.0, 12.0), (-120.0, 20.0)])
+def test_scattered_power_is_the_lambertian_integral_over_the_lit_strip(az, el):
+    """The closed form (the strip's solid angle) against the patch-by-patch integral, and the
+    strip's lower edge against the ray that grazes the roof edge on the satellite's side."""
+    u = _u(az, el)
+    out = scattered_path(u[None], H, W, S)
+    assert out["possible"][0]
+    # the shadow line: the ray toward the satellite leaves the near roof edge (height H at the
+    # near facade line) and reaches the far facade line (2 (W/2) across) this much lower
+    horizontal = np.hypot(u[0], u[1])
+    run = W / (abs(u[1]) / horizontal)  # horizontal distance from facade line to facade line
+    low = H - run * u[2] / horizontal
+    fraction = _lambertian_fraction_by_quadrature(u, max(low, 0.0), H, W / 2)
+    assert out["loss_db"][0] == pytest.approx(-10 * np.log10(fraction) + 3.0, abs=1e-6)
+    assert lit_strip_solid_angle(W / 2, max(low, 0.0), H) > 0
+    # the arrival direction: the strip's middle, straight across
+    assert out["arrival_elevation_rad"][0] == pytest.approx(
+        np.arctan2(0.5 * (max(low, 0.0) + H), W / 2))
+
+
+def test_scattered_extra_path_is_the_least_delay_point_of_the_strip():
+    u = _u(60.0, 18.0)
+    out = scattered_path(u[None], H, W, S)
+    low = H - W * np.tan(np.radians(18.0)) / np.sin(np.radians(60.0))
+    mid = 0.5 * (low + H)
+    x = np.linspace(-200.0, 200.0, 400001)
+    point = np.stack([x, np.full_like(x, -W / 2), np.full_like(x, mid)], axis=1)  # left facade
+    extra = np.linalg.norm(point, axis=1) - point @ u
+    assert out["extra_path_m"][0] == pytest.approx(extra.min(), abs=1e-4)
+    assert extra.min() > 0
+
+
+def test_no_scattering_from_a_facade_the_satellite_cannot_light_or_that_is_not_there():
+    # along the street: no light on the side facades; high across: the shadow line falls below
+    # the antenna and the whole facade is lit (still a strip); a cross street across the
+    # antenna: no facade
+    assert not scattered_path(_u(0.0, 20.0)[None], H, W, S)["possible"][0]
+    assert scattered_path(_u(90.0, 80.0)[None], H, W, S)["possible"][0]
+    street = _buildings([(0.0, 100.0, H)], [(0.0, 40.0, H), (60.0, 100.0, H)])
+    assert not scattered_path(_u(90.0, 15.0)[None], H, W, S, 50.0, street)["possible"][0]
+    assert scattered_path(_u(90.0, 15.0)[None], H, W, S, 30.0, street)["possible"][0]
+
+
+def test_scattering_keeps_a_low_satellite_across_the_street_and_never_replaces_line_of_sight():
+    def receive(az, el, s):
+        gain = lambda e: 46.5 - 28.5 * np.exp(-np.degrees(e) / 17.0)  # noqa: E731 (cn0 model)
+        return canyon_reception(np.radians([az]), np.radians([el]), 0.0, H, W, np.inf, np.inf,
+                                np.full(4, 15.0), LAMBDA_M, scattering_coefficient=s,
+                                antenna_gain_db=gain)
+
+    los, nlos, extra, loss = receive(90.0, 15.0, 0.0)
+    assert nlos[0] and loss[0] > 30.0  # deep behind the roof: only heavy diffraction
+    los, nlos, extra_s, loss_s = receive(90.0, 15.0, S)
+    assert nlos[0] and loss_s[0] < 15.0 and extra_s[0] > 0
+    # its C/N0 near the Berlin log's weakest NLOS GPS signals (21-23 dB-Hz)
+    cn0 = 46.5 - 28.5 * np.exp(-15.0 / 17.0) - loss_s[0]
+    assert 18.0 < cn0 < 28.0
+    los, nlos, extra, loss = receive(0.0, 15.0, S)  # along the street: line of sight
+    assert los[0] and loss[0] == 0.0 and extra[0] == 0.0
