@@ -29,7 +29,8 @@ def _need(path: Path) -> Path:
 
 
 def read_sp3_positions(path: Path) -> pd.DataFrame:
-    """Minimal SP3-a/c reader for the tests: epoch (GPS s since 1980-01-06), sv, x, y, z (m)."""
+    """Minimal SP3-a/c reader for the tests: epoch (GPS s since 1980-01-06), sv, x, y, z (m),
+    clock_s (the satellite clock, s; NaN where the file has none)."""
     rows, epoch = [], None
     for line in path.read_text().splitlines():
         if line.startswith("* "):
@@ -39,8 +40,10 @@ def read_sp3_positions(path: Path) -> pd.DataFrame:
         elif line.startswith("P") and epoch is not None:
             sv = line[1:4].strip().lstrip("G")
             xyz = [float(line[4 + 14 * k: 18 + 14 * k]) * 1e3 for k in range(3)]
-            rows.append((epoch, int(sv), *xyz))
-    return pd.DataFrame(rows, columns=["epoch", "sv", "x", "y", "z"])
+            clock_us = float(line[46:60] or "999999.999999")
+            rows.append((epoch, int(sv), *xyz,
+                         np.nan if clock_us >= 999999.0 else clock_us * 1e-6))
+    return pd.DataFrame(rows, columns=["epoch", "sv", "x", "y", "z", "clock_s"])
 
 
 @pytest.mark.parametrize("folder, nav_name, sp3_name", [
