@@ -6,7 +6,8 @@ Run:  PYTHONPATH=. python benchmarks/bench_canyon.py   (figures in BENCHMARKS.md
 
 A straight street driven at 10 m/s for an hour (truth at 10 Hz), the automotive receiver; the
 canyon is the Berlin street of ``scenarios/urban_canyon.yaml`` (eaves 20 m above the antenna with
-a 3 m spread per building, 22 m wide, 110 m blocks between 22 m cross streets). Timed:
+a 3 m spread per building, 22 m wide, 110 m blocks between 22 m cross streets), with and without
+the facades' diffuse scattering. Timed:
 ``Gnss.generate`` in-process, CPU time, best of two; the truth trajectory is built beforehand.
 """
 
@@ -45,14 +46,16 @@ def _truth(zones: dict):
 def main() -> None:
     for rate in (1, 10):
         config = GNSS_FIELD.check({"rate": rate}, ("gnss",), Context("bench"))
-        for label, zones in (("open sky", {}), ("canyon", CANYON)):
+        no_scattering = {"street": {**CANYON["street"], "scattering_coefficient": 0.0}}
+        for label, zones in (("open sky", {}), ("canyon, no scattering", no_scattering),
+                             ("canyon", CANYON)):
             truth = _truth(zones)
             cpu = []
             for seed in range(2):
                 start = time.process_time()
                 out = Gnss(config).generate(truth, np.random.default_rng(seed))
                 cpu.append(time.process_time() - start)
-            print(f"{rate:2d} Hz {label:8s}: CPU {min(cpu):.2f} s, "
+            print(f"{rate:2d} Hz {label:21s}: CPU {min(cpu):.2f} s, "
                   f"{len(out['gnss_raw'])} raw rows, "
                   f"{len(out['gnss_raw']) / len(out['gnss_fix']):.1f} satellites per epoch")
 
