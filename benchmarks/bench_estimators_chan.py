@@ -132,9 +132,10 @@ class FilterPyPeer:
                 self.model.start_clock(t, ep)
                 self.ref = self.model.ukf.x.copy()
                 self.ukf.P = self.model.ukf.p.copy()
-            self.model._w_prev = w[-1]
+            self.model._w_prev, self.model._f_prev = w[-1], f[-1]
+            self.model.ukf.x = self.ref
             z = np.concatenate([ep.pseudorange, ep.range_rate, np.zeros(2)])
-            self.ukf.update(z, R=self.model._measurement_noise(ep, True), ep=ep)
+            self.ukf.update(z, R=self.model.measurement_noise(ep, True), ep=ep)
             self.ref = boxplus(self.ref, self.ukf.x)
             self.ukf.x = np.zeros(N_STATES)
             t_prev = t

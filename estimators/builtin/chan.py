@@ -480,16 +480,22 @@ class TcUkf(_TightlyCoupled):
         if ep is None and not nhc:
             return
         self._predict(t)
-        blocks = [] if ep is None else [self._measurement_noise(ep)]
         z = [] if ep is None else [ep.pseudorange, ep.range_rate]
+        if nhc:
+            z.append(np.zeros(2))
+        # the driver draws the points of N(x_bar, P^xx + Q), P^xy without R, P -= K P^yy K^T
+        self.ukf.update(self._observe, np.concatenate(z), self.measurement_noise(ep, nhc), ep,
+                        nhc)
+
+    def measurement_noise(self, ep: gnss_model.RawEpoch | None, nhc: bool) -> np.ndarray:
+        """R of an update at the current state: the epoch's pseudoranges and range rates
+        (``ep``, None for an NHC-only update), then the two NHC rows if ``nhc``."""
+        blocks = [] if ep is None else [self._measurement_noise(ep)]
         if nhc:
             x = self.ukf.x
             blocks.append(self._nhc_noise(quat_to_dcm(x[QUAT]), x[VEL], self._w_prev - x[BG],
                                           self._f_prev - x[BA], x[POS]))
-            z.append(np.zeros(2))
-        z, r = np.concatenate(z), _block_diagonal(blocks)
-        # the driver draws the points of N(x_bar, P^xx + Q), P^xy without R, P -= K P^yy K^T
-        self.ukf.update(self._observe, z, r, ep, nhc)
+        return _block_diagonal(blocks)
 
     def solution(self, t: float) -> np.ndarray:
         """The mean of the propagated points; the std columns are those of the covariance
