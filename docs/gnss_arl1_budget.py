@@ -1,7 +1,8 @@
 """The numbers behind the "Not shown" analysis of docs/gnss-errors.md: the ARL1 static hour's
 residual std by elevation band with the geodetic preset's terms changed one at a time, the
 spread of the satellites' hour-mean residuals above 30 deg, and the true ionosphere against
-Klobuchar from the station's dual-frequency code (P2 - P1), beside the simulated one, and the
+Klobuchar from the station's dual-frequency code (P2 - P1), beside the simulated one, the real
+P1 residual split by that code into its ionosphere and ionosphere-free parts, and the
 broadcast orbit and clock against the NGA precise ephemeris of the same day along ARL1's lines
 of sight (the hour's signal-in-space error as the precise product gives it).
 
@@ -149,6 +150,24 @@ def main() -> None:
         left = both[column] - design @ coef
         print(f"{name}: ionosphere = {coef[0]:.2f} K + {coef[1]:.2f} m, the rest's std "
               f"{left.std():.2f} m ({len(both)} residuals)")
+
+    # the real P1 residual split by the station's own dual-frequency code: its ionosphere and
+    # T_GD part (I_dual - K) and what is left, the ionosphere-free residual (signal in space,
+    # troposphere, multipath); each epoch's mean removed from each part
+    parts = both.assign(iono_part=both["iono_dual"] - both["iono"])
+    parts["free_part"] = parts["pr_res"] - parts["iono_part"]
+    for key in ("pr_res", "iono_part", "free_part"):
+        parts[key] -= parts.groupby("tow")[key].transform("mean")
+    print("real hour-mean spread above 30 deg: P1 residual "
+          f"{hour_mean_spread(parts):.2f} m = ionosphere and T_GD part "
+          f"{hour_mean_spread(parts.assign(pr_res=parts['iono_part'])):.2f} m + "
+          "ionosphere-free part "
+          f"{hour_mean_spread(parts.assign(pr_res=parts['free_part'])):.2f} m")
+    means = parts.assign(el=np.degrees(parts["elevation"])).groupby("sv")[
+        ["el", "iono_part", "free_part"]].mean()
+    high = means[means["el"] > 30.0]
+    print(f"  their correlation over the satellites above 30 deg: "
+          f"{np.corrcoef(high['iono_part'], high['free_part'])[0, 1]:.2f}")
 
 
 if __name__ == "__main__":
