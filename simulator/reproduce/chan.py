@@ -45,7 +45,6 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -54,14 +53,13 @@ import yaml
 from simulator.dataset.io import Dataset
 from simulator.replay import run_estimator
 from simulator.reproduce import measures as m
-from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict
+from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 
 __all__ = ["COMPLETE_OUTAGES", "INITIAL_ERROR", "LEVER_ARM", "PAPER", "PARTIAL_OUTAGES",
            "initial_error_figures", "judge_cut", "measure_initial_error", "measure_windows",
            "run_filter", "settle_time", "short_complete_overrides", "short_partial_overrides",
            "table1"]
 
-SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 LEVER_ARM = [0.5, 0.0, -1.2]  # the Chan scenarios' antenna lever arm (body FRD), m
 SETTLE_BOUND_M = 10.0  # Figure 2's criterion: below 10 m ...
 SETTLE_WITHIN_S = 10.0  # ... within 10 s
@@ -98,7 +96,7 @@ def short_partial_overrides(seed: int) -> list[str]:
     one window for odd seeds, so that over several seeds each count but 4 falls on straight and
     on curved road. (Halving the windows to 30 s instead does not keep the claim's meaning: the
     errors then stay at the 1-3 m of the pseudorange solution.)"""
-    data = yaml.safe_load((SCENARIOS / "chan_partial_outages.yaml").read_text())
+    data = yaml.safe_load(scenario_path("chan_partial_outages.yaml").read_text())
     segments = data["trajectory"]["segments"]
     faults = data["faults"][:5]
     for k, fault in enumerate(faults):
@@ -110,7 +108,7 @@ def short_partial_overrides(seed: int) -> list[str]:
 def short_complete_overrides() -> list[str]:
     """``--set`` overrides cutting the complete-outage drive to its first outage (60 s from a
     straight into the first 40 m loop) and the loop the other way after it."""
-    data = yaml.safe_load((SCENARIOS / "chan_complete_outages.yaml").read_text())
+    data = yaml.safe_load(scenario_path("chan_complete_outages.yaml").read_text())
     segments = data["trajectory"]["segments"]
     return [f"trajectory.segments={json.dumps(segments[:6] + segments[-2:])}",
             f"faults={json.dumps(data['faults'][:1])}"]

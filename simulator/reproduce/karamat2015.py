@@ -46,7 +46,6 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable, Mapping
 from functools import partial
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -54,14 +53,14 @@ import yaml
 
 from simulator.dataset.io import Dataset
 from simulator.reproduce import measures as m
-from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict
+from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 from simulator.scoring.align import ERR_POS
 
 __all__ = ["COUNTS", "LOOP_S", "PAPER", "PROTOCOL", "SITE1_OFFSET_S", "VARIANTS", "gain",
            "measure_protocol", "protocol_overrides", "seed_maxima", "true_gyro_bias_z",
            "window_maxima", "window_wins"]
 
-SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "karamat2015_partial_outages.yaml"
+SCENARIO = "karamat2015_partial_outages.yaml"
 LOOP_S = 523.95  # one loop of the scenario's drive, s (the scenario's comment; a test checks it)
 SITE1_OFFSET_S = 390.0  # site 1's windows: this far into loops 1-4
 COUNTS = (3, 2, 1, 0)  # satellites left in a site's four passes
@@ -75,7 +74,7 @@ VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model":
 def protocol_overrides(loops: int, site_offset_s: float | None = None) -> list[str]:
     """``--set`` overrides cutting the drive to its first ``loops`` loops with the windows that
     end within them, only those ``site_offset_s`` into a loop when given (site 1: 390 s)."""
-    faults = yaml.safe_load(SCENARIO.read_text())["faults"]
+    faults = yaml.safe_load(scenario_path(SCENARIO).read_text())["faults"]
 
     def keep(fault: dict) -> bool:
         if fault["start"] + fault["duration"] > loops * LOOP_S:
@@ -231,7 +230,7 @@ def judge_gyro_bias(figures: Mapping[str, pd.DataFrame]) -> Verdict:
 
 
 PROTOCOL = Experiment(
-    "partial_outages", "karamat2015_partial_outages.yaml",
+    "partial_outages", SCENARIO,
     {label: {"name": "riss3d_tc_ekf", "config": config} for label, config in VARIANTS.items()},
     measure_protocol,
     quick_overrides=tuple(protocol_overrides(4, SITE1_OFFSET_S)))

@@ -8,22 +8,48 @@ names it ``PAPER``; ``simulator.reproduce.papers`` lists the modules. The runner
 table per experiment (index seed, one column per figure name) and hands the tables to each
 claim's ``judge``.
 
+The experiments run the scenarios shipped in the repository's ``scenarios/`` folder
+(``scenario_path``): the reproduction needs a checkout (installed with ``pip install -e``), as
+the README's commands make; an installation without the folder is told so.
+
 Public names
 ------------
-Figures, Experiment, Verdict, Claim, Paper, STATUSES.
+Figures, Experiment, Verdict, Claim, Paper, STATUSES, SCENARIO_DIR, scenario_path.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Literal
 
 import pandas as pd
 
 from simulator.dataset.io import Dataset
+from simulator.errors import InputError, Problem
 
-__all__ = ["STATUSES", "Claim", "Experiment", "Figures", "Paper", "Verdict"]
+__all__ = ["SCENARIO_DIR", "STATUSES", "Claim", "Experiment", "Figures", "Paper", "Verdict",
+           "scenario_path"]
+
+SCENARIO_DIR = Path(__file__).resolve().parents[2] / "scenarios"
+
+
+def scenario_path(name: str) -> Path:
+    """The shipped scenario ``name`` (a file of the checkout's ``scenarios/``).
+
+    Raises
+    ------
+    InputError
+        The installation has no such file (a wheel install carries no scenarios).
+    """
+    path = SCENARIO_DIR / name
+    if not path.is_file():
+        raise InputError([Problem(str(path), None, "", (
+            "the paper reproductions run the scenarios shipped in a landnav checkout and this "
+            "installation has none; clone the repository and install it with "
+            "'pip install -e .' (README), then run landnav reproduce from there"))])
+    return path
 
 Figures = dict[str, float]  # one seed's figures, flat: {"tc_ukf_nhc.w0.mean_3d_m": 12.3, ...}
 STATUSES = ("shown", "partly", "not shown")

@@ -41,14 +41,13 @@ from simulator.campaign.execute import completed, open_executor
 from simulator.outputs import atomic_output_dir
 from simulator.pipeline import estimate, generate, load_scenario
 from simulator.progress import progress
-from simulator.reproduce.paper import Experiment, Paper, Verdict
+from simulator.reproduce.paper import SCENARIO_DIR, Experiment, Paper, Verdict, scenario_path
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.report import write_report
 
 __all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings",
            "reproduce", "run_experiment", "seeds_of"]
 
-SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 FULL_SEEDS = 10  # seeds of a full run unless --runs says otherwise (issue 14: ten seeds)
 QUICK_SEEDS = 3  # seeds of --quick (issue 16: at least 3)
 SCHEDULER_TIMEOUT_S = 10.0
@@ -69,7 +68,7 @@ def measure_seed(experiment: Experiment, seed: int, overrides: Sequence[str],
                  work: Path) -> dict[str, float]:
     """One seed of an experiment in-process: generate the dataset under ``work``, replay every
     entry, measure, delete the dataset; the seed's figures."""
-    scenario = load_scenario(SCENARIOS / experiment.scenario, list(overrides), seed)
+    scenario = load_scenario(scenario_path(experiment.scenario), list(overrides), seed)
     with tempfile.TemporaryDirectory(dir=work, prefix=f"{experiment.key}-{seed}-") as tmp:
         dataset = generate(scenario, Path(tmp) / "dataset")
         solutions = {label: estimate(dataset, {**entry, "label": label})[0]
@@ -165,7 +164,7 @@ def version() -> str:
     except PackageNotFoundError:
         text = "landnav (not installed)"
     try:
-        commit = subprocess.run(["git", "-C", str(SCENARIOS.parent), "rev-parse", "--short",
+        commit = subprocess.run(["git", "-C", str(SCENARIO_DIR.parent), "rev-parse", "--short",
                                  "HEAD"], capture_output=True, text=True, timeout=10,
                                 check=True).stdout.strip()
         text += f", commit {commit}"
@@ -185,9 +184,13 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
     Raises
     ------
     InputError
-        An unknown paper, ``out`` existing without ``force``, a scheduler that does not answer.
+        An unknown paper, ``out`` existing without ``force``, a scheduler that does not answer,
+        an installation without the shipped scenarios.
     """
     loaded = [load_paper(key) for key in (papers or paper_keys())]
+    for paper in loaded:  # a missing scenario stops the run before any worker starts
+        for experiment in paper.experiments:
+            scenario_path(experiment.scenario)
     seeds = seeds_of(runs or (QUICK_SEEDS if quick else FULL_SEEDS))
     tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)))
              for p in loaded for e in p.experiments for seed in seeds]

@@ -18,6 +18,7 @@ from simulator.dataset.io import open_dataset, write_dataset
 from simulator.outputs import atomic_output_dir
 from simulator.reproduce import chan, karamat2015
 from simulator.reproduce import measures as m
+from simulator.reproduce.paper import scenario_path
 from simulator.scenario import load_scenario
 from tests.scoring_helpers import offset_solution
 
@@ -35,8 +36,9 @@ def _limit(t0: float, t1: float, count: int) -> tuple[float, float, str, str]:
 @pytest.fixture(scope="module")
 def truth() -> pd.DataFrame:
     """One loop of the Karamat drive on a rigid body (524 s, 100 Hz)."""
-    scenario = load_scenario(karamat2015.SCENARIO, ["trajectory.segments.0.repeat.times=1",
-                                                    "faults=[]", "vehicle=rigid"])
+    scenario = load_scenario(scenario_path(karamat2015.SCENARIO),
+                             ["trajectory.segments.0.repeat.times=1", "faults=[]",
+                              "vehicle=rigid"])
     return build_truth(scenario.data).table()
 
 
@@ -256,7 +258,7 @@ def test_karamat_gyro_bias_words(bias, status):
 def test_karamat_scenario_has_ten_sites_each_passed_with_3_2_1_0_satellites():
     """Every window lies at one of three places of the loop, and the windows of each place
     group into sites of four consecutive loops with 3, 2, 1, 0 satellites: ten sites."""
-    faults = yaml.safe_load(karamat2015.SCENARIO.read_text())["faults"]
+    faults = yaml.safe_load(scenario_path(karamat2015.SCENARIO).read_text())["faults"]
     assert len(faults) == 40
     passes: dict[float, list[tuple[int, int]]] = {}
     for f in faults:

@@ -41,6 +41,19 @@ def test_an_existing_folder_is_not_replaced_without_force(tmp_path, capsys):
     assert not list(tmp_path.glob(".out.tmp*"))
 
 
+def test_an_installation_without_the_shipped_scenarios_is_told_what_to_do(tmp_path, capsys,
+                                                                           monkeypatch):
+    from simulator.reproduce import paper
+
+    monkeypatch.setattr(paper, "SCENARIO_DIR", tmp_path / "no-scenarios")
+    out = tmp_path / "out"
+    assert main(["reproduce", "tan2008", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "pip install -e" in err and "Traceback" not in err
+    assert len(err.strip().splitlines()) == 1
+    assert not out.exists() and not list(tmp_path.glob(".out.tmp*"))
+
+
 def test_a_failing_run_is_reported_with_its_error():
     figures, error, _ = _execute(_Task("tan2008", "outage", 1, ("no.such.key=1",)))
     assert figures is None

@@ -9,8 +9,9 @@ import pytest
 
 from simulator.reproduce import cho2006, park2019, tan2008
 from simulator.reproduce import measures as m
+from simulator.reproduce.paper import SCENARIO_DIR
 from simulator.reproduce.papers import PAPERS, load_paper, paper_keys
-from simulator.reproduce.runner import SCENARIOS, judge
+from simulator.reproduce.runner import judge
 
 
 @pytest.mark.parametrize("fraction, n, need", [(0.9, 10, 9), (0.8, 10, 8), (0.9, 3, 3),
@@ -135,4 +136,4 @@ def test_every_registered_paper_loads_with_unique_keys_and_module_level_measures
         for e in paper.experiments:
             # picklable by reference: a module-level function
             assert e.measure.__qualname__ == e.measure.__name__
-            assert (SCENARIOS / e.scenario).is_file(), e.scenario
+            assert (SCENARIO_DIR / e.scenario).is_file(), e.scenario
