@@ -5,6 +5,10 @@ end to end."""
 from __future__ import annotations
 
 import html
+import os
+import subprocess
+import sys
+from pathlib import Path
 
 import pandas as pd
 import pytest
@@ -13,6 +17,8 @@ from simulator.cli import main
 from simulator.reproduce import tan2008
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.runner import _execute, _Task, run_experiment
+
+REPOSITORY = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -52,6 +58,18 @@ def test_an_installation_without_the_shipped_scenarios_is_told_what_to_do(tmp_pa
     assert "pip install -e" in err and "Traceback" not in err
     assert len(err.strip().splitlines()) == 1
     assert not out.exists() and not list(tmp_path.glob(".out.tmp*"))
+    # in a fresh interpreter, where the papers that read their scenarios when imported (Chan,
+    # Karamat) are first imported by the command line itself
+    code = ("import sys; from pathlib import Path; import simulator.reproduce.paper as p; "
+            f"p.SCENARIO_DIR = Path({str(tmp_path / 'none')!r}); "
+            "from simulator.cli import main; "
+            f"sys.exit(main(['reproduce', 'chan', '-o', {str(out)!r}]))")
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         timeout=300, cwd=tmp_path,
+                         env={**os.environ, "PYTHONPATH": str(REPOSITORY)})
+    assert run.returncode == 2, run.stderr
+    assert "pip install -e" in run.stderr and "Traceback" not in run.stderr
+    assert not out.exists()
 
 
 def test_a_failing_run_is_reported_with_its_error():
