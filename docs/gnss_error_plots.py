@@ -1,6 +1,7 @@
 """The figure of docs/gnss-errors.md: the static ARL1 hour (2015-07-19 00:00-01:00 GPST, real
 broadcast file) simulated with the ``geodetic`` and ``automotive`` presets beside the real
-station receiver, through the one residual procedure of ``tests/gnss/test_gnss_arl1.py``.
+station receiver, through the one residual procedure of ``tests/gnss/test_gnss_arl1.py``, and
+the second real station's hour (GEONET 0759, 2005-04-02) beside the geodetic preset there.
 
 Run from the repository root (needs ``../shared/refdata`` beside the checkout and georinex):
 
@@ -21,12 +22,16 @@ import numpy as np  # noqa: E402
 from test_gnss_arl1 import (  # noqa: E402
     ARL1_XYZ,
     ELEVATION_BINS_DEG,
+    GSI0759,
     SEEDS,
     _nav,
     _real_observations,
     _simulated,
     autocorrelation,
+    navigation,
+    real_observations,
     residuals,
+    simulated,
     std_by_elevation,
 )
 
@@ -40,7 +45,7 @@ def main() -> None:
     geodetic = [residuals(_simulated("geodetic", seed), nav, ARL1_XYZ) for seed in SEEDS]
     automotive = residuals(_simulated("automotive"), nav, ARL1_XYZ)
 
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.5))
+    fig, axes = plt.subplots(1, 4, figsize=(20, 4.5))
     centres = np.arange(len(ELEVATION_BINS_DEG) - 1)
     labels = [f"{a}-{b}" for a, b in zip(ELEVATION_BINS_DEG[:-1], ELEVATION_BINS_DEG[1:],
                                          strict=True)]
@@ -80,6 +85,24 @@ def main() -> None:
     ax.set_ylabel("pseudorange residual, m")
     ax.legend(fontsize=8, ncol=2)
     ax.set_title("Residuals over the hour")
+    ax = axes[3]
+    nav_gsi = navigation(GSI0759)
+    real_gsi = std_by_elevation(residuals(real_observations(GSI0759), nav_gsi, GSI0759.xyz,
+                                          week=GSI0759.week))
+    sims_gsi = np.array([std_by_elevation(residuals(simulated(GSI0759, "geodetic", seed),
+                                                    nav_gsi, GSI0759.xyz, week=GSI0759.week))
+                         for seed in SEEDS])
+    ax.bar(centres - 0.2, real_gsi, 0.4, label="real GSI 0759 (C1, 2005)")
+    ax.bar(centres + 0.2, sims_gsi.mean(axis=0), 0.4,
+           yerr=[sims_gsi.mean(axis=0) - sims_gsi.min(axis=0),
+                 sims_gsi.max(axis=0) - sims_gsi.mean(axis=0)],
+           label=f"geodetic preset there ({len(sims_gsi)} seeds, range)")
+    ax.plot(centres, std_real, "k_", markersize=20, mew=2, label="real ARL1 (2015)")
+    ax.set_xticks(centres, labels)
+    ax.set_xlabel("elevation band, deg")
+    ax.set_ylabel("pseudorange residual std, m")
+    ax.legend(fontsize=8)
+    ax.set_title("A second real station")
     fig.tight_layout()
     OUT.parent.mkdir(exist_ok=True)
     fig.savefig(OUT, dpi=90)
@@ -89,6 +112,8 @@ def main() -> None:
           round(autocorrelation(real, 60), 2), "geodetic",
           [round(autocorrelation(r, 30), 2) for r in geodetic],
           "automotive", round(autocorrelation(automotive, 30), 2))
+    print("GSI 0759 std by band real", np.round(real_gsi, 2), "geodetic mean",
+          np.round(sims_gsi.mean(0), 2))
     print("wrote", OUT)
 
 

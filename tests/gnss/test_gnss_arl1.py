@@ -4,12 +4,14 @@ residual procedure: broadcast orbit and clock (with relativistic term and T_GD),
 Klobuchar with the file's alpha/beta, Saastamoinen with the standard atmosphere and the Niell
 mapping, at the known antenna position; one receiver clock (bias, drift) per epoch removed;
 elevation above 10 deg. The real receiver's residuals are also given with the station's measured
-weather in the troposphere model, as the refdata README computed them."""
+weather in the troposphere model, as the refdata README computed them. A second real station
+(GEONET 0759, refdata 1c) goes through the same procedure."""
 
 from __future__ import annotations
 
 import datetime as dt
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,21 +25,44 @@ from simulator.gnss.constants import C_M_S, LAMBDA_L1_M, SECONDS_PER_WEEK
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
 from simulator.gnss.navfiles import read_rinex_nav
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
-from simulator.timebase import gps_to_utc
+from simulator.timebase import GPS_EPOCH, gps_to_utc
 
-FOLDER = Path(__file__).resolve().parents[3] / "shared" / "refdata" / "gnss" / \
-    "arl1_2015-07-19_gnsstk"
+REFDATA = Path(__file__).resolve().parents[3] / "shared" / "refdata" / "gnss"
+FOLDER = REFDATA / "arl1_2015-07-19_gnsstk"
 ARL1_XYZ = np.array([-740289.9180, -5457071.7340, 3207245.5420])  # RINEX APPROX POSITION
 WEEK = 1854  # 2015-07-19 00:00 GPST = week 1854, TOW 0
 
 
+@dataclass(frozen=True)
+class StaticHour:
+    """A real static receiver's hour of observations and the navigation file beside them."""
+
+    name: str
+    folder: Path
+    nav_name: str
+    obs_name: str
+    code: str  # the RINEX 2 code observable: P1 (P(Y)) or C1 (C/A)
+    xyz: np.ndarray  # the antenna's known position, ECEF m
+    week: int  # GPS week of the hour
+    tow0_s: float  # its first epoch, s of that week
+
+
+ARL1 = StaticHour("ARL1", FOLDER, "arlm200a.15n", "arlm200a.15o", "P1", ARL1_XYZ, WEEK, 0.0)
+# refdata 1c: GEONET station 0759 (Trimble 5700), 2005-04-02 00:00-00:59:30 GPST (Saturday of
+# week 1316), its F3 position; C1 code, no Doppler
+GSI0759 = StaticHour("GSI 0759", REFDATA / "gsi0759_2005-04-02_rtklib", "07590920.05n",
+                     "07590920.05o", "C1",
+                     np.array([-3976219.1454, 3382371.6073, 3652511.1964]), 1316, 518400.0)
+
+
 def residuals(obs: pd.DataFrame, nav: pd.DataFrame, rx: np.ndarray,
-              weather: tuple[float, float, float] | None = None) -> pd.DataFrame:
+              weather: tuple[float, float, float] | None = None, week: int = WEEK
+              ) -> pd.DataFrame:
     """Pseudorange (m) and Doppler (Hz) residuals of a static receiver at ``rx`` (ECEF, m).
 
-    ``obs`` has columns tow (GPS s of week ``WEEK``), sv, pseudorange (m), doppler (Hz);
+    ``obs`` has columns tow (GPS s of ``week``), sv, pseudorange (m), doppler (Hz);
     ``weather`` (p hPa, T K, e hPa) replaces the standard atmosphere in the troposphere."""
-    eph = ephemeris_arrays(nav, WEEK)
+    eph = ephemeris_arrays(nav, week)
     tow, sv = obs["tow"].to_numpy(), obs["sv"].to_numpy()
     pr = obs["pseudorange"].to_numpy()
     idx = select_ephemeris(eph, sv, tow)
@@ -56,7 +81,9 @@ def residuals(obs: pd.DataFrame, nav: pd.DataFrame, rx: np.ndarray,
     el = np.arcsin(-los_ned[:, 2])
     az = np.arctan2(los_ned[:, 1], los_ned[:, 0])
     iono = klobuchar_delay(lat, lon, az, el, tow, nav.attrs["iono_alpha"], nav.attrs["iono_beta"])
-    tropo = tropo_delay(lat, alt, el, 200.0, weather=weather)  # 2015-07-19 is day 200
+    gps_time = GPS_EPOCH + dt.timedelta(seconds=week * SECONDS_PER_WEEK + float(np.min(tow)))
+    day_of_year = float(gps_time.timetuple().tm_yday)  # 200 for ARL1's hour, 92 for GSI's
+    tropo = tropo_delay(lat, alt, el, day_of_year, weather=weather)
     vs = rotate_to_reception_frame(state["vel"], rng / C_M_S)
     rate = np.einsum("ni,ni->n", los, vs) / light_time_factor(los, state["pos"], vs,
                                                                rng / C_M_S)
@@ -72,42 +99,62 @@ def residuals(obs: pd.DataFrame, nav: pd.DataFrame, rx: np.ndarray,
     return out
 
 
-def _nav() -> pd.DataFrame:
-    path = FOLDER / "arlm200a.15n"
+def navigation(hour: StaticHour) -> pd.DataFrame:
+    path = hour.folder / hour.nav_name
     if not path.exists():
         pytest.skip(f"reference data {path} not available (needs the shared/ folder beside "
                     "the repository checkout)")
     return read_rinex_nav(path)
 
 
-def _real_observations() -> pd.DataFrame:
+def real_observations(hour: StaticHour) -> pd.DataFrame:
+    """The station's GPS code (and Doppler and C/N0 where the file has them), as the
+    observation table ``residuals`` reads."""
     georinex = pytest.importorskip("georinex", reason="georinex (test extra) reads the RINEX obs")
+    meas = [hour.code, "D1", "S1"] if hour.code == "P1" else [hour.code]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
-        ds = georinex.load(FOLDER / "arlm200a.15o", meas=["P1", "D1", "S1"])
-    frame = ds.to_dataframe().reset_index().dropna(subset=["P1", "D1"])
-    frame = frame[(frame["P1"] > 0) & frame["sv"].str.startswith("G")]
-    tow = (frame["time"] - pd.Timestamp(1980, 1, 6)).dt.total_seconds() - WEEK * SECONDS_PER_WEEK
+        ds = georinex.load(hour.folder / hour.obs_name, meas=meas)
+    frame = ds.to_dataframe().reset_index().dropna(subset=meas[:2])
+    frame = frame[(frame[hour.code] > 0) & frame["sv"].str.startswith("G")]
+    tow = ((frame["time"] - pd.Timestamp(1980, 1, 6)).dt.total_seconds()
+           - hour.week * SECONDS_PER_WEEK)
+    nothing = np.full(len(frame), np.nan)
     return pd.DataFrame({"tow": tow.to_numpy(), "sv": frame["sv"].str[1:].astype(int).to_numpy(),
-                         "pseudorange": frame["P1"].to_numpy(),
-                         "doppler": frame["D1"].to_numpy(), "cn0": frame["S1"].to_numpy()})
+                         "pseudorange": frame[hour.code].to_numpy(),
+                         "doppler": frame["D1"].to_numpy() if "D1" in frame else nothing,
+                         "cn0": frame["S1"].to_numpy() if "S1" in frame else nothing})
+
+
+def simulated(hour: StaticHour, preset: str, seed: int = 2015, **overrides) -> pd.DataFrame:
+    """The static hour simulated at the station's position and time with its navigation file
+    as the sky and ``preset`` (and ``overrides`` of its keys), as the observation table
+    ``residuals`` reads."""
+    lat, lon, alt = ecef_to_geodetic(hour.xyz)
+    start = {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": float(alt),
+             "heading": 0.0}
+    truth = drive([{"stop": {"duration": 3570}}], start=start,
+                  utc=gps_to_utc(hour.week, hour.tow0_s), rate_hz=1.0)
+    gnss = receiver(preset=preset, rate=1 / 30, constellation=str(hour.folder / hour.nav_name),
+                    **overrides)
+    raw = gnss.generate(truth, np.random.default_rng(seed))["gnss_raw"]
+    return pd.DataFrame({"tow": raw["t"].to_numpy() + hour.tow0_s, "sv": raw["sv"].to_numpy(),
+                         "pseudorange": raw["pseudorange"].to_numpy(),
+                         "doppler": raw["doppler"].to_numpy(), "cn0": raw["cn0"].to_numpy()})
+
+
+def _nav() -> pd.DataFrame:
+    return navigation(ARL1)
+
+
+def _real_observations() -> pd.DataFrame:
+    return real_observations(ARL1)
 
 
 def _simulated(preset: str, seed: int = 2015, **overrides) -> pd.DataFrame:
-    """The static hour simulated with ``preset`` (and ``overrides`` of its keys), as the
-    observation table ``residuals`` reads."""
-    lat, lon, alt = ecef_to_geodetic(ARL1_XYZ)
-    start = {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": float(alt),
-             "heading": 0.0}
-    utc = gps_to_utc(WEEK, 0.0)
-    assert utc == dt.datetime(2015, 7, 18, 23, 59, 43)
-    truth = drive([{"stop": {"duration": 3570}}], start=start, utc=utc, rate_hz=1.0)
-    gnss = receiver(preset=preset, rate=1 / 30, constellation=str(FOLDER / "arlm200a.15n"),
-                    **overrides)
-    raw = gnss.generate(truth, np.random.default_rng(seed))["gnss_raw"]
-    return pd.DataFrame({"tow": raw["t"].to_numpy(), "sv": raw["sv"].to_numpy(),
-                         "pseudorange": raw["pseudorange"].to_numpy(),
-                         "doppler": raw["doppler"].to_numpy(), "cn0": raw["cn0"].to_numpy()})
+    """The static ARL1 hour simulated with ``preset`` (``simulated``)."""
+    assert gps_to_utc(WEEK, 0.0) == dt.datetime(2015, 7, 18, 23, 59, 43)
+    return simulated(ARL1, preset, seed, **overrides)
 
 
 def test_static_residuals_beside_the_real_arl1_receiver():
@@ -207,6 +254,38 @@ def test_static_hour_time_behaviour_and_ionosphere_beside_arl1():
     assert 1.2 < np.mean(ratios) < 2.2
 
 
+def test_residuals_beside_a_second_real_station_and_the_range_both_show():
+    """The same procedure at a second real geodetic receiver (refdata 1c: GEONET 0759, a
+    Trimble 5700, C/A code, 2005-04-02 00:00-01:00 GPST, its own broadcast file as the sky):
+    its residual std by band is 1.27 / 0.56 / 0.75 / 1.03 m, ARL1's 1.26 / 0.96 / 0.47 / 0.37 m
+    (the 45-90 deg band differs by 2.8x between the two hours; the spread of the satellites'
+    hour means above 30 deg is 0.87 m at GSI 0759, 0.20 m at ARL1). The geodetic preset, at
+    each station's position, time and sky (mean of four seeds): ARL1 1.13 / 0.77 / 0.67 /
+    0.66 m, GSI 0759 1.25 / 0.62 / 0.49 / 0.58 m, within 30 % of the range the two real
+    receivers span in every band (the preset's levels were set from published figures, not from
+    either station). The autocorrelation at 30 s at GSI 0759: real 0.79, geodetic mean 0.72,
+    both in the issue's 0.3-0.8."""
+    stations = (ARL1, GSI0759)
+    real = {h.name: residuals(real_observations(h), navigation(h), h.xyz, week=h.week)
+            for h in stations}
+    real_std = np.array([std_by_elevation(real[h.name]) for h in stations])
+    low, high = real_std.min(axis=0), real_std.max(axis=0)
+    for hour in stations:
+        nav = navigation(hour)
+        sims = [residuals(simulated(hour, "geodetic", seed), nav, hour.xyz, week=hour.week)
+                for seed in SEEDS]
+        sim_std = np.mean([std_by_elevation(r) for r in sims], axis=0)
+        print(f"\n{hour.name}: real {np.round(std_by_elevation(real[hour.name]), 2)}, "
+              f"geodetic {np.round(sim_std, 2)}; the real range {np.round(low, 2)} - "
+              f"{np.round(high, 2)}")
+        assert np.all(sim_std >= 0.7 * low) and np.all(sim_std <= 1.3 * high)
+        if hour is GSI0759:
+            real_ac = autocorrelation(real[hour.name], 30)
+            sim_ac = np.mean([autocorrelation(r, 30) for r in sims])
+            print(f"autocorrelation at 30 s: real {real_ac:.2f}, geodetic mean {sim_ac:.2f}")
+            assert 0.3 < real_ac < 0.8 and 0.3 < sim_ac < 0.8
+
+
 @pytest.mark.xfail(strict=True, reason=(
     "not shown: geodetic-preset residual std by elevation band 10-20/20-30/30-45/45-90 deg is "
     "1.13/0.77/0.67/0.66 m (mean of four seeds, the ionosphere a smooth field over the pierce "
@@ -215,7 +294,9 @@ def test_static_hour_time_behaviour_and_ionosphere_beside_arl1():
     "ARL1's satellites above 30 deg agree within 0.2 m rms in their hour means, so that hour's "
     "broadcast errors were well below the published 0.7 m (Montenbruck et al. 2015; the "
     "day's NGA precise ephemeris gives 0.63 m along ARL1's lines of sight, but its "
-    "per-satellite offsets are not in the real P1 residuals: docs/gnss-errors.md); levels "
+    "per-satellite offsets are not in the real P1 residuals: docs/gnss-errors.md); a second "
+    "real station, GSI 0759 in 2005, shows 1.27/0.56/0.75/1.03 m, above the preset at high "
+    "elevation where ARL1 is below it (the test above); levels "
     "set from published figures, not fitted (docs/gnss-errors.md)"))
 def test_residual_std_by_elevation_within_30_percent_of_arl1():
     nav = _nav()
