@@ -58,7 +58,9 @@ a wall at distance D = w/2, infinitely long, between heights z1 and z2, Omega =
 2 (atan(z2 / D) - atan(z1 / D)) (``lit_strip_solid_angle``). The scattered field is
 depolarised (half its power in the co-polar RHCP: 3 dB), and it arrives from the strip
 (elevation atan(z_mid / D) across the street), where the antenna's gain is not the gain toward
-the satellite: the caller's ``antenna_gain_db`` gives the difference. Its extra path is that of
+the satellite: the caller's ``antenna_gain_db`` gives the difference (landnav passes the C/N0
+model's elevation shape, taken as the antenna's gain: the power reaching the ground varies by
+about 2 dB over elevation, the satellites' antennas being shaped to keep it flat). Its extra path is that of
 the strip's mid-height point of least delay, sqrt(D^2 + z^2) sqrt(1 - u_x^2) + D |u_y| - z u_z
 (the code loop locks on the composite's peak; the delay spread over the strip is a few metres).
 S = 0.4 is the default (Degli-Esposti et al. 2007 fitted S of about 0.4 to the Lambertian model
