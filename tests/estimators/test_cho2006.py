@@ -24,7 +24,8 @@ from simulator.errors import InputError
 from simulator.pipeline import estimate, generate, load_scenario
 from simulator.reproduce import cho2006 as exp
 from simulator.reproduce.measures import moving_off
-from simulator.reproduce.runner import SCENARIOS, run_experiment
+from simulator.reproduce.paper import scenario_path
+from simulator.reproduce.runner import run_experiment
 from simulator.scenario import Scenario, validate_data
 from tests.synthetic import FLAT_LOOP
 
@@ -40,7 +41,7 @@ def _dataset(name: str, seed: int, root, overrides: list[str] | None = None) -> 
     """scenarios/<name>.yaml generated with ``seed`` under ``root`` (reused if present)."""
     out = root / f"{name}-{seed}"
     if not out.exists():
-        generate(load_scenario(SCENARIOS / f"{name}.yaml", overrides, seed), out)
+        generate(load_scenario(scenario_path(f"{name}.yaml"), overrides, seed), out)
     return open_dataset(out)
 
 

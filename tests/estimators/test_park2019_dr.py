@@ -16,7 +16,8 @@ from estimators.registry import BUILTINS
 from simulator.earth import dcm_to_euler, euler_to_dcm, euler_to_quat, radii_of_curvature, skew
 from simulator.pipeline import generate, load_scenario
 from simulator.reproduce import park2019
-from simulator.reproduce.runner import SCENARIOS, run_experiment
+from simulator.reproduce.paper import scenario_path
+from simulator.reproduce.runner import run_experiment
 
 SEEDS = list(range(1, 11))
 
@@ -47,7 +48,7 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     integration leaves 0.8 m horizontal and 4 m height error (a finding noted in the docs)."""
     # a rigid body: the speed used is the truth's along-body speed, which only a rigid body's
     # velocity equals (the automotive body slips and heaves: 3.4 m after the drive)
-    scenario = load_scenario(SCENARIOS / park2019.GARAGE.scenario,
+    scenario = load_scenario(scenario_path(park2019.GARAGE.scenario),
                              ["sensors.imu.preset=ideal", "trajectory.rate=200", "vehicle=rigid"],
                              1)
     ds = generate(scenario, tmp_path / "g")
