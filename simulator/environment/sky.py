@@ -60,9 +60,10 @@ depolarised (half its power in the co-polar RHCP: 3 dB), and it arrives from the
 (elevation atan(z_mid / D) across the street), where the antenna's gain is not the gain toward
 the satellite: the caller's ``antenna_gain_db`` gives the difference (landnav passes the C/N0
 model's elevation shape, taken as the antenna's gain: the power reaching the ground varies by
-about 2 dB over elevation, the satellites' antennas being shaped to keep it flat). Its extra path is that of
-the strip's mid-height point of least delay, sqrt(D^2 + z^2) sqrt(1 - u_x^2) + D |u_y| - z u_z
-(the code loop locks on the composite's peak; the delay spread over the strip is a few metres).
+about 2 dB over elevation, the satellites' antennas being shaped to keep it flat). Its extra
+path is that of the strip's mid-height point of least delay,
+sqrt(D^2 + z^2) sqrt(1 - u_x^2) + D |u_y| - z u_z (the code loop locks on the composite's peak;
+the delay spread over the strip is a few metres).
 S = 0.4 is the default (Degli-Esposti et al. 2007 fitted S of about 0.4 to the Lambertian model
 for building walls measured at 1.3 GHz; ray-tracing tools use 0.2-0.5). At 15 deg elevation
 across a street as high as it is wide the path loses about 21 dB against the direct signal

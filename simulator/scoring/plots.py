@@ -21,7 +21,9 @@ limits, multipath, canyon zones) of the events table.
   shows as its staircase of floors);
 * ``horizontal_cdf``: the empirical CDF of the horizontal error, logarithmic error axis;
 * ``gnss_sky`` (datasets with raw GNSS): a sky plot of the tracked satellites' tracks, and the
-  number of satellites, HDOP/VDOP and C/N0 against time, every other fault hatched grey.
+  number of satellites, HDOP/VDOP and C/N0 against time, every other fault hatched grey; with
+  the dataset's ``truth_gnss`` also how many of the tracked signals were NLOS and the C/N0 of
+  LOS and NLOS signals apart.
 
 Public names
 ------------
@@ -300,11 +302,20 @@ def plot_gnss_sky(ev: Evaluation, path: Path, raw: pd.DataFrame,
     count.step(tracked.index, tracked.to_numpy(), where="post", label="tracked")
     if fix is not None:
         count.step(fix["t"], fix["num_sats"], where="post", label="used in the fix")
+    if "nlos" in raw:  # the truth says which signals arrived without line of sight
+        nlos = raw.groupby("t")["nlos"].sum().reindex(epochs, fill_value=0)
+        count.step(nlos.index, nlos.to_numpy(), where="post", label="of them NLOS (truth)")
         dop.plot(fix["t"], fix["hdop"], lw=1.0, label="HDOP")
         dop.plot(fix["t"], fix["vdop"], lw=1.0, label="VDOP")
         dop.set_yscale("log")
         dop.legend(loc="upper left", fontsize="x-small")
-    cn0.scatter(raw["t"], raw["cn0"], s=1, c=raw["sv"], cmap="tab20")
+    if "nlos" in raw:
+        for flag, label in ((0, "line of sight"), (1, "NLOS (truth)")):
+            part = raw[raw["nlos"] == flag]
+            cn0.scatter(part["t"], part["cn0"], s=1, label=label)
+        cn0.legend(loc="lower left", fontsize="x-small", markerscale=4)
+    else:
+        cn0.scatter(raw["t"], raw["cn0"], s=1, c=raw["sv"], cmap="tab20")
     for ax, label in ((count, "satellites"), (dop, "DOP"), (cn0, "C/N0 (dB-Hz)")):
         _shade(ax, ev, other_faults=True)
         ax.set_ylabel(label)

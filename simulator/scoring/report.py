@@ -157,6 +157,9 @@ def _plots(ev: Evaluation) -> list[tuple[str, str, Callable[[Evaluation, Path], 
     dataset = ev.dataset
     if dataset is not None and dataset.has("gnss_raw"):
         raw = dataset.read("gnss_raw", ["t", "sv", "cn0", "elevation", "azimuth"])
+        if dataset.has("truth_gnss"):  # which signals were NLOS, from the truth
+            raw = raw.merge(dataset.read("truth_gnss", ["t", "sv", "nlos"]), on=["t", "sv"],
+                            how="left")
         fix = (dataset.read("gnss_fix", ["t", "num_sats", "hdop", "vdop"])
                if dataset.has("gnss_fix") else None)
         if len(raw):
