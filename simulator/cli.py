@@ -28,7 +28,7 @@ Typical use:
 
   landnav validate scenarios/quickstart.yaml      check a scenario, list every problem
   landnav generate scenarios/quickstart.yaml -o out/quick   write the dataset
-  landnav generate scenarios/garage.yaml -o out/g --set sensors.imu.rate=200 --seed 3
+  landnav generate scenarios/parking_garage.yaml -o out/g --set sensors.imu.rate=200 --seed 3
   landnav campaign scenarios/karamat2015_partial_outages.yaml --runs 20 -o out/mc
 
 Run `landnav COMMAND --help` for each command's options. Reference documentation is in the

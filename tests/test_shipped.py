@@ -103,3 +103,23 @@ def test_help_teaches(capsys):
     result = subprocess.run([sys.executable, "-m", "simulator.cli", "generate", "--help"],
                             capture_output=True, text=True, cwd=REPO)
     assert "--force" in result.stdout and "--set" in result.stdout
+
+
+def test_every_scenario_the_readme_docs_and_help_name_exists(capsys):
+    """A user copies commands from the README, the docs and ``--help``: every
+    ``scenarios/NAME.yaml`` they name must ship (a help example once named a file that did
+    not)."""
+    import re
+
+    from simulator.commands import SUMMARIES
+
+    texts = [(REPO / "README.md").read_text()]
+    texts += [page.read_text() for page in sorted((REPO / "docs").glob("*.md"))]
+    for argv in (["--help"], *([command, "--help"] for command in SUMMARIES)):
+        with pytest.raises(SystemExit):
+            main(argv)
+        texts.append(capsys.readouterr().out)
+    named = {m for text in texts for m in re.findall(r"scenarios/([\w.-]+\.yaml)", text)}
+    assert len(named) >= 10
+    missing = sorted(name for name in named if not (REPO / "scenarios" / name).is_file())
+    assert not missing, missing
