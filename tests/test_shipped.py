@@ -123,3 +123,18 @@ def test_every_scenario_the_readme_docs_and_help_name_exists(capsys):
     assert len(named) >= 10
     missing = sorted(name for name in named if not (REPO / "scenarios" / name).is_file())
     assert not missing, missing
+
+
+def test_every_file_the_readme_and_docs_point_to_exists():
+    """Paths of the repository's own files named in the README, BENCHMARKS.md and the docs
+    (``simulator/...py``, ``tests/...py``, ``docs/...``) exist; ``PAPER`` stands for a paper's
+    name in docs/reproduction.md."""
+    import re
+
+    pattern = (r"\b(?:simulator|estimators|tests|benchmarks|docs|notebooks)/[\w/.-]+"
+               r"\.(?:py|md|yaml|png|ipynb|npz)")
+    pages = [REPO / "README.md", REPO / "BENCHMARKS.md", *sorted((REPO / "docs").glob("*.md"))]
+    named = {m for page in pages for m in re.findall(pattern, page.read_text())}
+    assert len(named) >= 50
+    missing = sorted(p for p in named if "PAPER" not in p and not (REPO / p).exists())
+    assert not missing, missing
