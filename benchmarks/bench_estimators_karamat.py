@@ -26,6 +26,7 @@ from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
 from simulator.replay import run_estimator
 from simulator.reproduce import karamat2015
+from simulator.reproduce.paper import scenario_path
 from simulator.scenario import load_scenario
 
 
@@ -97,8 +98,9 @@ def main() -> None:
     config = {"model": args.model, "coupling": args.coupling}
     with tempfile.TemporaryDirectory() as tmp:
         # the claim tests' rigid body (issue 13), the windows of the first eight loops
-        scenario = load_scenario(karamat2015.SCENARIO, [*karamat2015.protocol_overrides(8),
-                                                        "vehicle=rigid", "estimators=[]"], 2015)
+        scenario = load_scenario(scenario_path(karamat2015.SCENARIO),
+                                 [*karamat2015.protocol_overrides(8), "vehicle=rigid",
+                                  "estimators=[]"], 2015)
         dataset = open_dataset(generate_dataset(scenario, Path(tmp) / "hour",
                                                 show_progress=False))
         ours, cpus, peer, algebra = [], [], [], []

@@ -20,6 +20,7 @@ from simulator.errors import InputError
 from simulator.replay import run_estimator
 from simulator.reproduce import karamat2015 as karamat
 from simulator.reproduce.measures import horizontal_error
+from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from simulator.scenario import load_scenario
 
@@ -31,7 +32,7 @@ def one_loop(directory, sensors: str | None = None):
     overrides = ["trajectory.segments.0.repeat.times=1", "faults=[]", "estimators=[]", *RIGID]
     if sensors:
         overrides.append(f"sensors={sensors}")
-    scenario = load_scenario(karamat.SCENARIO, overrides, seed=1)
+    scenario = load_scenario(scenario_path(karamat.SCENARIO), overrides, seed=1)
     return open_dataset(generate_dataset(scenario, directory, show_progress=False))
 
 
@@ -89,8 +90,8 @@ def test_unknown_model_is_one_clear_error(tmp_path):
 
 def test_loop_duration_is_the_modules():
     """The protocol picks site 1's windows by the loop's duration: it must be the drive's."""
-    scenario = load_scenario(karamat.SCENARIO, ["trajectory.segments.0.repeat.times=1",
-                                                "faults=[]"])
+    scenario = load_scenario(scenario_path(karamat.SCENARIO),
+                             ["trajectory.segments.0.repeat.times=1", "faults=[]"])
     assert build_truth(scenario.data).duration_s == pytest.approx(karamat.LOOP_S, abs=0.01)
 
 

@@ -16,6 +16,7 @@ from simulator.errors import InputError
 from simulator.replay import run_estimator
 from simulator.reproduce import karamat2015 as karamat
 from simulator.reproduce.measures import horizontal_error
+from simulator.reproduce.paper import scenario_path
 from simulator.scenario import load_scenario
 
 
@@ -23,7 +24,7 @@ from simulator.scenario import load_scenario
 def ideal_automotive(tmp_path_factory):
     """The first loop of the Karamat drive (6 km: turns of 30-80 m, slopes, a stop) on the
     automotive body, with an ideal reduced IMU and odometer and no GNSS."""
-    scenario = load_scenario(karamat.SCENARIO, [
+    scenario = load_scenario(scenario_path(karamat.SCENARIO), [
         "trajectory.segments.0.repeat.times=1", "faults=[]", "estimators=[]",
         "vehicle=automotive", "sensors={imu: {preset: ideal, rate: 100, axes: riss3d}, "
         "odometer: {preset: ideal, rate: 10}}"], seed=1)
