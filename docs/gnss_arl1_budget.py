@@ -113,7 +113,7 @@ def main() -> None:
         std = np.mean([std_by_elevation(s) for s in sims], axis=0)
         spread = [hour_mean_spread(s) for s in sims]
         print(f"  {name}: {np.round(std, 2)}; hour-mean spread above 30 deg "
-              f"{np.round(spread, 2)}")
+              f"{min(spread):.2f}-{max(spread):.2f} m")
     print(f"real hour-mean spread above 30 deg: {hour_mean_spread(real):.2f} m")
 
     # the hour's signal-in-space error as the NGA precise ephemeris gives it

@@ -428,7 +428,7 @@ class Gnss(PresetSensor):
         # (which would otherwise make the error and the fix weights jump from epoch to epoch)
         # (below the horizon, where nothing is tracked, the pierce point of the horizon)
         pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce)
+        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, idx)
         self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
         mapping = model["tropo"] / model["zenith"]
         iono_true = model["iono"] * err["iono_ratio"]

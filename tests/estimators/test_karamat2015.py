@@ -111,24 +111,32 @@ def _maxima(protocol, label: str, count: int) -> np.ndarray:
 
 def test_every_variant_is_a_working_filter(protocol):
     """All three variants stay bounded over the ten seeds (median window maxima measured: tight
-    3.4 / 3.7 / 6.7 / 9.1 m, loose 8.8 / 5.6 / 8.2 / 9.2 m, simplified 4.9 / 8.0 / 7.6 / 10.1 m
-    at 3 / 2 / 1 / 0 satellites)."""
+    2.7 / 4.5 / 11.4 / 9.9 m, loose 10.7 / 7.4 / 10.2 / 12.0 m, simplified 5.2 / 10.5 / 13.8 /
+    12.7 m at 3 / 2 / 1 / 0 satellites)."""
     for label in ("tight", "loose", "simplified"):
         for count in (3, 2, 1, 0):
             assert np.median(_maxima(protocol, label, count)) < 20.0, (label, count)
 
 
-def test_mean_window_maximum_under_12_m(protocol):
+@pytest.mark.parametrize("count", [
+    3, 2,
+    pytest.param(1, marks=pytest.mark.xfail(strict=True, reason=(
+        "not shown at one satellite: mean window maximum 13.1 m over the ten seeds (per seed "
+        "4.7-30.4 m, so the mean's sampling spread is about 2.6 m); 11.8 m before session 6's "
+        "signal-in-space change, which also changed every later random draw: the claim sat "
+        "within one sampling spread of its bound either way; docs/reproduction_karamat2015.md"))),
+    0,
+])
+def test_mean_window_maximum_under_12_m(protocol, count):
     """Karamat et al. section 4.3.1: 'on average, the maximum position error is always less
     than 12 m, irrespective of the number of visible satellites' (measured means on the
-    automotive body: 3.2, 5.6, 11.8, 9.8 m at 3, 2, 1, 0 satellites; rigid 3.4, 5.0, 9.8,
-    9.7 m)."""
-    for count in (3, 2, 1, 0):
-        assert _maxima(protocol, "tight", count).mean() < 12.0
+    automotive body: 3.1, 5.9, 13.1, 10.2 m at 3, 2, 1, 0 satellites; session 5: 3.2, 5.6,
+    11.8, 9.8 m)."""
+    assert _maxima(protocol, "tight", count).mean() < 12.0
 
 
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 21 of the 30 "
-                   "windows with 1-3 satellites on the automotive body, 70 % (24 of 30 on a "
+@pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 20 of the 30 "
+                   "windows with 1-3 satellites on the automotive body, 67 % (24 of 30 on a "
                    "rigid body); docs/reproduction_karamat2015.md")
 def test_tight_beats_loose_with_one_to_three_satellites(protocol):
     """Issue 15: the tight filter beats ``coupling: loose`` (which has no GNSS below four
@@ -140,21 +148,21 @@ def test_tight_beats_loose_with_one_to_three_satellites(protocol):
 
 def test_enhanced_model_gains_16_percent_with_no_satellite(protocol):
     """Karamat et al. section 4.3.1: 16 % better than the earlier tightly coupled filter in the
-    zero-satellite windows (measured: 19 % on the automotive body, 17 % rigid)."""
+    zero-satellite windows (measured: 20 % on the automotive body, 17 % rigid)."""
     assert karamat.gain(protocol, (0,)) >= 0.16
 
 
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: the enhanced model gains 27 % over "
+@pytest.mark.xfail(strict=True, reason="claim not reproduced: the enhanced model gains 26 % over "
                    "all windows (24 % rigid; docs/reproduction_karamat2015.md)")
 def test_enhanced_model_gains_40_percent_overall(protocol):
     """Karamat et al. section 5: 40 % better than the earlier tightly coupled filter in overall
-    maximum 2-D error (measured: 27 %; 36, 43, 19, 19 % at 3, 2, 1, 0 satellites)."""
+    maximum 2-D error (measured: 26 %; 40, 43, 16, 20 % at 3, 2, 1, 0 satellites)."""
     assert karamat.gain(protocol, (3, 2, 1, 0)) >= 0.40
 
 
 def test_gyro_bias_within_005_deg_s_by_300_s(protocol):
     """Karamat et al. section 4.3.3: the vertical-gyro bias converges in about 300 s (measured:
-    the error at 300 s is at most 0.031 deg/s over the ten seeds)."""
+    the error at 300 s is at most 0.032 deg/s over the ten seeds)."""
     errors = protocol["tight.gyro_bias_error_300s_deg_s"].to_numpy()
     assert len(errors) == len(SEEDS)
     assert np.all(np.abs(errors) < 0.05)

@@ -323,9 +323,10 @@ def test_10hz_fix_errors_change_slowly_while_driving():
     automotive preset smooths the code with the carrier (Hatch filter, 100 s, RTCA DO-229);
     its raw code (carrier_smoothing 0: DLL noise correlated over 0.5 s only) jumps by a metre
     and more from one second to the next, and smoothing lowers the level. Measured over
-    3 x 290 s at 15 m/s (the default gps-almanac sky): per-second change 0.03 / 0.03 / 0.08 m
-    north / east / down (raw code 1.0 / 0.7 / 2.0 m); was 0.16 / 0.11 / 0.38 m with the former
-    100 s Gauss-Markov code error.
+    3 x 290 s at 15 m/s (the default gps-almanac sky): per-second change 0.04 / 0.02 / 0.10 m
+    north / east / down (raw code 1.0 / 0.7 / 2.0 m; session 5, before the signal-in-space
+    error's steps at record changes and with other draws: 0.03 / 0.03 / 0.08 m); was 0.16 /
+    0.11 / 0.38 m with the former 100 s Gauss-Markov code error.
     Averaging one second of fixes leaves the scatter as it is (real receivers: little gain; the
     white model went from 1.09 to 0.49 m)."""
     truth = drive([{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
