@@ -8,7 +8,7 @@ Issue 19 asks for at least 7 tracked satellites on average with at least 30 % of
 CEP50 of 5-20 m (the Berlin u-blox log of refdata 3d: 9.9 GPS satellites tracked, 53 % NLOS, the
 weakest at 21-23 dB-Hz). Measured (``PYTHONPATH=. python -m simulator.cli generate
 scenarios/urban_canyon.yaml -o OUT --seed N``; figures inside the ``downtown`` zone): seeds 1-3
-9.44 tracked of the 10 above the mask, 58 % NLOS, CEP50 7.0 m; seeds 4-8 9.52, 58 %, 7.3 m.
+9.44 tracked of the 10 above the mask, 58 % NLOS, CEP50 7.0 m; seeds 4-8 9.52, 58 %, 7.2 m.
 Before the facades' diffuse scattering (``scattering_coefficient`` 0: specular reflections and
 diffraction over the roofs only) the same street kept 6.94 (seeds 1-3), 42-44 % NLOS, CEP50
 8.5-9.7 m: a satellite 10-20 deg up across the street has no specular path (a single reflection
