@@ -202,6 +202,18 @@ def _sorted_sides(buildings: Buildings) -> tuple[np.ndarray, np.ndarray, np.ndar
             np.concatenate(buildings.height_m), len(buildings.start_m[0]))
 
 
+def _street(shape: tuple[int, ...], building_height_m: np.ndarray, street_width_m: np.ndarray,
+            along_m: np.ndarray, buildings: Buildings | None
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple | None]:
+    """The street's arrays broadcast to ``shape``: facade height, half width, the antenna's
+    along-street coordinate, and the buildings sorted for lookups (``_sorted_sides``; None for
+    continuous facades)."""
+    return (np.broadcast_to(np.asarray(building_height_m, dtype=float), shape),
+            np.broadcast_to(0.5 * np.asarray(street_width_m, dtype=float), shape),
+            np.broadcast_to(np.asarray(along_m, dtype=float), shape),
+            None if buildings is None else _sorted_sides(buildings))
+
+
 def _side_facade(sides: tuple | None, left: np.ndarray, s: np.ndarray, height: np.ndarray
                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The building at along-street coordinate s on the left (``left`` true) or right side:
@@ -328,13 +340,11 @@ def trace_paths(u: np.ndarray, building_height_m: np.ndarray, street_width_m: np
     """
     u = np.asarray(u, dtype=float)
     shape = u.shape[:-1]
-    height = np.broadcast_to(np.asarray(building_height_m, dtype=float), shape)
-    half = np.broadcast_to(0.5 * np.asarray(street_width_m, dtype=float), shape)
+    height, half, along, sides = _street(shape, building_height_m, street_width_m, along_m,
+                                         buildings)
     ahead = np.broadcast_to(np.asarray(ahead_m, dtype=float), shape)
     behind = np.broadcast_to(np.asarray(behind_m, dtype=float), shape)
-    along = np.broadcast_to(np.asarray(along_m, dtype=float), shape)
     end_height = height if buildings is None else np.full(shape, buildings.end_height_m)
-    sides = None if buildings is None else _sorted_sides(buildings)
     out = {}
     for name, walls in PATHS.items():  # seven paths
         d = u
@@ -391,18 +401,14 @@ def scattered_path(u: np.ndarray, building_height_m: np.ndarray, street_width_m:
     no antenna gain), ``arrival_elevation_rad`` (direction of the strip's middle) and
     ``extra_path_m``."""
     u = np.asarray(u, dtype=float)
-    shape = u.shape[:-1]
-    height = np.broadcast_to(np.asarray(building_height_m, dtype=float), shape)
-    half = np.broadcast_to(0.5 * np.asarray(street_width_m, dtype=float), shape)
-    along = np.broadcast_to(np.asarray(along_m, dtype=float), shape)
-    sides = None if buildings is None else _sorted_sides(buildings)
+    height, half, along, sides = _street(u.shape[:-1], building_height_m, street_width_m, along_m,
+                                         buildings)
     toward_left = u[..., 1] < 0  # a satellite on the left lights the right facade
     _, near_top, _ = _side_facade(sides, toward_left, along, height)
     across, far_top, _ = _side_facade(sides, ~toward_left, along, height)
-    sin_a = np.abs(u[..., 1]) / np.maximum(np.hypot(u[..., 0], u[..., 1]), 1e-12)
-    tan_el = u[..., 2] / np.maximum(np.hypot(u[..., 0], u[..., 1]), 1e-12)
+    # the ray over the near roof edge drops tan(el) / |sin a| = u_z / |u_y| per metre across
     with np.errstate(divide="ignore"):
-        shadow = near_top - 2.0 * half * tan_el / sin_a
+        shadow = near_top - 2.0 * half * u[..., 2] / np.abs(u[..., 1])
     low = np.clip(shadow, 0.0, far_top)
     omega = lit_strip_solid_angle(half, low, far_top)
     cos_incidence = np.abs(u[..., 1])
