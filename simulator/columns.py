@@ -48,6 +48,11 @@ GNSS_RAW = {
     # the satellite's broadcast health (IS-GPS-200 20.3.3.3.1.4; YUMA: the almanac's 6-bit
     # code): 0 healthy; any other value is tracked and reported but not to be used
     "health": "1",
+    # several systems and signals (SPEC section 5): one row per satellite, signal and epoch
+    "system": "", "signal": "", "frequency": "Hz", "group_delay": "m",
+    # carrier phase, RINEX sign (it grows with the range), the loss-of-lock indicator bits
+    # (RINEX 3.04: 1 lost lock, 2 half-cycle ambiguity) and the time since the arc began
+    "carrier_phase": "cycles", "lli": "1", "lock_time": "s",
 }
 
 # the true error terms of every signal above the horizon (tracked or not), so that
@@ -64,6 +69,14 @@ TRUTH_GNSS = {
     "iono_true": "m", "tropo_true": "m", "iono_true_rate": "m/s", "tropo_true_rate": "m/s",
     "sis_error": "m", "multipath": "m", "nlos_delay": "m", "code_noise": "m",
     "rate_noise": "m/s", "antenna_x": "m", "antenna_y": "m", "antenna_z": "m",
+    "system": "", "signal": "", "frequency": "Hz", "group_delay": "m",
+    # carrier_phase lambda = range + receiver_clock - (sat_clock + group_delay) - iono_true
+    #     + tropo_true + sis_error + carrier_multipath + nlos_delay + phase_noise
+    #     + lambda (ambiguity + half_cycle)
+    # (the arc's integer ambiguity, the half cycle still unresolved, the integer jump at the
+    # epoch a cycle slip happens, the arc's number)
+    "ambiguity": "cycles", "half_cycle": "cycles", "cycle_slip": "cycles", "arc": "1",
+    "carrier_multipath": "m", "phase_noise": "m",
 }
 
 # broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of GPS week
@@ -115,9 +128,11 @@ STREAMS = {
     "mag": ("mag.parquet", MAG),
     "events": ("events.parquet", EVENTS),
     "truth_gnss": ("truth_gnss.parquet", TRUTH_GNSS),
+    "gnss_base_raw": ("gnss_base_raw.parquet", GNSS_RAW),
+    "truth_gnss_base": ("truth_gnss_base.parquet", TRUTH_GNSS),
     "truth_sensors": ("truth_sensors.parquet", TRUTH_SENSORS),
 }
-SCORING_ONLY = ("truth", "truth_gnss", "truth_sensors", "events")
+SCORING_ONLY = ("truth", "truth_gnss", "truth_gnss_base", "truth_sensors", "events")
 
 # the columns a stream must have (SPEC section 5); an IMU needs ``t`` and at least one axis
 REQUIRED = {
@@ -135,6 +150,9 @@ REQUIRED = {
     "mag": ("t", "mag_x", "mag_y", "mag_z"),
     "events": tuple(EVENTS),
     "truth_gnss": ("t", "sv"),
+    "gnss_base_raw": ("t", "sv", "pseudorange", "pseudorange_rate", "doppler", "cn0"),
+    "truth_gnss_base": ("t", "sv"),
     "truth_sensors": ("t",),
 }
-TEXT_COLUMNS = ("zone", "kind", "detail")  # every other column of a stream is numeric
+# every other column of a stream is numeric
+TEXT_COLUMNS = ("zone", "kind", "detail", "system", "signal")

@@ -94,6 +94,9 @@ def generate_streams(scenario: Scenario | dict, show_progress: bool = True, fram
     drive = drive if drive is not None else build_drive(scenario)
     sensors = {k: v for k, v in scenario["sensors"].items() if v is not None}
     models = {name: SENSOR_MODELS[name](block) for name, block in sensors.items()}
+    for model in models.values():  # a sensor made by another (the base by the rover)
+        if getattr(model, "host", None) in models:
+            models[model.host].attach(model)
     rngs = {name: sensor_rng(scenario["seed"], name) for name in models}
     drawn: dict[str, dict] = {}
     with ThreadPoolExecutor(max_workers=_SENSOR_WORKERS) as pool:
@@ -229,6 +232,7 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
     data = scenario.data
     truth = generated.truth
     datasheet, true_values = _datasheet(data, generated.truth_keys)
+    base = generated.drawn.get("gnss_base", {}).get("position")
     return {
         "knowledge": KNOWLEDGE,
         "datasheet": datasheet,
@@ -244,6 +248,7 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
                    "alt": truth.origin.alt_m},
         "duration": truth.duration_s,
         "sensors": generated.drawn,
+        **({"gnss_base": base} if base is not None else {}),
     }
 
 

@@ -88,6 +88,8 @@ multipath effects in relative GPS positioning", Manuscripta Geodaetica 13, 172-1
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from simulator.gnss.atmosphere import klobuchar_pierce_point
@@ -179,15 +181,27 @@ def iono_field_correlation(distance_km: np.ndarray, lag_s: np.ndarray = 0.0) -> 
     return np.exp(-0.5 * d**2 - np.abs(np.asarray(lag_s, dtype=float)) / IONO_CORRELATION_TIME_S)
 
 
-def iono_field(rng: np.random.Generator, pierce_km: np.ndarray, t_s: np.ndarray
-               ) -> np.ndarray:
+def _sum_of_waves(k: np.ndarray, phase: np.ndarray, amp: np.ndarray, pierce_km: np.ndarray
+                  ) -> np.ndarray:
+    """sqrt(2 / M) sum_m a_m(t) cos(k_m . x + p_m) over the M waves, at pierce points
+    (3, n_sat, n_t) and amplitudes (M, n_t)."""
+    x, y, z = pierce_km
+    out = np.zeros(np.shape(x))
+    for m in range(len(k)):  # a loop over the waves; each is vectorised over signals x epochs
+        out += amp[m] * np.cos(k[m, 0] * x + k[m, 1] * y + k[m, 2] * z + phase[m])
+    return np.sqrt(2.0 / len(k)) * out
+
+
+def iono_field(rng: np.random.Generator, pierce_km: np.ndarray, t_s: np.ndarray,
+               length_km: float = IONO_CORRELATION_LENGTH_KM,
+               time_s: float = IONO_CORRELATION_TIME_S) -> np.ndarray:
     """A unit-variance random field over the pierce points with the correlation
     ``iono_field_correlation`` (d the chord): g(x, t) = sqrt(2 / M) sum_m a_m(t)
     cos(k_m . x + p_m), M ``IONO_FIELD_WAVES`` plane waves in space (random Fourier features,
     Rahimi & Recht 2007: for wave numbers k_m ~ N(0, I3 / L^2), the spectrum of the Gaussian
     correlation, and phases p_m uniform, E[g(x) g(x')] = E[cos(k . (x - x'))]
     = exp(-|x - x'|^2 / (2 L^2))), the amplitudes
-    a_m unit-variance Gauss-Markov processes over ``IONO_CORRELATION_TIME_S`` drawn every
+    a_m unit-variance Gauss-Markov processes over ``time_s`` drawn every
     ``IONO_GRID_STEP`` correlation times and interpolated. A sum of 64 waves is Gaussian to a
     good approximation; each drive draws its own waves.
 
@@ -197,33 +211,50 @@ def iono_field(rng: np.random.Generator, pierce_km: np.ndarray, t_s: np.ndarray
         Pierce points (``pierce_points_km``).
     t_s : ndarray, shape (n_epoch,)
         Epoch times, ascending.
+    length_km, time_s : float
+        The correlation length L and time (the regional field's by default).
     """
     waves = IONO_FIELD_WAVES
-    k = rng.standard_normal((waves, 3)) / IONO_CORRELATION_LENGTH_KM
+    k = rng.standard_normal((waves, 3)) / length_km
     phase = rng.uniform(0.0, 2.0 * np.pi, waves)
-    amp = gauss_markov_along(np.asarray(t_s, dtype=float) / IONO_CORRELATION_TIME_S, waves,
-                             rng, IONO_GRID_STEP)
-    x, y, z = pierce_km
-    out = np.zeros(np.shape(x))
-    for m in range(waves):  # a loop over the waves; each is vectorised over signals x epochs
-        out += amp[m] * np.cos(k[m, 0] * x + k[m, 1] * y + k[m, 2] * z + phase[m])
-    return np.sqrt(2.0 / waves) * out
+    amp = gauss_markov_along(np.asarray(t_s, dtype=float) / time_s, waves, rng, IONO_GRID_STEP)
+    return _sum_of_waves(k, phase, amp, pierce_km)
+
+
+class IonoField:
+    """``iono_field`` drawn once for the epochs of a drive (dt_s apart) and evaluated at any
+    receiver's pierce points at those epochs: the rover and the base station see one
+    ionosphere. Evaluated every ``IONO_FIELD_STEP_S`` (and at the last epoch) and interpolated
+    linearly (the draws are those of ``iono_field`` at those epochs)."""
+
+    def __init__(self, rng: np.random.Generator, n_epoch: int, dt_s: float,
+                 length_km: float = IONO_CORRELATION_LENGTH_KM,
+                 time_s: float = IONO_CORRELATION_TIME_S):
+        step = max(1, int(IONO_FIELD_STEP_S / dt_s))
+        self.n_epoch = n_epoch
+        self.coarse = np.unique(np.append(np.arange(0, n_epoch, step), n_epoch - 1))
+        self.k = rng.standard_normal((IONO_FIELD_WAVES, 3)) / length_km
+        self.phase = rng.uniform(0.0, 2.0 * np.pi, IONO_FIELD_WAVES)
+        self.amp = gauss_markov_along(self.coarse * dt_s / time_s, IONO_FIELD_WAVES, rng,
+                                      IONO_GRID_STEP)
+
+    def __call__(self, pierce_km: np.ndarray) -> np.ndarray:
+        """The field at pierce points (3, n_sat, n_epoch), shape (n_sat, n_epoch)."""
+        values = _sum_of_waves(self.k, self.phase, self.amp, pierce_km[..., self.coarse])
+        if len(self.coarse) == self.n_epoch:
+            return values
+        coarse, n_ep = self.coarse, self.n_epoch
+        k = np.arange(n_ep)
+        i = np.minimum(np.searchsorted(coarse, k, side="right") - 1, len(coarse) - 2)
+        w = (k - coarse[i]) / (coarse[i + 1] - coarse[i])
+        return values[:, i] * (1.0 - w) + values[:, i + 1] * w
 
 
 def iono_field_at_epochs(rng: np.random.Generator, pierce_km: np.ndarray, dt_s: float
                           ) -> np.ndarray:
     """``iono_field`` at every epoch (dt_s apart) of the pierce points (3, n_sat, n_epoch),
     evaluated every ``IONO_FIELD_STEP_S`` (and at the last epoch) and interpolated linearly."""
-    n_ep = pierce_km.shape[-1]
-    step = max(1, int(IONO_FIELD_STEP_S / dt_s))
-    coarse = np.unique(np.append(np.arange(0, n_ep, step), n_ep - 1))
-    values = iono_field(rng, pierce_km[..., coarse], coarse * dt_s)
-    if len(coarse) == n_ep:
-        return values
-    k = np.arange(n_ep)
-    i = np.minimum(np.searchsorted(coarse, k, side="right") - 1, len(coarse) - 2)
-    w = (k - coarse[i]) / (coarse[i + 1] - coarse[i])
-    return values[:, i] * (1.0 - w) + values[:, i + 1] * w
+    return IonoField(rng, pierce_km.shape[-1], dt_s)(pierce_km)
 
 
 def draw_receiver_clock(rng: np.random.Generator, oscillator: str, n: int, dt_s: float
@@ -260,7 +291,8 @@ def draw_sis(rng: np.random.Generator, sigma_m: float, record: np.ndarray) -> np
 
 def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndarray,
                      cn0_dbhz: np.ndarray, dt_s: float, u: np.ndarray,
-                     pierce_km: np.ndarray, record: np.ndarray) -> dict[str, np.ndarray]:
+                     pierce_km: np.ndarray, record: np.ndarray, shared: Any = None
+                     ) -> dict[str, np.ndarray]:
     """Every error term of the raw measurements before the receiver's carrier smoothing,
     shape (n_sat, n_epoch) unless noted.
 
@@ -279,10 +311,14 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
     record : ndarray of int, shape (n_sat, n_epoch)
         Index of the broadcast record each signal is computed from (-1: none), for the
         signal-in-space error (``draw_sis``).
+    shared : optional
+        Another receiver's draws of the same drive (its ``sis``, ``iono_field`` and
+        ``tropo_zenith_m``), taken instead of drawing them: a second receiver's sky.
 
     Returns
     -------
-    dict with ``sis`` (m); ``iono_ratio`` (true / broadcast ionosphere, module docstring);
+    dict with ``sis`` (m); ``iono_ratio`` (true / broadcast ionosphere, module docstring) and
+    ``iono_field`` (its ``IonoField``, None without variation, for a second receiver);
     ``tropo_zenith`` (scalar, m: the zenith troposphere the model misses, for the whole drive);
     ``multipath`` and ``multipath_sigma`` (m, correlated in u); ``code_noise`` and
     ``code_sigma`` (m: the DLL jitter for the signal's C/N0, a Gauss-Markov process over the
@@ -295,16 +331,22 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
     def unit_gm(rows: int, tau_s: float) -> np.ndarray:  # (rows, n_ep), unit variance
         return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
 
-    out = {"sis": draw_sis(rng, cfg["sis_error"], record)}
     # the ionosphere's error: a field smooth over the pierce points and in time (module
     # docstring), so that nearby signals share it and its rate (which the carrier smoothing's
     # code-carrier divergence sees) stays at the mm/s of a quiet ionosphere
-    field = (iono_field_at_epochs(rng, pierce_km, dt_s) if cfg["iono_residual"] > 0
+    if shared is None:
+        out = {"sis": draw_sis(rng, cfg["sis_error"], record)}
+        out["iono_field"] = IonoField(rng, n_ep, dt_s) if cfg["iono_residual"] > 0 else None
+    else:
+        out = {"sis": shared.sis, "iono_field": shared.iono_field}
+    field = (out["iono_field"](pierce_km) if out["iono_field"] is not None
              else np.zeros(shape))
     out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"] * field)
-    out["tropo_zenith"] = cfg["tropo_residual"] * rng.standard_normal()
+    out["tropo_zenith"] = (cfg["tropo_residual"] * rng.standard_normal() if shared is None
+                           else shared.tropo_zenith_m)
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
-    out["multipath"] = out["multipath_sigma"] * gauss_markov_along(u, n_sat, rng)
+    out["multipath_unit"] = gauss_markov_along(u, n_sat, rng)
+    out["multipath"] = out["multipath_sigma"] * out["multipath_unit"]
     out["code_sigma"] = scale * dll_sigma_m(cn0_dbhz, cfg["dll_bandwidth"],
                                             cfg["correlator_spacing"], cfg["integration_time"])
     out["code_noise"] = out["code_sigma"] * unit_gm(

@@ -10,7 +10,7 @@ and a fixed number of Gauss-Newton iterations runs as batched 4 x 4 linear algeb
 Public functions
 ----------------
 pack_epochs, solve_position, solve_velocity, dilution_of_precision, smooth_positions,
-receiver_fixes.
+primary_rows, receiver_fixes.
 
 References
 ----------
@@ -29,6 +29,7 @@ from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
+from simulator.gnss.signals import PRIMARY_SIGNAL
 from simulator.stochastic import ar1_filter
 
 if TYPE_CHECKING:
@@ -224,6 +225,14 @@ def smooth_positions(pos_m: np.ndarray, vel_m_s: np.ndarray, dt_s: float,
     return out
 
 
+def primary_rows(raw: pd.DataFrame) -> pd.DataFrame:
+    """The rows of each system's primary signal (all rows of a stream without ``signal``)."""
+    if "signal" not in raw or "system" not in raw:
+        return raw
+    primary = raw["system"].map(PRIMARY_SIGNAL)
+    return raw[(raw["signal"] == primary).to_numpy()]
+
+
 def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: float = 0.0,
                    dop_mask: float = np.inf) -> pd.DataFrame:
     """The fix stream (``simulator.columns.GNSS_FIX``) at epochs t from the raw measurements.
@@ -234,7 +243,8 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
         Fix epochs, s; every raw row's ``t`` must be one of them.
     raw : pandas.DataFrame
         Rows of ``gnss_raw`` (with ``pseudorange_std`` and ``pseudorange_rate_std``); rows whose
-        ``health`` is not 0 are left out.
+        ``health`` is not 0 are left out, and with several signals only each system's primary
+        one (``simulator.gnss.signals.PRIMARY_SIGNAL``: a single-frequency fix) is used.
     smoothing_time_constant_s : float
         0 for raw single-epoch fixes, else the time constant of ``smooth_positions``.
     dop_mask : float
@@ -246,6 +256,7 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     n = len(t)
     if "health" in raw:  # an unhealthy satellite is tracked and reported, never used
         raw = raw[raw["health"].to_numpy() == 0]
+    raw = primary_rows(raw)
     raw = raw.sort_values(["t", "sv"], kind="stable")
     epoch = np.searchsorted(t, raw["t"].to_numpy())
     sat_pos = raw[["sat_x", "sat_y", "sat_z"]].to_numpy()

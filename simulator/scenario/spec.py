@@ -77,6 +77,7 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     elif imu and traj["rate"] < imu["rate"]:
         ctx.error(path + ("trajectory", "rate"),
                   f"the truth rate {traj['rate']:g} Hz is below the IMU rate {imu['rate']:g} Hz")
+    _check_base(value["sensors"], path + ("sensors", "gnss_base"), ctx)
     profile = build_profile(value, ctx)
     if profile is not None:
         ctx.built["profile"] = profile
@@ -105,6 +106,21 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
             zones[name] = ZONE_FIELD.check({"sky": sky}, path + ("environment", "zones", name),
                                            ctx)
     return value
+
+
+def _check_base(sensors: dict, path: Path, ctx: Context) -> None:
+    """A base station needs a rover, whose epochs it shares: the rover's rate is a whole
+    multiple of the base's."""
+    base, rover = sensors.get("gnss_base"), sensors.get("gnss")
+    if base is None:
+        return
+    if rover is None:
+        ctx.error(path, "a base station needs sensors.gnss (it shares the rover's sky)")
+        return
+    ratio = rover["rate"] / base["rate"]
+    if abs(ratio - round(ratio)) > 1e-9 or round(ratio) < 1:
+        ctx.error(path + ("rate",), f"the rover's rate {rover['rate']:g} Hz must be a whole "
+                                    f"multiple of the base's {base['rate']:g} Hz")
 
 
 # Truth samples one generation may hold: about 750 bytes each with every sensor on (an hour at

@@ -78,15 +78,13 @@ from simulator.earth import (
     earth_rate_ned,
     ecef_to_geodetic,
     euler_to_dcm,
-    geodetic_rates,
     geodetic_to_ecef,
     ned_to_ecef_matrix,
 )
 from simulator.environment import ZONE_FIELD
 from simulator.environment.sky import canyon_reception, street_buildings
 from simulator.errors import InputError, Problem
-from simulator.gnss.atmosphere import broadcast_delays
-from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
+from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.constellation import (
     EXPANDABLE_SLOTS,
     almanac_gps_navigation,
@@ -96,24 +94,28 @@ from simulator.gnss.ephemeris import (
     EPHEMERIS_MAX_AGE_S,
     ephemeris_arrays,
     gather,
-    satellite_state,
     select_ephemeris,
 )
 from simulator.gnss.errors import (
     OSCILLATORS,
-    decorrelation_coordinate,
-    draw_error_terms,
-    draw_fading,
-    draw_receiver_clock,
-    pierce_points_km,
-    pseudorange_sigma,
-    smooth_code_errors,
 )
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
-from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
-from simulator.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
+from simulator.gnss.signals import SIGNALS, SYSTEMS, default_signals
+from simulator.schema import (
+    INVALID,
+    Boolean,
+    Context,
+    ListOf,
+    MapOf,
+    Number,
+    Path,
+    Record,
+    Text,
+    Vector,
+)
 from simulator.sensors.base import sample_times
+from simulator.sensors.gnss_observables import observe
 from simulator.sensors.presets import PresetSensor, fill_from_preset, known_preset
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.kinematics import Kinematics
@@ -122,27 +124,35 @@ if TYPE_CHECKING:
     import pandas as pd
 
 # the receivers' error levels and loops; sources in the module docstring, "Presets"
-_LOOPS = {"dll_bandwidth": 0.5, "correlator_spacing": 0.5, "fll_bandwidth": 2.0}
+_LOOPS = {"dll_bandwidth": 0.5, "correlator_spacing": 0.5, "fll_bandwidth": 2.0,
+          "pll_bandwidth": 15.0}
 _ATMOSPHERE_AND_SKY = {"iono_scale": 1.5, "iono_residual": 0.2, "tropo_residual": 0.05,
-                       "sis_error": 0.5}
+                       "sis_error": 0.5, "iono_gradient": "0.5 mm/km",
+                       "tropo_gradient": "0.25 mm/km"}
 _MULTIPATH_MOTION = {"multipath_distance": 10.0, "multipath_correlation_time": 120.0}
+_AUTOMOTIVE = {"clock": "tcxo", "tracking_noise": 1.0, **_LOOPS, "carrier_smoothing": 100.0,
+               "multipath": 0.3, "multipath_delay": 3.0, **_MULTIPATH_MOTION, "cn0_fading": 2.0,
+               "cn0_noise": 1.0, **_ATMOSPHERE_AND_SKY}
 PRESETS: dict[str, dict] = {
-    "automotive": {"clock": "tcxo", "tracking_noise": 1.0, **_LOOPS, "carrier_smoothing": 100.0,
-                   "multipath": 0.3, **_MULTIPATH_MOTION, "cn0_fading": 2.0, "cn0_noise": 1.0,
-                   **_ATMOSPHERE_AND_SKY},
+    "automotive": _AUTOMOTIVE,
+    "dual-band": _AUTOMOTIVE,
+    "smartphone": _AUTOMOTIVE,
     "geodetic": {"clock": "ocxo", "tracking_noise": 1.0, "dll_bandwidth": 0.2,
-                 "correlator_spacing": 0.1, "fll_bandwidth": 0.5, "carrier_smoothing": 0.0,
-                 "multipath": 0.13, **_MULTIPATH_MOTION, "cn0_fading": 0.5, "cn0_noise": 0.25,
+                 "correlator_spacing": 0.1, "fll_bandwidth": 0.5, "pll_bandwidth": 10.0,
+                 "carrier_smoothing": 0.0, "multipath": 0.13, "multipath_delay": 10.0,
+                 **_MULTIPATH_MOTION, "cn0_fading": 0.5, "cn0_noise": 0.25,
                  **_ATMOSPHERE_AND_SKY},
     "ideal": {"clock": "ideal", "tracking_noise": 0.0, **_LOOPS, "carrier_smoothing": 0.0,
-              "multipath": 0.0, **_MULTIPATH_MOTION, "cn0_fading": 0.0, "cn0_noise": 0.0,
-              "iono_scale": 1.0, "iono_residual": 0.0, "tropo_residual": 0.0,
-              "sis_error": 0.0},
+              "multipath": 0.0, "multipath_delay": 10.0, **_MULTIPATH_MOTION, "cn0_fading": 0.0,
+              "cn0_noise": 0.0, "iono_scale": 1.0, "iono_residual": 0.0, "tropo_residual": 0.0,
+              "sis_error": 0.0, "iono_gradient": 0.0, "tropo_gradient": 0.0},
 }
 # broadcast ionosphere used with the nominal constellation: the coefficients of the IGS
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
+# the systems whose orbits and clocks this receiver computes
+SYSTEMS_WITH_ORBITS = ("gps",)
 # the constellations known by name (anything else names a file)
 CONSTELLATIONS = ("gps-almanac", "nominal-gps")
 ALMANAC_MAX_AGE_S = 7 * 86400.0  # a YUMA almanac file is used up to a week from its TOA
@@ -151,7 +161,7 @@ _ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("de
 
 
 # the error levels a preset sets (a key the scenario gives overrides the preset's value)
-_ERROR_FIELDS = {
+ERROR_FIELDS = {
     "clock": Text(None, doc="receiver oscillator: tcxo, ocxo or ideal"),
     "tracking_noise": Number("", None, min=0,
                              doc="scale of the C/N0-driven DLL and FLL noise (0 = off)"),
@@ -181,13 +191,27 @@ _ERROR_FIELDS = {
                                 "smooth over the pierce points (1000 km) and in time (30 min)"),
     "tropo_residual": Number("m", None, min=0, doc="zenith troposphere model error 1-sigma"),
     "sis_error": Number("m", None, min=0, doc="signal-in-space range error 1-sigma"),
+    "pll_bandwidth": Number("Hz", None, gt=0,
+                            doc="carrier phase-lock loop noise bandwidth (third order): the "
+                                "phase jitter and the loop's dynamic stress"),
+    "multipath_delay": Number("m", None, gt=0,
+                              doc="extra path of the reflection giving the multipath: its "
+                                  "relative amplitude is the code multipath / this, which sets "
+                                  "the carrier multipath, and its phase turns with frequency"),
+    "iono_gradient": Number("", None, min=0,
+                            doc="rms horizontal gradient of the vertical L1 ionosphere from "
+                                "travelling disturbances (150 km, 15 min), e.g. '0.5 mm/km': "
+                                "what a base station at a distance does not share"),
+    "tropo_gradient": Number("", None, min=0,
+                             doc="1-sigma per horizontal axis of the zenith troposphere "
+                                 "residual's gradient, e.g. '0.25 mm/km', held for the drive"),
 }
 
 
 def _resolve(value: dict, path: Path, ctx: Context) -> dict:
     if not known_preset(value["preset"], PRESETS, "GNSS", path, ctx):
         return INVALID
-    value = fill_from_preset(value, PRESETS[value["preset"]], _ERROR_FIELDS, path, ctx, {})
+    value = fill_from_preset(value, PRESETS[value["preset"]], ERROR_FIELDS, path, ctx, {})
     if value is INVALID:
         return INVALID
     if value["clock"] not in OSCILLATORS:
@@ -217,6 +241,37 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
             return ctx.error(path + ("constellation",), str(exc))
     if value["cn0_horizon"] > value["cn0_zenith"]:
         return ctx.error(path + ("cn0_horizon",), "must not exceed cn0_zenith")
+    return resolve_signals(value, path, ctx)
+
+
+def resolve_signals(value: dict, path: Path, ctx: Context) -> dict:
+    """``systems`` known and with orbits, ``signals`` filled from the preset for each system
+    and known, ``carrier_phase`` defaulted to whether raw measurements are output."""
+    systems = value["systems"]
+    unknown = [name for name in systems if name not in SYSTEMS]
+    if unknown or not systems or len(set(systems)) < len(systems):
+        return ctx.error(path + ("systems",), f"expected distinct names among "
+                                              f"{', '.join(SYSTEMS)}, got {systems!r}")
+    without_orbits = [name for name in systems if name not in SYSTEMS_WITH_ORBITS]
+    if without_orbits:
+        return ctx.error(path + ("systems",), f"{', '.join(without_orbits)}: no orbit model "
+                                              f"yet (available: {', '.join(SYSTEMS_WITH_ORBITS)})")
+    given = value["signals"] or {}
+    extra = sorted(set(given) - set(systems))
+    if extra:
+        return ctx.error(path + ("signals",), f"names {', '.join(extra)}, not in systems")
+    signals = default_signals(value["preset"], systems)
+    for name, codes in given.items():
+        letter = SYSTEMS[name]
+        bad = [c for c in codes if (letter, c) not in SIGNALS]
+        if bad or not codes or len(set(codes)) < len(codes):
+            known = sorted(c for sys_, c in SIGNALS if sys_ == letter)
+            return ctx.error(path + ("signals", name), f"expected distinct signal codes among "
+                                                       f"{', '.join(known)}, got {codes!r}")
+        signals[name] = list(codes)
+    value["signals"] = signals
+    if value["carrier_phase"] is None:
+        value["carrier_phase"] = "raw" in value["outputs"]
     return value
 
 
@@ -239,7 +294,15 @@ GNSS_FIELD = Record(
                                  doc="satellites below it are not tracked"),
         "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
                                     doc="antenna position in the body frame (FRD) from the IMU"),
-        **_ERROR_FIELDS,
+        "systems": ListOf(Text(), ["gps"], min_len=1,
+                          doc="constellations tracked: gps, galileo, beidou, glonass, qzss"),
+        "signals": MapOf(ListOf(Text()), None,
+                         doc="per system, the RINEX 3 codes of the signals tracked, e.g. "
+                             "{gps: [1C, 2W]}; default: the preset's "
+                             "(simulator.gnss.signals.PRESET_SIGNALS)"),
+        "carrier_phase": Boolean(None, doc="output carrier phase, LLI and lock time (default: "
+                                           "when raw is an output)"),
+        **ERROR_FIELDS,
         "cn0_zenith": Number("", 46.5, doc="C/N0 of a satellite at zenith, dB-Hz"),
         "cn0_horizon": Number("", 18.0, doc="C/N0 extrapolated to the horizon, dB-Hz"),
         "cn0_threshold": Number("", 17.0,
@@ -379,10 +442,13 @@ class Gnss(PresetSensor):
                 "day or 'nominal-gps'")])
 
     # -- generation ----------------------------------------------------------------------------
-    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
-        cfg = self.config
-        t = sample_times(truth.duration_s, self.rate_hz)
-        dt_s = 1.0 / self.rate_hz
+    def attach(self, companion: PresetSensor) -> None:
+        """Make ``companion`` (the base station, ``sensors.gnss_base``) with this receiver: it
+        sees the same satellites, broadcast errors and atmosphere."""
+        self.base = companion
+
+    def broadcast(self, truth: Kinematics, t: np.ndarray) -> dict:
+        """The broadcast records each satellite uses at each epoch and what comes with them."""
         week0, tow0 = utc_to_gps(truth.utc_start)
         nav = self.navigation(truth)
         eph = ephemeris_arrays(nav, week0)
@@ -394,178 +460,43 @@ class Gnss(PresetSensor):
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
                                healthy_only=False)
         self._check_coverage(idx, t, truth, max_age)
-        health = np.where(idx >= 0, gather(eph, idx)["health"], 0.0)
-
-        # geometry: antenna, signal flight, look angles, broadcast delays (satellites x epochs)
-        ant = self.antenna(truth, t)
+        gathered = gather(eph, idx)
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
         new_year = dt.datetime(truth.utc_start.year, 1, 1)
         day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
-        geo = model = _signals_in_chunks(eph, idx, tow0 + t, ant, day_of_year, alpha, beta)
-        el, az = geo["elevation"], geo["azimuth"]
+        return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "t_gps": tow0 + t,
+                "health": np.where(idx >= 0, gathered["health"], 0.0),
+                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0), "alpha": alpha,
+                "beta": beta, "day_of_year": day_of_year}
 
-        # what the receiver tracks: the C/N0 fades with the motion (correlated like the
-        # multipath), the receiver's estimate of it adds white noise
-        u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
-                                     cfg["multipath_correlation_time"])
-        los, nlos, extra, loss = self.sky(
-            truth, t, az, el, ant["yaw"], ant["distance"], rng,
-            lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
-        signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
-                      + draw_fading(rng, cfg, u, el.shape[0]))
-        cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
-        have = idx >= 0
-        tracked = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos) \
-            & (cn0 >= cfg["cn0_threshold"])
+    def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
+        cfg = self.config
+        t = sample_times(truth.duration_s, self.rate_hz)
+        dt_s = 1.0 / self.rate_hz
+        sky = self.broadcast(truth, t)
+        ant = self.antenna(truth, t)
 
-        # errors and measurements
-        bias_s, drift_s_s, self.drawn["clock"] = draw_receiver_clock(rng, cfg["clock"], len(t),
-                                                                      dt_s)
-        self.true_errors.update(clock_bias=(t, C_M_S * bias_s), clock_drift=(t, C_M_S * drift_s_s))
-        # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
-        # (which would otherwise make the error and the fix weights jump from epoch to epoch)
-        # (below the horizon, where nothing is tracked, the pierce point of the horizon)
-        pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
-        err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, idx)
-        self.drawn["tropo_zenith_error_m"] = err["tropo_zenith"]
-        mapping = model["tropo"] / model["zenith"]
-        iono_true = model["iono"] * err["iono_ratio"]
-        err = smooth_code_errors(cfg, err, iono_true, tracked, dt_s)
-        tropo_true = model["tropo"] + err["tropo_zenith"] * mapping
-        # the true ionosphere's rate: the broadcast model's along the geometry, times the ratio,
-        # plus the ratio's own (slow) change
-        ratio_rate = (np.gradient(err["iono_ratio"], dt_s, axis=1) if len(t) > 1
-                      else np.zeros_like(err["iono_ratio"]))
-        iono_true_rate = model["iono_rate"] * err["iono_ratio"] + model["iono"] * ratio_rate
-        tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
-        nlos_delay = np.where(nlos & ~los, extra, 0.0)
-        sat_clock = C_M_S * geo["clock_s"]
-        sat_drift = C_M_S * geo["clock_drift_s_s"]
-        rx_clock = C_M_S * bias_s[None, :]
-        rx_drift = C_M_S * drift_s_s[None, :]
-        pseudorange = (geo["range"] + rx_clock - sat_clock + iono_true + tropo_true
-                       + err["sis"] + err["multipath"] + nlos_delay + err["code_noise"])
-        rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
-                + tropo_true_rate - iono_true_rate + err["rate_noise"])
-        pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping, dt_s,
-                                             np.linalg.norm(ant["v_ned"], axis=1))
+        def reception(az: np.ndarray, el: np.ndarray, antenna_gain_db: Callable
+                      ) -> tuple[np.ndarray, ...]:
+            return self.sky(truth, t, az, el, ant["yaw"], ant["distance"], rng, antenna_gain_db)
 
-        table = _RowTable(t, svs)
-        raw = table(tracked, {
-            "pseudorange": pseudorange, "pseudorange_rate": rate,
-            "doppler": -rate / LAMBDA_L1_M, "cn0": cn0,
-            "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
-            "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
-            "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
-            "sat_clock": sat_clock, "sat_clock_drift": sat_drift, "iono": model["iono"],
-            "tropo": model["tropo"], "elevation": el, "azimuth": az,
-            "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
-            "health": health.astype(np.int64),
-        })[list(col.GNSS_RAW)]
-        truth_table = table(have & (el > 0), {
-            "tracked": tracked.astype(np.int8), "los": los.astype(np.int8),
-            "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
-            "range": geo["range"], "range_rate": geo["range_rate"],
-            "receiver_clock": rx_clock, "receiver_clock_drift": rx_drift,
-            "iono_true": iono_true, "tropo_true": tropo_true,
-            "iono_true_rate": iono_true_rate, "tropo_true_rate": tropo_true_rate,
-            "sis_error": err["sis"], "multipath": err["multipath"], "nlos_delay": nlos_delay,
-            "code_noise": err["code_noise"], "rate_noise": err["rate_noise"],
-            "antenna_x": ant["pos"][None, :, 0], "antenna_y": ant["pos"][None, :, 1],
-            "antenna_z": ant["pos"][None, :, 2],
-        })[list(col.TRUTH_GNSS)]
-        used = np.unique(idx[idx >= 0])
-        out = {"gnss_nav": nav.iloc[used].reset_index(drop=True)[list(col.GNSS_NAV)],
-               "truth_gnss": truth_table}
+        rover = observe(cfg, t, dt_s, sky, ant, rng, reception)
+        self.drawn.update(rover.drawn)
+        self.true_errors.update(clock_bias=(t, rover.clock_m), clock_drift=(t, rover.drift_m_s))
+        used = np.unique(sky["idx"][sky["idx"] >= 0])
+        out = {"gnss_nav": sky["nav"].iloc[used].reset_index(drop=True)[list(col.GNSS_NAV)],
+               "truth_gnss": rover.truth}
         # the raw stream always comes out here: faults act on the measurements and the fixes
         # are recomputed from them; the generator drops it if the scenario did not ask for it
-        out["gnss_raw"] = raw
+        out["gnss_raw"] = rover.raw
         if "fix" in cfg["outputs"]:
-            out["gnss_fix"] = receiver_fixes(t, raw, cfg["smoothing"], cfg["dop_mask"])
+            out["gnss_fix"] = receiver_fixes(t, rover.raw, cfg["smoothing"], cfg["dop_mask"])
+        base = getattr(self, "base", None)
+        if base is not None:
+            out.update(base.observe_with(self, truth, t, dt_s, sky, rover.shared))
         return out
-
-
-CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives
-COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
-BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
-# what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
-_KEPT = ("pos", "vel", "clock_s", "clock_drift_s_s", "range", "range_rate", "tau_rate",
-         "elevation", "azimuth", "iono", "tropo", "zenith", "iono_rate", "tropo_rate")
-
-
-def _signals(eph: dict[str, np.ndarray], t_gps: np.ndarray, ant: dict[str, np.ndarray],
-             day_of_year: np.ndarray, alpha: list[float], beta: list[float]
-             ) -> dict[str, np.ndarray]:
-    """Signal geometry, look angles and broadcast delays (with rates) of gathered ephemerides
-    (n_sat, n_epoch) received by the antenna ``ant`` (arrays over the same n_epoch)."""
-    geo = signal_geometry(eph, t_gps, ant["pos"], ant["vel"])
-    look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
-    lat_rate, lon_rate, alt_rate = geodetic_rates(ant["lat"], ant["alt"], ant["v_ned"])
-    model = broadcast_delays(
-        ant["lat"], ant["lon"], ant["alt"], look["azimuth"], look["elevation"], t_gps,
-        day_of_year, alpha, beta,
-        rates={"lat": lat_rate, "lon": lon_rate, "alt": alt_rate, "azimuth": look["azimuth_rate"],
-               "elevation": look["elevation_rate"]})
-    return {**geo, **look, **model}
-
-
-def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
-                         ant: dict[str, np.ndarray]) -> np.ndarray:
-    """Satellites (rows of idx) that may rise above the horizon during these epochs: their
-    elevation, sampled every ``COARSE_STEP_S`` without the light-time correction, exceeds
-    ``BELOW_HORIZON_MARGIN_RAD`` somewhere."""
-    n = len(t_gps)
-    step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
-    cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
-    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
-    lat, lon = ant["lat"][cols], ant["lon"][cols]
-    up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
-    rel = pos - ant["pos"][None, cols]
-    sin_el = np.einsum("sek,ek->se", rel, up) / np.linalg.norm(rel, axis=-1)
-    return np.flatnonzero((sin_el > np.sin(BELOW_HORIZON_MARGIN_RAD)).any(axis=1)
-                          & (idx >= 0).any(axis=1))
-
-
-def _signals_in_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
-                       ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
-                       beta: list[float]) -> dict[str, np.ndarray]:
-    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time and only
-    for the satellites that may be above the horizon in each chunk; the others keep elevation
-    -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
-    n_sat, n_ep = idx.shape
-    first = {k: v[:1] for k, v in ant.items()}
-    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
-    fill = {"elevation": -np.pi / 2, "zenith": 1.0}
-    out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
-    for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
-        cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
-        ant_c = {k: v[cols] for k, v in ant.items()}
-        rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
-        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
-                        alpha, beta)
-        for key in _KEPT:
-            out[key][rows, cols] = part[key]
-    return out
-
-
-class _RowTable:
-    """Flattens (satellite, epoch) arrays into stream rows: epochs first, satellites in PRN
-    order within an epoch, only where a mask is set."""
-
-    def __init__(self, t: np.ndarray, svs: np.ndarray):
-        self.t, self.svs = t, svs
-
-    def __call__(self, mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
-        import pandas as pd
-
-        m = mask.T
-        out = {"t": np.broadcast_to(self.t[:, None], m.shape)[m],
-               "sv": np.broadcast_to(self.svs[None, :], m.shape)[m]}
-        for key, value in columns.items():
-            out[key] = np.swapaxes(np.broadcast_to(value, mask.shape), 0, 1)[m]
-        return pd.DataFrame(out)
 
 
 def _street_ends(truth: Kinematics, zone: str, t: np.ndarray, distance: np.ndarray

@@ -1,0 +1,400 @@
+"""One receiver's raw measurements of every signal it tracks: the geometry of each satellite,
+the error terms (its own and those it shares with a second receiver of the same drive), and
+code, Doppler, C/N0 and carrier phase per signal, as stream rows.
+
+The rover (``sensors.gnss``) and the base station (``sensors.gnss_base``) run ``observe`` on the
+same broadcast records and epochs; the base takes the rover's ``Shared`` draws (signal-in-space
+error, the two ionosphere fields, the troposphere residual and its gradient, the orbit error
+vectors), so that what differs between them is what their separation makes differ:
+
+- the ionosphere: the regional field (1000 km) and the travelling disturbances (150 km,
+  ``TID_LENGTH_KM``) evaluated at each receiver's own pierce points;
+- the troposphere: the zenith residual plus a horizontal gradient held for the drive;
+- the orbit: each broadcast record's orbit error vector (``ORBIT_ERROR_M`` per axis) projected
+  on each receiver's line of sight (the classic |dr| b / rho of relative positioning).
+
+Measurement model of signal s at frequency f (lambda = c / f), in metres, gamma_s = (f_L1/f)^2:
+
+    pseudorange = range + receiver_clock - sat_clock_s + gamma_s I + T + sis + m_code_s
+                  + nlos_delay + code_noise_s
+    carrier_phase lambda = range + receiver_clock - (sat_clock_s + group_delay_s) - gamma_s I
+                  + T + sis + m_carrier_s + nlos_delay + phase_noise_s
+                  + lambda (ambiguity + half_cycle)
+
+(``sat_clock_s`` = c (dt_sv - k_s T_GD) the clock a user of the signal applies, ``group_delay_s``
+= c k_s T_GD, ``simulator.gnss.signals.group_delay_factor``; the carrier carries no hardware
+delay). The carrier phase has RINEX's sign: it grows with the range, as the pseudorange does.
+
+Public names
+------------
+TID_LENGTH_KM, TID_TIME_S, ORBIT_ERROR_M, Shared, Observed, observe, signal_geometry_chunks.
+
+References
+----------
+Travelling ionospheric disturbances: Hernandez-Pajares, Juan & Sanz, "Medium-scale traveling
+ionospheric disturbances affecting GPS measurements: spatial and temporal analysis", J.
+Geophys. Res. 111, A07S11, 2006 (wavelengths 100-300 km, periods 10-60 min).
+Broadcast orbit errors of about a metre per axis: Montenbruck, Steigenberger & Hauschild,
+"Broadcast versus precise ephemerides: a multi-GNSS perspective", GPS Solutions 19, 2015.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from simulator import columns as col
+from simulator.earth import ecef_to_ned, geodetic_rates
+from simulator.gnss.atmosphere import broadcast_delays, klobuchar_obliquity
+from simulator.gnss.carrier import (
+    draw_slips,
+    dynamic_stress_cycles,
+    phase_arcs,
+    pll_sigma_cycles,
+    reflection_multipath,
+    slip_probability,
+)
+from simulator.gnss.constants import C_M_S, F_L1_HZ
+from simulator.gnss.ephemeris import gather, satellite_state
+from simulator.gnss.errors import (
+    IonoField,
+    decorrelation_coordinate,
+    draw_error_terms,
+    draw_fading,
+    draw_receiver_clock,
+    gauss_markov_along,
+    loop_time_constant_s,
+    pierce_points_km,
+    pseudorange_sigma,
+    smooth_code_errors,
+)
+from simulator.gnss.receiver import (
+    cn0_model,
+    dll_sigma_m,
+    fll_sigma_hz,
+    look_angles,
+    signal_geometry,
+)
+from simulator.gnss.signals import (
+    SYSTEMS,
+    carrier_frequency_hz,
+    group_delay_factor,
+    iono_factor,
+    signal,
+)
+from simulator.stochastic import gauss_markov
+
+TID_LENGTH_KM = 150.0  # correlation length of the travelling disturbances' field
+TID_TIME_S = 900.0  # their correlation time
+ORBIT_ERROR_M = 1.0  # broadcast orbit error per axis, 1-sigma
+_CA_CHIP_RATE_HZ = 1.023e6
+
+
+@dataclass
+class Shared:
+    """The draws two receivers of one drive share (module docstring)."""
+
+    sis: np.ndarray
+    iono_field: IonoField | None
+    tid: IonoField
+    tid_sigma_m: float
+    tropo_zenith_m: float
+    tropo_gradient: np.ndarray  # zenith residual change per metre north, east
+    orbit_m: np.ndarray  # per broadcast record, (n_records, 3)
+    origin_lla: tuple[float, float, float]
+    los: np.ndarray  # the first receiver's lines of sight (n_sat, n_epoch, 3)
+    seed: int  # of the second receiver's own random stream
+
+
+@dataclass
+class Observed:
+    raw: pd.DataFrame
+    truth: pd.DataFrame
+    clock_m: np.ndarray
+    drift_m_s: np.ndarray
+    drawn: dict
+    shared: Shared
+
+
+def _rows(t: np.ndarray, svs: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray],
+          order: int, n_signals: int) -> pd.DataFrame:
+    """(satellite, epoch) arrays as stream rows where ``mask``, with a sort key putting epochs
+    first, then satellites in PRN order, then signals in the receiver's order."""
+    m = mask.T
+    ep, sat = np.nonzero(m)
+    out = {"t": t[ep], "sv": svs[sat]}
+    for key, value in columns.items():
+        if isinstance(value, str):
+            out[key] = np.full(len(ep), value, dtype=object)
+        else:
+            out[key] = np.broadcast_to(value, mask.shape)[sat, ep]
+    frame = pd.DataFrame(out)
+    frame["_key"] = (ep.astype(np.int64) * len(svs) + sat) * n_signals + order
+    return frame
+
+
+def _sorted(pieces: list[pd.DataFrame], names: list[str]) -> pd.DataFrame:
+    frame = pd.concat(pieces, ignore_index=True) if len(pieces) > 1 else pieces[0]
+    frame = frame.iloc[np.argsort(frame["_key"].to_numpy(), kind="stable")]
+    return frame.reset_index(drop=True)[names]
+
+
+def _switches(state: np.ndarray) -> np.ndarray:
+    """Where a boolean state differs from the previous epoch's (False at the first)."""
+    out = np.zeros_like(state)
+    out[:, 1:] = state[:, 1:] != state[:, :-1]
+    return out
+
+
+def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int, n_ep: int,
+                  dt_s: float, ant: dict, los: np.ndarray) -> Shared:
+    """The first receiver's draws a second one shares, made after all its other error draws
+    (so that they do not change them)."""
+    tid = IonoField(rng, n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
+    gradient = cfg["tropo_gradient"] * rng.standard_normal(2)
+    orbit = ORBIT_ERROR_M * rng.standard_normal((n_records, 3))
+    seed = int(rng.integers(2**62))
+    return Shared(sis=err["sis"], iono_field=err["iono_field"], tid=tid,
+                  tid_sigma_m=cfg["iono_gradient"] * TID_LENGTH_KM * 1e3,
+                  tropo_zenith_m=float(err["tropo_zenith"]), tropo_gradient=gradient,
+                  orbit_m=orbit,
+                  origin_lla=(float(ant["lat"][0]), float(ant["lon"][0]), float(ant["alt"][0])),
+                  los=los, seed=seed)
+
+
+def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
+            rng: np.random.Generator,
+            reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
+            shared: Shared | None = None) -> Observed:
+    """Every signal's measurements of one receiver (module docstring).
+
+    Parameters
+    ----------
+    cfg : dict
+        The receiver's resolved block (``sensors.gnss`` or ``sensors.gnss_base``).
+    sky : dict
+        The broadcast records in use (``Gnss.broadcast``).
+    ant : dict of ndarray
+        The antenna over the epochs (``Gnss.antenna``).
+    reception : callable
+        (azimuth, elevation, antenna gain) -> (los, nlos, extra path, C/N0 loss), the
+        environment's effect on each signal.
+    shared : Shared, optional
+        The first receiver's shared draws; None for the first receiver (it draws them).
+    """
+    eph, idx, svs = sky["eph"], sky["idx"], sky["svs"]
+    n_sat, n_ep = idx.shape
+    geo = model = signal_geometry_chunks(eph, idx, sky["t_gps"], ant, sky["day_of_year"],
+                                         sky["alpha"], sky["beta"])
+    el, az = geo["elevation"], geo["azimuth"]
+
+    # what the receiver tracks: the C/N0 fades with the motion (correlated like the
+    # multipath), the receiver's estimate of it adds white noise
+    u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
+                                 cfg["multipath_correlation_time"])
+    los, nlos, extra, loss = reception(
+        az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
+    signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
+                  + draw_fading(rng, cfg, u, n_sat))
+    cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+    have = idx >= 0
+    visible = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos)
+    tracked = visible & (cn0 >= cfg["cn0_threshold"])
+
+    bias_s, drift_s_s, drawn_clock = draw_receiver_clock(rng, cfg["clock"], n_ep, dt_s)
+    # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
+    # (below the horizon, where nothing is tracked, the pierce point of the horizon)
+    pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
+    err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, idx,
+                           None if shared is None else shared)
+    if shared is None:
+        shared = _shared_draws(rng, cfg, err, len(eph["toe_s"]), n_ep, dt_s, ant, geo["los"])
+    else:  # the orbit error seen along this receiver's lines of sight
+        orbit = shared.orbit_m[np.maximum(idx, 0)]
+        err["sis"] = np.where(have, err["sis"] + np.einsum(
+            "sek,sek->se", orbit, geo["los"] - shared.los), 0.0)
+    drawn = {"clock": drawn_clock, "tropo_zenith_error_m": shared.tropo_zenith_m,
+             "tropo_gradient_m_per_km": (shared.tropo_gradient * 1e3).tolist()}
+
+    # the atmosphere this receiver sees
+    mapping = model["tropo"] / model["zenith"]
+    ned = ecef_to_ned(ant["pos"], *shared.origin_lla)
+    tropo_zenith = shared.tropo_zenith_m + ned[:, :2] @ shared.tropo_gradient
+    tropo_true = model["tropo"] + tropo_zenith[None, :] * mapping
+    tid = shared.tid_sigma_m * shared.tid(pierce) * klobuchar_obliquity(np.maximum(el, 0.0))
+    iono_true = model["iono"] * err["iono_ratio"] + tid
+    # its rate: the broadcast model's along the geometry times the ratio, plus the (slow)
+    # change of the ratio and of the disturbances
+    iono_true_rate = model["iono_rate"] * err["iono_ratio"]
+    if n_ep > 1:
+        iono_true_rate = iono_true_rate + model["iono"] * np.gradient(
+            err["iono_ratio"], dt_s, axis=1) + np.gradient(tid, dt_s, axis=1)
+    tropo_true_rate = model["tropo_rate"] * (1.0 + tropo_zenith[None, :] / model["zenith"])
+
+    rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
+    sat_clock = C_M_S * geo["clock_s"]  # the L1 clock: T_GD applied
+    sat_drift = C_M_S * geo["clock_drift_s_s"]
+    tgd_m = C_M_S * sky["tgd_s"]
+    nlos_delay = np.where(nlos & ~los, extra, 0.0)
+    speed = np.linalg.norm(ant["v_ned"], axis=1)
+    # the reflection's quadrature component (its in-phase one is the code multipath's process)
+    quadrature = gauss_markov_along(u, n_sat, rng)
+    los_jerk = (np.gradient(np.gradient(geo["range_rate"], dt_s, axis=1), dt_s, axis=1)
+                if n_ep > 2 else np.zeros((n_sat, n_ep)))
+    reflected = _switches(nlos & ~los)  # a switch between direct and reflected: lock lost
+    scale = cfg["tracking_noise"]
+
+    def unit_gm(tau_s: float) -> np.ndarray:
+        return gauss_markov(n_ep, dt_s, np.ones(n_sat), tau_s, rng).T
+
+    system_of = np.full(n_sat, "G")
+    codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
+    raw_pieces, truth_pieces = [], []
+    for order, (letter, code) in enumerate(codes):  # one pass per signal, vectorised
+        spec = signal(letter, code)
+        first = code == cfg["signals"][next(k for k, v in SYSTEMS.items() if v == letter)][0]
+        rows_here = (system_of == letter)[:, None]
+        freq = float(carrier_frequency_hz(letter, code))
+        lam = C_M_S / freq
+        k_iono = float(iono_factor(freq))
+        if first and letter == "G" and code == "1C":
+            cn0_true, cn0_out, tracked_s = signal_cn0, cn0, tracked & rows_here
+            code_sigma, code_noise = err["code_sigma"], err["code_noise"]
+            rate_sigma, rate_noise = err["rate_sigma"], err["rate_noise"]
+        else:
+            cn0_true = signal_cn0 + spec.cn0_offset_db
+            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+            tracked_s = visible & rows_here & (cn0_out >= cfg["cn0_threshold"])
+            if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
+                tracked_s &= tracked
+            code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
+                                             cfg["correlator_spacing"], cfg["integration_time"]
+                                             ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
+            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]))
+            rate_sigma = scale * lam * fll_sigma_hz(cn0_true, cfg["fll_bandwidth"],
+                                                    cfg["integration_time"])
+            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]))
+        code_mp, carrier_mp = reflection_multipath(
+            err["multipath_unit"], quadrature, err["multipath_sigma"], cfg["multipath_delay"],
+            freq - F_L1_HZ, lam)
+        iono_s = k_iono * iono_true
+        terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
+                                   iono_s, tracked_s, dt_s)
+        group_delay = group_delay_factor(letter, code) * tgd_m
+        sat_clock_s = sat_clock + tgd_m - group_delay
+        pseudorange = (geo["range"] + rx_clock - sat_clock_s + iono_s + tropo_true + err["sis"]
+                       + terms["multipath"] + nlos_delay + terms["code_noise"])
+        rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
+                + tropo_true_rate - k_iono * iono_true_rate + rate_noise)
+        pr_std, rate_std = pseudorange_sigma(
+            cfg, {"code_sigma": code_sigma, "multipath_sigma": err["multipath_sigma"],
+                  "rate_sigma": rate_sigma}, k_iono * model["iono"], mapping, dt_s, speed)
+        raw = {"system": letter, "signal": code, "frequency": freq,
+               "pseudorange": pseudorange, "pseudorange_rate": rate, "doppler": -rate / lam,
+               "cn0": cn0_out, "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
+               "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
+               "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
+               "sat_clock": sat_clock_s, "sat_clock_drift": sat_drift,
+               "iono": k_iono * model["iono"], "tropo": model["tropo"], "elevation": el,
+               "azimuth": az, "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
+               "health": sky["health"].astype(np.int64), "group_delay": group_delay}
+        truth = {"system": letter, "signal": code, "frequency": freq,
+                 "tracked": tracked_s.astype(np.int8), "los": los.astype(np.int8),
+                 "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
+                 "range": geo["range"], "range_rate": geo["range_rate"],
+                 "receiver_clock": rx_clock[None, :], "receiver_clock_drift": rx_drift[None, :],
+                 "iono_true": iono_s, "tropo_true": tropo_true,
+                 "iono_true_rate": k_iono * iono_true_rate, "tropo_true_rate": tropo_true_rate,
+                 "sis_error": err["sis"], "multipath": terms["multipath"],
+                 "nlos_delay": nlos_delay, "code_noise": terms["code_noise"],
+                 "rate_noise": rate_noise, "antenna_x": ant["pos"][None, :, 0],
+                 "antenna_y": ant["pos"][None, :, 1], "antenna_z": ant["pos"][None, :, 2],
+                 "group_delay": group_delay}
+        if cfg["carrier_phase"]:
+            sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
+                                                    cfg["integration_time"])
+            phase_noise = lam * sigma_cycles * rng.standard_normal(el.shape)
+            stress = dynamic_stress_cycles(los_jerk, lam, cfg["pll_bandwidth"])
+            chance = (slip_probability(sigma_cycles, stress, cfg["pll_bandwidth"], dt_s,
+                                       spec.pilot) if scale > 0 else np.zeros(el.shape))
+            arcs = phase_arcs(rng, tracked_s, draw_slips(rng, chance, tracked_s), reflected,
+                              dt_s, spec.pilot, spec.frame_s)
+            phase_m = (geo["range"] + rx_clock - (sat_clock + tgd_m) - iono_s + tropo_true
+                       + err["sis"] + carrier_mp + nlos_delay + phase_noise)
+            raw.update(carrier_phase=phase_m / lam + arcs.ambiguity + arcs.half,
+                       lli=arcs.lli, lock_time=arcs.lock_time)
+            truth.update(ambiguity=arcs.ambiguity, half_cycle=arcs.half,
+                         cycle_slip=arcs.cycle_slip, arc=arcs.arc, carrier_multipath=carrier_mp,
+                         phase_noise=phase_noise)
+        raw_pieces.append(_rows(t, svs, tracked_s, raw, order, len(codes)))
+        truth_pieces.append(_rows(t, svs, have & rows_here & (el > 0), truth, order, len(codes)))
+    raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0].columns]
+    truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0].columns]
+    return Observed(raw=_sorted(raw_pieces, raw_names), truth=_sorted(truth_pieces, truth_names),
+                    clock_m=rx_clock, drift_m_s=rx_drift, drawn=drawn, shared=shared)
+
+
+CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives
+COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
+BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
+# what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
+_KEPT = ("pos", "vel", "los", "clock_s", "clock_drift_s_s", "range", "range_rate", "tau_rate",
+         "elevation", "azimuth", "iono", "tropo", "zenith", "iono_rate", "tropo_rate")
+
+
+def _signals(eph: dict[str, np.ndarray], t_gps: np.ndarray, ant: dict[str, np.ndarray],
+             day_of_year: np.ndarray, alpha: list[float], beta: list[float]
+             ) -> dict[str, np.ndarray]:
+    """Signal geometry, look angles and broadcast delays (with rates) of gathered ephemerides
+    (n_sat, n_epoch) received by the antenna ``ant`` (arrays over the same n_epoch)."""
+    geo = signal_geometry(eph, t_gps, ant["pos"], ant["vel"])
+    look = look_angles(geo["los"], geo["los_rate"], ant["lat"], ant["lon"])
+    lat_rate, lon_rate, alt_rate = geodetic_rates(ant["lat"], ant["alt"], ant["v_ned"])
+    model = broadcast_delays(
+        ant["lat"], ant["lon"], ant["alt"], look["azimuth"], look["elevation"], t_gps,
+        day_of_year, alpha, beta,
+        rates={"lat": lat_rate, "lon": lon_rate, "alt": alt_rate, "azimuth": look["azimuth_rate"],
+               "elevation": look["elevation_rate"]})
+    return {**geo, **look, **model}
+
+
+def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
+                         ant: dict[str, np.ndarray]) -> np.ndarray:
+    """Satellites (rows of idx) that may rise above the horizon during these epochs: their
+    elevation, sampled every ``COARSE_STEP_S`` without the light-time correction, exceeds
+    ``BELOW_HORIZON_MARGIN_RAD`` somewhere."""
+    n = len(t_gps)
+    step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
+    cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
+    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
+    lat, lon = ant["lat"][cols], ant["lon"][cols]
+    up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+    rel = pos - ant["pos"][None, cols]
+    sin_el = np.einsum("sek,ek->se", rel, up) / np.linalg.norm(rel, axis=-1)
+    return np.flatnonzero((sin_el > np.sin(BELOW_HORIZON_MARGIN_RAD)).any(axis=1)
+                          & (idx >= 0).any(axis=1))
+
+
+def signal_geometry_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
+                       ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
+                       beta: list[float]) -> dict[str, np.ndarray]:
+    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time and only
+    for the satellites that may be above the horizon in each chunk; the others keep elevation
+    -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
+    n_sat, n_ep = idx.shape
+    first = {k: v[:1] for k, v in ant.items()}
+    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
+    fill = {"elevation": -np.pi / 2, "zenith": 1.0}
+    out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
+    for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
+        cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
+        ant_c = {k: v[cols] for k, v in ant.items()}
+        rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
+        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
+                        alpha, beta)
+        for key in _KEPT:
+            out[key][rows, cols] = part[key]
+    return out
