@@ -33,7 +33,8 @@ def run(args: argparse.Namespace) -> int:
     dataset = open_dataset(args.dataset)
     if args.rinex:
         obs, nav = export_rinex(dataset, args.rinex, args.force, option="--rinex")
-        print(f"wrote {obs} and {nav}")
+        base = obs.with_name(f"{obs.stem}_base.obs")
+        print(f"wrote {obs}, {nav}" + (f" and {base}" if dataset.has("gnss_base_raw") else ""))
     if args.nmea:
         export_nmea(dataset, args.nmea, args.force, option="--nmea")
         print(f"wrote {args.nmea}")

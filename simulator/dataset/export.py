@@ -9,6 +9,7 @@ export_rinex, export_nmea.
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 import numpy as np
@@ -38,11 +39,13 @@ def _gps_start(dataset: Dataset) -> tuple[int, float]:
 
 def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
                  option: str = "export_rinex") -> tuple[Path, Path]:
-    """Write ``DIR/NAME.obs`` (C1C, D1C, S1C of ``gnss_raw``) and ``DIR/NAME.nav`` (the broadcast
-    elements of ``gnss_nav`` and the broadcast ionosphere), ``NAME`` the dataset folder's name;
-    their paths. Both files are made before either is moved into place (never an ``.obs``
-    without its ``.nav``); an existing file is replaced only with ``force``. ``option`` names
-    the caller in the message for a dataset without those streams."""
+    """Write ``DIR/NAME.obs`` (every signal of ``gnss_raw``: C, L, D, S) and ``DIR/NAME.nav``
+    (the broadcast elements of ``gnss_nav`` and the broadcast ionosphere), ``NAME`` the dataset
+    folder's name, and, when the dataset has a base station, ``DIR/NAME_base.obs`` (its
+    ``gnss_base_raw``, APPROX POSITION its true position); the paths of the first two. The
+    files are made before any is moved into place (never an ``.obs`` without its ``.nav``); an
+    existing file is replaced only with ``force``. ``option`` names the caller in the message
+    for a dataset without those streams."""
     _need(dataset, "gnss_raw", option)
     _need(dataset, "gnss_nav", option)
     week, tow = _gps_start(dataset)
@@ -53,8 +56,15 @@ def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
     name = Path(dataset.path).resolve().name
     obs, nav = out / f"{name}.obs", out / f"{name}.nav"
     iono = dataset.manifest.get("sensors", {}).get("gnss", {}).get("broadcast_iono", {})
-    with (atomic_output_file(obs, force, [dataset.path]) as obs_tmp,
-          atomic_output_file(nav, force, [dataset.path]) as nav_tmp):
+    base = out / f"{name}_base.obs" if dataset.has("gnss_base_raw") else None
+    with contextlib.ExitStack() as stack:
+        obs_tmp = stack.enter_context(atomic_output_file(obs, force, [dataset.path]))
+        nav_tmp = stack.enter_context(atomic_output_file(nav, force, [dataset.path]))
+        if base is not None:
+            base_tmp = stack.enter_context(atomic_output_file(base, force, [dataset.path]))
+            where = dataset.manifest["gnss_base"]
+            write_rinex_obs(base_tmp, dataset.read("gnss_base_raw"), week, tow,
+                            np.array([where["x"], where["y"], where["z"]]), marker="BASE")
         write_rinex_obs(obs_tmp, dataset.read("gnss_raw"), week, tow, approx)
         write_rinex_nav(nav_tmp, dataset.read("gnss_nav"), leap_seconds(gps_to_utc(week, tow)),
                         iono.get("alpha"), iono.get("beta"))

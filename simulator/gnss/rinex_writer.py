@@ -1,5 +1,6 @@
-"""RINEX 3.04 writers: a GPS observation file (C1C pseudorange, D1C Doppler, S1C C/N0) from the
-``gnss_raw`` stream and a GPS navigation file from the ``gnss_nav`` stream.
+"""RINEX 3.04 writers: an observation file (per signal: pseudorange, carrier phase with its
+loss-of-lock indicator, Doppler, C/N0) from the ``gnss_raw`` stream and a GPS navigation file
+from the ``gnss_nav`` stream.
 
 Epochs are written in GPS time (the dataset's ``t`` plus the GPS time of ``t = 0``); values are
 rounded to the formats' resolution (F14.3 for observations, D19.12 for navigation parameters).
@@ -27,6 +28,7 @@ from simulator.gnss.constants import SECONDS_PER_WEEK
 from simulator.timebase import GPS_EPOCH, gps_to_utc, leap_seconds
 
 PROGRAM = "landnav"
+_SYSTEM_NAMES = {"G": "GPS", "E": "GALILEO", "C": "BEIDOU", "R": "GLONASS", "J": "QZSS"}
 # the order of the 28 numbers after the clock epoch of a GPS record (RINEX 3.04 Table A6),
 # with the fields the navigation table does not hold written as the constant beside them
 _NAV_ORDER = (
@@ -63,26 +65,70 @@ def _stamp() -> str:
     return dt.datetime.now(dt.UTC).strftime("%Y%m%d %H%M%S UTC")
 
 
+def _obs_types(raw: pd.DataFrame) -> dict[str, list[tuple[str, str]]]:
+    """Per system (in order of appearance): its observation types as (RINEX code, column)
+    pairs, C L D S for each of its signals in the receiver's order (L only with carrier
+    phase)."""
+    kinds = [("C", "pseudorange"), ("L", "carrier_phase"), ("D", "doppler"), ("S", "cn0")]
+    out: dict[str, list[tuple[str, str]]] = {}
+    for system in pd.unique(raw["system"]):
+        signals = pd.unique(raw.loc[raw["system"] == system, "signal"])
+        out[str(system)] = [(f"{k}{sig}", column) for sig in signals for k, column in kinds
+                            if column in raw]
+    return out
+
+
+def _type_lines(system: str, codes: list[str]) -> list[str]:
+    """SYS / # / OBS TYPES: A1, 2X, I3, 13 (1X, A3), continued on lines of 6X + 13 types."""
+    lines = []
+    for i in range(0, len(codes), 13):
+        head = f"{system}  {len(codes):3d}" if i == 0 else " " * 6
+        lines.append(_label(head + "".join(f" {c}" for c in codes[i:i + 13]),
+                            "SYS / # / OBS TYPES"))
+    return lines
+
+
+def _cells(values: np.ndarray, lli: np.ndarray | None, ssi: np.ndarray) -> np.ndarray:
+    """F14.3 observation, LLI digit (blank for 0) and signal strength digit; 16 blanks where
+    the value is missing."""
+    text = np.char.mod("%14.3f", np.nan_to_num(values))
+    flag = np.full(len(values), " ") if lli is None else np.where(
+        lli > 0, np.char.mod("%d", np.nan_to_num(lli).astype(int) & 3), " ")
+    cell = np.char.add(np.char.add(text, flag), np.char.mod("%d", ssi))
+    return np.where(np.isnan(values), " " * 16, cell)
+
+
 def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_s: float,
                     approx_xyz_m: np.ndarray, marker: str = "LANDNAV") -> Path:
-    """Write the raw measurements as a RINEX 3.04 GPS observation file.
+    """Write the raw measurements as a RINEX 3.04 observation file.
+
+    Every system's signals get the observation types C (pseudorange), L (carrier phase, when
+    the stream has it, with the loss-of-lock indicator), D (Doppler) and S (C/N0, dB-Hz), e.g.
+    ``C1C L1C D1C S1C C2W L2W D2W S2W``; each value carries the signal strength indicator.
 
     Parameters
     ----------
     raw : pandas.DataFrame
-        The ``gnss_raw`` stream (``t``, ``sv``, ``pseudorange``, ``doppler``, ``cn0``).
+        The ``gnss_raw`` stream (``t``, ``sv``, ``pseudorange``, ``doppler``, ``cn0``; with
+        ``system``, ``signal``, ``carrier_phase`` and ``lli`` where it has them: without,
+        GPS L1 C/A).
     gps_week, gps_tow_s : GPS time of ``t = 0``.
     approx_xyz_m : array_like, shape (3,)
         The APPROX POSITION XYZ header value (e.g. the first fix), m.
     """
     path = Path(path)
-    raw = raw.sort_values(["t", "sv"], kind="stable")
+    if "signal" not in raw:
+        raw = raw.assign(system="G", signal="1C")
+    types = _obs_types(raw)
+    raw = raw.sort_values(["t", "system", "sv"], kind="stable")
     first = _gps_datetime(gps_week, gps_tow_s + float(raw["t"].iloc[0])) if len(raw) else \
         _gps_datetime(gps_week, gps_tow_s)
     x, y, z = (float(v) for v in approx_xyz_m)
     times = np.unique(raw["t"].to_numpy())
+    letters = "".join(types) if len(types) > 1 else next(iter(types), "G")
+    kind = "M (MIXED)" if len(types) > 1 else f"{letters} ({_SYSTEM_NAMES.get(letters, '')})"
     lines = [
-        _label("     3.04           OBSERVATION DATA    G (GPS)", "RINEX VERSION / TYPE"),
+        _label(f"     3.04           OBSERVATION DATA    {kind}", "RINEX VERSION / TYPE"),
         _label(f"{PROGRAM:<20}{PROGRAM:<20}{_stamp()}", "PGM / RUN BY / DATE"),
         _label(marker, "MARKER NAME"),
         _label("NON_PHYSICAL", "MARKER TYPE"),
@@ -91,27 +137,48 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
         _label(f"{'0':<20}{'LANDNAV SIMULATED':<20}", "ANT # / TYPE"),
         _label(f"{x:14.4f}{y:14.4f}{z:14.4f}", "APPROX POSITION XYZ"),
         _label(f"{0.0:14.4f}{0.0:14.4f}{0.0:14.4f}", "ANTENNA: DELTA H/E/N"),
-        _label("G    3 C1C D1C S1C", "SYS / # / OBS TYPES"),
-        _label("DBHZ", "SIGNAL STRENGTH UNIT"),
     ]
+    for system, pairs in types.items():
+        lines += _type_lines(system, [code for code, _ in pairs])
+    lines.append(_label("DBHZ", "SIGNAL STRENGTH UNIT"))
     if len(times) > 1:
         lines.append(_label(f"{float(np.min(np.diff(times))):10.3f}", "INTERVAL"))
     lines += [
         _label(f"{first.year:6d}{first.month:6d}{first.day:6d}{first.hour:6d}{first.minute:6d}"
                f"{first.second + first.microsecond / 1e6:13.7f}     GPS", "TIME OF FIRST OBS"),
+    ]
+    for system, pairs in types.items():  # no phase corrections applied (RINEX 3.04 A2)
+        lines += [_label(f"{system} {code} {0.0:8.5f}", "SYS / PHASE SHIFT") for code, column in pairs
+                  if column == "carrier_phase"]
+    lines += [
         _label(f"{leap_seconds(gps_to_utc(gps_week, gps_tow_s)):6d}", "LEAP SECONDS"),
         _label("", "END OF HEADER"),
     ]
-    ssi = signal_strength_indicator(raw["cn0"].to_numpy())
-    rows = raw.assign(ssi=ssi)
-    for t, epoch in rows.groupby("t", sort=True):
+    # one text line per satellite and epoch: each system's signals side by side
+    records = []
+    for system, pairs in types.items():  # one pass per system, vectorised over its rows
+        rows = raw[raw["system"] == system]
+        values = [c for c in ("pseudorange", "carrier_phase", "doppler", "cn0", "lli")
+                  if c in rows]
+        wide = rows.set_index(["t", "sv", "signal"])[values].unstack("signal")
+        line = np.char.mod(f"{system}%02d", wide.index.get_level_values("sv").to_numpy())
+        for code, column in pairs:
+            sig = code[1:]
+            values = wide[(column, sig)].to_numpy(dtype=float)
+            cn0 = wide[("cn0", sig)].to_numpy(dtype=float)
+            ssi = signal_strength_indicator(np.nan_to_num(cn0, nan=0.0))
+            lli = wide[("lli", sig)].to_numpy(dtype=float) if column == "carrier_phase" \
+                else None
+            line = np.char.add(line, _cells(values, lli, ssi))
+        records.append(pd.DataFrame({"t": wide.index.get_level_values("t").to_numpy(),
+                                     "system": system, "line": np.char.rstrip(line)}))
+    table = pd.concat(records, ignore_index=True).sort_values(["t", "system"], kind="stable")
+    for t, epoch in table.groupby("t", sort=True):  # one pass per epoch: its header line
         stamp = _gps_datetime(gps_week, gps_tow_s + float(t))
         seconds = stamp.second + stamp.microsecond / 1e6
         lines.append(f"> {stamp.year:4d} {stamp.month:02d} {stamp.day:02d} {stamp.hour:02d} "
                      f"{stamp.minute:02d}{seconds:11.7f}  0{len(epoch):3d}")
-        for sv, pr, dop, cn0, s in epoch[["sv", "pseudorange", "doppler", "cn0",
-                                           "ssi"]].itertuples(index=False):
-            lines.append(f"G{int(sv):02d}{pr:14.3f} {s:1d}{dop:14.3f} {s:1d}{cn0:14.3f}  ")
+        lines += epoch["line"].tolist()
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
     return path
 

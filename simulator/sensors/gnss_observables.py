@@ -235,6 +235,10 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     tropo_true_rate = model["tropo_rate"] * (1.0 + tropo_zenith[None, :] / model["zenith"])
 
     rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
+    # t is the receiver's epoch, its clock's reading: it measures at GPS time t - dt_r, so the
+    # range is that instant's (first order in dt_r; 1e-4 s of bias moves a range by up to 8 cm,
+    # which two receivers' double differences would not cancel). Like a RINEX time tag.
+    rng_m = geo["range"] - geo["range_rate"] * bias_s[None, :]
     sat_clock = C_M_S * geo["clock_s"]  # the L1 clock: T_GD applied
     sat_drift = C_M_S * geo["clock_drift_s_s"]
     tgd_m = C_M_S * sky["tgd_s"]
@@ -285,7 +289,7 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
                                    iono_s, tracked_s, dt_s)
         group_delay = group_delay_factor(letter, code) * tgd_m
         sat_clock_s = sat_clock + tgd_m - group_delay
-        pseudorange = (geo["range"] + rx_clock - sat_clock_s + iono_s + tropo_true + err["sis"]
+        pseudorange = (rng_m + rx_clock - sat_clock_s + iono_s + tropo_true + err["sis"]
                        + terms["multipath"] + nlos_delay + terms["code_noise"])
         rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
                 + tropo_true_rate - k_iono * iono_true_rate + rate_noise)
@@ -304,7 +308,7 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         truth = {"system": letter, "signal": code, "frequency": freq,
                  "tracked": tracked_s.astype(np.int8), "los": los.astype(np.int8),
                  "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
-                 "range": geo["range"], "range_rate": geo["range_rate"],
+                 "range": rng_m, "range_rate": geo["range_rate"],
                  "receiver_clock": rx_clock[None, :], "receiver_clock_drift": rx_drift[None, :],
                  "iono_true": iono_s, "tropo_true": tropo_true,
                  "iono_true_rate": k_iono * iono_true_rate, "tropo_true_rate": tropo_true_rate,
@@ -322,7 +326,7 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
                                        spec.pilot) if scale > 0 else np.zeros(el.shape))
             arcs = phase_arcs(rng, tracked_s, draw_slips(rng, chance, tracked_s), reflected,
                               dt_s, spec.pilot, spec.frame_s)
-            phase_m = (geo["range"] + rx_clock - (sat_clock + tgd_m) - iono_s + tropo_true
+            phase_m = (rng_m + rx_clock - (sat_clock + tgd_m) - iono_s + tropo_true
                        + err["sis"] + carrier_mp + nlos_delay + phase_noise)
             raw.update(carrier_phase=phase_m / lam + arcs.ambiguity + arcs.half,
                        lli=arcs.lli, lock_time=arcs.lock_time)
