@@ -37,6 +37,15 @@ def _gps_start(dataset: Dataset) -> tuple[int, float]:
             float(dataset.field("gps_time_start", "tow")))
 
 
+def _receiver_clock(dataset: Dataset, stream: str) -> pd.Series | None:
+    """The receiver's clock error c dt_r (m) per epoch ``t`` from its GNSS truth, so that the
+    RINEX epochs are the receiver's time tags (``write_rinex_obs``); None without the truth."""
+    if not dataset.has(stream):
+        return None
+    truth = dataset.read(stream)
+    return truth.groupby("t")["receiver_clock"].first()
+
+
 def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
                  option: str = "export_rinex") -> tuple[Path, Path]:
     """Write ``DIR/NAME.obs`` (every signal of ``gnss_raw``: C, L, D, S) and ``DIR/NAME.nav``
@@ -64,8 +73,10 @@ def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
             base_tmp = stack.enter_context(atomic_output_file(base, force, [dataset.path]))
             where = dataset.manifest["gnss_base"]
             write_rinex_obs(base_tmp, dataset.read("gnss_base_raw"), week, tow,
-                            np.array([where["x"], where["y"], where["z"]]), marker="BASE")
-        write_rinex_obs(obs_tmp, dataset.read("gnss_raw"), week, tow, approx)
+                            np.array([where["x"], where["y"], where["z"]]), marker="BASE",
+                            receiver_clock_m=_receiver_clock(dataset, "truth_gnss_base"))
+        write_rinex_obs(obs_tmp, dataset.read("gnss_raw"), week, tow, approx,
+                        receiver_clock_m=_receiver_clock(dataset, "truth_gnss"))
         write_rinex_nav(nav_tmp, dataset.read("gnss_nav"), leap_seconds(gps_to_utc(week, tow)),
                         iono.get("alpha"), iono.get("beta"))
     return obs, nav

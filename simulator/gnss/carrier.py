@@ -145,6 +145,8 @@ def phase_arcs(rng: np.random.Generator, tracked: np.ndarray, slips: np.ndarray,
     if not pilot:
         half_per_arc = 0.5 * (rng.random(n_arcs) < 0.5)
         resolve_s = rng.uniform(0.0, frame_s, n_arcs)
+    if n_arcs == 0:  # nothing tracked: one placeholder arc for the (empty) look-ups below
+        ambiguity_per_arc, half_per_arc, resolve_s, jump = (np.zeros(1) for _ in range(4))
     k = np.arange(n_ep)
     arc_start = np.maximum.accumulate(np.where(starts, k, 0), axis=1)
     lock_time = np.where(tracked, (k - arc_start) * dt_s, 0.0)

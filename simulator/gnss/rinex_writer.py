@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from simulator.gnss.constants import SECONDS_PER_WEEK
+from simulator.gnss.constants import C_M_S, SECONDS_PER_WEEK
 from simulator.timebase import GPS_EPOCH, gps_to_utc, leap_seconds
 
 PROGRAM = "landnav"
@@ -99,7 +99,8 @@ def _cells(values: np.ndarray, lli: np.ndarray | None, ssi: np.ndarray) -> np.nd
 
 
 def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_s: float,
-                    approx_xyz_m: np.ndarray, marker: str = "LANDNAV") -> Path:
+                    approx_xyz_m: np.ndarray, marker: str = "LANDNAV",
+                    receiver_clock_m: pd.Series | None = None) -> Path:
     """Write the raw measurements as a RINEX 3.04 observation file.
 
     Every system's signals get the observation types C (pseudorange), L (carrier phase, when
@@ -115,14 +116,24 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
     gps_week, gps_tow_s : GPS time of ``t = 0``.
     approx_xyz_m : array_like, shape (3,)
         The APPROX POSITION XYZ header value (e.g. the first fix), m.
+    receiver_clock_m : pandas.Series, optional
+        The receiver clock error c dt_r (m) at each epoch ``t`` (index). The epochs are then
+        written as RINEX has them, the receiver's time tags t + dt_r: a receiver stamps its
+        measurements with its own clock, and GNSS software takes the transmit time as the tag
+        minus pseudorange / c, which is the true one only so (with true-time tags two
+        receivers' clock errors would not cancel in double differences: 1e-4 s moves a range
+        by up to 8 cm). Without it, the true times t.
     """
     path = Path(path)
     if "signal" not in raw:
         raw = raw.assign(system="G", signal="1C")
+    tag_s = (pd.Series(0.0, index=np.unique(raw["t"].to_numpy())) if receiver_clock_m is None
+             else receiver_clock_m / C_M_S)
     types = _obs_types(raw)
     raw = raw.sort_values(["t", "system", "sv"], kind="stable")
-    first = _gps_datetime(gps_week, gps_tow_s + float(raw["t"].iloc[0])) if len(raw) else \
-        _gps_datetime(gps_week, gps_tow_s)
+    first = (_gps_datetime(gps_week, gps_tow_s + float(raw["t"].iloc[0])
+                           + float(tag_s.get(raw["t"].iloc[0], 0.0)))
+             if len(raw) else _gps_datetime(gps_week, gps_tow_s))
     x, y, z = (float(v) for v in approx_xyz_m)
     times = np.unique(raw["t"].to_numpy())
     letters = "".join(types) if len(types) > 1 else next(iter(types), "G")
@@ -148,8 +159,8 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
                f"{first.second + first.microsecond / 1e6:13.7f}     GPS", "TIME OF FIRST OBS"),
     ]
     for system, pairs in types.items():  # no phase corrections applied (RINEX 3.04 A2)
-        lines += [_label(f"{system} {code} {0.0:8.5f}", "SYS / PHASE SHIFT") for code, column in pairs
-                  if column == "carrier_phase"]
+        lines += [_label(f"{system} {code} {0.0:8.5f}", "SYS / PHASE SHIFT")
+                  for code, column in pairs if column == "carrier_phase"]
     lines += [
         _label(f"{leap_seconds(gps_to_utc(gps_week, gps_tow_s)):6d}", "LEAP SECONDS"),
         _label("", "END OF HEADER"),
@@ -174,8 +185,9 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
                                      "system": system, "line": np.char.rstrip(line)}))
     table = pd.concat(records, ignore_index=True).sort_values(["t", "system"], kind="stable")
     for t, epoch in table.groupby("t", sort=True):  # one pass per epoch: its header line
-        stamp = _gps_datetime(gps_week, gps_tow_s + float(t))
-        seconds = stamp.second + stamp.microsecond / 1e6
+        exact = gps_tow_s + float(t) + float(tag_s.get(t, 0.0))
+        stamp = _gps_datetime(gps_week, np.floor(exact))  # the fraction kept to 0.1 us
+        seconds = stamp.second + (exact - np.floor(exact))
         lines.append(f"> {stamp.year:4d} {stamp.month:02d} {stamp.day:02d} {stamp.hour:02d} "
                      f"{stamp.minute:02d}{seconds:11.7f}  0{len(epoch):3d}")
         lines += epoch["line"].tolist()

@@ -103,7 +103,6 @@ _GEODETIC = {"gps": ["1C", "2W", "5Q"], "galileo": ["1C", "5Q", "7Q"], "beidou":
              "glonass": ["1C", "2C"], "qzss": ["1C", "2L", "5Q"]}
 PRESET_SIGNALS: dict[str, dict[str, list[str]]] = {
     "geodetic": _GEODETIC,
-    "ideal": _GEODETIC,
     "dual-band": {"gps": ["1C", "2L"], "galileo": ["1C", "7Q"], "beidou": ["2I", "7I"],
                   "glonass": ["1C", "2C"], "qzss": ["1C", "2L"]},
     "smartphone": {"gps": ["1C", "5Q"], "galileo": ["1C", "5Q"], "beidou": ["2I"],
@@ -153,7 +152,7 @@ def group_delay_factor(system: str, code: str) -> float:
 
 
 def default_signals(preset: str, systems: list[str]) -> dict[str, list[str]]:
-    """The signals of ``preset`` (``PRESET_SIGNALS``; another preset: the automotive set) for
-    each of ``systems``."""
+    """The signals of ``preset`` (``PRESET_SIGNALS``; another preset, ``ideal`` among them: the
+    automotive set, L1 only) for each of ``systems``."""
     table = PRESET_SIGNALS.get(preset, PRESET_SIGNALS["automotive"])
     return {name: list(table[name]) for name in systems}

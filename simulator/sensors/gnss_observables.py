@@ -42,9 +42,9 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import ecef_to_ned, geodetic_rates
@@ -87,6 +87,9 @@ from simulator.gnss.signals import (
 )
 from simulator.stochastic import gauss_markov
 
+if TYPE_CHECKING:
+    import pandas as pd
+
 TID_LENGTH_KM = 150.0  # correlation length of the travelling disturbances' field
 TID_TIME_S = 900.0  # their correlation time
 ORBIT_ERROR_M = 1.0  # broadcast orbit error per axis, 1-sigma
@@ -123,6 +126,8 @@ def _rows(t: np.ndarray, svs: np.ndarray, mask: np.ndarray, columns: dict[str, n
           order: int, n_signals: int) -> pd.DataFrame:
     """(satellite, epoch) arrays as stream rows where ``mask``, with a sort key putting epochs
     first, then satellites in PRN order, then signals in the receiver's order."""
+    import pandas as pd
+
     m = mask.T
     ep, sat = np.nonzero(m)
     out = {"t": t[ep], "sv": svs[sat]}
@@ -137,6 +142,8 @@ def _rows(t: np.ndarray, svs: np.ndarray, mask: np.ndarray, columns: dict[str, n
 
 
 def _sorted(pieces: list[pd.DataFrame], names: list[str]) -> pd.DataFrame:
+    import pandas as pd
+
     frame = pd.concat(pieces, ignore_index=True) if len(pieces) > 1 else pieces[0]
     frame = frame.iloc[np.argsort(frame["_key"].to_numpy(), kind="stable")]
     return frame.reset_index(drop=True)[names]
@@ -235,10 +242,7 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     tropo_true_rate = model["tropo_rate"] * (1.0 + tropo_zenith[None, :] / model["zenith"])
 
     rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
-    # t is the receiver's epoch, its clock's reading: it measures at GPS time t - dt_r, so the
-    # range is that instant's (first order in dt_r; 1e-4 s of bias moves a range by up to 8 cm,
-    # which two receivers' double differences would not cancel). Like a RINEX time tag.
-    rng_m = geo["range"] - geo["range_rate"] * bias_s[None, :]
+    rng_m = geo["range"]
     sat_clock = C_M_S * geo["clock_s"]  # the L1 clock: T_GD applied
     sat_drift = C_M_S * geo["clock_drift_s_s"]
     tgd_m = C_M_S * sky["tgd_s"]

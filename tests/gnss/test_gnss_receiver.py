@@ -274,7 +274,7 @@ def test_smoothed_fixes_are_quieter_and_follow_the_motion():
 def test_chunked_evaluation_with_horizon_screen_changes_nothing(monkeypatch):
     """Evaluating the signals in chunks of epochs, only for the satellites the coarse screen
     lets through, gives the same streams as evaluating every satellite at once."""
-    import simulator.sensors.gnss as gnss_module
+    import simulator.sensors.gnss_observables as gnss_module
 
     truth = drive([{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
                    {"straight": {"length": 3000}}], rate_hz=1.0)
@@ -290,7 +290,7 @@ def test_chunked_evaluation_with_horizon_screen_changes_nothing(monkeypatch):
 @pytest.fixture(autouse=True)
 def _small_chunks(monkeypatch):
     """Every test here runs with short chunks, so chunk boundaries are crossed."""
-    import simulator.sensors.gnss as gnss_module
+    import simulator.sensors.gnss_observables as gnss_module
 
     monkeypatch.setattr(gnss_module, "CHUNK_EPOCHS", 97)
 
