@@ -33,6 +33,10 @@ SHORTENED: dict[str, list[str]] = {
     "sumo_city_canyon": ["trajectory.max_duration=150"],  # 150 s after the initial stop (6 min)
     # two loops of sixteen with the four windows that end in them (2 h 20 min -> 17.5 min)
     "karamat2015_partial_outages": karamat_overrides(2),
+    # the whole hour with the real navigation file runs in tests/gnss/test_carrier_twin.py
+    # (it needs ../shared); here 300 s on the nominal constellation
+    "geonet_baseline_twin": ["trajectory.segments.0.stop.duration=300",
+                             "sensors.gnss.constellation=nominal-gps"],
 }
 
 # zones a (shortened) run must pass through: the library scenarios are what their comments say

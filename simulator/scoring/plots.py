@@ -305,6 +305,7 @@ def plot_gnss_sky(ev: Evaluation, path: Path, raw: pd.DataFrame,
     if "nlos" in raw:  # the truth says which signals arrived without line of sight
         nlos = raw.groupby("t")["nlos"].sum().reindex(epochs, fill_value=0)
         count.step(nlos.index, nlos.to_numpy(), where="post", label="of them NLOS (truth)")
+    if fix is not None:
         dop.plot(fix["t"], fix["hdop"], lw=1.0, label="HDOP")
         dop.plot(fix["t"], fix["vdop"], lw=1.0, label="VDOP")
         dop.set_yscale("log")

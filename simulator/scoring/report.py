@@ -18,6 +18,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from simulator.gnss.fix import primary_rows
 from simulator.scoring.evaluate import Evaluation
 from simulator.scoring.metrics import OUTAGE_KIND, degraded_windows
 
@@ -156,10 +157,10 @@ def _plots(ev: Evaluation) -> list[tuple[str, str, Callable[[Evaluation, Path], 
         out.append(("horizontal_cdf", "CDF of horizontal error", plot.plot_horizontal_cdf))
     dataset = ev.dataset
     if dataset is not None and dataset.has("gnss_raw"):
-        raw = dataset.read("gnss_raw", ["t", "sv", "cn0", "elevation", "azimuth"])
+        raw = primary_rows(dataset.read("gnss_raw"))[["t", "sv", "cn0", "elevation", "azimuth"]]
         if dataset.has("truth_gnss"):  # which signals were NLOS, from the truth
-            raw = raw.merge(dataset.read("truth_gnss", ["t", "sv", "nlos"]), on=["t", "sv"],
-                            how="left")
+            truth = primary_rows(dataset.read("truth_gnss"))[["t", "sv", "nlos"]]
+            raw = raw.merge(truth, on=["t", "sv"], how="left")
         fix = (dataset.read("gnss_fix", ["t", "num_sats", "hdop", "vdop"])
                if dataset.has("gnss_fix") else None)
         if len(raw):

@@ -52,13 +52,72 @@ def test_rinex_observations_read_back_with_georinex(exported):
         obs = georinex.load(root / "rinex" / "ds.obs")
     frame = obs.to_dataframe().reset_index().dropna(subset=["C1C"])
     t0 = pd.Timestamp("2024-05-01T03:00:00") + pd.Timedelta(seconds=18)  # GPS = UTC + 18 s
-    frame["t"] = (frame["time"] - t0).dt.total_seconds()
+    # the epochs are the receiver's time tags: the true time plus its clock error
+    tag = (frame["time"] - t0).dt.total_seconds()
+    frame["t"] = tag.round(2)
+    clock = ds.read("truth_gnss").groupby("t")["receiver_clock"].first()
+    np.testing.assert_allclose(tag - frame["t"], clock.loc[frame["t"]].to_numpy() / 299792458.0,
+                               atol=1.5e-6)  # georinex keeps epochs to the microsecond
     frame["sv"] = frame["sv"].str[1:].astype(int)
     merged = raw.merge(frame, on=["t", "sv"], how="outer", indicator=True)
     assert (merged["_merge"] == "both").all() and len(merged) == len(raw) > 100
     # identical to the file format's resolution (F14.3)
-    for ours, theirs in (("pseudorange", "C1C"), ("doppler", "D1C"), ("cn0", "S1C")):
+    for ours, theirs in (("pseudorange", "C1C"), ("carrier_phase", "L1C"), ("doppler", "D1C"),
+                         ("cn0", "S1C")):
         assert np.abs(merged[ours] - merged[theirs]).max() <= 0.0005 + 1e-9
+
+
+BASE_SCENARIO = {
+    **SCENARIO, "name": "export-base", "environment": {"zones": {}},
+    "trajectory": {"kind": "segments", "segments": [{"stop": {"duration": 60}}]},
+    "sensors": {"gnss": {"rate": 1, "preset": "geodetic", "outputs": ["raw"]},
+                "gnss_base": {"offset": {"east": 2000.0, "north": 500.0, "up": 10.0}}},
+}
+
+
+@pytest.fixture(scope="module")
+def exported_with_base(tmp_path_factory):
+    root = tmp_path_factory.mktemp("export_base")
+    (root / "s.yaml").write_text(yaml.safe_dump(BASE_SCENARIO))
+    assert main(["generate", str(root / "s.yaml"), "-o", str(root / "ds")]) == 0
+    assert main(["export", str(root / "ds"), "--rinex", str(root / "rinex")]) == 0
+    return root, open_dataset(root / "ds")
+
+
+@pytest.mark.parametrize(("stream", "file", "truth"), [
+    ("gnss_raw", "ds.obs", "truth_gnss"), ("gnss_base_raw", "ds_base.obs", "truth_gnss_base")])
+def test_rinex_of_every_signal_and_the_base_reads_back_with_georinex(exported_with_base, stream,
+                                                                      file, truth):
+    """Rover and base files carry C, L, D, S of GPS 1C, 2W and 5Q (the geodetic preset) with
+    the LLI; georinex reads back the dataset's values to the format's resolution."""
+    georinex = pytest.importorskip("georinex")
+    root, ds = exported_with_base
+    raw = ds.read(stream)
+    header = (root / "rinex" / file).read_text().split("END OF HEADER")[0]
+    assert "C1C L1C D1C S1C C2W L2W D2W S2W C5Q L5Q D5Q S5Q" in header
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        obs = georinex.load(root / "rinex" / file, useindicators=True)
+    frame = obs.to_dataframe().reset_index()
+    t0 = pd.Timestamp("2024-05-01T03:00:00") + pd.Timedelta(seconds=18)
+    frame["t"] = (frame["time"] - t0).dt.total_seconds().round(2)
+    frame["sv"] = frame["sv"].str[1:].astype(int)
+    for signal in ("1C", "2W", "5Q"):
+        ours = raw[raw["signal"] == signal]
+        theirs = frame.dropna(subset=[f"C{signal}"])
+        merged = ours.merge(theirs, on=["t", "sv"], how="outer", indicator=True)
+        assert (merged["_merge"] == "both").all() and len(merged) > 100
+        for column, code in (("pseudorange", "C"), ("carrier_phase", "L"), ("doppler", "D"),
+                             ("cn0", "S")):
+            assert np.abs(merged[column] - merged[f"{code}{signal}"]).max() <= 0.0005 + 1e-9
+        if signal != "5Q":  # georinex leaves out the LLI of the last signal (a pilot: bit 0
+            # only, at each arc's first epoch)
+            lli = merged[f"L{signal}lli"].fillna(0).astype(int)
+            np.testing.assert_array_equal(lli, merged["lli"] & 3)
+    manifest = json.loads((ds.path / "manifest.json").read_text())
+    assert manifest["gnss_base"]["x"] == pytest.approx(
+        ds.read("truth_gnss_base")["antenna_x"].iloc[0])
+    assert ds.has(truth)
 
 
 def test_rinex_navigation_reads_back_with_georinex_and_our_reader(exported):
