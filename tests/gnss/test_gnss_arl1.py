@@ -23,6 +23,7 @@ from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.atmosphere import klobuchar_delay, tropo_delay, water_vapour_pressure
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M, SECONDS_PER_WEEK
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
+from simulator.gnss.fix import primary_rows
 from simulator.gnss.navfiles import read_rinex_nav
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
 from simulator.timebase import GPS_EPOCH, gps_to_utc
@@ -137,7 +138,7 @@ def simulated(hour: StaticHour, preset: str, seed: int = 2015, **overrides) -> p
                   utc=gps_to_utc(hour.week, hour.tow0_s), rate_hz=1.0)
     gnss = receiver(preset=preset, rate=1 / 30, constellation=str(hour.folder / hour.nav_name),
                     **overrides)
-    raw = gnss.generate(truth, np.random.default_rng(seed))["gnss_raw"]
+    raw = primary_rows(gnss.generate(truth, np.random.default_rng(seed))["gnss_raw"])  # L1 C/A
     return pd.DataFrame({"tow": raw["t"].to_numpy() + hour.tow0_s, "sv": raw["sv"].to_numpy(),
                          "pseudorange": raw["pseudorange"].to_numpy(),
                          "doppler": raw["doppler"].to_numpy(), "cn0": raw["cn0"].to_numpy()})
