@@ -47,6 +47,13 @@ Presets (the figures they follow):
   0.5 m, not fitted to the ARL1 hour, whose high satellites agree within 0.2 m:
   docs/gnss-errors.md); zenith troposphere residual 5 cm.
 
+Signals (``systems``, ``signals``, ``carrier_phase``): each preset tracks the signals of its
+receiver class (``simulator.gnss.signals.PRESET_SIGNALS``: ``geodetic`` GPS 1C 2W 5Q,
+``dual-band`` a u-blox F9P-class 1C 2L, ``smartphone`` 1C 5Q, ``automotive`` and ``ideal`` 1C);
+``dual-band`` and ``smartphone`` have the automotive error levels. Carrier phase, arcs, slips
+and the base station (``sensors.gnss_base``): ``simulator.sensors.gnss_observables``,
+docs/gnss-carrier.md.
+
 Streams: ``gnss_raw`` (one row per tracked signal, unhealthy satellites included with their
 ``health`` code), ``gnss_fix`` (one row per epoch from the healthy signals: 3D fix from four
 signals, 2D from three, else fix = 0 and NaN position), ``gnss_nav`` (the broadcast
@@ -56,7 +63,7 @@ the measurements.
 
 Public names
 ------------
-GNSS_FIELD, PRESETS, Gnss.
+GNSS_FIELD, PRESETS, ERROR_FIELDS, SYSTEMS_WITH_ORBITS, resolve_signals, Gnss.
 
 References
 ----------
