@@ -78,12 +78,20 @@ class RawEpoch:
     range_rate_std: np.ndarray
 
 
+L1_FREQUENCY_HZ = 1575.42e6  # GPS L1, Galileo E1 (IS-GPS-200 3.3.1.1)
+
+
 def raw_epoch(block: np.ndarray, columns: Mapping[str, int]) -> RawEpoch:
     """Corrected measurements of a ``gnss_raw`` epoch block (rows = satellites) whose column
     positions are ``columns`` (the replay's ``self.columns["gnss_raw"]``). Rows of unhealthy
-    satellites (``health`` not 0, where the stream has the column) are left out."""
+    satellites (``health`` not 0, where the stream has the column) are left out, and of a
+    receiver tracking several signals only the L1/E1 ones (``frequency`` 1575.42 MHz) are kept:
+    the single-frequency measurement these models take (the broadcast ionosphere ``iono`` is
+    that of each signal's own frequency)."""
     if "health" in columns:
         block = block[block[:, columns["health"]] == 0]
+    if "frequency" in columns:
+        block = block[block[:, columns["frequency"]] == L1_FREQUENCY_HZ]
     def c(name: str) -> np.ndarray:
         return block[:, columns[name]]
 

@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from simulator.geoid import geoid_undulation_m
+from simulator.gnss.fix import primary_rows
 from simulator.timebase import gps_to_utc
 
 KNOTS_PER_M_S = 3600.0 / 1852.0  # international nautical mile, 1852 m
@@ -108,6 +109,7 @@ def nmea_sentences(fix: pd.DataFrame, raw: pd.DataFrame, gps_week: int,
         The ``gnss_fix`` and ``gnss_raw`` streams (``raw`` may be empty: GSV then lists none).
     gps_week, gps_tow_s : GPS time of ``t = 0``.
     """
+    raw = primary_rows(raw)  # one row per satellite
     by_epoch = dict(tuple(raw.groupby("t"))) if len(raw) else {}
     empty = pd.DataFrame(columns=["sv", "elevation", "azimuth", "cn0"])
     lines: list[str] = []
