@@ -133,7 +133,8 @@ def _gnss_satellite_limit(streams, intervals, params, context) -> None:
         # ``count`` usable satellites: an unhealthy one (tracked, never used) is not one of them
         healthy = (raw["health"] == 0).to_numpy() if "health" in raw else np.ones(len(raw), bool)
         elevation = raw["elevation"].where(healthy, -np.inf)
-        rank = elevation.groupby(raw["t"]).rank(ascending=False, method="first").to_numpy()
+        # a satellite's rank among the epoch's satellites (its signals share its elevation)
+        rank = elevation.groupby(raw["t"]).rank(ascending=False, method="dense").to_numpy()
         lost = inside & ((rank > params["count"]) | ~healthy)
     _set_tracked(streams, raw.loc[lost, ["t", "sv"]])
     streams["gnss_raw"] = raw.loc[~lost].reset_index(drop=True)
@@ -168,8 +169,9 @@ def _gnss_multipath(streams, intervals, params, context) -> None:
     raw["pseudorange"] = raw["pseudorange"].to_numpy() + error
     if "truth_gnss" in streams:
         truth = streams["truth_gnss"]
-        extra = pd.Series(error, index=pd.MultiIndex.from_arrays([t, raw["sv"].to_numpy()]))
-        key = pd.MultiIndex.from_arrays([truth["t"].to_numpy(), truth["sv"].to_numpy()])
+        names = ["t", "sv"] + (["signal"] if "signal" in raw and "signal" in truth else [])
+        extra = pd.Series(error, index=pd.MultiIndex.from_frame(raw[names]))
+        key = pd.MultiIndex.from_frame(truth[names])
         truth["multipath"] = truth["multipath"].to_numpy() + extra.reindex(key).fillna(
             0.0).to_numpy()
     _refix(streams, intervals, context)

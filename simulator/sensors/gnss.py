@@ -134,8 +134,8 @@ if TYPE_CHECKING:
 _LOOPS = {"dll_bandwidth": 0.5, "correlator_spacing": 0.5, "fll_bandwidth": 2.0,
           "pll_bandwidth": 15.0}
 _ATMOSPHERE_AND_SKY = {"iono_scale": 1.5, "iono_residual": 0.2, "tropo_residual": 0.05,
-                       "sis_error": 0.5, "iono_gradient": "0.5 mm/km",
-                       "tropo_gradient": "0.25 mm/km"}
+                       "sis_error": 0.5, "iono_gradient": 0.5e-6,  # 0.5 mm/km
+                       "tropo_gradient": 0.25e-6}  # 0.25 mm/km per axis
 _MULTIPATH_MOTION = {"multipath_distance": 10.0, "multipath_correlation_time": 120.0}
 _AUTOMOTIVE = {"clock": "tcxo", "tracking_noise": 1.0, **_LOOPS, "carrier_smoothing": 100.0,
                "multipath": 0.3, "multipath_delay": 3.0, **_MULTIPATH_MOTION, "cn0_fading": 2.0,
