@@ -123,30 +123,28 @@ class Observed:
 
 
 def _rows(t: np.ndarray, svs: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray],
-          order: int, n_signals: int) -> pd.DataFrame:
-    """(satellite, epoch) arrays as stream rows where ``mask``, with a sort key putting epochs
-    first, then satellites in PRN order, then signals in the receiver's order."""
-    import pandas as pd
-
-    m = mask.T
-    ep, sat = np.nonzero(m)
+          order: int, n_signals: int) -> dict[str, np.ndarray]:
+    """(satellite, epoch) arrays as stream columns where ``mask`` (a text value fills its
+    column), with a sort key ``_key`` putting epochs first, then satellites in PRN order, then
+    signals in the receiver's order."""
+    ep, sat = np.nonzero(mask.T)
     out = {"t": t[ep], "sv": svs[sat]}
     for key, value in columns.items():
         if isinstance(value, str):
             out[key] = np.full(len(ep), value, dtype=object)
         else:
             out[key] = np.broadcast_to(value, mask.shape)[sat, ep]
-    frame = pd.DataFrame(out)
-    frame["_key"] = (ep.astype(np.int64) * len(svs) + sat) * n_signals + order
-    return frame
+    out["_key"] = (ep.astype(np.int64) * len(svs) + sat) * n_signals + order
+    return out
 
 
-def _sorted(pieces: list[pd.DataFrame], names: list[str]) -> pd.DataFrame:
+def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFrame:
+    """The pieces' rows in one table, in the order of their keys."""
     import pandas as pd
 
-    frame = pd.concat(pieces, ignore_index=True) if len(pieces) > 1 else pieces[0]
-    frame = frame.iloc[np.argsort(frame["_key"].to_numpy(), kind="stable")]
-    return frame.reset_index(drop=True)[names]
+    order = np.argsort(np.concatenate([p["_key"] for p in pieces]), kind="stable")
+    return pd.DataFrame({name: np.concatenate([p[name] for p in pieces])[order]
+                         for name in names})
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
@@ -339,8 +337,8 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
                          phase_noise=phase_noise)
         raw_pieces.append(_rows(t, svs, tracked_s, raw, order, len(codes)))
         truth_pieces.append(_rows(t, svs, have & rows_here & (el > 0), truth, order, len(codes)))
-    raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0].columns]
-    truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0].columns]
+    raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0]]
+    truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0]]
     return Observed(raw=_sorted(raw_pieces, raw_names), truth=_sorted(truth_pieces, truth_names),
                     clock_m=rx_clock, drift_m_s=rx_drift, drawn=drawn, shared=shared)
 
