@@ -242,3 +242,34 @@ def test_the_twin_of_a_simulated_drive_reproduces_its_statistics(quickstart, tmp
     assert 0.97 < rows["gnss.cn0_p50_dbhz"]["ratio"] < 1.03
     assert 0.8 < rows["odometer.speed_error_std_m_s"]["ratio"] < 1.25
     assert 0.6 < rows["estimator.gnss_only_horizontal_rms_m"]["ratio"] < 1.6
+
+
+def test_smartloc_trace(tmp_path):
+    """The smartLoc excerpt: its GPS and GLONASS measurements with their NLOS labels, and the
+    heading convention (0 = east, counter-clockwise) checked against the reference's own
+    positions: the velocity from heading and speed matches the positions' differences."""
+    source = _refdata() / "vehicle" / "smartloc_berlin_2016-06-06" / "tu_chemnitz_berlin_1_raw.csv"
+    assert main(["import", "smartloc", str(source), "-o", str(tmp_path / "s")]) == 0
+    dataset = open_dataset(tmp_path / "s")
+    csv = pd.read_csv(source, sep=";")
+    raw = dataset.read("gnss_raw")
+    sbas = csv["GNSS identifier (gnssId) []"].str.upper() == "SBAS"
+    assert len(raw) == int((~sbas).sum()) - int(
+        (csv["Receiver tracking status (recStat) []"].isna()).sum())
+    assert set(raw["system"]) == {"G", "R"}
+    assert set(raw["nlos"].dropna()) <= {0.0, 1.0} and raw["nlos"].mean() > 0.2
+    np.testing.assert_allclose(raw["pseudorange_rate"] * raw["frequency"] / 299792458.0,
+                               -raw["doppler"])
+    truth = dataset.read("truth")
+    from simulator.earth import ecef_to_ned, geodetic_to_ecef
+
+    ecef = geodetic_to_ecef(np.radians(truth["lat"]), np.radians(truth["lon"]),
+                            truth["alt"]).reshape(-1, 3)
+    ned = ecef_to_ned(ecef, np.radians(truth["lat"].iloc[0]), np.radians(truth["lon"].iloc[0]),
+                      truth["alt"].iloc[0])
+    t = truth["t"].to_numpy()
+    v_pos = np.diff(ned[:, :2], axis=0) / np.diff(t)[:, None]
+    v_mid = 0.5 * (truth[["vn", "ve"]].to_numpy()[1:] + truth[["vn", "ve"]].to_numpy()[:-1])
+    assert np.median(np.linalg.norm(v_pos - v_mid, axis=1)) < 0.3
+    assert main(["estimate", str(dataset.path), "-e", "gnss_wls", "-o",
+                 str(tmp_path / "w.parquet")]) == 2
