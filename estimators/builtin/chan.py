@@ -237,7 +237,8 @@ class _TightlyCoupled(Estimator):
             self._next_nhc += 1.0 / self.config["nhc_rate"]
 
     def on_gnss_raw(self, t: float, block: np.ndarray) -> None:
-        ep = gnss_model.raw_epoch(block, self.columns["gnss_raw"])
+        cols = self.columns["gnss_raw"]
+        ep = gnss_model.raw_epoch(gnss_model.single_frequency(block, cols), cols)
         if not self._clock_started:
             self.start_clock(t, ep)
             self._clock_started = True

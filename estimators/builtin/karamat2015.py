@@ -337,7 +337,8 @@ class RissTcEkf(Estimator):
         rows = rows[np.isfinite(rows[:, self._col_pr])]
         if len(rows) == 0:
             return
-        self._update_ranges(gnss_model.raw_epoch(rows, self.columns["gnss_raw"]))
+        self._update_ranges(gnss_model.raw_epoch(gnss_model.single_frequency(
+            rows, self.columns["gnss_raw"]), self.columns["gnss_raw"]))
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         if self._tight:

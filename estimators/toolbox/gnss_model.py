@@ -38,8 +38,8 @@ The constants (speed of light, the GPS Earth rotation rate) are imported from th
 
 Public names
 ------------
-RawEpoch, raw_epoch, predict, los_jacobians, antenna_offset, clock_transition, clock_noise,
-correlated_noise_inflation, TCXO_H0, TCXO_H_MINUS2.
+RawEpoch, single_frequency, raw_epoch, predict, los_jacobians, antenna_offset, clock_transition,
+clock_noise, correlated_noise_inflation, TCXO_H0, TCXO_H_MINUS2.
 """
 
 from __future__ import annotations
@@ -78,20 +78,25 @@ class RawEpoch:
     range_rate_std: np.ndarray
 
 
-L1_FREQUENCY_HZ = 1575.42e6  # GPS L1, Galileo E1 (IS-GPS-200 3.3.1.1)
+L1_BAND_HZ = (1559e6, 1592e6)  # the L1/E1/B1 band (B1I 1561.098, L1/E1 1575.42 MHz)
+
+
+def single_frequency(block: np.ndarray, columns: Mapping[str, int]) -> np.ndarray:
+    """The rows of a ``gnss_raw`` epoch block in the L1/E1/B1 band (all rows of a stream
+    without ``frequency``): what a single-frequency filter takes from a receiver that tracks
+    several signals per satellite (each row's ``iono`` is that of its own frequency)."""
+    if "frequency" not in columns:
+        return block
+    f = block[:, columns["frequency"]]
+    return block[(f > L1_BAND_HZ[0]) & (f < L1_BAND_HZ[1])]
 
 
 def raw_epoch(block: np.ndarray, columns: Mapping[str, int]) -> RawEpoch:
     """Corrected measurements of a ``gnss_raw`` epoch block (rows = satellites) whose column
     positions are ``columns`` (the replay's ``self.columns["gnss_raw"]``). Rows of unhealthy
-    satellites (``health`` not 0, where the stream has the column) are left out, and of a
-    receiver tracking several signals only the L1/E1 ones (``frequency`` 1575.42 MHz) are kept:
-    the single-frequency measurement these models take (the broadcast ionosphere ``iono`` is
-    that of each signal's own frequency)."""
+    satellites (``health`` not 0, where the stream has the column) are left out."""
     if "health" in columns:
         block = block[block[:, columns["health"]] == 0]
-    if "frequency" in columns:
-        block = block[block[:, columns["frequency"]] == L1_FREQUENCY_HZ]
     def c(name: str) -> np.ndarray:
         return block[:, columns[name]]
 
