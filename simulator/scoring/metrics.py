@@ -78,6 +78,7 @@ from simulator.scoring.align import (
     sensor_error_name,
 )
 from simulator.scoring.align import solution_errors as _solution_errors
+from simulator.scoring.consistency import AXES, BLOCKS, block_nees, consistency_scores, nis_scores
 
 OUTAGE_KIND = "gnss_outage"  # events.parquet kind of a stretch without any GNSS measurement
 DEGRADED_KINDS = ("gnss_satellite_limit", "gnss_multipath")  # fault kinds that limit GNSS
@@ -85,8 +86,6 @@ CANYON = "canyon"  # the kind of a degraded window made by a zone with an urban-
 COVERAGE_PERIODS = 1.5  # a moment is covered when a row lies within this many output periods
 NEES_DOF = 3  # degrees of freedom of each NEES group (three axes)
 _STD = tuple(col.SOLUTION_STD)
-_NEES_GROUPS = {"position": (ERR_POS, _STD[0:3]), "velocity": (ERR_VEL, _STD[3:6]),
-                "attitude": (ERR_ATT, _STD[6:9])}
 
 
 def _number(x: float) -> float | None:
@@ -196,14 +195,10 @@ def _sensor_errors(e: pd.DataFrame) -> dict:
 
 def _nees(errors: pd.DataFrame) -> dict:
     out: dict = {}
-    for group, (err_names, std_names) in _NEES_GROUPS.items():
-        if not set(std_names) <= set(errors.columns):
-            out[group] = None
-            continue
-        e = errors[list(err_names)].to_numpy(float)
-        s = errors[list(std_names)].to_numpy(float)
-        ok = np.isfinite(e).all(axis=1) & np.isfinite(s).all(axis=1) & (s > 0).all(axis=1)
-        out[group] = _number(np.mean(np.sum((e[ok] / s[ok]) ** 2, axis=1))) if ok.any() else None
+    for block in BLOCKS:
+        nees = block_nees(errors, block)
+        has = all(AXES[axis][1] in errors for axis in block.axes)
+        out[block.name] = _number(np.nanmean(nees)) if has and np.isfinite(nees).any() else None
     out["expected"] = float(NEES_DOF)
     return out
 
@@ -262,6 +257,10 @@ def score_errors(errors: SolutionErrors, truth: pd.DataFrame, events: pd.DataFra
         scores["sensor_errors"] = sensor_errors
     if any(name in e.columns for name in _STD):
         scores["nees"] = _nees(e)
+        scores["consistency"] = consistency_scores(e)
+    nis = nis_scores(e)
+    if nis is not None:
+        scores["nis"] = nis
     if runtime is not None:
         scores["runtime"] = {"seconds": _number(runtime["runtime_s"]),
                              "realtime_factor": _number(runtime["realtime_factor"])}
