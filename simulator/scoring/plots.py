@@ -12,7 +12,8 @@ limits, multipath, canyon zones) of the events table.
 * ``position_errors``: north, east and down errors against time, with the solution's +-3 sigma
   (``std_n, std_e, std_d``) as a band where it has them;
 * ``attitude_errors``: roll, pitch and yaw errors (deg), +-3 sigma where ``std_roll...`` exist;
-  the legend names every solution (also one without roll); the y-range of each error panel
+  the legend names every solution (also one without roll, and one without any attitude as
+  "not estimated"); the y-range of each error panel
   follows the errors (at most ``BAND_RANGE`` times the largest error), so a huge sigma band
   does not flatten them;
 * ``nees``: one panel per consistency block (position, velocity, attitude; horizontal and yaw
@@ -45,6 +46,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.ticker import FuncFormatter
 
 from simulator.scoring.align import ERR_ATT, ERR_H, ERR_POS, local_ned
@@ -241,6 +243,9 @@ def _error_panels(ev: Evaluation, path: Path, names: tuple[str, ...], stds: tupl
             legend.setdefault(label, handle)
         ax.set(ylabel=f"{title} ({unit})")
         ax.grid(alpha=0.3)
+    for label in ev.results:  # a solution with none of the axes is named as such
+        if label not in legend:
+            legend[f"{label}: not estimated"] = Line2D([], [], color=colours[label], ls=":")
     axes[0].set_title(heading)
     if legend:  # nothing to list when no solution has any of the axes
         axes[0].legend(list(legend.values()), list(legend), loc="upper left", fontsize="x-small",

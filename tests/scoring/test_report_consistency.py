@@ -42,8 +42,9 @@ def written(tmp_path_factory):
     planar[["std_n", "std_e"]] = 0.5
     planar["std_yaw"] = np.radians(2.0)
     exact = sub[list(ins.columns[:10])]
+    fixes = exact.assign(roll=np.nan, pitch=np.nan, yaw=np.nan)  # no attitude at all
     ev = score_solutions(ds, {"ins": (ins, None), "planar": (planar, None),
-                              "exact": (exact, None)})
+                              "exact": (exact, None), "fixes": (fixes, None)})
     (tmp / "report").mkdir()
     with saved_figures() as figures:
         text = write_report(tmp / "report", ev, "quickstart").read_text()
@@ -86,14 +87,15 @@ def test_attitude_legend_names_every_solution(written):
     _, _, figures = written
     legend = figures["attitude_errors"].axes[0].get_legend()
     labels = {t.get_text() for t in legend.get_texts()}
-    assert {"ins", "planar", "exact", "ins ±3σ"} <= labels  # planar has no roll
+    assert labels == {"GNSS outage", "ins", "ins ±3σ", "planar", "planar ±3σ", "exact",
+                      "fixes: not estimated"}  # planar has no roll, fixes no attitude
 
 
 def test_a_huge_sigma_band_does_not_flatten_the_errors(written):
     ev, _, figures = written
     yaw_axis = figures["attitude_errors"].axes[2]
     largest = max(np.nanmax(np.abs(np.degrees(r.errors.errors["err_yaw"])))
-                  for r in ev.results.values())
+                  for label, r in ev.results.items() if label != "fixes")
     low, high = yaw_axis.get_ylim()
     assert high == pytest.approx(-low)
     assert largest < high <= 3.0 * largest < 540.0
