@@ -58,7 +58,7 @@ from simulator.scoring.consistency import (
     consistency_blocks,
 )
 from simulator.scoring.evaluate import Evaluation
-from simulator.scoring.metrics import DEGRADED_KINDS, NEES_DOF, OUTAGE_KIND, degraded_windows
+from simulator.scoring.metrics import DEGRADED_KINDS, OUTAGE_KIND, degraded_windows
 
 MAX_WINDOW_PANELS = 6  # zoomed map panels, the longest windows first
 NEES_FLOOR = 1e-2  # lower end of the NEES plot's axis
@@ -70,7 +70,6 @@ _ERROR_MARGIN = 1.5  # an error panel's y-range is at least this many times the 
 ZOOM_RATIO = 20.0
 _OUTAGE_COLOUR, _DEGRADED_COLOUR = "tab:red", "tab:orange"
 _DPI = 110
-_NEES_BOUNDS = chi2_band(NEES_DOF)  # two-sided 95 % bounds of one epoch's 3-D NEES
 _STD_POS, _STD_ATT = ("std_n", "std_e", "std_d"), ("std_roll", "std_pitch", "std_yaw")
 
 

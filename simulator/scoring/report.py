@@ -75,13 +75,17 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> list[str]:
 
 
 def text_table(scores: dict[str, dict]) -> str:
-    """A compact fixed-width table of the main scores, one line per label (m, m/s, deg)."""
+    """A compact fixed-width table of the main scores, one line per label (m, m/s, deg); the
+    worst outage end error is ``no-row`` when the solution has no end error at some outage (it
+    would otherwise be the worst of the outages it spoke at)."""
     header = ["label", *(title for _, _, title in _TEXT_COLUMNS), "worst_outage_end_%"]
     rows = []
     for label, s in scores.items():
-        ends = [o["end_percent"] for o in s["outages"] or () if o["end_percent"] is not None]
+        outages = s["outages"] or ()
+        ends = [o["end_percent"] for o in outages if o["end_percent"] is not None]
+        silent = any(o["end_horizontal"] is None for o in outages)
         rows.append([label, *(format_number(_value(s, g, k)) for g, k, _ in _TEXT_COLUMNS),
-                     format_number(max(ends) if ends else None)])
+                     "no-row" if silent else format_number(max(ends) if ends else None)])
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
     return "\n".join("  ".join(c.rjust(w) if i else c.ljust(w)
                                for i, (c, w) in enumerate(zip(r, widths, strict=True)))

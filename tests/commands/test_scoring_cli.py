@@ -217,7 +217,8 @@ def test_run_with_a_bad_estimator_leaves_nothing(tmp_path, capsys):
     assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["quickstart.yaml"]
 
 
-def test_solution_cut_off_at_an_outage_start_has_no_end_error(dataset, shifted, tmp_path):
+def test_solution_cut_off_at_an_outage_start_has_no_end_error(dataset, shifted, tmp_path,
+                                                               capsys):
     """A solution that stops talking at an outage's start is not scored by its last row: its
     end error is missing (null), its coverage of the outage and of the drive drops."""
     a, b = OUTAGES[1]
@@ -236,3 +237,8 @@ def test_solution_cut_off_at_an_outage_start_has_no_end_error(dataset, shifted, 
     full = scores["full"]["outages"][1]
     assert full["end_horizontal"] == pytest.approx(5.0, abs=1e-5)
     assert full["coverage"]["fraction"] == pytest.approx(1.0)
+    # the printed table: its worst outage end is not the one outage it spoke at
+    lines = {line.split()[0]: line.split() for line in capsys.readouterr().out.splitlines()}
+    assert lines["silent"][-1] == "no-row"
+    assert float(lines["full"][-1]) == pytest.approx(
+        max(o["end_percent"] for o in scores["full"]["outages"]), abs=1e-3)
