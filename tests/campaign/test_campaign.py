@@ -153,6 +153,10 @@ def test_gnss_outage_scores_are_means_over_the_runs_outages(tmp_path):
         values = [np.nan if o[key] is None else o[key] for o in outages]
         assert row[f"outages.{key}"] == pytest.approx(np.mean(values), rel=1e-12, nan_ok=True)
     assert np.isnan(row["outages.end_horizontal"])
+    # the summary counts both runs as missing the end error, and the report says so
+    end = _group(_summary(out), "gnss_only")["scores"]["outages.end_horizontal"]
+    assert end == {"mean": None, "median": None, "p95": None, "count": 0, "missing": 2}
+    assert "- / - / - (2 missing)" in (out / "report.md").read_text()
     assert (out / "plots" / "outage_end.png").is_file()
 
 
