@@ -18,6 +18,8 @@ SUMMARIES = {
     "reproduce": "run the seed papers' experiments over seeds, judge each claim, report",
     "export": "write a dataset as RINEX 3.04, NMEA 0183 or a ROS 2 bag (MCAP)",
     "import": "turn a real recording into a dataset, its reference in place of the truth",
+    "twin": "write a scenario that drives the simulator along a dataset's reference",
+    "compare": "put two datasets' statistics side by side (a recording and its twin)",
     "schema": "print the JSON Schema of the scenario file (editor completion)",
     "presets": "list the sensor presets with their parameters",
 }

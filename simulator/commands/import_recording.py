@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import argparse
+import textwrap
 
 from simulator.commands import SUMMARIES
 
@@ -14,14 +15,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     kinds = "\n".join(f"  {name:10s} {text}" for name, (_, text) in KINDS.items())
     p = sub.add_parser(
         "import", help=SUMMARIES["import"], formatter_class=argparse.RawDescriptionHelpFormatter,
-        description="Turn a real recording into a landnav dataset: its streams in landnav's "
+        description=textwrap.fill(
+                    "Turn a real recording into a landnav dataset: its streams in landnav's "
                     "files, columns and units (frames converted, every stream's own timestamps "
                     "kept), its reference trajectory as truth.parquet (the manifest says "
                     "\"reference\": true and where it came from), so that `landnav estimate` "
                     "and `landnav score` run on it unchanged; scores are then against that "
                     "reference. What a recording lacks (a broadcast ephemeris, a DOP) is NaN "
                     "and listed in the manifest, and an estimator that needs it is refused by "
-                    f"name.\n\nKINDS:\n{kinds}\n\nExample:\n  landnav import comma2k19 "
+                    "name.", 92) + f"\n\nKINDS:\n{kinds}\n\nExample:\n  landnav import comma2k19 "
                     "path/to/segment -o out/c2k19 && landnav score out/c2k19 -e ins_odo_ekf")
     p.add_argument("kind", metavar="KIND", choices=sorted(KINDS), help="the recording's kind")
     p.add_argument("sources", metavar="SOURCE", nargs="+", help="the recording's files/folder")

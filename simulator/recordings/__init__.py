@@ -7,6 +7,8 @@ Modules
 common      the reference as truth, the datasheet of the recording's sensors, writing
 comma2k19   comma2k19 segments (phone IMU, CAN speed, u-blox raw GNSS, comma's pose)
 gsdc        Google Smartphone Decimeter Challenge traces (device_gnss.csv, ground_truth.csv)
+smartloc    TU Chemnitz smartLoc traces (u-blox raw measurements, reference, NLOS labels)
+twin        a dataset's twin scenario
 
 Public names
 ------------
@@ -27,6 +29,12 @@ def _comma2k19(sources: list[str]) -> Recording:
     return read_comma2k19(sources)
 
 
+def _smartloc(sources: list[str]) -> Recording:
+    from simulator.recordings.smartloc import read_smartloc
+
+    return read_smartloc(sources)
+
+
 def _gsdc(sources: list[str]) -> Recording:
     from simulator.recordings.gsdc import read_gsdc
 
@@ -37,6 +45,7 @@ KINDS: dict[str, tuple[Callable[[list[str]], Recording], str]] = {
     "comma2k19": (_comma2k19, "a comma2k19 segment folder (processed_log/, global_pose/)"),
     "gsdc": (_gsdc, "a Google Smartphone Decimeter Challenge trace: device_gnss.csv and "
                     "ground_truth.csv (or the folder holding them)"),
+    "smartloc": (_smartloc, "a TU Chemnitz smartLoc CSV (u-blox raw, reference, NLOS labels)"),
 }
 
 

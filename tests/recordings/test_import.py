@@ -187,3 +187,89 @@ def test_bad_sources_give_one_message(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "Traceback" not in err and "global_pose" in err and "device_gnss.csv" in err
     assert not (tmp_path / "x").exists() and not (tmp_path / "y").exists()
+
+
+def test_twin_follows_the_reference_and_compare_reports_both(comma, tmp_path, capsys):
+    """The twin of the comma2k19 minute: its truth follows the recording's reference (the
+    recorded-trajectory fit), its sensors are the datasheet's presets at the recording's rates,
+    and `compare` reports every statistic on both with the plots."""
+    _, real = comma
+    scenario = tmp_path / "twin.yaml"
+    assert main(["twin", str(real.path), "-o", str(scenario)]) == 0
+    assert (tmp_path / "twin.drive.parquet").is_file()
+    assert main(["generate", str(scenario), "-o", str(tmp_path / "sim")]) == 0
+    sim = open_dataset(tmp_path / "sim")
+    assert pd.Timestamp(sim.manifest["utc_start"]) == pd.Timestamp(real.manifest["utc_start"])
+    for sensor in ("imu", "odometer", "gnss"):
+        assert sim.manifest["datasheet"][sensor]["preset"] == real.manifest["datasheet"][
+            sensor]["preset"]
+        assert sim.manifest["datasheet"][sensor]["rate"] == real.manifest["datasheet"][
+            sensor]["rate"]
+    ref, twin = real.read("truth"), sim.read("truth")
+    t = twin["t"].to_numpy()
+    inside = t <= ref["t"].iloc[-1] - ref["t"].iloc[0]
+    lat = np.radians(np.interp(t[inside] + ref["t"].iloc[0], ref["t"], ref["lat"]))
+    d_n = np.radians(twin["lat"].to_numpy()[inside]) - lat
+    d_e = (np.radians(twin["lon"].to_numpy()[inside])
+           - np.radians(np.interp(t[inside] + ref["t"].iloc[0], ref["t"], ref["lon"]))
+           ) * np.cos(lat)
+    assert np.median(6.371e6 * np.hypot(d_n, d_e)) < 1.0
+    report = tmp_path / "cmp"
+    assert main(["compare", str(real.path), str(sim.path), "--report", str(report),
+                 "-e", "gnss_only"]) == 0
+    text = (report / "report.md").read_text()
+    for statistic in ("imu.gyro_rms", "imu.accel_rms", "odometer.speed_error_std",
+                      "gnss.satellites_per_epoch_median", "gnss.cn0_p50", "gnss.fix_error_p95",
+                      "estimator.gnss_only_horizontal_rms_m", "Largest mismatches"):
+        assert statistic in text
+    for plot in ("imu_psd.png", "cn0.png", "fix_error.png"):
+        assert (report / plot).stat().st_size > 1000
+    assert "Look first at" in text
+
+
+def test_the_twin_of_a_simulated_drive_reproduces_its_statistics(quickstart, tmp_path):
+    """Closure: the twin of a simulated dataset (same presets, same sky, the trajectory refitted
+    from its truth, other random draws) matches it where the statistic is set by the models
+    rather than by the draws."""
+    from simulator.scoring.compare import compare_datasets
+
+    scenario = tmp_path / "twin.yaml"
+    assert main(["twin", str(quickstart.path), "-o", str(scenario)]) == 0
+    assert main(["generate", str(scenario), "-o", str(tmp_path / "sim")]) == 0
+    rows = {r["statistic"]: r for r in compare_datasets(
+        quickstart, open_dataset(tmp_path / "sim"), "gnss_only")["rows"]}
+    assert rows["gnss.satellites_per_epoch_median"]["ratio"] == 1.0
+    assert 0.97 < rows["gnss.cn0_p50_dbhz"]["ratio"] < 1.03
+    assert 0.8 < rows["odometer.speed_error_std_m_s"]["ratio"] < 1.25
+    assert 0.6 < rows["estimator.gnss_only_horizontal_rms_m"]["ratio"] < 1.6
+
+
+def test_smartloc_trace(tmp_path):
+    """The smartLoc excerpt: its GPS and GLONASS measurements with their NLOS labels, and the
+    heading convention (0 = east, counter-clockwise) checked against the reference's own
+    positions: the velocity from heading and speed matches the positions' differences."""
+    source = _refdata() / "vehicle" / "smartloc_berlin_2016-06-06" / "tu_chemnitz_berlin_1_raw.csv"
+    assert main(["import", "smartloc", str(source), "-o", str(tmp_path / "s")]) == 0
+    dataset = open_dataset(tmp_path / "s")
+    csv = pd.read_csv(source, sep=";")
+    raw = dataset.read("gnss_raw")
+    sbas = csv["GNSS identifier (gnssId) []"].str.upper() == "SBAS"
+    assert len(raw) == int((~sbas).sum()) - int(
+        (csv["Receiver tracking status (recStat) []"].isna()).sum())
+    assert set(raw["system"]) == {"G", "R"}
+    assert set(raw["nlos"].dropna()) <= {0.0, 1.0} and raw["nlos"].mean() > 0.2
+    np.testing.assert_allclose(raw["pseudorange_rate"] * raw["frequency"] / 299792458.0,
+                               -raw["doppler"])
+    truth = dataset.read("truth")
+    from simulator.earth import ecef_to_ned, geodetic_to_ecef
+
+    ecef = geodetic_to_ecef(np.radians(truth["lat"]), np.radians(truth["lon"]),
+                            truth["alt"]).reshape(-1, 3)
+    ned = ecef_to_ned(ecef, np.radians(truth["lat"].iloc[0]), np.radians(truth["lon"].iloc[0]),
+                      truth["alt"].iloc[0])
+    t = truth["t"].to_numpy()
+    v_pos = np.diff(ned[:, :2], axis=0) / np.diff(t)[:, None]
+    v_mid = 0.5 * (truth[["vn", "ve"]].to_numpy()[1:] + truth[["vn", "ve"]].to_numpy()[:-1])
+    assert np.median(np.linalg.norm(v_pos - v_mid, axis=1)) < 0.3
+    assert main(["estimate", str(dataset.path), "-e", "gnss_wls", "-o",
+                 str(tmp_path / "w.parquet")]) == 2
