@@ -81,8 +81,9 @@ def flatten_scores(scores: dict) -> dict[str, float]:
     ``outages.missing`` (the windows without an end error) and, for each per-window score, its
     mean over the windows, NaN when any window lacks it; a solution without GNSS has no outage
     columns. Nested groups flatten to ``sensor_errors.gyro_bias_z.rms``,
-    ``consistency.position.nse.n``; bookkeeping (``rows``, expected values, epoch counts) is
-    left out.
+    ``consistency.position.nse.n``; a list of numbers (``rtk.refix_times``) to its mean (NaN
+    when one is missing), ``.count`` and ``.missing``; bookkeeping (``rows``, expected values,
+    epoch counts) is left out.
     """
     out: dict[str, float] = {}
     for group, value in scores.items():
@@ -93,12 +94,17 @@ def flatten_scores(scores: dict) -> dict[str, float]:
                 if (k in _SKIPPED_KEYS or f"{group}.{k}" in _SKIPPED
                         or (v is None and group in _BLOCK_GROUPS)):
                     continue
-                if isinstance(v, dict):
+                if isinstance(v, dict | list):
                     out.update(flatten_scores({f"{group}.{k}": v}))
                 else:
                     out[f"{group}.{k}"] = _number(v)
-        elif isinstance(value, list):
+        elif isinstance(value, list) and all(isinstance(e, dict) for e in value):
             out.update(_flatten_windows(group, value))
+        elif isinstance(value, list):  # numbers, None where missing (``rtk.refix_times``)
+            numbers = [{"value": v} for v in value]
+            out.update({f"{group}.count": float(len(value)),
+                        f"{group}.missing": float(sum(v is None for v in value)),
+                        group: _window_mean(numbers, "value")})
     return out
 
 

@@ -348,6 +348,14 @@ def test_flatten_scores_means_over_outages_and_counts_the_silent_ones():
     assert flat["outages.end_percent"] == pytest.approx(3.75)  # over the two that moved
 
 
+def test_flatten_scores_of_a_list_of_numbers_counts_the_missing_ones():
+    flat = flatten_scores({"rtk": {"fix_rate": 0.9, "refix_times": [1.0, None, 3.0]}})
+    assert flat["rtk.fix_rate"] == 0.9 and np.isnan(flat["rtk.refix_times"])
+    assert flat["rtk.refix_times.count"] == 3 and flat["rtk.refix_times.missing"] == 1
+    flat = flatten_scores({"rtk": {"refix_times": [1.0, 3.0]}})
+    assert flat["rtk.refix_times"] == 2.0 and flat["rtk.refix_times.missing"] == 0
+
+
 @pytest.mark.parametrize("extra, message", [
     (["--sweep", "sensors.imu.rat=1,2"], "sensors.imu.rat: unknown key"),
     (["--sweep", "sensors.imu.rate=50,-1"], "--sweep: sensors.imu.rate: -1 must be greater"),
