@@ -6,8 +6,8 @@ Parquet field metadata. Extra columns a model adds must be declared here too.
 Public names
 ------------
 TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV, BARO, MAG, EVENTS, TRUTH_GNSS, STREAMS,
-IMU_AXES, SOLUTION, SOLUTION_STD, SENSOR_ERRORS, TRUTH_SENSORS, DATASET_FORMAT, REQUIRED,
-TEXT_COLUMNS.
+IMU_AXES, SOLUTION, SOLUTION_STD, SOLUTION_NIS, SENSOR_ERRORS, TRUTH_SENSORS, DATASET_FORMAT,
+REQUIRED, TEXT_COLUMNS.
 """
 
 from __future__ import annotations
@@ -88,6 +88,9 @@ SOLUTION_STD = {
     "std_n": "m", "std_e": "m", "std_d": "m", "std_vn": "m/s", "std_ve": "m/s", "std_vd": "m/s",
     "std_roll": "rad", "std_pitch": "rad", "std_yaw": "rad",
 }
+# optional: the normalised innovation squared of the GNSS update applied at a row (v^T S^-1 v)
+# and its degrees of freedom (the number of measurements); NaN on rows without an update
+SOLUTION_NIS = {"nis_gnss": "1", "nis_gnss_dof": "1"}
 
 # estimated sensor errors (SPEC section 7), the same names in a solution and in
 # truth_sensors.parquet: IMU errors on the unit's own axes (FRD), measured minus true; scale
