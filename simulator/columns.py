@@ -5,9 +5,9 @@ Parquet field metadata. Extra columns a model adds must be declared here too.
 
 Public names
 ------------
-TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV, BARO, MAG, EVENTS, TRUTH_GNSS, STREAMS,
-IMU_AXES, SOLUTION, SOLUTION_STD, SENSOR_ERRORS, TRUTH_SENSORS, DATASET_FORMAT, REQUIRED,
-TEXT_COLUMNS.
+TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV_KEPLER, GNSS_NAV, BARO, MAG, EVENTS,
+TRUTH_GNSS, STREAMS, IMU_AXES, SOLUTION, SOLUTION_STD, SENSOR_ERRORS, TRUTH_SENSORS,
+DATASET_FORMAT, REQUIRED, TEXT_COLUMNS.
 """
 
 from __future__ import annotations
@@ -68,12 +68,21 @@ TRUTH_GNSS = {
 
 # broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of GPS week
 # ``week`` (toc may fall just outside [0, 604800) when the clock epoch is in the adjacent week)
-GNSS_NAV = {
+GNSS_NAV_KEPLER = {
     "sv": "1", "week": "1", "toe": "s", "toc": "s",
     "af0": "s", "af1": "s/s", "af2": "s/s^2", "tgd": "s", "iode": "1", "health": "1",
     "sqrt_a": "m^0.5", "e": "1", "i0": "rad", "omega0": "rad", "omega": "rad", "m0": "rad",
     "delta_n": "rad/s", "omega_dot": "rad/s", "idot": "rad/s",
     "cuc": "rad", "cus": "rad", "crc": "m", "crs": "m", "cic": "rad", "cis": "rad",
+}
+# every system's broadcast parameters: the Keplerian ones (GPS, QZSS, Galileo, BeiDou), the
+# system letter, the second group delay (Galileo BGD E5b/E1, BeiDou TGD2), Galileo's data
+# source, and GLONASS's state vector at t_b (PZ-90) with its frequency channel
+# (simulator.gnss.navfiles says what each holds per system)
+GNSS_NAV = {
+    "system": "", **GNSS_NAV_KEPLER, "tgd2": "s", "data_source": "1",
+    "glo_x": "m", "glo_y": "m", "glo_z": "m", "glo_vx": "m/s", "glo_vy": "m/s", "glo_vz": "m/s",
+    "glo_ax": "m/s^2", "glo_ay": "m/s^2", "glo_az": "m/s^2", "glo_channel": "1",
 }
 
 BARO = {"t": "s", "pressure": "Pa", "altitude": "m"}
@@ -130,11 +139,11 @@ REQUIRED = {
     "gnss_raw": ("t", "sv", "pseudorange", "pseudorange_rate", "doppler", "cn0", "sat_x",
                  "sat_y", "sat_z", "sat_vx", "sat_vy", "sat_vz", "sat_clock", "sat_clock_drift",
                  "iono", "tropo", "elevation", "azimuth"),
-    "gnss_nav": tuple(GNSS_NAV),
+    "gnss_nav": tuple(GNSS_NAV_KEPLER),
     "baro": ("t", "pressure"),
     "mag": ("t", "mag_x", "mag_y", "mag_z"),
     "events": tuple(EVENTS),
     "truth_gnss": ("t", "sv"),
     "truth_sensors": ("t",),
 }
-TEXT_COLUMNS = ("zone", "kind", "detail")  # every other column of a stream is numeric
+TEXT_COLUMNS = ("zone", "kind", "detail", "system")  # every other column of a stream is numeric

@@ -75,9 +75,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from simulator import columns as col
 from simulator.gnss.constants import MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, SECONDS_PER_WEEK
 from simulator.gnss.navfiles import read_yuma
+from simulator.gnss.nominal import circular_records
 from simulator.timebase import GPS_EPOCH, utc_to_gps
 
 if TYPE_CHECKING:
@@ -162,8 +162,6 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     pandas.DataFrame
         The navigation table (``simulator.columns.GNSS_NAV``).
     """
-    import pandas as pd
-
     slots = nominal_slots(expanded)
     week, tow = utc_to_gps(utc)
     first = np.floor(tow / interval_s) * interval_s
@@ -176,22 +174,9 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     node_lon = (raan0[:, None] - GHA_EPOCH_RAD
                 - (OMEGA_E_DOT_RAD_S - RAAN_RATE_RAD_S) * since[None, :])
     arg_lat = arg_lat0[:, None] + MEAN_MOTION_RAD_S * since[None, :]
-    toe_week = np.floor(toe_abs / SECONDS_PER_WEEK)
-    toe = toe_abs - toe_week * SECONDS_PER_WEEK
-    n_slot, n_toe = node_lon.shape
-    nav = pd.DataFrame(0.0, index=range(n_slot * n_toe), columns=list(col.GNSS_NAV))
-    nav["sv"] = np.repeat(slots["prn"].to_numpy(), n_toe)
-    nav["week"] = np.tile(toe_week, n_slot).astype(int)
-    nav["toe"] = nav["toc"] = np.tile(toe, n_slot)
-    nav["iode"] = np.tile(np.arange(n_toe) % 256, n_slot)
-    nav["health"] = 0
-    nav["sqrt_a"] = (MU_GPS_M3_S2 / MEAN_MOTION_RAD_S**2) ** (1.0 / 6.0)
-    nav["i0"] = INCLINATION_RAD
-    # broadcast convention: node longitude at toe = omega0 - omega_e * toe (IS-GPS-200 20-IV)
-    nav["omega0"] = np.angle(np.exp(1j * (node_lon + OMEGA_E_DOT_RAD_S * toe[None, :]))).ravel()
-    nav["m0"] = np.angle(np.exp(1j * arg_lat)).ravel()  # omega = 0: M0 is the arg. of latitude
-    nav["omega_dot"] = RAAN_RATE_RAD_S
-    nav = nav.astype({"sv": int, "week": int, "iode": int, "health": int})
+    a_m = (MU_GPS_M3_S2 / MEAN_MOTION_RAD_S**2) ** (1.0 / 3.0)
+    nav = circular_records("G", slots["prn"].to_numpy(), node_lon, arg_lat, toe_abs, a_m,
+                           INCLINATION_RAD, RAAN_RATE_RAD_S)
     return nav
 
 
