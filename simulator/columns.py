@@ -38,7 +38,9 @@ GNSS_FIX = {
 }
 
 GNSS_RAW = {
-    "t": "s", "sv": "1", "pseudorange": "m", "pseudorange_rate": "m/s", "doppler": "Hz",
+    # system: the RINEX letter (G, E, C, R, J); sv is the PRN (GLONASS: slot) within it
+    "t": "s", "sv": "1", "system": "", "pseudorange": "m", "pseudorange_rate": "m/s",
+    "doppler": "Hz",
     "cn0": "dB-Hz", "sat_x": "m", "sat_y": "m", "sat_z": "m",
     "sat_vx": "m/s", "sat_vy": "m/s", "sat_vz": "m/s",
     "sat_clock": "m", "sat_clock_drift": "m/s", "iono": "m", "tropo": "m",
@@ -58,7 +60,7 @@ GNSS_RAW = {
 # (multipath and code_noise as the receiver delivers them, after its carrier smoothing;
 # code_noise then holds the smoothing's ionosphere divergence too: simulator.gnss.errors)
 TRUTH_GNSS = {
-    "t": "s", "sv": "1", "tracked": "1", "los": "1", "nlos": "1",
+    "t": "s", "sv": "1", "system": "", "tracked": "1", "los": "1", "nlos": "1",
     "elevation": "rad", "azimuth": "rad", "range": "m", "range_rate": "m/s",
     "receiver_clock": "m", "receiver_clock_drift": "m/s",
     "iono_true": "m", "tropo_true": "m", "iono_true_rate": "m/s", "tropo_true_rate": "m/s",

@@ -7,7 +7,7 @@ user algorithm and must be used there even where they coincide with the WGS-84 v
 
 Public names
 ------------
-C_M_S, F_L1_HZ, LAMBDA_L1_M, CHIP_L1CA_M, MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, F_REL_S_SQRTM,
+C_M_S, F_L1_HZ, LAMBDA_L1_M, F_B1I_HZ, CHIP_L1CA_M, MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, F_REL_S_SQRTM,
 SECONDS_PER_WEEK, MU_GAL_M3_S2, OMEGA_E_GAL_RAD_S, MU_BDS_M3_S2, OMEGA_E_BDS_RAD_S,
 MU_GLO_M3_S2, OMEGA_E_GLO_RAD_S, A_E_GLO_M, J2_GLO, KEPLER_CONSTANTS, relativistic_constant.
 
@@ -31,6 +31,7 @@ from simulator.timebase import SECONDS_PER_WEEK
 C_M_S = 299792458.0  # speed of light in vacuum, m/s (IS-GPS-200 20.3.4.3)
 F_L1_HZ = 1575.42e6  # L1 carrier frequency, Hz (154 x 10.23 MHz)
 LAMBDA_L1_M = C_M_S / F_L1_HZ  # L1 carrier wavelength, m (0.1903 m)
+F_B1I_HZ = 1561.098e6  # BeiDou B1I carrier, Hz (BDS SIS ICD B1I 3.0, 3.2); Galileo E1 = L1
 CHIP_L1CA_M = C_M_S / 1.023e6  # C/A-code chip length, m (293.05 m)
 MU_GPS_M3_S2 = 3.986005e14  # GPS value of the Earth's gravitational constant, m^3/s^2 (Table 20-IV)
 OMEGA_E_DOT_RAD_S = 7.2921151467e-5  # GPS value of the Earth rotation rate, rad/s (Table 20-IV)
@@ -59,7 +60,8 @@ def relativistic_constant(mu_m3_s2: float) -> float:
 
 
 __all__ = [
-    "C_M_S", "F_L1_HZ", "LAMBDA_L1_M", "CHIP_L1CA_M", "MU_GPS_M3_S2", "OMEGA_E_DOT_RAD_S",
+    "C_M_S", "F_L1_HZ", "LAMBDA_L1_M", "F_B1I_HZ", "CHIP_L1CA_M", "MU_GPS_M3_S2",
+    "OMEGA_E_DOT_RAD_S",
     "F_REL_S_SQRTM", "SECONDS_PER_WEEK", "MU_GAL_M3_S2", "OMEGA_E_GAL_RAD_S", "MU_BDS_M3_S2",
     "OMEGA_E_BDS_RAD_S", "MU_GLO_M3_S2", "OMEGA_E_GLO_RAD_S", "A_E_GLO_M", "J2_GLO",
     "KEPLER_CONSTANTS", "relativistic_constant",

@@ -44,8 +44,8 @@ solution); a record without a usable orbit (square root of the semi-major axis b
 Public names
 ------------
 EPHEMERIS_FIT_INTERVAL_S, EPHEMERIS_MAX_AGE_S, MAX_AGE_S, MIN_SQRT_A, MIN_RADIUS_M,
-BEIDOU_GEO_PRNS, SYSTEM_CODES, system_codes, ephemeris_arrays, select_ephemeris, gather,
-satellite_state.
+BEIDOU_GEO_PRNS, SYSTEM_CODES, system_codes, primary_frequency_hz, ephemeris_arrays,
+select_ephemeris, gather, satellite_state.
 
 References
 ----------
@@ -64,8 +64,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from simulator.gnss.constants import KEPLER_CONSTANTS, SECONDS_PER_WEEK, relativistic_constant
-from simulator.gnss.glonass import GLONASS_MAX_AGE_S, StateTable
+from simulator.gnss.constants import (
+    F_B1I_HZ,
+    F_L1_HZ,
+    KEPLER_CONSTANTS,
+    SECONDS_PER_WEEK,
+    relativistic_constant,
+)
+from simulator.gnss.glonass import GLONASS_MAX_AGE_S, StateTable, carrier_frequencies_hz
 from simulator.gnss.timesystems import BDS_WEEK_OFFSET, BDT_MINUS_GPST_S, offset_polynomials
 
 if TYPE_CHECKING:
@@ -82,6 +88,15 @@ SYSTEM_CODES = "GJECR"  # integer code of each system in the arrays (its index h
 _KEPLER_ITERATIONS = 8  # Newton steps on Kepler's equation: below 1e-15 rad for e < 0.1
 _GEO_TILT_RAD = np.radians(-5.0)  # BDS SIS ICD 5.2.4.12: R_X(-5 deg)
 _R = SYSTEM_CODES.index("R")
+
+
+def primary_frequency_hz(system: np.ndarray, channel: np.ndarray) -> np.ndarray:
+    """Carrier frequency (Hz) of each satellite's primary signal, the one ``clock_s`` is for:
+    GPS/QZSS L1 and Galileo E1 1575.42 MHz, BeiDou B1I 1561.098 MHz, GLONASS G1 on its FDMA
+    channel (``glonass.carrier_frequencies_hz``)."""
+    system = np.asarray(system)
+    g1, _ = carrier_frequencies_hz(channel)
+    return np.where(system == "R", g1, np.where(system == "C", F_B1I_HZ, F_L1_HZ))
 
 
 def system_codes(system: np.ndarray) -> np.ndarray:
@@ -335,5 +350,6 @@ def _beidou_geo_to_ecef(pos: np.ndarray, vel: np.ndarray, angle: np.ndarray,
 
 
 __all__ = ["EPHEMERIS_FIT_INTERVAL_S", "EPHEMERIS_MAX_AGE_S", "MAX_AGE_S", "MIN_SQRT_A",
-           "MIN_RADIUS_M", "BEIDOU_GEO_PRNS", "SYSTEM_CODES", "system_codes", "ephemeris_arrays",
+           "MIN_RADIUS_M", "BEIDOU_GEO_PRNS", "SYSTEM_CODES", "system_codes",
+           "primary_frequency_hz", "ephemeris_arrays",
            "select_ephemeris", "gather", "satellite_state"]
