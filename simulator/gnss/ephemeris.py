@@ -12,7 +12,7 @@ The receiver's one call (arrays of shape S, e.g. satellites x epochs):
 
     eph = ephemeris_arrays(nav, week0)                 # once per navigation table
     idx = select_ephemeris(eph, sv, t, system=system)  # record of each (system, sv) at t
-    state = satellite_state(gather(eph, idx), t_tx)    # pos, vel, clocks at transmit times
+    state = satellite_state(gather(eph, idx, STATE_KEYS), t_tx)  # pos, vel, clocks at t_tx
 
 ``satellite_state`` returns per element ``pos``, ``vel`` (ECEF of the transmit time: WGS-84 /
 CGCS2000 / PZ-90, all within centimetres of ITRF), ``clock_s`` (the satellite clock offset from
@@ -44,8 +44,8 @@ solution); a record without a usable orbit (square root of the semi-major axis b
 Public names
 ------------
 EPHEMERIS_FIT_INTERVAL_S, EPHEMERIS_MAX_AGE_S, MAX_AGE_S, MIN_SQRT_A, MIN_RADIUS_M,
-BEIDOU_GEO_PRNS, SYSTEM_CODES, system_codes, primary_frequency_hz, ephemeris_arrays,
-select_ephemeris, gather, satellite_state.
+BEIDOU_GEO_PRNS, SYSTEM_CODES, STATE_KEYS, system_codes, primary_frequency_hz,
+ephemeris_arrays, select_ephemeris, gather, satellite_state.
 
 References
 ----------
@@ -88,6 +88,7 @@ SYSTEM_CODES = "GJECR"  # integer code of each system in the arrays (its index h
 _KEPLER_ITERATIONS = 8  # Newton steps on Kepler's equation: below 1e-15 rad for e < 0.1
 _GEO_TILT_RAD = np.radians(-5.0)  # BDS SIS ICD 5.2.4.12: R_X(-5 deg)
 _R = SYSTEM_CODES.index("R")
+_BLOCK = 16384  # elements evaluated together by satellite_state
 
 
 def primary_frequency_hz(system: np.ndarray, channel: np.ndarray) -> np.ndarray:
@@ -184,9 +185,8 @@ def select_ephemeris(eph: dict[str, np.ndarray], sv: np.ndarray, t_s: np.ndarray
     -------
     ndarray of int, the broadcast shape of sv, t_s and system; -1 where no record qualifies.
     """
-    sv, t_s, system = np.broadcast_arrays(np.asarray(sv, dtype=int),
-                                          np.asarray(t_s, dtype=float), np.asarray(system))
-    code = system_codes(system)
+    sv, t_s, code = np.broadcast_arrays(np.asarray(sv, dtype=int),
+                                        np.asarray(t_s, dtype=float), system_codes(system))
     usable = _usable(eph)
     good = np.flatnonzero(usable & (eph["health"] == 0) if healthy_only else usable)
     span = 4.0 * SECONDS_PER_WEEK  # keys of different satellites never interleave
@@ -211,11 +211,20 @@ def select_ephemeris(eph: dict[str, np.ndarray], sv: np.ndarray, t_s: np.ndarray
     return np.where(ok, idx, -1)
 
 
-def gather(eph: dict[str, np.ndarray], idx: np.ndarray) -> dict[str, np.ndarray]:
-    """The parameters of records ``idx`` (any shape; -1 entries give record 0); the GLONASS
-    state table is passed on as it is."""
+# what ``satellite_state`` reads of a record: gather only these for large arrays of states
+STATE_KEYS = ("system", "sv", "system_code", "toe", "toe_s", "toc_s", "sqrt_a", "e", "i0",
+              "omega0", "omega", "m0", "delta_n", "omega_dot", "idot", "cuc", "cus", "crc",
+              "crs", "cic", "cis", "af0", "af1", "af2", "tgd", "group_delay", "mu", "omega_e",
+              "f_rel", "geo", "tsys_a0", "tsys_a1", "tsys_ref_s", "glonass_row", "glonass")
+
+
+def gather(eph: dict[str, np.ndarray], idx: np.ndarray,
+           keys: tuple[str, ...] | None = None) -> dict[str, np.ndarray]:
+    """The parameters of records ``idx`` (any shape; -1 entries give record 0), all of them or
+    only ``keys`` (e.g. ``STATE_KEYS``); the GLONASS state table is passed on as it is."""
     safe = np.where(idx < 0, 0, idx)
-    return {k: (v[safe] if isinstance(v, np.ndarray) else v) for k, v in eph.items()}
+    chosen = eph if keys is None else {k: eph[k] for k in keys if k in eph}
+    return {k: (v[safe] if isinstance(v, np.ndarray) else v) for k, v in chosen.items()}
 
 
 def satellite_state(eph: dict[str, np.ndarray], t_s: np.ndarray) -> dict[str, np.ndarray]:
@@ -245,6 +254,22 @@ def satellite_state(eph: dict[str, np.ndarray], t_s: np.ndarray) -> dict[str, np
         ``system_time_offset_s``: the system's time minus GPST beyond whole seconds (s).
     """
     t = np.broadcast_to(np.asarray(t_s, dtype=float), np.broadcast(eph["toe_s"], t_s).shape)
+    if t.size <= _BLOCK:
+        return _state(eph, t)
+    # in blocks of elements that stay in the processor's cache (twice as fast for an hour of
+    # 100 satellites at 1 Hz as one pass over the whole arrays)
+    flat = {k: (np.broadcast_to(v, t.shape).reshape(-1) if isinstance(v, np.ndarray) else v)
+            for k, v in eph.items()}
+    t_flat = t.reshape(-1)
+    blocks = [_state({k: (v[a:a + _BLOCK] if isinstance(v, np.ndarray) else v)
+                      for k, v in flat.items()}, t_flat[a:a + _BLOCK])
+              for a in range(0, t.size, _BLOCK)]
+    return {k: np.concatenate([b[k] for b in blocks]).reshape(t.shape + blocks[0][k].shape[1:])
+            for k in blocks[0]}
+
+
+def _state(eph: dict[str, np.ndarray], t: np.ndarray) -> dict[str, np.ndarray]:
+    """``satellite_state`` of parameters broadcast to the shape of ``t``."""
     codes = np.broadcast_to(eph.get("system_code", np.zeros((), dtype=int)), t.shape)
     glonass = codes == _R
     if glonass.all():
@@ -350,6 +375,6 @@ def _beidou_geo_to_ecef(pos: np.ndarray, vel: np.ndarray, angle: np.ndarray,
 
 
 __all__ = ["EPHEMERIS_FIT_INTERVAL_S", "EPHEMERIS_MAX_AGE_S", "MAX_AGE_S", "MIN_SQRT_A",
-           "MIN_RADIUS_M", "BEIDOU_GEO_PRNS", "SYSTEM_CODES", "system_codes",
+           "MIN_RADIUS_M", "BEIDOU_GEO_PRNS", "SYSTEM_CODES", "STATE_KEYS", "system_codes",
            "primary_frequency_hz", "ephemeris_arrays",
            "select_ephemeris", "gather", "satellite_state"]

@@ -95,6 +95,7 @@ from simulator.gnss.constellation import (
     sky_navigation,
 )
 from simulator.gnss.ephemeris import (
+    STATE_KEYS,
     ephemeris_arrays,
     gather,
     primary_frequency_hz,
@@ -544,7 +545,7 @@ def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.
     n = len(t_gps)
     step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
     cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
-    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
+    pos = satellite_state(gather(eph, idx[:, cols], STATE_KEYS), t_gps[None, cols])["pos"]
     lat, lon = ant["lat"][cols], ant["lon"][cols]
     up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
     rel = pos - ant["pos"][None, cols]
@@ -561,15 +562,16 @@ def _signals_in_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.nd
     -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
     n_sat, n_ep = idx.shape
     first = {k: v[:1] for k, v in ant.items()}
-    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
+    shapes = _signals(gather(eph, idx[:1, :1], STATE_KEYS), t_gps[:1], first, day_of_year[:1],
+                      alpha, beta)
     fill = {"elevation": -np.pi / 2, "zenith": 1.0}
     out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
     for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
         cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
         ant_c = {k: v[cols] for k, v in ant.items()}
         rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
-        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
-                        alpha, beta)
+        part = _signals(gather(eph, idx[rows, cols], STATE_KEYS), t_gps[cols], ant_c,
+                        day_of_year[cols], alpha, beta)
         for key in _KEPT:
             out[key][rows, cols] = part[key]
     return out
