@@ -1,6 +1,7 @@
-"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the GPS
-satellites in view, and the receiver's own fixes computed from them, so that a fix degrades
-exactly when and how the measurements do.
+"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the
+satellites in view (GPS, and with ``systems`` Galileo, BeiDou, GLONASS, QZSS, each on its
+primary signal: docs/gnss-systems.md), and the receiver's own fixes computed from them, so that
+a fix degrades exactly when and how the measurements do.
 
 Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
 ``constellation`` (``gps-almanac``, the default: the real GPS constellation of the shipped
