@@ -93,3 +93,33 @@ def test_slot_channels_match_a_real_receiver_header():
                                / "BRDM00DLR_S_20230730000_01D_MN.rnx"))
     glo = nav[nav["system"] == "R"].groupby("sv")["glo_channel"].first()
     assert all(SLOT_CHANNELS[slot] == channel for slot, channel in glo.items())
+
+
+def _d19(value: float) -> str:
+    """A RINEX 2 D19.12 field."""
+    mantissa, exponent = f"{value:.12E}".split("E")
+    return f"{mantissa}D{int(exponent):+03d}".rjust(19)
+
+
+def test_rinex2_glonass_file_reads_as_the_rinex3_record(tmp_path):
+    """R01's first record of refdata 1e written in the RINEX 2.11 GLONASS layout (Table A11:
+    two-digit year, the same fields) reads back to the same table row as the RINEX 3 file."""
+    nav3 = read_rinex_nav(_need(REF / "gnss/multignss_2023-03-14_gnss_lib_py"
+                                / "BRDM00DLR_S_20230730000_01D_MN.rnx"))
+    row = nav3[(nav3["system"] == "R") & (nav3["sv"] == 1)].iloc[0]
+    km = {k: row[k] / 1e3 for k in ("glo_x", "glo_y", "glo_z", "glo_vx", "glo_vy", "glo_vz",
+                                     "glo_ax", "glo_ay", "glo_az")}
+    header = ["     2.11           G: GLONASS NAV DATA                     RINEX VERSION / TYPE",
+              "                                                            END OF HEADER"]
+    body = [" 1 23  3 14  0 15  0.0" + _d19(row["af0"]) + _d19(row["af1"]) + _d19(172830.0),
+            "   " + _d19(km["glo_x"]) + _d19(km["glo_vx"]) + _d19(km["glo_ax"]) + _d19(0.0),
+            "   " + _d19(km["glo_y"]) + _d19(km["glo_vy"]) + _d19(km["glo_ay"]) + _d19(1.0),
+            "   " + _d19(km["glo_z"]) + _d19(km["glo_vz"]) + _d19(km["glo_az"]) + _d19(0.0)]
+    path = tmp_path / "brdc0730.23g"
+    path.write_text("\n".join(header + body) + "\n")
+    nav2 = read_rinex_nav(path)
+    assert len(nav2) == 1 and nav2["system"].iloc[0] == "R"
+    columns = ["sv", "week", "toe", "toc", "af0", "af1", "health", "iode", "glo_channel",
+               *km]
+    np.testing.assert_allclose(nav2[columns].iloc[0].to_numpy(dtype=float),
+                               row[columns].to_numpy(dtype=float), rtol=1e-12)
