@@ -39,7 +39,10 @@ GLONASST_MINUS_UTC_S = 3 * 3600.0  # GLONASST = UTC(SU) + 3 h
 # into (system time - GPST): GAGP (GPGA in RINEX 3.00-3.02) holds A0G, A1G of the GGTO, GST -
 # GPST (Galileo OS SIS ICD 5.1.8; refdata 1e confirms the sign: the Galileo clocks then agree
 # with CODE's within 0.8 m, 4.5 m with the other sign); GLGP is
-# tau_GPS = GPST - GLONASST (ICD 2008 4.5); BDGP and QZGP are system time - GPST (RINEX 3.04
+# tau_GPS = GPST - GLONASST (ICD 2008 4.5; GNSSTk's TimeSystemCorrection, an independent
+# reading, also adds it going from GLONASS to GPS time; refdata 1e cannot tell, its precise
+# GLONASS clocks carry the analysis' own system bias); BDGP and QZGP are system time - GPST
+# (BDS SIS ICD 5.2.4.19: t_GPS = t_BDT - (A0GPS + A1GPS t); RINEX 3.04
 # Table A5: "correction to transform the system time to GPS time").
 HEADER_OFFSET_SIGN: dict[str, tuple[tuple[str, ...], float]] = {
     "E": (("GAGP", "GPGA"), 1.0), "R": (("GLGP",), -1.0), "C": (("BDGP",), 1.0),
