@@ -8,11 +8,15 @@ exact in float64 and week crossovers need no special case. Each system's broadca
 moved onto that axis (``simulator.gnss.timesystems``: BDT = GPST - 14 s, BDT week 0 = GPS week
 1356; GLONASS t_b from UTC); an orbit is evaluated at t - toe, the same in either time scale.
 
-The receiver's one call (arrays of shape S, e.g. satellites x epochs):
+The receiver's one call (arrays broadcast to a shape S, e.g. satellites x epochs):
 
-    eph = ephemeris_arrays(nav, week0)                 # once per navigation table
-    idx = select_ephemeris(eph, sv, t, system=system)  # record of each (system, sv) at t
-    state = satellite_state(gather(eph, idx, STATE_KEYS), t_tx)  # pos, vel, clocks at t_tx
+    eph = ephemeris_arrays(nav, week0)                   # once per navigation table
+    state = satellites_at(eph, system, sv, t_tx)         # every satellite at its transmit time
+
+or, in steps (to keep the records fixed over the light-time iterations):
+
+    idx = select_ephemeris(eph, sv, t, system=system)    # record of each (system, sv) at t
+    state = satellite_state(gather(eph, idx, STATE_KEYS), t_tx)
 
 ``satellite_state`` returns per element ``pos``, ``vel`` (ECEF of the transmit time: WGS-84 /
 CGCS2000 / PZ-90, all within centimetres of ITRF), ``clock_s`` (the satellite clock offset from
@@ -23,7 +27,7 @@ clock and subtract another signal's instead; ``eph["tgd"]``/``eph["tgd2"]`` hold
 ``system_time_offset_s`` (the system's time minus GPST beyond whole seconds, from the file's
 ``TIME SYSTEM CORR``: a receiver without an inter-system bias in its clock model corrects the
 satellite clock by it). The system letter and number of each element are ``eph["system"]``
-and ``eph["sv"]`` of the gathered records.
+and ``eph["sv"]`` of the gathered records, returned again as ``system`` and ``sv``.
 
 Algorithms: GPS IS-GPS-200 Table 20-IV; QZSS IS-QZSS-PNT the same; Galileo OS SIS ICD 5.1.1
 (its own mu); BeiDou BDS SIS ICD B1I 5.2.4.12 (CGCS2000 mu and Omega_e; MEO and IGSO as GPS;
@@ -45,7 +49,7 @@ Public names
 ------------
 EPHEMERIS_FIT_INTERVAL_S, EPHEMERIS_MAX_AGE_S, MAX_AGE_S, MIN_SQRT_A, MIN_RADIUS_M,
 BEIDOU_GEO_PRNS, SYSTEM_CODES, STATE_KEYS, system_codes, primary_frequency_hz,
-ephemeris_arrays, select_ephemeris, gather, satellite_state.
+ephemeris_arrays, select_ephemeris, gather, satellite_state, satellites_at.
 
 References
 ----------
@@ -290,7 +294,29 @@ def _state(eph: dict[str, np.ndarray], t: np.ndarray) -> dict[str, np.ndarray]:
               else np.zeros(t.shape))
     return {"pos": pos, "vel": vel, "clock_s": clock, "clock_drift_s_s": drift,
             "relativistic_s": rel, "group_delay_s": np.broadcast_to(group_delay, t.shape),
-            "system_time_offset_s": np.broadcast_to(offset, t.shape)}
+            "system_time_offset_s": np.broadcast_to(offset, t.shape),
+            "system": np.broadcast_to(eph.get("system", "G"), t.shape),
+            "sv": np.broadcast_to(eph["sv"], t.shape)}
+
+
+def satellites_at(eph: dict[str, np.ndarray], system: np.ndarray, sv: np.ndarray,
+                  t_s: np.ndarray, healthy_only: bool = False,
+                  max_age_s: float | None = None) -> dict[str, np.ndarray]:
+    """The receiver's one call: broadcast states of satellites (``system``, ``sv``) at GPS
+    times ``t_s`` (all broadcast together, e.g. (n_sat, 1) against (n_sat, n_epoch) transmit
+    times), each from its record nearest in time (``select_ephemeris``).
+
+    Returns
+    -------
+    dict: ``satellite_state``'s arrays (with ``system`` and ``sv``), ``record`` (index in
+    ``eph``, -1 where none qualifies) and ``valid`` (record >= 0; elsewhere the values are
+    those of record 0 and mean nothing).
+    """
+    idx = select_ephemeris(eph, sv, t_s, max_age_s=max_age_s, healthy_only=healthy_only,
+                           system=system)
+    state = satellite_state(gather(eph, idx, STATE_KEYS), t_s)
+    state["record"], state["valid"] = idx, idx >= 0
+    return state
 
 
 def _keplerian(eph: dict[str, np.ndarray], t: np.ndarray, skip: np.ndarray
@@ -377,4 +403,4 @@ def _beidou_geo_to_ecef(pos: np.ndarray, vel: np.ndarray, angle: np.ndarray,
 __all__ = ["EPHEMERIS_FIT_INTERVAL_S", "EPHEMERIS_MAX_AGE_S", "MAX_AGE_S", "MIN_SQRT_A",
            "MIN_RADIUS_M", "BEIDOU_GEO_PRNS", "SYSTEM_CODES", "STATE_KEYS", "system_codes",
            "primary_frequency_hz", "ephemeris_arrays",
-           "select_ephemeris", "gather", "satellite_state"]
+           "select_ephemeris", "gather", "satellite_state", "satellites_at"]

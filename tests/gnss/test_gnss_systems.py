@@ -26,7 +26,13 @@ from test_gnss_orbits import REF, _need, read_sp3_positions
 
 from simulator.earth import ecef_to_geodetic
 from simulator.gnss.constants import C_M_S
-from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
+from simulator.gnss.ephemeris import (
+    ephemeris_arrays,
+    gather,
+    satellite_state,
+    satellites_at,
+    select_ephemeris,
+)
 from simulator.gnss.navfiles import read_rinex_nav
 from simulator.timebase import GPS_EPOCH
 
@@ -52,12 +58,15 @@ def _read_clock(path) -> pd.DataFrame:
 
 
 def _broadcast_at(nav: pd.DataFrame, table: pd.DataFrame) -> tuple[dict, np.ndarray]:
-    """Broadcast states of the rows of ``table`` (epoch, system, sv) that have a record."""
+    """Broadcast states of the rows of ``table`` (epoch, system, sv) that have a healthy
+    record, through the receiver's one call (``satellites_at``)."""
     eph = ephemeris_arrays(nav, WEEK)
     t = table["epoch"].to_numpy() - WEEK * 604800.0
-    idx = select_ephemeris(eph, table["sv"].to_numpy(), t, system=table["system"].to_numpy())
-    use = idx >= 0
-    return satellite_state(gather(eph, idx[use]), t[use]), use
+    system, sv = table["system"].to_numpy(), table["sv"].to_numpy()
+    state = satellites_at(eph, system, sv, t, healthy_only=True)
+    use = state["valid"]
+    assert (state["system"][use] == system[use]).all() and (state["sv"][use] == sv[use]).all()
+    return {k: v[use] for k, v in state.items()}, use
 
 
 def test_mixed_navigation_file_reads_as_georinex_reads_it():
