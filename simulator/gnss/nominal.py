@@ -141,20 +141,12 @@ def circular_records(system: str, prns: np.ndarray, node_lon: np.ndarray, arg_la
     -------
     pandas.DataFrame, the navigation table (``simulator.columns.GNSS_NAV``).
     """
-    import pandas as pd
-
     omega_e = KEPLER_CONSTANTS[system][1]
     sys_abs = toe_gps_abs + (BDT_MINUS_GPST_S - BDS_WEEK_OFFSET * SECONDS_PER_WEEK
                              if system == "C" else 0.0)
-    week = np.floor(sys_abs / SECONDS_PER_WEEK)
-    toe = sys_abs - week * SECONDS_PER_WEEK
     n_sat, n_toe = node_lon.shape
-    nav = pd.DataFrame(0.0, index=range(n_sat * n_toe), columns=list(col.GNSS_NAV))
-    nav["system"] = system
-    nav["sv"] = np.repeat(prns, n_toe)
-    nav["week"] = np.tile(week, n_sat)
-    nav["toe"] = nav["toc"] = np.tile(toe, n_sat)
-    nav["iode"] = np.tile(np.arange(n_toe) % 256, n_sat)
+    nav = _records(system, prns, sys_abs, np.arange(n_toe) % 256)
+    toe = sys_abs - np.floor(sys_abs / SECONDS_PER_WEEK) * SECONDS_PER_WEEK
 
     def per_sat(value: float | np.ndarray) -> np.ndarray:
         return np.repeat(np.broadcast_to(np.asarray(value, dtype=float), (n_sat,)), n_toe)
@@ -164,8 +156,27 @@ def circular_records(system: str, prns: np.ndarray, node_lon: np.ndarray, arg_la
     nav["omega_dot"] = per_sat(node_rate)
     nav["omega0"] = np.angle(np.exp(1j * (node_lon + omega_e * toe[None, :]))).ravel()
     nav["m0"] = np.angle(np.exp(1j * arg_lat)).ravel()
-    return nav.astype({c: int for c in ("sv", "week", "iode", "health", "data_source",
-                                        "glo_channel")})
+    return nav.astype({c: int for c in _INT_COLUMNS})
+
+
+_INT_COLUMNS = ("sv", "week", "iode", "health", "data_source", "glo_channel")
+
+
+def _records(system: str, prns: np.ndarray, toe_abs: np.ndarray, iode: np.ndarray
+             ) -> pd.DataFrame:
+    """An empty navigation table of satellites ``prns`` (rows) x record times ``toe_abs``
+    (seconds since the system's week 0), with system, sv, week, toe = toc and iode set."""
+    import pandas as pd
+
+    n_sat, n_toe = len(prns), len(toe_abs)
+    week = np.floor(toe_abs / SECONDS_PER_WEEK)
+    nav = pd.DataFrame(0.0, index=range(n_sat * n_toe), columns=list(col.GNSS_NAV))
+    nav["system"] = system
+    nav["sv"] = np.repeat(prns, n_toe)
+    nav["week"] = np.tile(week, n_sat)
+    nav["toe"] = nav["toc"] = np.tile(toe_abs - week * SECONDS_PER_WEEK, n_sat)
+    nav["iode"] = np.tile(iode, n_sat)
+    return nav
 
 
 def _toe_grid(utc: dt.datetime, span_s: float, interval_s: float, offset_s: float = 0.0
@@ -230,7 +241,6 @@ def nominal_glonass_navigation(utc: dt.datetime, span_s: float = 86400.0) -> pd.
     """The nominal GLONASS constellation (module docstring): state-vector records every 30 min
     covering ``span_s`` from ``utc``, one orbit per slot integrated through them (ICD 2008
     A.3.1.2, no lunisolar term) from the nominal circular state at the first t_b."""
-    import pandas as pd
 
     leap = leap_seconds(utc)
     # t_b on the UTC quarter hours (Moscow time is UTC + 3 h), as GPS seconds
@@ -255,20 +265,13 @@ def nominal_glonass_navigation(utc: dt.datetime, span_s: float = 86400.0) -> pd.
             state = rk4_step(state, no_lunisolar, STEP_S)
         states.append(state)
     states = np.stack(states, axis=1)  # (n_sat, n_toe, 6)
-    n_sat, n_toe = states.shape[:2]
-    week = np.floor(toe / SECONDS_PER_WEEK)
-    nav = pd.DataFrame(0.0, index=range(n_sat * n_toe), columns=list(col.GNSS_NAV))
-    nav["system"] = "R"
-    nav["sv"] = np.repeat(np.array(GLONASS.prns), n_toe)
-    nav["week"] = np.tile(week, n_sat)
-    nav["toe"] = nav["toc"] = np.tile(toe - week * SECONDS_PER_WEEK, n_sat)
+    n_toe = states.shape[1]
     moscow_s = (toe - leap + 3 * 3600.0) % 86400.0  # t_b in Moscow time of day
-    nav["iode"] = np.tile(moscow_s // 900, n_sat)
+    nav = _records("R", np.array(GLONASS.prns), toe, moscow_s // 900)
     for k, key in enumerate(("glo_x", "glo_y", "glo_z", "glo_vx", "glo_vy", "glo_vz")):
         nav[key] = states[..., k].ravel()
     nav["glo_channel"] = np.repeat([SLOT_CHANNELS[p] for p in GLONASS.prns], n_toe)
-    return nav.astype({c: int for c in ("sv", "week", "iode", "health", "data_source",
-                                        "glo_channel")})
+    return nav.astype({c: int for c in _INT_COLUMNS})
 
 
 def _rotation(node_lon: np.ndarray, inclination: float) -> np.ndarray:
