@@ -123,3 +123,24 @@ def test_rinex2_glonass_file_reads_as_the_rinex3_record(tmp_path):
                *km]
     np.testing.assert_allclose(nav2[columns].iloc[0].to_numpy(dtype=float),
                                row[columns].to_numpy(dtype=float), rtol=1e-12)
+
+
+def test_rinex305_glonass_records_have_a_fourth_line(tmp_path):
+    """RINEX 3.05 adds a status-flags line to each GLONASS record (Table A10): refdata 1e's
+    R01 and G01 records, the former given that line, read as in the 3.04 file."""
+    source = _need(REF / "gnss/multignss_2023-03-14_gnss_lib_py"
+                   / "BRDM00DLR_S_20230730000_01D_MN.rnx")
+    lines = source.read_text().splitlines()
+    end = next(i for i, x in enumerate(lines) if "END OF HEADER" in x)
+    r01 = next(i for i, x in enumerate(lines) if x.startswith("R01"))
+    g01 = next(i for i, x in enumerate(lines) if x.startswith("G01"))
+    header = [lines[0].replace("3.04", "3.05", 1)] + lines[1:end + 1]
+    flags = "    " + _d19(0.0) + _d19(0.0) + _d19(0.0) + _d19(0.0)
+    text = header + lines[r01:r01 + 4] + [flags] + lines[g01:g01 + 8]
+    (tmp_path / "v305.rnx").write_text("\n".join(text) + "\n")
+    got = read_rinex_nav(tmp_path / "v305.rnx").set_index(["system", "sv"])
+    want = read_rinex_nav(source).groupby(["system", "sv"]).first()
+    assert list(got.index) == [("G", 1), ("R", 1)]
+    for key in got.index:
+        np.testing.assert_allclose(got.loc[key, ["toe", "af0", "glo_x", "sqrt_a"]].to_numpy(float),
+                                   want.loc[key, ["toe", "af0", "glo_x", "sqrt_a"]].to_numpy(float))
