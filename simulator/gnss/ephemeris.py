@@ -181,7 +181,8 @@ def select_ephemeris(eph: dict[str, np.ndarray], sv: np.ndarray, t_s: np.ndarray
         Satellite numbers, times (GPS s since the start of the reference week) and RINEX
         system letters (default ``G``).
     max_age_s : float or None
-        Records with |t - toe| above this are not used (default: ``MAX_AGE_S`` of each system).
+        Records with |t - toe| above this are not used (default: ``MAX_AGE_S`` of each system;
+        GLONASS records never beyond theirs, the span their orbit is integrated over).
     healthy_only : bool
         Leave out records whose health is not 0.
 
@@ -205,11 +206,11 @@ def select_ephemeris(eph: dict[str, np.ndarray], sv: np.ndarray, t_s: np.ndarray
     left = np.clip(right - 1, 0, len(key) - 1)
     pick = np.where(np.abs(key[left] - query) <= np.abs(key[right] - query), left, right)
     idx = good[pick]
-    if max_age_s is None:
-        ages = np.array([MAX_AGE_S[c] for c in SYSTEM_CODES])
-        limit = ages[eph["system_code"][idx]]
-    else:
-        limit = max_age_s
+    ages = np.array([MAX_AGE_S[c] for c in SYSTEM_CODES])
+    picked = eph["system_code"][idx]
+    # a GLONASS record is integrated over its own age limit only: never used beyond it
+    limit = (ages[picked] if max_age_s is None
+             else np.where(picked == _R, np.minimum(max_age_s, ages[_R]), max_age_s))
     ok = ((eph["sv"][idx] == sv) & (eph["system_code"][idx] == code)
           & (np.abs(eph["toe_s"][idx] - t_s) <= limit))
     return np.where(ok, idx, -1)

@@ -144,3 +144,19 @@ def test_rinex305_glonass_records_have_a_fourth_line(tmp_path):
     for key in got.index:
         np.testing.assert_allclose(got.loc[key, ["toe", "af0", "glo_x", "sqrt_a"]].to_numpy(float),
                                    want.loc[key, ["toe", "af0", "glo_x", "sqrt_a"]].to_numpy(float))
+
+
+def test_glonass_records_are_never_used_beyond_their_integrated_span():
+    """Even when a caller allows older records (an almanac's week), a GLONASS record is not
+    selected beyond the +-30 min its orbit is integrated over."""
+    from simulator.gnss.ephemeris import ephemeris_arrays, select_ephemeris
+
+    nav = read_rinex_nav(_need(REF / "gnss/multignss_2023-03-14_gnss_lib_py"
+                               / "BRDM00DLR_S_20230730000_01D_MN.rnx"))
+    eph = ephemeris_arrays(nav, 2253)
+    last_tb = nav.loc[(nav["system"] == "R") & (nav["sv"] == 1), "toe"].max()
+    t = np.array([last_tb + GLONASS_MAX_AGE_S, last_tb + GLONASS_MAX_AGE_S + 1.0])
+    idx = select_ephemeris(eph, 1, t, max_age_s=7 * 86400.0, system="R")
+    assert idx[0] >= 0 and idx[1] == -1
+    gps = select_ephemeris(eph, 1, t + 86400.0, max_age_s=7 * 86400.0, system="G")
+    assert (gps >= 0).all()  # other systems take the caller's limit
