@@ -68,8 +68,9 @@ TRUTH_GNSS = {
     "rate_noise": "m/s", "antenna_x": "m", "antenna_y": "m", "antenna_z": "m",
 }
 
-# broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of GPS week
-# ``week`` (toc may fall just outside [0, 604800) when the clock epoch is in the adjacent week)
+# broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of week
+# ``week`` of the system's time (GPS; BDT for BeiDou; toc may fall just outside [0, 604800)
+# when the clock epoch is in the adjacent week)
 GNSS_NAV_KEPLER = {
     "sv": "1", "week": "1", "toe": "s", "toc": "s",
     "af0": "s", "af1": "s/s", "af2": "s/s^2", "tgd": "s", "iode": "1", "health": "1",
@@ -148,4 +149,5 @@ REQUIRED = {
     "truth_gnss": ("t", "sv"),
     "truth_sensors": ("t",),
 }
-TEXT_COLUMNS = ("zone", "kind", "detail", "system")  # every other column of a stream is numeric
+# every other column of a stream is numeric
+TEXT_COLUMNS = ("zone", "kind", "detail", "system", "signal")
