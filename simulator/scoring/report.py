@@ -206,10 +206,11 @@ def _plots(ev: Evaluation) -> list[tuple[str, str, Callable[[Evaluation, Path], 
         out.append(("horizontal_cdf", "CDF of horizontal error", plot.plot_horizontal_cdf))
     dataset = ev.dataset
     if dataset is not None and dataset.has("gnss_raw"):
-        raw = dataset.read("gnss_raw", ["t", "sv", "cn0", "elevation", "azimuth"])
+        # a measurement is named by its epoch, system (several systems) and satellite
+        keys = ["t", "system", "sv"] if "system" in dataset.units("gnss_raw") else ["t", "sv"]
+        raw = dataset.read("gnss_raw", [*keys, "cn0", "elevation", "azimuth"])
         if dataset.has("truth_gnss"):  # which signals were NLOS, from the truth
-            raw = raw.merge(dataset.read("truth_gnss", ["t", "sv", "nlos"]), on=["t", "sv"],
-                            how="left")
+            raw = raw.merge(dataset.read("truth_gnss", [*keys, "nlos"]), on=keys, how="left")
         fix = (dataset.read("gnss_fix", ["t", "num_sats", "hdop", "vdop"])
                if dataset.has("gnss_fix") else None)
         if len(raw):
