@@ -8,7 +8,7 @@ so that a constellation plugs in by (system, sv, signal, frequency).
 
 Public names
 ------------
-SYSTEMS, Signal, SIGNALS, PRESET_SIGNALS, PRIMARY_SIGNAL, signal, carrier_frequency_hz,
+Signal, SIGNALS, PRESET_SIGNALS, PRIMARY_SIGNAL, signal, carrier_frequency_hz,
 iono_factor, group_delay_factor, default_signals.
 
 References
@@ -38,7 +38,6 @@ import numpy as np
 from simulator.gnss.constants import F_L1_HZ
 
 F0_HZ = 10.23e6  # GPS fundamental frequency
-SYSTEMS = {"gps": "G", "galileo": "E", "beidou": "C", "glonass": "R", "qzss": "J"}
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,7 @@
-"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the GPS
-satellites in view, and the receiver's own fixes computed from them, so that a fix degrades
-exactly when and how the measurements do.
+"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the
+satellites in view (GPS, and with ``systems`` Galileo, BeiDou, GLONASS, QZSS, each on its
+primary signal: docs/gnss-systems.md), and the receiver's own fixes computed from them, so that
+a fix degrades exactly when and how the measurements do.
 
 Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
 ``constellation`` (``gps-almanac``, the default: the real GPS constellation of the shipped
@@ -63,7 +64,7 @@ the measurements.
 
 Public names
 ------------
-GNSS_FIELD, PRESETS, ERROR_FIELDS, SYSTEMS_WITH_ORBITS, resolve_signals, Gnss.
+GNSS_FIELD, PRESETS, ERROR_FIELDS, resolve_signals, Gnss.
 
 References
 ----------
@@ -94,11 +95,12 @@ from simulator.errors import InputError, Problem
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.constellation import (
     EXPANDABLE_SLOTS,
-    almanac_gps_navigation,
-    nominal_gps_navigation,
+    GPS_SKIES,
+    QZSS_WITHOUT_FILE,
+    missing_systems,
+    sky_navigation,
 )
 from simulator.gnss.ephemeris import (
-    EPHEMERIS_MAX_AGE_S,
     ephemeris_arrays,
     gather,
     select_ephemeris,
@@ -108,7 +110,8 @@ from simulator.gnss.errors import (
 )
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
-from simulator.gnss.signals import SIGNALS, SYSTEMS, default_signals
+from simulator.gnss.signals import SIGNALS, default_signals
+from simulator.gnss.timesystems import SYSTEMS
 from simulator.schema import (
     INVALID,
     Boolean,
@@ -158,10 +161,8 @@ PRESETS: dict[str, dict] = {
 # broadcast file brdc1190.21n (2021-04-29), a moderate solar-activity day
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
-# the systems whose orbits and clocks this receiver computes
-SYSTEMS_WITH_ORBITS = ("gps",)
 # the constellations known by name (anything else names a file)
-CONSTELLATIONS = ("gps-almanac", "nominal-gps")
+CONSTELLATIONS = GPS_SKIES
 ALMANAC_MAX_AGE_S = 7 * 86400.0  # a YUMA almanac file is used up to a week from its TOA
 # a zone the environment block does not describe, or describes in part: the schema's defaults
 _ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
@@ -232,6 +233,10 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
         return ctx.error(path + ("expanded_slots",), "only applies to constellation "
                                                      "'nominal-gps' (name it: the default is "
                                                      "'gps-almanac')")
+    if len(set(value["systems"])) < len(value["systems"]):
+        return ctx.error(path + ("systems",), "names a system more than once")
+    if source in CONSTELLATIONS and "qzss" in value["systems"]:
+        return ctx.error(path + ("systems",), QZSS_WITHOUT_FILE)
     if source not in CONSTELLATIONS:
         candidates = [FilePath(source)]
         if ctx.file and not FilePath(source).is_absolute():
@@ -243,26 +248,26 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
                              "existing RINEX navigation or YUMA almanac file")
         value["constellation"] = str(found[0].resolve())
         try:
-            read_navigation(found[0])
+            nav = read_navigation(found[0])
         except (ValueError, OSError) as exc:
             return ctx.error(path + ("constellation",), str(exc))
+        problem = missing_systems(nav, value["systems"], str(found[0]))
+        if problem:
+            return ctx.error(path + ("systems",), problem)
     if value["cn0_horizon"] > value["cn0_zenith"]:
         return ctx.error(path + ("cn0_horizon",), "must not exceed cn0_zenith")
     return resolve_signals(value, path, ctx)
 
 
 def resolve_signals(value: dict, path: Path, ctx: Context) -> dict:
-    """``systems`` known and with orbits, ``signals`` filled from the preset for each system
-    and known, ``carrier_phase`` defaulted to whether raw measurements are output."""
+    """``systems`` known and distinct (the rover's block has checked them against its sky),
+    ``signals`` filled from the preset for each system and known, ``carrier_phase`` defaulted
+    to whether raw measurements are output."""
     systems = value["systems"]
     unknown = [name for name in systems if name not in SYSTEMS]
     if unknown or not systems or len(set(systems)) < len(systems):
         return ctx.error(path + ("systems",), f"expected distinct names among "
                                               f"{', '.join(SYSTEMS)}, got {systems!r}")
-    without_orbits = [name for name in systems if name not in SYSTEMS_WITH_ORBITS]
-    if without_orbits:
-        return ctx.error(path + ("systems",), f"{', '.join(without_orbits)}: no orbit model "
-                                              f"yet (available: {', '.join(SYSTEMS_WITH_ORBITS)})")
     given = value["signals"] or {}
     extra = sorted(set(given) - set(systems))
     if extra:
@@ -294,6 +299,10 @@ GNSS_FIELD = Record(
                                   "2020-01-01, 31 satellites, re-epoched to the drive by whole "
                                   "ground-track repeats), 'nominal-gps' (the 24 SPS slots) or a "
                                   "RINEX navigation file or YUMA almanac"),
+        "systems": ListOf(Text(choices=list(SYSTEMS)), ["gps"], min_len=1,
+                          doc="satellite systems received: gps, galileo, beidou, glonass, "
+                              "qzss (from the named sky's nominal constellations, or from the "
+                              "navigation file, which must have them)"),
         "expanded_slots": ListOf(Text(choices=list(EXPANDABLE_SLOTS)), [],
                                  doc="expandable slots of 'nominal-gps' split into their fore/aft "
                                      "pairs (SPS PS 2008 Table 3.4-2); [B1, D2, F2] = 27 slots"),
@@ -301,8 +310,6 @@ GNSS_FIELD = Record(
                                  doc="satellites below it are not tracked"),
         "antenna_lever_arm": Vector(3, Number("m"), [0.0, 0.0, 0.0],
                                     doc="antenna position in the body frame (FRD) from the IMU"),
-        "systems": ListOf(Text(), ["gps"], min_len=1,
-                          doc="constellations tracked: gps, galileo, beidou, glonass, qzss"),
         "signals": MapOf(ListOf(Text()), None,
                          doc="per system, the RINEX 3 codes of the signals tracked, e.g. "
                              "{gps: [1C, 2W]}; default: the preset's "
@@ -348,18 +355,15 @@ class Gnss(PresetSensor):
 
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:
-        """The navigation table used for the drive (a named constellation or the named file)."""
+        """The navigation table used for the drive: the enabled systems of the named sky or of
+        the named file (``simulator.gnss.constellation.sky_navigation``)."""
         week0, _ = utc_to_gps(truth.utc_start)
-        if self.config["constellation"] == "gps-almanac":
-            nav = almanac_gps_navigation(truth.utc_start, truth.duration_s)
+        nav = sky_navigation(self.config["constellation"], self.config["systems"],
+                             truth.utc_start, truth.duration_s, self.config["expanded_slots"],
+                             reference_week=week0)
+        if self.config["constellation"] in CONSTELLATIONS:
             nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
-            return nav
-        if self.config["constellation"] == "nominal-gps":
-            nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0,
-                                         expanded=self.config["expanded_slots"])
-            nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
-            return nav
-        return read_navigation(self.config["constellation"], reference_week=week0)
+        return nav
 
     def antenna(self, truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
         """Antenna ECEF position and velocity, geodetic position, and heading at times t."""
@@ -435,16 +439,18 @@ class Gnss(PresetSensor):
         return los, nlos, extra, loss
 
     def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
-                        max_age_s: float) -> None:
+                        max_age_s: float | None) -> None:
         """A navigation file that does not cover the drive is an input error, not a silent
         outage: at least four satellites need an ephemeris at every epoch."""
         short = (idx >= 0).sum(axis=0) < 4
         if short.any():
             raise InputError([Problem(
                 self.config["constellation"], None, "sensors.gnss.constellation",
-                f"fewer than four satellites have an ephemeris within {max_age_s / 3600:g} h "
-                "(half the broadcast fit interval; older records are not used) "
-                f"of the drive from t = {t[short][0]:g} s (the drive starts "
+                "fewer than four satellites have an ephemeris within "
+                + (f"{max_age_s / 3600:g} h" if max_age_s else "its validity (half the "
+                   "broadcast fit interval: GPS and Galileo 2 h, BeiDou and QZSS 1 h, GLONASS "
+                   "30 min; older records are not used)")
+                + f" of the drive from t = {t[short][0]:g} s (the drive starts "
                 f"{truth.utc_start:%Y-%m-%d %H:%M:%S} UTC); use a navigation file of that "
                 "day or 'nominal-gps'")])
 
@@ -462,10 +468,11 @@ class Gnss(PresetSensor):
         # an almanac describes the orbits for days (coarsely); an ephemeris only within its fit
         # interval. Unhealthy satellites are tracked and flagged; the fixes leave them out.
         almanac = nav.attrs.get("kind") == "almanac"
-        max_age = ALMANAC_MAX_AGE_S if almanac else EPHEMERIS_MAX_AGE_S
-        svs = np.unique(nav["sv"].to_numpy())
+        max_age = ALMANAC_MAX_AGE_S if almanac else None  # None: each system's own
+        sats = nav[["system", "sv"]].drop_duplicates().sort_values(["system", "sv"])
+        systems, svs = sats["system"].to_numpy(dtype=str), sats["sv"].to_numpy(dtype=int)
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
-                               healthy_only=False)
+                               healthy_only=False, system=systems[:, None])
         self._check_coverage(idx, t, truth, max_age)
         gathered = gather(eph, idx)
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
@@ -473,7 +480,11 @@ class Gnss(PresetSensor):
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
         new_year = dt.datetime(truth.utc_start.year, 1, 1)
         day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
-        return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "t_gps": tow0 + t,
+        # each satellite's system and GLONASS frequency channel (the signals' frequencies)
+        channel = nav.groupby(["system", "sv"])["glo_channel"].first().loc[
+            list(zip(systems, svs, strict=True))].to_numpy()
+        return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "systems": systems,
+                "channel": np.nan_to_num(channel.astype(float)), "t_gps": tow0 + t,
                 "health": np.where(idx >= 0, gathered["health"], 0.0),
                 "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0), "alpha": alpha,
                 "beta": beta, "day_of_year": day_of_year}

@@ -58,7 +58,7 @@ from simulator.gnss.carrier import (
     slip_probability,
 )
 from simulator.gnss.constants import C_M_S, F_L1_HZ
-from simulator.gnss.ephemeris import gather, satellite_state
+from simulator.gnss.ephemeris import STATE_KEYS, gather, satellite_state
 from simulator.gnss.errors import (
     IonoField,
     decorrelation_coordinate,
@@ -79,12 +79,13 @@ from simulator.gnss.receiver import (
     signal_geometry,
 )
 from simulator.gnss.signals import (
-    SYSTEMS,
+    PRIMARY_SIGNAL,
     carrier_frequency_hz,
     group_delay_factor,
     iono_factor,
     signal,
 )
+from simulator.gnss.timesystems import SYSTEMS
 from simulator.stochastic import gauss_markov
 
 if TYPE_CHECKING:
@@ -241,9 +242,16 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
 
     rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
     rng_m = geo["range"]
-    sat_clock = C_M_S * geo["clock_s"]  # the L1 clock: T_GD applied
+    # the satellite clock against GPS time: the broadcast one of the primary signal (GPS: L1,
+    # T_GD applied) against its system's time plus the broadcast system-time offset, as a
+    # receiver applying GGTO / tau_GPS has it
+    sat_clock = C_M_S * (geo["clock_s"] + geo["system_time_offset_s"])
     sat_drift = C_M_S * geo["clock_drift_s_s"]
-    tgd_m = C_M_S * sky["tgd_s"]
+    system_of = sky["systems"]
+    # GPS and QZSS: the other signals' group delays from T_GD (signals.group_delay_factor);
+    # the other systems' clocks are their primary signal's, used for all their signals
+    gps_like = np.isin(system_of, ("G", "J"))[:, None]
+    tgd_m = np.where(gps_like, C_M_S * sky["tgd_s"], 0.0)
     nlos_delay = np.where(nlos & ~los, extra, 0.0)
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
@@ -256,17 +264,17 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     def unit_gm(tau_s: float) -> np.ndarray:
         return gauss_markov(n_ep, dt_s, np.ones(n_sat), tau_s, rng).T
 
-    system_of = np.full(n_sat, "G")
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     raw_pieces, truth_pieces = [], []
     for order, (letter, code) in enumerate(codes):  # one pass per signal, vectorised
         spec = signal(letter, code)
-        first = code == cfg["signals"][next(k for k, v in SYSTEMS.items() if v == letter)][0]
         rows_here = (system_of == letter)[:, None]
-        freq = float(carrier_frequency_hz(letter, code))
+        # per satellite (GLONASS: its FDMA channel); the other systems' rows are not used
+        freq = np.where(rows_here, carrier_frequency_hz(letter, code, sky["channel"])[:, None],
+                        F_L1_HZ)
         lam = C_M_S / freq
-        k_iono = float(iono_factor(freq))
-        if first and letter == "G" and code == "1C":
+        k_iono = iono_factor(freq)
+        if code == PRIMARY_SIGNAL[letter]:  # the error terms drawn for the primary signals
             cn0_true, cn0_out, tracked_s = signal_cn0, cn0, tracked & rows_here
             code_sigma, code_noise = err["code_sigma"], err["code_noise"]
             rate_sigma, rate_noise = err["rate_sigma"], err["rate_noise"]
@@ -347,7 +355,8 @@ CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fas
 COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
 BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
 # what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
-_KEPT = ("pos", "vel", "los", "clock_s", "clock_drift_s_s", "range", "range_rate", "tau_rate",
+_KEPT = ("pos", "vel", "los", "clock_s", "clock_drift_s_s", "system_time_offset_s", "range",
+         "range_rate", "tau_rate",
          "elevation", "azimuth", "iono", "tropo", "zenith", "iono_rate", "tropo_rate")
 
 
@@ -375,7 +384,7 @@ def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.
     n = len(t_gps)
     step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
     cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
-    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
+    pos = satellite_state(gather(eph, idx[:, cols], STATE_KEYS), t_gps[None, cols])["pos"]
     lat, lon = ant["lat"][cols], ant["lon"][cols]
     up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
     rel = pos - ant["pos"][None, cols]
@@ -392,15 +401,16 @@ def signal_geometry_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: n
     -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
     n_sat, n_ep = idx.shape
     first = {k: v[:1] for k, v in ant.items()}
-    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
+    shapes = _signals(gather(eph, idx[:1, :1], STATE_KEYS), t_gps[:1], first, day_of_year[:1],
+                      alpha, beta)
     fill = {"elevation": -np.pi / 2, "zenith": 1.0}
     out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
     for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
         cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
         ant_c = {k: v[cols] for k, v in ant.items()}
         rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
-        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
-                        alpha, beta)
+        part = _signals(gather(eph, idx[rows, cols], STATE_KEYS), t_gps[cols], ant_c,
+                        day_of_year[cols], alpha, beta)
         for key in _KEPT:
             out[key][rows, cols] = part[key]
     return out

@@ -98,7 +98,6 @@ def test_double_differenced_ionosphere_grows_with_the_baseline():
      "whole multiple"),
     ({"gnss": {"rate": 1}, "gnss_base": {}}, "exactly one of position and offset"),
     ({"gnss": {"rate": 1, "signals": {"gps": ["9X"]}}}, "signal codes"),
-    ({"gnss": {"rate": 1, "systems": ["galileo"]}}, "no orbit model"),
 ])
 def test_bad_base_or_signal_blocks_are_refused(sensors, message):
     with pytest.raises(InputError, match=message):
