@@ -120,6 +120,9 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
         raise InputError([Problem(file, line, "", f"malformed YAML: {message}")]) from None
     except yaml.YAMLError as exc:
         raise InputError([Problem(file, None, "", f"malformed YAML: {exc}")]) from None
+    except RecursionError:  # the pure-Python parser (no libyaml) recurses once per level
+        raise InputError([Problem(file, None, "", f"malformed YAML: nested more than "
+                                  f"{MAX_DEPTH} levels deep")]) from None
     finally:
         loader.dispose()
     return data, lines
