@@ -80,6 +80,8 @@ def run(args: argparse.Namespace) -> int:
     solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
     write_solution(solution, args.output, args.force, [dataset.path],
                    uses_gnss=info["uses_gnss"])
+    compiled = (f" (and {info['compile_s']:.1f} s compiling numba kernels, not counted)"
+                if info["compile_s"] > 0 else "")
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
-          f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")
+          f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time{compiled}")
     return 0
