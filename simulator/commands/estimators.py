@@ -4,9 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from estimators.registry import get_estimator, list_estimators
 from simulator.commands import SUMMARIES
-from simulator.errors import InputError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -20,6 +18,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from estimators.registry import get_estimator, list_estimators
+    from simulator.errors import InputError
+
     names = list_estimators()
     width = max(len(n) for n in names)
     for name in names:

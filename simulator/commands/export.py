@@ -7,8 +7,6 @@ from __future__ import annotations
 import argparse
 
 from simulator.commands import SUMMARIES
-from simulator.dataset.export import export_nmea, export_rinex
-from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 
 
@@ -27,6 +25,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.dataset.export import export_nmea, export_rinex
+    from simulator.dataset.io import open_dataset
+
     if not args.rinex and not args.nmea:
         raise InputError([Problem("landnav export", None, "", "nothing to do: give --rinex DIR "
                                   "and/or --nmea FILE")])

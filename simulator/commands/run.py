@@ -8,10 +8,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from simulator import pipeline
 from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
-from simulator.scoring.report import print_scores
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -31,6 +29,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator import pipeline
+    from simulator.scoring.report import print_scores
+
     scenario = pipeline.load_scenario(args.scenario, args.overrides, args.seed)
     out = Path(args.output) if args.output else Path("runs") / scenario.name
     result = pipeline.run(scenario, out, args.force)

@@ -7,15 +7,14 @@ import argparse
 import contextlib
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from simulator import pipeline
 from simulator.commands import SUMMARIES
-from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
-from simulator.outputs import atomic_output_dir
-from simulator.scoring.evaluate import write_scores
-from simulator.scoring.readers import check_solution, read_solution_file
-from simulator.scoring.report import print_scores, write_report
+
+if TYPE_CHECKING:
+    from simulator import pipeline
+    from simulator.dataset.io import Dataset
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -46,6 +45,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def _from_files(paths: list[str], dataset: Dataset) -> pipeline.Solutions:
     """Read and check each solution file (any format of docs/solution-format.md); the notes
     on what was converted go to stderr."""
+    from simulator.scoring.readers import check_solution, read_solution_file
+
     gps = dataset.manifest.get("gps_time_start") or {"week": 0, "tow": 0.0}
     truth = dataset.read("truth")
     out: pipeline.Solutions = {}
@@ -63,6 +64,12 @@ def _from_files(paths: list[str], dataset: Dataset) -> pipeline.Solutions:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator import pipeline
+    from simulator.dataset.io import open_dataset
+    from simulator.outputs import atomic_output_dir
+    from simulator.scoring.evaluate import write_scores
+    from simulator.scoring.report import print_scores, write_report
+
     if not args.solution and not args.estimator:
         raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
                                   "FILE... and/or -e NAME...")])
