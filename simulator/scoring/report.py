@@ -18,6 +18,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from simulator.columns import SENSOR_ERRORS
+from simulator.display_units import display
 from simulator.scoring.evaluate import Evaluation
 from simulator.scoring.metrics import OUTAGE_KIND, degraded_windows
 
@@ -127,8 +129,13 @@ def _window_lines(scores: dict[str, dict], group: str, n: int, empty: str) -> li
     return markdown_table(header, rows)
 
 
+def _sensor_value(x: float | None, column: str) -> str:
+    """An estimated sensor error in its datasheet unit (deg/h, mg, ppm, ...)."""
+    return "-" if x is None else display(x, SENSOR_ERRORS.get(column, ""))
+
+
 def _sensor_lines(scores: dict[str, dict]) -> list[str]:
-    rows = [[label, name, format_number(v["rms"]), format_number(v["final"])]
+    rows = [[label, name, _sensor_value(v["rms"], name), _sensor_value(v["final"], name)]
             for label, s in scores.items() for name, v in (s.get("sensor_errors") or {}).items()]
     if not rows:
         return ["No solution estimates a sensor error the dataset has the truth of."]
