@@ -31,13 +31,15 @@ class MyEstimator(Estimator):
     needs = ("imu", "odometer")
     uses = ("gnss_fix",)
     paper = "example: 2-D DR/GNSS EKF with a gyro-bias state, after Cho & Choi 2006"
-    defaults = {
-        "gnss_sigma": 3.0,  # GNSS horizontal position noise, m (1-sigma)
-        "speed_sigma": 0.1,  # odometer speed noise, m/s
-        "gyro_psd": 1e-3,  # z-gyro white noise, rad/s/sqrt(Hz)
-        "yaw_sigma0": 0.05,  # initial yaw uncertainty, rad
-        "bias_sigma0": 0.02,  # z-gyro turn-on bias, rad/s (1-sigma; 1 deg/s = 0.0175)
-        "bias_psd": 1e-5,  # z-gyro bias random walk, rad/s/sqrt(s)
+    defaults = {"gnss_sigma": 3.0, "speed_sigma": 0.1, "gyro_psd": 1e-3, "yaw_sigma0": 0.05,
+                "bias_sigma0": 0.02, "bias_psd": 1e-5}
+    config_help = {  # key -> (SI unit, meaning), shown by `landnav estimators NAME`
+        "gnss_sigma": ("m", "GNSS horizontal position noise, 1-sigma"),
+        "speed_sigma": ("m/s", "odometer speed noise, 1-sigma"),
+        "gyro_psd": ("rad/s/sqrt(Hz)", "z-gyro white noise"),
+        "yaw_sigma0": ("rad", "initial yaw uncertainty, 1-sigma"),
+        "bias_sigma0": ("rad/s", "z-gyro turn-on bias, 1-sigma"),
+        "bias_psd": ("rad/s^2/sqrt(Hz)", "z-gyro bias random walk"),
     }
     output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "gyro_bias_z")
 
