@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
 from simulator.commands import SUMMARIES
 from simulator.errors import InputError, Problem
@@ -79,7 +78,7 @@ def run(args: argparse.Namespace) -> int:
 
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
-    solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
+    solution, info = pipeline.estimate(dataset, entry, show_progress=True)
     write_solution(solution, args.output, args.force, [dataset.path],
                    uses_gnss=info["uses_gnss"])
     compiled = (f" (and {info['compile_s']:.1f} s compiling numba kernels, not counted)"

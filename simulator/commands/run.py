@@ -34,7 +34,7 @@ def run(args: argparse.Namespace) -> int:
 
     scenario = pipeline.load_scenario(args.scenario, args.overrides, args.seed)
     out = Path(args.output) if args.output else Path("runs") / scenario.name
-    result = pipeline.run(scenario, out, args.force)
+    result = pipeline.run(scenario, out, args.force, show_progress=True)
     if scenario.data["estimators"]:
         print_scores(result.evaluation)
     else:

@@ -79,8 +79,8 @@ def run(args: argparse.Namespace) -> int:
                                                             [dataset.path]))
                       if args.report else None)
         solutions = _from_files(args.solution, dataset)
-        for label, solved in pipeline.run_estimators(dataset,
-                                                     dict.fromkeys(args.estimator)).items():
+        for label, solved in pipeline.run_estimators(dataset, dict.fromkeys(args.estimator),
+                                                     show_progress=True).items():
             if label in solutions:
                 raise InputError([Problem(args.dataset, None, "", f"label {label!r} is both a "
                                           "solution file's stem and an estimator's name")])
