@@ -99,7 +99,16 @@ def test_nesting_beyond_max_depth(tmp_path, capsys):
 def test_impossible_date(tmp_path, capsys, utc):
     text = GOOD_HEAD.replace("start: {lat: 37.5", f"start: {{utc: {utc}, lat: 37.5")
     message = _validate(tmp_path, text, capsys)
-    assert ":2: start.utc:" in message and "not a valid value" in message
+    assert ":2: start.utc:" in message and "is not a valid ISO 8601 UTC time" in message
+
+
+def test_an_impossible_date_hides_no_other_problem(tmp_path, capsys):
+    """Every problem of the file in one run: the date, an unknown key and a negative rate."""
+    text = GOOD_HEAD.replace("start: {lat: 37.5", "start: {utc: 2023-02-30T00:00:00Z, lat: 37.5")
+    text += "sensors:\n  imu: {preset: ideal, rate: -100}\nspeeed: 3\n"
+    message = _validate(tmp_path, text, capsys)
+    assert "start.utc: '2023-02-30T00:00:00Z' is not a valid ISO 8601 UTC time" in message
+    assert "sensors.imu.rate:" in message and "speeed" in message
 
 
 def test_scientific_numbers_are_numbers(tmp_path):
