@@ -28,7 +28,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "docs/solution-format.md, RTKLIB .pos, NMEA GGA/RMC) and/or estimators run "
                     "here (-e, a registered name or module:Class, labelled by name). Prints a "
                     "compact table; --json writes the scores keyed by label; --report writes "
-                    "report.md with plots into DIR (atomically; an existing DIR needs --force).")
+                    "report.md with plots and report.html (the same, plots embedded) into DIR "
+                    "(atomically; an existing DIR needs --force).")
     p.add_argument("dataset", metavar="DATASET", help="dataset directory")
     p.add_argument("--solution", nargs="+", action="extend", metavar="FILE", default=[],
                    help="solution file(s): .parquet, .csv, RTKLIB .pos, NMEA")
@@ -36,7 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="estimator(s) to run over the dataset and score (registered name or "
                         "module:Class, found from the current directory as python -m does)")
     p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
-    p.add_argument("--report", metavar="DIR", help="write report.md and plots/ into DIR")
+    p.add_argument("--report", metavar="DIR",
+                   help="write report.md, plots/ and report.html into DIR")
     p.add_argument("--force", action="store_true",
                    help="overwrite an existing --json file or report DIR")
     p.set_defaults(run=run)
@@ -68,7 +70,7 @@ def run(args: argparse.Namespace) -> int:
     from simulator.dataset.io import open_dataset
     from simulator.outputs import atomic_output_dir
     from simulator.scoring.evaluate import write_scores
-    from simulator.scoring.report import print_scores, write_report
+    from simulator.scoring.report import print_scores
 
     if not args.solution and not args.estimator:
         raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
@@ -91,7 +93,7 @@ def run(args: argparse.Namespace) -> int:
             write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])
             print(f"wrote {args.json}")
         if report_dir is not None:
-            write_report(report_dir, ev, f"Scores on {dataset.path.name}")
+            pipeline.write_report(report_dir, ev, f"Scores on {dataset.path.name}")
     if args.report:
-        print(f"wrote {Path(args.report) / 'report.md'}")
+        print(f"wrote {Path(args.report) / 'report.md'} and report.html")
     return 0

@@ -23,6 +23,7 @@ from tests.scoring_helpers import (
     write_scoring_dataset,
 )
 from tests.synthetic import write_synthetic
+from tests.test_html_report import check_report_html
 
 OUTAGES = ((40.0, 60.0), (120.0, 150.0))
 
@@ -119,6 +120,7 @@ def test_score_report_is_written_atomically(dataset, shifted, tmp_path, capsys):
     assert "shifted" in text and "5.000" in text and "20.000" in text
     for png in ("map", "position_errors", "attitude_errors", "horizontal_cdf"):
         assert f"(plots/{png}.png)" in text and (report / "plots" / f"{png}.png").is_file()
+    assert "shifted" in "".join(check_report_html(report).text)  # every plot embedded
     assert main(args) == 2  # exists: kept unless --force
     assert "--force" in capsys.readouterr().err
     assert main([*args, "--force"]) == 0
@@ -188,6 +190,7 @@ def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
     assert scores["hold"]["runtime"]["seconds"] > 0
     text = (out / "report.md").read_text()
     assert "hold" in text and "(plots/map.png)" in text and (out / "plots" / "map.png").is_file()
+    assert "hold" in "".join(check_report_html(out).text)  # the same report, plots embedded
     assert "hold" in capsys.readouterr().out
     # the solution file it wrote scores like the run did
     assert main(["score", str(out / "dataset"), "--solution",
