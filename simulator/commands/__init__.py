@@ -13,7 +13,7 @@ SUMMARIES = {
     "run": "generate, run the scenario's estimators, score, write the report",
     "campaign": "Monte Carlo over seeds and sweeps, locally or on Dask; resumable",
     "reproduce": "run the seed papers' experiments over seeds, judge each claim, report",
-    "export": "write a dataset's GNSS streams as RINEX 3.04 and NMEA 0183",
+    "export": "write a dataset as RINEX 3.04, NMEA 0183 or a ROS 2 bag (MCAP)",
     "schema": "print the JSON Schema of the scenario file (editor completion)",
     "presets": "list the sensor presets with their parameters",
 }
