@@ -27,9 +27,11 @@ and truth-referenced scoring.
 A scenario (YAML) describes the drive, the sensors, the faults and the estimators to run.
 Typical use:
 
+  landnav run scenarios/quickstart.yaml -o runs/quickstart   the main job: dataset, estimators,
+                                                  scores, runs/quickstart/report.html
   landnav validate scenarios/quickstart.yaml      check a scenario, list every problem
-  landnav generate scenarios/quickstart.yaml -o out/quick   write the dataset
   landnav generate scenarios/parking_garage.yaml -o out/g --set sensors.imu.rate=200 --seed 3
+  landnav estimators ins_odo_ekf                  an estimator's streams and config keys
   landnav campaign scenarios/karamat2015_partial_outages.yaml --runs 20 -o out/mc
 
 Run `landnav COMMAND --help` for each command's options. Reference documentation is in the
