@@ -31,7 +31,7 @@ print(json.dumps({"code": code, "heavy": [m for m in json.loads(sys.argv[2]) if 
 
 def _fresh(argv: list[str]) -> dict:
     done = subprocess.run([sys.executable, "-c", PROBE, json.dumps(argv), json.dumps(HEAVY)],
-                          capture_output=True, text=True, cwd=REPO, timeout=120,
+                          capture_output=True, text=True, cwd=REPO, timeout=600,
                           env={"PYTHONPATH": str(REPO), "PATH": "/usr/bin:/bin"})
     assert done.returncode == 0, done.stderr
     return json.loads(done.stdout.splitlines()[-1])
