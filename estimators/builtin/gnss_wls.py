@@ -58,6 +58,7 @@ class GnssWls(Estimator):
     initialises_itself = True
     output_rate_hz = 1.0
     defaults = {"elevation_mask": 10.0}
+    config_help = {"elevation_mask": ("deg", "satellites below this elevation are left out")}
     output_columns = OUTPUT_COLUMNS
 
     def setup(self) -> None:

@@ -19,8 +19,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from simulator.recordings.common import Recording, write_recording
+if TYPE_CHECKING:  # imported where a recording is read: `landnav import --help` lists KINDS
+    from simulator.recordings.common import Recording
 
 
 def _comma2k19(sources: list[str]) -> Recording:
@@ -52,5 +54,7 @@ KINDS: dict[str, tuple[Callable[[list[str]], Recording], str]] = {
 def import_recording(kind: str, sources: list[str], out_dir: str | Path,
                      force: bool = False) -> Path:
     """Read a recording of ``kind`` from ``sources`` and write it as a dataset at ``out_dir``."""
+    from simulator.recordings.common import write_recording
+
     reader, _ = KINDS[kind]
     return write_recording(reader([str(s) for s in sources]), out_dir, force)
