@@ -31,7 +31,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
               "simulator.errors", "simulator.schema", "simulator.tables", "simulator.timebase",
               "simulator.progress", "simulator.stochastic", "simulator.outputs",
               "simulator.geoid", "simulator.compilation",
-              "simulator.display_units", "simulator.html_report")),
+              "simulator.display_units", "simulator.html_report", "simulator.datasheet")),
     ("trajectory", ("simulator.trajectory", "simulator.vehicle", "simulator.environment")),
     ("drive", ("simulator.drive",)),
     ("gnss", ("simulator.gnss",)),
