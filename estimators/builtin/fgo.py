@@ -33,9 +33,16 @@ keyframes is the latest keyframe's estimate predicted with the IMU preintegrated
 its std columns the keyframe's marginal covariance plus the preintegration's. Attitude sigmas
 map the navigation-frame rotation covariance to ZYX Euler angles (``_euler_sigma``).
 
+``fgo_tc`` is the same smoother on the raw measurements: each epoch's corrected pseudoranges
+and pseudorange rates (``toolbox.gnss_model``: broadcast corrections, Sagnac rotation) against
+the antenna's position and velocity and a two-state receiver clock per keyframe [c dt, c dt']
+linked by the oscillator's process noise (``gnss_model.clock_noise``); code sigma the
+receiver's reported one in quadrature with the horizontal UERE scaled by C/N0, range-rate sigma
+the receiver's (at least 2 cm/s); one clock, so the first system's satellites only.
+
 Public classes
 --------------
-FgoLooselyCoupled.
+FgoLooselyCoupled, FgoTightlyCoupled.
 """
 
 from __future__ import annotations
@@ -47,6 +54,7 @@ import numpy as np
 
 from estimators.base import Estimator
 from estimators.toolbox.constraints import NonholonomicNoise
+from estimators.toolbox.gnss_model import clock_noise, predict, raw_epoch
 from estimators.toolbox.installation import Installation
 from simulator.datasheet import fix_uere_m
 from simulator.earth import (
@@ -168,10 +176,11 @@ class FgoLooselyCoupled(Estimator):
         self._imu_cols = [c["imu"].get(a) for a in ("gyro_x", "gyro_y", "gyro_z", "accel_x",
                                                      "accel_y", "accel_z")]
         self._increments = self.imu_output == "increment"
-        self._fix_cols = [c["gnss_fix"][k] for k in ("lat", "lon", "alt", "vn", "ve", "vd",
-                                                     "fix")]
-        self._hdop = c["gnss_fix"].get("hdop")
-        self._vdop = c["gnss_fix"].get("vdop")
+        fix_cols = c.get("gnss_fix", {})
+        self._fix_cols = [fix_cols.get(k) for k in ("lat", "lon", "alt", "vn", "ve", "vd",
+                                                    "fix")]
+        self._hdop = fix_cols.get("hdop")
+        self._vdop = fix_cols.get("vdop")
         self._speed_col = c.get("odometer", {}).get("speed")
         self._speeds: list[float] = []
 
@@ -261,7 +270,9 @@ class FgoLooselyCoupled(Estimator):
             return
         self._keyframe(t, (lat, lon, alt, vn, ve, vd, row))
 
-    def _keyframe(self, t: float, fix: tuple | None) -> None:
+    def _keyframe(self, t: float, measurement: object | None) -> None:
+        """A new keyframe at ``t``: the IMU factor since the last one, the GNSS factors of
+        ``measurement`` (``_gnss_factors``), the odometer factor, the smoother's update."""
         gtsam = self._g
         if t - self._t_key < 1e-3 or self._pim.deltaTij() <= 0.0:
             return
@@ -274,44 +285,9 @@ class FgoLooselyCoupled(Estimator):
         values.insert(self._x(k), predicted.pose())
         values.insert(self._v(k), predicted.velocity())
         values.insert(self._b(k), self._bias)
-        if fix is not None:
-            lat, lon, alt, vn, ve, vd, row = fix
-            ned = ecef_to_ned(geodetic_to_ecef(math.radians(lat), math.radians(lon), alt)
-                              .reshape(1, 3), self._lat0, self._lon0, self._alt0).ravel()
-            hdop = float(row[self._hdop]) if self._hdop is not None else math.nan
-            vdop = float(row[self._vdop]) if self._vdop is not None else math.nan
-            hdop = hdop if math.isfinite(hdop) else DEFAULT_DOP
-            vdop = vdop if math.isfinite(vdop) else 2 * DEFAULT_DOP
-            sigma = np.array([self._uere_h * hdop / math.sqrt(2),
-                              self._uere_h * hdop / math.sqrt(2), self._uere * vdop])
-            e_key = self._e(k)
-            current = self._smoother.calculateEstimate()
-            if self._e_key is None:
-                graph.add(gtsam.PriorFactorVector(e_key, np.zeros(3),
-                                                  gtsam.noiseModel.Diagonal.Sigmas(sigma)))
-                values.insert(e_key, np.zeros(3))
-            elif current.exists(self._e_key):
-                phi = math.exp(-(t - self._t_e) / self._fix_tau)
-                graph.add(gtsam.CustomFactor(
-                    gtsam.noiseModel.Diagonal.Sigmas(sigma * math.sqrt(1.0 - phi * phi)),
-                    [self._e_key, e_key], partial(_markov_error, phi, self._e_key, e_key)))
-                values.insert(e_key, phi * current.atVector(self._e_key))
-            else:  # the last error state left the window in an outage: its forecast as prior
-                phi = math.exp(-(t - self._t_e) / self._fix_tau)
-                cov = phi * phi * self._e_cov + np.diag(sigma**2) * (1.0 - phi * phi)
-                graph.add(gtsam.PriorFactorVector(e_key, phi * self._e_last,
-                                                  gtsam.noiseModel.Gaussian.Covariance(cov)))
-                values.insert(e_key, phi * self._e_last)
-            graph.add(gtsam.CustomFactor(
-                gtsam.noiseModel.Diagonal.Sigmas(FIX_WHITE_SIGMA_M),
-                [self._x(k), e_key], partial(_fix_error, ned, self._antenna, self._x(k),
-                                             e_key)))
-            self._e_key, self._t_e = e_key, t
-            v_fix = np.array([vn, ve, vd])
-            if np.isfinite(v_fix).all():
-                graph.add(gtsam.PriorFactorVector(
-                    self._v(k), v_fix,
-                    gtsam.noiseModel.Diagonal.Sigmas(FIX_VELOCITY_SIGMA_M_S)))
+        stamps = {self._x(k): t, self._v(k): t, self._b(k): t}
+        if measurement is not None:
+            self._gnss_factors(graph, values, stamps, k, t, measurement)
         if self._speeds and self.config["odometer"]:
             speed = float(np.mean(self._speeds))
             lateral, vertical = self._slip.sigma(speed, float(self._last_rate[2]),
@@ -325,17 +301,13 @@ class FgoLooselyCoupled(Estimator):
             graph.add(gtsam.CustomFactor(gtsam.noiseModel.Diagonal.Sigmas(sigmas),
                                          [self._x(k), self._v(k)], error))
         self._speeds = []
-        stamps = {self._x(k): t, self._v(k): t, self._b(k): t}
-        if fix is not None:
-            stamps[self._e(k)] = t
         self._update(graph, values, stamps)
         estimate = self._smoother.calculateEstimate()
         self._state = gtsam.NavState(estimate.atPose3(self._x(k)),
                                      estimate.atVector(self._v(k)))
         self._bias = estimate.atConstantBias(self._b(k))
-        if fix is not None:
-            self._e_last = estimate.atVector(self._e_key)
-            self._e_cov = self._smoother.marginalCovariance(self._e_key)
+        if measurement is not None:
+            self._after_gnss(estimate, k)
         cov_pose = self._smoother.marginalCovariance(self._x(k))
         cov_vel = self._smoother.marginalCovariance(self._v(k))
         rot = self._state.pose().rotation().matrix()
@@ -347,6 +319,53 @@ class FgoLooselyCoupled(Estimator):
         self._pim.resetIntegrationAndSetBias(self._bias)
         self._k = k
         self._t_key = t
+
+    def _gnss_factors(self, graph, values, stamps: dict, k: int, t: float,
+                      fix: tuple) -> None:
+        """The fix at the antenna with its Gauss-Markov error state, and its velocity."""
+        gtsam = self._g
+        lat, lon, alt, vn, ve, vd, row = fix
+        ned = ecef_to_ned(geodetic_to_ecef(math.radians(lat), math.radians(lon), alt)
+                          .reshape(1, 3), self._lat0, self._lon0, self._alt0).ravel()
+        hdop = float(row[self._hdop]) if self._hdop is not None else math.nan
+        vdop = float(row[self._vdop]) if self._vdop is not None else math.nan
+        hdop = hdop if math.isfinite(hdop) else DEFAULT_DOP
+        vdop = vdop if math.isfinite(vdop) else 2 * DEFAULT_DOP
+        sigma = np.array([self._uere_h * hdop / math.sqrt(2),
+                          self._uere_h * hdop / math.sqrt(2), self._uere * vdop])
+        e_key = self._e(k)
+        current = self._smoother.calculateEstimate()
+        if self._e_key is None:
+            graph.add(gtsam.PriorFactorVector(e_key, np.zeros(3),
+                                              gtsam.noiseModel.Diagonal.Sigmas(sigma)))
+            values.insert(e_key, np.zeros(3))
+        elif current.exists(self._e_key):
+            phi = math.exp(-(t - self._t_e) / self._fix_tau)
+            graph.add(gtsam.CustomFactor(
+                gtsam.noiseModel.Diagonal.Sigmas(sigma * math.sqrt(1.0 - phi * phi)),
+                [self._e_key, e_key], partial(_markov_error, phi, self._e_key, e_key)))
+            values.insert(e_key, phi * current.atVector(self._e_key))
+        else:  # the last error state left the window in an outage: its forecast as prior
+            phi = math.exp(-(t - self._t_e) / self._fix_tau)
+            cov = phi * phi * self._e_cov + np.diag(sigma**2) * (1.0 - phi * phi)
+            graph.add(gtsam.PriorFactorVector(e_key, phi * self._e_last,
+                                              gtsam.noiseModel.Gaussian.Covariance(cov)))
+            values.insert(e_key, phi * self._e_last)
+        graph.add(gtsam.CustomFactor(
+            gtsam.noiseModel.Diagonal.Sigmas(FIX_WHITE_SIGMA_M),
+            [self._x(k), e_key], partial(_fix_error, ned, self._antenna, self._x(k),
+                                         e_key)))
+        self._e_key, self._t_e = e_key, t
+        v_fix = np.array([vn, ve, vd])
+        if np.isfinite(v_fix).all():
+            graph.add(gtsam.PriorFactorVector(
+                self._v(k), v_fix,
+                gtsam.noiseModel.Diagonal.Sigmas(FIX_VELOCITY_SIGMA_M_S)))
+        stamps[e_key] = t
+
+    def _after_gnss(self, estimate, k: int) -> None:
+        self._e_last = estimate.atVector(self._e_key)
+        self._e_cov = self._smoother.marginalCovariance(self._e_key)
 
     def solution(self, t: float) -> list[float]:
         if t - self._t_key >= 2.0 * float(self.config["keyframe_interval"]):
@@ -419,3 +438,149 @@ def _random_walk(group: dict) -> float:
     walk = float(group.get("random_walk") or 0.0) ** 2
     instability = 2.0 * float(group.get("bias_instability") or 0.0) ** 2 / BIAS_TIME_S
     return max(walk + instability, BIAS_WALK_FLOOR)
+
+
+class FgoTightlyCoupled(FgoLooselyCoupled):
+    """Fixed-lag factor-graph smoother on pseudoranges and pseudorange rates with receiver
+    clock states (``fgo_lc``'s IMU, odometer and NHC factors)."""
+
+    name = "fgo_tc"
+    needs = ("imu", "gnss_raw")
+    uses = ("odometer",)
+    paper = ("baseline: GTSAM fixed-lag smoother, IMU preintegration (Forster et al. 2017) "
+             "with pseudorange, Doppler, clock, odometer and non-holonomic factors")
+    defaults = {**FgoLooselyCoupled.defaults, "elevation_mask": 10.0}
+    config_help = {**FgoLooselyCoupled.config_help,
+                   "elevation_mask": ("deg", "satellites below this elevation are left out")}
+    output_columns = OUTPUT_COLUMNS + ("clock_bias", "clock_drift")
+
+    def setup(self) -> None:
+        super().setup()
+        self._raw = self.columns["gnss_raw"]
+        self._mask = math.radians(float(self.config["elevation_mask"]))
+        self._c_key: int | None = None
+        self._t_c = 0.0
+        self._c_last = np.zeros(2)
+        self._c_cov = np.eye(2)
+        self._sigma_floor = fix_uere_m(self.datasheet.get("gnss") or {}, ionosphere=False) \
+            or DEFAULT_UERE_M
+
+    def _c(self, k: int) -> int:
+        return self._g.symbol("c", k)
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        """Not used: the tightly coupled smoother takes the raw measurements."""
+
+    def on_gnss_raw(self, t: float, block: np.ndarray) -> None:
+        cols = self._raw
+        if "health" in cols:
+            block = block[block[:, cols["health"]] == 0]
+        if "elevation" in cols:
+            block = block[~(block[:, cols["elevation"]] < self._mask)]
+        ep = raw_epoch(block, cols)
+        ok = (np.isfinite(ep.pseudorange) & np.isfinite(ep.range_rate)
+              & np.isfinite(ep.sat_pos).all(axis=1))
+        if "system_code" in cols:  # one clock: the first system's satellites only
+            codes = block[:, cols["system_code"]]
+            ok &= codes == codes[ok][0] if ok.any() else ok
+        if ok.sum() < 4:
+            if t - self._t_key >= float(self.config["keyframe_interval"]):
+                self._keyframe(t, None)
+            return
+        cn0 = block[:, cols["cn0"]][ok] if "cn0" in cols else np.full(ok.sum(), 45.0)
+        sigma_code = np.hypot(np.nan_to_num(ep.pseudorange_std[ok], nan=1.0),
+                              self._sigma_floor / np.sqrt(np.clip(
+                                  10 ** ((cn0 - 45.0) / 20.0), 0.1, 1.0)))
+        sigma_rate = np.where(np.isfinite(ep.range_rate_std[ok]), ep.range_rate_std[ok], 0.1)
+        self._keyframe(t, (ep.sat_pos[ok], ep.sat_vel[ok], ep.pseudorange[ok],
+                           ep.range_rate[ok], sigma_code, np.maximum(sigma_rate, 0.02)))
+
+    def _gnss_factors(self, graph, values, stamps: dict, k: int, t: float,
+                      epoch: tuple) -> None:
+        gtsam = self._g
+        sat_pos, sat_vel, rho, rate, sigma_code, sigma_rate = epoch
+        c_key = self._c(k)
+        current = self._smoother.calculateEstimate()
+        if self._c_key is None:
+            pose = values.atPose3(self._x(k))
+            antenna = self._origin + self._c_ne0 @ (pose.translation()
+                                                    + pose.rotation().matrix() @ self._antenna)
+            v_ecef = self._c_ne0 @ values.atVector(self._v(k))
+            geometric, geometric_rate, _ = predict(sat_pos, sat_vel, antenna, v_ecef)
+            start = np.array([np.median(rho - geometric), np.median(rate - geometric_rate)])
+            graph.add(gtsam.PriorFactorVector(c_key, start,
+                                              gtsam.noiseModel.Diagonal.Sigmas([30.0, 3.0])))
+            values.insert(c_key, start)
+        else:
+            dt = t - self._t_c
+            phi = np.array([[1.0, dt], [0.0, 1.0]])
+            q = clock_noise(dt)
+            if current.exists(self._c_key):
+                graph.add(gtsam.CustomFactor(gtsam.noiseModel.Gaussian.Covariance(q),
+                                             [self._c_key, c_key],
+                                             partial(_clock_error, phi, self._c_key, c_key)))
+                values.insert(c_key, phi @ current.atVector(self._c_key))
+            else:  # the last clock state left the window: its forecast as prior
+                graph.add(gtsam.PriorFactorVector(
+                    c_key, phi @ self._c_last,
+                    gtsam.noiseModel.Gaussian.Covariance(phi @ self._c_cov @ phi.T + q)))
+                values.insert(c_key, phi @ self._c_last)
+        sigma = np.concatenate([sigma_code, sigma_rate])
+        graph.add(gtsam.CustomFactor(
+            gtsam.noiseModel.Diagonal.Sigmas(sigma), [self._x(k), self._v(k), c_key],
+            partial(_range_error, epoch[:4], self._antenna, self._origin, self._c_ne0,
+                    self._x(k), self._v(k), c_key)))
+        stamps[c_key] = t
+        self._c_key, self._t_c = c_key, t
+
+    def _after_gnss(self, estimate, k: int) -> None:
+        self._c_last = estimate.atVector(self._c_key)
+        self._c_cov = self._smoother.marginalCovariance(self._c_key)
+
+    def solution(self, t: float) -> list[float]:
+        row = super().solution(t)
+        if self._c_key is None:
+            return [*row, math.nan, math.nan]
+        dt = t - self._t_c
+        return [*row, float(self._c_last[0] + self._c_last[1] * dt), float(self._c_last[1])]
+
+
+def _clock_error(phi: np.ndarray, before: int, after: int, this, values, jacobians):
+    """Custom-factor error of the two-state clock: c_k - Phi c_(k-1)."""
+    if jacobians is not None:
+        jacobians[0] = -phi
+        jacobians[1] = np.eye(2)
+    return values.atVector(after) - phi @ values.atVector(before)
+
+
+def _range_error(epoch: tuple, arm: np.ndarray, origin: np.ndarray, c_ne: np.ndarray,
+                 pose_key: int, vel_key: int, clock_key: int, this, values, jacobians):
+    """Custom-factor error of an epoch's corrected pseudoranges and range rates against the
+    antenna's state (``toolbox.gnss_model.predict``: Sagnac rotation, flight time) and the
+    clock [cb, d]; Jacobians on the pose tangent (rotation, translation), the velocity and
+    the clock (the range rates' dependence on the position is left out: 1e-4 of theirs)."""
+    sat_pos, sat_vel, rho, rate = epoch
+    pose = values.atPose3(pose_key)
+    rot = pose.rotation().matrix()
+    v = values.atVector(vel_key)
+    clock = values.atVector(clock_key)
+    antenna = origin + c_ne @ (pose.translation() + rot @ arm)
+    predicted, predicted_rate, los = predict(sat_pos, sat_vel, antenna, c_ne @ v,
+                                             clock[0], clock[1])
+    m = len(rho)
+    if jacobians is not None:
+        los_local = los @ c_ne  # (m, 3): unit vectors in the frame at the origin
+        skew = np.array([[0.0, -arm[2], arm[1]], [arm[2], 0.0, -arm[0]],
+                         [-arm[1], arm[0], 0.0]])
+        pose_jac = np.zeros((2 * m, 6))
+        pose_jac[:m, :3] = los_local @ rot @ skew
+        pose_jac[:m, 3:] = -los_local @ rot
+        vel_jac = np.zeros((2 * m, 3))
+        vel_jac[m:] = -los_local
+        clock_jac = np.zeros((2 * m, 2))
+        clock_jac[:m, 0] = 1.0
+        clock_jac[m:, 1] = 1.0
+        jacobians[0] = pose_jac
+        jacobians[1] = vel_jac
+        jacobians[2] = clock_jac
+    return np.concatenate([predicted - rho, predicted_rate - rate])

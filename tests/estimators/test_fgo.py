@@ -1,6 +1,7 @@
-"""``fgo_lc``, the GTSAM fixed-lag smoother, on the quickstart drive: it estimates the IMU's
-turn-on biases (against truth_sensors), follows the truth, and claims position sigmas of the
-size of its errors."""
+"""``fgo_lc`` and ``fgo_tc``, the GTSAM fixed-lag smoothers, on the quickstart drive: the loosely
+coupled one estimates the IMU's turn-on biases (against truth_sensors), follows the truth and
+claims north and down sigmas of the size of its errors; the tightly coupled one follows the
+truth and the receiver clock."""
 
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ pytest.importorskip("gtsam")
 def solved(quickstart):
     from simulator import pipeline
 
-    solutions = pipeline.run_estimators(quickstart, ["fgo_lc", "gnss_only"])
+    solutions = pipeline.run_estimators(quickstart, ["fgo_lc", "fgo_tc", "gnss_only"])
     return quickstart, solutions, pipeline.score(quickstart, solutions).scores()
 
 
@@ -44,3 +45,16 @@ def test_follows_the_truth_with_honest_position_sigmas(solved):
     for error, sigma in ((north, frame["std_n"]), (down, frame["std_d"])):
         nse = float(np.mean((error.to_numpy()[late] / sigma.to_numpy()[late]) ** 2))
         assert 0.3 < nse < 3.0
+
+
+def test_tightly_coupled_follows_the_truth_and_the_clock(solved):
+    dataset, solutions, scores = solved
+    assert scores["fgo_tc"]["horizontal"]["rms"] < 1.0
+    frame = solutions["fgo_tc"][0]
+    truth = dataset.read("truth_sensors")
+    late = frame["t"].to_numpy() > 60.0
+    drift = frame["clock_drift"] - np.interp(frame["t"], truth["t"], truth["clock_drift"])
+    bias = frame["clock_bias"] - np.interp(frame["t"], truth["t"], truth["clock_bias"])
+    assert abs(np.mean(drift[late])) < 0.2      # m/s, of a drift of 80 m/s
+    # the clock takes the ionosphere left after the broadcast model, common to all satellites
+    assert abs(np.mean(bias[late])) < 15.0 and np.std(bias[late]) < 3.0

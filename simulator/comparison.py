@@ -150,17 +150,14 @@ def _statistics(dataset: Dataset) -> dict[str, Any]:
 
 
 def _estimator_rms(dataset: Dataset, name: str) -> float:
-    # the replay (the layer below scoring) and this layer's scorer: not the pipeline above
+    from simulator import pipeline
     from simulator.errors import InputError
-    from simulator.replay import run_estimator
-    from simulator.scoring.evaluate import score_solutions
 
     try:
-        frame, info = run_estimator(dataset, name, show_progress=False)
+        solved = pipeline.run_estimators(dataset, [name])
     except InputError:
         return math.nan
-    scores = score_solutions(dataset, {info["label"]: (frame, info)}).scores()
-    return float(scores[info["label"]]["horizontal"]["rms"])
+    return float(pipeline.score(dataset, solved).scores()[name]["horizontal"]["rms"])
 
 
 def compare_datasets(first: Dataset, second: Dataset,
