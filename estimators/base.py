@@ -12,6 +12,8 @@ An estimator is a subclass of ``Estimator``. The class declares
   every GNSS epoch;
 * ``defaults``: its configuration keys and their default values; the scenario's ``config``
   mapping is merged over them and an unknown key is an error;
+* ``config_help``: for each key of ``defaults``, its unit (SI, as the value is given; ``""`` for
+  a switch, a name or a plain number) and what it sets; ``landnav estimators NAME`` shows them;
 * ``output_columns``: the columns of its solution rows after ``t`` (the nine navigation columns
   of SPEC section 7, then optionally ``std_*`` columns and free extra columns);
 * ``initialises_itself``: True if it needs no initial state (it starts from the first fixes).
@@ -95,6 +97,7 @@ class Estimator:
     paper: ClassVar[str] = ""
     output_rate_hz: ClassVar[float] = 10.0
     defaults: ClassVar[Mapping[str, Any]] = {}
+    config_help: ClassVar[Mapping[str, tuple[str, str]]] = {}  # key -> (SI unit, meaning)
     output_columns: ClassVar[tuple[str, ...]] = NAV_COLUMNS
     initialises_itself: ClassVar[bool] = False
 

@@ -16,6 +16,7 @@ import sys
 import threading
 from types import FrameType
 
+from simulator import __version__
 from simulator.commands import MODULES, SUMMARIES
 from simulator.errors import InputError, Terminated
 
@@ -26,9 +27,11 @@ and truth-referenced scoring.
 A scenario (YAML) describes the drive, the sensors, the faults and the estimators to run.
 Typical use:
 
+  landnav run scenarios/quickstart.yaml -o runs/quickstart   the main job: dataset, estimators,
+                                                  scores, runs/quickstart/report.html
   landnav validate scenarios/quickstart.yaml      check a scenario, list every problem
-  landnav generate scenarios/quickstart.yaml -o out/quick   write the dataset
   landnav generate scenarios/parking_garage.yaml -o out/g --set sensors.imu.rate=200 --seed 3
+  landnav estimators ins_odo_ekf                  an estimator's streams and config keys
   landnav campaign scenarios/karamat2015_partial_outages.yaml --runs 20 -o out/mc
 
 Run `landnav COMMAND --help` for each command's options. Reference documentation is in the
@@ -38,13 +41,16 @@ schema), dataset-format.md, solution-format.md, scores.md, faults.md, estimator_
 
 
 def build_parser(command: str | None = None) -> argparse.ArgumentParser:
-    """The parser; only ``command``'s module is imported (all of them when None)."""
+    """The parser; only ``command``'s module is imported (none when None: ``landnav --help``
+    needs only the one-line summaries). A command module imports what its work needs inside
+    its ``run``, so that ``landnav COMMAND --help`` imports no numerical library."""
     parser = argparse.ArgumentParser(
         prog="landnav", description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"landnav {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, summary in SUMMARIES.items():
-        if command in (None, name):
+        if command == name:
             module = MODULES.get(name, name)
             importlib.import_module(f"simulator.commands.{module}").add_parser(sub)
         else:
@@ -71,7 +77,7 @@ def main(argv: list[str] | None = None) -> int:
         os.environ.setdefault(name, value)
     argv = sys.argv[1:] if argv is None else argv
     command = _command_name(argv)
-    args = build_parser(command if command in SUMMARIES else None).parse_args(argv)
+    args = build_parser(command).parse_args(argv)
     try:
         code = _run(args)
         sys.stdout.flush()

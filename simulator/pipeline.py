@@ -35,6 +35,7 @@ from simulator import scenario as scenarios
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.html_report import write_html_report
 from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
 from simulator.scenario import Scenario
@@ -104,9 +105,12 @@ def score(dataset: Dataset, solutions: Solutions) -> Evaluation:
 def write_report(directory: str | Path, evaluation: Evaluation, title: str,
                  note: str | None = None) -> Path:
     """Write ``report.md`` (metrics, per-outage table) and its ``plots/`` into ``directory``
-    (made if missing); the path of ``report.md``."""
+    (made if missing), and ``report.html``, the same page with every plot embedded
+    (``simulator.html_report``); the path of ``report.md``."""
     Path(directory).mkdir(parents=True, exist_ok=True)
-    return report.write_report(Path(directory), evaluation, title, note)
+    path = report.write_report(Path(directory), evaluation, title, note)
+    write_html_report(path)
+    return path
 
 
 @dataclass

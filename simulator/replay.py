@@ -35,6 +35,7 @@ import pandas as pd
 from estimators.base import GNSS_STREAMS, Estimator, InitialState
 from estimators.registry import get_estimator
 from simulator import columns as col
+from simulator.compilation import CompileWatch
 from simulator.dataset.io import Dataset
 from simulator.dataset.parquet import read_table, write_table
 from simulator.earth import (
@@ -243,9 +244,11 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     solution : DataFrame
         ``t`` (strictly increasing) and the estimator's ``output_columns`` (SPEC section 7).
     info : dict
-        ``label``, ``name``, ``runtime_s`` (wall time of the estimator run, s) and
-        ``realtime_factor`` (data duration / runtime) and ``uses_gnss`` (whether a GNSS stream
-        reached the estimator).
+        ``label``, ``name``, ``runtime_s`` (wall time of the replay's message loop, s, less the
+        time numba spent compiling kernels in it: ``simulator.compilation``),
+        ``realtime_factor`` (data duration / runtime), ``uses_gnss`` (whether a GNSS stream
+        reached the estimator) and ``compile_s`` (numba compilation during the run, s; 0 when
+        the kernels came from the on-disk cache).
 
     Raises
     ------
@@ -267,49 +270,51 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                                       "stream; use an estimator that initialises itself")])
         initial = initial_state(dataset.read("truth"), float(t[0]), init,
                                 dataset.manifest.get("sensors"))
-    try:
-        estimator = cls(config, initial, {s.name: s.columns for s in streams},
-                        {s.name: s.units for s in streams}, imu_output=imu_output(dataset),
-                        datasheet=dataset.manifest.get("datasheet"))
-    except BaseException as exc:
-        failure = _plugin_failure(cls, "setup", None, exc)
-        if failure is None:
-            raise
-        raise failure from None
-    gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
-    out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
-    out = np.full((len(out_t), len(cls.output_columns)), np.nan)
-    kept = np.zeros(len(out_t), dtype=bool)
+    with CompileWatch(label) as compiling:
+        try:
+            estimator = cls(config, initial, {s.name: s.columns for s in streams},
+                            {s.name: s.units for s in streams}, imu_output=imu_output(dataset),
+                            datasheet=dataset.manifest.get("datasheet"))
+        except BaseException as exc:
+            failure = _plugin_failure(cls, "setup", None, exc)
+            if failure is None:
+                raise
+            raise failure from None
+        gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
+        out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
+        out = np.full((len(out_t), len(cls.output_columns)), np.nan)
+        kept = np.zeros(len(out_t), dtype=bool)
 
-    handlers = [getattr(estimator, f"on_{s.name}") for s in streams]
-    messages = [s.messages for s in streams]
-    t_list, sid_list, idx_list = t.tolist(), sid.tolist(), idx.tolist()
-    solution = estimator.solution
-    start = time.perf_counter()
-    k = 0
-    asks = zip(out_t.tolist(), upto.tolist(), strict=True)
-    asking: float | None = None  # the solution time being asked for, else None (a message)
-    try:
-        for j, (t_out, n_before) in enumerate(progress(asks, label, show_progress,
-                                                       len(out_t))):
-            while k < n_before:
-                s = sid_list[k]
-                handlers[s](t_list[k], messages[s][idx_list[k]])
-                k += 1
-            asking = t_out
-            row = solution(t_out)
-            asking = None
-            if row is not None:
-                out[j] = _solution_row(row, cls, t_out)
-                kept[j] = True
-    except BaseException as exc:  # which call failed follows from where the loop stood
-        method, at = (("solution", asking) if asking is not None
-                      else (f"on_{streams[sid_list[k]].name}", t_list[k]))
-        failure = _plugin_failure(cls, method, at, exc)
-        if failure is None:
-            raise
-        raise failure from None
-    runtime = time.perf_counter() - start
+        handlers = [getattr(estimator, f"on_{s.name}") for s in streams]
+        messages = [s.messages for s in streams]
+        t_list, sid_list, idx_list = t.tolist(), sid.tolist(), idx.tolist()
+        solution = estimator.solution
+        compiled_before = compiling.seconds
+        start = time.perf_counter()
+        k = 0
+        asks = zip(out_t.tolist(), upto.tolist(), strict=True)
+        asking: float | None = None  # the solution time being asked for, else None (a message)
+        try:
+            for j, (t_out, n_before) in enumerate(progress(asks, label, show_progress,
+                                                           len(out_t))):
+                while k < n_before:
+                    s = sid_list[k]
+                    handlers[s](t_list[k], messages[s][idx_list[k]])
+                    k += 1
+                asking = t_out
+                row = solution(t_out)
+                asking = None
+                if row is not None:
+                    out[j] = _solution_row(row, cls, t_out)
+                    kept[j] = True
+        except BaseException as exc:  # which call failed follows from where the loop stood
+            method, at = (("solution", asking) if asking is not None
+                          else (f"on_{streams[sid_list[k]].name}", t_list[k]))
+            failure = _plugin_failure(cls, method, at, exc)
+            if failure is None:
+                raise
+            raise failure from None
+        runtime = time.perf_counter() - start - (compiling.seconds - compiled_before)
     position = out[kept][:, [cls.output_columns.index("lat"), cls.output_columns.index("lon")]]
     if not np.isfinite(position).all(axis=1).any():
         raise InputError([Problem(_where(cls), None, "", "gave no solution row with a position "
@@ -321,7 +326,7 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
     duration = float(t[-1] - t[0])
     info = {"label": label, "name": name, "runtime_s": runtime,
             "realtime_factor": duration / runtime if runtime > 0 else float("inf"),
-            "uses_gnss": bool(gnss)}
+            "uses_gnss": bool(gnss), "compile_s": compiling.seconds}
     return frame, info
 
 

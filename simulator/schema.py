@@ -195,9 +195,9 @@ class DateTime(Field):
         elif isinstance(value, str):
             try:
                 stamp = dt.datetime.fromisoformat(value.replace("Z", "+00:00"))
-            except ValueError:
-                return ctx.error(path, f"{value!r} is not an ISO 8601 time "
-                                       "(example: 2019-05-01T03:00:00Z)")
+            except ValueError as exc:
+                return ctx.error(path, f"{value!r} is not a valid ISO 8601 UTC time ({exc}; "
+                                       "example: 2019-05-01T03:00:00Z)")
         else:
             return ctx.error(path, f"expected an ISO 8601 UTC time, got {value!r}")
         if stamp.tzinfo is not None:

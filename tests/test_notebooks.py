@@ -23,7 +23,8 @@ def test_notebook_runs(path, monkeypatch):
     nbclient = pytest.importorskip("nbclient")
     notebook = nbformat.read(path, as_version=4)
     before = _entries()
-    client = nbclient.NotebookClient(notebook, timeout=300, kernel_name="python3",
+    # a hang guard per cell (a first run compiles numba kernels: minutes on a loaded machine)
+    client = nbclient.NotebookClient(notebook, timeout=1200, kernel_name="python3",
                                      resources={"metadata": {"path": str(REPO)}})
     client.execute()
     outputs = [o for cell in notebook.cells if cell.cell_type == "code"

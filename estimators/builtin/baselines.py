@@ -49,6 +49,8 @@ class GnssOnly(Estimator):
     initialises_itself = True
     # s after a fix during which it is extrapolated: bridges one missed epoch of a 1 Hz receiver
     defaults = {"max_extrapolation": 2.0}
+    config_help = {"max_extrapolation": ("s", "how long after a fix its position is "
+                                              "extrapolated with its velocity; none after")}
 
     def setup(self) -> None:
         c = self.columns["gnss_fix"]
@@ -92,6 +94,10 @@ class DeadReckoning(Estimator):
     # odometer reads exactly zero, hold the heading and learn the yaw-gyro bias as the mean of
     # its readings (a zero angular rate update, Groves 2013 section 15.3.3), removed once moving
     defaults = {"earth_rate": True, "standstill": True}
+    config_help = {
+        "earth_rate": ("", "remove the Earth and transport rates from the yaw rate"),
+        "standstill": ("", "learn the yaw-gyro bias while the odometer reads zero"),
+    }
 
     def setup(self) -> None:
         init = self.initial

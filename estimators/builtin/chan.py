@@ -138,6 +138,27 @@ DEFAULTS = {
     "pseudorange_correlation_time": 0.0,
     "gnss_interval": 1.0,  # s, the epoch interval the correlation is counted in
 }
+CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ekf`
+    "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
+    "nhc_std": ("m/s", "its 1-sigma on the body y and z velocity; null: from the car's physics"),
+    "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
+    "nhc_rate": ("Hz", "constraint updates per second while GPS is missing"),
+    "lever_arm": ("m", "IMU to GPS antenna, body FRD"),
+    "initial_position_std": ("m", "initial position uncertainty per axis, 1-sigma"),
+    "initial_velocity_std": ("m/s", "initial velocity uncertainty per axis, 1-sigma"),
+    "initial_attitude_std": ("deg", "initial roll, pitch, yaw uncertainty, 1-sigma"),
+    "accel_bias_std": ("m/s^2", "prior of the accelerometer biases, 1-sigma"),
+    "gyro_bias_std": ("rad/s", "prior of the gyro biases, 1-sigma"),
+    "accel_noise": ("m/s^2/sqrt(Hz)", "accelerometer white noise (velocity random walk)"),
+    "gyro_noise": ("rad/s/sqrt(Hz)", "gyro white noise (angle random walk)"),
+    "accel_bias_walk": ("m/s^3/sqrt(Hz)", "accelerometer bias random walk"),
+    "gyro_bias_walk": ("rad/s^2/sqrt(Hz)", "gyro bias random walk"),
+    "pseudorange_std": ("m", "pseudorange noise when the stream reports none, 1-sigma"),
+    "range_rate_std": ("m/s", "pseudorange-rate noise when the stream reports none, 1-sigma"),
+    "pseudorange_correlation_time": ("s", "correlation time of the pseudorange errors (0: "
+                                          "white, as the paper treats them)"),
+    "gnss_interval": ("s", "the epoch interval the correlation is counted in"),
+}
 
 
 class _TightlyCoupled(Estimator):
@@ -148,6 +169,7 @@ class _TightlyCoupled(Estimator):
     paper = PAPER
     output_columns = (*NAV_COLUMNS, *STD_COLUMNS, *SENSOR_COLUMNS)
     defaults = DEFAULTS
+    config_help = CONFIG_HELP
 
     def setup(self) -> None:
         cfg = self.config
@@ -416,6 +438,9 @@ class TcUkf(_TightlyCoupled):
 
     name = "tc_ukf"
     defaults = {**DEFAULTS, "alpha": 0.99, "beta": 2.0}
+    config_help = {**CONFIG_HELP,
+                   "alpha": ("", "spread of the sigma points (Wan and van der Merwe 2000)"),
+                   "beta": ("", "prior-distribution weight, 2 for a Gaussian")}
 
     def setup(self) -> None:
         super().setup()

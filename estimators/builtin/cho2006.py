@@ -218,6 +218,8 @@ class _ChoDr(Estimator):
     paper = PAPER
     output_rate_hz = 10.0
     defaults = {"standstill_calibration": True}
+    config_help = {"standstill_calibration": ("", "calibrate the sensor biases at each "
+                                                  "standstill (the initial one without odometer)")}
     # set by the model
     _imu_columns: tuple[str, str, str] = ("", "", "")
     _gyro_channels: tuple[int, ...] = ()  # which of the three inputs are gyros
@@ -474,6 +476,12 @@ class Drm2Spkf(_Drm2):
     name = "dr2d_drm2_spkf"
     paper = f"{PAPER}: DRM2 with the scaled simplex sigma-point filter (eqs. 19-32)"
     defaults = {"standstill_calibration": True, "alpha": 0.3, "beta": 2.0, "w0": 0.0}
+    config_help = {
+        **_ChoDr.config_help,
+        "alpha": ("", "spread of the simplex sigma points, in [1e-4, 1] (eq. 21)"),
+        "beta": ("", "prior-distribution weight of the central point, 2 for a Gaussian (eq. 21)"),
+        "w0": ("", "weight of the central sigma point (Julier 2003)"),
+    }
 
     def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
         checks = (("alpha", 1e-4 <= self.config["alpha"] <= 1.0, "must be in [1e-4, 1] (eq. 21)"),

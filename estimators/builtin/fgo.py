@@ -122,6 +122,12 @@ class FgoLooselyCoupled(Estimator):
     paper = ("baseline: GTSAM fixed-lag smoother, IMU preintegration (Forster et al. 2017) "
              "with GNSS position/velocity, odometer and non-holonomic factors")
     defaults = {"lag": 10.0, "keyframe_interval": 1.0, "odometer": True, "nhc": True}
+    config_help = {
+        "lag": ("s", "keyframes the fixed-lag smoother keeps"),
+        "keyframe_interval": ("s", "time between keyframes (and their GNSS fixes)"),
+        "odometer": ("", "odometer speed factors, when the dataset has an odometer"),
+        "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
+    }
     output_columns = OUTPUT_COLUMNS
 
     def setup(self) -> None:
@@ -444,6 +450,8 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
     paper = ("baseline: GTSAM fixed-lag smoother, IMU preintegration (Forster et al. 2017) "
              "with pseudorange, Doppler, clock, odometer and non-holonomic factors")
     defaults = {**FgoLooselyCoupled.defaults, "elevation_mask": 10.0}
+    config_help = {**FgoLooselyCoupled.config_help,
+                   "elevation_mask": ("deg", "satellites below this elevation are left out")}
     output_columns = OUTPUT_COLUMNS + ("clock_bias", "clock_drift")
 
     def setup(self) -> None:

@@ -248,6 +248,14 @@ class RissTcEkf(Estimator):
     defaults = {"model": "enhanced", "coupling": "tight", "tilt_window": 2.0,
                 "accel_update_interval": 1.0, "odometer_speed_noise": 0.2,
                 "nhc_point": "rear_axle"}
+    config_help = {
+        "model": ("", "enhanced (eqs. 1-58) or simplified, the earlier model"),
+        "coupling": ("", "tight (pseudoranges and rates) or loose (position and velocity fixes)"),
+        "tilt_window": ("s", "averaging of eq. 2's accelerometer and odometer acceleration"),
+        "accel_update_interval": ("s", "time between the accelerometer updates of eqs. 50-58"),
+        "odometer_speed_noise": ("m/s", "1-sigma white noise of one odometer speed sample"),
+        "nhc_point": ("", "where the velocity lies along the body: rear_axle or imu"),
+    }
     output_columns = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                       "std_n", "std_e", "std_d", "std_yaw",
                       "gyro_bias_z", "accel_bias_x", "accel_bias_y", "clock_bias", "clock_drift")

@@ -152,6 +152,39 @@ def _dr3d_navigate(q: np.ndarray, c_old: np.ndarray, pos: np.ndarray, v_prev: np
     return q_new, c_new, np.array([lat_new, lon_new, h_new]), v
 
 
+# config key -> (SI unit, meaning), of both filters (`landnav estimators dr3d_ekf`)
+CONFIG_HELP = {
+    "adaptive": ("", "the noise adaptation rules of section III-D"),
+    "baro": ("", "barometric height in step 1"),
+    "step": ("s", "propagation period (step 1 of section III-C)"),
+    "gyro_noise_density": ("rad/s/sqrt(Hz)", "gyro white noise (Table 1)"),
+    "gyro_bias_sigma": ("rad/s", "gyro bias, Gauss-Markov steady state"),
+    "gyro_bias_time_constant": ("s", "its time constant (tau_2 of eq. 29)"),
+    "gyro_bias_initial": ("rad/s", "initial gyro-bias uncertainty (Table 1 zero-point offset)"),
+    "scale_sigma": ("1", "odometer scale factor, Gauss-Markov steady state"),
+    "scale_time_constant": ("s", "its time constant (tau_1 of eq. 29)"),
+    "scale_initial": ("1", "initial scale-factor uncertainty"),
+    "position_initial": ("m", "initial position uncertainty per axis"),
+    "attitude_initial": ("rad", "initial roll and pitch uncertainty"),
+    "heading_initial": ("rad", "initial yaw uncertainty"),
+    "tilt_sigma": ("rad", "accelerometer roll and pitch noise"),
+    "tilt_sigma_inflated": ("rad", "the same while accelerating (adaptive)"),
+    "baro_sigma": ("m", "barometric height noise"),
+    "baro_sigma_inflated": ("m", "the same when the adaptive rules inflate it"),
+    "baro_offset_time_constant": ("s", "time constant of the barometer height offset"),
+    "gps_horizontal_sigma": ("m", "GPS horizontal position noise"),
+    "gps_vertical_sigma": ("m", "GPS height noise"),
+    "gps_height_max_vdop": ("", "largest VDOP at which the GPS height is used"),
+    "gps_speed_sigma": ("m/s", "GPS speed noise"),
+    "gps_speed_sigma_inflated": ("m/s", "the same when the adaptive rules inflate it"),
+    "gps_course_sigma": ("rad", "GPS course noise"),
+    "gps_course_sigma_inflated": ("rad", "the same when the adaptive rules inflate it"),
+    "course_min_speed": ("m/s", "speed above which the GPS course is used"),
+    "speed_error_sigma": ("m/s", "odometer speed error, Gauss-Markov steady state"),
+    "speed_error_time_constant": ("s", "its time constant"),
+}
+
+
 class _FixColumns:
     """Column positions of the ``gnss_fix`` stream used by both filters."""
 
@@ -281,6 +314,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         "gps_course_sigma_inflated": 5.0 * DEG,
         "course_min_speed": 1.0,  # m/s
     }
+    config_help = {k: CONFIG_HELP[k] for k in defaults}
 
     def setup(self) -> None:
         c = self.config
@@ -464,6 +498,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         "gps_horizontal_sigma": 3.0,  # m
         "gps_speed_sigma": 0.1,  # m/s
     }
+    config_help = {k: CONFIG_HELP[k] for k in defaults}
 
     def setup(self) -> None:
         c = self.config

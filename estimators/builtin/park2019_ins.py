@@ -91,6 +91,12 @@ class ParkInsOdometer(Estimator):
     paper = "Park et al. 2019 (IEEE Access), eqs. 1-14: INS/GPS/odometer EKF with NHC"
     defaults = {"nhc": True, "nhc_point": "rear_axle", "fix_error_states": False,
                 "odometer_scale_state": False}
+    config_help = {
+        "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
+        "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
+        "fix_error_states": ("", "three Gauss-Markov states of the GNSS fix's correlated error"),
+        "odometer_scale_state": ("", "an odometer scale-factor state"),
+    }
     output_columns = SOLUTION_COLUMNS
 
     NOISE = InsNoise(accel_noise=0.19e-3 * G0, gyro_noise=0.02 * DEG,

@@ -83,6 +83,15 @@ class TanLinearisedKF(Estimator):
     defaults = {"nhc": True, "height_constraint": True, "mag_heading": True,
                 "update_interval": 0.5, "standstill": 60.0, "course_speed": 5.0,
                 "open_loop_outages": True}
+    config_help = {
+        "nhc": ("", "zero lateral and vertical body velocity during outages (eqs. 6-7)"),
+        "height_constraint": ("", "hold the last GPS-aided height during outages (section 3.2)"),
+        "mag_heading": ("", "magnetometer heading during outages (eq. 8)"),
+        "update_interval": ("s", "period of the aiding updates in outages"),
+        "standstill": ("s", "zero-velocity and zero-rate updates over the first seconds"),
+        "course_speed": ("m/s", "speed above which the GPS course aids the heading"),
+        "open_loop_outages": ("", "open the loop during outages (the paper's design)"),
+    }
     output_columns = SOLUTION_COLUMNS
 
     NOISE = InsNoise(accel_noise=0.2e-3 * G0, gyro_noise=0.1 * DEG,

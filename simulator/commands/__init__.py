@@ -10,7 +10,7 @@ MODULES = {"import": "import_recording"}
 SUMMARIES = {
     "validate": "check scenario files; print every problem as file:line: key: message",
     "generate": "write the dataset of a scenario (truth, sensor streams, events)",
-    "estimators": "list the registered estimators (name, streams it needs, paper)",
+    "estimators": "list the registered estimators, or describe one (streams, config keys)",
     "estimate": "run one estimator causally over a dataset, write its solution",
     "score": "score solutions against a dataset's truth (table, JSON, report)",
     "run": "generate, run the scenario's estimators, score, write the report",

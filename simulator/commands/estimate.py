@@ -3,18 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import sys
 
-import yaml
-
-from estimators.registry import entry_problems
-from simulator import pipeline
 from simulator.commands import SUMMARIES
-from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
-from simulator.replay import write_solution
-from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
-from simulator.schema import INVALID, Context
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -41,6 +32,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def _pairs(items: list[str], option: str) -> dict:
+    import yaml
+
     out: dict = {}
     problems = []
     for text in items:
@@ -59,6 +52,10 @@ def _pairs(items: list[str], option: str) -> dict:
 
 def _entry(args: argparse.Namespace) -> dict:
     """The command-line options as a scenario estimator entry, validated like one."""
+    from estimators.registry import entry_problems
+    from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
+    from simulator.schema import INVALID, Context
+
     given = {"name": args.estimator, "label": args.label,
              "init": _pairs(args.init, "--init") or None,
              "config": _pairs(args.config, "--set") or None}
@@ -75,11 +72,17 @@ def _entry(args: argparse.Namespace) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator import pipeline
+    from simulator.dataset.io import open_dataset
+    from simulator.replay import write_solution
+
     entry = _entry(args)
     dataset = open_dataset(args.dataset)
-    solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
+    solution, info = pipeline.estimate(dataset, entry, show_progress=True)
     write_solution(solution, args.output, args.force, [dataset.path],
                    uses_gnss=info["uses_gnss"])
+    compiled = (f" (and {info['compile_s']:.1f} s compiling numba kernels, not counted)"
+                if info["compile_s"] > 0 else "")
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
-          f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time")
+          f"{info['runtime_s']:.2f} s, {info['realtime_factor']:.0f} x real time{compiled}")
     return 0

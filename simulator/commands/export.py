@@ -8,8 +8,6 @@ import argparse
 from pathlib import Path
 
 from simulator.commands import SUMMARIES
-from simulator.dataset.export import export_nmea, export_rinex
-from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 
 
@@ -37,6 +35,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.dataset.export import export_nmea, export_rinex
+    from simulator.dataset.io import open_dataset
+
     if not args.rinex and not args.nmea and not args.mcap:
         raise InputError([Problem("landnav export", None, "", "nothing to do: give --rinex DIR, "
                                   "--nmea FILE and/or --mcap FILE")])

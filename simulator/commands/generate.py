@@ -7,8 +7,6 @@ import time
 
 from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
-from simulator.dataset.generate import generate_dataset
-from simulator.scenario import load_scenario
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -27,6 +25,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.dataset.generate import generate_dataset
+    from simulator.scenario import load_scenario
+
     scenario = load_scenario(args.scenario, args.overrides, args.seed)
     start = time.perf_counter()
     out = generate_dataset(scenario, args.output, force=args.force)

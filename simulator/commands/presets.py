@@ -11,7 +11,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "presets", help=SUMMARIES["presets"],
         description="List every sensor preset (sensors.<sensor>.preset) with the parameters it "
-                    "sets, in SI units; their sources are in docs/scenario-reference.md.")
+                    "sets, in the units of datasheets (deg/h, deg/sqrt(h), mg, ug/sqrt(Hz), %, "
+                    "ppm, hPa; the dataset files hold SI); their sources are in "
+                    "docs/scenario-reference.md.")
     p.set_defaults(run=run)
 
 

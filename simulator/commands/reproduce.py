@@ -11,8 +11,8 @@ from pathlib import Path
 from simulator.commands import SUMMARIES
 from simulator.commands.options import worker_problems
 from simulator.errors import InputError, Problem
+from simulator.reproduce import FULL_SEEDS, QUICK_SEEDS
 from simulator.reproduce.papers import load_paper, paper_keys
-from simulator.reproduce.runner import FULL_SEEDS, QUICK_SEEDS, reproduce
 
 MAX_RUNS = 1000  # seeds per experiment
 
@@ -34,9 +34,21 @@ def _papers_help() -> str:
     return "\n".join(lines)
 
 
+class _ListPapers(argparse.Action):
+    """``--list``: print every paper's title, claims and scenarios and exit, as ``--help``
+    does (it imports the paper modules, so it is not part of ``--help``)."""
+
+    def __init__(self, option_strings: list[str], dest: str, **kwargs) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *args) -> None:
+        print(_papers_help())
+        parser.exit()
+
+
 def _wrap(text: str) -> str:
     """Each paragraph of ``text`` filled to 78 columns; indented lines kept as they are."""
-    return "\n\n".join(p if p.startswith(("  ", "Papers", "Examples")) else textwrap.fill(p, 78)
+    return "\n\n".join(p if p.startswith(("  ", "Examples")) else textwrap.fill(p, 78)
                        for p in text.split("\n\n"))
 
 
@@ -55,12 +67,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
             "embedded), DIR/figures/PAPER/EXPERIMENT.parquet (index seed, one column per "
             "figure) and DIR/failures.parquet when a run failed (the others go on; the report "
             "names the seed and the error). Nothing is written until the run is complete.\n\n"
-            f"Papers (all when none is named):\n{_papers_help()}\n\n"
+            f"Papers (all when none is named): {', '.join(paper_keys())}; `landnav "
+            "reproduce --list` shows each one's claims and scenarios.\n\n"
             "Examples:\n"
             "  landnav reproduce --quick -o out/repro          every paper, 3 seeds, short "
             "drives\n"
             "  landnav reproduce cho2006 tan2008 --runs 10 --workers 2 -o out/repro-ct\n"
             "  landnav reproduce park2019 --scheduler tcp://10.0.0.5:8786 -o out/park"))
+    p.add_argument("--list", action=_ListPapers,
+                   help="list every paper with its title, claims and scenarios, and exit")
     p.add_argument("papers", nargs="*", metavar="PAPER",
                    help="paper keys (default: every registered paper)")
     p.add_argument("--runs", type=int, default=None, metavar="N",
@@ -100,6 +115,8 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.reproduce.runner import reproduce
+
     workers = _check(args)
     out = Path(args.output)
     empty_dir = out.is_dir() and not out.is_symlink() and not any(out.iterdir())

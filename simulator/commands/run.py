@@ -1,17 +1,15 @@
 """``landnav run SCENARIO [-o DIR]``: the main job. Generate the dataset, run every estimator the
 scenario names, score them and write the report, all into one directory written atomically:
-``DIR/dataset/``, ``DIR/solutions/LABEL.parquet``, ``DIR/scores.json``, ``DIR/report.md`` and
-``DIR/plots/``."""
+``DIR/dataset/``, ``DIR/solutions/LABEL.parquet``, ``DIR/scores.json``, ``DIR/report.md`` with
+``DIR/plots/``, and ``DIR/report.html`` (the same report, plots embedded)."""
 
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
 
-from simulator import pipeline
 from simulator.commands import SUMMARIES
 from simulator.commands.options import add_scenario_options
-from simulator.scoring.report import print_scores
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -20,7 +18,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
         description="The main job: generate the scenario's dataset into DIR/dataset/, run every "
                     "estimator the scenario names over it (causally), write their solutions to "
                     "DIR/solutions/LABEL.parquet, the scores to DIR/scores.json (keyed by label)"
-                    " and DIR/report.md with its plots. DIR is written under a temporary name "
+                    ", DIR/report.md with its plots and DIR/report.html (the same report in "
+                    "one self-contained page, plots embedded: open it in a browser). DIR is "
+                    "written under a temporary name "
                     "and renamed when complete; an existing DIR is kept unless --force.")
     p.add_argument("scenario", metavar="SCENARIO", help="YAML scenario file")
     p.add_argument("-o", "--output", metavar="DIR",
@@ -31,13 +31,17 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator import pipeline
+    from simulator.scoring.report import print_scores
+
     scenario = pipeline.load_scenario(args.scenario, args.overrides, args.seed)
     out = Path(args.output) if args.output else Path("runs") / scenario.name
-    result = pipeline.run(scenario, out, args.force)
+    result = pipeline.run(scenario, out, args.force, show_progress=True)
     if scenario.data["estimators"]:
         print_scores(result.evaluation)
     else:
         print("no estimator was named in the scenario; the dataset and report were written")
     print(f"wrote {out} ({scenario.name}, seed {scenario.seed}): dataset/, "
-          f"{len(result.evaluation.results)} solution(s), scores.json, report.md")
+          f"{len(result.evaluation.results)} solution(s), scores.json, report.md, "
+          "report.html")
     return 0

@@ -7,15 +7,14 @@ import argparse
 import contextlib
 import sys
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from simulator import pipeline
 from simulator.commands import SUMMARIES
-from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
-from simulator.outputs import atomic_output_dir
-from simulator.scoring.evaluate import write_scores
-from simulator.scoring.readers import check_solution, read_solution_file
-from simulator.scoring.report import print_scores, write_report
+
+if TYPE_CHECKING:
+    from simulator import pipeline
+    from simulator.dataset.io import Dataset
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -29,7 +28,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                     "docs/solution-format.md, RTKLIB .pos, NMEA GGA/RMC) and/or estimators run "
                     "here (-e, a registered name or module:Class, labelled by name). Prints a "
                     "compact table; --json writes the scores keyed by label; --report writes "
-                    "report.md with plots into DIR (atomically; an existing DIR needs --force).")
+                    "report.md with plots and report.html (the same, plots embedded) into DIR "
+                    "(atomically; an existing DIR needs --force).")
     p.add_argument("dataset", metavar="DATASET", help="dataset directory")
     p.add_argument("--solution", nargs="+", action="extend", metavar="FILE", default=[],
                    help="solution file(s): .parquet, .csv, RTKLIB .pos, NMEA")
@@ -37,7 +37,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="estimator(s) to run over the dataset and score (registered name or "
                         "module:Class, found from the current directory as python -m does)")
     p.add_argument("--json", metavar="OUT", help="write the scores as JSON")
-    p.add_argument("--report", metavar="DIR", help="write report.md and plots/ into DIR")
+    p.add_argument("--report", metavar="DIR",
+                   help="write report.md, plots/ and report.html into DIR")
     p.add_argument("--force", action="store_true",
                    help="overwrite an existing --json file or report DIR")
     p.set_defaults(run=run)
@@ -46,6 +47,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def _from_files(paths: list[str], dataset: Dataset) -> pipeline.Solutions:
     """Read and check each solution file (any format of docs/solution-format.md); the notes
     on what was converted go to stderr."""
+    from simulator.scoring.readers import check_solution, read_solution_file
+
     gps = dataset.manifest.get("gps_time_start") or {"week": 0, "tow": 0.0}
     truth = dataset.read("truth")
     out: pipeline.Solutions = {}
@@ -63,6 +66,12 @@ def _from_files(paths: list[str], dataset: Dataset) -> pipeline.Solutions:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator import pipeline
+    from simulator.dataset.io import open_dataset
+    from simulator.outputs import atomic_output_dir
+    from simulator.scoring.evaluate import write_scores
+    from simulator.scoring.report import print_scores
+
     if not args.solution and not args.estimator:
         raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
                                   "FILE... and/or -e NAME...")])
@@ -72,8 +81,8 @@ def run(args: argparse.Namespace) -> int:
                                                             [dataset.path]))
                       if args.report else None)
         solutions = _from_files(args.solution, dataset)
-        for label, solved in pipeline.run_estimators(dataset,
-                                                     dict.fromkeys(args.estimator)).items():
+        for label, solved in pipeline.run_estimators(dataset, dict.fromkeys(args.estimator),
+                                                     show_progress=True).items():
             if label in solutions:
                 raise InputError([Problem(args.dataset, None, "", f"label {label!r} is both a "
                                           "solution file's stem and an estimator's name")])
@@ -87,7 +96,7 @@ def run(args: argparse.Namespace) -> int:
             write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])
             print(f"wrote {args.json}")
         if report_dir is not None:
-            write_report(report_dir, ev, f"Scores on {dataset.path.name}")
+            pipeline.write_report(report_dir, ev, f"Scores on {dataset.path.name}")
     if args.report:
-        print(f"wrote {Path(args.report) / 'report.md'}")
+        print(f"wrote {Path(args.report) / 'report.md'} and report.html")
     return 0

@@ -7,7 +7,6 @@ import sys
 
 from simulator.commands import SUMMARIES
 from simulator.errors import InputError
-from simulator.pipeline import load_scenario
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -24,6 +23,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.pipeline import load_scenario
+
     failed = False
     for path in args.scenarios:
         try:

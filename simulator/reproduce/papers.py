@@ -11,9 +11,12 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+from typing import TYPE_CHECKING
 
 from simulator.errors import InputError, Problem
-from simulator.reproduce.paper import Paper
+
+if TYPE_CHECKING:
+    from simulator.reproduce.paper import Paper
 
 __all__ = ["PAPERS", "load_paper", "paper_keys"]
 

@@ -1,5 +1,6 @@
-"""The reproduction report: ``report.md`` and a self-contained ``report.html`` (its plots
-embedded as base64 PNG, no external file), written into the run's output folder.
+"""The reproduction report: ``report.md`` and a self-contained ``report.html`` (the Markdown
+rendered by ``simulator.html_report``, its plots embedded as base64 PNG, no external file),
+written into the run's output folder.
 
 Contents, in order: the run's settings (seeds, quick or full, wall and CPU time, landnav version
 and commit); a summary table (paper x how many claims are shown / partly / not shown); then per
@@ -18,8 +19,6 @@ write_report, summary_counts, PLOTS.
 
 from __future__ import annotations
 
-import base64
-import html
 import io
 from collections.abc import Sequence
 from pathlib import Path
@@ -28,6 +27,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from matplotlib.figure import Figure
 
+from simulator.html_report import write_html_report
 from simulator.reproduce.paper import STATUSES
 from simulator.scoring.report import markdown_table
 
@@ -156,60 +156,9 @@ def _markdown(results: Sequence[PaperResult], settings: Settings,
     return "\n".join(lines) + "\n"
 
 
-def _html_table(header: list[str], rows: list[list[str]]) -> str:
-    def cell(text: str, tag: str) -> str:
-        escaped = html.escape(str(text))
-        # **word** -> <b>word</b>, the one markup the cells use
-        parts = escaped.split("**")
-        escaped = "".join(f"<b{_STATUS_CLASS.get(p, '')}>{p}</b>" if i % 2 else p
-                          for i, p in enumerate(parts))
-        return f"<{tag}>{escaped}</{tag}>"
-
-    head = "".join(cell(h, "th") for h in header)
-    body = "".join("<tr>" + "".join(cell(c, "td") for c in row) + "</tr>" for row in rows)
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-
-
-_STATUS_CLASS = {"shown": " class='shown'", "partly": " class='partly'",
-                 "not shown": " class='not-shown'"}  # the verdict words, coloured
-_STYLE = """.shown{color:#1b6e20;} .partly{color:#a65f00;} .not-shown{color:#b00020;}
-body{font-family:sans-serif;max-width:1200px;margin:auto;padding:1em;}
-table{border-collapse:collapse;margin:0.5em 0;font-size:0.9em;}
-td,th{border:1px solid #bbb;padding:4px 6px;vertical-align:top;text-align:left;}
-th{background:#eee;} img{max-width:100%;}"""
-
-
-def _html(results: Sequence[PaperResult], settings: Settings, pngs: dict[str, bytes]) -> str:
-    counts = summary_counts(results)
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'>",
-             "<title>landnav reproduce</title>", f"<style>{_STYLE}</style></head><body>",
-             "<h1>landnav reproduce: the seed papers' claims</h1>",
-             "<p>Each claim beside landnav's figure over seeds (paired per seed where two "
-             "estimators are compared) with one word: shown, partly or not shown, and the "
-             "reason.</p><h2>Run</h2>",
-             _html_table(["setting", "value"], [list(r) for r in _settings_rows(settings)]),
-             "<h2>Summary</h2>",
-             _html_table(["paper", *STATUSES], [[r.paper.key, *(str(counts[r.paper.key][s])
-                                                                for s in STATUSES)]
-                                                for r in results])]
-    for r in results:
-        parts += [f"<h2>{html.escape(r.paper.key)}: {html.escape(r.paper.title)}</h2>",
-                  f"<p>{html.escape(r.paper.citation)}</p><h3>Experiments</h3>",
-                  _html_table(["experiment", "scenario", "entries", "seeds with figures",
-                               "failed seeds"], _experiment_rows(r)),
-                  "<h3>Claims</h3>",
-                  _html_table(["claim", "paper", "landnav", "conditions that differ",
-                               "verdict"], _claim_rows(r))]
-        failures = _failure_rows(r)
-        if failures:
-            parts += ["<h3>Failed runs</h3>",
-                      _html_table(["experiment", "seed", "error"], failures)]
-        if r.paper.key in pngs:
-            data = base64.b64encode(pngs[r.paper.key]).decode("ascii")
-            parts.append(f"<img alt='{html.escape(r.paper.key)}: per-seed figures' "
-                         f"src='data:image/png;base64,{data}'>")
-    parts.append("</body></html>")
-    return "\n".join(parts) + "\n"
+# the verdict words, coloured in the HTML page
+VERDICT_COLOURS = {"shown": "color:#1b6e20", "partly": "color:#a65f00",
+                   "not shown": "color:#b00020"}
 
 
 def write_report(directory: Path, results: Sequence[PaperResult], settings: Settings) -> Path:
@@ -222,7 +171,7 @@ def write_report(directory: Path, results: Sequence[PaperResult], settings: Sett
         for key, png in pngs.items():
             (directory / PLOTS / f"{key}.png").write_bytes(png)
             plots[key] = f"{PLOTS}/{key}.png"
-    (directory / "report.html").write_text(_html(results, settings, pngs), encoding="utf-8")
     path = directory / "report.md"
     path.write_text(_markdown(results, settings, plots), encoding="utf-8")
+    write_html_report(path, VERDICT_COLOURS)
     return path

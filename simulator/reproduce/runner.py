@@ -41,6 +41,7 @@ from simulator.campaign.execute import completed, open_executor
 from simulator.outputs import atomic_output_dir
 from simulator.pipeline import estimate, generate, load_scenario
 from simulator.progress import progress
+from simulator.reproduce import FULL_SEEDS, QUICK_SEEDS
 from simulator.reproduce.paper import SCENARIO_DIR, Experiment, Paper, Verdict, scenario_path
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.report import write_report
@@ -48,8 +49,6 @@ from simulator.reproduce.report import write_report
 __all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings",
            "reproduce", "run_experiment", "seeds_of"]
 
-FULL_SEEDS = 10  # seeds of a full run unless --runs says otherwise (issue 14: ten seeds)
-QUICK_SEEDS = 3  # seeds of --quick (issue 16: at least 3)
 SCHEDULER_TIMEOUT_S = 10.0
 
 

@@ -22,6 +22,7 @@ import inspect
 import json
 from typing import Any
 
+from simulator.display_units import display
 from simulator.scenario.spec import SCENARIO_FIELD
 from simulator.schema import (
     REQUIRED,
@@ -262,30 +263,53 @@ def _sources(module: Any) -> str:
 def _preset_lines() -> list[str]:
     lines = ["## Sensor presets", "",
              "`sensors.<sensor>.preset` fills every key of the sensor's block; keys given beside "
-             "it override the preset's values. Values are SI (`landnav presets` prints them).", ""]
+             "it override the preset's values. Values are shown in datasheet units "
+             "(`landnav presets` prints them so); a scenario may give them so, as strings with "
+             "their unit, and the dataset's files hold SI.", ""]
     for sensor, (presets, module) in SENSOR_PRESETS.items():
         lines += [f"### {sensor}", "", "| preset | parameters |", "|---|---|"]
         for name, values in presets.items():
-            lines.append(f"| `{name}` | {_cell(_parameters(values))} |")
+            lines.append(f"| `{name}` | {_cell(_parameters(values, _sensor_fields(sensor)))} |")
         sources = _sources(module)
         lines += ["", f"Sources ({module.__name__}):", "", "```", sources, "```", ""] \
             if sources else [""]
     return lines
 
 
-def _parameters(values: dict) -> str:
-    """A preset's parameters as ``key=value, ...``."""
-    return ", ".join(f"{k}={_value(v)}" for k, v in values.items()) or "(all errors off)"
+def _parameters(values: dict, fields: dict[str, Field]) -> str:
+    """A preset's parameters as ``key=value, ...``, each dimensional value in its datasheet
+    unit (``simulator.display_units``; the schema's ``fields`` give each key's SI unit)."""
+    return ", ".join(f"{k}={_value(v, fields.get(k))}" for k, v in values.items()) \
+        or "(all errors off)"
 
 
-def _value(v: Any) -> str:
+def _si_unit(field: Field | None) -> str | None:
+    """The SI unit of a number field (one number, one per axis, or drawn-or-fixed), else None."""
+    while field is not None and not isinstance(field, Number):
+        field = (getattr(field, "number", None) or getattr(field, "sigma", None)
+                 or getattr(field, "item", None))
+    return field.unit if field is not None else None
+
+
+def _value(v: Any, field: Field | None = None) -> str:
     if isinstance(v, dict):
-        return "{" + ", ".join(f"{k}: {_value(x)}" for k, x in v.items()) + "}"
+        sub = getattr(field, "fields", {})
+        return "{" + ", ".join(f"{k}: {_value(x, sub.get(k))}" for k, x in v.items()) + "}"
+    unit = _si_unit(field)
+    is_number = isinstance(v, (int, float)) and not isinstance(v, bool)
+    numbers = isinstance(v, (list, tuple)) and all(
+        isinstance(x, (int, float)) and not isinstance(x, bool) for x in v)
+    if unit is not None and (is_number or numbers):
+        return display(list(v) if numbers else v, unit)
     if isinstance(v, (list, tuple)):
         return "[" + ", ".join(_value(x) for x in v) + "]"
     if isinstance(v, float):
         return f"{v:.6g}"
     return str(v)
+
+
+def _sensor_fields(sensor: str) -> dict[str, Field]:
+    return SCENARIO_FIELD.fields["sensors"].fields[sensor].fields
 
 
 def reference_markdown() -> str:
@@ -309,7 +333,8 @@ def presets_text() -> str:
     lines = []
     for sensor, (presets, _) in SENSOR_PRESETS.items():
         for name, values in presets.items():
-            lines.append(f"{sensor:9s} {name:20s} {_parameters(values)}")
+            lines.append(f"{sensor:9s} {name:20s} "
+                         f"{_parameters(values, _sensor_fields(sensor))}")
     return "\n".join(lines)
 
 

@@ -5,7 +5,7 @@ The reader is bounded: alias expansion and nesting depth are limited (``MAX_NODE
 line instead of exhausting memory or the stack. Plain scalars that YAML 1.1 leaves as strings but
 every reader means as numbers (``1.0e9``, ``1e-3``: YAML 1.1 wants a sign in the exponent and a dot
 in the mantissa) are read as floats, and a timestamp that is not a real date (``2024-13-45``) is
-refused with its line.
+left as its text, for the schema to report with every other problem of the file.
 
 Public functions
 ----------------
@@ -42,14 +42,16 @@ def _refuse(file: str, node: yaml.Node, path: tuple, message: str) -> InputError
                                message)])
 
 
-def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader, path: tuple, file: str) -> Any:
+def _scalar(node: yaml.ScalarNode, loader: yaml.SafeLoader) -> Any:
     if not node.style and node.tag == "tag:yaml.org,2002:str" and _PLAIN_FLOAT.match(
             node.value):
         return float(node.value)
     try:
         return loader.construct_object(node, deep=True)
-    except (ValueError, OverflowError) as exc:
-        raise _refuse(file, node, path, f"{node.value!r} is not a valid value ({exc})") from None
+    except (ValueError, OverflowError):
+        # YAML's reading of the text failed (a timestamp that is no real date, 2024-13-45): the
+        # text goes to the schema, whose field reports it with the file's other problems
+        return node.value
 
 
 def _construct(node: yaml.Node, loader: yaml.SafeLoader, path: tuple, lines: dict,
@@ -60,7 +62,7 @@ def _construct(node: yaml.Node, loader: yaml.SafeLoader, path: tuple, lines: dic
         raise _refuse(file, node, path, f"the file expands to more than {MAX_NODES} values "
                       "(aliases repeated inside aliases?); write the content out")
     if not isinstance(node, (yaml.MappingNode, yaml.SequenceNode)):
-        return _scalar(node, loader, path, file)
+        return _scalar(node, loader)
     if len(path) >= MAX_DEPTH:
         raise _refuse(file, node, path, f"nested more than {MAX_DEPTH} levels deep")
     if id(node) in budget.open:
@@ -120,6 +122,9 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
         raise InputError([Problem(file, line, "", f"malformed YAML: {message}")]) from None
     except yaml.YAMLError as exc:
         raise InputError([Problem(file, None, "", f"malformed YAML: {exc}")]) from None
+    except RecursionError:  # the pure-Python parser (no libyaml) recurses once per level
+        raise InputError([Problem(file, None, "", f"malformed YAML: nested more than "
+                                  f"{MAX_DEPTH} levels deep")]) from None
     finally:
         loader.dispose()
     return data, lines

@@ -20,6 +20,8 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from simulator.columns import SENSOR_ERRORS
+from simulator.display_units import display
 from simulator.gnss.fix import primary_rows
 from simulator.scoring.consistency import CONSISTENCY_SKIP_S
 from simulator.scoring.evaluate import Evaluation
@@ -178,8 +180,13 @@ def _consistency_lines(scores: dict[str, dict]) -> list[str]:
     return lines
 
 
+def _sensor_value(x: float | None, column: str) -> str:
+    """An estimated sensor error in its datasheet unit (deg/h, mg, ppm, ...)."""
+    return "-" if x is None else display(x, SENSOR_ERRORS.get(column, ""))
+
+
 def _sensor_lines(scores: dict[str, dict]) -> list[str]:
-    rows = [[label, name, format_number(v["rms"]), format_number(v["final"])]
+    rows = [[label, name, _sensor_value(v["rms"], name), _sensor_value(v["final"], name)]
             for label, s in scores.items() for name, v in (s.get("sensor_errors") or {}).items()]
     if not rows:
         return ["No solution estimates a sensor error the dataset has the truth of."]

@@ -7,13 +7,13 @@ Model::
     p_sl(t) = sea_level_pressure + (drift + r) t
 
 * p_std: the ICAO / U.S. 1976 standard atmosphere (``simulator.environment.atmosphere``) at the
-  truth's height above mean sea level H: with ``geoid: true`` (the ``bosch-bmp280`` preset) the
-  orthometric height H = h - N, N the EGM96 geoid undulation at the truth's position
-  (``simulator.geoid``; the atmosphere is layered on equipotential surfaces, so pressure
-  follows the geoid: at ARL1, N = -26.9 m, about 3 hPa); with ``geoid: false`` (the default
-  and ``preset: ideal``, unchanged) the ellipsoidal height h, so the ideal barometer's altitude
-  is the truth altitude. A non-standard sea-level pressure scales the whole column (the
-  altimeter-setting convention);
+  truth's height above mean sea level H, the orthometric height H = h - N, N the EGM96 geoid
+  undulation at the truth's position (``simulator.geoid``; the atmosphere is layered on
+  equipotential surfaces, so pressure follows the geoid: at ARL1, N = -26.9 m, about 3 hPa).
+  This is the air's, not the sensor's: ``preset: ideal`` (no sensor error) reads the pressure
+  of the true orthometric height too. ``geoid: false`` takes the ellipsoidal height h instead
+  (an atmosphere layered on the ellipsoid, for comparisons). A non-standard sea-level pressure
+  scales the whole column (the altimeter-setting convention);
 * ``drift``: sea-level pressure change per hour (Pa/h, given, e.g. "-1 hPa/h" for a passing
   front);
 * r ~ N(0, ``weather_drift``^2), the weather's rate drawn once per run (``drawn["drift_rate"]``
@@ -30,9 +30,9 @@ Model::
 * then clipping to ``range`` [min, max] and rounding to ``resolution``.
 
 The ``altitude`` column is the pressure altitude of the measured pressure (standard atmosphere,
-101325 Pa at sea level): with ``geoid: true`` an error-free barometer reads the orthometric
-height, which differs from the truth's ellipsoidal altitude by N (estimators calibrate the
-barometer's offset against GNSS heights, which absorbs it).
+101325 Pa at sea level): an error-free barometer reads the orthometric height, which differs
+from the truth's ellipsoidal altitude by N (estimators calibrate the barometer's offset against
+GNSS heights, which absorbs it).
 
 Public names
 ------------
@@ -76,13 +76,13 @@ _FIELDS = {
     "temperature_coefficient": Number("Pa/K", None, min=0,
                                       doc="1-sigma pressure offset per kelvin, drawn once per run"),
     "temperature": TEMPERATURE_FIELD,
-    "geoid": Boolean(None, doc="pressure of the height above the EGM96 geoid (mean sea level); "
-                               "false: of the ellipsoidal height"),
+    "geoid": Boolean(None, doc="pressure of the height above the EGM96 geoid (mean sea level, "
+                               "the default); false: of the ellipsoidal height"),
     "sea_level_pressure": Number("Pa", None, gt=0, doc="sea-level pressure at t = 0"),
     "resolution": Number("Pa", None, min=0, doc="quantisation step"),
     "range": Vector(2, Number("Pa", gt=0), None, doc="lowest and highest pressure measured"),
 }
-_DEFAULTS = {"rate": 10.0, "sea_level_pressure": P0_PA, "range": None, "geoid": False}
+_DEFAULTS = {"rate": 10.0, "sea_level_pressure": P0_PA, "range": None, "geoid": True}
 
 
 def _check_range(out: dict, path: Path, ctx: Context) -> dict:

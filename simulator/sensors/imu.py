@@ -201,7 +201,7 @@ def _group_fields(unit: str, random_walk_unit: str, gyro: bool) -> dict[str, Fie
                                     doc="white noise density (angle / velocity random walk)"),
         "random_walk": AxisNumber(random_walk_unit, min=0, doc="bias random walk density"),
         "ramp": AxisNumber(f"{unit}/s", min=0, doc="rate ramp, drawn sign"),
-        "scale_factor": DrawnOrFixed("", doc="scale-factor error, 1-sigma, drawn once"),
+        "scale_factor": DrawnOrFixed("1", doc="scale-factor error, 1-sigma, drawn once"),
         "misalignment": AxisNumber("rad", min=0, doc="axis misalignment / cross-coupling, "
                                                      "1-sigma"),
         "range": AxisNumber(unit, gt=0, doc="saturation limit"),

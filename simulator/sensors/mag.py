@@ -60,7 +60,7 @@ _FIELDS = {
     "rate": Number("Hz", None, gt=0, max=1000, doc="sample rate"),
     "noise": Number("T", None, min=0, doc="white noise per axis, 1-sigma"),
     "hard_iron": Number("T", None, min=0, doc="hard-iron offset per axis, 1-sigma"),
-    "soft_iron": Number("", None, min=0, doc="soft-iron matrix elements, 1-sigma"),
+    "soft_iron": Number("1", None, min=0, doc="soft-iron matrix elements, 1-sigma"),
     "disturbance": Number("T", None, min=0, doc="field disturbance in covered zones, 1-sigma"),
     "disturbance_time": Number("s", None, gt=0, doc="correlation time of the disturbance"),
 }

@@ -8,7 +8,7 @@ A drive is described by two sets of piecewise polynomials (``RoadProfile``):
   down);
 * in time: the travelled distance s(t), piecewise cubic (constant jerk pieces).
 
-Geometry choices (a navigation researcher would expect them; they are documented in README):
+Geometry choices (a navigation researcher would expect them; they are documented in docs/drives.md):
 
 * ``turn`` and ``helix`` are entered and left through transition curves (curvature a smoothstep
   in s, a clothoid with rounded ends) whose

@@ -416,6 +416,21 @@ def _resolve_paths(traj: dict, base: Path) -> None:
                 net[k] = str((base / net[k]).resolve())
 
 
+SUMO_PACKAGES = ("sumo", "libsumo", "sumolib")  # of the extra: pip install -e '.[sumo]'
+
+
+def _require_sumo() -> None:
+    """Refuse a SUMO drive, with what to install, when SUMO is not installed (it is an extra:
+    almost half of a full installation)."""
+    import importlib.util
+
+    missing = [name for name in SUMO_PACKAGES if importlib.util.find_spec(name) is None]
+    if missing:
+        raise NetworkError((), "a SUMO drive needs SUMO, an optional part of landnav "
+                           f"({', '.join(missing)} not installed): pip install -e '.[sumo]' in "
+                           "the checkout, or pip install 'landnav[sumo]'")
+
+
 def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | None:
     """The ``PROFILE_BUILDERS`` entry of kind ``sumo`` (see the module docstring).
 
@@ -425,6 +440,7 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
     traj = scenario["trajectory"]
     base = Path(ctx.file).resolve().parent if ctx is not None else Path.cwd()
     try:
+        _require_sumo()
         _resolve_paths(traj, base)
         network = prepare_network(traj["network"], base, traj["ego"]["decel"])
         drive = run_sumo(traj, network)

@@ -231,8 +231,9 @@ def test_a_failing_estimator_is_recorded_and_the_others_go_on(tmp_path, capsys):
     assert _group(summary, "fails")["failed"] == 2 and _group(summary, "hold")["failed"] == 0
     assert _group(summary, "fails")["scores"]["horizontal.rms"]["count"] == 0
     assert "deliberate failure" in (out / "report.md").read_text()
-    printed = capsys.readouterr()  # not a terminal: no progress bar, only the closing line
-    assert printed.err == "" and len(printed.out.splitlines()) == 1
+    printed = capsys.readouterr()  # not a terminal: no bar; progress lines if it took long
+    assert all(line.startswith("runs: ") for line in printed.err.splitlines())
+    assert len(printed.out.splitlines()) == 1
     assert "2 result(s) ok, 2 failed" in printed.out and str(out) in printed.out
     args = ["campaign", str(scenario), "--runs", "2", "--workers", "2", "-o", str(out)]
     assert main(args) == 0  # a failed run is done ...

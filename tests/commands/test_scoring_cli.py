@@ -23,6 +23,7 @@ from tests.scoring_helpers import (
     write_scoring_dataset,
 )
 from tests.synthetic import write_synthetic
+from tests.test_html_report import check_report_html
 
 OUTAGES = ((40.0, 60.0), (120.0, 150.0))
 
@@ -119,6 +120,7 @@ def test_score_report_is_written_atomically(dataset, shifted, tmp_path, capsys):
     assert "shifted" in text and "5.000" in text and "20.000" in text
     for png in ("map", "position_errors", "attitude_errors", "horizontal_cdf"):
         assert f"(plots/{png}.png)" in text and (report / "plots" / f"{png}.png").is_file()
+    assert "shifted" in "".join(check_report_html(report).text)  # every plot embedded
     assert main(args) == 2  # exists: kept unless --force
     assert "--force" in capsys.readouterr().err
     assert main([*args, "--force"]) == 0
@@ -142,7 +144,10 @@ def test_score_runs_a_registered_estimator(tmp_path):
     scores = _strict_json(tmp_path / "s.json")
     assert list(scores) == ["gnss_only"]
     assert scores["gnss_only"]["runtime"]["seconds"] > 0
-    assert scores["gnss_only"]["runtime"]["realtime_factor"] > 1
+    runtime = scores["gnss_only"]["runtime"]  # the data's span over the replay's wall time
+    fix_t = open_dataset(ds).read("gnss_fix")["t"]
+    assert runtime["realtime_factor"] * runtime["seconds"] == pytest.approx(
+        fix_t.iloc[-1] - fix_t.iloc[0], rel=1e-3)
     frame, _ = run_estimator(open_dataset(ds), "gnss_only", show_progress=False)
     frame.to_parquet(tmp_path / "gnss_only.parquet")
     assert main(["score", str(ds), "--solution", str(tmp_path / "gnss_only.parquet"),
@@ -185,6 +190,7 @@ def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
     assert scores["hold"]["runtime"]["seconds"] > 0
     text = (out / "report.md").read_text()
     assert "hold" in text and "(plots/map.png)" in text and (out / "plots" / "map.png").is_file()
+    assert "hold" in "".join(check_report_html(out).text)  # the same report, plots embedded
     assert "hold" in capsys.readouterr().out
     # the solution file it wrote scores like the run did
     assert main(["score", str(out / "dataset"), "--solution",

@@ -89,7 +89,7 @@ def test_quick_run_of_every_paper(tmp_path, capsys):
     page = (out / "report.html").read_text()
     for key in paper_keys():
         paper = load_paper(key)
-        assert paper.title in md and html.escape(paper.title) in page
+        assert paper.title in md and html.escape(paper.title, quote=False) in page
         for experiment in paper.experiments:
             table = pd.read_parquet(out / "figures" / key / f"{experiment.key}.parquet")
             assert list(table.index) == [1, 2, 3], (key, experiment.key)
@@ -107,7 +107,7 @@ def test_help_lists_the_papers(capsys):
     text = capsys.readouterr().out
     for key in paper_keys():
         assert key in text
-        assert load_paper(key).claims[0].key in text
+    assert "landnav reproduce --list" in text  # each paper's claims: tests/commands/test_help.py
 
 
 def test_on_a_dask_cluster_the_figures_are_those_of_an_in_process_run(tmp_path):

@@ -76,10 +76,10 @@ def test_registered():
     assert SENSOR_MODELS["baro"] is Barometer
 
 
-def test_ideal_barometer_altitude_is_truth():
+def test_ideal_barometer_altitude_is_the_true_orthometric_height():
     truth = drive_truth()
     out = as_frame(make({}).generate(truth, np.random.default_rng(1))["baro"])
-    np.testing.assert_allclose(out["altitude"], truth.position(out["t"])[:, 2], atol=1e-6)
+    np.testing.assert_allclose(out["altitude"], msl_height(truth, out["t"]), atol=1e-6)
 
 
 def test_bmp280_noise_bias_resolution():
@@ -104,7 +104,7 @@ def test_weather_drift_and_range():
     out = as_frame(make({"drift": "-1 hPa/h", "rate": 1}).generate(truth,
                                                                    np.random.default_rng(5))["baro"])
     p = out["pressure"].to_numpy()
-    p0 = pressure_pa(truth.position([0.0])[0, 2])
+    p0 = pressure_pa(msl_height(truth, [0.0])[0])
     # the whole column scales with the sea-level pressure
     assert p[-1] - p[0] == pytest.approx(-100.0 * p0 / 101325.0, rel=1e-9)
     clipped = as_frame(make({"range": ["300 hPa", "1000 hPa"]}).generate(
@@ -152,7 +152,7 @@ def test_temperature_sensitivity():
     for seed in range(300):
         out = as_frame(baro.generate(truth, np.random.default_rng(seed))["baro"])
         t = out["t"].to_numpy()
-        error = out["pressure"].to_numpy() - pressure_pa(truth.position(t)[:, 2])
+        error = out["pressure"].to_numpy() - pressure_pa(msl_height(truth, t))
         k = baro.drawn["temperature_coefficient"]
         np.testing.assert_allclose(error, k * 10 * (1 - np.exp(-t / 300)), atol=1e-6)
         ks.append(k)
@@ -198,11 +198,18 @@ def test_pressure_at_arl1_follows_the_geoid():
     assert np.median(np.abs(np.array(means) - p_orthometric)) < 100.0
 
 
-def test_ideal_barometer_keeps_the_ellipsoidal_height():
-    """``preset: ideal`` (geoid: false) is unchanged: its altitude is the truth's; geoid: true
-    without errors reads the orthometric height."""
-    truth = truth_from_segments([{"stop": {"duration": 10.0}}], rate_hz=1.0, start=ARL1)
-    ideal = as_frame(make({}).generate(truth, np.random.default_rng(0))["baro"])
-    np.testing.assert_allclose(ideal["altitude"], ARL1["alt"], atol=1e-6)
-    msl = as_frame(make({"geoid": True}).generate(truth, np.random.default_rng(0))["baro"])
-    np.testing.assert_allclose(msl["altitude"], msl_height(truth, msl["t"]), atol=1e-6)
+def test_ideal_barometer_reads_the_orthometric_height(shared_dir):
+    """``preset: ideal`` has no sensor error, but the air's pressure follows the orthometric
+    height: standing at 100 m ellipsoidal height on an EGM96 grid node whose undulation is
+    published (35 N 135 E, N = 36.355 m, UNAVCO calculator via RTKLIB's t_geoid.c, refdata
+    tables/geoid_egm96_rtklib_utest.csv), it reads 100 - 36.355 = 63.645 m, within the grid's
+    centimetre storage; ``geoid: false`` reads the ellipsoidal height."""
+    table = pd.read_csv(shared_dir / "refdata" / "tables" / "geoid_egm96_rtklib_utest.csv",
+                        comment="#")
+    node = table[(table.lat_deg == 35.0) & (table.lon_deg == 135.0)].iloc[0]
+    start = {"lat": 35.0, "lon": 135.0, "alt": 100.0, "heading": 0.0}
+    truth = truth_from_segments([{"stop": {"duration": 10.0}}], rate_hz=1.0, start=start)
+    ideal = as_frame(make({"preset": "ideal"}).generate(truth, np.random.default_rng(0))["baro"])
+    np.testing.assert_allclose(ideal["altitude"], 100.0 - node.geoid_N_m, atol=0.0051)
+    flat = as_frame(make({"geoid": False}).generate(truth, np.random.default_rng(0))["baro"])
+    np.testing.assert_allclose(flat["altitude"], 100.0, atol=1e-6)

@@ -206,14 +206,30 @@ def test_fitted_presets_follow_real_curves(preset, device, group, axis):
     check_real(preset, device, group, axis, _CACHE[preset], 40.0)
 
 
+PRINTED_DIGITS_REL = 5e-3  # the tool prints 3 significant digits: up to half a unit in the 3rd
+
+
+def adev_relative_uncertainty(tau_s: np.ndarray, record_s: float) -> np.ndarray:
+    """1-sigma relative uncertainty of an Allan deviation estimated from a record of
+    ``record_s`` at ``tau_s``: 1 / sqrt(2 (K - 1)) with K = record / tau non-overlapping
+    clusters (IEEE Std 952-1997, Annex C, eq. C.2). imu_utils' overlapping estimate is at
+    least this good, so this is the conservative bound."""
+    clusters = np.floor(record_s / tau_s)
+    return 1.0 / np.sqrt(2.0 * (clusters - 1.0))
+
+
 @pytest.mark.parametrize("preset, device, group, axis", [("adis16448", "16448", "accel", "y"),
                                                          ("adis16448", "16448", "accel", "x"),
                                                          ("bosch-bmi160", "BMI160", "accel", "z")])
 def test_fit_tool_gives_the_preset_values(preset, device, group, axis):
-    # tools/fit_imu_presets.py reproduces what the preset holds (printed to 3 digits), including
-    # its choice of a Gauss-Markov bias only where the four terms miss the curve by over 10 %
+    """tools/fit_imu_presets.py reproduces what the preset holds: the Allan curve of the
+    preset's terms and that of the tool's fit today agree, at every tau fitted, within the
+    3-digit printing plus the real curve's own 1-sigma uncertainty there. The individual
+    terms are not compared: within that uncertainty the minimax optimum is flat, and terms
+    trade against each other (the ramp of the ADIS y accelerometer sits at the tool's
+    negligible-term threshold) as scipy's optimisers change between releases."""
     from simulator.sensors.imu_presets import IMU_PRESETS
-    from tools.fit_imu_presets import NAMES, fit_axis
+    from tools.fit_imu_presets import NAMES, fit_axis, model
 
     if not REAL.is_dir():
         pytest.skip(f"real IMU Allan curves not found at {REAL} (shared/refdata is missing)")
@@ -221,9 +237,15 @@ def test_fit_tool_gives_the_preset_values(preset, device, group, axis):
     params, bandwidth, misfit = fit_axis(tau, dev)
     held = IMU_PRESETS[preset][group]
     i = "xyz".index(axis)
-    for name, value in zip(NAMES, params, strict=True):
-        assert value == pytest.approx(held.get(name, [0.0] * 3)[i], rel=5e-3), name
-    assert bandwidth == pytest.approx(held["bandwidth"][i], rel=5e-3)
+    held_params = np.array([held.get(name, [0.0] * 3)[i] for name in NAMES])
+    fitted = (tau >= 4.5 * tau[0]) & (tau <= tau[-1] / 5)  # the tool's range
+    record_s = 2.0 * tau[-1]  # imu_utils' longest tau is half the record
+    allowed = PRINTED_DIGITS_REL + adev_relative_uncertainty(tau[fitted], record_s)
+    apart = np.abs(model(tau[fitted], held_params) / model(tau[fitted], params) - 1.0)
+    worst = np.argmax(apart / allowed)
+    assert apart[worst] <= allowed[worst], (
+        f"{apart[worst]:.2%} apart at tau {tau[fitted][worst]:.3g} s, {allowed[worst]:.2%} allowed")
+    assert bandwidth == pytest.approx(held["bandwidth"][i], rel=PRINTED_DIGITS_REL)
     assert misfit < 0.10
 
 

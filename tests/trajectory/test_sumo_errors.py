@@ -91,3 +91,12 @@ def test_libsumo_is_not_reentrant():
             sumo_source._simulate({}, None)
     finally:
         sumo_source._SUMO_LOCK.release()
+
+
+def test_a_sumo_drive_without_sumo_says_what_to_install(tmp_path, capsys, monkeypatch):
+    """SUMO is an optional part (``pip install -e '.[sumo]'``): without it, a SUMO scenario is
+    refused with what to install, naming the file and the trajectory."""
+    monkeypatch.setattr(sumo_source, "SUMO_PACKAGES", ("sumo", "landnav_no_such_package"))
+    err = _fails(_scenario(tmp_path, HILLS, {"length": 500}), capsys, tmp_path)
+    assert "trajectory: a SUMO drive needs SUMO" in err
+    assert "landnav_no_such_package not installed" in err and "pip install -e '.[sumo]'" in err
