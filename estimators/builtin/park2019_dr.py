@@ -87,6 +87,7 @@ from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.gating import threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.nav_error import euler_error_jacobian
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
 from simulator.earth import OMEGA_E_RAD_S, dcm_to_euler, normal_gravity, quat_to_dcm, wrap_angle
 
@@ -97,19 +98,6 @@ ACCEL_NORM_THRESHOLD_M_S2 = 0.059  # Park section III-D rule 1 (0.006 g)
 LOW_SPEED_THRESHOLD_M_S = 5.0  # Park section III-D rule 2 ("approximately 4 ~ 6 m/s")
 BARO_INNOVATION_THRESHOLD_M = 2.5  # Park section III-D rule 3 (80 % of one floor)
 _LEVEL = np.array([1.0, 0.0, 0.0, 0.0])  # identity quaternion
-
-
-def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
-    """d(roll, pitch, yaw) / d psi, shape (3, 3), at the attitude of the body-to-NED DCM
-    ``c_bn``, for the toolbox attitude error psi (C_b^n(estimate) = (I + [psi x]) C_b^n): the
-    Euler-rate matrix M(roll, pitch) times C_n^b, since psi is the body-frame rotation
-    C_n^b psi (Groves 2013, eq. 2.56 for M)."""
-    roll = math.atan2(c_bn[2, 1], c_bn[2, 2])
-    sr, cr = math.sin(roll), math.cos(roll)
-    sp = -c_bn[2, 0]
-    cp = math.sqrt(max(1.0 - sp * sp, 1e-12))
-    m = np.array([[1.0, sr * sp / cp, cr * sp / cp], [0.0, cr, -sr], [0.0, sr / cp, cr / cp]])
-    return m @ c_bn.T
 
 
 @njit(cache=True)
