@@ -84,12 +84,14 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
+from estimators.toolbox.datasheet import fix_error_model, imu_error_model
 from estimators.toolbox.gating import threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.nav_error import euler_error_jacobian
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
 from simulator.earth import OMEGA_E_RAD_S, dcm_to_euler, normal_gravity, quat_to_dcm, wrap_angle
+from simulator.errors import InputError
 
 PAPER = ("Park et al. 2019, MEMS 3D DR/GPS Integrated System for Land Vehicle Application "
          "Robust to GPS Outages, IEEE Access 7")
@@ -98,6 +100,14 @@ ACCEL_NORM_THRESHOLD_M_S2 = 0.059  # Park section III-D rule 1 (0.006 g)
 LOW_SPEED_THRESHOLD_M_S = 5.0  # Park section III-D rule 2 ("approximately 4 ~ 6 m/s")
 BARO_INNOVATION_THRESHOLD_M = 2.5  # Park section III-D rule 3 (80 % of one floor)
 _LEVEL = np.array([1.0, 0.0, 0.0, 0.0])  # identity quaternion
+TUNINGS = ("datasheet", "paper")
+G0 = 9.80665  # m/s^2
+# dr3d_ekf's states added by the datasheet tuning after Park's ten: the accelerometers' roll and
+# pitch error, the barometer's offset error, the fix's correlated north, east, down error
+TILT, BARO, FIX = slice(10, 12), 12, slice(13, 16)
+N_DR3D_SHEET = 16
+METRES_PER_PASCAL = 0.0833  # height per pascal near sea level (standard atmosphere), m/Pa
+BARO_RATE_TIME_S = 600.0  # the weather's constant pressure rate as a random walk over 10 min
 
 
 @njit(cache=True)
@@ -146,7 +156,7 @@ class _FixColumns:
     def __init__(self, columns: dict[str, int]):
         self.lat, self.lon, self.alt = columns["lat"], columns["lon"], columns["alt"]
         self.speed, self.course = columns["speed"], columns["course"]
-        self.fix, self.vdop = columns["fix"], columns["vdop"]
+        self.fix, self.hdop, self.vdop = columns["fix"], columns["hdop"], columns["vdop"]
 
 
 class _StepAccumulator:
@@ -242,6 +252,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
                       "std_yaw", "odometer_scale_factor", "gyro_bias_x", "gyro_bias_y",
                       "gyro_bias_z")
     defaults = {
+        "tuning": "datasheet",  # "paper": Park's 10 states and the values below only
         "adaptive": True,  # section III-D noise adaptation rules
         "baro": True,  # barometric height in step 1
         "step": 0.05,  # s, step-1 period (20 Hz, section III-C)
@@ -290,24 +301,60 @@ class Dr3dEkf(_OdometerDeadReckoning):
         p0 = np.diag(np.r_[[c["position_initial"] ** 2] * 3, c["scale_initial"] ** 2,
                            [c["attitude_initial"] ** 2] * 2, c["heading_initial"] ** 2,
                            [c["gyro_bias_initial"] ** 2] * 3])
-        self._kf = ErrorState(p0)
         # rule 1's reference norm: normal gravity until the first standstill, then the mean
         # specific-force norm measured at standstill (it absorbs the accelerometer bias)
         self._g = float(np.squeeze(normal_gravity(self._pos[0], self._pos[2])))
         self._still_norm_sum = 0.0
         self._still_steps = 0
-        self._eye = np.eye(10)
-        self._f = np.zeros((10, 10))  # eq. 30; the time-varying blocks are filled each step
+        if c["tuning"] not in TUNINGS:
+            raise InputError(f"dr3d_ekf: config tuning must be one of {', '.join(TUNINGS)}, "
+                             f"got {c['tuning']!r}")
+        self._sheet = c["tuning"] == "datasheet"
+        n = N_DR3D_SHEET if self._sheet else 10
+        self._tilt_bias = np.zeros(2)  # accelerometer tilt error estimate (roll, pitch), rad
+        self._baro_bias = 0.0  # barometer offset error estimate, m
+        self._fix_error = np.zeros(3)  # the fix's correlated error estimate, NED m
+        self._dop_known = False
+        if self._sheet:
+            p0 = self._datasheet_states(p0)
+        self._kf = ErrorState(p0)
+        self._eye = np.eye(n)
+        self._f = np.zeros((n, n))  # eq. 30; the time-varying blocks are filled each step
         # eq. 29: first-order Gauss-Markov scale factor and gyro biases
         f_gm, q_gm = gauss_markov_continuous(
             [c["scale_time_constant"], *[c["gyro_bias_time_constant"]] * 3],
             [c["scale_sigma"], *[c["gyro_bias_sigma"]] * 3])
         self._f[3, 3] = f_gm[0]
         self._f[7:10, 7:10] = np.diag(f_gm[1:])
-        self._q_c = np.zeros(10)
+        self._q_c = np.zeros(n)
         self._q_c[3] = q_gm[0]
         self._q_c[4:7] = c["gyro_noise_density"] ** 2
         self._q_c[7:10] = q_gm[1:]
+        if self._sheet:
+            self._q_c[4:7] = self._imu_model.gyro_noise**2
+            self._q_c[TILT] = 2 * self._imu_model.accel_bias_sigma**2 / (
+                self._imu_model.accel_bias_tau * G0**2)
+            self._f[TILT, TILT] = -1.0 / self._imu_model.accel_bias_tau
+            self._q_c[BARO] = self._baro_rate_sigma**2 * BARO_RATE_TIME_S
+            self._f[FIX, FIX] = -1.0 / self._fix_model.correlated_tau
+
+    def _datasheet_states(self, p0: np.ndarray) -> np.ndarray:
+        """``tuning: datasheet`` (class docstring): the gyro noise, in-run and turn-on bias of
+        the datasheet's IMU (``toolbox.datasheet``) and P0 with the six added states."""
+        imu = self._imu_model = imu_error_model(self.datasheet)
+        self._fix_model = fix_error_model(self.datasheet)
+        baro = self.datasheet.get("baro") or {}
+        self._baro_rate_sigma = float(baro.get("weather_drift") or 0.0) * METRES_PER_PASCAL
+        self._baro_noise = math.hypot(float(baro.get("noise") or 0.0),
+                                      float(baro.get("resolution") or 0.0) / math.sqrt(12.0)
+                                      ) * METRES_PER_PASCAL
+        p = np.zeros((N_DR3D_SHEET, N_DR3D_SHEET))
+        p[:10, :10] = p0
+        p[7:10, 7:10] = np.eye(3) * imu.gyro_bias_initial**2
+        p[TILT, TILT] = np.eye(2) * (imu.accel_bias_initial / G0) ** 2
+        p[FIX, FIX] = np.diag(self._fix_model.correlated_sigma(1.0, 2.0) ** 2)  # again at the
+        # first fix, with its DOPs
+        return p
 
     # -- messages ---------------------------------------------------------------------------
     def on_baro(self, t: float, row: np.ndarray) -> None:
@@ -322,19 +369,34 @@ class Dr3dEkf(_OdometerDeadReckoning):
         c = self.config
         lat, lon, alt = math.radians(row[fx.lat]), math.radians(row[fx.lon]), float(row[fx.alt])
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
+        dops = float(row[fx.hdop]), float(row[fx.vdop])
         if good_height and math.isfinite(self._baro_h):
-            self._track_baro_offset(t, self._baro_h - alt)
+            if self._sheet and self._baro_offset is None:  # the offset's error is a state
+                self._baro_offset = self._baro_h - alt
+                self._reset_states(slice(BARO, BARO + 1), np.sqrt(
+                    self._fix_model.correlated_sigma(*dops)[2:] ** 2
+                    + self._fix_model.white_sigma(*dops)[2:] ** 2))
+            elif not self._sheet:
+                self._track_baro_offset(t, self._baro_h - alt)
         n = 3 if good_height else 2
-        dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=10)
+        n_x = len(self._eye)
+        dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=n_x)
+        var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
+        if self._sheet:  # the fix is the truth plus its correlated error, plus white noise
+            if not self._dop_known:
+                self._reset_states(FIX, self._fix_model.correlated_sigma(*dops))
+                self._dop_known = True
+            dz += self._fix_error
+            h_pos[:, FIX] = np.eye(3)
+            var = list(self._fix_model.white_sigma(*dops)[:n] ** 2)
         rows = [h_pos[:n]]
         dzs = [dz[:n]]
-        var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
         speed = self._s * self._u
         slow = c["adaptive"] and speed < LOW_SPEED_THRESHOLD_M_S
         jac = euler_error_jacobian(self._cbn)
         pitch = -math.asin(self._cbn[2, 0])
         if math.isfinite(row[fx.speed]):
-            h = np.zeros(10)
+            h = np.zeros(n_x)
             h[3] = abs(self._u) * math.cos(pitch)
             h[4:7] = -abs(speed) * math.sin(pitch) * jac[1]
             rows.append(h[None])
@@ -343,7 +405,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
             # the course is the heading of the body x axis (no side slip; eq. 41's last row)
             dz_c, h_c = heading(self._q, float(row[fx.course]), n_states=9)
-            h = np.zeros((1, 10))
+            h = np.zeros((1, n_x))
             h[0, 4:7] = h_c[0, 6:9]  # the INS layout's psi columns to this filter's
             rows.append(h)
             dzs.append(dz_c)
@@ -352,6 +414,17 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._feedback()
 
     # -- filter -----------------------------------------------------------------------------
+    def _reset_states(self, states: slice, sigma: np.ndarray) -> None:
+        """Size added states when their size is first known (the fix's DOPs): variance
+        sigma^2, no cross-covariance; a Gauss-Markov state's driving noise with it."""
+        p = self._kf.p
+        p[states, :] = 0.0
+        p[:, states] = 0.0
+        idx = np.arange(len(p))[states]
+        p[idx, idx] = np.asarray(sigma) ** 2
+        if states == FIX:
+            self._q_c[FIX] = 2 * np.asarray(sigma) ** 2 / self._fix_model.correlated_tau
+
     def _track_baro_offset(self, t: float, offset: float) -> None:
         if self._baro_offset is None:
             self._baro_offset = offset
@@ -372,16 +445,25 @@ class Dr3dEkf(_OdometerDeadReckoning):
             dt, self._f)
         self._kf.predict(self._eye + self._f * dt, np.diag(self._q_c * dt))
         if self._imu.has_accel:
-            self._step_one(f_b)
+            self._step_one(f_b, dtheta / dt)
 
-    def _step_one(self, f_b: np.ndarray) -> None:
-        """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer."""
+    def _step_one(self, f_b: np.ndarray, rate: np.ndarray) -> None:
+        """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer. With
+        ``tuning: datasheet`` the specific force first loses the turn's centripetal
+        acceleration (s u w_z sideways, -s u w_y down: the car moves along its x axis) and the
+        tilt carries the accelerometers' bias as two states."""
         c = self.config
         cbn = self._cbn
+        n_x = len(self._eye)
         roll, pitch = math.atan2(cbn[2, 1], cbn[2, 2]), -math.asin(cbn[2, 0])
         jac = euler_error_jacobian(cbn)
-        h = np.zeros((2, 10))
+        h = np.zeros((2, n_x))
         h[:, 4:7] = jac[:2]
+        if self._sheet:
+            v = self._s * self._u
+            f_b = f_b - np.array([0.0, v * rate[2], -v * rate[1]])
+            roll, pitch = roll + self._tilt_bias[0], pitch + self._tilt_bias[1]
+            h[:, TILT] = np.eye(2)
         roll_acc = math.atan2(-f_b[1], -f_b[2])
         pitch_acc = math.atan2(f_b[0], math.hypot(f_b[1], f_b[2]))
         dz = [math.remainder(roll - roll_acc, 2.0 * math.pi), pitch - pitch_acc]
@@ -398,11 +480,15 @@ class Dr3dEkf(_OdometerDeadReckoning):
             var = c["tilt_sigma"] ** 2
         rows, dzs, variances = [h], [dz], [var, var]
         if self._use_baro and self._baro_new and self._baro_offset is not None:
-            dz_h, h_h = barometric_height(self._pos[2], self._baro_h, self._baro_offset, 10)
+            dz_h, h_h = barometric_height(self._pos[2], self._baro_h,
+                                          self._baro_offset + self._baro_bias, n_x)
             var_h = c["baro_sigma"] ** 2
+            if self._sheet:  # the offset's error is a state; the rest white
+                h_h[0, BARO] = 1.0
+                var_h = self._baro_noise**2
             if c["adaptive"]:
                 var_h = threshold_variance(abs(dz_h[0]), BARO_INNOVATION_THRESHOLD_M,
-                                           c["baro_sigma"], c["baro_sigma_inflated"])
+                                           math.sqrt(var_h), c["baro_sigma_inflated"])
             rows.append(h_h)
             dzs.append(dz_h)
             variances.append(var_h)
@@ -420,6 +506,10 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._s -= dx[3]
         self._q, self._cbn = attitude_step(self._q, dx[4:7], self._zero3)
         self._bias -= dx[7:10]
+        if self._sheet:
+            self._tilt_bias -= dx[TILT]
+            self._baro_bias -= dx[BARO]
+            self._fix_error -= dx[FIX]
 
     def solution(self, t: float) -> list[float]:
         p = self._kf.p
