@@ -70,6 +70,19 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   has no tilt: eq. 3 reduces to a rotation about the body z axis). It estimates no height:
   ``alt``, ``vd``, roll and pitch are NaN.
 
+* ``tuning`` (both filters; default ``datasheet``). ``paper``: Park's states and the values
+  above, which the reproduction (``simulator.reproduce.park2019``) asks for explicitly so its
+  figures stay put. ``datasheet``: the gyro noise, in-run and turn-on bias of the datasheet's
+  IMU (``toolbox.datasheet``), and the states Park's model lacks, without which it claimed a
+  confidence it did not have (0.12 deg of roll against 5 deg of error on the quickstart): the
+  fix's correlated error (north, east and, in 3-D, down; ``toolbox.datasheet.
+  fix_error_model``, sized by the first fix's DOPs, its white remainder as the GPS noise);
+  in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
+  dominant error) and the barometer offset's error (set at the first good fix, a random walk
+  of the datasheet's weather drift; its white noise the sensor's), with the turn's
+  centripetal acceleration s u w removed from the g-slave specific force; in 2-D the z gyro's
+  scale-factor error as bias process noise (s times the change of rate).
+
 Public classes
 --------------
 Dr2dOdoEkf, Dr3dEkf.
@@ -530,6 +543,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
     paper = PAPER + ", section II-B (eqs. 15-19)"
     output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "gyro_bias_z")
     defaults = {
+        "tuning": "datasheet",  # "paper": the 5 states of eq. 17 and the values below only
         "step": 0.05,  # s, covariance propagation period
         "gyro_noise_density": 0.02 * DEG,  # rad/s/sqrt(Hz), SMI130 (Table 1)
         "gyro_bias_sigma": 0.01 * DEG,  # rad/s, Gauss-Markov steady state
@@ -545,26 +559,50 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
 
     def setup(self) -> None:
         c = self.config
+        if c["tuning"] not in TUNINGS:
+            raise InputError(f"dr2d_odo_ekf: config tuning must be one of "
+                             f"{', '.join(TUNINGS)}, got {c['tuning']!r}")
+        self._sheet = c["tuning"] == "datasheet"
         init = self.initial
         self._lat, self._lon = float(init.position[0]), float(init.position[1])
         self._h = float(init.position[2])  # for the radii only: the 2-D filter has no height
         self._yaw = float(init.attitude[2])
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
+        self._fix_error = np.zeros(2)  # the fix's correlated north, east error (datasheet), m
+        self._dop_known = False
         self._take_inputs()
-        p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
-                                                         c["heading_initial"] ** 2,
-                                                         c["gyro_bias_initial"] ** 2])
+        n = 7 if self._sheet else 5
+        gyro_noise, bias_sigma, bias_tau, bias_initial = (
+            c["gyro_noise_density"], c["gyro_bias_sigma"], c["gyro_bias_time_constant"],
+            c["gyro_bias_initial"])
+        if self._sheet:  # the datasheet's z gyro, and the fix's correlated error as two states
+            imu = imu_error_model(self.datasheet)
+            gyro_noise, bias_sigma, bias_tau, bias_initial = (
+                imu.gyro_noise, imu.gyro_bias_sigma, imu.gyro_bias_tau, imu.gyro_bias_initial)
+            self._fix_model = fix_error_model(self.datasheet)
+            self._gyro_scale = imu.gyro_scale_sigma
+            self._rate = 0.0
+        p0 = np.zeros((n, n))
+        p0[:5, :5] = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
+                                                                 c["heading_initial"] ** 2,
+                                                                 bias_initial**2])
+        self._f = np.zeros((n, n))
+        self._q_c = np.zeros(n)
+        if self._sheet:
+            sigma = self._fix_model.correlated_sigma(1.0, 2.0)[:2]  # again at the first fix
+            p0[5:7, 5:7] = np.diag(sigma**2)
+            self._f[5:7, 5:7] = np.eye(2) * (-1.0 / self._fix_model.correlated_tau)
+            self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
         self._kf = ErrorState(p0)
         # Gauss-Markov speed error and z-gyro bias
-        f_gm, q_gm = gauss_markov_continuous(
-            [c["speed_error_time_constant"], c["gyro_bias_time_constant"]],
-            [c["speed_error_sigma"], c["gyro_bias_sigma"]])
-        self._q_c = np.array([0.0, 0.0, q_gm[0], c["gyro_noise_density"] ** 2, q_gm[1]])
-        self._f = np.zeros((5, 5))
+        f_gm, q_gm = gauss_markov_continuous([c["speed_error_time_constant"], bias_tau],
+                                             [c["speed_error_sigma"], bias_sigma])
+        self._q_c[2:5] = q_gm[0], gyro_noise**2, q_gm[1]
         self._f[2, 2] = f_gm[0]
         self._f[3, 4] = -1.0  # dpsi' = -(z-gyro bias error)
         self._f[4, 4] = f_gm[1]
+        self._eye = np.eye(n)
 
     def _speed(self) -> float:
         return self._u - self._speed_error if self._u != 0.0 else 0.0
@@ -579,6 +617,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         w_ie, w_en = frame_rates(self._lat, self._h, v_ned)
         w_in_d = w_ie[2] + w_en[2]
         yaw_old = self._yaw
+        rate = acc.dtheta[2] / dt
         self._yaw += acc.dtheta[2] - (self._bias + w_in_d) * dt
         acc.reset()
         yaw_mid = 0.5 * (yaw_old + self._yaw)
@@ -589,7 +628,11 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         moving = 1.0 if self._u != 0.0 else 0.0
         f[0, 2], f[1, 2] = cy * moving, sy * moving
         f[0, 3], f[1, 3] = -v * sy, v * cy
-        self._kf.predict(np.eye(5) + f * dt, np.diag(self._q_c * dt))
+        q_d = np.diag(self._q_c * dt)
+        if self._sheet:  # the scale-factor error moves the bias by s d(rate) (toolbox.datasheet)
+            q_d[4, 4] += (self._gyro_scale * (rate - self._rate)) ** 2
+            self._rate = rate
+        self._kf.predict(self._eye + f * dt, q_d)
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         """Eqs. 18-19: GPS north, east position and ground speed."""
@@ -601,13 +644,29 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         dz, _ = gnss_position(_LEVEL, np.array([self._lat, self._lon, self._h]),
                               np.array([math.radians(row[fx.lat]), math.radians(row[fx.lon]),
                                         self._h]), n_states=5)
+        n = len(self._eye)
         dz = dz[:2]
-        h = np.eye(5)[:2]
+        h = self._eye[:2].copy()
         var = [c["gps_horizontal_sigma"] ** 2] * 2
+        speed_var = c["gps_speed_sigma"] ** 2
+        if self._sheet:  # the fix is the truth plus its correlated error, plus white noise
+            dops = float(row[fx.hdop]), float(row[fx.vdop])
+            if not self._dop_known:
+                sigma = self._fix_model.correlated_sigma(*dops)[:2]
+                p = self._kf.p
+                p[5:7, :] = 0.0
+                p[:, 5:7] = 0.0
+                p[5:7, 5:7] = np.diag(sigma**2)
+                self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
+                self._dop_known = True
+            dz = dz + self._fix_error
+            h[:, 5:7] = np.eye(2)
+            var = list(self._fix_model.white_sigma(*dops)[:2] ** 2)
+            speed_var = self._fix_model.velocity_sigma(*dops)[0] ** 2
         if self._u != 0.0 and math.isfinite(row[fx.speed]):
             dz = np.r_[dz, abs(self._speed()) - row[fx.speed]]
-            h = np.eye(5)[:3]
-            var.append(c["gps_speed_sigma"] ** 2)
+            h = np.vstack([h, np.eye(n)[2]])
+            var.append(speed_var)
         self._kf.update(dz, h, np.diag(var))
         dx = self._kf.feedback()
         rn, re = radii(self._lat)
@@ -616,6 +675,8 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._speed_error += dx[2]
         self._yaw -= dx[3]
         self._bias -= dx[4]
+        if self._sheet:
+            self._fix_error -= dx[5:7]
 
     def solution(self, t: float) -> list[float]:
         v = self._speed()
