@@ -79,8 +79,9 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   fix_error_model``, sized by the first fix's DOPs, its white remainder as the GPS noise);
   in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
   dominant error) and the barometer offset's error (set at the first good fix, a random walk
-  of the datasheet's weather drift; its white noise the sensor's), with the turn's
-  centripetal acceleration s u w removed from the g-slave specific force; in 2-D the z gyro's
+  of the datasheet's weather drift; its white noise the sensor's), with the car's own
+  acceleration (the odometer speed's change over 0.5 s forwards, the turn's centripetal s u w
+  sideways) removed from the g-slave specific force; in 2-D the z gyro's
   scale-factor error as bias process noise (s times the change of rate).
 
 Public classes
@@ -120,6 +121,7 @@ G0 = 9.80665  # m/s^2
 TILT, BARO, FIX = slice(10, 12), 12, slice(13, 16)
 N_DR3D_SHEET = 16
 METRES_PER_PASCAL = 0.0833  # height per pascal near sea level (standard atmosphere), m/Pa
+ACCEL_WINDOW_S = 0.5  # odometer speeds differenced for the along-track acceleration, s
 BARO_RATE_TIME_S = 600.0  # the weather's constant pressure rate as a random walk over 10 min
 
 
@@ -226,6 +228,8 @@ class _OdometerDeadReckoning(Estimator):
 
     def _take_inputs(self) -> None:
         self._u = 0.0  # latest odometer reading, m/s
+        self._u_history: list[tuple[float, float]] = []
+        self._accel = 0.0  # along-track acceleration from the odometer, m/s^2
         self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment",
                                      self.initial.t)
         self._odo = self.columns["odometer"]["speed"]
@@ -242,6 +246,13 @@ class _OdometerDeadReckoning(Estimator):
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         self._u = float(row[self._odo])
+        # the along-track acceleration over the last ACCEL_WINDOW_S (its mean, the speed's
+        # difference across the window)
+        self._u_history.append((t, self._u))
+        while len(self._u_history) > 2 and t - self._u_history[1][0] >= ACCEL_WINDOW_S:
+            self._u_history.pop(0)
+        t0, u0 = self._u_history[0]
+        self._accel = (self._u - u0) / (t - t0) if t - t0 > 0 else 0.0
 
     def _take_fix(self, row: np.ndarray) -> bool:
         """Whether a fix epoch has a position; if so the dead reckoning is first brought up to
@@ -462,8 +473,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
 
     def _step_one(self, f_b: np.ndarray, rate: np.ndarray) -> None:
         """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer. With
-        ``tuning: datasheet`` the specific force first loses the turn's centripetal
-        acceleration (s u w_z sideways, -s u w_y down: the car moves along its x axis) and the
+        ``tuning: datasheet`` the specific force first loses the car's own acceleration (the
+        odometer's along-track acceleration over the last 0.5 s forwards, the turn's
+        centripetal s u w_z sideways, -s u w_y down: the car moves along its x axis) and the
         tilt carries the accelerometers' bias as two states."""
         c = self.config
         cbn = self._cbn
@@ -474,7 +486,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         h[:, 4:7] = jac[:2]
         if self._sheet:
             v = self._s * self._u
-            f_b = f_b - np.array([0.0, v * rate[2], -v * rate[1]])
+            f_b = f_b - np.array([self._s * self._accel, v * rate[2], -v * rate[1]])
             roll, pitch = roll + self._tilt_bias[0], pitch + self._tilt_bias[1]
             h[:, TILT] = np.eye(2)
         roll_acc = math.atan2(-f_b[1], -f_b[2])
