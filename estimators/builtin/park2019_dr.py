@@ -70,6 +70,20 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   has no tilt: eq. 3 reduces to a rotation about the body z axis). It estimates no height:
   ``alt``, ``vd``, roll and pitch are NaN.
 
+* ``tuning`` (both filters; default ``datasheet``). ``paper``: Park's states and the values
+  above, which the reproduction (``simulator.reproduce.park2019``) asks for explicitly so its
+  figures stay put. ``datasheet``: the gyro noise, in-run and turn-on bias of the datasheet's
+  IMU (``toolbox.datasheet``), and the states Park's model lacks, without which it claimed a
+  confidence it did not have (0.12 deg of roll against 5 deg of error on the quickstart): the
+  fix's correlated error (north, east and, in 3-D, down; ``toolbox.datasheet.
+  fix_error_model``, sized by the first fix's DOPs, its white remainder as the GPS noise);
+  in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
+  dominant error) and the barometer offset's error (set at the first good fix, a random walk
+  of the datasheet's weather drift; its white noise the sensor's), with the car's own
+  acceleration (the odometer speed's change over 0.5 s forwards, the turn's centripetal s u w
+  sideways) removed from the g-slave specific force; in 2-D the z gyro's
+  scale-factor error as bias process noise (s times the change of rate).
+
 Public classes
 --------------
 Dr2dOdoEkf, Dr3dEkf.
@@ -84,11 +98,14 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
+from estimators.toolbox.datasheet import fix_error_model, imu_error_model
 from estimators.toolbox.gating import threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.nav_error import euler_error_jacobian
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
 from simulator.earth import OMEGA_E_RAD_S, dcm_to_euler, normal_gravity, quat_to_dcm, wrap_angle
+from simulator.errors import InputError
 
 PAPER = ("Park et al. 2019, MEMS 3D DR/GPS Integrated System for Land Vehicle Application "
          "Robust to GPS Outages, IEEE Access 7")
@@ -97,19 +114,15 @@ ACCEL_NORM_THRESHOLD_M_S2 = 0.059  # Park section III-D rule 1 (0.006 g)
 LOW_SPEED_THRESHOLD_M_S = 5.0  # Park section III-D rule 2 ("approximately 4 ~ 6 m/s")
 BARO_INNOVATION_THRESHOLD_M = 2.5  # Park section III-D rule 3 (80 % of one floor)
 _LEVEL = np.array([1.0, 0.0, 0.0, 0.0])  # identity quaternion
-
-
-def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
-    """d(roll, pitch, yaw) / d psi, shape (3, 3), at the attitude of the body-to-NED DCM
-    ``c_bn``, for the toolbox attitude error psi (C_b^n(estimate) = (I + [psi x]) C_b^n): the
-    Euler-rate matrix M(roll, pitch) times C_n^b, since psi is the body-frame rotation
-    C_n^b psi (Groves 2013, eq. 2.56 for M)."""
-    roll = math.atan2(c_bn[2, 1], c_bn[2, 2])
-    sr, cr = math.sin(roll), math.cos(roll)
-    sp = -c_bn[2, 0]
-    cp = math.sqrt(max(1.0 - sp * sp, 1e-12))
-    m = np.array([[1.0, sr * sp / cp, cr * sp / cp], [0.0, cr, -sr], [0.0, sr / cp, cr / cp]])
-    return m @ c_bn.T
+TUNINGS = ("datasheet", "paper")
+G0 = 9.80665  # m/s^2
+# dr3d_ekf's states added by the datasheet tuning after Park's ten: the accelerometers' roll and
+# pitch error, the barometer's offset error, the fix's correlated north, east, down error
+TILT, BARO, FIX = slice(10, 12), 12, slice(13, 16)
+N_DR3D_SHEET = 16
+METRES_PER_PASCAL = 0.0833  # height per pascal near sea level (standard atmosphere), m/Pa
+ACCEL_WINDOW_S = 0.5  # odometer speeds differenced for the along-track acceleration, s
+BARO_RATE_TIME_S = 600.0  # the weather's constant pressure rate as a random walk over 10 min
 
 
 @njit(cache=True)
@@ -154,6 +167,8 @@ def _dr3d_navigate(q: np.ndarray, c_old: np.ndarray, pos: np.ndarray, v_prev: np
 
 # config key -> (SI unit, meaning), of both filters (`landnav estimators dr3d_ekf`)
 CONFIG_HELP = {
+    "tuning": ("", "datasheet: noise and states from the manifest's datasheet (default); "
+                   "paper: Park et al.'s model and values, for the reproduction"),
     "adaptive": ("", "the noise adaptation rules of section III-D"),
     "baro": ("", "barometric height in step 1"),
     "step": ("s", "propagation period (step 1 of section III-C)"),
@@ -191,7 +206,7 @@ class _FixColumns:
     def __init__(self, columns: dict[str, int]):
         self.lat, self.lon, self.alt = columns["lat"], columns["lon"], columns["alt"]
         self.speed, self.course = columns["speed"], columns["course"]
-        self.fix, self.vdop = columns["fix"], columns["vdop"]
+        self.fix, self.hdop, self.vdop = columns["fix"], columns["hdop"], columns["vdop"]
 
 
 class _StepAccumulator:
@@ -248,6 +263,8 @@ class _OdometerDeadReckoning(Estimator):
 
     def _take_inputs(self) -> None:
         self._u = 0.0  # latest odometer reading, m/s
+        self._u_history: list[tuple[float, float]] = []
+        self._accel = 0.0  # along-track acceleration from the odometer, m/s^2
         self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment",
                                      self.initial.t)
         self._odo = self.columns["odometer"]["speed"]
@@ -264,6 +281,13 @@ class _OdometerDeadReckoning(Estimator):
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         self._u = float(row[self._odo])
+        # the along-track acceleration over the last ACCEL_WINDOW_S (its mean, the speed's
+        # difference across the window)
+        self._u_history.append((t, self._u))
+        while len(self._u_history) > 2 and t - self._u_history[1][0] >= ACCEL_WINDOW_S:
+            self._u_history.pop(0)
+        t0, u0 = self._u_history[0]
+        self._accel = (self._u - u0) / (t - t0) if t - t0 > 0 else 0.0
 
     def _take_fix(self, row: np.ndarray) -> bool:
         """Whether a fix epoch has a position; if so the dead reckoning is first brought up to
@@ -287,6 +311,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
                       "std_yaw", "odometer_scale_factor", "gyro_bias_x", "gyro_bias_y",
                       "gyro_bias_z")
     defaults = {
+        "tuning": "datasheet",  # "paper": Park's 10 states and the values below only
         "adaptive": True,  # section III-D noise adaptation rules
         "baro": True,  # barometric height in step 1
         "step": 0.05,  # s, step-1 period (20 Hz, section III-C)
@@ -336,24 +361,60 @@ class Dr3dEkf(_OdometerDeadReckoning):
         p0 = np.diag(np.r_[[c["position_initial"] ** 2] * 3, c["scale_initial"] ** 2,
                            [c["attitude_initial"] ** 2] * 2, c["heading_initial"] ** 2,
                            [c["gyro_bias_initial"] ** 2] * 3])
-        self._kf = ErrorState(p0)
         # rule 1's reference norm: normal gravity until the first standstill, then the mean
         # specific-force norm measured at standstill (it absorbs the accelerometer bias)
         self._g = float(np.squeeze(normal_gravity(self._pos[0], self._pos[2])))
         self._still_norm_sum = 0.0
         self._still_steps = 0
-        self._eye = np.eye(10)
-        self._f = np.zeros((10, 10))  # eq. 30; the time-varying blocks are filled each step
+        if c["tuning"] not in TUNINGS:
+            raise InputError(f"dr3d_ekf: config tuning must be one of {', '.join(TUNINGS)}, "
+                             f"got {c['tuning']!r}")
+        self._sheet = c["tuning"] == "datasheet"
+        n = N_DR3D_SHEET if self._sheet else 10
+        self._tilt_bias = np.zeros(2)  # accelerometer tilt error estimate (roll, pitch), rad
+        self._baro_bias = 0.0  # barometer offset error estimate, m
+        self._fix_error = np.zeros(3)  # the fix's correlated error estimate, NED m
+        self._dop_known = False
+        if self._sheet:
+            p0 = self._datasheet_states(p0)
+        self._kf = ErrorState(p0)
+        self._eye = np.eye(n)
+        self._f = np.zeros((n, n))  # eq. 30; the time-varying blocks are filled each step
         # eq. 29: first-order Gauss-Markov scale factor and gyro biases
         f_gm, q_gm = gauss_markov_continuous(
             [c["scale_time_constant"], *[c["gyro_bias_time_constant"]] * 3],
             [c["scale_sigma"], *[c["gyro_bias_sigma"]] * 3])
         self._f[3, 3] = f_gm[0]
         self._f[7:10, 7:10] = np.diag(f_gm[1:])
-        self._q_c = np.zeros(10)
+        self._q_c = np.zeros(n)
         self._q_c[3] = q_gm[0]
         self._q_c[4:7] = c["gyro_noise_density"] ** 2
         self._q_c[7:10] = q_gm[1:]
+        if self._sheet:
+            self._q_c[4:7] = self._imu_model.gyro_noise**2
+            self._q_c[TILT] = 2 * self._imu_model.accel_bias_sigma**2 / (
+                self._imu_model.accel_bias_tau * G0**2)
+            self._f[TILT, TILT] = -1.0 / self._imu_model.accel_bias_tau
+            self._q_c[BARO] = self._baro_rate_sigma**2 * BARO_RATE_TIME_S
+            self._f[FIX, FIX] = -1.0 / self._fix_model.correlated_tau
+
+    def _datasheet_states(self, p0: np.ndarray) -> np.ndarray:
+        """``tuning: datasheet`` (class docstring): the gyro noise, in-run and turn-on bias of
+        the datasheet's IMU (``toolbox.datasheet``) and P0 with the six added states."""
+        imu = self._imu_model = imu_error_model(self.datasheet)
+        self._fix_model = fix_error_model(self.datasheet)
+        baro = self.datasheet.get("baro") or {}
+        self._baro_rate_sigma = float(baro.get("weather_drift") or 0.0) * METRES_PER_PASCAL
+        self._baro_noise = math.hypot(float(baro.get("noise") or 0.0),
+                                      float(baro.get("resolution") or 0.0) / math.sqrt(12.0)
+                                      ) * METRES_PER_PASCAL
+        p = np.zeros((N_DR3D_SHEET, N_DR3D_SHEET))
+        p[:10, :10] = p0
+        p[7:10, 7:10] = np.eye(3) * imu.gyro_bias_initial**2
+        p[TILT, TILT] = np.eye(2) * (imu.accel_bias_initial / G0) ** 2
+        p[FIX, FIX] = np.diag(self._fix_model.correlated_sigma(1.0, 2.0) ** 2)  # again at the
+        # first fix, with its DOPs
+        return p
 
     # -- messages ---------------------------------------------------------------------------
     def on_baro(self, t: float, row: np.ndarray) -> None:
@@ -368,19 +429,34 @@ class Dr3dEkf(_OdometerDeadReckoning):
         c = self.config
         lat, lon, alt = math.radians(row[fx.lat]), math.radians(row[fx.lon]), float(row[fx.alt])
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
+        dops = float(row[fx.hdop]), float(row[fx.vdop])
         if good_height and math.isfinite(self._baro_h):
-            self._track_baro_offset(t, self._baro_h - alt)
+            if self._sheet and self._baro_offset is None:  # the offset's error is a state
+                self._baro_offset = self._baro_h - alt
+                self._reset_states(slice(BARO, BARO + 1), np.sqrt(
+                    self._fix_model.correlated_sigma(*dops)[2:] ** 2
+                    + self._fix_model.white_sigma(*dops)[2:] ** 2))
+            elif not self._sheet:
+                self._track_baro_offset(t, self._baro_h - alt)
         n = 3 if good_height else 2
-        dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=10)
+        n_x = len(self._eye)
+        dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=n_x)
+        var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
+        if self._sheet:  # the fix is the truth plus its correlated error, plus white noise
+            if not self._dop_known:
+                self._reset_states(FIX, self._fix_model.correlated_sigma(*dops))
+                self._dop_known = True
+            dz += self._fix_error
+            h_pos[:, FIX] = np.eye(3)
+            var = list(self._fix_model.white_sigma(*dops)[:n] ** 2)
         rows = [h_pos[:n]]
         dzs = [dz[:n]]
-        var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
         speed = self._s * self._u
         slow = c["adaptive"] and speed < LOW_SPEED_THRESHOLD_M_S
         jac = euler_error_jacobian(self._cbn)
         pitch = -math.asin(self._cbn[2, 0])
         if math.isfinite(row[fx.speed]):
-            h = np.zeros(10)
+            h = np.zeros(n_x)
             h[3] = abs(self._u) * math.cos(pitch)
             h[4:7] = -abs(speed) * math.sin(pitch) * jac[1]
             rows.append(h[None])
@@ -389,7 +465,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
             # the course is the heading of the body x axis (no side slip; eq. 41's last row)
             dz_c, h_c = heading(self._q, float(row[fx.course]), n_states=9)
-            h = np.zeros((1, 10))
+            h = np.zeros((1, n_x))
             h[0, 4:7] = h_c[0, 6:9]  # the INS layout's psi columns to this filter's
             rows.append(h)
             dzs.append(dz_c)
@@ -398,6 +474,17 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._feedback()
 
     # -- filter -----------------------------------------------------------------------------
+    def _reset_states(self, states: slice, sigma: np.ndarray) -> None:
+        """Size added states when their size is first known (the fix's DOPs): variance
+        sigma^2, no cross-covariance; a Gauss-Markov state's driving noise with it."""
+        p = self._kf.p
+        p[states, :] = 0.0
+        p[:, states] = 0.0
+        idx = np.arange(len(p))[states]
+        p[idx, idx] = np.asarray(sigma) ** 2
+        if states == FIX:
+            self._q_c[FIX] = 2 * np.asarray(sigma) ** 2 / self._fix_model.correlated_tau
+
     def _track_baro_offset(self, t: float, offset: float) -> None:
         if self._baro_offset is None:
             self._baro_offset = offset
@@ -418,16 +505,26 @@ class Dr3dEkf(_OdometerDeadReckoning):
             dt, self._f)
         self._kf.predict(self._eye + self._f * dt, np.diag(self._q_c * dt))
         if self._imu.has_accel:
-            self._step_one(f_b)
+            self._step_one(f_b, dtheta / dt)
 
-    def _step_one(self, f_b: np.ndarray) -> None:
-        """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer."""
+    def _step_one(self, f_b: np.ndarray, rate: np.ndarray) -> None:
+        """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer. With
+        ``tuning: datasheet`` the specific force first loses the car's own acceleration (the
+        odometer's along-track acceleration over the last 0.5 s forwards, the turn's
+        centripetal s u w_z sideways, -s u w_y down: the car moves along its x axis) and the
+        tilt carries the accelerometers' bias as two states."""
         c = self.config
         cbn = self._cbn
+        n_x = len(self._eye)
         roll, pitch = math.atan2(cbn[2, 1], cbn[2, 2]), -math.asin(cbn[2, 0])
         jac = euler_error_jacobian(cbn)
-        h = np.zeros((2, 10))
+        h = np.zeros((2, n_x))
         h[:, 4:7] = jac[:2]
+        if self._sheet:
+            v = self._s * self._u
+            f_b = f_b - np.array([self._s * self._accel, v * rate[2], -v * rate[1]])
+            roll, pitch = roll + self._tilt_bias[0], pitch + self._tilt_bias[1]
+            h[:, TILT] = np.eye(2)
         roll_acc = math.atan2(-f_b[1], -f_b[2])
         pitch_acc = math.atan2(f_b[0], math.hypot(f_b[1], f_b[2]))
         dz = [math.remainder(roll - roll_acc, 2.0 * math.pi), pitch - pitch_acc]
@@ -444,11 +541,15 @@ class Dr3dEkf(_OdometerDeadReckoning):
             var = c["tilt_sigma"] ** 2
         rows, dzs, variances = [h], [dz], [var, var]
         if self._use_baro and self._baro_new and self._baro_offset is not None:
-            dz_h, h_h = barometric_height(self._pos[2], self._baro_h, self._baro_offset, 10)
+            dz_h, h_h = barometric_height(self._pos[2], self._baro_h,
+                                          self._baro_offset + self._baro_bias, n_x)
             var_h = c["baro_sigma"] ** 2
+            if self._sheet:  # the offset's error is a state; the rest white
+                h_h[0, BARO] = 1.0
+                var_h = self._baro_noise**2
             if c["adaptive"]:
                 var_h = threshold_variance(abs(dz_h[0]), BARO_INNOVATION_THRESHOLD_M,
-                                           c["baro_sigma"], c["baro_sigma_inflated"])
+                                           math.sqrt(var_h), c["baro_sigma_inflated"])
             rows.append(h_h)
             dzs.append(dz_h)
             variances.append(var_h)
@@ -466,6 +567,10 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._s -= dx[3]
         self._q, self._cbn = attitude_step(self._q, dx[4:7], self._zero3)
         self._bias -= dx[7:10]
+        if self._sheet:
+            self._tilt_bias -= dx[TILT]
+            self._baro_bias -= dx[BARO]
+            self._fix_error -= dx[FIX]
 
     def solution(self, t: float) -> list[float]:
         p = self._kf.p
@@ -486,6 +591,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
     paper = PAPER + ", section II-B (eqs. 15-19)"
     output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "gyro_bias_z")
     defaults = {
+        "tuning": "datasheet",  # "paper": the 5 states of eq. 17 and the values below only
         "step": 0.05,  # s, covariance propagation period
         "gyro_noise_density": 0.02 * DEG,  # rad/s/sqrt(Hz), SMI130 (Table 1)
         "gyro_bias_sigma": 0.01 * DEG,  # rad/s, Gauss-Markov steady state
@@ -502,26 +608,50 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
 
     def setup(self) -> None:
         c = self.config
+        if c["tuning"] not in TUNINGS:
+            raise InputError(f"dr2d_odo_ekf: config tuning must be one of "
+                             f"{', '.join(TUNINGS)}, got {c['tuning']!r}")
+        self._sheet = c["tuning"] == "datasheet"
         init = self.initial
         self._lat, self._lon = float(init.position[0]), float(init.position[1])
         self._h = float(init.position[2])  # for the radii only: the 2-D filter has no height
         self._yaw = float(init.attitude[2])
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
+        self._fix_error = np.zeros(2)  # the fix's correlated north, east error (datasheet), m
+        self._dop_known = False
         self._take_inputs()
-        p0 = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
-                                                         c["heading_initial"] ** 2,
-                                                         c["gyro_bias_initial"] ** 2])
+        n = 7 if self._sheet else 5
+        gyro_noise, bias_sigma, bias_tau, bias_initial = (
+            c["gyro_noise_density"], c["gyro_bias_sigma"], c["gyro_bias_time_constant"],
+            c["gyro_bias_initial"])
+        if self._sheet:  # the datasheet's z gyro, and the fix's correlated error as two states
+            imu = imu_error_model(self.datasheet)
+            gyro_noise, bias_sigma, bias_tau, bias_initial = (
+                imu.gyro_noise, imu.gyro_bias_sigma, imu.gyro_bias_tau, imu.gyro_bias_initial)
+            self._fix_model = fix_error_model(self.datasheet)
+            self._gyro_scale = imu.gyro_scale_sigma
+            self._rate = 0.0
+        p0 = np.zeros((n, n))
+        p0[:5, :5] = np.diag([c["position_initial"] ** 2] * 2 + [c["speed_error_sigma"] ** 2,
+                                                                 c["heading_initial"] ** 2,
+                                                                 bias_initial**2])
+        self._f = np.zeros((n, n))
+        self._q_c = np.zeros(n)
+        if self._sheet:
+            sigma = self._fix_model.correlated_sigma(1.0, 2.0)[:2]  # again at the first fix
+            p0[5:7, 5:7] = np.diag(sigma**2)
+            self._f[5:7, 5:7] = np.eye(2) * (-1.0 / self._fix_model.correlated_tau)
+            self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
         self._kf = ErrorState(p0)
         # Gauss-Markov speed error and z-gyro bias
-        f_gm, q_gm = gauss_markov_continuous(
-            [c["speed_error_time_constant"], c["gyro_bias_time_constant"]],
-            [c["speed_error_sigma"], c["gyro_bias_sigma"]])
-        self._q_c = np.array([0.0, 0.0, q_gm[0], c["gyro_noise_density"] ** 2, q_gm[1]])
-        self._f = np.zeros((5, 5))
+        f_gm, q_gm = gauss_markov_continuous([c["speed_error_time_constant"], bias_tau],
+                                             [c["speed_error_sigma"], bias_sigma])
+        self._q_c[2:5] = q_gm[0], gyro_noise**2, q_gm[1]
         self._f[2, 2] = f_gm[0]
         self._f[3, 4] = -1.0  # dpsi' = -(z-gyro bias error)
         self._f[4, 4] = f_gm[1]
+        self._eye = np.eye(n)
 
     def _speed(self) -> float:
         return self._u - self._speed_error if self._u != 0.0 else 0.0
@@ -536,6 +666,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         w_ie, w_en = frame_rates(self._lat, self._h, v_ned)
         w_in_d = w_ie[2] + w_en[2]
         yaw_old = self._yaw
+        rate = acc.dtheta[2] / dt
         self._yaw += acc.dtheta[2] - (self._bias + w_in_d) * dt
         acc.reset()
         yaw_mid = 0.5 * (yaw_old + self._yaw)
@@ -546,7 +677,11 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         moving = 1.0 if self._u != 0.0 else 0.0
         f[0, 2], f[1, 2] = cy * moving, sy * moving
         f[0, 3], f[1, 3] = -v * sy, v * cy
-        self._kf.predict(np.eye(5) + f * dt, np.diag(self._q_c * dt))
+        q_d = np.diag(self._q_c * dt)
+        if self._sheet:  # the scale-factor error moves the bias by s d(rate) (toolbox.datasheet)
+            q_d[4, 4] += (self._gyro_scale * (rate - self._rate)) ** 2
+            self._rate = rate
+        self._kf.predict(self._eye + f * dt, q_d)
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         """Eqs. 18-19: GPS north, east position and ground speed."""
@@ -558,13 +693,29 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         dz, _ = gnss_position(_LEVEL, np.array([self._lat, self._lon, self._h]),
                               np.array([math.radians(row[fx.lat]), math.radians(row[fx.lon]),
                                         self._h]), n_states=5)
+        n = len(self._eye)
         dz = dz[:2]
-        h = np.eye(5)[:2]
+        h = self._eye[:2].copy()
         var = [c["gps_horizontal_sigma"] ** 2] * 2
+        speed_var = c["gps_speed_sigma"] ** 2
+        if self._sheet:  # the fix is the truth plus its correlated error, plus white noise
+            dops = float(row[fx.hdop]), float(row[fx.vdop])
+            if not self._dop_known:
+                sigma = self._fix_model.correlated_sigma(*dops)[:2]
+                p = self._kf.p
+                p[5:7, :] = 0.0
+                p[:, 5:7] = 0.0
+                p[5:7, 5:7] = np.diag(sigma**2)
+                self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
+                self._dop_known = True
+            dz = dz + self._fix_error
+            h[:, 5:7] = np.eye(2)
+            var = list(self._fix_model.white_sigma(*dops)[:2] ** 2)
+            speed_var = self._fix_model.velocity_sigma(*dops)[0] ** 2
         if self._u != 0.0 and math.isfinite(row[fx.speed]):
             dz = np.r_[dz, abs(self._speed()) - row[fx.speed]]
-            h = np.eye(5)[:3]
-            var.append(c["gps_speed_sigma"] ** 2)
+            h = np.vstack([h, np.eye(n)[2]])
+            var.append(speed_var)
         self._kf.update(dz, h, np.diag(var))
         dx = self._kf.feedback()
         rn, re = radii(self._lat)
@@ -573,6 +724,8 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._speed_error += dx[2]
         self._yaw -= dx[3]
         self._bias -= dx[4]
+        if self._sheet:
+            self._fix_error -= dx[5:7]
 
     def solution(self, t: float) -> list[float]:
         v = self._speed()

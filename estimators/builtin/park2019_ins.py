@@ -58,6 +58,20 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
   too small for its error (the garage's own overconfidence), so the first fix's innovation is
   partly taken as fix error, which then decays over 100 s (docs/reproduction_park2019_ins.md).
 
+* ``tuning`` (default ``datasheet``): where its noise comes from. ``paper``: the values above
+  (Park's Table 1 and the choices named), which the reproduction (``simulator.reproduce.
+  park2019``) asks for explicitly so that its figures stay put. ``datasheet``: from what a
+  user knows of the sensors (``toolbox.datasheet``): the IMU's noise densities, in-run bias
+  instability and turn-on bias range, its scale factors as bias process noise; the fix's
+  error as three Gauss-Markov states of the receiver's correlated error budget (correlation
+  time 30 min, sized by the first fix's DOPs; the +1 to +7 m height offset of a
+  single-frequency fix is this error, docs/gnss-errors.md) plus the white equivalent of its
+  smoothed noise, and its velocity at 0.05 m/s per range rate times the DOP, each behind a
+  chi-square gate (0.999; after five rejections in a row the next fix is taken); the
+  odometer's tick quantisation or speed cut-off, its age (latency plus half the counting
+  interval) times the acceleration, and the 3 % scale as above (``fix_error_states`` is
+  implied; ``odometer_scale_state`` as configured).
+
 The filter is closed loop (errors fed back after each update).
 
 Public classes
@@ -74,13 +88,22 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox import aiding
 from estimators.toolbox.constraints import NonholonomicNoise
-from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
+from estimators.toolbox.datasheet import (
+    fix_error_model,
+    imu_error_model,
+    odometer_delay_s,
+    odometer_speed_sigma,
+)
+from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise, ins_noise
 from estimators.toolbox.installation import Installation
+from simulator.earth import quat_to_dcm
 from simulator.errors import InputError
 
 G0 = 9.80665  # standard gravity, m/s^2 (datasheet mg)
 DEG = math.pi / 180.0
 NHC_POINTS = ("rear_axle", "imu")
+TUNINGS = ("datasheet", "paper")
+GATE_PROBABILITY = 0.999  # chi-square gate of the fixes with the datasheet tuning
 
 
 class ParkInsOdometer(Estimator):
@@ -89,9 +112,11 @@ class ParkInsOdometer(Estimator):
     name = "ins_odo_ekf"
     needs = ("imu", "odometer", "gnss_fix")
     paper = "Park et al. 2019 (IEEE Access), eqs. 1-14: INS/GPS/odometer EKF with NHC"
-    defaults = {"nhc": True, "nhc_point": "rear_axle", "fix_error_states": False,
-                "odometer_scale_state": False}
+    defaults = {"tuning": "datasheet", "nhc": True, "nhc_point": "rear_axle",
+                "fix_error_states": False, "odometer_scale_state": False}
     config_help = {
+        "tuning": ("", "datasheet: noise from the manifest's datasheet (default); paper: the "
+                       "values chosen for the reproduction of Park et al."),
         "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
         "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
         "fix_error_states": ("", "three Gauss-Markov states of the GNSS fix's correlated error"),
@@ -115,27 +140,40 @@ class ParkInsOdometer(Estimator):
         if self.config["nhc_point"] not in NHC_POINTS:
             raise InputError(f"ins_odo_ekf: config nhc_point must be one of "
                              f"{', '.join(NHC_POINTS)}, got {self.config['nhc_point']!r}")
+        if self.config["tuning"] not in TUNINGS:
+            raise InputError(f"ins_odo_ekf: config tuning must be one of {', '.join(TUNINGS)}, "
+                             f"got {self.config['tuning']!r}")
+        self._sheet = self.config["tuning"] == "datasheet"
         site = Installation.from_datasheet(self.datasheet)
-        # the receiver's fix error is correlated over its carrier-smoothing time (the datasheet's
-        # carrier_smoothing; code_correlation_time in datasets made before it): three
-        # Gauss-Markov states of that time constant
         gnss = self.datasheet.get("gnss") or {}
-        tau = float(gnss.get("carrier_smoothing") or gnss.get("code_correlation_time") or 0.0)
-        self._fix_states = self.config["fix_error_states"] and tau > 0
+        if self._sheet:
+            noise, p0, fix_sigma, fix_tau = self._datasheet_model()
+            self._fix_states, scale_state = True, self.config["odometer_scale_state"]
+        else:
+            # the receiver's fix error is correlated over its carrier-smoothing time (the
+            # datasheet's carrier_smoothing; code_correlation_time in datasets made before it):
+            # three Gauss-Markov states of that time constant
+            noise, p0, fix_sigma = self.NOISE, self.P0_SIGMA, self.FIX_SIGMA
+            fix_tau = float(gnss.get("carrier_smoothing") or gnss.get("code_correlation_time")
+                            or 0.0)
+            self._fix_states = self.config["fix_error_states"] and fix_tau > 0
+            scale_state = self.config["odometer_scale_state"]
         sigma, taus = [], []
         if self._fix_states:
-            sigma, taus = list(self.FIX_SIGMA), [tau] * 3
+            sigma, taus = list(fix_sigma), [fix_tau] * 3
         self._scale_col = None
-        if self.config["odometer_scale_state"]:  # a random constant (tau = inf)
+        if scale_state:  # a random constant (tau = inf)
             self._scale_col = 15 + len(sigma)
             sigma.append(self.ODOMETER_SCALE_SIGMA)
             taus.append(np.inf)
         markov = dict(extra_sigma=np.array(sigma), extra_tau=np.array(taus)) if sigma else {}
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
-                             self.P0_SIGMA, self.NOISE, mounting=site.mounting, **markov)
+                             p0, noise, mounting=site.mounting, **markov)
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]
+        self._dop = [c.get("hdop"), c.get("vdop")]
+        self._dop_known = False
         self._speed = self.columns["odometer"]["speed"]
         self._antenna = site.antenna
         # the constraint where it holds: the rear axle, with the car's slip as its noise; at the
@@ -148,6 +186,21 @@ class ParkInsOdometer(Estimator):
         self._r_fix = np.zeros((6, 6))
         self._r_fix[:3, :3] = self.R_POSITION_WHITE if self._fix_states else self.R_POSITION
         self._r_fix[3:, 3:] = self.R_VELOCITY
+
+    def _datasheet_model(self) -> tuple[InsNoise, np.ndarray, np.ndarray, float]:
+        """The IMU noise, P0 and fix-error states of ``tuning: datasheet`` (module docstring):
+        from the datasheet's IMU (``toolbox.datasheet.imu_error_model``), receiver
+        (``fix_error_model``; the states' size is set again at the first fix from its DOPs)
+        and odometer (its speed quantisation and latency, ``odometer_speed_sigma``)."""
+        imu = imu_error_model(self.datasheet)
+        noise = ins_noise(imu)
+        p0 = self.P0_SIGMA.copy()
+        p0[9:12], p0[12:15] = imu.accel_bias_initial, imu.gyro_bias_initial
+        self._fix_model = fix_error_model(self.datasheet)
+        self._odo_sigma = odometer_speed_sigma(self.datasheet)
+        self._odo_still_sigma = odometer_speed_sigma(self.datasheet, 0.0)
+        self._odo_delay = odometer_delay_s(self.datasheet)
+        return noise, p0, self._fix_model.correlated_sigma(1.0, 2.0), self._fix_model.correlated_tau
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         self.ins.add_imu(t, row)
@@ -169,8 +222,22 @@ class ParkInsOdometer(Estimator):
             h_p[:, 15:18] = np.eye(3)
         dz_v, h_v = aiding.gnss_velocity(ins.v, np.nan_to_num(values[3:6]), n, ins.q,
                                          ins.mean_rate, self._antenna)
-        ins.update(np.concatenate([dz_p, dz_v])[keep], np.vstack([h_p, h_v])[keep],
-                   self._r_fix[np.ix_(keep, keep)])
+        if not self._sheet:
+            ins.update(np.concatenate([dz_p, dz_v])[keep], np.vstack([h_p, h_v])[keep],
+                       self._r_fix[np.ix_(keep, keep)])
+            return
+        dops = [float(row[i]) if i is not None else math.nan for i in self._dop]
+        model = self._fix_model
+        if not self._dop_known:  # the correlated error's size at this receiver's geometry
+            for k, sigma in enumerate(model.correlated_sigma(*dops)):
+                ins.set_extra_sigma(k, float(sigma))
+            self._dop_known = True
+        # a fix that does not fit (a reflected signal's metres) is left out, not averaged in
+        ins.gated_update(dz_p, h_p, np.diag(model.white_sigma(*dops) ** 2), GATE_PROBABILITY)
+        rows = keep[3:]
+        if rows.any():
+            r_v = np.diag(model.velocity_sigma(*dops)[rows] ** 2)
+            ins.gated_update(dz_v[rows], h_v[rows], r_v, GATE_PROBABILITY)
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         ins = self.ins
@@ -179,13 +246,18 @@ class ParkInsOdometer(Estimator):
         dz, h = aiding.odometer(ins.q, ins.v, speed, self.config["nhc"], ins.n_states,
                                 ins.mean_rate, self._rear)
         r = self._r_odo
-        if self._scale_col is None:
-            r[0, 0] = self.R_ODOMETER + (self.ODOMETER_SCALE_SIGMA * speed) ** 2
-        else:  # the odometer reads (1 + k) v: dz = v_x - speed / (1 + k_est)
+        scale_sigma = self.ODOMETER_SCALE_SIGMA
+        if self._scale_col is not None:  # the odometer reads (1 + k) v: dz = v_x - speed / (1 + k)
             k = ins.extra[self._scale_col - 15]
             dz[0] = dz[0] + speed - speed / (1.0 + k)
             h[0, self._scale_col] = speed / (1.0 + k) ** 2
-            r[0, 0] = self.R_ODOMETER
+            scale_sigma = 0.0
+        if self._sheet:  # its resolution (or cut-off), its age times the acceleration
+            accel = ins.mean_force[0] + quat_to_dcm(ins.q)[2, 0] * G0
+            sigma = self._odo_sigma if speed != 0.0 else self._odo_still_sigma
+            r[0, 0] = sigma**2 + (self._odo_delay * accel) ** 2 + (scale_sigma * speed) ** 2
+        else:
+            r[0, 0] = self.R_ODOMETER + (scale_sigma * speed) ** 2
         if self._slip is not None and len(r) == 3:
             lateral, vertical = self._slip.sigma_of_state(ins.q, ins.v, ins.mean_rate,
                                                           ins.mean_force)

@@ -18,7 +18,7 @@ closed loop, and decayed by exp(-dt / tau) between updates (the process's expect
 
 Public names
 ------------
-InsNoise, InsFilter.
+InsNoise, InsFilter, ins_noise.
 """
 
 from __future__ import annotations
@@ -31,6 +31,8 @@ from numba import njit
 
 from estimators.base import InitialState
 from estimators.toolbox import nav_error
+from estimators.toolbox.datasheet import ImuErrorModel
+from estimators.toolbox.gating import innovation_covariance, passes_gate
 from estimators.toolbox.ins_error import BA, BG, N_STATES, discretise, noise_psd, system_matrix
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.strapdown import propagate
@@ -51,6 +53,11 @@ class InsNoise:
     accel_bias_sigma, gyro_bias_sigma : steady-state 1-sigma of the Gauss-Markov in-run biases,
         m/s^2 and rad/s.
     accel_bias_tau, gyro_bias_tau : their correlation times, s.
+    accel_scale_sigma, gyro_scale_sigma : 1-sigma scale-factor errors (dimensionless), not
+        states: as a reading x changes by dx over a flush, its bias (which absorbs s x) moves
+        by s dx, so (s dx)^2 joins the bias's process noise (``toolbox.datasheet``).
+    gyro_g_sensitivity : gyro g-sensitivity, rad/s per m/s^2, likewise with the change of the
+        specific force.
     """
 
     accel_noise: float
@@ -59,6 +66,19 @@ class InsNoise:
     gyro_bias_sigma: float
     accel_bias_tau: float
     gyro_bias_tau: float
+    accel_scale_sigma: float = 0.0
+    gyro_scale_sigma: float = 0.0
+    gyro_g_sensitivity: float = 0.0
+
+
+def ins_noise(imu: ImuErrorModel) -> InsNoise:
+    """The ``InsNoise`` of an IMU's datasheet error model (``toolbox.datasheet``)."""
+    return InsNoise(accel_noise=imu.accel_noise, gyro_noise=imu.gyro_noise,
+                    accel_bias_sigma=imu.accel_bias_sigma, gyro_bias_sigma=imu.gyro_bias_sigma,
+                    accel_bias_tau=imu.accel_bias_tau, gyro_bias_tau=imu.gyro_bias_tau,
+                    accel_scale_sigma=imu.accel_scale_sigma,
+                    gyro_scale_sigma=imu.gyro_scale_sigma,
+                    gyro_g_sensitivity=imu.gyro_g_sensitivity)
 
 
 @njit(cache=True)
@@ -157,6 +177,7 @@ class InsFilter:
         self._n = 0
         self._prev = np.zeros(12)
         self._sums = np.zeros(7)
+        self._rejected = 0  # measurements rejected in a row by ``gated_update``
         self.mean_rate = np.zeros(3)  # compensated body angular rate over the last flush, rad/s
         self.mean_rate_dt = 0.0  # the length of that flush, s
         self.mean_force = np.zeros(3)  # compensated specific force over it, body, m/s^2
@@ -171,6 +192,16 @@ class InsFilter:
         self._gqg[extra, extra] = 2 * extra_sigma**2 / self._extra_tau
         self._f = np.zeros((self.n_states, self.n_states))
         self._f[extra, extra] = -1.0 / self._extra_tau
+
+    def set_extra_sigma(self, index: int, sigma: float) -> None:
+        """Reset the steady-state 1-sigma of extra state ``index`` (0 = the first after the
+        15): its variance, its cross-covariances zeroed, and its driving noise (a state whose
+        size is learnt at the first measurement, such as a fix error scaled by the DOP)."""
+        k = N_STATES + index
+        self.kf.p[k, :] = 0.0
+        self.kf.p[:, k] = 0.0
+        self.kf.p[k, k] = sigma * sigma
+        self._gqg[k, k] = 2 * sigma * sigma / self._extra_tau[index]
 
     def add_imu(self, t: float, row: np.ndarray) -> None:
         """Buffer one IMU sample (integrated at the next ``flush``)."""
@@ -195,15 +226,24 @@ class InsFilter:
         dt = self._sums[6]
         if dt <= 0.0:
             return
-        self.mean_rate = self._sums[3:6] / dt
-        self.mean_rate_dt = dt
+        rate = self._sums[3:6] / dt
         c_bn = quat_to_dcm(self.q)
         f_body = c_bn.T @ (self._sums[0:3] / dt)
-        self.mean_force = f_body
         n = self.noise
         self._f[:N_STATES, :N_STATES] = system_matrix(self.pos[0], self.pos[2], self.v, c_bn,
                                                       f_body, n.accel_bias_tau, n.gyro_bias_tau)
-        self.kf.predict(*discretise(self._f, self._gqg, dt))
+        phi, q_d = discretise(self._f, self._gqg, dt)
+        if self.mean_rate_dt > 0 and (n.accel_scale_sigma or n.gyro_scale_sigma
+                                      or n.gyro_g_sensitivity):
+            d_rate, d_force = rate - self.mean_rate, f_body - self.mean_force
+            ia, ig = np.arange(N_STATES)[BA], np.arange(N_STATES)[BG]
+            q_d[ia, ia] += (n.accel_scale_sigma * d_force) ** 2
+            q_d[ig, ig] += ((n.gyro_scale_sigma * d_rate) ** 2
+                            + (n.gyro_g_sensitivity * d_force) ** 2)
+        self.mean_rate = rate
+        self.mean_rate_dt = dt
+        self.mean_force = f_body
+        self.kf.predict(phi, q_d)
         if len(self.extra):
             self.extra *= np.exp(-dt / self._extra_tau)
 
@@ -212,6 +252,22 @@ class InsFilter:
         self.kf.update(dz, h, r)
         if self.kf.closed_loop:
             self._remove(self.kf.feedback())
+
+    def gated_update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray,
+                     probability: float = 0.999, max_rejected: int = 5) -> bool:
+        """``update`` only when the innovation passes the chi-square gate at ``probability``
+        (``gating.passes_gate``); whether it did. After ``max_rejected`` measurements rejected
+        in a row the next one is taken whatever its innovation: a filter whose own error has
+        grown past its covariance (after an outage) would otherwise reject every fix for
+        ever."""
+        nu = dz - h @ self.kf.x
+        if (self._rejected < max_rejected
+                and not passes_gate(nu, innovation_covariance(self.kf.p, h, r), probability)):
+            self._rejected += 1
+            return False
+        self._rejected = 0
+        self.update(dz, h, r)
+        return True
 
     def set_closed_loop(self, closed: bool) -> None:
         """Switch loops; closing it removes the open-loop estimate from the nominal solution."""
@@ -233,17 +289,21 @@ class InsFilter:
         return q, v, pos, np.concatenate([self.ba - x[BA], self.bg - x[BG]])
 
     def solution_row(self) -> list[float]:
-        """lat, lon (deg), alt, vn, ve, vd, roll, pitch, yaw, std_n ... std_vd, std_yaw and the
-        bias estimates (``SOLUTION_COLUMNS``). std_yaw is the 1-sigma of psi_d, the yaw error
-        for a level vehicle (to first order in the tilt)."""
+        """lat, lon (deg), alt, vn, ve, vd, roll, pitch, yaw, std_n ... std_vd, std_roll,
+        std_pitch, std_yaw and the bias estimates (``SOLUTION_COLUMNS``). The Euler angles'
+        1-sigma are those of psi mapped by ``nav_error.euler_error_jacobian``."""
         q, v, pos, biases = self.corrected()
         roll, pitch, yaw = quat_to_euler(q)
-        std = np.sqrt(np.diag(self.kf.p)[:6])
+        p = self.kf.p
+        std = np.sqrt(np.diag(p)[:6])
+        jac = nav_error.euler_error_jacobian(quat_to_dcm(q))
+        std_att = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", jac, p[6:9, 6:9], jac), 0.0))
         return [np.degrees(pos[0]), np.degrees(pos[1]), pos[2], *v, float(roll), float(pitch),
-                float(yaw), *std, float(np.sqrt(self.kf.p[8, 8])), *biases]
+                float(yaw), *std, *std_att, *biases]
 
 
 SOLUTION_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
-                    "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd", "std_yaw",
+                    "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd", "std_roll",
+                    "std_pitch", "std_yaw",
                     "accel_bias_x", "accel_bias_y", "accel_bias_z",
                     "gyro_bias_x", "gyro_bias_y", "gyro_bias_z")

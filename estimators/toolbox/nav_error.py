@@ -16,10 +16,12 @@ adds them (initial errors, tests).
 
 Public names
 ------------
-NAV_ERROR_STATES, perturb, correct.
+NAV_ERROR_STATES, perturb, correct, euler_error_jacobian.
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 
@@ -59,3 +61,16 @@ def correct(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dx: np.ndarray
     dx = np.asarray(dx, dtype=float)
     q_new = quat_multiply(rotvec_to_quat(-dx[6:9]), q)
     return q_new, np.asarray(v, float) - dx[3:6], _shift(np.asarray(pos, float), -dx[0:3])
+
+
+def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
+    """d(roll, pitch, yaw) / d psi, shape (3, 3), at the attitude of the body-to-NED DCM
+    ``c_bn``, for the toolbox attitude error psi (C_b^n(estimate) = (I + [psi x]) C_b^n): the
+    Euler-rate matrix M(roll, pitch) times C_n^b, since psi is the body-frame rotation
+    C_n^b psi (Groves 2013, eq. 2.56 for M)."""
+    roll = math.atan2(c_bn[2, 1], c_bn[2, 2])
+    sr, cr = math.sin(roll), math.cos(roll)
+    sp = -c_bn[2, 0]
+    cp = math.sqrt(max(1.0 - sp * sp, 1e-12))
+    m = np.array([[1.0, sr * sp / cp, cr * sp / cp], [0.0, cr, -sr], [0.0, sr / cp, cr / cp]])
+    return m @ c_bn.T

@@ -11,8 +11,9 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from estimators.builtin.park2019_dr import _dr3d_navigate, euler_error_jacobian
+from estimators.builtin.park2019_dr import _dr3d_navigate
 from estimators.registry import BUILTINS
+from estimators.toolbox.nav_error import euler_error_jacobian
 from simulator.earth import dcm_to_euler, euler_to_dcm, euler_to_quat, radii_of_curvature, skew
 from simulator.pipeline import generate, load_scenario
 from simulator.reproduce import park2019

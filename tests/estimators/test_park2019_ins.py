@@ -53,6 +53,11 @@ def test_nhc_is_used_in_the_garage(runs):
     assert np.median(with_nhc) < np.median(without)
 
 
+def test_an_unknown_tuning_is_refused():
+    with pytest.raises(InputError, match="tuning must be one of datasheet, paper"):
+        ParkInsOdometer({"tuning": "guess"}, None, {}, {})
+
+
 def test_an_unknown_nhc_point_is_refused():
     with pytest.raises(InputError, match="nhc_point must be one of rear_axle, imu"):
         ParkInsOdometer({"nhc_point": "front_axle"}, None, {}, {})
@@ -68,7 +73,7 @@ def test_fix_error_states_take_the_receivers_carrier_smoothing_time():
                "gnss_fix": {c: i + 1 for i, c in enumerate(
                    ("lat", "lon", "alt", "vn", "ve", "vd", "fix"))},
                "odometer": {"speed": 1}}
-    config = {"fix_error_states": True, "odometer_scale_state": True}
+    config = {"tuning": "paper", "fix_error_states": True, "odometer_scale_state": True}
 
     def states(smoothing: float) -> int:
         sheet = {"gnss": {"carrier_smoothing": smoothing}}
@@ -76,7 +81,10 @@ def test_fix_error_states_take_the_receivers_carrier_smoothing_time():
         return est.ins.n_states
 
     assert states(100.0) == 19 and states(0.0) == 16
-    assert ParkInsOdometer(None, initial, columns, {}, imu_output="rate").ins.n_states == 15
+    paper = {"tuning": "paper"}
+    assert ParkInsOdometer(paper, initial, columns, {}, imu_output="rate").ins.n_states == 15
+    # the datasheet tuning always carries the fix's correlated error
+    assert ParkInsOdometer(None, initial, columns, {}, imu_output="rate").ins.n_states == 18
 
 
 def test_the_antenna_lever_arm_is_taken_from_the_datasheet(tmp_path):

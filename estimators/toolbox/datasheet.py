@@ -1,0 +1,208 @@
+"""Noise and initial uncertainty of a filter from what a user knows before the drive: the
+dataset's ``datasheet`` (``Estimator.datasheet``: each sensor's data-sheet parameters, SI units)
+and the fix's own dilution of precision. One home for the translation, so that every filter
+that tunes itself "from the datasheet" means the same thing.
+
+* ``imu_error_model``: the IMU's white noises are its noise densities; its in-run biases a
+  first-order Gauss-Markov process whose steady-state sigma is the bias instability, the extra
+  Gauss-Markov term and the bias random walk over the correlation time in quadrature (Groves
+  2013, section 4.4.3 and eq. 14.84 for the Gauss-Markov PSD 2 sigma^2 / tau); the turn-on
+  bias range the initial bias uncertainty (the g-sensitivity of a gyro under gravity is a
+  turn-on bias too). Scale-factor and misalignment errors are not states: a scale-factor error
+  s acts as a bias s x on a reading x, which moves by s dx when the reading changes, so
+  ``InsFilter`` adds (s dx)^2 to the bias's process noise over each interval
+  (``InsNoise.gyro_scale_sigma``, ``accel_scale_sigma``; the gyro's g-sensitivity times the
+  change of specific force likewise).
+* ``fix_error_model``: the position error of a receiver's fix, per unit DOP, split by time
+  behaviour (the user range error budget of Kaplan & Hegarty 2017, section 10.2, with the
+  receiver's own parameters):
+
+  - correlated over the drive (``correlated_sigma``, correlation time ``CORRELATED_TAU_S``):
+    signal in space (``sis_error``), the ionosphere's residual after the broadcast model
+    (``iono_scale`` - 1 plus its variation ``iono_scale`` x ``iono_residual``, times the
+    Klobuchar model's night-time vertical delay of 5 ns (IS-GPS-200 20.3.3.5.2.5, its
+    smallest value, so a lower bound of the day's) and the obliquity at 30 deg elevation,
+    1.77) and the troposphere's residual (``tropo_residual`` of a 2.3 m zenith delay, same
+    obliquity). Per axis: north and east HDOP / sqrt(2), down VDOP times that range error.
+  - the rest, code tracking noise (``tracking_noise``, lowered by the Hatch filter to
+    1 / sqrt(2N - 1), N = ``carrier_smoothing`` x ``rate`` epochs) and multipath
+    (``multipath``): correlated over the carrier-smoothing time T, so given to the filter as
+    the white noise of the same low-frequency spectrum, variance 2 sigma^2 T / dt at the fix
+    interval dt (Brown & Hwang, 4th ed., section 2.9: a first-order Gauss-Markov process's PSD
+    at zero frequency is 2 sigma^2 T).
+  - velocity: 0.05 m/s per range rate (u-blox NEO-M8 data sheet; the ``automotive`` FLL's
+    0.024-0.08 m/s at 45-35 dB-Hz, docs/gnss-errors.md) times the DOP.
+
+* ``odometer_speed_sigma``: the white 1-sigma of an odometer's speed: the tick count's
+  quantisation, 1 / (``ticks_per_meter`` dt) over an interval dt = 1 / ``rate``, uniform, so
+  divided by sqrt(12) (a CAN speed timed by its tooth edges instead has the step
+  ``speed_resolution``), in quadrature with a 0.05 m/s floor (the wheel's own motion on the
+  road that the body does not share: chosen). ``odometer_delay_s``: how old the speed is
+  when stamped, the ``latency`` plus half the counting interval of a tick-count speed (the
+  mean over the interval stamped at its end).
+
+Public names
+------------
+ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, odometer_speed_sigma,
+odometer_delay_s, CORRELATED_TAU_S.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+C_M_S = 299_792_458.0  # speed of light, m/s
+KLOBUCHAR_NIGHT_DELAY_M = 5e-9 * C_M_S  # the broadcast model's constant night-time term, m
+OBLIQUITY_30_DEG = 1.77  # Klobuchar's obliquity factor 1 + 16 (0.53 - E)^3 at E = 30 deg
+TROPO_ZENITH_DELAY_M = 2.3  # sea-level zenith delay of a standard atmosphere, m
+CORRELATED_TAU_S = 1800.0  # ionosphere and ephemeris residuals change over tens of minutes
+RANGE_RATE_SIGMA_M_S = 0.05  # a car receiver's range-rate noise (u-blox NEO-M8: 0.05 m/s)
+DEFAULT_BIAS_TAU_S = 600.0  # correlation time of the in-run bias when the sheet gives none
+
+
+@dataclass(frozen=True)
+class ImuErrorModel:
+    """Per axis, SI units: white noise densities (per sqrt(Hz)), in-run Gauss-Markov bias sigma
+    and correlation time, turn-on bias 1-sigma, scale-factor 1-sigma (misalignment included)
+    and the gyro's g-sensitivity (rad/s per m/s^2)."""
+
+    accel_noise: float
+    gyro_noise: float
+    accel_bias_sigma: float
+    gyro_bias_sigma: float
+    accel_bias_tau: float
+    gyro_bias_tau: float
+    accel_bias_initial: float
+    gyro_bias_initial: float
+    accel_scale_sigma: float
+    gyro_scale_sigma: float
+    gyro_g_sensitivity: float
+
+
+def _value(group: Mapping[str, Any], key: str) -> float:
+    """A per-axis datasheet value as one number (the largest axis), 0 when absent."""
+    v = group.get(key)
+    if v is None:
+        return 0.0
+    if isinstance(v, Mapping):  # a fixed true value given as {fixed: ...}: a known value
+        return 0.0
+    return float(np.max(np.abs(np.atleast_1d(np.asarray(v, dtype=float)))))
+
+
+def _group(imu: Mapping[str, Any], name: str) -> tuple[float, float, float, float, float, float]:
+    g = imu.get(name) or {}
+    tau = float(g.get("bias_correlation_time") or DEFAULT_BIAS_TAU_S)
+    in_run = math.sqrt(_value(g, "bias_instability") ** 2 + _value(g, "gauss_markov_sigma") ** 2
+                       + _value(g, "random_walk") ** 2 * tau / 3.0)
+    scale = math.hypot(_value(g, "scale_factor"), _value(g, "misalignment"))
+    return (_value(g, "noise_density"), in_run, tau, _value(g, "bias"), scale,
+            _value(g, "g_sensitivity"))
+
+
+def imu_error_model(datasheet: Mapping[str, Any]) -> ImuErrorModel:
+    """The IMU's error model (module docstring) from a dataset's ``datasheet``.
+
+    The random walk's variance over the correlation time tau, K^2 tau / 3 (the mean variance of
+    a random walk over an interval of length tau), joins the instability. The turn-on bias
+    adds the gyro's g-sensitivity times gravity in quadrature. Floors keep a perfect sensor's
+    filter numerically sound: 1e-6 of a typical MEMS value.
+    """
+    imu = datasheet.get("imu") or {}
+    a_noise, a_run, a_tau, a_bias, a_scale, _ = _group(imu, "accel")
+    g_noise, g_run, g_tau, g_bias, g_scale, g_sens = _group(imu, "gyro")
+    g_bias = math.hypot(g_bias, g_sens * 9.80665)
+    return ImuErrorModel(accel_noise=max(a_noise, 1e-9), gyro_noise=max(g_noise, 1e-10),
+                         accel_bias_sigma=max(a_run, 1e-8), gyro_bias_sigma=max(g_run, 1e-10),
+                         accel_bias_tau=a_tau, gyro_bias_tau=g_tau,
+                         accel_bias_initial=max(a_bias, 1e-6),
+                         gyro_bias_initial=max(g_bias, 1e-8),
+                         accel_scale_sigma=a_scale, gyro_scale_sigma=g_scale,
+                         gyro_g_sensitivity=g_sens)
+
+
+@dataclass(frozen=True)
+class FixErrorModel:
+    """A receiver's fix error per unit DOP (module docstring): the user range errors in m
+    (``correlated_range``, ``white_range``: the latter already the white equivalent at the fix
+    interval), their correlation time, and the range-rate 1-sigma (m/s)."""
+
+    correlated_range: float
+    white_range: float
+    correlated_tau: float
+    range_rate: float
+
+    def correlated_sigma(self, hdop: float, vdop: float) -> np.ndarray:
+        """NED 1-sigma (m) of the drive-long correlated error at these DOPs."""
+        return self.correlated_range * _axes(hdop, vdop)
+
+    def white_sigma(self, hdop: float, vdop: float) -> np.ndarray:
+        """NED 1-sigma (m) of the white-equivalent remainder at these DOPs."""
+        return self.white_range * _axes(hdop, vdop)
+
+    def velocity_sigma(self, hdop: float, vdop: float) -> np.ndarray:
+        """NED 1-sigma (m/s) of the fix's velocity at these DOPs."""
+        return self.range_rate * _axes(hdop, vdop)
+
+
+def _axes(hdop: float, vdop: float) -> np.ndarray:
+    h = hdop / math.sqrt(2.0) if math.isfinite(hdop) and hdop > 0 else 1.0
+    v = vdop if math.isfinite(vdop) and vdop > 0 else 2.0
+    return np.array([h, h, v])
+
+
+def fix_error_model(datasheet: Mapping[str, Any]) -> FixErrorModel:
+    """The fix error budget (module docstring) from the datasheet's ``gnss`` block; a block
+    without these keys (an ``ideal`` receiver) gives a 0.1 m floor."""
+    gnss = datasheet.get("gnss") or {}
+
+    def key(name: str, default: float = 0.0) -> float:
+        v = gnss.get(name)
+        return default if v is None else float(v)
+
+    iono_scale = key("iono_scale", 1.0)
+    iono = ((abs(iono_scale - 1.0) + iono_scale * key("iono_residual"))
+            * KLOBUCHAR_NIGHT_DELAY_M * OBLIQUITY_30_DEG)
+    tropo = key("tropo_residual") * TROPO_ZENITH_DELAY_M * OBLIQUITY_30_DEG
+    correlated = math.sqrt(key("sis_error") ** 2 + iono**2 + tropo**2)
+    rate = key("rate", 1.0)
+    smoothing = key("carrier_smoothing")
+    n_smooth = max(smoothing * rate, 1.0)
+    noise = key("tracking_noise") / math.sqrt(2.0 * n_smooth - 1.0)
+    white = math.hypot(noise, key("multipath"))
+    if smoothing > 0:  # the white noise of the smoothed error's low-frequency spectrum
+        white *= math.sqrt(2.0 * smoothing * rate)
+    return FixErrorModel(correlated_range=max(correlated, 0.1), white_range=max(white, 0.1),
+                         correlated_tau=CORRELATED_TAU_S, range_rate=RANGE_RATE_SIGMA_M_S)
+
+
+ODOMETER_FLOOR_M_S = 0.05  # wheel motion the body does not share, m/s (chosen)
+
+
+def odometer_speed_sigma(datasheet: Mapping[str, Any], speed: float = 1.0) -> float:
+    """White 1-sigma of the odometer's speed, m/s (module docstring); a reading of exactly 0
+    below a ``min_speed`` cut-off may be any speed under it (uniform: min_speed / sqrt(3))."""
+    odo = datasheet.get("odometer") or {}
+    min_speed = float(odo.get("min_speed") or 0.0)
+    if speed == 0.0 and min_speed > 0:
+        return math.hypot(ODOMETER_FLOOR_M_S, min_speed / math.sqrt(3.0))
+    rate = float(odo.get("rate") or 10.0)
+    ticks = float(odo.get("ticks_per_meter") or 0.0)
+    if odo.get("tooth_timing"):
+        step = float(odo.get("speed_resolution") or 0.0)
+    else:
+        step = rate / ticks if ticks > 0 else float(odo.get("speed_resolution") or 0.0)
+    return math.hypot(ODOMETER_FLOOR_M_S, step / math.sqrt(12.0))
+
+
+def odometer_delay_s(datasheet: Mapping[str, Any]) -> float:
+    """Age of the odometer's speed at its time stamp, s (module docstring)."""
+    odo = datasheet.get("odometer") or {}
+    delay = float(odo.get("latency") or 0.0)
+    if float(odo.get("ticks_per_meter") or 0.0) > 0 and not odo.get("tooth_timing"):
+        delay += 0.5 / float(odo.get("rate") or 10.0)
+    return delay
