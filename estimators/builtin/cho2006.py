@@ -83,6 +83,7 @@ import math
 import numpy as np
 
 from estimators.base import NAV_COLUMNS, Estimator
+from estimators.builtin.cho2006_tuning import TUNINGS, Tuning, datasheet_tuning, paper_tuning
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
@@ -98,15 +99,7 @@ MIN_STOP_S = 2.0  # shortest stop whose gyro average replaces the calibration
 STOPPED_M_S = 1e-3  # odometer speed read as a stopped wheel (below any encoder's resolution)
 MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
 DEG = math.pi / 180.0
-
-# eqs. 33-35 (DRM2 state order [P_N, P_E, V, theta, psi, d_ax, d_gy, d_gz])
-P0_DRM2 = np.diag([50.0**2, 50.0**2, 5.0**2, (10 * DEG) ** 2, (180 * DEG) ** 2, 1.0, 1.0, 1.0])
-Q_DRM2 = np.diag([0.0, 0.0, 0.1**2, (0.1 * DEG) ** 2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0])
-# DRM1 state order [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], eqs. 33-34 term by term
-P0_DRM1 = np.diag([50.0**2, 50.0**2, 5.0**2, 5.0**2, (180 * DEG) ** 2, 1.0, 1.0, 1.0])
-Q_DRM1 = np.diag([0.0, 0.0, 0.1**2, 0.1**2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0])
-R_GPS = np.diag([15.0**2, 15.0**2, 0.3**2])  # eq. 35: north, east (m), speed (m/s)
-
+SIGMA_SETS = ("simplex", "symmetric")  # the SPKF's point sets (estimators.toolbox.sigma_points)
 
 def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: float,
                     g: float) -> np.ndarray:
@@ -117,10 +110,11 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     position moves with the mean of the step's old (eq. 24a-b) and new (eq. 5) velocity
     vectors (the trapezoidal rule).
     """
-    pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T
+    pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T[:8]
     f_x, w_y, w_z = u
     out = np.empty_like(x)
-    v_new = v + ((1.0 - d_ax) * f_x - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
+    f_h = (1.0 - d_ax) * f_x - (x[:, 8] if x.shape[1] > 8 else 0.0)  # eq. 14b (+ bias, eq. 9)
+    v_new = v + (f_h - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
     psi_new = psi + (1.0 - d_gz) * w_z * dt  # eq. 24e
     out[:, 0] = pn + 0.5 * (v * np.cos(psi) + v_new * np.cos(psi_new)) * dt  # eqs. 24a, 5
     out[:, 1] = pe + 0.5 * (v * np.sin(psi) + v_new * np.sin(psi_new)) * dt  # eqs. 24b, 5
@@ -137,15 +131,18 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
 def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarray:
     """Transition matrix of ``drm2_transition`` at ``x`` (8,) (Cho & Choi eqs. 16-17, with the
     trapezoidal position step)."""
-    _, _, v, th, psi, d_ax, d_gy, d_gz = x
+    _, _, v, th, psi, d_ax, d_gy, d_gz = x[:8]
     f_x, w_y, w_z = u
     st, ct = math.sin(th), math.cos(th)
-    v_new = v + ((1.0 - d_ax) * f_x - g * st) * ct * dt
+    f_h = (1.0 - d_ax) * f_x - (x[8] if x.size > 8 else 0.0)
+    v_new = v + (f_h - g * st) * ct * dt
     psi_new = psi + (1.0 - d_gz) * w_z * dt
-    phi = np.eye(8)
-    # A_3 (eq. 17c) with SF_ax = 1 - d_ax, and the scale-factor column
-    phi[2, 3] = (g * st * st - (1.0 - d_ax) * f_x * st - g * ct * ct) * dt
+    phi = np.eye(x.size)
+    # A_3 (eq. 17c) with SF_ax = 1 - d_ax (and the bias), and the scale-factor column
+    phi[2, 3] = (g * st * st - f_h * st - g * ct * ct) * dt
     phi[2, 5] = -f_x * ct * dt
+    if x.size > 8:
+        phi[2, 8] = -ct * dt
     phi[3, 6] = -w_y * dt  # A_4 (eq. 17d)
     phi[4, 7] = -w_z * dt
     # position rows: A_1 and A_2 (eq. 17a-b) at the old and at the new velocity vector
@@ -170,9 +167,11 @@ def drm1_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     position moves with the mean of the old and the new velocity (eq. 3 names the new one,
     which puts the position a dt / 2 ahead while accelerating).
     """
-    pn, pe, vn, ve, psi, d_ax, d_ay, d_gz = x.T
+    pn, pe, vn, ve, psi, d_ax, d_ay, d_gz = x.T[:8]
     f_x, f_y, w_z = u
     fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
+    if x.shape[1] > 8:  # accelerometer biases (the datasheet tuning's states)
+        fxc, fyc = fxc - x[:, 8], fyc - x[:, 9]
     turn = (1.0 - d_gz) * w_z * dt
     c, s = np.cos(psi + 0.5 * turn), np.sin(psi + 0.5 * turn)
     out = np.empty_like(x)
@@ -195,12 +194,16 @@ def drm1_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarr
     mid = psi + 0.5 * (1.0 - d_gz) * w_z * dt
     c, s = math.cos(mid), math.sin(mid)
     fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
-    phi = np.eye(8)
+    if x.size > 8:
+        fxc, fyc = fxc - x[8], fyc - x[9]
+    phi = np.eye(x.size)
     # velocity rows: d/d psi, d/d d_ax, d/d d_ay, d/d d_gz (through the mid heading)
     dvn_dpsi, dve_dpsi = (-s * fxc - c * fyc) * dt, (c * fxc - s * fyc) * dt
     phi[2, 4], phi[2, 5], phi[2, 6] = dvn_dpsi, -c * f_x * dt, s * f_y * dt
     phi[3, 4], phi[3, 5], phi[3, 6] = dve_dpsi, -s * f_x * dt, -c * f_y * dt
     phi[2, 7], phi[3, 7] = -0.5 * w_z * dt * dvn_dpsi, -0.5 * w_z * dt * dve_dpsi
+    if x.size > 8:  # d/d b_ax, d/d b_ay
+        phi[2, 8], phi[2, 9], phi[3, 8], phi[3, 9] = -c * dt, s * dt, -s * dt, -c * dt
     phi[0] += 0.5 * dt * phi[2]  # the position moves with the old and new velocity (eq. 3)
     phi[1] += 0.5 * dt * phi[3]
     phi[0, 2] += 0.5 * dt
@@ -217,13 +220,17 @@ class _ChoDr(Estimator):
     uses = ("odometer",)
     paper = PAPER
     output_rate_hz = 10.0
-    defaults = {"standstill_calibration": True}
+    defaults = {"standstill_calibration": True, "tuning": "datasheet"}
     # set by the model
+    _model = ""  # "drm1" or "drm2" (cho2006_tuning)
     _imu_columns: tuple[str, str, str] = ("", "", "")
     _gyro_channels: tuple[int, ...] = ()  # which of the three inputs are gyros
-    _p0 = _q = np.zeros((8, 8))
 
     def setup(self) -> None:
+        if self.config["tuning"] not in TUNINGS:
+            raise InputError([Problem("config", None, "", (
+                f"config key 'tuning' of estimator {self.name} must be one of "
+                f"{', '.join(TUNINGS)}, got {self.config['tuning']!r}"))])
         init = self.initial
         self._lat0, self._lon0, self._h0 = (float(v) for v in init.position)
         rn, re = radii_of_curvature(self._lat0)
@@ -233,7 +240,7 @@ class _ChoDr(Estimator):
         self._cols = [imu[c] for c in self._imu_columns]
         self._increment = self.imu_output == "increment"
         fix = self.columns["gnss_fix"]
-        self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
+        self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"], fix["hdop"])
         self._s0 = self._s1 = self._s2 = 0.0  # the three inputs integrated over the DR step
         self._acc_t = 0.0  # time accumulated in the current DR step
         self._t_imu = init.t
@@ -244,7 +251,25 @@ class _ChoDr(Estimator):
         self._still_t = 0.0
         self._first_stop = self._still  # the initial standstill: calibrated however short
         self._odo_speed = self.columns.get("odometer", {}).get("speed")
-        self._start_filter(self._initial_state(), self._p0.copy())
+        self._tuning = self._make_tuning(0.0)
+        x0 = self._initial_state()
+        self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
+                           self._tuning.p0.copy())
+
+    def _make_tuning(self, still_s: float) -> Tuning:
+        """The configured tuning (``cho2006_tuning``) after ``still_s`` s of calibration."""
+        if self.config["tuning"] == "paper":
+            return paper_tuning(self._model)
+        return datasheet_tuning(self._model, self.datasheet, still_s)
+
+    @property
+    def _q(self) -> np.ndarray:
+        return self._tuning.q
+
+    @property
+    def _bias_states(self) -> int:
+        """Accelerometer-bias states appended to the paper's eight (datasheet tuning)."""
+        return len(self._tuning.p0) - 8
 
     # -- to be provided by the model and filter -------------------------------------------
     def _initial_state(self) -> np.ndarray:
@@ -256,7 +281,7 @@ class _ChoDr(Estimator):
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         raise NotImplementedError
 
-    def _update(self, z: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> None:
         raise NotImplementedError
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
@@ -308,6 +333,8 @@ class _ChoDr(Estimator):
             mean = self._still_sum / self._still_t
             for i in self._gyro_channels:
                 self._bias[i] = mean[i]
+            if self._first_stop:  # the residual bias's noise follows the calibration's length
+                self._tuning = self._make_tuning(self._still_t)
         self._first_stop = False
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
@@ -322,7 +349,7 @@ class _ChoDr(Estimator):
             self._end_standstill()
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        fix, lat, lon, vn, ve = (float(row[i]) for i in self._fix_cols)
+        fix, lat, lon, vn, ve, hdop = (float(row[i]) for i in self._fix_cols)
         if not (fix > 0 and math.isfinite(lat) and math.isfinite(vn)):
             return
         if self._still and math.hypot(vn, ve) > MOVE_SPEED_M_S:
@@ -331,21 +358,27 @@ class _ChoDr(Estimator):
         z = np.array([(math.radians(lat) - self._lat0) * self._rn,
                       (math.radians(lon) - self._lon0) * self._re * math.cos(self._lat0),
                       math.hypot(vn, ve)])  # eq. 18
-        self._update(z)
+        self._update(z, self._tuning.r(hdop))
 
     # -- output ----------------------------------------------------------------------------
     @property
     def _accel_index(self) -> int:
         return self._imu_columns.index("accel_x")
 
-    def _row(self, x: np.ndarray, p: np.ndarray, vn: float, ve: float,
-             pitch: float) -> list[float]:
-        """The navigation columns (NaN where not estimated), then std_n and std_e."""
+    def _row(self, x: np.ndarray, p: np.ndarray, vn: float, ve: float, pitch: float,
+             p_vel: np.ndarray) -> list[float]:
+        """The navigation columns (NaN where not estimated), then std_n, std_e, std_vn and
+        std_ve (``p_vel``: the 2 x 2 covariance of vn, ve)."""
         lat = self._lat0 + x[0] / self._rn
         lon = self._lon0 + x[1] / (self._re * math.cos(self._lat0))
         nan = math.nan
         return [math.degrees(lat), math.degrees(lon), nan, vn, ve, nan, nan, pitch,
-                float(wrap_angle(x[4])), math.sqrt(p[0, 0]), math.sqrt(p[1, 1])]
+                float(wrap_angle(x[4])), math.sqrt(p[0, 0]), math.sqrt(p[1, 1]),
+                math.sqrt(max(p_vel[0, 0], 0.0)), math.sqrt(max(p_vel[1, 1], 0.0))]
+
+    def _accel_bias(self, x: np.ndarray, axis: int) -> float:
+        """The estimated accelerometer bias of the ``axis``-th bias state (NaN without one)."""
+        return float(x[8 + axis]) if self._bias_states > axis else math.nan
 
 
 def _sf(d: float) -> float:
@@ -357,12 +390,12 @@ def _sf(d: float) -> float:
 class _Drm2(_ChoDr):
     """DRM2 model (eqs. 4-8, 14b)."""
 
+    _model = "drm2"
     _imu_columns = ("accel_x", "gyro_y", "gyro_z")
     _gyro_channels = (1, 2)
-    _p0, _q = P0_DRM2, Q_DRM2
-    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_pitch", "std_yaw",
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_vn", "std_ve", "std_pitch", "std_yaw",
                       "accel_scale_factor_x", "gyro_scale_factor_y", "gyro_scale_factor_z",
-                      "gyro_bias_y", "gyro_bias_z", "speed_h")
+                      "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "speed_h")
 
     def _initial_state(self) -> np.ndarray:
         init = self.initial
@@ -379,24 +412,28 @@ class _Drm2(_ChoDr):
 
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """h(x) = [P_N, P_E, V] for states (k, 8) and its (constant) Jacobian (eq. 16)."""
-        return x[:, :3], np.eye(3, 8)
+        return x[:, :3], np.eye(3, x.shape[1])
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
         v, th, psi = x[2], x[3], x[4]
-        return [*self._row(x, p, v * math.cos(psi), v * math.sin(psi), th),
+        c, s = math.cos(psi), math.sin(psi)
+        jac = np.array([[c, -v * s], [s, v * c]])  # (vn, ve) over (V, psi)
+        p_vel = jac @ p[np.ix_([2, 4], [2, 4])] @ jac.T
+        return [*self._row(x, p, v * c, v * s, th, p_vel),
                 math.sqrt(p[3, 3]), math.sqrt(p[4, 4]), _sf(x[5]), _sf(x[6]), _sf(x[7]),
-                self._bias[1], self._bias[2], v]
+                self._bias[1], self._bias[2], self._accel_bias(x, 0), v]
 
 
 class _Drm1(_ChoDr):
     """DRM1 model (eqs. 2-3)."""
 
+    _model = "drm1"
     _imu_columns = ("accel_x", "accel_y", "gyro_z")
     _gyro_channels = (2,)
-    _p0, _q = P0_DRM1, Q_DRM1
-    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "accel_scale_factor_x",
-                      "accel_scale_factor_y", "gyro_scale_factor_z", "gyro_bias_z")
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_vn", "std_ve", "std_yaw",
+                      "accel_scale_factor_x", "accel_scale_factor_y", "gyro_scale_factor_z",
+                      "gyro_bias_z", "accel_bias_x", "accel_bias_y")
 
     def _initial_state(self) -> np.ndarray:
         init = self.initial
@@ -413,7 +450,7 @@ class _Drm1(_ChoDr):
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """h(x) = [P_N, P_E, |V|] for states (k, 8) and its Jacobian at the first row."""
         speed = np.hypot(x[:, 2], x[:, 3])
-        h = np.zeros((3, 8))
+        h = np.zeros((3, x.shape[1]))
         h[0, 0] = h[1, 1] = 1.0
         if speed[0] > 0.0:
             h[2, 2:4] = x[0, 2:4] / speed[0]
@@ -421,8 +458,9 @@ class _Drm1(_ChoDr):
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
-        return [*self._row(x, p, x[2], x[3], math.nan), math.sqrt(p[4, 4]),
-                _sf(x[5]), _sf(x[6]), _sf(x[7]), self._bias[2]]
+        return [*self._row(x, p, x[2], x[3], math.nan, p[2:4, 2:4]), math.sqrt(p[4, 4]),
+                _sf(x[5]), _sf(x[6]), _sf(x[7]), self._bias[2], self._accel_bias(x, 0),
+                self._accel_bias(x, 1)]
 
 
 class _Ekf(_ChoDr):
@@ -437,11 +475,11 @@ class _Ekf(_ChoDr):
         self._x = self._transition(self._x[None, :], None, u, dt)[0]
         _, self._p = kf_predict(self._x, self._p, phi, self._q * dt)
 
-    def _update(self, z: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> None:
         zhat, h = self._measure(self._x[None, :])
         rows = [0, 1, 2] if h[2].any() else [0, 1]
         nu = z[rows] - zhat[0, rows]
-        self._x, self._p, _ = kf_update(self._x, self._p, nu, h[rows], R_GPS[np.ix_(rows, rows)])
+        self._x, self._p, _ = kf_update(self._x, self._p, nu, h[rows], r[np.ix_(rows, rows)])
         self._x[4] = wrap_angle(self._x[4])
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
@@ -473,34 +511,37 @@ class Drm2Spkf(_Drm2):
 
     name = "dr2d_drm2_spkf"
     paper = f"{PAPER}: DRM2 with the scaled simplex sigma-point filter (eqs. 19-32)"
-    defaults = {"standstill_calibration": True, "alpha": 0.3, "beta": 2.0, "w0": 0.0}
+    defaults = {"standstill_calibration": True, "tuning": "datasheet", "alpha": 0.3,
+                "beta": 2.0, "w0": 0.0, "sigma_set": "simplex"}
 
     def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
         checks = (("alpha", 1e-4 <= self.config["alpha"] <= 1.0, "must be in [1e-4, 1] (eq. 21)"),
                   ("w0", 0.0 <= self.config["w0"] < 1.0, "must be in [0, 1)"),
-                  ("beta", self.config["beta"] >= 0.0, "must not be negative"))
+                  ("beta", self.config["beta"] >= 0.0, "must not be negative"),
+                  ("sigma_set", self.config["sigma_set"] in SIGMA_SETS,
+                   f"must be one of {', '.join(SIGMA_SETS)}"))
         problems = [f"config key {key!r} of estimator {self.name} {rule}, got "
                     f"{self.config[key]!r}" for key, ok, rule in checks if not ok]
         if problems:
             raise InputError([Problem("config", None, "", p) for p in problems])
         plus, minus = angle_hooks([4])
-        self._ukf = SigmaPointFilter(x0, p0, points="simplex", alpha=self.config["alpha"],
+        self._ukf = SigmaPointFilter(x0, p0, points=self.config["sigma_set"],
+                                     alpha=self.config["alpha"],
                                      beta=self.config["beta"], w0=self.config["w0"],
                                      boxplus=plus, boxminus=minus, augment=True)
         self._since_draw = 0.0
-        self._q_draw = self._q * DRAW_INTERVAL_S
 
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         if self._since_draw >= DRAW_INTERVAL_S - 1e-9:
             self._ukf.covariance(redraw=True)  # eq. 26; the next propagation draws afresh
             self._since_draw = 0.0
-        self._ukf.propagate(self._transition, u, dt, q=self._q_draw)  # eqs. 22-25
+        self._ukf.propagate(self._transition, u, dt, q=self._q * DRAW_INTERVAL_S)  # eqs. 22-25
         self._since_draw += dt
 
-    def _update(self, z: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> None:
         if self._ukf.sigma is not None:
             self._ukf.covariance()  # eq. 26
-        self._ukf.update(lambda xs: self._measure(xs)[0], z, R_GPS)  # eqs. 27-32
+        self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
         self._since_draw = 0.0
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:

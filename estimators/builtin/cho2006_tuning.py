@@ -1,0 +1,173 @@
+"""Noise and initial uncertainty of the Cho & Choi 2006 filters (``estimators.builtin.cho2006``):
+the paper's printed values, or values derived from what a user knows.
+
+* ``paper_tuning``: P0, Q and R of eqs. 33-35 (R = 15 m per position axis and 0.3 m/s on the
+  speed, whatever the receiver reports); the reproduction of the paper uses these.
+* ``datasheet_tuning``: the default. The navigation states keep eq. 33's priors (a user without
+  a compass knows nothing of the heading; the paper's 50 m, 5 m/s and 10 deg pitch), and
+  everything else comes from the dataset's ``datasheet`` (docs/dataset-format.md):
+
+  - the sensor-error states: each scale factor's 1-sigma is the datasheet's ``scale_factor``
+    (eq. 33 gives 1, a 100 % error), each accelerometer bias's the datasheet's turn-on ``bias``
+    with its Gauss-Markov sigma and bias instability added in quadrature;
+  - Q: the angle and velocity random walks of the gyros' and accelerometers' ``noise_density``
+    (Groves 2013, section 4.4.3: the variance of the integrated white noise grows as N^2 t);
+    on the heading and pitch also the gyro bias left after the standstill calibration, the
+    calibration's own noise N / sqrt(T_still) with the datasheet's in-run instability, held
+    over ``BIAS_HOLD_S`` (its correlated growth b t counted as the random walk that reaches the
+    same spread then: q = b^2 T); on the accelerometer biases the datasheet's random walk and
+    instability (a Gauss-Markov bias of sigma s and time T drifts by 2 s^2 / T per second);
+  - R from each fix's own HDOP (``gnss_fix.hdop``): per horizontal axis HDOP sigma_UERE /
+    sqrt(2), sigma_UERE = sqrt(sis_error^2 + (MULTIPATH_ELEVATION_FACTOR multipath)^2) from the
+    receiver's datasheet (signal in space and code multipath; the Hatch filter leaves the
+    tracking noise a few centimetres), at least ``MIN_FIX_SIGMA_M``; the speed's 1-sigma
+    HDOP sigma_rate / sqrt(2) with the pseudorange-rate noise of an FLL at 40 dB-Hz
+    (``RATE_SIGMA_M_S``, scaled by the datasheet's ``tracking_noise``);
+  - the car's model errors (``vehicle`` in the datasheet, absent on a rigid body): the
+    forward-acceleration error of the planar model on a real body (surge and side slip,
+    ``CAR_ACCEL_SIGMA_M_S2``), and the pitch gyro's share of the yaw rate while the body rolls
+    in a turn (``CAR_PITCH_RATE_SIGMA``: w_z sin(roll) ~ 0.4 deg/s in a 0.4 g turn at 4 deg/g,
+    which DRM2's pitch, integrating the y gyro alone (eq. 24d), takes as pitch rate).
+
+Public names
+------------
+PAPER_P0, PAPER_Q, PAPER_R, Tuning, paper_tuning, datasheet_tuning, TUNINGS.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+DEG = math.pi / 180.0
+TUNINGS = ("datasheet", "paper")
+
+# eqs. 33-35. DRM2 state order [P_N, P_E, V, theta, psi, d_ax, d_gy, d_gz]; DRM1 (not printed)
+# [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], term by term
+PAPER_P0 = {
+    "drm2": np.diag([50.0**2, 50.0**2, 5.0**2, (10 * DEG) ** 2, (180 * DEG) ** 2, 1.0, 1.0, 1.0]),
+    "drm1": np.diag([50.0**2, 50.0**2, 5.0**2, 5.0**2, (180 * DEG) ** 2, 1.0, 1.0, 1.0]),
+}
+PAPER_Q = {
+    "drm2": np.diag([0.0, 0.0, 0.1**2, (0.1 * DEG) ** 2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0]),
+    "drm1": np.diag([0.0, 0.0, 0.1**2, 0.1**2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0]),
+}
+PAPER_R = np.diag([15.0**2, 15.0**2, 0.3**2])  # north, east (m), speed (m/s)
+
+BIAS_HOLD_S = 10.0  # s over which a residual gyro bias is counted as a random walk
+MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
+MIN_FIX_SIGMA_M = 0.1  # the smallest fix 1-sigma per axis believed
+RATE_SIGMA_M_S = 0.04  # pseudorange-rate noise at 40 dB-Hz, 2 Hz FLL (Kaplan & Hegarty eq. 8.37)
+MIN_SPEED_SIGMA_M_S = 0.01
+CAR_ACCEL_SIGMA_M_S2 = 0.05  # planar model's forward-acceleration error on a real body, 1 s
+CAR_PITCH_RATE_SIGMA = 0.2 * DEG  # rad/s, roll-induced pitch-rate error, held 1 s
+MIN_SCALE_SIGMA = 1e-4  # a scale-factor state's smallest prior (an ideal sensor's)
+MIN_BIAS_SIGMA = 1e-4  # m/s^2, an accelerometer-bias state's smallest prior
+
+
+@dataclass(frozen=True)
+class Tuning:
+    """P0 and Q (variance growth per second) of a filter's states, and its fix noise.
+
+    ``uere_m`` None means the fixed ``PAPER_R``; otherwise the fix's position variance per
+    axis is (HDOP uere_m)^2 / 2 and the speed's (HDOP speed_sigma_m_s)^2 / 2.
+    """
+
+    p0: np.ndarray
+    q: np.ndarray
+    uere_m: float | None = None
+    speed_sigma_m_s: float = 0.0
+
+    def r(self, hdop: float) -> np.ndarray:
+        """The 3 x 3 noise of a fix [north, east, speed] reporting ``hdop``."""
+        if self.uere_m is None or not math.isfinite(hdop):
+            return PAPER_R if self.uere_m is None else np.diag([1e6, 1e6, 1.0])
+        pos = max(hdop * self.uere_m / math.sqrt(2.0), MIN_FIX_SIGMA_M)
+        speed = max(hdop * self.speed_sigma_m_s / math.sqrt(2.0), MIN_SPEED_SIGMA_M_S)
+        return np.diag([pos**2, pos**2, speed**2])
+
+
+def paper_tuning(model: str) -> Tuning:
+    """Eqs. 33-35 for ``model`` ``"drm1"`` or ``"drm2"``."""
+    return Tuning(PAPER_P0[model].copy(), PAPER_Q[model].copy())
+
+
+def _axis(value: Any, axis: int) -> float:
+    """A datasheet parameter for one axis (x, y, z = 0, 1, 2): a number or a list of three."""
+    if value is None:
+        return 0.0
+    if isinstance(value, (list, tuple)):
+        return float(value[axis] or 0.0)
+    return float(value)
+
+
+def _bias_terms(group: Mapping[str, Any], axis: int) -> tuple[float, float]:
+    """Turn-on 1-sigma (bias, Gauss-Markov sigma, instability in quadrature) and the in-run
+    drift of the bias (variance growth per second) of one axis of an IMU datasheet group."""
+    turn_on = _axis(group.get("bias"), axis)
+    gm = _axis(group.get("gauss_markov_sigma"), axis)
+    gm_time = _axis(group.get("gauss_markov_correlation_time"), axis)
+    instability = _axis(group.get("bias_instability"), axis)
+    walk = _axis(group.get("random_walk"), axis)
+    sigma = math.sqrt(turn_on**2 + gm**2 + instability**2)
+    growth = walk**2 + (2.0 * gm**2 / gm_time if gm_time > 0.0 else 0.0)
+    growth += instability**2 / BIAS_HOLD_S
+    return sigma, growth
+
+
+def _gyro_rate_noise(gyro: Mapping[str, Any], axis: int, still_s: float) -> float:
+    """Variance growth per second of an angle integrated from one gyro axis whose bias was
+    calibrated over ``still_s`` seconds of standstill (module docstring)."""
+    density = _axis(gyro.get("noise_density"), axis)
+    instability = _axis(gyro.get("bias_instability"), axis)
+    gm = _axis(gyro.get("gauss_markov_sigma"), axis)
+    walk = _axis(gyro.get("random_walk"), axis)
+    calibration = density / math.sqrt(max(still_s, 1.0))
+    residual = calibration**2 + instability**2 + gm**2 + walk**2 * BIAS_HOLD_S
+    return density**2 + residual * BIAS_HOLD_S
+
+
+def _receiver(gnss: Mapping[str, Any]) -> tuple[float, float]:
+    """sigma_UERE (m) and the pseudorange-rate 1-sigma (m/s) of the receiver's datasheet."""
+    sis = float(gnss.get("sis_error") or 0.0)
+    multipath = float(gnss.get("multipath") or 0.0) * MULTIPATH_ELEVATION_FACTOR
+    uere = max(math.hypot(sis, multipath), MIN_FIX_SIGMA_M)
+    tracking = gnss.get("tracking_noise")
+    rate = RATE_SIGMA_M_S * (1.0 if tracking is None else float(tracking))
+    return uere, rate
+
+
+def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -> Tuning:
+    """The default tuning (module docstring) of ``model`` (``"drm1"``, ``"drm2"``) from a
+    manifest's ``datasheet``; the states are the paper's and the accelerometer biases (one for
+    DRM2's forward axis, two for DRM1) appended. ``still_s``: the initial standstill's length."""
+    imu = datasheet.get("imu") or {}
+    gyro, accel = imu.get("gyro") or {}, imu.get("accel") or {}
+    car = (datasheet.get("vehicle") or {}).get("preset", "rigid") != "rigid"
+    uere, rate = _receiver(datasheet.get("gnss") or {})
+    p0 = PAPER_P0[model].diagonal().copy()
+    q = np.zeros(8)
+    accel_axes = (0,) if model == "drm2" else (0, 1)
+    gyro_sf = (1, 2) if model == "drm2" else (2,)
+    car_accel = CAR_ACCEL_SIGMA_M_S2**2 if car else 0.0
+    if model == "drm2":
+        q[2] = _axis(accel.get("noise_density"), 0) ** 2 + car_accel
+        q[3] = _gyro_rate_noise(gyro, 1, still_s) + (CAR_PITCH_RATE_SIGMA**2 if car else 0.0)
+        p0[5] = max(_axis(accel.get("scale_factor"), 0), MIN_SCALE_SIGMA) ** 2
+    else:
+        q[2] = q[3] = max(_axis(accel.get("noise_density"), a) ** 2 for a in (0, 1)) + car_accel
+        p0[5] = max(_axis(accel.get("scale_factor"), 0), MIN_SCALE_SIGMA) ** 2
+        p0[6] = max(_axis(accel.get("scale_factor"), 1), MIN_SCALE_SIGMA) ** 2
+    q[4] = _gyro_rate_noise(gyro, 2, still_s)
+    for i in gyro_sf:
+        p0[5 + i] = max(_axis(gyro.get("scale_factor"), i), MIN_SCALE_SIGMA) ** 2
+    bias_p0, bias_q = [], []
+    for a in accel_axes:
+        sigma, growth = _bias_terms(accel, a)
+        bias_p0.append(max(sigma, MIN_BIAS_SIGMA) ** 2)
+        bias_q.append(growth)
+    return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate)
