@@ -83,7 +83,14 @@ import math
 import numpy as np
 
 from estimators.base import NAV_COLUMNS, Estimator
-from estimators.builtin.cho2006_tuning import TUNINGS, Tuning, datasheet_tuning, paper_tuning
+from estimators.builtin.cho2006_tuning import (
+    TUNINGS,
+    TURN_HOLD_S,
+    FixNoiseMatching,
+    Tuning,
+    datasheet_tuning,
+    paper_tuning,
+)
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
@@ -111,13 +118,15 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     vectors (the trapezoidal rule).
     """
     pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T[:8]
-    f_x, w_y, w_z = u
+    f_x, w_y, w_z = u[:3]
+    lat = u[3] if len(u) > 3 else 0.0  # lateral velocity of the IMU (m/s), 0 in the paper
     out = np.empty_like(x)
     f_h = (1.0 - d_ax) * f_x - (x[:, 8] if x.shape[1] > 8 else 0.0)  # eq. 14b (+ bias, eq. 9)
     v_new = v + (f_h - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
     psi_new = psi + (1.0 - d_gz) * w_z * dt  # eq. 24e
-    out[:, 0] = pn + 0.5 * (v * np.cos(psi) + v_new * np.cos(psi_new)) * dt  # eqs. 24a, 5
-    out[:, 1] = pe + 0.5 * (v * np.sin(psi) + v_new * np.sin(psi_new)) * dt  # eqs. 24b, 5
+    c0, s0, c1, s1 = np.cos(psi), np.sin(psi), np.cos(psi_new), np.sin(psi_new)
+    out[:, 0] = pn + 0.5 * (v * c0 - lat * s0 + v_new * c1 - lat * s1) * dt  # eqs. 24a, 5
+    out[:, 1] = pe + 0.5 * (v * s0 + lat * c0 + v_new * s1 + lat * c1) * dt  # eqs. 24b, 5
     out[:, 2] = v_new
     out[:, 3] = th + (1.0 - d_gy) * w_y * dt  # eq. 24d
     out[:, 4] = wrap_angle(psi_new)
@@ -132,7 +141,8 @@ def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarr
     """Transition matrix of ``drm2_transition`` at ``x`` (8,) (Cho & Choi eqs. 16-17, with the
     trapezoidal position step)."""
     _, _, v, th, psi, d_ax, d_gy, d_gz = x[:8]
-    f_x, w_y, w_z = u
+    f_x, w_y, w_z = u[:3]
+    lat = u[3] if len(u) > 3 else 0.0
     st, ct = math.sin(th), math.cos(th)
     f_h = (1.0 - d_ax) * f_x - (x[8] if x.size > 8 else 0.0)
     v_new = v + (f_h - g * st) * ct * dt
@@ -149,11 +159,11 @@ def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarr
     c0, s0, c1, s1 = math.cos(psi), math.sin(psi), math.cos(psi_new), math.sin(psi_new)
     half = 0.5 * dt
     phi[0, 2] += half * c0
-    phi[0, 4] -= half * v * s0
+    phi[0, 4] -= half * (v * s0 + lat * c0)
     phi[1, 2] += half * s0
-    phi[1, 4] += half * v * c0
-    phi[0] += half * (c1 * phi[2] - v_new * s1 * phi[4])
-    phi[1] += half * (s1 * phi[2] + v_new * c1 * phi[4])
+    phi[1, 4] += half * (v * c0 - lat * s0)
+    phi[0] += half * (c1 * phi[2] - (v_new * s1 + lat * c1) * phi[4])
+    phi[1] += half * (s1 * phi[2] + (v_new * c1 - lat * s1) * phi[4])
     return phi
 
 
@@ -252,6 +262,9 @@ class _ChoDr(Estimator):
         self._first_stop = self._still  # the initial standstill: calibrated however short
         self._odo_speed = self.columns.get("odometer", {}).get("speed")
         self._tuning = self._make_tuning(0.0)
+        self._lateral = 0.0  # the IMU's lateral velocity in the last step (DRM2 on a car)
+        datasheet = self.config["tuning"] == "datasheet"
+        self._matching = FixNoiseMatching() if datasheet else None
         x0 = self._initial_state()
         self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
                            self._tuning.p0.copy())
@@ -262,8 +275,12 @@ class _ChoDr(Estimator):
             return paper_tuning(self._model)
         return datasheet_tuning(self._model, self.datasheet, still_s)
 
-    @property
-    def _q(self) -> np.ndarray:
+    def _inputs(self, u: np.ndarray) -> np.ndarray:
+        """The model's inputs from the step's mean bias-compensated IMU inputs ``u``."""
+        return u
+
+    def _q_step(self, u: np.ndarray) -> np.ndarray:
+        """Q (variance growth per second) over a step with inputs ``u``."""
         return self._tuning.q
 
     @property
@@ -281,7 +298,9 @@ class _ChoDr(Estimator):
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         raise NotImplementedError
 
-    def _update(self, z: np.ndarray, r: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Update with the fix ``z`` [north, east, speed] and its noise ``r``; returns the
+        innovation and its covariance (position rows first)."""
         raise NotImplementedError
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
@@ -324,8 +343,7 @@ class _ChoDr(Estimator):
                 self._still_sum += u * dt
                 self._still_t += dt
                 return
-        u = u - self._bias
-        self._propagate(u, dt)
+        self._propagate(self._inputs(u - self._bias), dt)
 
     def _end_standstill(self) -> None:
         self._still = False
@@ -358,7 +376,13 @@ class _ChoDr(Estimator):
         z = np.array([(math.radians(lat) - self._lat0) * self._rn,
                       (math.radians(lon) - self._lon0) * self._re * math.cos(self._lat0),
                       math.hypot(vn, ve)])  # eq. 18
-        self._update(z, self._tuning.r(hdop))
+        r = self._tuning.r(hdop, self._matching.scale if self._matching else 1.0)
+        if self._lateral:  # the speed's share of the lateral velocity (``Drm2._measure``)
+            r[2, 2] += (0.5 * self._lateral**2 / max(abs(float(self._estimate()[0][2])),
+                                                     MOVE_SPEED_M_S)) ** 2
+        nu, s = self._update(z, r)
+        if self._matching is not None:
+            self._matching.add(nu[:2], s[:2, :2], r[:2, :2])
 
     # -- output ----------------------------------------------------------------------------
     @property
@@ -403,6 +427,28 @@ class _Drm2(_ChoDr):
         v = float(init.velocity[0] * math.cos(yaw) + init.velocity[1] * math.sin(yaw))
         return np.array([0.0, 0.0, v, float(init.attitude[1]), yaw, 0.0, 0.0, 0.0])
 
+    def _inputs(self, u: np.ndarray) -> np.ndarray:
+        """The pitch rate of a body rolling in a turn (datasheet tuning on a car): theta_dot =
+        w_y cos(roll) - w_z sin(roll), roll = -k V w_z (``cho2006_tuning``), so w_y + k V
+        w_z^2 to first order; eq. 24d integrates w_y alone."""
+        k, arm = self._tuning.roll_gradient, self._tuning.rear_axle_m
+        if not (k or arm):
+            return u
+        out = np.append(u, arm * u[2])  # the IMU's lateral velocity (``_measure``)
+        out[1] += k * self._estimate()[0][2] * u[2] ** 2
+        self._lateral = float(out[3])
+        return out
+
+    def _q_step(self, u: np.ndarray) -> np.ndarray:
+        """Q with the pitch-rate error of the unknown part of the roll (w_z sigma_roll, held
+        over a turn: ``cho2006_tuning.TURN_HOLD_S``)."""
+        sigma = self._tuning.roll_sigma
+        if not sigma:
+            return self._tuning.q
+        q = self._tuning.q.copy()
+        q[3, 3] += (u[2] * sigma) ** 2 * TURN_HOLD_S
+        return q
+
     def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
                     dt: float) -> np.ndarray:
         return drm2_transition(x, w, u, dt, self._g)
@@ -411,16 +457,19 @@ class _Drm2(_ChoDr):
         return drm2_jacobian(x, u, dt, self._g)
 
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """h(x) = [P_N, P_E, V] for states (k, 8) and its (constant) Jacobian (eq. 16)."""
+        """h(x) = [P_N, P_E, V] for states (k, n) and its (constant) Jacobian (eq. 16). With a
+        lateral velocity (datasheet tuning on a car) the GPS speed is sqrt(V^2 + lat^2), more
+        than V by lat^2 / (2 V): 0.08 m/s at 5 m/s in a 10 m turn, counted in R; the norm
+        itself would be blind to the sign of V and let the EKF settle on -V."""
         return x[:, :3], np.eye(3, x.shape[1])
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
-        v, th, psi = x[2], x[3], x[4]
+        v, th, psi, lat = x[2], x[3], x[4], self._lateral
         c, s = math.cos(psi), math.sin(psi)
-        jac = np.array([[c, -v * s], [s, v * c]])  # (vn, ve) over (V, psi)
+        jac = np.array([[c, -v * s - lat * c], [s, v * c - lat * s]])  # (vn, ve) / (V, psi)
         p_vel = jac @ p[np.ix_([2, 4], [2, 4])] @ jac.T
-        return [*self._row(x, p, v * c, v * s, th, p_vel),
+        return [*self._row(x, p, v * c - lat * s, v * s + lat * c, th, p_vel),
                 math.sqrt(p[3, 3]), math.sqrt(p[4, 4]), _sf(x[5]), _sf(x[6]), _sf(x[7]),
                 self._bias[1], self._bias[2], self._accel_bias(x, 0), v]
 
@@ -473,14 +522,15 @@ class _Ekf(_ChoDr):
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         phi = self._jacobian(self._x, u, dt)
         self._x = self._transition(self._x[None, :], None, u, dt)[0]
-        _, self._p = kf_predict(self._x, self._p, phi, self._q * dt)
+        _, self._p = kf_predict(self._x, self._p, phi, self._q_step(u) * dt)
 
-    def _update(self, z: np.ndarray, r: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         zhat, h = self._measure(self._x[None, :])
         rows = [0, 1, 2] if h[2].any() else [0, 1]
         nu = z[rows] - zhat[0, rows]
-        self._x, self._p, _ = kf_update(self._x, self._p, nu, h[rows], r[np.ix_(rows, rows)])
+        self._x, self._p, s = kf_update(self._x, self._p, nu, h[rows], r[np.ix_(rows, rows)])
         self._x[4] = wrap_angle(self._x[4])
+        return nu, s
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._x, self._p
@@ -535,14 +585,15 @@ class Drm2Spkf(_Drm2):
         if self._since_draw >= DRAW_INTERVAL_S - 1e-9:
             self._ukf.covariance(redraw=True)  # eq. 26; the next propagation draws afresh
             self._since_draw = 0.0
-        self._ukf.propagate(self._transition, u, dt, q=self._q * DRAW_INTERVAL_S)  # eqs. 22-25
+        self._ukf.propagate(self._transition, u, dt,  # eqs. 22-25
+                            q=self._q_step(u) * DRAW_INTERVAL_S)
         self._since_draw += dt
 
-    def _update(self, z: np.ndarray, r: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if self._ukf.sigma is not None:
             self._ukf.covariance()  # eq. 26
-        self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
         self._since_draw = 0.0
+        return self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._ukf.x, self._ukf.p

@@ -25,13 +25,19 @@ the paper's printed values, or values derived from what a user knows.
     (``RATE_SIGMA_M_S``, scaled by the datasheet's ``tracking_noise``);
   - the car's model errors (``vehicle`` in the datasheet, absent on a rigid body): the
     forward-acceleration error of the planar model on a real body (surge and side slip,
-    ``CAR_ACCEL_SIGMA_M_S2``), and the pitch gyro's share of the yaw rate while the body rolls
-    in a turn (``CAR_PITCH_RATE_SIGMA``: w_z sin(roll) ~ 0.4 deg/s in a 0.4 g turn at 4 deg/g,
-    which DRM2's pitch, integrating the y gyro alone (eq. 24d), takes as pitch rate).
+    ``CAR_ACCEL_SIGMA_M_S2``), and DRM2's body roll: its pitch integrates the y gyro alone
+    (eq. 24d), but a body rolled by phi pitches at w_y cos(phi) - w_z sin(phi) (ZYX Euler
+    rates); a car rolls out of a turn by ``ROLL_GRADIENT`` per lateral acceleration V w_z,
+    which DRM2 compensates (``Drm2._inputs``), and the rest of the roll (camber, the gradient's
+    spread, ``ROLL_SIGMA``) enters Q as w_z^2 ROLL_SIGMA^2 TURN_HOLD_S (it keeps its sign
+    through a turn). Uncompensated, a 0.3 g turn at 4.6 deg/g (landnav's automotive body)
+    leaks 1.4 deg of roll times the yaw rate into the pitch: 2.2 deg of pitch error per 90 deg
+    turn, always of the same sign, which the term g sin(theta) turns into speed error.
 
 Public names
 ------------
-PAPER_P0, PAPER_Q, PAPER_R, Tuning, paper_tuning, datasheet_tuning, TUNINGS.
+PAPER_P0, PAPER_Q, PAPER_R, TUNINGS, TURN_HOLD_S, Tuning, FixNoiseMatching, paper_tuning,
+datasheet_tuning.
 """
 
 from __future__ import annotations
@@ -42,6 +48,10 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from estimators.toolbox.gnss_model import correlated_noise_inflation
+from estimators.toolbox.installation import Installation
+from simulator.earth import G0_M_S2 as G0
 
 DEG = math.pi / 180.0
 TUNINGS = ("datasheet", "paper")
@@ -60,11 +70,17 @@ PAPER_R = np.diag([15.0**2, 15.0**2, 0.3**2])  # north, east (m), speed (m/s)
 
 BIAS_HOLD_S = 10.0  # s over which a residual gyro bias is counted as a random walk
 MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
+FIX_CORRELATION_S = 10.0  # s: a fix's error counted as correlated over this (module docstring)
+MATCHING_FIXES = 20.0  # fixes in the covariance-matching average (its e-folding length)
 MIN_FIX_SIGMA_M = 0.1  # the smallest fix 1-sigma per axis believed
 RATE_SIGMA_M_S = 0.04  # pseudorange-rate noise at 40 dB-Hz, 2 Hz FLL (Kaplan & Hegarty eq. 8.37)
 MIN_SPEED_SIGMA_M_S = 0.01
 CAR_ACCEL_SIGMA_M_S2 = 0.05  # planar model's forward-acceleration error on a real body, 1 s
-CAR_PITCH_RATE_SIGMA = 0.2 * DEG  # rad/s, roll-induced pitch-rate error, held 1 s
+ROLL_GRADIENT = 5.0 * DEG / G0  # rad per m/s^2: a passenger car's 3-7 deg/g (Gillespie 1992)
+ROLL_SIGMA = 1.5 * DEG  # rad: road camber (2 %, 1.15 deg) and the roll gradient's spread
+ROAD_SLOPE_SIGMA = 0.03  # rad: grade and bank of a road, which DRM1's level frame ignores
+ROAD_SLOPE_HOLD_S = 20.0  # s over which a road keeps its grade
+TURN_HOLD_S = 10.0  # s: a turn, over which a roll-induced pitch-rate error keeps its sign
 MIN_SCALE_SIGMA = 1e-4  # a scale-factor state's smallest prior (an ideal sensor's)
 MIN_BIAS_SIGMA = 1e-4  # m/s^2, an accelerometer-bias state's smallest prior
 
@@ -81,14 +97,41 @@ class Tuning:
     q: np.ndarray
     uere_m: float | None = None
     speed_sigma_m_s: float = 0.0
+    roll_gradient: float = 0.0  # rad per m/s^2 of lateral acceleration (0: no body roll)
+    roll_sigma: float = 0.0  # rad, the roll not explained by roll_gradient
+    rear_axle_m: float = 0.0  # m, the IMU ahead of the rear axle (its lateral velocity's arm)
 
-    def r(self, hdop: float) -> np.ndarray:
-        """The 3 x 3 noise of a fix [north, east, speed] reporting ``hdop``."""
+    def r(self, hdop: float, scale: float = 1.0) -> np.ndarray:
+        """The 3 x 3 noise of a fix [north, east, speed] reporting ``hdop``, the position's
+        variance times ``scale`` (``FixNoiseMatching``)."""
         if self.uere_m is None or not math.isfinite(hdop):
-            return PAPER_R if self.uere_m is None else np.diag([1e6, 1e6, 1.0])
+            return PAPER_R.copy() if self.uere_m is None else np.diag([1e6, 1e6, 1.0])
         pos = max(hdop * self.uere_m / math.sqrt(2.0), MIN_FIX_SIGMA_M)
         speed = max(hdop * self.speed_sigma_m_s / math.sqrt(2.0), MIN_SPEED_SIGMA_M_S)
-        return np.diag([pos**2, pos**2, speed**2])
+        return np.diag([scale * pos**2, scale * pos**2, speed**2])
+
+
+class FixNoiseMatching:
+    """Covariance matching of the fixes' position noise (Mehra 1972; Mohamed & Schwarz 1999,
+    "Adaptive Kalman filtering for INS/GPS", J. Geodesy 73): the fix's real variance per axis
+    is estimated as the running mean of nu^2 - (H P H^T) over the position rows (innovation
+    nu, predicted covariance H P H^T = S - R), and the HDOP-based variance is scaled up to it
+    (never down). A street canyon's reflected signals leave HDOP unchanged while the fixes
+    move by metres: without this the filter believes them to a metre."""
+
+    def __init__(self) -> None:
+        self.scale = 1.0
+        self._excess = 0.0  # running mean of the ratio (nu^2 - HPH^T) / R, per axis
+        self._weight = 0.0
+
+    def add(self, nu: np.ndarray, s: np.ndarray, r: np.ndarray) -> None:
+        """Learn from one update's position rows: innovations ``nu`` (2,), their covariance
+        ``s`` (2, 2) and the noise ``r`` (2, 2) the update used."""
+        hph = np.diag(s - r)
+        ratio = float(np.mean((nu**2 - hph) / np.diag(r))) * self.scale
+        self._weight = min(self._weight + 1.0, MATCHING_FIXES)
+        self._excess += (ratio - self._excess) / self._weight
+        self.scale = max(1.0, self._excess)
 
 
 def paper_tuning(model: str) -> Tuning:
@@ -135,7 +178,8 @@ def _receiver(gnss: Mapping[str, Any]) -> tuple[float, float]:
     """sigma_UERE (m) and the pseudorange-rate 1-sigma (m/s) of the receiver's datasheet."""
     sis = float(gnss.get("sis_error") or 0.0)
     multipath = float(gnss.get("multipath") or 0.0) * MULTIPATH_ELEVATION_FACTOR
-    uere = max(math.hypot(sis, multipath), MIN_FIX_SIGMA_M)
+    inflation = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)
+    uere = max(math.hypot(sis, multipath), MIN_FIX_SIGMA_M) * inflation
     tracking = gnss.get("tracking_noise")
     rate = RATE_SIGMA_M_S * (1.0 if tracking is None else float(tracking))
     return uere, rate
@@ -156,7 +200,7 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     car_accel = CAR_ACCEL_SIGMA_M_S2**2 if car else 0.0
     if model == "drm2":
         q[2] = _axis(accel.get("noise_density"), 0) ** 2 + car_accel
-        q[3] = _gyro_rate_noise(gyro, 1, still_s) + (CAR_PITCH_RATE_SIGMA**2 if car else 0.0)
+        q[3] = _gyro_rate_noise(gyro, 1, still_s)
         p0[5] = max(_axis(accel.get("scale_factor"), 0), MIN_SCALE_SIGMA) ** 2
     else:
         q[2] = q[3] = max(_axis(accel.get("noise_density"), a) ** 2 for a in (0, 1)) + car_accel
@@ -169,5 +213,10 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     for a in accel_axes:
         sigma, growth = _bias_terms(accel, a)
         bias_p0.append(max(sigma, MIN_BIAS_SIGMA) ** 2)
-        bias_q.append(growth)
-    return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate)
+        road = (G0 * ROAD_SLOPE_SIGMA) ** 2 / ROAD_SLOPE_HOLD_S if model == "drm1" else 0.0
+        bias_q.append(growth + road)
+    roll = model == "drm2" and car
+    rear = Installation.from_datasheet(datasheet).rear_axle
+    arm = float(-rear[0]) if roll and rear is not None else 0.0
+    return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate,
+                  ROLL_GRADIENT if roll else 0.0, ROLL_SIGMA if roll else 0.0, arm)
