@@ -81,6 +81,9 @@ ROLL_SIGMA = 1.5 * DEG  # rad: road camber (2 %, 1.15 deg) and the roll gradient
 ROAD_SLOPE_SIGMA = 0.03  # rad: grade and bank of a road, which DRM1's level frame ignores
 ROAD_SLOPE_HOLD_S = 20.0  # s over which a road keeps its grade
 TURN_HOLD_S = 10.0  # s: a turn, over which a roll-induced pitch-rate error keeps its sign
+# the model's own floor: the 10 Hz trapezoidal DR step's error with error-free sensors (eq. 24)
+MIN_ACCEL_NOISE = 0.01  # m/s^2/sqrt(Hz)
+MIN_GYRO_NOISE = 2e-5  # rad/s/sqrt(Hz)
 MIN_SCALE_SIGMA = 1e-4  # a scale-factor state's smallest prior (an ideal sensor's)
 MIN_BIAS_SIGMA = 1e-4  # m/s^2, an accelerometer-bias state's smallest prior
 
@@ -218,5 +221,8 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     roll = model == "drm2" and car
     rear = Installation.from_datasheet(datasheet).rear_axle
     arm = float(-rear[0]) if roll and rear is not None else 0.0
+    q[2:4] = np.maximum(q[2:4], MIN_ACCEL_NOISE**2 if model == "drm1" else
+                        [MIN_ACCEL_NOISE**2, MIN_GYRO_NOISE**2])
+    q[4] = max(q[4], MIN_GYRO_NOISE**2)
     return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate,
                   ROLL_GRADIENT if roll else 0.0, ROLL_SIGMA if roll else 0.0, arm)

@@ -263,3 +263,65 @@ def test_every_stop_recalibrates_a_drifting_gyro_bias(tmp_path, name):
     between = sol["gyro_bias_z"].to_numpy()[(t > 20.0) & (t < stopped[0])]
     assert np.allclose(between, first, atol=6e-5)
     assert sol["gyro_bias_z"].iloc[-1] == pytest.approx(second, abs=6e-5)
+
+
+# -- consistency of the default (datasheet) tuning -----------------------------------------
+
+CONSISTENCY_SEEDS = (1, 2, 3)
+AXES = {"n": ("err_n", "std_n"), "e": ("err_e", "std_e"), "vn": ("err_vn", "std_vn"),
+        "ve": ("err_ve", "std_ve"), "pitch": ("err_pitch", "std_pitch"),
+        "yaw": ("err_yaw", "std_yaw")}
+
+
+def _nse(ds: Dataset, solution) -> dict[str, float]:
+    """Per axis, the mean of (error / sigma)^2 from 60 s after the first row (SPEC section 8)."""
+    from simulator.scoring.align import solution_errors
+
+    e = solution_errors(ds.read("truth"), solution).errors
+    late = e[e["t"] >= e["t"].iloc[0] + 60.0]
+    return {axis: float(np.mean((late[err] / late[std]) ** 2))
+            for axis, (err, std) in AXES.items() if std in late}
+
+
+@pytest.fixture(scope="module")
+def consistency(root):
+    """nse per filter, seed and axis on situation II's road (Crossbow unit, 165 s), no
+    initial error, default tuning."""
+    out = {}
+    for seed in CONSISTENCY_SEEDS:
+        ds = _dataset("cho2006_situation2", seed, root / "consistency", ["estimators=[]"])
+        for name in ("dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
+            out[name, seed] = _nse(ds, _run(ds, name))
+    return out
+
+
+@pytest.mark.parametrize("name", ["dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"])
+def test_datasheet_tuning_is_never_overconfident_tenfold(consistency, name):
+    """No axis of any seed has a mean squared normalised error above 10 (measured at most 3.1,
+    DRM2's north on seed 2); 2-D filters write NaN height and roll (SPEC section 7)."""
+    for seed in CONSISTENCY_SEEDS:
+        nse = consistency[name, seed]
+        assert set(nse) >= {"n", "e", "vn", "ve", "yaw"}
+        assert all(value < 10.0 for value in nse.values()), (seed, nse)
+
+
+@pytest.mark.parametrize("name", ["dr2d_drm2_ekf", "dr2d_drm2_spkf"])
+def test_drm2_datasheet_tuning_is_consistent(consistency, name):
+    """Mean over the seeds within 0.3-3 on position, velocity and yaw (measured EKF: 1.7-2.4,
+    0.9-1.1, 1.1). Pitch is left out of the mean: it carries the forward accelerometer's bias
+    (the two are one unobservable combination, eq. 11), so each seed's pitch error is one
+    draw of that bias over g and three seeds do not pin its mean (measured 0.0-0.4 per seed
+    against a sigma of 1.7 deg from the 30 mg datasheet bias)."""
+    for axis in ("n", "e", "vn", "ve", "yaw"):
+        mean = np.mean([consistency[name, seed][axis] for seed in CONSISTENCY_SEEDS])
+        assert 0.3 < mean < 3.0, (axis, mean)
+
+
+@pytest.mark.xfail(strict=True, reason="DRM1's velocity is ten times too cautious on this road: "
+                   "its accelerometer-bias states take the road's grade and bank as a random "
+                   "walk, and the road here is level most of the time "
+                   "(docs/reproduction_cho2006.md)")
+def test_drm1_datasheet_tuning_velocity_is_consistent(consistency):
+    for axis in ("vn", "ve"):
+        mean = np.mean([consistency["dr2d_drm1_ekf", seed][axis] for seed in CONSISTENCY_SEEDS])
+        assert 0.3 < mean < 3.0, (axis, mean)
