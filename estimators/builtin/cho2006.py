@@ -84,12 +84,14 @@ import numpy as np
 
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.builtin.cho2006_tuning import (
+    LATERAL_HOLD_S,
     TUNINGS,
     TURN_HOLD_S,
     FixNoiseMatching,
     Tuning,
     datasheet_tuning,
     paper_tuning,
+    stopped_speed_sigma,
 )
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
@@ -105,6 +107,7 @@ MOVE_SPEED_M_S = 0.5  # GPS speed that ends the initial standstill
 MIN_STOP_S = 2.0  # shortest stop whose gyro average replaces the calibration
 STOPPED_M_S = 1e-3  # odometer speed read as a stopped wheel (below any encoder's resolution)
 MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
+ALIGNED_HEADING_VAR = (30.0 * math.pi / 180.0) ** 2  # rad^2: heading found (zero-speed update)
 DEG = math.pi / 180.0
 SIGMA_SETS = ("simplex", "symmetric")  # the SPKF's point sets (estimators.toolbox.sigma_points)
 
@@ -233,6 +236,7 @@ class _ChoDr(Estimator):
     defaults = {"standstill_calibration": True, "tuning": "datasheet"}
     # set by the model
     _model = ""  # "drm1" or "drm2" (cho2006_tuning)
+    _velocity_states: tuple[int, ...] = ()  # the states of the velocity (zero at a stop)
     _imu_columns: tuple[str, str, str] = ("", "", "")
     _gyro_channels: tuple[int, ...] = ()  # which of the three inputs are gyros
 
@@ -263,8 +267,10 @@ class _ChoDr(Estimator):
         self._odo_speed = self.columns.get("odometer", {}).get("speed")
         self._tuning = self._make_tuning(0.0)
         self._lateral = 0.0  # the IMU's lateral velocity in the last step (DRM2 on a car)
+        self._lateral_var = 0.0  # its error variance, (m/s)^2
         datasheet = self.config["tuning"] == "datasheet"
         self._matching = FixNoiseMatching() if datasheet else None
+        self._stop_sigma = stopped_speed_sigma(self.datasheet)
         x0 = self._initial_state()
         self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
                            self._tuning.p0.copy())
@@ -301,6 +307,10 @@ class _ChoDr(Estimator):
     def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Update with the fix ``z`` [north, east, speed] and its noise ``r``; returns the
         innovation and its covariance (position rows first)."""
+        raise NotImplementedError
+
+    def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
+        """Update with a direct measurement ``z`` of the states ``index`` with noise ``r``."""
         raise NotImplementedError
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
@@ -360,7 +370,16 @@ class _ChoDr(Estimator):
         stopped = abs(float(row[self._odo_speed])) < STOPPED_M_S
         if stopped and not self._still and self.config["standstill_calibration"]:
             self._step()  # the motion up to the stop
+            p = self._estimate()[1]
+            if self._matching is not None and p[4, 4] < ALIGNED_HEADING_VAR:
+                # datasheet tuning: the wheel reads below its cut-off speed (not before the
+                # heading is found: the SPKF's points still span half a turn then, and the
+                # covariance formed from them to update loses its definiteness)
+                index = list(self._velocity_states)
+                self._linear_update(index, np.zeros(len(index)),
+                                    np.eye(len(index)) * self._stop_sigma**2)
             self._still = True
+            self._lateral = self._lateral_var = 0.0
             self._still_sum[:] = 0.0
             self._still_t = 0.0
         elif not stopped and self._still:
@@ -415,6 +434,7 @@ class _Drm2(_ChoDr):
     """DRM2 model (eqs. 4-8, 14b)."""
 
     _model = "drm2"
+    _velocity_states = (2,)
     _imu_columns = ("accel_x", "gyro_y", "gyro_z")
     _gyro_channels = (1, 2)
     output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_vn", "std_ve", "std_pitch", "std_yaw",
@@ -437,6 +457,7 @@ class _Drm2(_ChoDr):
         out = np.append(u, arm * u[2])  # the IMU's lateral velocity (``_measure``)
         out[1] += k * self._estimate()[0][2] * u[2] ** 2
         self._lateral = float(out[3])
+        self._lateral_var = self._tuning.lateral_variance(self._lateral)
         return out
 
     def _q_step(self, u: np.ndarray) -> np.ndarray:
@@ -447,6 +468,8 @@ class _Drm2(_ChoDr):
             return self._tuning.q
         q = self._tuning.q.copy()
         q[3, 3] += (u[2] * sigma) ** 2 * TURN_HOLD_S
+        q[0, 0] += self._lateral_var * LATERAL_HOLD_S  # the lateral velocity's error
+        q[1, 1] += self._lateral_var * LATERAL_HOLD_S
         return q
 
     def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
@@ -468,7 +491,9 @@ class _Drm2(_ChoDr):
         v, th, psi, lat = x[2], x[3], x[4], self._lateral
         c, s = math.cos(psi), math.sin(psi)
         jac = np.array([[c, -v * s - lat * c], [s, v * c - lat * s]])  # (vn, ve) / (V, psi)
-        p_vel = jac @ p[np.ix_([2, 4], [2, 4])] @ jac.T
+        across = np.array([-s, c])
+        p_vel = jac @ p[np.ix_([2, 4], [2, 4])] @ jac.T + self._lateral_var * np.outer(across,
+                                                                                      across)
         return [*self._row(x, p, v * c - lat * s, v * s + lat * c, th, p_vel),
                 math.sqrt(p[3, 3]), math.sqrt(p[4, 4]), _sf(x[5]), _sf(x[6]), _sf(x[7]),
                 self._bias[1], self._bias[2], self._accel_bias(x, 0), v]
@@ -478,6 +503,7 @@ class _Drm1(_ChoDr):
     """DRM1 model (eqs. 2-3)."""
 
     _model = "drm1"
+    _velocity_states = (2, 3)
     _imu_columns = ("accel_x", "accel_y", "gyro_z")
     _gyro_channels = (2,)
     output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_vn", "std_ve", "std_yaw",
@@ -531,6 +557,10 @@ class _Ekf(_ChoDr):
         self._x, self._p, s = kf_update(self._x, self._p, nu, h[rows], r[np.ix_(rows, rows)])
         self._x[4] = wrap_angle(self._x[4])
         return nu, s
+
+    def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
+        h = np.eye(len(self._x))[index]
+        self._x, self._p, _ = kf_update(self._x, self._p, z - self._x[index], h, r)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._x, self._p
@@ -594,6 +624,16 @@ class Drm2Spkf(_Drm2):
             self._ukf.covariance()  # eq. 26
         self._since_draw = 0.0
         return self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
+
+    def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
+        """A measurement linear in the states: the Kalman update itself (the points would
+        only approximate it); the next propagation draws fresh points."""
+        if self._ukf.sigma is not None:
+            self._ukf.covariance(redraw=True)
+        self._since_draw = 0.0
+        h = np.eye(len(self._ukf.x))[index]
+        self._ukf.x, self._ukf.p, _ = kf_update(self._ukf.x, self._ukf.p,
+                                                z - self._ukf.x[index], h, r)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._ukf.x, self._ukf.p

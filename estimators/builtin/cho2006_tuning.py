@@ -37,7 +37,7 @@ the paper's printed values, or values derived from what a user knows.
 Public names
 ------------
 PAPER_P0, PAPER_Q, PAPER_R, TUNINGS, TURN_HOLD_S, Tuning, FixNoiseMatching, paper_tuning,
-datasheet_tuning.
+datasheet_tuning, stopped_speed_sigma.
 """
 
 from __future__ import annotations
@@ -80,7 +80,10 @@ ROLL_GRADIENT = 5.0 * DEG / G0  # rad per m/s^2: a passenger car's 3-7 deg/g (Gi
 ROLL_SIGMA = 1.5 * DEG  # rad: road camber (2 %, 1.15 deg) and the roll gradient's spread
 ROAD_SLOPE_SIGMA = 0.03  # rad: grade and bank of a road, which DRM1's level frame ignores
 ROAD_SLOPE_HOLD_S = 20.0  # s over which a road keeps its grade
-TURN_HOLD_S = 10.0  # s: a turn, over which a roll-induced pitch-rate error keeps its sign
+TURN_HOLD_S = 10.0
+LATERAL_FRACTION = 0.5  # the lateral velocity's error in a turn's transient, share of it
+LATERAL_HOLD_S = 1.0  # s over which that error keeps its sign
+DR_RATE_HZ = 10.0  # the filters' DR rate (cho2006.DR_STEP_S)
 # the model's own floor: the 10 Hz trapezoidal DR step's error with error-free sensors (eq. 24)
 MIN_ACCEL_NOISE = 0.01  # m/s^2/sqrt(Hz)
 MIN_GYRO_NOISE = 2e-5  # rad/s/sqrt(Hz)
@@ -103,6 +106,12 @@ class Tuning:
     roll_gradient: float = 0.0  # rad per m/s^2 of lateral acceleration (0: no body roll)
     roll_sigma: float = 0.0  # rad, the roll not explained by roll_gradient
     rear_axle_m: float = 0.0  # m, the IMU ahead of the rear axle (its lateral velocity's arm)
+    lateral_noise_m_s: float = 0.0  # the gyro noise's share of the lateral velocity, 1-sigma
+
+    def lateral_variance(self, lateral_m_s: float) -> float:
+        """Error variance of the IMU's lateral velocity ``lateral_m_s`` = arm w_z: the gyro's
+        noise over a DR step and ``LATERAL_FRACTION`` of it (module docstring)."""
+        return self.lateral_noise_m_s**2 + (LATERAL_FRACTION * lateral_m_s) ** 2
 
     def r(self, hdop: float, scale: float = 1.0) -> np.ndarray:
         """The 3 x 3 noise of a fix [north, east, speed] reporting ``hdop``, the position's
@@ -224,5 +233,18 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     q[2:4] = np.maximum(q[2:4], MIN_ACCEL_NOISE**2 if model == "drm1" else
                         [MIN_ACCEL_NOISE**2, MIN_GYRO_NOISE**2])
     q[4] = max(q[4], MIN_GYRO_NOISE**2)
+    lateral_noise = arm * _axis(gyro.get("noise_density"), 2) * math.sqrt(DR_RATE_HZ)
     return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate,
-                  ROLL_GRADIENT if roll else 0.0, ROLL_SIGMA if roll else 0.0, arm)
+                  ROLL_GRADIENT if roll else 0.0, ROLL_SIGMA if roll else 0.0, arm, lateral_noise)
+
+
+def stopped_speed_sigma(datasheet: Mapping[str, Any]) -> float:
+    """1-sigma of the speed when the odometer reads zero: the reading's cut-off (its
+    ``min_speed``, its ``speed_resolution``, or one tick per output interval,
+    rate / ticks_per_meter), the true speed uniform below it (cut-off / sqrt(3));
+    ``MIN_SPEED_SIGMA_M_S`` without an odometer datasheet."""
+    odo = datasheet.get("odometer") or {}
+    ticks, rate = float(odo.get("ticks_per_meter") or 0.0), float(odo.get("rate") or 0.0)
+    cut = max(float(odo.get("min_speed") or 0.0), float(odo.get("speed_resolution") or 0.0),
+              rate / ticks if ticks > 0.0 else 0.0)
+    return max(cut / math.sqrt(3.0), MIN_SPEED_SIGMA_M_S)
