@@ -93,6 +93,7 @@ from estimators.builtin.cho2006_tuning import (
     paper_tuning,
     stopped_speed_sigma,
 )
+from estimators.toolbox.gating import chi2_threshold, normalised_innovation_squared
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
@@ -107,6 +108,7 @@ MOVE_SPEED_M_S = 0.5  # GPS speed that ends the initial standstill
 MIN_STOP_S = 2.0  # shortest stop whose gyro average replaces the calibration
 STOPPED_M_S = 1e-3  # odometer speed read as a stopped wheel (below any encoder's resolution)
 MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
+GATE_PROBABILITY = 0.999  # a fix beyond this chi-square quantile is weighted down to it
 ALIGNED_HEADING_VAR = (30.0 * math.pi / 180.0) ** 2  # rad^2: heading found (zero-speed update)
 DEG = math.pi / 180.0
 SIGMA_SETS = ("simplex", "symmetric")  # the SPKF's point sets (estimators.toolbox.sigma_points)
@@ -316,6 +318,10 @@ class _ChoDr(Estimator):
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
 
+    def _predicted(self) -> tuple[np.ndarray, np.ndarray]:
+        """The state and covariance predicted to now (before an update)."""
+        return self._estimate()
+
     # -- messages --------------------------------------------------------------------------
     def on_imu(self, t: float, row: np.ndarray) -> None:
         dt = t - self._t_imu
@@ -399,9 +405,17 @@ class _ChoDr(Estimator):
         if self._lateral:  # the speed's share of the lateral velocity (``Drm2._measure``)
             r[2, 2] += (0.5 * self._lateral**2 / max(abs(float(self._estimate()[0][2])),
                                                      MOVE_SPEED_M_S)) ** 2
-        nu, s = self._update(z, r)
-        if self._matching is not None:
-            self._matching.add(nu[:2], s[:2, :2], r[:2, :2])
+        if self._matching is None:
+            self._update(z, r)
+            return
+        x, p = self._predicted()
+        hph, nu = p[:2, :2], z[:2] - x[:2]
+        d2 = normalised_innovation_squared(nu, hph + r[:2, :2])
+        gate = chi2_threshold(2, GATE_PROBABILITY)
+        if d2 > gate and p[4, 4] < ALIGNED_HEADING_VAR:
+            r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
+        self._update(z, r)
+        self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
 
     # -- output ----------------------------------------------------------------------------
     @property
@@ -636,4 +650,9 @@ class Drm2Spkf(_Drm2):
                                                 z - self._ukf.x[index], h, r)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._ukf.x, self._ukf.p
+
+    def _predicted(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._ukf.sigma is not None:
+            self._ukf.covariance()  # eq. 26, from the propagated points (kept for the update)
         return self._ukf.x, self._ukf.p

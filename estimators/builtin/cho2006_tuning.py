@@ -71,6 +71,7 @@ PAPER_R = np.diag([15.0**2, 15.0**2, 0.3**2])  # north, east (m), speed (m/s)
 BIAS_HOLD_S = 10.0  # s over which a residual gyro bias is counted as a random walk
 MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
 FIX_CORRELATION_S = 10.0  # s: a fix's error counted as correlated over this (module docstring)
+FIX_INFLATION = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)  # on a 1 Hz fix's sigma
 MATCHING_FIXES = 20.0  # fixes in the covariance-matching average (its e-folding length)
 MIN_FIX_SIGMA_M = 0.1  # the smallest fix 1-sigma per axis believed
 RATE_SIGMA_M_S = 0.04  # pseudorange-rate noise at 40 dB-Hz, 2 Hz FLL (Kaplan & Hegarty eq. 8.37)
@@ -96,7 +97,8 @@ class Tuning:
     """P0 and Q (variance growth per second) of a filter's states, and its fix noise.
 
     ``uere_m`` None means the fixed ``PAPER_R``; otherwise the fix's position variance per
-    axis is (HDOP uere_m)^2 / 2 and the speed's (HDOP speed_sigma_m_s)^2 / 2.
+    axis is (HDOP uere_m)^2 / 2 (``white_position_var``), times the covariance-matching scale
+    and the correlation inflation squared, and the speed's (HDOP speed_sigma_m_s)^2 / 2.
     """
 
     p0: np.ndarray
@@ -113,21 +115,26 @@ class Tuning:
         noise over a DR step and ``LATERAL_FRACTION`` of it (module docstring)."""
         return self.lateral_noise_m_s**2 + (LATERAL_FRACTION * lateral_m_s) ** 2
 
+    def white_position_var(self, hdop: float) -> float:
+        """The position variance per axis of a fix reporting ``hdop``, as if its errors were
+        independent between fixes (m^2)."""
+        return max(hdop * (self.uere_m or 0.0) / math.sqrt(2.0), MIN_FIX_SIGMA_M) ** 2
+
     def r(self, hdop: float, scale: float = 1.0) -> np.ndarray:
         """The 3 x 3 noise of a fix [north, east, speed] reporting ``hdop``, the position's
         variance times ``scale`` (``FixNoiseMatching``)."""
         if self.uere_m is None or not math.isfinite(hdop):
             return PAPER_R.copy() if self.uere_m is None else np.diag([1e6, 1e6, 1.0])
-        pos = max(hdop * self.uere_m / math.sqrt(2.0), MIN_FIX_SIGMA_M)
+        pos = self.white_position_var(hdop) * scale * FIX_INFLATION**2
         speed = max(hdop * self.speed_sigma_m_s / math.sqrt(2.0), MIN_SPEED_SIGMA_M_S)
-        return np.diag([scale * pos**2, scale * pos**2, speed**2])
+        return np.diag([pos, pos, speed**2])
 
 
 class FixNoiseMatching:
     """Covariance matching of the fixes' position noise (Mehra 1972; Mohamed & Schwarz 1999,
     "Adaptive Kalman filtering for INS/GPS", J. Geodesy 73): the fix's real variance per axis
     is estimated as the running mean of nu^2 - (H P H^T) over the position rows (innovation
-    nu, predicted covariance H P H^T = S - R), and the HDOP-based variance is scaled up to it
+    nu, predicted covariance H P H^T), and the HDOP-based variance is scaled up to it
     (never down). A street canyon's reflected signals leave HDOP unchanged while the fixes
     move by metres: without this the filter believes them to a metre."""
 
@@ -136,11 +143,11 @@ class FixNoiseMatching:
         self._excess = 0.0  # running mean of the ratio (nu^2 - HPH^T) / R, per axis
         self._weight = 0.0
 
-    def add(self, nu: np.ndarray, s: np.ndarray, r: np.ndarray) -> None:
-        """Learn from one update's position rows: innovations ``nu`` (2,), their covariance
-        ``s`` (2, 2) and the noise ``r`` (2, 2) the update used."""
-        hph = np.diag(s - r)
-        ratio = float(np.mean((nu**2 - hph) / np.diag(r))) * self.scale
+    def add(self, nu: np.ndarray, hph: np.ndarray, white_var: float) -> None:
+        """Learn from one fix's position rows: innovations ``nu`` (2,), the predicted
+        covariance ``hph`` (2, 2) and the fix's HDOP variance per axis ``white_var``
+        (``Tuning.white_position_var``)."""
+        ratio = float(np.mean(nu**2 - np.diag(hph))) / white_var
         self._weight = min(self._weight + 1.0, MATCHING_FIXES)
         self._excess += (ratio - self._excess) / self._weight
         self.scale = max(1.0, self._excess)
@@ -190,8 +197,7 @@ def _receiver(gnss: Mapping[str, Any]) -> tuple[float, float]:
     """sigma_UERE (m) and the pseudorange-rate 1-sigma (m/s) of the receiver's datasheet."""
     sis = float(gnss.get("sis_error") or 0.0)
     multipath = float(gnss.get("multipath") or 0.0) * MULTIPATH_ELEVATION_FACTOR
-    inflation = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)
-    uere = max(math.hypot(sis, multipath), MIN_FIX_SIGMA_M) * inflation
+    uere = max(math.hypot(sis, multipath), MIN_FIX_SIGMA_M)
     tracking = gnss.get("tracking_noise")
     rate = RATE_SIGMA_M_S * (1.0 if tracking is None else float(tracking))
     return uere, rate
