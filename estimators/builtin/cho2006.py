@@ -107,6 +107,7 @@ MOVE_ACCEL_M_S2 = 0.2  # forward specific-force change that ends the initial sta
 MOVE_SPEED_M_S = 0.5  # GPS speed that ends the initial standstill
 MIN_STOP_S = 2.0  # shortest stop whose gyro average replaces the calibration
 STOPPED_M_S = 1e-3  # odometer speed read as a stopped wheel (below any encoder's resolution)
+STOPPED_SIGMA_M_S = 0.01  # speed 1-sigma of a car whose wheel has read zero for MIN_STOP_S
 MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
 GATE_PROBABILITY = 0.999  # a fix beyond this chi-square quantile is weighted down to it
 ALIGNED_HEADING_VAR = (30.0 * math.pi / 180.0) ** 2  # rad^2: heading found (zero-speed update)
@@ -273,6 +274,7 @@ class _ChoDr(Estimator):
         datasheet = self.config["tuning"] == "datasheet"
         self._matching = FixNoiseMatching() if datasheet else None
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
+        self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
         x0 = self._initial_state()
         self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
                            self._tuning.p0.copy())
@@ -314,6 +316,14 @@ class _ChoDr(Estimator):
     def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
         """Update with a direct measurement ``z`` of the states ``index`` with noise ``r``."""
         raise NotImplementedError
+
+    def _zero_velocity(self, sigma: float) -> None:
+        """The velocity states measured as zero with 1-sigma ``sigma`` (m/s), once the heading
+        is found (before, the SPKF's points span half a turn, and the covariance formed from
+        them for an update loses its definiteness)."""
+        if self._estimate()[1][4, 4] < ALIGNED_HEADING_VAR:
+            index = list(self._velocity_states)
+            self._linear_update(index, np.zeros(len(index)), np.eye(len(index)) * sigma**2)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
@@ -358,11 +368,14 @@ class _ChoDr(Estimator):
             else:
                 self._still_sum += u * dt
                 self._still_t += dt
+                if self._odo_stop and self._still_t >= MIN_STOP_S:
+                    self._zero_velocity(STOPPED_SIGMA_M_S)  # the wheel has stayed still
+                    self._odo_stop = False
                 return
         self._propagate(self._inputs(u - self._bias), dt)
 
     def _end_standstill(self) -> None:
-        self._still = False
+        self._still = self._odo_stop = False
         if self._still_t > 0.0 and (self._first_stop or self._still_t >= MIN_STOP_S):
             mean = self._still_sum / self._still_t
             for i in self._gyro_channels:
@@ -376,14 +389,9 @@ class _ChoDr(Estimator):
         stopped = abs(float(row[self._odo_speed])) < STOPPED_M_S
         if stopped and not self._still and self.config["standstill_calibration"]:
             self._step()  # the motion up to the stop
-            p = self._estimate()[1]
-            if self._matching is not None and p[4, 4] < ALIGNED_HEADING_VAR:
-                # datasheet tuning: the wheel reads below its cut-off speed (not before the
-                # heading is found: the SPKF's points still span half a turn then, and the
-                # covariance formed from them to update loses its definiteness)
-                index = list(self._velocity_states)
-                self._linear_update(index, np.zeros(len(index)),
-                                    np.eye(len(index)) * self._stop_sigma**2)
+            self._odo_stop = self._matching is not None  # datasheet tuning (module docstring)
+            if self._odo_stop:
+                self._zero_velocity(self._stop_sigma)
             self._still = True
             self._lateral = self._lateral_var = 0.0
             self._still_sum[:] = 0.0
