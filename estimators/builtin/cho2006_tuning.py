@@ -70,7 +70,7 @@ PAPER_R = np.diag([15.0**2, 15.0**2, 0.3**2])  # north, east (m), speed (m/s)
 
 BIAS_HOLD_S = 10.0  # s over which a residual gyro bias is counted as a random walk
 MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
-FIX_CORRELATION_S = 10.0  # s: a fix's error counted as correlated over this (module docstring)
+FIX_CORRELATION_S = 30.0  # s: a fix's error counted as correlated over this (module docstring)
 FIX_INFLATION = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)  # on a 1 Hz fix's sigma
 MATCHING_FIXES = 20.0  # fixes in the covariance-matching average (its e-folding length)
 MIN_FIX_SIGMA_M = 0.1  # the smallest fix 1-sigma per axis believed
@@ -78,11 +78,11 @@ RATE_SIGMA_M_S = 0.04  # pseudorange-rate noise at 40 dB-Hz, 2 Hz FLL (Kaplan & 
 MIN_SPEED_SIGMA_M_S = 0.01
 CAR_ACCEL_SIGMA_M_S2 = 0.05  # planar model's forward-acceleration error on a real body, 1 s
 ROLL_GRADIENT = 5.0 * DEG / G0  # rad per m/s^2: a passenger car's 3-7 deg/g (Gillespie 1992)
-ROLL_SIGMA = 1.5 * DEG  # rad: road camber (2 %, 1.15 deg) and the roll gradient's spread
+ROLL_SIGMA = 0.75 * DEG  # rad: the roll gradient's spread and the camber's net share
 ROAD_SLOPE_SIGMA = 0.03  # rad: grade and bank of a road, which DRM1's level frame ignores
 ROAD_SLOPE_HOLD_S = 20.0  # s over which a road keeps its grade
 TURN_HOLD_S = 10.0
-LATERAL_FRACTION = 0.5  # the lateral velocity's error in a turn's transient, share of it
+LATERAL_FRACTION = 1.0  # the lateral velocity's error in a turn's transient, share of it
 LATERAL_HOLD_S = 1.0  # s over which that error keeps its sign
 DR_RATE_HZ = 10.0  # the filters' DR rate (cho2006.DR_STEP_S)
 # the model's own floor: the 10 Hz trapezoidal DR step's error with error-free sensors (eq. 24)
