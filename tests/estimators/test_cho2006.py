@@ -27,6 +27,7 @@ from simulator.reproduce.measures import moving_off
 from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from simulator.scenario import Scenario, validate_data
+from simulator.scoring.align import solution_errors
 from tests.synthetic import FLAT_LOOP
 
 SEEDS = range(1, 11)
@@ -275,8 +276,6 @@ AXES = {"n": ("err_n", "std_n"), "e": ("err_e", "std_e"), "vn": ("err_vn", "std_
 
 def _nse(ds: Dataset, solution) -> dict[str, float]:
     """Per axis, the mean of (error / sigma)^2 from 60 s after the first row (SPEC section 8)."""
-    from simulator.scoring.align import solution_errors
-
     e = solution_errors(ds.read("truth"), solution).errors
     late = e[e["t"] >= e["t"].iloc[0] + 60.0]
     return {axis: float(np.mean((late[err] / late[std]) ** 2))
@@ -297,8 +296,8 @@ def consistency(root):
 
 @pytest.mark.parametrize("name", ["dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"])
 def test_datasheet_tuning_is_never_overconfident_tenfold(consistency, name):
-    """No axis of any seed has a mean squared normalised error above 10 (measured at most 3.1,
-    DRM2's north on seed 2); 2-D filters write NaN height and roll (SPEC section 7)."""
+    """No axis of any seed has a mean squared normalised error above 10 (measured at most 2.2,
+    DRM2's yaw on seed 1); 2-D filters write NaN height and roll (SPEC section 7)."""
     for seed in CONSISTENCY_SEEDS:
         nse = consistency[name, seed]
         assert set(nse) >= {"n", "e", "vn", "ve", "yaw"}
@@ -307,9 +306,10 @@ def test_datasheet_tuning_is_never_overconfident_tenfold(consistency, name):
 
 @pytest.mark.parametrize("name", ["dr2d_drm2_ekf", "dr2d_drm2_spkf"])
 def test_drm2_datasheet_tuning_is_consistent(consistency, name):
-    """Mean over the seeds within 0.3-3 on position, velocity and yaw (measured EKF: 1.7-2.4,
-    0.9-1.1, 1.1). Pitch is left out of the mean: it carries the forward accelerometer's bias
-    (the two are one unobservable combination, eq. 11), so each seed's pitch error is one
+    """Mean over the seeds within 0.3-3 on position, velocity and yaw (measured EKF: north
+    1.19, east 0.88, velocity 1.16 and 1.03, yaw 1.18). Pitch is left out of the mean: it
+    carries the forward accelerometer's bias (the two are one unobservable combination, eq.
+    11), so each seed's pitch error is one
     draw of that bias over g and three seeds do not pin its mean (measured 0.0-0.4 per seed
     against a sigma of 1.7 deg from the 30 mg datasheet bias)."""
     for axis in ("n", "e", "vn", "ve", "yaw"):
@@ -317,11 +317,12 @@ def test_drm2_datasheet_tuning_is_consistent(consistency, name):
         assert 0.3 < mean < 3.0, (axis, mean)
 
 
-@pytest.mark.xfail(strict=True, reason="DRM1's velocity is ten times too cautious on this road: "
-                   "its accelerometer-bias states take the road's grade and bank as a random "
-                   "walk, and the road here is level most of the time "
-                   "(docs/reproduction_cho2006.md)")
-def test_drm1_datasheet_tuning_velocity_is_consistent(consistency):
-    for axis in ("vn", "ve"):
+def test_drm1_datasheet_tuning_is_cautious_but_not_tenfold(consistency):
+    """DRM1 sits at the band's lower edge: mean over the seeds measured 0.50 (north), 0.39
+    (east), 0.36 and 0.31 (velocity), 0.37 (yaw). Its accelerometer-bias states take the
+    road's grade and bank as a random walk (its level frame senses g sin(grade), eq. 2), which
+    the 5 % slopes here need and the level stretches do not; a third of that walk lets it
+    diverge on the open road (docs/reproduction_cho2006.md). Asserted: between 0.15 and 3."""
+    for axis in ("n", "e", "vn", "ve", "yaw"):
         mean = np.mean([consistency["dr2d_drm1_ekf", seed][axis] for seed in CONSISTENCY_SEEDS])
-        assert 0.3 < mean < 3.0, (axis, mean)
+        assert 0.15 < mean < 3.0, (axis, mean)
