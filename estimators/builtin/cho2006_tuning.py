@@ -13,7 +13,8 @@ the paper's printed values, or values derived from what a user knows.
   - Q: the angle and velocity random walks of the gyros' and accelerometers' ``noise_density``
     (Groves 2013, section 4.4.3: the variance of the integrated white noise grows as N^2 t);
     on the heading and pitch also the gyro bias left after the standstill calibration, the
-    calibration's own noise N / sqrt(T_still) with the datasheet's in-run instability, held
+    calibration's own noise N / sqrt(T_still) with the datasheet's in-run instability, its
+    g-sensitivity at 0.1 g and its temperature coefficient over 1 K, held
     over ``BIAS_HOLD_S`` (its correlated growth b t counted as the random walk that reaches the
     same spread then: q = b^2 T); on the accelerometer biases the datasheet's random walk and
     instability (a Gauss-Markov bias of sigma s and time T drifts by 2 s^2 / T per second);
@@ -69,6 +70,8 @@ PAPER_Q = {
 PAPER_R = np.diag([15.0**2, 15.0**2, 0.3**2])  # north, east (m), speed (m/s)
 
 BIAS_HOLD_S = 10.0  # s over which a residual gyro bias is counted as a random walk
+DRIVING_ACCEL_M_S2 = 0.1 * 9.80665  # a drive's rms acceleration, on the g-sensitivity
+TEMPERATURE_CHANGE_K = 1.0  # the unit's temperature change after its calibration
 MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
 FIX_CORRELATION_S = 30.0  # s: a fix's error counted as correlated over this (module docstring)
 FIX_INFLATION = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)  # on a 1 Hz fix's sigma
@@ -188,8 +191,11 @@ def _gyro_rate_noise(gyro: Mapping[str, Any], axis: int, still_s: float) -> floa
     instability = _axis(gyro.get("bias_instability"), axis)
     gm = _axis(gyro.get("gauss_markov_sigma"), axis)
     walk = _axis(gyro.get("random_walk"), axis)
+    g_sensitivity = _axis(gyro.get("g_sensitivity"), axis) * DRIVING_ACCEL_M_S2
+    temperature = _axis(gyro.get("temperature_coefficient"), axis) * TEMPERATURE_CHANGE_K
     calibration = density / math.sqrt(max(still_s, 1.0))
-    residual = calibration**2 + instability**2 + gm**2 + walk**2 * BIAS_HOLD_S
+    residual = (calibration**2 + instability**2 + gm**2 + walk**2 * BIAS_HOLD_S
+                + g_sensitivity**2 + temperature**2)
     return density**2 + residual * BIAS_HOLD_S
 
 
