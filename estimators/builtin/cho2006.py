@@ -12,7 +12,18 @@ Estimators
 
 All three propagate at 10 Hz (the IMU samples of each 0.1 s are averaged; the paper's DR runs
 at 10 Hz) and update with each 1 Hz GPS fix: north and east position and horizontal speed
-(eq. 18). P0, Q and R are eqs. 33-35.
+(eq. 18).
+
+Tuning (``config: {tuning: datasheet | paper}``, ``estimators.builtin.cho2006_tuning``):
+``paper`` is P0, Q and R of eqs. 33-35 and the paper's eight states; the reproduction names it.
+``datasheet`` (the default) takes the noise and the sensor-error priors from the dataset's
+datasheet, R from each fix's HDOP, and adds what a consistent filter on a real car needs:
+accelerometer-bias states (DRM2's pitch and forward bias are one unobservable combination,
+eq. 11, so without the bias state its pitch claims the bias's accuracy), DRM2's pitch rate
+corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle, fixes
+weighted down beyond a 99.9 % chi-square gate, and, with an odometer, a zero-velocity update
+at each stop. The SPKF's ``sigma_set: simplex | symmetric`` picks the point set (the simplex
+set's non-zero third moments, docs/reproduction_cho2006.md).
 
 Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction_cho2006.md)
 ----------------------------------------------------------------------------------------
@@ -68,8 +79,10 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   Much smaller alphas shrink the points towards a linearisation, the EKF's weakness. All three
   are ``config`` keys (docs/reproduction_cho2006.md gives the figures for alpha = 1 and 0.1).
 
-Outputs: latitude, longitude, horizontal velocity, yaw (and DRM2's pitch); height, vertical
-velocity and roll (and DRM1's pitch) are NaN, as they are not estimated.
+Outputs: latitude, longitude, horizontal velocity, yaw (and DRM2's pitch) with their 1-sigma
+(``std_vn``, ``std_ve`` from the speed's and heading's covariance for DRM2); height, vertical
+velocity and roll (and DRM1's pitch) are NaN, as they are not estimated, and so are the
+accelerometer-bias columns under the paper's tuning.
 
 Public classes
 --------------

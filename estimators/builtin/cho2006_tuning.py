@@ -18,22 +18,36 @@ the paper's printed values, or values derived from what a user knows.
     over ``BIAS_HOLD_S`` (its correlated growth b t counted as the random walk that reaches the
     same spread then: q = b^2 T); on the accelerometer biases the datasheet's random walk and
     instability (a Gauss-Markov bias of sigma s and time T drifts by 2 s^2 / T per second);
-  - R from each fix's own HDOP (``gnss_fix.hdop``): per horizontal axis HDOP sigma_UERE /
-    sqrt(2), sigma_UERE = sqrt(sis_error^2 + (MULTIPATH_ELEVATION_FACTOR multipath)^2) from the
-    receiver's datasheet (signal in space and code multipath; the Hatch filter leaves the
-    tracking noise a few centimetres), at least ``MIN_FIX_SIGMA_M``; the speed's 1-sigma
-    HDOP sigma_rate / sqrt(2) with the pseudorange-rate noise of an FLL at 40 dB-Hz
-    (``RATE_SIGMA_M_S``, scaled by the datasheet's ``tracking_noise``);
+  - R from each fix's own HDOP (``gnss_fix.hdop``): per horizontal axis the variance
+    (HDOP sigma_UERE)^2 / 2, sigma_UERE = sqrt(sis_error^2 + (MULTIPATH_ELEVATION_FACTOR
+    multipath)^2) from the receiver's datasheet (signal in space and code multipath; the Hatch
+    filter leaves the tracking noise a few centimetres), at least ``MIN_FIX_SIGMA_M``, raised
+    to the fixes' measured scatter by covariance matching (``FixNoiseMatching``: a street
+    canyon's reflected signals leave HDOP unchanged) and counted as correlated over
+    ``FIX_CORRELATION_S`` (``gnss_model.correlated_noise_inflation``; the signal-in-space and
+    canyon errors hold for minutes, and a filter treating them as white believes the mean
+    of its fixes to a fraction of their sigma); the speed's 1-sigma HDOP sigma_rate / sqrt(2)
+    with the pseudorange-rate noise of an FLL at 40 dB-Hz (``RATE_SIGMA_M_S``, scaled by the
+    datasheet's ``tracking_noise``);
   - the car's model errors (``vehicle`` in the datasheet, absent on a rigid body): the
     forward-acceleration error of the planar model on a real body (surge and side slip,
-    ``CAR_ACCEL_SIGMA_M_S2``), and DRM2's body roll: its pitch integrates the y gyro alone
-    (eq. 24d), but a body rolled by phi pitches at w_y cos(phi) - w_z sin(phi) (ZYX Euler
-    rates); a car rolls out of a turn by ``ROLL_GRADIENT`` per lateral acceleration V w_z,
-    which DRM2 compensates (``Drm2._inputs``), and the rest of the roll (camber, the gradient's
-    spread, ``ROLL_SIGMA``) enters Q as w_z^2 ROLL_SIGMA^2 TURN_HOLD_S (it keeps its sign
+    ``CAR_ACCEL_SIGMA_M_S2``); for DRM2 the body's roll and the IMU's lateral velocity. Its
+    pitch integrates the y gyro alone (eq. 24d), but a body rolled by phi pitches at w_y
+    cos(phi) - w_z sin(phi) (ZYX Euler rates); a car rolls out of a turn by ``ROLL_GRADIENT``
+    per lateral acceleration V w_z, which DRM2 compensates (``Drm2._inputs``), and the rest of
+    the roll (``ROLL_SIGMA``) enters Q as w_z^2 ROLL_SIGMA^2 TURN_HOLD_S (it keeps its sign
     through a turn). Uncompensated, a 0.3 g turn at 4.6 deg/g (landnav's automotive body)
     leaks 1.4 deg of roll times the yaw rate into the pitch: 2.2 deg of pitch error per 90 deg
-    turn, always of the same sign, which the term g sin(theta) turns into speed error.
+    turn, always of the same sign, which the term g sin(theta) turns into speed error. Eq. 5
+    moves the IMU along its heading; an IMU ahead of the rear axle (the datasheet's
+    ``rear_axle``, where the wheels roll without side slip) moves sideways at w_z times that
+    distance, the kinematic side slip (5 deg in a 20 m turn); its error (the gyro's noise,
+    and the understeer that cancels it near 20 m/s: ``LATERAL_FRACTION`` of it) enters Q;
+  - DRM1's accelerometer biases also take the road's grade and bank as a random walk
+    (``ROAD_SLOPE_SIGMA`` per ``ROAD_SLOPE_HOLD_S``): its level frame (eq. 2) senses g
+    sin(grade) as acceleration;
+  - a stop: the odometer's zero reading bounds the speed by the wheel's cut-off
+    (``stopped_speed_sigma``), and a zero held for 2 s is a stop.
 
 Public names
 ------------
