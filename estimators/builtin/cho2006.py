@@ -98,6 +98,7 @@ import numpy as np
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.builtin.cho2006_tuning import (
     LATERAL_HOLD_S,
+    PAPER_R,
     TUNINGS,
     TURN_HOLD_S,
     FixNoiseMatching,
@@ -109,7 +110,7 @@ from estimators.builtin.cho2006_tuning import (
 from estimators.toolbox.gating import chi2_threshold, normalised_innovation_squared
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
-from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
+from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks, psd_sqrt
 from simulator.earth import normal_gravity, radii_of_curvature, wrap_angle
 from simulator.errors import InputError, Problem
 
@@ -430,6 +431,10 @@ class _ChoDr(Estimator):
             self._update(z, r)
             return
         x, p = self._predicted()
+        if p[4, 4] >= ALIGNED_HEADING_VAR:
+            # the heading not yet found: the fixes weighted as eq. 35 weighs them, which lets the
+            # 180 deg prior of eq. 33 converge (the sigma points span half a turn until then)
+            r = np.maximum(r, PAPER_R)
         hph, nu = p[:2, :2], z[:2] - x[:2]
         d2 = normalised_innovation_squared(nu, hph + r[:2, :2])
         gate = chi2_threshold(2, GATE_PROBABILITY)
@@ -658,7 +663,20 @@ class Drm2Spkf(_Drm2):
         if self._ukf.sigma is not None:
             self._ukf.covariance()  # eq. 26
         self._since_draw = 0.0
-        return self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
+        out = self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
+        if self._matching is not None:  # datasheet tuning
+            self._repair_covariance()
+        return out
+
+    def _repair_covariance(self) -> None:
+        """Eq. 29 subtracts K P_yy K^T from P; while the heading points still span half a
+        turn (eq. 33's 180 deg) the points' P_yy and P_xy are not a joint covariance with P,
+        and P can lose its definiteness (a negative heading variance 3 s after moving off,
+        seen on an outage drive). The nearest positive-definite matrix replaces it
+        (``ukf.psd_sqrt``, Higham 1988); the paper's tuning keeps eq. 29 as printed."""
+        if np.linalg.eigvalsh(self._ukf.p)[0] < 0.0:
+            root = psd_sqrt(self._ukf.p)
+            self._ukf.p = root @ root.T
 
     def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
         """A measurement linear in the states: the Kalman update itself (the points would
