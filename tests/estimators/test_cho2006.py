@@ -90,7 +90,9 @@ def test_drm2_transition_matrix_has_the_terms_of_eq_17():
 def test_registered_with_the_spec_config_keys():
     for name in ("dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
         assert "standstill_calibration" in get_estimator(name).defaults
-    assert {"alpha", "beta", "w0"} <= set(get_estimator("dr2d_drm2_spkf").defaults)
+    assert {"alpha", "beta", "w0", "sigma_set"} <= set(get_estimator("dr2d_drm2_spkf").defaults)
+    for name in ("dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
+        assert get_estimator(name).defaults["tuning"] == "datasheet"
 
 
 @pytest.fixture(scope="module")
@@ -169,7 +171,8 @@ def test_increment_output_gives_the_rate_output_solution(root):
 
 
 @pytest.mark.parametrize("config, key", [({"alpha": 0.0}, "alpha"), ({"alpha": 1.5}, "alpha"),
-                                         ({"w0": 1.0}, "w0"), ({"beta": -1.0}, "beta")])
+                                         ({"w0": 1.0}, "w0"), ({"beta": -1.0}, "beta"),
+                                         ({"sigma_set": "cubature"}, "sigma_set")])
 def test_spkf_refuses_parameters_outside_their_ranges(root, config, key):
     ds = _dataset("cho2006_situation2", 1, root)
     with pytest.raises(InputError, match=f"'{key}' of estimator dr2d_drm2_spkf"):
