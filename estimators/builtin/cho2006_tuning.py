@@ -14,7 +14,8 @@ the paper's printed values, or values derived from what a user knows.
     (Groves 2013, section 4.4.3: the variance of the integrated white noise grows as N^2 t);
     on the heading and pitch also the gyro bias left after the standstill calibration, the
     calibration's own noise N / sqrt(T_still) with the datasheet's in-run instability, its
-    g-sensitivity at 0.1 g and its temperature coefficient over 1 K, held
+    g-sensitivity at 0.1 g and its temperature coefficient over the warm-up the datasheet's
+    ``temperature`` block gives (a constant offset is calibrated away), held
     over ``BIAS_HOLD_S`` (its correlated growth b t counted as the random walk that reaches the
     same spread then: q = b^2 T); on the accelerometer biases the datasheet's random walk and
     instability (a Gauss-Markov bias of sigma s and time T drifts by 2 s^2 / T per second);
@@ -85,7 +86,6 @@ PAPER_R = np.diag([15.0**2, 15.0**2, 0.3**2])  # north, east (m), speed (m/s)
 
 BIAS_HOLD_S = 10.0  # s over which a residual gyro bias is counted as a random walk
 DRIVING_ACCEL_M_S2 = 0.1 * 9.80665  # a drive's rms acceleration, on the g-sensitivity
-TEMPERATURE_CHANGE_K = 1.0  # the unit's temperature change after its calibration
 MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
 FIX_CORRELATION_S = 30.0  # s: a fix's error counted as correlated over this (module docstring)
 FIX_INFLATION = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)  # on a 1 Hz fix's sigma
@@ -198,15 +198,17 @@ def _bias_terms(group: Mapping[str, Any], axis: int) -> tuple[float, float]:
     return sigma, growth
 
 
-def _gyro_rate_noise(gyro: Mapping[str, Any], axis: int, still_s: float) -> float:
+def _gyro_rate_noise(gyro: Mapping[str, Any], axis: int, still_s: float,
+                     warmup_k: float) -> float:
     """Variance growth per second of an angle integrated from one gyro axis whose bias was
-    calibrated over ``still_s`` seconds of standstill (module docstring)."""
+    calibrated over ``still_s`` seconds of standstill, in a unit whose temperature moves by
+    ``warmup_k`` after it (module docstring)."""
     density = _axis(gyro.get("noise_density"), axis)
     instability = _axis(gyro.get("bias_instability"), axis)
     gm = _axis(gyro.get("gauss_markov_sigma"), axis)
     walk = _axis(gyro.get("random_walk"), axis)
     g_sensitivity = _axis(gyro.get("g_sensitivity"), axis) * DRIVING_ACCEL_M_S2
-    temperature = _axis(gyro.get("temperature_coefficient"), axis) * TEMPERATURE_CHANGE_K
+    temperature = _axis(gyro.get("temperature_coefficient"), axis) * warmup_k
     calibration = density / math.sqrt(max(still_s, 1.0))
     residual = (calibration**2 + instability**2 + gm**2 + walk**2 * BIAS_HOLD_S
                 + g_sensitivity**2 + temperature**2)
@@ -229,6 +231,7 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     DRM2's forward axis, two for DRM1) appended. ``still_s``: the initial standstill's length."""
     imu = datasheet.get("imu") or {}
     gyro, accel = imu.get("gyro") or {}, imu.get("accel") or {}
+    warmup = abs(float((imu.get("temperature") or {}).get("warmup") or 0.0))
     car = (datasheet.get("vehicle") or {}).get("preset", "rigid") != "rigid"
     uere, rate = _receiver(datasheet.get("gnss") or {})
     p0 = PAPER_P0[model].diagonal().copy()
@@ -238,13 +241,13 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     car_accel = CAR_ACCEL_SIGMA_M_S2**2 if car else 0.0
     if model == "drm2":
         q[2] = _axis(accel.get("noise_density"), 0) ** 2 + car_accel
-        q[3] = _gyro_rate_noise(gyro, 1, still_s)
+        q[3] = _gyro_rate_noise(gyro, 1, still_s, warmup)
         p0[5] = max(_axis(accel.get("scale_factor"), 0), MIN_SCALE_SIGMA) ** 2
     else:
         q[2] = q[3] = max(_axis(accel.get("noise_density"), a) ** 2 for a in (0, 1)) + car_accel
         p0[5] = max(_axis(accel.get("scale_factor"), 0), MIN_SCALE_SIGMA) ** 2
         p0[6] = max(_axis(accel.get("scale_factor"), 1), MIN_SCALE_SIGMA) ** 2
-    q[4] = _gyro_rate_noise(gyro, 2, still_s)
+    q[4] = _gyro_rate_noise(gyro, 2, still_s, warmup)
     for i in gyro_sf:
         p0[5 + i] = max(_axis(gyro.get("scale_factor"), i), MIN_SCALE_SIGMA) ** 2
     bias_p0, bias_q = [], []
