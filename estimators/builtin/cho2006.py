@@ -289,8 +289,8 @@ class _ChoDr(Estimator):
         self._tuning = self._make_tuning(0.0)
         self._lateral = 0.0  # the IMU's lateral velocity in the last step (DRM2 on a car)
         self._lateral_var = 0.0  # its error variance, (m/s)^2
-        datasheet = self.config["tuning"] == "datasheet"
-        self._matching = FixNoiseMatching() if datasheet else None
+        self._datasheet = self.config["tuning"] == "datasheet"
+        self._matching = FixNoiseMatching()
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
         self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
         x0 = self._initial_state()
@@ -407,7 +407,7 @@ class _ChoDr(Estimator):
         stopped = abs(float(row[self._odo_speed])) < STOPPED_M_S
         if stopped and not self._still and self.config["standstill_calibration"]:
             self._step()  # the motion up to the stop
-            self._odo_stop = self._matching is not None  # datasheet tuning (module docstring)
+            self._odo_stop = self._datasheet  # (module docstring)
             if self._odo_stop:
                 self._zero_velocity(self._stop_sigma)
             self._still = True
@@ -427,11 +427,11 @@ class _ChoDr(Estimator):
         z = np.array([(math.radians(lat) - self._lat0) * self._rn,
                       (math.radians(lon) - self._lon0) * self._re * math.cos(self._lat0),
                       math.hypot(vn, ve)])  # eq. 18
-        r = self._tuning.r(hdop, self._matching.scale if self._matching else 1.0)
+        r = self._tuning.r(hdop, self._matching.scale)
         if self._lateral:  # the speed's share of the lateral velocity (``Drm2._measure``)
             r[2, 2] += (0.5 * self._lateral**2 / max(abs(float(self._estimate()[0][2])),
                                                      MOVE_SPEED_M_S)) ** 2
-        if self._matching is None:
+        if not self._datasheet:
             self._update(z, r)
             return
         x, p = self._predicted()
@@ -671,7 +671,7 @@ class Drm2Spkf(_Drm2):
             self._ukf.covariance()  # eq. 26
         self._since_draw = 0.0
         out = self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
-        if self._matching is not None:  # datasheet tuning
+        if self._datasheet:
             self._repair_covariance()
         return out
 
