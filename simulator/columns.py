@@ -7,7 +7,7 @@ Public names
 ------------
 TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV_KEPLER, GNSS_NAV, BARO, MAG, EVENTS,
 TRUTH_GNSS, STREAMS, IMU_AXES, SOLUTION, SOLUTION_STD, SOLUTION_NIS, SENSOR_ERRORS,
-TRUTH_SENSORS, DATASET_FORMAT, REQUIRED, TEXT_COLUMNS.
+TRUTH_SENSORS, SOLUTION_FIX, DATASET_FORMAT, REQUIRED, TEXT_COLUMNS.
 """
 
 from __future__ import annotations
@@ -103,6 +103,8 @@ SOLUTION_STD = {
 # optional: the normalised innovation squared of the GNSS update applied at a row (v^T S^-1 v)
 # and its degrees of freedom (the number of measurements); NaN on rows without an update
 SOLUTION_NIS = {"nis_gnss": "1", "nis_gnss_dof": "1"}
+# the integer-ambiguity status of a relative (RTK) solution: 0 none, 1 float, 2 fixed
+SOLUTION_FIX = {"fix_status": "1"}
 
 # estimated sensor errors (SPEC section 7), the same names in a solution and in
 # truth_sensors.parquet: IMU errors on the unit's own axes (FRD), measured minus true; scale

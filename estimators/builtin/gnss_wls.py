@@ -39,6 +39,7 @@ from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 
 C_N0_FLOOR_M = 0.5      # a: the sigma of a strong signal, m
 C_N0_SCALE_M = 300.0    # b: sigma^2 = a^2 + b^2 10^(-C/N0/10), m
+DEFAULT_CN0_DBHZ = 45.0
 ITERATIONS = 8
 BAND_HZ = 50e6  # carriers within 25 MHz share a band: L1/E1/G1 (FDMA) apart from B1I, L5/E5a
 CONVERGED_M = 1e-4
@@ -168,8 +169,11 @@ def _solve(start: np.ndarray, sat_pos: np.ndarray, sat_vel: np.ndarray, rho: np.
 def _sigma(reported: np.ndarray, cn0: np.ndarray | None, floor: float) -> np.ndarray:
     """1-sigma per measurement: the receiver's report where finite and positive, else the
     C/N0 model (or ``floor`` without C/N0)."""
-    model = (np.sqrt(C_N0_FLOOR_M**2 + C_N0_SCALE_M**2 * 10.0 ** (-cn0 / 10.0))
-             if cn0 is not None else np.full(len(reported), floor))
+    if cn0 is None:
+        model = np.full(len(reported), floor)
+    else:  # a signal without a C/N0 (an observation file that has none) is taken at 45 dB-Hz
+        cn0 = np.where(np.isfinite(cn0), cn0, DEFAULT_CN0_DBHZ)
+        model = np.sqrt(C_N0_FLOOR_M**2 + C_N0_SCALE_M**2 * 10.0 ** (-cn0 / 10.0))
     return np.where(np.isfinite(reported) & (reported > 0), reported, model)
 
 

@@ -28,9 +28,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.comparison import compare_datasets, write_comparison
     from simulator.dataset.io import open_dataset
     from simulator.outputs import atomic_output_dir
-    from simulator.comparison import compare_datasets, write_comparison
 
     first, second = open_dataset(args.first), open_dataset(args.second)
     estimator = None if args.estimator == "none" else args.estimator

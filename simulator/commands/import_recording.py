@@ -28,6 +28,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("kind", metavar="KIND", choices=sorted(KINDS), help="the recording's kind")
     p.add_argument("sources", metavar="SOURCE", nargs="+", help="the recording's files/folder")
     p.add_argument("-o", "--output", metavar="DIR", required=True, help="dataset directory")
+    p.add_argument("--reference", metavar="LAT,LON,HEIGHT|FILE",
+                   help="rinex: the true position (deg, deg, m ellipsoidal) or a CSV with t "
+                        "(or tow), lat, lon, alt; default the header's approximate position")
     p.add_argument("--force", action="store_true", help="replace an existing DIR")
     p.set_defaults(run=run)
 
@@ -35,6 +38,6 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from simulator.recordings import import_recording
 
-    out = import_recording(args.kind, args.sources, args.output, args.force)
+    out = import_recording(args.kind, args.sources, args.output, args.force, args.reference)
     print(f"wrote {out} ({args.kind}: the reference trajectory is its truth)")
     return 0

@@ -8,6 +8,7 @@ common      the reference as truth, the datasheet of the recording's sensors, wr
 comma2k19   comma2k19 segments (phone IMU, CAN speed, u-blox raw GNSS, comma's pose)
 gsdc        Google Smartphone Decimeter Challenge traces (device_gnss.csv, ground_truth.csv)
 smartloc    TU Chemnitz smartLoc traces (u-blox raw measurements, reference, NLOS labels)
+rinex       a receiver's RINEX observation and navigation files with a reference position
 twin        a dataset's twin scenario
 
 Public names
@@ -35,6 +36,12 @@ def _smartloc(sources: list[str]) -> Recording:
     return read_smartloc(sources)
 
 
+def _rinex(sources: list[str], reference: str | None = None) -> Recording:
+    from simulator.recordings.rinex import read_rinex_recording
+
+    return read_rinex_recording(sources, reference)
+
+
 def _gsdc(sources: list[str]) -> Recording:
     from simulator.recordings.gsdc import read_gsdc
 
@@ -46,11 +53,18 @@ KINDS: dict[str, tuple[Callable[[list[str]], Recording], str]] = {
     "gsdc": (_gsdc, "a Google Smartphone Decimeter Challenge trace: device_gnss.csv and "
                     "ground_truth.csv (or the folder holding them)"),
     "smartloc": (_smartloc, "a TU Chemnitz smartLoc CSV (u-blox raw, reference, NLOS labels)"),
+    "rinex": (_rinex, "a RINEX observation file and a navigation file (2 or 3); the reference "
+                      "from --reference"),
 }
 
 
 def import_recording(kind: str, sources: list[str], out_dir: str | Path,
-                     force: bool = False) -> Path:
-    """Read a recording of ``kind`` from ``sources`` and write it as a dataset at ``out_dir``."""
+                     force: bool = False, reference: str | None = None) -> Path:
+    """Read a recording of ``kind`` from ``sources`` and write it as a dataset at ``out_dir``;
+    ``reference`` (the ``rinex`` kind only) is a position or a trajectory file."""
     reader, _ = KINDS[kind]
-    return write_recording(reader([str(s) for s in sources]), out_dir, force)
+    if kind == "rinex":
+        recording = _rinex([str(s) for s in sources], reference)
+    else:
+        recording = reader([str(s) for s in sources])
+    return write_recording(recording, out_dir, force)

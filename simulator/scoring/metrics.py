@@ -43,6 +43,7 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   ``None`` for a group whose three columns are not all present), and ``expected`` = 3, its value
   for a consistent estimator (Bar-Shalom, Li and Kirubarajan 2001, section 5.4); the file gives
   no cross-covariances, so P is taken diagonal;
+* ``rtk`` (only when the solution has ``fix_status``): ``simulator.scoring.rtk``.
 * ``consistency`` (only when the solution has ``std_*`` columns) and ``nis`` (only when it has
   ``nis_gnss`` and ``nis_gnss_dof``): ``simulator.scoring.consistency``, after the solution's
   first ``CONSISTENCY_SKIP_S`` = 60 s;
@@ -87,6 +88,7 @@ from simulator.scoring.align import (
 )
 from simulator.scoring.align import solution_errors as _solution_errors
 from simulator.scoring.consistency import AXES, BLOCKS, block_nees, consistency_scores, nis_scores
+from simulator.scoring.rtk import rtk_scores
 
 OUTAGE_KIND = "gnss_outage"  # events.parquet kind of a stretch without any GNSS measurement
 DEGRADED_KINDS = ("gnss_satellite_limit", "gnss_multipath")  # fault kinds that limit GNSS
@@ -282,6 +284,12 @@ def score_errors(errors: SolutionErrors, truth: pd.DataFrame, events: pd.DataFra
     nis = nis_scores(e)
     if nis is not None:
         scores["nis"] = nis
+    if "fix_status" in e.columns:
+        error_3d = np.sqrt(np.sum(e[list(ERR_POS)].to_numpy(float) ** 2, axis=1))
+        outages = events.loc[events["kind"] == OUTAGE_KIND].sort_values("t_start")
+        scores["rtk"] = rtk_scores(e["t"].to_numpy(float), error_3d,
+                                   e["fix_status"].to_numpy(float),
+                                   list(zip(outages["t_start"], outages["t_end"], strict=True)))
     if runtime is not None:
         scores["runtime"] = {"seconds": _number(runtime["runtime_s"]),
                              "realtime_factor": _number(runtime["realtime_factor"])}

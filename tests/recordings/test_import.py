@@ -273,3 +273,33 @@ def test_smartloc_trace(tmp_path):
     assert np.median(np.linalg.norm(v_pos - v_mid, axis=1)) < 0.3
     assert main(["estimate", str(dataset.path), "-e", "gnss_wls", "-o",
                  str(tmp_path / "w.parquet")]) == 2
+
+
+def test_rinex_station_hour(tmp_path):
+    """GEONET 0759's hour (refdata 1c) with its navigation file and its F3 position as the
+    reference: the satellite states computed from the navigation file put the corrected
+    pseudoranges on the geometric ranges up to one clock per epoch (residual spread at the
+    station's published level, 0.77 m), and the snapshot least squares lands within metres."""
+    folder = _refdata() / "gnss" / "gsi0759_2005-04-02_rtklib"
+    out = tmp_path / "rx"
+    assert main(["import", "rinex", str(folder / "07590920.05o"), str(folder / "07590920.05n"),
+                 "--reference", "35.160866522,139.613842697,68.3892", "-o", str(out)]) == 0
+    dataset = open_dataset(out)
+    raw = dataset.read("gnss_raw")
+    assert raw["t"].nunique() == 120 and set(raw["system"]) == {"G"}
+    from estimators.toolbox.gnss_model import predict
+    from simulator.earth import geodetic_to_ecef
+
+    station = geodetic_to_ecef(np.radians(35.160866522), np.radians(139.613842697),
+                               68.3892).ravel()
+    high = raw[raw["elevation"] > np.radians(15.0)]
+    geometric, _, _ = predict(high[["sat_x", "sat_y", "sat_z"]].to_numpy(),
+                              high[["sat_vx", "sat_vy", "sat_vz"]].to_numpy(), station,
+                              np.zeros(3))
+    residual = (high["pseudorange"] + high["sat_clock"] - high["iono"] - high["tropo"]
+                - geometric).to_numpy(copy=True)
+    residual -= pd.Series(residual).groupby(high["t"].to_numpy()).transform("mean").to_numpy()
+    assert 0.4 < np.std(residual) < 1.2
+    scores = tmp_path / "s.json"
+    assert main(["score", str(out), "-e", "gnss_wls", "--json", str(scores)]) == 0
+    assert json.loads(scores.read_text())["gnss_wls"]["horizontal"]["rms"] < 3.0
