@@ -24,14 +24,8 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.arguments import hours_and_repeat
-from estimators.builtin.cho2006 import (
-    DR_STEP_S,
-    P0_DRM2,
-    Q_DRM2,
-    R_GPS,
-    drm2_jacobian,
-    drm2_transition,
-)
+from estimators.builtin.cho2006 import DR_STEP_S, drm2_jacobian, drm2_transition
+from estimators.builtin.cho2006_tuning import PAPER_P0, PAPER_Q, PAPER_R
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.earth import normal_gravity, radii_of_curvature
@@ -67,7 +61,8 @@ def run_peer(kind: str, u: np.ndarray, z: np.ndarray, g: float) -> float:
     fixes = dict(zip(fix_step.tolist(), range(len(z)), strict=True))
     if kind == "ekf":
         f = ExtendedKalmanFilter(8, 3)
-        f.x, f.P, f.R, f.Q = x0.copy(), P0_DRM2.copy(), R_GPS, Q_DRM2 * DR_STEP_S
+        f.x, f.P, f.R = x0.copy(), PAPER_P0["drm2"].copy(), PAPER_R
+        f.Q = PAPER_Q["drm2"] * DR_STEP_S
         start = time.process_time()
         for k in range(len(u)):
             f.F = drm2_jacobian(f.x, u[k], DR_STEP_S, g)
@@ -84,7 +79,7 @@ def run_peer(kind: str, u: np.ndarray, z: np.ndarray, g: float) -> float:
         return drm2_transition(x[None, :], None, uk[0], dt, g)[0]
 
     f = UnscentedKalmanFilter(8, 3, DR_STEP_S, lambda x: x[:3], fx, points)
-    f.x, f.P, f.R, f.Q = x0.copy(), P0_DRM2.copy(), R_GPS, Q_DRM2 * DR_STEP_S
+    f.x, f.P, f.R, f.Q = x0.copy(), PAPER_P0["drm2"].copy(), PAPER_R, PAPER_Q["drm2"] * DR_STEP_S
     start = time.process_time()
     for k in range(len(u)):
         uk[0] = u[k]

@@ -12,7 +12,22 @@ Estimators
 
 All three propagate at 10 Hz (the IMU samples of each 0.1 s are averaged; the paper's DR runs
 at 10 Hz) and update with each 1 Hz GPS fix: north and east position and horizontal speed
-(eq. 18). P0, Q and R are eqs. 33-35.
+(eq. 18).
+
+Tuning (``config: {tuning: datasheet | paper}``, ``estimators.builtin.cho2006_tuning``):
+``paper`` is P0, Q and R of eqs. 33-35 and the paper's eight states; the reproduction names it.
+``datasheet`` (the default) takes the noise and the sensor-error priors from the dataset's
+datasheet, R from each fix's HDOP, and adds what a consistent filter on a real car needs:
+accelerometer-bias states (DRM2's pitch and forward bias are one unobservable combination,
+eq. 11, so without the bias state its pitch claims the bias's accuracy), DRM2's pitch rate
+corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle, fixes
+weighted down beyond a 99.9 % chi-square gate, and, with an odometer, a zero-velocity update
+at each stop. The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
+``auto`` (the default) is the paper's simplex set with the paper's tuning and the symmetric
+set with the datasheet's: the simplex set's non-zero third moments move unobservable states
+under eq. 33's 180 deg heading prior (docs/reproduction_cho2006.md), and with the datasheet's
+R it lost the heading at the start on 3 of 10 seeds of two drives (urban canyon, garage),
+where the symmetric set converged on every seed.
 
 Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction_cho2006.md)
 ----------------------------------------------------------------------------------------
@@ -68,8 +83,10 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   Much smaller alphas shrink the points towards a linearisation, the EKF's weakness. All three
   are ``config`` keys (docs/reproduction_cho2006.md gives the figures for alpha = 1 and 0.1).
 
-Outputs: latitude, longitude, horizontal velocity, yaw (and DRM2's pitch); height, vertical
-velocity and roll (and DRM1's pitch) are NaN, as they are not estimated.
+Outputs: latitude, longitude, horizontal velocity, yaw (and DRM2's pitch) with their 1-sigma
+(``std_vn``, ``std_ve`` from the speed's and heading's covariance for DRM2); height, vertical
+velocity and roll (and DRM1's pitch) are NaN, as they are not estimated, and so are the
+accelerometer-bias columns under the paper's tuning.
 
 Public classes
 --------------
@@ -83,9 +100,21 @@ import math
 import numpy as np
 
 from estimators.base import NAV_COLUMNS, Estimator
+from estimators.builtin.cho2006_tuning import (
+    LATERAL_HOLD_S,
+    PAPER_R,
+    TUNINGS,
+    TURN_HOLD_S,
+    FixNoiseMatching,
+    Tuning,
+    datasheet_tuning,
+    paper_tuning,
+    stopped_speed_sigma,
+)
+from estimators.toolbox.gating import chi2_threshold, normalised_innovation_squared
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
-from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks
+from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks, psd_sqrt
 from simulator.earth import normal_gravity, radii_of_curvature, wrap_angle
 from simulator.errors import InputError, Problem
 
@@ -96,17 +125,12 @@ MOVE_ACCEL_M_S2 = 0.2  # forward specific-force change that ends the initial sta
 MOVE_SPEED_M_S = 0.5  # GPS speed that ends the initial standstill
 MIN_STOP_S = 2.0  # shortest stop whose gyro average replaces the calibration
 STOPPED_M_S = 1e-3  # odometer speed read as a stopped wheel (below any encoder's resolution)
+STOPPED_SIGMA_M_S = 0.01  # speed 1-sigma of a car whose wheel has read zero for MIN_STOP_S
 MIN_SPEED_UPDATE_M_S = 0.5  # DRM1: below this the speed measurement is left out
+GATE_PROBABILITY = 0.999  # a fix beyond this chi-square quantile is weighted down to it
+ALIGNED_HEADING_VAR = (30.0 * math.pi / 180.0) ** 2  # rad^2: heading found (zero-speed update)
 DEG = math.pi / 180.0
-
-# eqs. 33-35 (DRM2 state order [P_N, P_E, V, theta, psi, d_ax, d_gy, d_gz])
-P0_DRM2 = np.diag([50.0**2, 50.0**2, 5.0**2, (10 * DEG) ** 2, (180 * DEG) ** 2, 1.0, 1.0, 1.0])
-Q_DRM2 = np.diag([0.0, 0.0, 0.1**2, (0.1 * DEG) ** 2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0])
-# DRM1 state order [P_N, P_E, V_N, V_E, psi, d_ax, d_ay, d_gz], eqs. 33-34 term by term
-P0_DRM1 = np.diag([50.0**2, 50.0**2, 5.0**2, 5.0**2, (180 * DEG) ** 2, 1.0, 1.0, 1.0])
-Q_DRM1 = np.diag([0.0, 0.0, 0.1**2, 0.1**2, (0.1 * DEG) ** 2, 0.0, 0.0, 0.0])
-R_GPS = np.diag([15.0**2, 15.0**2, 0.3**2])  # eq. 35: north, east (m), speed (m/s)
-
+SIGMA_SETS = ("simplex", "symmetric")  # the SPKF's point sets (estimators.toolbox.sigma_points)
 
 def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: float,
                     g: float) -> np.ndarray:
@@ -117,13 +141,16 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     position moves with the mean of the step's old (eq. 24a-b) and new (eq. 5) velocity
     vectors (the trapezoidal rule).
     """
-    pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T
-    f_x, w_y, w_z = u
+    pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T[:8]
+    f_x, w_y, w_z = u[:3]
+    lat = u[3] if len(u) > 3 else 0.0  # lateral velocity of the IMU (m/s), 0 in the paper
     out = np.empty_like(x)
-    v_new = v + ((1.0 - d_ax) * f_x - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
+    f_h = (1.0 - d_ax) * f_x - (x[:, 8] if x.shape[1] > 8 else 0.0)  # eq. 14b (+ bias, eq. 9)
+    v_new = v + (f_h - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
     psi_new = psi + (1.0 - d_gz) * w_z * dt  # eq. 24e
-    out[:, 0] = pn + 0.5 * (v * np.cos(psi) + v_new * np.cos(psi_new)) * dt  # eqs. 24a, 5
-    out[:, 1] = pe + 0.5 * (v * np.sin(psi) + v_new * np.sin(psi_new)) * dt  # eqs. 24b, 5
+    c0, s0, c1, s1 = np.cos(psi), np.sin(psi), np.cos(psi_new), np.sin(psi_new)
+    out[:, 0] = pn + 0.5 * (v * c0 - lat * s0 + v_new * c1 - lat * s1) * dt  # eqs. 24a, 5
+    out[:, 1] = pe + 0.5 * (v * s0 + lat * c0 + v_new * s1 + lat * c1) * dt  # eqs. 24b, 5
     out[:, 2] = v_new
     out[:, 3] = th + (1.0 - d_gy) * w_y * dt  # eq. 24d
     out[:, 4] = wrap_angle(psi_new)
@@ -137,26 +164,30 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
 def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarray:
     """Transition matrix of ``drm2_transition`` at ``x`` (8,) (Cho & Choi eqs. 16-17, with the
     trapezoidal position step)."""
-    _, _, v, th, psi, d_ax, d_gy, d_gz = x
-    f_x, w_y, w_z = u
+    _, _, v, th, psi, d_ax, d_gy, d_gz = x[:8]
+    f_x, w_y, w_z = u[:3]
+    lat = u[3] if len(u) > 3 else 0.0
     st, ct = math.sin(th), math.cos(th)
-    v_new = v + ((1.0 - d_ax) * f_x - g * st) * ct * dt
+    f_h = (1.0 - d_ax) * f_x - (x[8] if x.size > 8 else 0.0)
+    v_new = v + (f_h - g * st) * ct * dt
     psi_new = psi + (1.0 - d_gz) * w_z * dt
-    phi = np.eye(8)
-    # A_3 (eq. 17c) with SF_ax = 1 - d_ax, and the scale-factor column
-    phi[2, 3] = (g * st * st - (1.0 - d_ax) * f_x * st - g * ct * ct) * dt
+    phi = np.eye(x.size)
+    # A_3 (eq. 17c) with SF_ax = 1 - d_ax (and the bias), and the scale-factor column
+    phi[2, 3] = (g * st * st - f_h * st - g * ct * ct) * dt
     phi[2, 5] = -f_x * ct * dt
+    if x.size > 8:
+        phi[2, 8] = -ct * dt
     phi[3, 6] = -w_y * dt  # A_4 (eq. 17d)
     phi[4, 7] = -w_z * dt
     # position rows: A_1 and A_2 (eq. 17a-b) at the old and at the new velocity vector
     c0, s0, c1, s1 = math.cos(psi), math.sin(psi), math.cos(psi_new), math.sin(psi_new)
     half = 0.5 * dt
     phi[0, 2] += half * c0
-    phi[0, 4] -= half * v * s0
+    phi[0, 4] -= half * (v * s0 + lat * c0)
     phi[1, 2] += half * s0
-    phi[1, 4] += half * v * c0
-    phi[0] += half * (c1 * phi[2] - v_new * s1 * phi[4])
-    phi[1] += half * (s1 * phi[2] + v_new * c1 * phi[4])
+    phi[1, 4] += half * (v * c0 - lat * s0)
+    phi[0] += half * (c1 * phi[2] - (v_new * s1 + lat * c1) * phi[4])
+    phi[1] += half * (s1 * phi[2] + (v_new * c1 - lat * s1) * phi[4])
     return phi
 
 
@@ -170,9 +201,11 @@ def drm1_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     position moves with the mean of the old and the new velocity (eq. 3 names the new one,
     which puts the position a dt / 2 ahead while accelerating).
     """
-    pn, pe, vn, ve, psi, d_ax, d_ay, d_gz = x.T
+    pn, pe, vn, ve, psi, d_ax, d_ay, d_gz = x.T[:8]
     f_x, f_y, w_z = u
     fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
+    if x.shape[1] > 8:  # accelerometer biases (the datasheet tuning's states)
+        fxc, fyc = fxc - x[:, 8], fyc - x[:, 9]
     turn = (1.0 - d_gz) * w_z * dt
     c, s = np.cos(psi + 0.5 * turn), np.sin(psi + 0.5 * turn)
     out = np.empty_like(x)
@@ -195,12 +228,16 @@ def drm1_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarr
     mid = psi + 0.5 * (1.0 - d_gz) * w_z * dt
     c, s = math.cos(mid), math.sin(mid)
     fxc, fyc = (1.0 - d_ax) * f_x, (1.0 - d_ay) * f_y
-    phi = np.eye(8)
+    if x.size > 8:
+        fxc, fyc = fxc - x[8], fyc - x[9]
+    phi = np.eye(x.size)
     # velocity rows: d/d psi, d/d d_ax, d/d d_ay, d/d d_gz (through the mid heading)
     dvn_dpsi, dve_dpsi = (-s * fxc - c * fyc) * dt, (c * fxc - s * fyc) * dt
     phi[2, 4], phi[2, 5], phi[2, 6] = dvn_dpsi, -c * f_x * dt, s * f_y * dt
     phi[3, 4], phi[3, 5], phi[3, 6] = dve_dpsi, -s * f_x * dt, -c * f_y * dt
     phi[2, 7], phi[3, 7] = -0.5 * w_z * dt * dvn_dpsi, -0.5 * w_z * dt * dve_dpsi
+    if x.size > 8:  # d/d b_ax, d/d b_ay
+        phi[2, 8], phi[2, 9], phi[3, 8], phi[3, 9] = -c * dt, s * dt, -s * dt, -c * dt
     phi[0] += 0.5 * dt * phi[2]  # the position moves with the old and new velocity (eq. 3)
     phi[1] += 0.5 * dt * phi[3]
     phi[0, 2] += 0.5 * dt
@@ -217,15 +254,22 @@ class _ChoDr(Estimator):
     uses = ("odometer",)
     paper = PAPER
     output_rate_hz = 10.0
-    defaults = {"standstill_calibration": True}
+    defaults = {"standstill_calibration": True, "tuning": "datasheet"}
     config_help = {"standstill_calibration": ("", "calibrate the sensor biases at each "
-                                                  "standstill (the initial one without odometer)")}
+                                                  "standstill (the initial one without odometer)"),
+                   "tuning": ("", "datasheet: noise and states from the manifest's datasheet "
+                                  "(default); paper: eqs. 33-35 with the paper's eight states")}
     # set by the model
+    _model = ""  # "drm1" or "drm2" (cho2006_tuning)
+    _velocity_states: tuple[int, ...] = ()  # the states of the velocity (zero at a stop)
     _imu_columns: tuple[str, str, str] = ("", "", "")
     _gyro_channels: tuple[int, ...] = ()  # which of the three inputs are gyros
-    _p0 = _q = np.zeros((8, 8))
 
     def setup(self) -> None:
+        if self.config["tuning"] not in TUNINGS:
+            raise InputError([Problem("config", None, "", (
+                f"config key 'tuning' of estimator {self.name} must be one of "
+                f"{', '.join(TUNINGS)}, got {self.config['tuning']!r}"))])
         init = self.initial
         self._lat0, self._lon0, self._h0 = (float(v) for v in init.position)
         rn, re = radii_of_curvature(self._lat0)
@@ -235,7 +279,7 @@ class _ChoDr(Estimator):
         self._cols = [imu[c] for c in self._imu_columns]
         self._increment = self.imu_output == "increment"
         fix = self.columns["gnss_fix"]
-        self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"])
+        self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"], fix["hdop"])
         self._s0 = self._s1 = self._s2 = 0.0  # the three inputs integrated over the DR step
         self._acc_t = 0.0  # time accumulated in the current DR step
         self._t_imu = init.t
@@ -246,7 +290,35 @@ class _ChoDr(Estimator):
         self._still_t = 0.0
         self._first_stop = self._still  # the initial standstill: calibrated however short
         self._odo_speed = self.columns.get("odometer", {}).get("speed")
-        self._start_filter(self._initial_state(), self._p0.copy())
+        self._tuning = self._make_tuning(0.0)
+        self._lateral = 0.0  # the IMU's lateral velocity in the last step (DRM2 on a car)
+        self._lateral_var = 0.0  # its error variance, (m/s)^2
+        self._datasheet = self.config["tuning"] == "datasheet"
+        self._matching = FixNoiseMatching()
+        self._stop_sigma = stopped_speed_sigma(self.datasheet)
+        self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
+        x0 = self._initial_state()
+        self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
+                           self._tuning.p0.copy())
+
+    def _make_tuning(self, still_s: float) -> Tuning:
+        """The configured tuning (``cho2006_tuning``) after ``still_s`` s of calibration."""
+        if self.config["tuning"] == "paper":
+            return paper_tuning(self._model)
+        return datasheet_tuning(self._model, self.datasheet, still_s)
+
+    def _inputs(self, u: np.ndarray) -> np.ndarray:
+        """The model's inputs from the step's mean bias-compensated IMU inputs ``u``."""
+        return u
+
+    def _q_step(self, u: np.ndarray) -> np.ndarray:
+        """Q (variance growth per second) over a step with inputs ``u``."""
+        return self._tuning.q
+
+    @property
+    def _bias_states(self) -> int:
+        """Accelerometer-bias states appended to the paper's eight (datasheet tuning)."""
+        return len(self._tuning.p0) - 8
 
     # -- to be provided by the model and filter -------------------------------------------
     def _initial_state(self) -> np.ndarray:
@@ -258,11 +330,29 @@ class _ChoDr(Estimator):
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         raise NotImplementedError
 
-    def _update(self, z: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Update with the fix ``z`` [north, east, speed] and its noise ``r``; returns the
+        innovation and its covariance (position rows first)."""
         raise NotImplementedError
+
+    def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
+        """Update with a direct measurement ``z`` of the states ``index`` with noise ``r``."""
+        raise NotImplementedError
+
+    def _zero_velocity(self, sigma: float) -> None:
+        """The velocity states measured as zero with 1-sigma ``sigma`` (m/s), once the heading
+        is found (before, the SPKF's points span half a turn, and the covariance formed from
+        them for an update loses its definiteness)."""
+        if self._estimate()[1][4, 4] < ALIGNED_HEADING_VAR:
+            index = list(self._velocity_states)
+            self._linear_update(index, np.zeros(len(index)), np.eye(len(index)) * sigma**2)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         raise NotImplementedError
+
+    def _predicted(self) -> tuple[np.ndarray, np.ndarray]:
+        """The state and covariance predicted to now (before an update)."""
+        return self._estimate()
 
     # -- messages --------------------------------------------------------------------------
     def on_imu(self, t: float, row: np.ndarray) -> None:
@@ -300,16 +390,20 @@ class _ChoDr(Estimator):
             else:
                 self._still_sum += u * dt
                 self._still_t += dt
+                if self._odo_stop and self._still_t >= MIN_STOP_S:
+                    self._zero_velocity(STOPPED_SIGMA_M_S)  # the wheel has stayed still
+                    self._odo_stop = False
                 return
-        u = u - self._bias
-        self._propagate(u, dt)
+        self._propagate(self._inputs(u - self._bias), dt)
 
     def _end_standstill(self) -> None:
-        self._still = False
+        self._still = self._odo_stop = False
         if self._still_t > 0.0 and (self._first_stop or self._still_t >= MIN_STOP_S):
             mean = self._still_sum / self._still_t
             for i in self._gyro_channels:
                 self._bias[i] = mean[i]
+            if self._first_stop:  # the residual bias's noise follows the calibration's length
+                self._tuning = self._make_tuning(self._still_t)
         self._first_stop = False
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
@@ -317,14 +411,18 @@ class _ChoDr(Estimator):
         stopped = abs(float(row[self._odo_speed])) < STOPPED_M_S
         if stopped and not self._still and self.config["standstill_calibration"]:
             self._step()  # the motion up to the stop
+            self._odo_stop = self._datasheet  # (module docstring)
+            if self._odo_stop:
+                self._zero_velocity(self._stop_sigma)
             self._still = True
+            self._lateral = self._lateral_var = 0.0
             self._still_sum[:] = 0.0
             self._still_t = 0.0
         elif not stopped and self._still:
             self._end_standstill()
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        fix, lat, lon, vn, ve = (float(row[i]) for i in self._fix_cols)
+        fix, lat, lon, vn, ve, hdop = (float(row[i]) for i in self._fix_cols)
         if not (fix > 0 and math.isfinite(lat) and math.isfinite(vn)):
             return
         if self._still and math.hypot(vn, ve) > MOVE_SPEED_M_S:
@@ -333,21 +431,45 @@ class _ChoDr(Estimator):
         z = np.array([(math.radians(lat) - self._lat0) * self._rn,
                       (math.radians(lon) - self._lon0) * self._re * math.cos(self._lat0),
                       math.hypot(vn, ve)])  # eq. 18
-        self._update(z)
+        r = self._tuning.r(hdop, self._matching.scale)
+        if self._lateral:  # the speed's share of the lateral velocity (``Drm2._measure``)
+            r[2, 2] += (0.5 * self._lateral**2 / max(abs(float(self._estimate()[0][2])),
+                                                     MOVE_SPEED_M_S)) ** 2
+        if not self._datasheet:
+            self._update(z, r)
+            return
+        x, p = self._predicted()
+        if p[4, 4] >= ALIGNED_HEADING_VAR:
+            # the heading not yet found: the fixes weighted as eq. 35 weighs them, which lets the
+            # 180 deg prior of eq. 33 converge (the sigma points span half a turn until then)
+            r = np.maximum(r, PAPER_R)
+        hph, nu = p[:2, :2], z[:2] - x[:2]
+        d2 = normalised_innovation_squared(nu, hph + r[:2, :2])
+        gate = chi2_threshold(2, GATE_PROBABILITY)
+        if d2 > gate and p[4, 4] < ALIGNED_HEADING_VAR:
+            r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
+        self._update(z, r)
+        self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
 
     # -- output ----------------------------------------------------------------------------
     @property
     def _accel_index(self) -> int:
         return self._imu_columns.index("accel_x")
 
-    def _row(self, x: np.ndarray, p: np.ndarray, vn: float, ve: float,
-             pitch: float) -> list[float]:
-        """The navigation columns (NaN where not estimated), then std_n and std_e."""
+    def _row(self, x: np.ndarray, p: np.ndarray, vn: float, ve: float, pitch: float,
+             p_vel: np.ndarray) -> list[float]:
+        """The navigation columns (NaN where not estimated), then std_n, std_e, std_vn and
+        std_ve (``p_vel``: the 2 x 2 covariance of vn, ve)."""
         lat = self._lat0 + x[0] / self._rn
         lon = self._lon0 + x[1] / (self._re * math.cos(self._lat0))
         nan = math.nan
         return [math.degrees(lat), math.degrees(lon), nan, vn, ve, nan, nan, pitch,
-                float(wrap_angle(x[4])), math.sqrt(p[0, 0]), math.sqrt(p[1, 1])]
+                float(wrap_angle(x[4])), math.sqrt(p[0, 0]), math.sqrt(p[1, 1]),
+                math.sqrt(max(p_vel[0, 0], 0.0)), math.sqrt(max(p_vel[1, 1], 0.0))]
+
+    def _accel_bias(self, x: np.ndarray, axis: int) -> float:
+        """The estimated accelerometer bias of the ``axis``-th bias state (NaN without one)."""
+        return float(x[8 + axis]) if self._bias_states > axis else math.nan
 
 
 def _sf(d: float) -> float:
@@ -359,18 +481,44 @@ def _sf(d: float) -> float:
 class _Drm2(_ChoDr):
     """DRM2 model (eqs. 4-8, 14b)."""
 
+    _model = "drm2"
+    _velocity_states = (2,)
     _imu_columns = ("accel_x", "gyro_y", "gyro_z")
     _gyro_channels = (1, 2)
-    _p0, _q = P0_DRM2, Q_DRM2
-    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_pitch", "std_yaw",
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_vn", "std_ve", "std_pitch", "std_yaw",
                       "accel_scale_factor_x", "gyro_scale_factor_y", "gyro_scale_factor_z",
-                      "gyro_bias_y", "gyro_bias_z", "speed_h")
+                      "gyro_bias_y", "gyro_bias_z", "accel_bias_x", "speed_h")
 
     def _initial_state(self) -> np.ndarray:
         init = self.initial
         yaw = float(init.attitude[2])
         v = float(init.velocity[0] * math.cos(yaw) + init.velocity[1] * math.sin(yaw))
         return np.array([0.0, 0.0, v, float(init.attitude[1]), yaw, 0.0, 0.0, 0.0])
+
+    def _inputs(self, u: np.ndarray) -> np.ndarray:
+        """The pitch rate of a body rolling in a turn (datasheet tuning on a car): theta_dot =
+        w_y cos(roll) - w_z sin(roll), roll = -k V w_z (``cho2006_tuning``), so w_y + k V
+        w_z^2 to first order; eq. 24d integrates w_y alone."""
+        k, arm = self._tuning.roll_gradient, self._tuning.rear_axle_m
+        if not (k or arm):
+            return u
+        out = np.append(u, arm * u[2])  # the IMU's lateral velocity (``_measure``)
+        out[1] += k * self._estimate()[0][2] * u[2] ** 2
+        self._lateral = float(out[3])
+        self._lateral_var = self._tuning.lateral_variance(self._lateral)
+        return out
+
+    def _q_step(self, u: np.ndarray) -> np.ndarray:
+        """Q with the pitch-rate error of the unknown part of the roll (w_z sigma_roll, held
+        over a turn: ``cho2006_tuning.TURN_HOLD_S``)."""
+        sigma = self._tuning.roll_sigma
+        if not sigma:
+            return self._tuning.q
+        q = self._tuning.q.copy()
+        q[3, 3] += (u[2] * sigma) ** 2 * TURN_HOLD_S
+        q[0, 0] += self._lateral_var * LATERAL_HOLD_S  # the lateral velocity's error
+        q[1, 1] += self._lateral_var * LATERAL_HOLD_S
+        return q
 
     def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
                     dt: float) -> np.ndarray:
@@ -380,25 +528,35 @@ class _Drm2(_ChoDr):
         return drm2_jacobian(x, u, dt, self._g)
 
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """h(x) = [P_N, P_E, V] for states (k, 8) and its (constant) Jacobian (eq. 16)."""
-        return x[:, :3], np.eye(3, 8)
+        """h(x) = [P_N, P_E, V] for states (k, n) and its (constant) Jacobian (eq. 16). With a
+        lateral velocity (datasheet tuning on a car) the GPS speed is sqrt(V^2 + lat^2), more
+        than V by lat^2 / (2 V): 0.08 m/s at 5 m/s in a 10 m turn, counted in R; the norm
+        itself would be blind to the sign of V and let the EKF settle on -V."""
+        return x[:, :3], np.eye(3, x.shape[1])
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
-        v, th, psi = x[2], x[3], x[4]
-        return [*self._row(x, p, v * math.cos(psi), v * math.sin(psi), th),
+        v, th, psi, lat = x[2], x[3], x[4], self._lateral
+        c, s = math.cos(psi), math.sin(psi)
+        jac = np.array([[c, -v * s - lat * c], [s, v * c - lat * s]])  # (vn, ve) / (V, psi)
+        across = np.array([-s, c])
+        p_vel = jac @ p[np.ix_([2, 4], [2, 4])] @ jac.T + self._lateral_var * np.outer(across,
+                                                                                      across)
+        return [*self._row(x, p, v * c - lat * s, v * s + lat * c, th, p_vel),
                 math.sqrt(p[3, 3]), math.sqrt(p[4, 4]), _sf(x[5]), _sf(x[6]), _sf(x[7]),
-                self._bias[1], self._bias[2], v]
+                self._bias[1], self._bias[2], self._accel_bias(x, 0), v]
 
 
 class _Drm1(_ChoDr):
     """DRM1 model (eqs. 2-3)."""
 
+    _model = "drm1"
+    _velocity_states = (2, 3)
     _imu_columns = ("accel_x", "accel_y", "gyro_z")
     _gyro_channels = (2,)
-    _p0, _q = P0_DRM1, Q_DRM1
-    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_yaw", "accel_scale_factor_x",
-                      "accel_scale_factor_y", "gyro_scale_factor_z", "gyro_bias_z")
+    output_columns = (*NAV_COLUMNS, "std_n", "std_e", "std_vn", "std_ve", "std_yaw",
+                      "accel_scale_factor_x", "accel_scale_factor_y", "gyro_scale_factor_z",
+                      "gyro_bias_z", "accel_bias_x", "accel_bias_y")
 
     def _initial_state(self) -> np.ndarray:
         init = self.initial
@@ -415,7 +573,7 @@ class _Drm1(_ChoDr):
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """h(x) = [P_N, P_E, |V|] for states (k, 8) and its Jacobian at the first row."""
         speed = np.hypot(x[:, 2], x[:, 3])
-        h = np.zeros((3, 8))
+        h = np.zeros((3, x.shape[1]))
         h[0, 0] = h[1, 1] = 1.0
         if speed[0] > 0.0:
             h[2, 2:4] = x[0, 2:4] / speed[0]
@@ -423,8 +581,9 @@ class _Drm1(_ChoDr):
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
-        return [*self._row(x, p, x[2], x[3], math.nan), math.sqrt(p[4, 4]),
-                _sf(x[5]), _sf(x[6]), _sf(x[7]), self._bias[2]]
+        return [*self._row(x, p, x[2], x[3], math.nan, p[2:4, 2:4]), math.sqrt(p[4, 4]),
+                _sf(x[5]), _sf(x[6]), _sf(x[7]), self._bias[2], self._accel_bias(x, 0),
+                self._accel_bias(x, 1)]
 
 
 class _Ekf(_ChoDr):
@@ -437,14 +596,19 @@ class _Ekf(_ChoDr):
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         phi = self._jacobian(self._x, u, dt)
         self._x = self._transition(self._x[None, :], None, u, dt)[0]
-        _, self._p = kf_predict(self._x, self._p, phi, self._q * dt)
+        _, self._p = kf_predict(self._x, self._p, phi, self._q_step(u) * dt)
 
-    def _update(self, z: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         zhat, h = self._measure(self._x[None, :])
         rows = [0, 1, 2] if h[2].any() else [0, 1]
         nu = z[rows] - zhat[0, rows]
-        self._x, self._p, _ = kf_update(self._x, self._p, nu, h[rows], R_GPS[np.ix_(rows, rows)])
+        self._x, self._p, s = kf_update(self._x, self._p, nu, h[rows], r[np.ix_(rows, rows)])
         self._x[4] = wrap_angle(self._x[4])
+        return nu, s
+
+    def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
+        h = np.eye(len(self._x))[index]
+        self._x, self._p, _ = kf_update(self._x, self._p, z - self._x[index], h, r)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._x, self._p
@@ -475,41 +639,78 @@ class Drm2Spkf(_Drm2):
 
     name = "dr2d_drm2_spkf"
     paper = f"{PAPER}: DRM2 with the scaled simplex sigma-point filter (eqs. 19-32)"
-    defaults = {"standstill_calibration": True, "alpha": 0.3, "beta": 2.0, "w0": 0.0}
+    defaults = {"standstill_calibration": True, "tuning": "datasheet", "alpha": 0.3,
+                "beta": 2.0, "w0": 0.0, "sigma_set": "auto"}
     config_help = {
         **_ChoDr.config_help,
         "alpha": ("", "spread of the simplex sigma points, in [1e-4, 1] (eq. 21)"),
         "beta": ("", "prior-distribution weight of the central point, 2 for a Gaussian (eq. 21)"),
         "w0": ("", "weight of the central sigma point (Julier 2003)"),
+        "sigma_set": ("", "auto (simplex with paper tuning, symmetric with datasheet), simplex "
+                          "or symmetric"),
     }
 
     def _start_filter(self, x0: np.ndarray, p0: np.ndarray) -> None:
         checks = (("alpha", 1e-4 <= self.config["alpha"] <= 1.0, "must be in [1e-4, 1] (eq. 21)"),
                   ("w0", 0.0 <= self.config["w0"] < 1.0, "must be in [0, 1)"),
-                  ("beta", self.config["beta"] >= 0.0, "must not be negative"))
+                  ("beta", self.config["beta"] >= 0.0, "must not be negative"),
+                  ("sigma_set", self.config["sigma_set"] in ("auto", *SIGMA_SETS),
+                   f"must be auto or one of {', '.join(SIGMA_SETS)}"))
         problems = [f"config key {key!r} of estimator {self.name} {rule}, got "
                     f"{self.config[key]!r}" for key, ok, rule in checks if not ok]
         if problems:
             raise InputError([Problem("config", None, "", p) for p in problems])
         plus, minus = angle_hooks([4])
-        self._ukf = SigmaPointFilter(x0, p0, points="simplex", alpha=self.config["alpha"],
+        points = self.config["sigma_set"]
+        if points == "auto":  # the paper's set with the paper's tuning (module docstring)
+            points = "simplex" if self.config["tuning"] == "paper" else "symmetric"
+        self._ukf = SigmaPointFilter(x0, p0, points=points,
+                                     alpha=self.config["alpha"],
                                      beta=self.config["beta"], w0=self.config["w0"],
                                      boxplus=plus, boxminus=minus, augment=True)
         self._since_draw = 0.0
-        self._q_draw = self._q * DRAW_INTERVAL_S
 
     def _propagate(self, u: np.ndarray, dt: float) -> None:
         if self._since_draw >= DRAW_INTERVAL_S - 1e-9:
             self._ukf.covariance(redraw=True)  # eq. 26; the next propagation draws afresh
             self._since_draw = 0.0
-        self._ukf.propagate(self._transition, u, dt, q=self._q_draw)  # eqs. 22-25
+        self._ukf.propagate(self._transition, u, dt,  # eqs. 22-25
+                            q=self._q_step(u) * DRAW_INTERVAL_S)
         self._since_draw += dt
 
-    def _update(self, z: np.ndarray) -> None:
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if self._ukf.sigma is not None:
             self._ukf.covariance()  # eq. 26
-        self._ukf.update(lambda xs: self._measure(xs)[0], z, R_GPS)  # eqs. 27-32
         self._since_draw = 0.0
+        out = self._ukf.update(lambda xs: self._measure(xs)[0], z, r)  # eqs. 27-32
+        if self._datasheet:
+            self._repair_covariance()
+        return out
+
+    def _repair_covariance(self) -> None:
+        """Eq. 29 subtracts K P_yy K^T from P; while the heading points still span half a
+        turn (eq. 33's 180 deg) the points' P_yy and P_xy are not a joint covariance with P,
+        and P can lose its definiteness (a negative heading variance 3 s after moving off,
+        seen on an outage drive). The nearest positive-definite matrix replaces it
+        (``ukf.psd_sqrt``, Higham 1988); the paper's tuning keeps eq. 29 as printed."""
+        if np.linalg.eigvalsh(self._ukf.p)[0] < 0.0:
+            root = psd_sqrt(self._ukf.p)
+            self._ukf.p = root @ root.T
+
+    def _linear_update(self, index: list[int], z: np.ndarray, r: np.ndarray) -> None:
+        """A measurement linear in the states: the Kalman update itself (the points would
+        only approximate it); the next propagation draws fresh points."""
+        if self._ukf.sigma is not None:
+            self._ukf.covariance(redraw=True)
+        self._since_draw = 0.0
+        h = np.eye(len(self._ukf.x))[index]
+        self._ukf.x, self._ukf.p, _ = kf_update(self._ukf.x, self._ukf.p,
+                                                z - self._ukf.x[index], h, r)
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
+        return self._ukf.x, self._ukf.p
+
+    def _predicted(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._ukf.sigma is not None:
+            self._ukf.covariance()  # eq. 26, from the propagated points (kept for the update)
         return self._ukf.x, self._ukf.p

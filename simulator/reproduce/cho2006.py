@@ -16,7 +16,7 @@ Figures per seed (``LABEL.figure``):
 Public names
 ------------
 PAPER, SITUATION1, SITUATION2, SITUATION3, DR_OUTAGE, CONVERGED_DEG, SETTLE_S, DR_HORIZON_S,
-ANGLES_EKF, ANGLES_LARGE, track_errors, heading_label.
+ANGLES_EKF, ANGLES_LARGE, PAPER_CONFIG, track_errors, heading_label.
 """
 
 from __future__ import annotations
@@ -39,6 +39,8 @@ ANGLES_EKF = (-45.0, -90.0)  # the EKF must converge from these (a working EKF)
 ANGLES_LARGE = (-140.0, -160.0, -175.0)  # where the SPKF must be at least as robust
 SITUATION_INIT = {"attitude_error": [0.0, -5.0, -10.0]}  # situations I and III (pitch, heading)
 SHORT = {"dr2d_drm1_ekf": "drm1", "dr2d_drm2_ekf": "ekf", "dr2d_drm2_spkf": "spkf"}
+# the paper's P0, Q and R (eqs. 33-35), named so that the figures do not follow the default
+PAPER_CONFIG = {"tuning": "paper"}
 
 
 def heading_label(name: str, angle_deg: float) -> str:
@@ -96,24 +98,27 @@ SITUATION2 = Experiment(
     key="situation2", scenario="cho2006_situation2.yaml",
     entries={
         **{heading_label("dr2d_drm1_ekf", a): {"name": "dr2d_drm1_ekf",
-                                               "init": {"heading_error": a}}
+                                               "init": {"heading_error": a},
+                                               "config": PAPER_CONFIG}
            for a in (0.0, -45.0, -90.0)},
-        **{heading_label(name, a): {"name": name, "init": {"heading_error": a}}
+        **{heading_label(name, a): {"name": name, "init": {"heading_error": a},
+                                    "config": PAPER_CONFIG}
            for a in (*ANGLES_EKF, *ANGLES_LARGE)
            for name in ("dr2d_drm2_ekf", "dr2d_drm2_spkf")}},
     measure=_heading_rms)
 DR_OUTAGE = Experiment(
     key="dr_outage", scenario="cho2006_dr_outage.yaml",
-    entries={"drm1": {"name": "dr2d_drm1_ekf"}, "drm2": {"name": "dr2d_drm2_ekf"}},
+    entries={"drm1": {"name": "dr2d_drm1_ekf", "config": PAPER_CONFIG},
+             "drm2": {"name": "dr2d_drm2_ekf", "config": PAPER_CONFIG}},
     measure=_dr_error)
 SITUATION1 = Experiment(
     key="situation1", scenario="cho2006_situation1.yaml",
-    entries={SHORT[n]: {"name": n, "init": SITUATION_INIT}
+    entries={SHORT[n]: {"name": n, "init": SITUATION_INIT, "config": PAPER_CONFIG}
              for n in ("dr2d_drm2_ekf", "dr2d_drm2_spkf")},
     measure=_scale_factor)
 SITUATION3 = Experiment(
     key="situation3", scenario="cho2006_situation3.yaml",
-    entries={SHORT[n]: {"name": n, "init": SITUATION_INIT}
+    entries={SHORT[n]: {"name": n, "init": SITUATION_INIT, "config": PAPER_CONFIG}
              for n in ("dr2d_drm2_ekf", "dr2d_drm2_spkf")},
     measure=_outage_errors)
 

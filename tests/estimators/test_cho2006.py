@@ -27,6 +27,7 @@ from simulator.reproduce.measures import moving_off
 from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from simulator.scenario import Scenario, validate_data
+from simulator.scoring.consistency import normalised_errors
 from tests.synthetic import FLAT_LOOP
 
 SEEDS = range(1, 11)
@@ -89,7 +90,9 @@ def test_drm2_transition_matrix_has_the_terms_of_eq_17():
 def test_registered_with_the_spec_config_keys():
     for name in ("dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
         assert "standstill_calibration" in get_estimator(name).defaults
-    assert {"alpha", "beta", "w0"} <= set(get_estimator("dr2d_drm2_spkf").defaults)
+    assert {"alpha", "beta", "w0", "sigma_set"} <= set(get_estimator("dr2d_drm2_spkf").defaults)
+    for name in ("dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
+        assert get_estimator(name).defaults["tuning"] == "datasheet"
 
 
 @pytest.fixture(scope="module")
@@ -168,7 +171,8 @@ def test_increment_output_gives_the_rate_output_solution(root):
 
 
 @pytest.mark.parametrize("config, key", [({"alpha": 0.0}, "alpha"), ({"alpha": 1.5}, "alpha"),
-                                         ({"w0": 1.0}, "w0"), ({"beta": -1.0}, "beta")])
+                                         ({"w0": 1.0}, "w0"), ({"beta": -1.0}, "beta"),
+                                         ({"sigma_set": "cubature"}, "sigma_set")])
 def test_spkf_refuses_parameters_outside_their_ranges(root, config, key):
     ds = _dataset("cho2006_situation2", 1, root)
     with pytest.raises(InputError, match=f"'{key}' of estimator dr2d_drm2_spkf"):
@@ -263,3 +267,62 @@ def test_every_stop_recalibrates_a_drifting_gyro_bias(tmp_path, name):
     between = sol["gyro_bias_z"].to_numpy()[(t > 20.0) & (t < stopped[0])]
     assert np.allclose(between, first, atol=6e-5)
     assert sol["gyro_bias_z"].iloc[-1] == pytest.approx(second, abs=6e-5)
+
+
+# -- consistency of the default (datasheet) tuning -----------------------------------------
+
+CONSISTENCY_SEEDS = (1, 2, 3)
+
+
+def _nse(ds: Dataset, solution) -> dict[str, float]:
+    """Per axis, the mean of (error / sigma)^2 from 60 s after the first row (SPEC section 8),
+    the axes the solution has a sigma for."""
+    nse = normalised_errors(ds.read("truth"), solution)
+    return {axis: value for axis, value in nse.items() if np.isfinite(value)}
+
+
+@pytest.fixture(scope="module")
+def consistency(root):
+    """nse per filter, seed and axis on situation II's road (Crossbow unit, 165 s), no
+    initial error, default tuning."""
+    out = {}
+    for seed in CONSISTENCY_SEEDS:
+        ds = _dataset("cho2006_situation2", seed, root / "consistency", ["estimators=[]"])
+        for name in ("dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"):
+            out[name, seed] = _nse(ds, _run(ds, name))
+    return out
+
+
+@pytest.mark.parametrize("name", ["dr2d_drm1_ekf", "dr2d_drm2_ekf", "dr2d_drm2_spkf"])
+def test_datasheet_tuning_is_never_overconfident_tenfold(consistency, name):
+    """No axis of any seed has a mean squared normalised error above 10 (measured at most 2.2,
+    DRM2's yaw on seed 1); 2-D filters write NaN height and roll (SPEC section 7)."""
+    for seed in CONSISTENCY_SEEDS:
+        nse = consistency[name, seed]
+        assert set(nse) >= {"n", "e", "vn", "ve", "yaw"}
+        assert not {"d", "vd", "roll"} & set(nse)  # NaN: not estimated
+        assert all(value < 10.0 for value in nse.values()), (seed, nse)
+
+
+@pytest.mark.parametrize("name", ["dr2d_drm2_ekf", "dr2d_drm2_spkf"])
+def test_drm2_datasheet_tuning_is_consistent(consistency, name):
+    """Mean over the seeds within 0.3-3 on position, velocity and yaw (measured EKF: north
+    1.19, east 0.88, velocity 1.16 and 1.03, yaw 1.18). Pitch is left out of the mean: it
+    carries the forward accelerometer's bias (the two are one unobservable combination, eq.
+    11), so each seed's pitch error is one
+    draw of that bias over g and three seeds do not pin its mean (measured 0.0-0.4 per seed
+    against a sigma of 1.7 deg from the 30 mg datasheet bias)."""
+    for axis in ("n", "e", "vn", "ve", "yaw"):
+        mean = np.mean([consistency[name, seed][axis] for seed in CONSISTENCY_SEEDS])
+        assert 0.3 < mean < 3.0, (axis, mean)
+
+
+def test_drm1_datasheet_tuning_is_cautious_but_not_tenfold(consistency):
+    """DRM1 sits at the band's lower edge: mean over the seeds measured 0.50 (north), 0.39
+    (east), 0.36 and 0.31 (velocity), 0.37 (yaw). Its accelerometer-bias states take the
+    road's grade and bank as a random walk (its level frame senses g sin(grade), eq. 2), which
+    the 5 % slopes here need and the level stretches do not; a third of that walk lets it
+    diverge on the open road (docs/reproduction_cho2006.md). Asserted: between 0.15 and 3."""
+    for axis in ("n", "e", "vn", "ve", "yaw"):
+        mean = np.mean([consistency["dr2d_drm1_ekf", seed][axis] for seed in CONSISTENCY_SEEDS])
+        assert 0.15 < mean < 3.0, (axis, mean)

@@ -85,3 +85,23 @@ def test_bad_parameters_raise():
         simplex_points(X, P, w0=1.0)
     with pytest.raises(ValueError, match="positive"):
         symmetric_points(X, P, alpha=1.0, kappa=-4.0)
+
+
+def test_simplex_third_moments_are_not_a_gaussians():
+    """A Gaussian's third central moments are zero, so a quadratic function of one variable is
+    uncorrelated with every other (E[x_i^2 x_j] = 0 for independent zero-mean x). The
+    symmetric set keeps that exactly; the spherical simplex set, built axis by axis with one
+    far point per axis (Julier 2003), does not: with unit covariance its weighted E[x_i^2 x_j]
+    is of order alpha for i < j (-0.91 alpha for the first pair, n = 4; -0.15 and -0.27 at
+    alpha = 0.3). In Cho & Choi's SPKF this is what moves the z-gyro scale factor on a
+    straight road under a wide heading prior (docs/reproduction_cho2006.md): the heading
+    points' squared spread, mapped through cos(psi), correlates with the scale factor drawn
+    beside them."""
+    n = 4
+    for alpha in (1.0, 0.3):
+        sym, wm_s, _ = symmetric_points(np.zeros(n), np.eye(n), alpha=alpha, kappa=3.0 - n)
+        simp, wm_p, _ = simplex_points(np.zeros(n), np.eye(n), alpha=alpha)
+        for i, j in ((0, 1), (1, 3), (2, 3)):
+            assert wm_s @ (sym[:, i] ** 2 * sym[:, j]) == pytest.approx(0.0, abs=1e-12)
+            skew = wm_p @ (simp[:, i] ** 2 * simp[:, j])
+            assert abs(skew) > 0.1, (alpha, i, j, skew)
