@@ -85,8 +85,10 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gnss_model, nav_error
+from estimators.toolbox.gating import chi2_threshold
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import (
@@ -115,6 +117,29 @@ PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Veh
 COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
 NHC_POINTS = ("rear_axle", "imu")
+IONO = 17  # the ionosphere-residual state, after the 17 (datasheet tuning)
+GATE_PROBABILITY = 0.999  # chi-square gate of each pseudorange innovation (1 dof: 10.8)
+PSEUDORANGE_STD_FLOOR = 0.1  # m, what is left of a pseudorange's variance at least
+
+
+# the values chosen for the reproduction (the paper prints no P0, Q or R): ``tuning: paper``
+PAPER_TUNING = {
+    "accel_bias_std": 10 * MILLI_G,  # m/s^2, prior
+    "gyro_bias_std": 0.2 * DEG_S,  # rad/s, prior
+    "accel_noise": 0.1 * MILLI_G_RT_HZ * 3,  # m/s^2/sqrt(Hz), velocity random walk (3x datasheet:
+    "gyro_noise": 0.005 * DEG_S_RT_HZ * 3,  # rad/s/sqrt(Hz) unmodelled scale factors, vibration)
+    "accel_bias_walk": 1e-4,  # m/s^2/sqrt(s)
+    "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
+    "gyro_scale_factor": 0.0,  # 1-sigma, with the misalignment: rate-proportional gyro noise
+    # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
+    "pseudorange_correlation_time": 0.0,
+    "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
+}
+TUNINGS = ("datasheet", "paper")
+TUNED_KEYS = tuple(PAPER_TUNING)
+SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
+IONO_CORRELATION_TIME_S = 1800.0  # s: the broadcast ionosphere residual's (docs/gnss-errors.md)
+KLOBUCHAR_RESIDUAL = 0.5  # the broadcast model leaves about half the delay (Klobuchar 1987)
 
 
 DEFAULTS = {
@@ -122,21 +147,16 @@ DEFAULTS = {
     "nhc_std": None,  # m/s, body y and z velocity; None: from the car's physics (docstring)
     "nhc_point": "rear_axle",  # where the NHC holds: rear_axle (the datasheet's) or imu
     "nhc_rate": 1.0,  # Hz, NHC alone when GPS is missing
-    "lever_arm": [0.0, 0.0, 0.0],  # IMU to GPS antenna, body FRD, m
+    "lever_arm": None,  # IMU to GPS antenna, body FRD, m; None: the datasheet's (else zero)
     "initial_position_std": 10.0,  # m per axis
     "initial_velocity_std": 0.5,  # m/s
     "initial_attitude_std": [1.0, 1.0, 3.0],  # deg roll, pitch, yaw
-    "accel_bias_std": 10 * MILLI_G,  # m/s^2, prior
-    "gyro_bias_std": 0.2 * DEG_S,  # rad/s, prior
-    "accel_noise": 0.1 * MILLI_G_RT_HZ * 3,  # m/s^2/sqrt(Hz), velocity random walk (3x datasheet:
-    "gyro_noise": 0.005 * DEG_S_RT_HZ * 3,  # rad/s/sqrt(Hz) unmodelled scale factors, vibration)
-    "accel_bias_walk": 1e-4,  # m/s^2/sqrt(s)
-    "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
+    "tuning": "datasheet",  # datasheet | paper: where the None keys below come from
+    **dict.fromkeys(TUNED_KEYS),  # None: from ``tuning`` (module docstring); a number fixes it
     "pseudorange_std": 3.0,  # m, when the stream reports none
     "range_rate_std": 0.1,  # m/s, when the stream reports none
-    # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
-    "pseudorange_correlation_time": 0.0,
     "gnss_interval": 1.0,  # s, the epoch interval the correlation is counted in
+    "gate_probability": None,  # pseudorange gate; None: 0.999 (datasheet), off (paper)
 }
 
 
@@ -146,7 +166,7 @@ class _TightlyCoupled(Estimator):
 
     needs = ("imu", "gnss_raw")
     paper = PAPER
-    output_columns = (*NAV_COLUMNS, *STD_COLUMNS, *SENSOR_COLUMNS)
+    output_columns = (*NAV_COLUMNS, *STD_COLUMNS, *SENSOR_COLUMNS, "nis_gnss", "nis_gnss_dof")
     defaults = DEFAULTS
 
     def setup(self) -> None:
@@ -155,13 +175,25 @@ class _TightlyCoupled(Estimator):
         self._gyro_idx = [imu[c] for c in ("gyro_x", "gyro_y", "gyro_z")]
         self._accel_idx = [imu[c] for c in ("accel_x", "accel_y", "accel_z")]
         self._increments = self.imu_output == "increment"
-        self._lever = np.asarray(cfg["lever_arm"], dtype=float)
-        self._pr_inflation = gnss_model.correlated_noise_inflation(
-            cfg["pseudorange_correlation_time"], cfg["gnss_interval"])
         if cfg["nhc_point"] not in NHC_POINTS:
             raise InputError(f"config of {self.name}: nhc_point must be one of "
                              f"{', '.join(NHC_POINTS)}, got {cfg['nhc_point']!r}")
+        if cfg["tuning"] not in TUNINGS:
+            raise InputError(f"config of {self.name}: tuning must be one of "
+                             f"{', '.join(TUNINGS)}, got {cfg['tuning']!r}")
         site = Installation.from_datasheet(self.datasheet)
+        lever = cfg["lever_arm"] if cfg["lever_arm"] is not None else site.antenna
+        self._lever = np.zeros(3) if lever is None else np.asarray(lever, dtype=float)
+        self.tuning = self._tuning(cfg)
+        tun = self.tuning
+        self._pr_inflation = gnss_model.correlated_noise_inflation(
+            tun["pseudorange_correlation_time"], cfg["gnss_interval"])
+        self._iono = tun["iono_scale_std"] > 0.0
+        self.n_states = N_STATES + int(self._iono)
+        gate = cfg["gate_probability"]
+        if gate is None and cfg["tuning"] == "datasheet":
+            gate = GATE_PROBABILITY
+        self._gate_p = gate
         self._nhc_point = site.rear_axle if cfg["nhc_point"] == "rear_axle" else None
         self._nhc_physics = (constraints.NonholonomicNoise(site.wheelbase or 2.7)
                              if cfg["nhc_std"] is None and self._nhc_point is not None
@@ -169,20 +201,46 @@ class _TightlyCoupled(Estimator):
         self._t_imu: float | None = None
         self._w_prev = np.zeros(3)
         self._f_prev = np.zeros(3)
+        self._rate_sq = np.zeros(3)  # sum of w^2 dt per body axis since the last Q
         self._clock_started = False
         self._t_update = self.initial.t
         self._next_nhc = np.inf
         self._buf_w: list[np.ndarray] = []
         self._buf_f: list[np.ndarray] = []
         self._buf_dt: list[float] = []
-        p0 = np.zeros(N_STATES)
+        self.nis_gnss = np.nan  # NIS of the last GNSS update and its dof (NaN between them)
+        self.nis_gnss_dof = np.nan
+        p0 = np.zeros(self.n_states)
         p0[0:3] = cfg["initial_position_std"]
         p0[3:6] = cfg["initial_velocity_std"]
         p0[6:9] = np.radians(cfg["initial_attitude_std"])
-        p0[9:12] = cfg["accel_bias_std"]
-        p0[12:15] = cfg["gyro_bias_std"]
+        p0[9:12] = tun["accel_bias_std"]
+        p0[12:15] = tun["gyro_bias_std"]
         p0[15:17] = CLOCK_INIT_STD
+        if self._iono:
+            p0[IONO] = tun["iono_scale_std"]
         self._p0 = np.diag(p0**2)
+
+    def _tuning(self, cfg: dict) -> dict:
+        """P0, Q and R figures: the config's numbers where given, else those of ``tuning``:
+        ``paper`` (``PAPER_TUNING``) or ``datasheet`` (module docstring; the paper's values
+        when the dataset has no IMU datasheet)."""
+        base = dict(PAPER_TUNING)
+        sheet = ImuDatasheet.from_datasheet(self.datasheet)
+        if cfg["tuning"] == "datasheet" and sheet is not None:
+            g, a = sheet.gyro, sheet.accel
+            gravity = 9.80665
+            gnss = self.datasheet.get("gnss") or {}
+            base.update(
+                accel_noise=a.noise_density, gyro_noise=g.noise_density,
+                # the accelerometers' scale factor and misalignment under gravity act as a bias
+                accel_bias_std=float(np.sqrt(a.bias**2 + (gravity * a.scale_factor) ** 2
+                                             + (gravity * a.misalignment) ** 2)),
+                gyro_bias_std=g.bias, accel_bias_walk=a.bias_walk, gyro_bias_walk=g.bias_walk,
+                gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
+                pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
+                iono_scale_std=_iono_scale_std(gnss))
+        return {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
 
     # -- inputs --------------------------------------------------------------------------------
     def _imu_sample(self, t: float, row: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -193,24 +251,41 @@ class _TightlyCoupled(Estimator):
             w, f = w / dt, f / dt
         return w, f, dt
 
-    def process_noise(self, dt: float) -> np.ndarray:
+    def process_noise(self, dt: float, c_bn: np.ndarray) -> np.ndarray:
         """Discrete Q over ``dt`` (s) on the tangent/error state (white accelerometer and gyro
-        noise, bias random walks, the receiver clock)."""
-        cfg = self.config
-        q = np.zeros((N_STATES, N_STATES))
-        q[3:6, 3:6] = np.eye(3) * cfg["accel_noise"] ** 2 * dt
-        q[6:9, 6:9] = np.eye(3) * cfg["gyro_noise"] ** 2 * dt
-        q[9:12, 9:12] = np.eye(3) * cfg["accel_bias_walk"] ** 2 * dt
-        q[12:15, 12:15] = np.eye(3) * cfg["gyro_bias_walk"] ** 2 * dt
+        noise, bias random walks, the receiver clock, the ionosphere state), with the gyro
+        scale-factor and misalignment errors of the rates turned since the last call
+        (``gyro_scale_factor`` s: PSD s^2 w^2 ``SCALE_FACTOR_TIME_S`` per body axis, rotated
+        by the attitude C_b^n)."""
+        tun = self.tuning
+        q = np.zeros((self.n_states, self.n_states))
+        q[3:6, 3:6] = np.eye(3) * tun["accel_noise"] ** 2 * dt
+        q_gyro = np.full(3, tun["gyro_noise"] ** 2 * dt)
+        q_gyro += tun["gyro_scale_factor"] ** 2 * SCALE_FACTOR_TIME_S * self._rate_sq
+        self._rate_sq = np.zeros(3)
+        q[6:9, 6:9] = (c_bn * q_gyro) @ c_bn.T
+        q[9:12, 9:12] = np.eye(3) * tun["accel_bias_walk"] ** 2 * dt
+        q[12:15, 12:15] = np.eye(3) * tun["gyro_bias_walk"] ** 2 * dt
         q[15:17, 15:17] = gnss_model.clock_noise(dt)
+        if self._iono:
+            q[IONO, IONO] = (tun["iono_scale_std"] ** 2
+                             * (1.0 - np.exp(-2.0 * dt / IONO_CORRELATION_TIME_S)))
         return q
 
     def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
+        """R of an epoch's pseudoranges and range rates: the receiver's reported variances
+        (the config's when the stream has none), less the ionosphere residual a state carries
+        (``iono_scale_std`` times the broadcast delay), the rest scaled by the correlated-noise
+        inflation of ``pseudorange_correlation_time``."""
         cfg = self.config
-        pr = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std, cfg["pseudorange_std"])
-        pr = pr * self._pr_inflation
+        var = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
+                       cfg["pseudorange_std"]) ** 2
+        if self._iono:
+            var = np.maximum(var - (self.tuning["iono_scale_std"] * _iono_delay(ep)) ** 2,
+                             PSEUDORANGE_STD_FLOOR**2)
+        var = var * self._pr_inflation**2
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
-        return np.diag(np.concatenate([pr, rr]) ** 2)
+        return np.diag(np.concatenate([var, rr**2]))
 
     def _nhc_noise(self, c_bn: np.ndarray, v: np.ndarray, rate: np.ndarray, f: np.ndarray,
                    pos: np.ndarray) -> np.ndarray:
@@ -253,14 +328,38 @@ class _TightlyCoupled(Estimator):
 
     def _output(self, pos: np.ndarray, v: np.ndarray, q: np.ndarray, biases: np.ndarray,
                 clock: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """A solution row; the attitude sigmas are those of the Euler angles
+        (``nav_error.euler_covariance`` of the psi block); the NIS of the last GNSS update is
+        written once, NaN in the rows after it."""
         roll, pitch, yaw = quat_to_euler(q)
-        std = np.sqrt(np.maximum(np.diag(p)[:9], 0.0))
+        std = np.sqrt(np.maximum(np.diag(p)[:6], 0.0))
+        p_euler = nav_error.euler_covariance(roll, pitch, yaw, p[6:9, 6:9])
+        std_att = np.sqrt(np.maximum(np.diag(p_euler), 0.0))
+        nis = (self.nis_gnss, self.nis_gnss_dof)
+        self.nis_gnss = self.nis_gnss_dof = np.nan
         return np.concatenate([[np.degrees(pos[0]), np.degrees(pos[1]), pos[2], *v, roll, pitch,
-                                yaw], std, biases, clock])
+                                yaw], std, std_att, biases, clock, nis])
+
+    def _gate(self, nu: np.ndarray, s_diag: np.ndarray) -> np.ndarray:
+        """Which of m pseudorange innovations ``nu`` (variances ``s_diag``) pass the chi-square
+        gate of one degree of freedom at ``gate_probability`` (all when it is off): a
+        non-line-of-sight delay of tens of metres fails it (Groves 2013, section 17.3.1).
+        The variance is H P H^T plus the reported (not inflated) R: the correlated-noise
+        inflation sets an epoch's weight in the long run, the innovation of one epoch is
+        distributed with the error's own variance."""
+        if self._gate_p is None:
+            return np.ones(len(nu), dtype=bool)
+        return nu**2 <= chi2_threshold(1, float(self._gate_p)) * s_diag
+
+    def _record_nis(self, nu: np.ndarray, s: np.ndarray) -> None:
+        """NIS nu^T S^-1 nu of the GNSS rows of an update and its dof (SPEC section 8)."""
+        self.nis_gnss = float(nu @ np.linalg.solve(s, nu))
+        self.nis_gnss_dof = float(len(nu))
 
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
         """Buffer the IMU interval ending now (its start sample first); the filters integrate
         a buffer in one compiled call."""
+        self._rate_sq += w**2 * dt
         if not self._buf_dt:
             self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
         self._buf_w.append(w)
@@ -281,6 +380,24 @@ class _TightlyCoupled(Estimator):
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         raise NotImplementedError
+
+
+def _iono_scale_std(receiver: dict) -> float:
+    """1-sigma of the broadcast ionosphere's relative residual from the receiver's datasheet:
+    the true delay is ``iono_scale`` (1 + ``iono_residual`` g) times the broadcast model's
+    (docs/gnss-errors.md), so the residual is (scale - 1) + scale residual g, of rms
+    sqrt((scale - 1)^2 + (scale residual)^2); ``KLOBUCHAR_RESIDUAL`` without a datasheet."""
+    if "iono_scale" not in receiver:
+        return KLOBUCHAR_RESIDUAL
+    scale, residual = float(receiver["iono_scale"]), float(receiver.get("iono_residual", 0.0))
+    return float(np.hypot(scale - 1.0, scale * residual))
+
+
+def _iono_delay(ep: gnss_model.RawEpoch) -> np.ndarray:
+    """The broadcast ionosphere delay of each satellite (m; 0 where the stream has none)."""
+    if ep.iono is None:
+        return np.zeros(len(ep.sv))
+    return np.nan_to_num(ep.iono)
 
 
 def _antenna_ecef(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, lever: np.ndarray,
@@ -351,7 +468,7 @@ def _boxminus(xs: np.ndarray, ref: np.ndarray, rm: float, rt: float) -> np.ndarr
     displacement (m), velocity, the rotation vector of q_i * conj(q_ref) (the NED-frame attitude
     error of ``nav_error``), biases, clock."""
     k = xs.shape[0]
-    out = np.empty((k, N_STATES))
+    out = np.empty((k, ref.shape[0] - 1))
     lat0, lon0, h0 = ref[0], ref[1], ref[2]
     a2, b2, c2, d2 = ref[6], -ref[7], -ref[8], -ref[9]
     for i in range(k):
@@ -370,7 +487,7 @@ def _boxminus(xs: np.ndarray, ref: np.ndarray, rm: float, rt: float) -> np.ndarr
         out[i, 6], out[i, 7], out[i, 8] = x * scale, y * scale, z * scale
         for j in range(3):
             out[i, 3 + j] = xs[i, 3 + j] - ref[3 + j]
-        for j in range(8):  # biases and clock
+        for j in range(ref.shape[0] - 10):  # biases, clock (and the ionosphere state)
             out[i, 9 + j] = xs[i, 10 + j] - ref[10 + j]
     return out
 
@@ -382,7 +499,7 @@ def boxplus(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
     if np.ndim(dx) == 1:
         return boxplus(x, dx[None, :])[0]
     d_lat, d_lon, d_h = geodetic_rates(x[0], x[2], dx[:, 0:3])
-    out = np.empty((len(dx), N_NOMINAL))
+    out = np.empty((len(dx), len(x)))
     out[:, 0], out[:, 1], out[:, 2] = x[0] + d_lat, x[1] + d_lon, x[2] + d_h
     out[:, VEL] = x[VEL] + dx[:, 3:6]
     out[:, QUAT] = quat_multiply(rotvec_to_quat(dx[:, 6:9]), x[QUAT])
@@ -419,7 +536,7 @@ class TcUkf(_TightlyCoupled):
     def setup(self) -> None:
         super().setup()
         init = self.initial
-        x0 = np.zeros(N_NOMINAL)
+        x0 = np.zeros(N_NOMINAL + int(self._iono))
         x0[POS], x0[VEL], x0[QUAT] = init.position, init.velocity, init.quaternion
         self.ukf = SigmaPointFilter(x0, self._p0, points="symmetric",
                                     alpha=self.config["alpha"], beta=self.config["beta"],
@@ -438,7 +555,8 @@ class TcUkf(_TightlyCoupled):
         """Covariance of the propagated points plus Q over the interval (paper step 3)."""
         self._flush()
         if self._propagated:
-            self.ukf.covariance(self.process_noise(t - self._t_update))
+            self.ukf.covariance(self.process_noise(t - self._t_update,
+                                                   quat_to_dcm(self.ukf.x[QUAT])))
             self._t_update = t
             self._propagated = False
 
@@ -468,6 +586,8 @@ class TcUkf(_TightlyCoupled):
             r, v, _ = _antenna_ecef(pts[:, POS], pts[:, VEL], c_bn, self._lever, w_eb)
             pr, rate, _ = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, pts[:, 16],
                                              pts[:, 17])
+            if self._iono:
+                pr = pr + pts[:, N_NOMINAL, None] * _iono_delay(ep)[None, :]
             parts += [pr, rate]
         if nhc:
             rate = self._w_prev[None, :] - pts[:, BG]
@@ -480,12 +600,26 @@ class TcUkf(_TightlyCoupled):
         if ep is None and not nhc:
             return
         self._predict(t)
+        if ep is not None and self._gate_p is not None:
+            ep = self._gated(ep)
         z = [] if ep is None else [ep.pseudorange, ep.range_rate]
         if nhc:
             z.append(np.zeros(2))
         # the driver draws the points of N(x_bar, P^xx + Q), P^xy without R, P -= K P^yy K^T
-        self.ukf.update(self._observe, np.concatenate(z), self.measurement_noise(ep, nhc), ep,
-                        nhc)
+        nu, p_yy = self.ukf.update(self._observe, np.concatenate(z),
+                                   self.measurement_noise(ep, nhc), ep, nhc)
+        if ep is not None:
+            k = 2 * len(ep.sv)
+            self._record_nis(nu[:k], p_yy[:k, :k])
+
+    def _gated(self, ep: gnss_model.RawEpoch) -> gnss_model.RawEpoch:
+        """The epoch without the pseudoranges that fail the gate (``_gate``), their
+        innovations' variances from the sigma points drawn for the update (a satellite that
+        fails keeps no row here, its range rate included)."""
+        m = len(ep.sv)
+        z_hat, p_zz = self.ukf.predict_measurement(self._observe, ep, False)
+        s_pr = np.diag(p_zz)[:m] + np.diag(self._measurement_noise(ep))[:m] / self._pr_inflation**2
+        return gnss_model.select(ep, self._gate(ep.pseudorange - z_hat[:m], s_pr))
 
     def measurement_noise(self, ep: gnss_model.RawEpoch | None, nhc: bool) -> np.ndarray:
         """R of an update at the current state: the epoch's pseudoranges and range rates
@@ -567,6 +701,7 @@ class TcEkf(_TightlyCoupled):
         self._ba = np.zeros(3)
         self._bg = np.zeros(3)
         self._clock = np.zeros(2)
+        self._iono_scale = 0.0  # estimated relative residual of the broadcast ionosphere
         self._err = ErrorState(self._p0)
         self._dth_prev = np.zeros(3)
         self._dv_prev = np.zeros(3)
@@ -593,10 +728,16 @@ class TcEkf(_TightlyCoupled):
         self._dth_prev, self._dv_prev = dth[-1], dv[-1]
         total = float(dt.sum())
         self._clock[0] += self._clock[1] * total
-        fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), dv.sum(axis=0) / total)
+        c_bn = quat_to_dcm(self._q)
+        fm = np.zeros((self.n_states, self.n_states))
+        fm[:N_STATES, :N_STATES] = error_dynamics(self._pos, self._v, c_bn,
+                                                  dv.sum(axis=0) / total)
+        if self._iono:  # first-order Gauss-Markov
+            fm[IONO, IONO] = -1.0 / IONO_CORRELATION_TIME_S
+            self._iono_scale *= np.exp(-total / IONO_CORRELATION_TIME_S)
         fm *= total
-        phi = np.eye(N_STATES) + fm + 0.5 * fm @ fm
-        self._err.predict(phi, self.process_noise(total))
+        phi = np.eye(self.n_states) + fm + 0.5 * fm @ fm
+        self._err.predict(phi, self.process_noise(total, c_bn))
 
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         if len(ep.sv) == 0:
@@ -608,6 +749,7 @@ class TcEkf(_TightlyCoupled):
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         self._flush()
         nhc = bool(self.config["nhc"])
+        n = self.n_states
         dz, rows, noise = [], [], []
         c_bn = quat_to_dcm(self._q)
         if ep is not None:
@@ -617,19 +759,28 @@ class TcEkf(_TightlyCoupled):
                                                self._clock[1])
             u = los @ c_ne  # lines of sight in NED, (m, 3)
             m = len(pr)
-            h_pr = np.zeros((m, N_STATES))
+            h_pr = np.zeros((m, n))
             h_pr[:, 0:3] = -u
             h_pr[:, 6:9] = u @ skew(c_bn @ self._lever)
             h_pr[:, 15] = 1.0
-            h_rr = np.zeros((m, N_STATES))
+            if self._iono:
+                iono = _iono_delay(ep)
+                pr = pr + self._iono_scale * iono
+                h_pr[:, IONO] = iono
+            h_rr = np.zeros((m, n))
             h_rr[:, 3:6] = -u
             h_rr[:, 16] = 1.0
-            dz += [pr - ep.pseudorange, rate - ep.range_rate]
-            rows += [h_pr, h_rr]
-            noise.append(self._measurement_noise(ep))
+            r_gnss = self._measurement_noise(ep)
+            dz_pr = pr - ep.pseudorange
+            s_pr = (np.einsum("ij,jk,ik->i", h_pr, self._err.p, h_pr)
+                    + np.diag(r_gnss)[:m] / self._pr_inflation**2)
+            keep = np.concatenate([self._gate(dz_pr, s_pr), np.ones(m, dtype=bool)])
+            dz.append(np.concatenate([dz_pr, rate - ep.range_rate])[keep])
+            rows.append(np.vstack([h_pr, h_rr])[keep])
+            noise.append(r_gnss[np.ix_(keep, keep)])
         if nhc:
             rate = self._w_prev - self._bg
-            z_nhc, h_nhc = constraints.nonholonomic(self._q, self._v, N_STATES, rate,
+            z_nhc, h_nhc = constraints.nonholonomic(self._q, self._v, n, rate,
                                                     self._nhc_point, slice(12, 15))
             dz.append(z_nhc)
             rows.append(h_nhc)
@@ -637,12 +788,17 @@ class TcEkf(_TightlyCoupled):
                                          self._pos))
         if not dz:
             return
-        self._err.update(np.concatenate(dz), np.vstack(rows), _block_diagonal(noise))
+        s = self._err.update(np.concatenate(dz), np.vstack(rows), _block_diagonal(noise))
+        if ep is not None:  # closed loop: the error estimate was zero, the innovation is -dz
+            k = len(dz[0])
+            self._record_nis(dz[0], s[:k, :k])
         dx = self._err.feedback()
         self._q, self._v, self._pos = nav_error.correct(self._q, self._v, self._pos, dx[0:9])
         self._ba = self._ba - dx[9:12]
         self._bg = self._bg - dx[12:15]
         self._clock = self._clock - dx[15:17]
+        if self._iono:
+            self._iono_scale -= dx[IONO]
 
     def solution(self, t: float) -> np.ndarray:
         self._flush()

@@ -12,11 +12,13 @@ Errors are estimate minus truth, as in the NED-frame INS error states of Groves 
 
 The 9-vector dx = [dr, dv, psi] is the navigation block of an error state; ``correct`` removes
 estimated errors from a solution (closed-loop feedback, or open-loop output) and ``perturb``
-adds them (initial errors, tests).
+adds them (initial errors, tests). ``euler_covariance`` turns the covariance of psi into that of
+the roll, pitch and yaw errors a solution reports (its ``std_roll ... std_yaw`` columns, which
+the scores compare with Euler-angle errors).
 
 Public names
 ------------
-NAV_ERROR_STATES, perturb, correct.
+NAV_ERROR_STATES, perturb, correct, euler_covariance.
 """
 
 from __future__ import annotations
@@ -59,3 +61,19 @@ def correct(q: np.ndarray, v: np.ndarray, pos: np.ndarray, dx: np.ndarray
     dx = np.asarray(dx, dtype=float)
     q_new = quat_multiply(rotvec_to_quat(-dx[6:9]), q)
     return q_new, np.asarray(v, float) - dx[3:6], _shift(np.asarray(pos, float), -dx[0:3])
+
+
+def euler_covariance(roll: float, pitch: float, yaw: float, p_psi: np.ndarray) -> np.ndarray:
+    """Covariance (3, 3) of the ZYX Euler-angle errors [d roll, d pitch, d yaw] (rad^2) of an
+    attitude whose NED-frame error psi has covariance ``p_psi`` (3, 3).
+
+    To first order psi = E d_euler, the columns of E being the axes the three angles turn
+    about, resolved in NED: the body x axis C_b^n [1, 0, 0] = [cos p cos y, cos p sin y,
+    -sin p] (roll), the once-yawed y axis [-sin y, cos y, 0] (pitch) and the NED z axis (yaw)
+    (differentiating C_b^n of Groves 2013, eq. 2.22); so P_euler = E^-1 P_psi E^-T.
+    The roll and pitch of a level car are psi_n and psi_e rotated by the yaw, not psi_n and
+    psi_e themselves. Singular at pitch +-90 deg."""
+    cp, sp, cy, sy = np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
+    e = np.array([[cp * cy, -sy, 0.0], [cp * sy, cy, 0.0], [-sp, 0.0, 1.0]])
+    e_inv = np.linalg.inv(e)
+    return e_inv @ p_psi @ e_inv.T
