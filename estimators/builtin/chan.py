@@ -84,8 +84,7 @@ import numpy as np
 from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
-from estimators.toolbox import constraints, gnss_model, nav_error
-from estimators.toolbox.gating import chi2_threshold
+from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
@@ -239,8 +238,12 @@ class _TightlyCoupled(Estimator):
                 gyro_bias_std=g.bias, accel_bias_walk=a.bias_walk, gyro_bias_walk=g.bias_walk,
                 gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
-                iono_scale_std=_iono_scale_std(gnss))
-        return {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
+                iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
+                iono_common=_iono_residual(gnss)[0])
+        tuned = {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
+        tuned["iono_common"] = min(base.get("iono_common", tuned["iono_scale_std"]),
+                                   tuned["iono_scale_std"])
+        return tuned
 
     # -- inputs --------------------------------------------------------------------------------
     def _imu_sample(self, t: float, row: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -274,14 +277,15 @@ class _TightlyCoupled(Estimator):
 
     def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """R of an epoch's pseudoranges and range rates: the receiver's reported variances
-        (the config's when the stream has none), less the ionosphere residual a state carries
-        (``iono_scale_std`` times the broadcast delay), the rest scaled by the correlated-noise
+        (the config's when the stream has none), less the ionosphere residual common to the
+        satellites, which the state carries (``_iono_residual``: the part of the field that
+        differs between satellites stays in R), the rest scaled by the correlated-noise
         inflation of ``pseudorange_correlation_time``."""
         cfg = self.config
         var = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
                        cfg["pseudorange_std"]) ** 2
         if self._iono:
-            var = np.maximum(var - (self.tuning["iono_scale_std"] * _iono_delay(ep)) ** 2,
+            var = np.maximum(var - (self.tuning["iono_common"] * _iono_delay(ep)) ** 2,
                              PSEUDORANGE_STD_FLOOR**2)
         var = var * self._pr_inflation**2
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
@@ -349,11 +353,11 @@ class _TightlyCoupled(Estimator):
         distributed with the error's own variance."""
         if self._gate_p is None:
             return np.ones(len(nu), dtype=bool)
-        return nu**2 <= chi2_threshold(1, float(self._gate_p)) * s_diag
+        return gating.rows_passing(nu, s_diag, float(self._gate_p))
 
     def _record_nis(self, nu: np.ndarray, s: np.ndarray) -> None:
         """NIS nu^T S^-1 nu of the GNSS rows of an update and its dof (SPEC section 8)."""
-        self.nis_gnss = float(nu @ np.linalg.solve(s, nu))
+        self.nis_gnss = gating.normalised_innovation_squared(nu, s)
         self.nis_gnss_dof = float(len(nu))
 
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
@@ -382,15 +386,16 @@ class _TightlyCoupled(Estimator):
         raise NotImplementedError
 
 
-def _iono_scale_std(receiver: dict) -> float:
-    """1-sigma of the broadcast ionosphere's relative residual from the receiver's datasheet:
-    the true delay is ``iono_scale`` (1 + ``iono_residual`` g) times the broadcast model's
-    (docs/gnss-errors.md), so the residual is (scale - 1) + scale residual g, of rms
-    sqrt((scale - 1)^2 + (scale residual)^2); ``KLOBUCHAR_RESIDUAL`` without a datasheet."""
+def _iono_residual(receiver: dict) -> tuple[float, float]:
+    """The broadcast ionosphere's relative residual from the receiver's datasheet: the true
+    delay is ``iono_scale`` (1 + ``iono_residual`` g) times the broadcast model's, g a field
+    over the sky (docs/gnss-errors.md), so the residual is (scale - 1) + scale residual g.
+    Returns its part common to the satellites, |scale - 1|, and the 1-sigma of the field's,
+    scale residual (``KLOBUCHAR_RESIDUAL`` and 0 without a datasheet)."""
     if "iono_scale" not in receiver:
-        return KLOBUCHAR_RESIDUAL
+        return KLOBUCHAR_RESIDUAL, 0.0
     scale, residual = float(receiver["iono_scale"]), float(receiver.get("iono_residual", 0.0))
-    return float(np.hypot(scale - 1.0, scale * residual))
+    return abs(scale - 1.0), scale * residual
 
 
 def _iono_delay(ep: gnss_model.RawEpoch) -> np.ndarray:
