@@ -87,6 +87,7 @@ from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.range_bias import RangeBiasChannels
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
@@ -133,10 +134,19 @@ PAPER_TUNING = {
     # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
     "pseudorange_correlation_time": 0.0,
     "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
+    "range_bias_channels": 0,  # per-satellite range-error states (0: none)
 }
 TUNINGS = ("datasheet", "paper")
 TUNED_KEYS = tuple(PAPER_TUNING)
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
+RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
+RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
+# the share of the ionosphere field's 1-sigma that differs between satellites: their pierce
+# points on the 350 km shell lie up to about a thousand km apart and the field's correlation
+# is exp(-d^2 / (2 L^2)), L = 1000 km (docs/gnss-errors.md): about 0.75 at a typical 750 km,
+# so sqrt(1 - 0.75) of it is each satellite's own, the rest common (the ionosphere state)
+IONO_FIELD_OWN_SHARE = 0.5
+SIS_ERROR_M = 0.5  # m: the signal-in-space error without a receiver datasheet (IS-GPS-200 URA)
 IONO_CORRELATION_TIME_S = 1800.0  # s: the broadcast ionosphere residual's (docs/gnss-errors.md)
 KLOBUCHAR_RESIDUAL = 0.5  # the broadcast model leaves about half the delay (Klobuchar 1987)
 
@@ -189,6 +199,16 @@ class _TightlyCoupled(Estimator):
             tun["pseudorange_correlation_time"], cfg["gnss_interval"])
         self._iono = tun["iono_scale_std"] > 0.0
         self.n_states = N_STATES + int(self._iono)
+        n_channels = int(tun["range_bias_channels"])
+        self._channels = (RangeBiasChannels(self.n_states, n_channels, RANGE_BIAS_TIME_S)
+                          if n_channels > 0 else None)
+        self.n_states += n_channels
+        gnss = self.datasheet.get("gnss") or {}
+        self._sis = float(gnss.get("sis_error", SIS_ERROR_M))
+        self._iono_field = _iono_residual(gnss)[1]
+        # 1 / correlation time of the states after the 17 (Gauss-Markov), 1/s
+        self._inv_tau = np.r_[np.full(int(self._iono), 1.0 / IONO_CORRELATION_TIME_S),
+                              np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S)]
         gate = cfg["gate_probability"]
         if gate is None and cfg["tuning"] == "datasheet":
             gate = GATE_PROBABILITY
@@ -239,7 +259,7 @@ class _TightlyCoupled(Estimator):
                 gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
                 iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
-                iono_common=_iono_residual(gnss)[0])
+                iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
         tuned = {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
         tuned["iono_common"] = min(base.get("iono_common", tuned["iono_scale_std"]),
                                    tuned["iono_scale_std"])
@@ -273,23 +293,46 @@ class _TightlyCoupled(Estimator):
         if self._iono:
             q[IONO, IONO] = (tun["iono_scale_std"] ** 2
                              * (1.0 - np.exp(-2.0 * dt / IONO_CORRELATION_TIME_S)))
+        if self._channels is not None:
+            ch = slice(self._channels.first, self.n_states)
+            q[ch, ch] = np.diag(self._channels.transition(dt)[1])
         return q
 
     def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """R of an epoch's pseudoranges and range rates: the receiver's reported variances
-        (the config's when the stream has none), less the ionosphere residual common to the
-        satellites, which the state carries (``_iono_residual``: the part of the field that
-        differs between satellites stays in R), the rest scaled by the correlated-noise
-        inflation of ``pseudorange_correlation_time``."""
+        (the config's when the stream has none), less what states carry: the ionosphere
+        residual common to the satellites (``_iono_residual``) and each satellite's slowly
+        varying error (``_range_bias_sigma``); the rest (tracking noise and multipath after the
+        carrier smoothing) scaled by the correlated-noise inflation of
+        ``pseudorange_correlation_time``."""
         cfg = self.config
         var = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
                        cfg["pseudorange_std"]) ** 2
         if self._iono:
-            var = np.maximum(var - (self.tuning["iono_common"] * _iono_delay(ep)) ** 2,
-                             PSEUDORANGE_STD_FLOOR**2)
+            var = var - (self.tuning["iono_common"] * _iono_delay(ep)) ** 2
+        if self._channels is not None:
+            var = var - self._range_bias_sigma(ep) ** 2
+        var = np.maximum(var, PSEUDORANGE_STD_FLOOR**2)
         var = var * self._pr_inflation**2
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
         return np.diag(np.concatenate([var, rr**2]))
+
+    def _range_bias_sigma(self, ep: gnss_model.RawEpoch) -> np.ndarray:
+        """Prior 1-sigma (m) of each satellite's range-error state: the signal-in-space error
+        and the satellite's own share of the ionosphere field, sqrt(sis^2 + (s field I)^2),
+        s = ``IONO_FIELD_OWN_SHARE``, I the broadcast delay (``_iono_residual``)."""
+        return np.hypot(self._sis, IONO_FIELD_OWN_SHARE * self._iono_field * _iono_delay(ep))
+
+    def _channel_rows(self, ep: gnss_model.RawEpoch, t: float, p: np.ndarray
+                      ) -> tuple[gnss_model.RawEpoch, np.ndarray, np.ndarray]:
+        """The epoch's satellites that have a range-error channel, their state indices and
+        which of them are new to their channel (reset in ``p``); without channels, the epoch
+        and empty index arrays."""
+        if self._channels is None:
+            return ep, np.zeros(0, dtype=int), np.zeros(0, dtype=bool)
+        idx, new = self._channels.assign(ep.sv, t, self._range_bias_sigma(ep), p)
+        keep = idx >= 0
+        return gnss_model.select(ep, keep), idx[keep], new[keep]
 
     def _nhc_noise(self, c_bn: np.ndarray, v: np.ndarray, rate: np.ndarray, f: np.ndarray,
                    pos: np.ndarray) -> np.ndarray:
@@ -518,11 +561,14 @@ def boxminus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
     return _boxminus(np.ascontiguousarray(xs), x, float(rm), float(rt))
 
 
-def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray
-        ) -> np.ndarray:
-    """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook)."""
+def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
+        inv_tau: np.ndarray) -> np.ndarray:
+    """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook); the
+    Gauss-Markov states after the nominal 18 decay with their 1 / correlation times
+    ``inv_tau``."""
     points = np.ascontiguousarray(points)
     _propagate_points(points, w, f, dt)
+    points[:, N_NOMINAL:] *= np.exp(-float(dt.sum()) * inv_tau)
     return points
 
 
@@ -541,19 +587,20 @@ class TcUkf(_TightlyCoupled):
     def setup(self) -> None:
         super().setup()
         init = self.initial
-        x0 = np.zeros(N_NOMINAL + int(self._iono))
+        x0 = np.zeros(N_NOMINAL + self.n_states - N_STATES)
         x0[POS], x0[VEL], x0[QUAT] = init.position, init.velocity, init.quaternion
         self.ukf = SigmaPointFilter(x0, self._p0, points="symmetric",
                                     alpha=self.config["alpha"], beta=self.config["beta"],
                                     boxplus=boxplus, boxminus=boxminus)
         self._propagated = False  # points moved since the covariance was last formed
+        self._channel = np.zeros(0, dtype=int)  # range-error states of the epoch's satellites
 
     # -- propagation ---------------------------------------------------------------------------
     def _flush(self) -> None:
         """Move the sigma points (drawn at the last update) through the buffered IMU samples;
         the driver sets the mean (paper steps 2-3)."""
         if self._buf_dt:
-            self.ukf.propagate(_fx, *self._take_buffer())
+            self.ukf.propagate(_fx, *self._take_buffer(), self._inv_tau)
             self._propagated = True
 
     def _predict(self, t: float) -> None:
@@ -593,6 +640,7 @@ class TcUkf(_TightlyCoupled):
                                              pts[:, 17])
             if self._iono:
                 pr = pr + pts[:, N_NOMINAL, None] * _iono_delay(ep)[None, :]
+            pr = pr + pts[:, self._channel + 1]  # tangent index + 1: the quaternion's 4
             parts += [pr, rate]
         if nhc:
             rate = self._w_prev[None, :] - pts[:, BG]
@@ -605,6 +653,14 @@ class TcUkf(_TightlyCoupled):
         if ep is None and not nhc:
             return
         self._predict(t)
+        if ep is not None:
+            ep, self._channel, new = self._channel_rows(ep, t, self.ukf.p)
+            self.ukf.x[self._channel[new] + 1] = 0.0
+            self.ukf.sigma = None  # drawn from the reset channels
+            if len(ep.sv) == 0:
+                ep = None
+                if not nhc:
+                    return
         if ep is not None and self._gate_p is not None:
             ep = self._gated(ep)
         z = [] if ep is None else [ep.pseudorange, ep.range_rate]
@@ -623,8 +679,11 @@ class TcUkf(_TightlyCoupled):
         fails keeps no row here, its range rate included)."""
         m = len(ep.sv)
         z_hat, p_zz = self.ukf.predict_measurement(self._observe, ep, False)
-        s_pr = np.diag(p_zz)[:m] + np.diag(self._measurement_noise(ep))[:m] / self._pr_inflation**2
-        return gnss_model.select(ep, self._gate(ep.pseudorange - z_hat[:m], s_pr))
+        s_pr = (np.diag(p_zz)[:m]
+                + np.diag(self._measurement_noise(ep))[:m] / self._pr_inflation**2)
+        keep = self._gate(ep.pseudorange - z_hat[:m], s_pr)
+        self._channel = self._channel[keep]
+        return gnss_model.select(ep, keep)
 
     def measurement_noise(self, ep: gnss_model.RawEpoch | None, nhc: bool) -> np.ndarray:
         """R of an update at the current state: the epoch's pseudoranges and range rates
@@ -706,7 +765,7 @@ class TcEkf(_TightlyCoupled):
         self._ba = np.zeros(3)
         self._bg = np.zeros(3)
         self._clock = np.zeros(2)
-        self._iono_scale = 0.0  # estimated relative residual of the broadcast ionosphere
+        self._extra = np.zeros(self.n_states - N_STATES)  # ionosphere, range-error estimates
         self._err = ErrorState(self._p0)
         self._dth_prev = np.zeros(3)
         self._dv_prev = np.zeros(3)
@@ -737,9 +796,9 @@ class TcEkf(_TightlyCoupled):
         fm = np.zeros((self.n_states, self.n_states))
         fm[:N_STATES, :N_STATES] = error_dynamics(self._pos, self._v, c_bn,
                                                   dv.sum(axis=0) / total)
-        if self._iono:  # first-order Gauss-Markov
-            fm[IONO, IONO] = -1.0 / IONO_CORRELATION_TIME_S
-            self._iono_scale *= np.exp(-total / IONO_CORRELATION_TIME_S)
+        extra = np.arange(N_STATES, self.n_states)  # first-order Gauss-Markov states
+        fm[extra, extra] = -self._inv_tau
+        self._extra *= np.exp(-total * self._inv_tau)
         fm *= total
         phi = np.eye(self.n_states) + fm + 0.5 * fm @ fm
         self._err.predict(phi, self.process_noise(total, c_bn))
@@ -758,6 +817,11 @@ class TcEkf(_TightlyCoupled):
         dz, rows, noise = [], [], []
         c_bn = quat_to_dcm(self._q)
         if ep is not None:
+            ep, channel, new = self._channel_rows(ep, t, self._err.p)
+            self._extra[channel[new] - N_STATES] = 0.0
+            if len(ep.sv) == 0:
+                ep = None
+        if ep is not None:
             w_eb = self._w_prev - self._bg - _earth_rate_body(c_bn, self._pos[0])
             r, v, c_ne = _antenna_ecef(self._pos, self._v, c_bn, self._lever, w_eb)
             pr, rate, los = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, self._clock[0],
@@ -770,8 +834,10 @@ class TcEkf(_TightlyCoupled):
             h_pr[:, 15] = 1.0
             if self._iono:
                 iono = _iono_delay(ep)
-                pr = pr + self._iono_scale * iono
+                pr = pr + self._extra[IONO - N_STATES] * iono
                 h_pr[:, IONO] = iono
+            pr = pr + self._extra[channel - N_STATES]
+            h_pr[np.arange(m), channel] = 1.0
             h_rr = np.zeros((m, n))
             h_rr[:, 3:6] = -u
             h_rr[:, 16] = 1.0
@@ -802,8 +868,7 @@ class TcEkf(_TightlyCoupled):
         self._ba = self._ba - dx[9:12]
         self._bg = self._bg - dx[12:15]
         self._clock = self._clock - dx[15:17]
-        if self._iono:
-            self._iono_scale -= dx[IONO]
+        self._extra -= dx[N_STATES:]
 
     def solution(self, t: float) -> np.ndarray:
         self._flush()
