@@ -131,6 +131,7 @@ PAPER_TUNING = {
     "accel_bias_walk": 1e-4,  # m/s^2/sqrt(s)
     "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
     "gyro_scale_factor": 0.0,  # 1-sigma, with the misalignment: rate-proportional gyro noise
+    "accel_scale_factor": 0.0,  # the same for the accelerometers, on the non-gravity force
     # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
     "pseudorange_correlation_time": 0.0,
     "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
@@ -138,6 +139,7 @@ PAPER_TUNING = {
 }
 TUNINGS = ("datasheet", "paper")
 TUNED_KEYS = tuple(PAPER_TUNING)
+STANDARD_GRAVITY = 9.80665  # m/s^2
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
 RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
 RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
@@ -221,6 +223,7 @@ class _TightlyCoupled(Estimator):
         self._w_prev = np.zeros(3)
         self._f_prev = np.zeros(3)
         self._rate_sq = np.zeros(3)  # sum of w^2 dt per body axis since the last Q
+        self._force_sq = np.zeros(3)  # the same of the specific force less 1 g down
         self._clock_started = False
         self._t_update = self.initial.t
         self._next_nhc = np.inf
@@ -248,7 +251,7 @@ class _TightlyCoupled(Estimator):
         sheet = ImuDatasheet.from_datasheet(self.datasheet)
         if cfg["tuning"] == "datasheet" and sheet is not None:
             g, a = sheet.gyro, sheet.accel
-            gravity = 9.80665
+            gravity = STANDARD_GRAVITY
             gnss = self.datasheet.get("gnss") or {}
             base.update(
                 accel_noise=a.noise_density, gyro_noise=g.noise_density,
@@ -257,6 +260,7 @@ class _TightlyCoupled(Estimator):
                                              + (gravity * a.misalignment) ** 2)),
                 gyro_bias_std=g.bias, accel_bias_walk=a.bias_walk, gyro_bias_walk=g.bias_walk,
                 gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
+                accel_scale_factor=float(np.hypot(a.scale_factor, a.misalignment)),
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
                 iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
                 iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
@@ -279,10 +283,15 @@ class _TightlyCoupled(Estimator):
         noise, bias random walks, the receiver clock, the ionosphere state), with the gyro
         scale-factor and misalignment errors of the rates turned since the last call
         (``gyro_scale_factor`` s: PSD s^2 w^2 ``SCALE_FACTOR_TIME_S`` per body axis, rotated
-        by the attitude C_b^n)."""
+        by the attitude C_b^n), and the accelerometers' on the specific force less the 1 g
+        of a level car (under gravity alone the error is constant: a bias the states
+        carry)."""
         tun = self.tuning
         q = np.zeros((self.n_states, self.n_states))
-        q[3:6, 3:6] = np.eye(3) * tun["accel_noise"] ** 2 * dt
+        q_accel = np.full(3, tun["accel_noise"] ** 2 * dt)
+        q_accel += tun["accel_scale_factor"] ** 2 * SCALE_FACTOR_TIME_S * self._force_sq
+        self._force_sq = np.zeros(3)
+        q[3:6, 3:6] = (c_bn * q_accel) @ c_bn.T
         q_gyro = np.full(3, tun["gyro_noise"] ** 2 * dt)
         q_gyro += tun["gyro_scale_factor"] ** 2 * SCALE_FACTOR_TIME_S * self._rate_sq
         self._rate_sq = np.zeros(3)
@@ -407,6 +416,7 @@ class _TightlyCoupled(Estimator):
         """Buffer the IMU interval ending now (its start sample first); the filters integrate
         a buffer in one compiled call."""
         self._rate_sq += w**2 * dt
+        self._force_sq += (f + np.array([0.0, 0.0, STANDARD_GRAVITY])) ** 2 * dt
         if not self._buf_dt:
             self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
         self._buf_w.append(w)
