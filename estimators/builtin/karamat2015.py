@@ -290,6 +290,7 @@ class RissTcEkf(Estimator):
         rear = Installation.from_datasheet(self.datasheet).rear_axle
         self._arm = -rear if rear is not None and cfg["nhc_point"] == "rear_axle" else None
         self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
+        self._heading_offset = 0.0  # direction of travel minus azimuth state, while moving
         d_e, d_n, _, _ = self._arm_offset()
         self._lat, self._lon = self._moved(-d_n, -d_e)  # the rear axle at the start (at rest)
         self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n]]))
@@ -488,11 +489,15 @@ class RissTcEkf(Estimator):
 
     def _heading(self) -> float:
         """The direction of travel: the horizontal velocity's direction (against it while
-        reversing) when moving, else the azimuth state."""
+        reversing) when moving; at a standstill the last one, turned since by the azimuth
+        state (the azimuth state itself drifts from the heading by up to tens of degrees,
+        module docstring)."""
         if abs(self._vo) > 1.0 and math.hypot(self._ve, self._vn) > 0.5:
             sign = 1.0 if self._vo > 0.0 else -1.0
-            return math.atan2(sign * self._ve, sign * self._vn)
-        return self._az
+            heading = math.atan2(sign * self._ve, sign * self._vn)
+            self._heading_offset = float(wrap_angle(heading - self._az))
+            return heading
+        return float(wrap_angle(self._az + self._heading_offset))
 
     def _noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Gauss-Markov transition factors and the discrete process noise Q_d over ``dt``
