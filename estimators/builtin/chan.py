@@ -46,19 +46,44 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   the rows of every sigma point with ``constraints.body_velocity_points``. It is stacked with
   the GPS measurements at each GPS epoch and applied alone at 1 Hz when an expected GPS epoch
   has not come half an interval after its time (complete outages).
-* Not printed: P0, Q, R. P0: ``initial_position_std`` per axis (10 m), 0.5 m/s, 1 deg roll and
-  pitch, 3 deg yaw, the bias priors of an automotive MEMS IMU (10 mg, 0.2 deg/s), cb and d taken
-  from the first GPS epoch's residuals with 30 m and 3 m/s. Q: white noise of the IMU (config
-  ``accel_noise``, ``gyro_noise``, velocity and angle random walks of the automotive MEMS
-  preset), small bias random walks, and the receiver-clock model of a TCXO
-  (``gnss_model.clock_noise``). R: the receiver's reported pseudorange and pseudorange-rate
-  1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``); the config's
-  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them; white,
-  as the paper treats them, unless ``pseudorange_correlation_time`` (s) names the correlation
-  time of the pseudorange errors, which scales their sigma by
-  ``gnss_model.correlated_noise_inflation`` (a receiver's errors are correlated over its carrier
-  smoothing and longer: with white R the filters' position NEES is 40-90 on open sky,
-  docs/reproduction_chan.md).
+* Not printed: P0, Q, R. Two settings, ``tuning``:
+
+  - ``paper`` (what the reproduction, ``simulator/reproduce/chan.py``, uses, so that its
+    figures do not move): P0 ``initial_position_std`` per axis (10 m), 0.5 m/s, 1 deg roll and
+    pitch, 3 deg yaw, the bias priors of an automotive MEMS IMU (10 mg, 0.2 deg/s), cb and d
+    from the first GPS epoch's residuals with 30 m and 3 m/s; Q 3x the automotive preset's
+    white noise, small bias random walks, the TCXO clock (``gnss_model.clock_noise``); R the
+    receiver's reported 1-sigma of each signal (the config's ``pseudorange_std``, 3 m, and
+    ``range_rate_std``, 0.1 m/s, when the stream lacks them), white, as the paper treats
+    them; no gate (``PAPER_TUNING``).
+  - ``datasheet`` (the default): what a user knows from the dataset's datasheet
+    (``toolbox.sensor_datasheet``): the noise densities; the bias priors are the turn-on
+    biases (the accelerometers' with their scale factor and misalignment under 1 g), the bias
+    walks the rate random walk with the bias instability; the gyro and accelerometer scale
+    factors and misalignments times the rate and the non-gravity specific force as extra
+    white noise over ``SCALE_FACTOR_TIME_S`` (a constant scale-factor error adds up over a
+    turn, which a white Q only approximates). The receiver's pseudorange errors are
+    correlated in time (docs/gnss-errors.md), so R white at 1 Hz made the filters 10-1000x
+    over-confident (position NEES 40-1989). Modelled as states instead: one Gauss-Markov
+    ionosphere state (the broadcast model's relative residual, a row of the broadcast delay
+    I on every pseudorange; prior sqrt((scale - 1)^2 + (scale residual)^2) of the receiver
+    datasheet's ``iono_scale``, ``iono_residual``; 30 min) and one range-error state per
+    satellite (``toolbox.range_bias``, 16 channels, 30 min: the signal-in-space error and the
+    satellite's own share of the ionosphere field, ``IONO_FIELD_OWN_SHARE``); R keeps the
+    rest of the reported variance (tracking noise and multipath after the carrier smoothing),
+    scaled by the correlated-noise inflation of the datasheet's ``carrier_smoothing``
+    (``gnss_model.correlated_noise_inflation``). A chi-square gate (1 dof, probability
+    ``gate_probability``, 0.999) drops each pseudorange whose innovation is not plausible
+    against H P H^T plus its reported (uninflated) variance: the NLOS delays of a street
+    canyon, tens of metres, which no reported sigma contains (Groves 2013, section 17.3.1;
+    the EKF keeps that satellite's range rate, the UKF drops both rows).
+
+  Each of the ``TUNED_KEYS`` given as a number in the config overrides the setting's value.
+  The antenna lever arm is the datasheet's ``antenna_lever_arm`` unless ``lever_arm`` is given.
+  The solution's attitude sigmas are those of roll, pitch and yaw
+  (``nav_error.euler_covariance``; the psi-frame sigmas were written as roll and pitch before,
+  which misstated the tilt sigmas by the heading's rotation), and ``nis_gnss``,
+  ``nis_gnss_dof`` give the NIS of each GNSS update's rows (SPEC section 8).
 * The EKF (eqs. 4-6): position error rate dr' = dv as printed (eq. 4), velocity and attitude error
   equations in the psi convention of ``nav_error`` (eq. 5: -[f^n x] psi - C_b^n dba
   - (2 w_ie + w_en) x dv - (2 dw_ie + dw_en) x v; eq. 6: psi' = -w_in x psi - C_b^n dbg - dw_in,

@@ -80,7 +80,23 @@ update the estimated errors are removed from the navigation state and sensor-err
 The Gauss-Markov tilt and odometer-acceleration corrections decay as their models do.
 
 The Gauss-Markov parameters are images lost from our copy of the paper; chosen here from the
-IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md).
+IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md). That is
+``tuning: paper``, which the reproduction (``simulator/reproduce/karamat2015.py``) names so that
+its figures do not move. ``tuning: datasheet`` (the default) takes what a user knows of the
+dataset's sensors (``toolbox.sensor_datasheet``): the gyro and accelerometer bias priors are
+their turn-on biases (the accelerometers' with scale factor and misalignment under 1 g), the
+biases' Gauss-Markov driving noise the datasheet's bias walk, the azimuth's white noise the
+gyro's noise density plus its scale factor and misalignment times the turn rate over
+``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
+correlated-noise inflation of the receiver's carrier smoothing
+(``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
+``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
+of a canyon. ``nis_gnss`` and ``nis_gnss_dof`` give the NIS of each GNSS update (SPEC section
+8). At a standstill the reported heading is the last direction of travel turned by the
+azimuth state since (the azimuth state itself was reported before, tens of degrees off). No
+velocity, roll or pitch sigma is written: the mechanisation recomputes the velocity from the
+odometer and the tilt from the accelerometers at every step (eqs. 2-6), so the covariance of
+the velocity and tilt states does not describe the reported values.
 
 Public names
 ------------
