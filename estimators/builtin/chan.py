@@ -157,6 +157,7 @@ PAPER_TUNING = {
     "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
     "gyro_scale_factor": 0.0,  # 1-sigma, with the misalignment: rate-proportional gyro noise
     "accel_scale_factor": 0.0,  # the same for the accelerometers, on the non-gravity force
+    "gyro_z_scale_factor_std": 0.0,  # prior of a z-gyro scale-factor state (0: no state)
     # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
     "pseudorange_correlation_time": 0.0,
     "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
@@ -230,12 +231,18 @@ class _TightlyCoupled(Estimator):
         self._channels = (RangeBiasChannels(self.n_states, n_channels, RANGE_BIAS_TIME_S)
                           if n_channels > 0 else None)
         self.n_states += n_channels
+        # the z gyro's scale-factor error: the last state (a car turns about z: a constant
+        # error adds up over every turn one way, 11 deg over the garage's six helix turns at
+        # 0.5 %, which no white Q describes)
+        self._sf = self.n_states if tun["gyro_z_scale_factor_std"] > 0.0 else None
+        self.n_states += int(self._sf is not None)
         gnss = self.datasheet.get("gnss") or {}
         self._sis = float(gnss.get("sis_error", SIS_ERROR_M))
         self._iono_field = _iono_residual(gnss)[1]
         # 1 / correlation time of the states after the 17 (Gauss-Markov), 1/s
         self._inv_tau = np.r_[np.full(int(self._iono), 1.0 / IONO_CORRELATION_TIME_S),
-                              np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S)]
+                              np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S),
+                              np.zeros(int(self._sf is not None))]
         gate = cfg["gate_probability"]
         if gate is None and cfg["tuning"] == "datasheet":
             gate = GATE_PROBABILITY
@@ -266,6 +273,8 @@ class _TightlyCoupled(Estimator):
         p0[15:17] = CLOCK_INIT_STD
         if self._iono:
             p0[IONO] = tun["iono_scale_std"]
+        if self._sf is not None:
+            p0[self._sf] = tun["gyro_z_scale_factor_std"]
         self._p0 = np.diag(p0**2)
 
     def _tuning(self, cfg: dict) -> dict:
@@ -286,6 +295,7 @@ class _TightlyCoupled(Estimator):
                 gyro_bias_std=g.bias, accel_bias_walk=a.bias_walk, gyro_bias_walk=g.bias_walk,
                 gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
                 accel_scale_factor=float(np.hypot(a.scale_factor, a.misalignment)),
+                gyro_z_scale_factor_std=g.scale_factor,
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
                 iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
                 iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
@@ -318,7 +328,10 @@ class _TightlyCoupled(Estimator):
         self._force_sq = np.zeros(3)
         q[3:6, 3:6] = (c_bn * q_accel) @ c_bn.T
         q_gyro = np.full(3, tun["gyro_noise"] ** 2 * dt)
-        q_gyro += tun["gyro_scale_factor"] ** 2 * SCALE_FACTOR_TIME_S * self._rate_sq
+        sf2 = np.full(3, tun["gyro_scale_factor"] ** 2)
+        if self._sf is not None:  # the state carries the z axis's scale factor
+            sf2[2] = max(sf2[2] - tun["gyro_z_scale_factor_std"] ** 2, 0.0)
+        q_gyro += sf2 * SCALE_FACTOR_TIME_S * self._rate_sq
         self._rate_sq = np.zeros(3)
         q[6:9, 6:9] = (c_bn * q_gyro) @ c_bn.T
         q[9:12, 9:12] = np.eye(3) * tun["accel_bias_walk"] ** 2 * dt
@@ -328,7 +341,7 @@ class _TightlyCoupled(Estimator):
             q[IONO, IONO] = (tun["iono_scale_std"] ** 2
                              * (1.0 - np.exp(-2.0 * dt / IONO_CORRELATION_TIME_S)))
         if self._channels is not None:
-            ch = slice(self._channels.first, self.n_states)
+            ch = slice(self._channels.first, self._channels.first + self._channels.n)
             q[ch, ch] = np.diag(self._channels.transition(dt)[1])
         return q
 
@@ -520,7 +533,8 @@ N_NOMINAL = 18
 
 
 @njit(cache=True)
-def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray) -> None:
+def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
+                      sf_col: int) -> None:
     """Integrate every point (rows of x, the ``TcUkf`` nominal layout) in place through the
     buffered IMU intervals: one RK4 step of Chan eqs. 1-3 per interval, bias-corrected rates at
     its start (row j of w, f), end (row j + 1) and their mean at its middle; cb' = d."""
@@ -536,6 +550,9 @@ def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarra
             for a in range(3):
                 rates[0, a] = w[j, a] - x[i, 13 + a]
                 rates[2, a] = w[j + 1, a] - x[i, 13 + a]
+                if a == 2 and sf_col >= 0:  # the z gyro reads (1 + s) times the rate
+                    rates[0, a] /= 1.0 + x[i, sf_col]
+                    rates[2, a] /= 1.0 + x[i, sf_col]
                 rates[1, a] = 0.5 * (rates[0, a] + rates[2, a])
                 rates[3, a] = f[j, a] - x[i, 10 + a]
                 rates[5, a] = f[j + 1, a] - x[i, 10 + a]
@@ -597,12 +614,12 @@ def boxminus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
-        inv_tau: np.ndarray) -> np.ndarray:
+        inv_tau: np.ndarray, sf_col: int) -> np.ndarray:
     """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook); the
     Gauss-Markov states after the nominal 18 decay with their 1 / correlation times
     ``inv_tau``."""
     points = np.ascontiguousarray(points)
-    _propagate_points(points, w, f, dt)
+    _propagate_points(points, w, f, dt, sf_col)
     points[:, N_NOMINAL:] *= np.exp(-float(dt.sum()) * inv_tau)
     return points
 
@@ -635,7 +652,8 @@ class TcUkf(_TightlyCoupled):
         """Move the sigma points (drawn at the last update) through the buffered IMU samples;
         the driver sets the mean (paper steps 2-3)."""
         if self._buf_dt:
-            self.ukf.propagate(_fx, *self._take_buffer(), self._inv_tau)
+            sf_col = -1 if self._sf is None else self._sf + 1  # nominal: tangent index + 1
+            self.ukf.propagate(_fx, *self._take_buffer(), self._inv_tau, sf_col)
             self._propagated = True
 
     def _predict(self, t: float) -> None:
@@ -820,6 +838,8 @@ class TcEkf(_TightlyCoupled):
             w_c, f_c = w[1:] - self._bg, f[1:] - self._ba
         else:
             w_c = 0.5 * (w[1:] + w[:-1]) - self._bg
+        if self._sf is not None:
+            w_c[:, 2] /= 1.0 + self._extra[-1]
             f_c = 0.5 * (f[1:] + f[:-1]) - self._ba
         dth, dv = w_c * dt[:, None], f_c * dt[:, None]
         self._q, self._v, self._pos = _strapdown_block(self._q, self._v, self._pos, dth, dv,
@@ -833,6 +853,8 @@ class TcEkf(_TightlyCoupled):
                                                   dv.sum(axis=0) / total)
         extra = np.arange(N_STATES, self.n_states)  # first-order Gauss-Markov states
         fm[extra, extra] = -self._inv_tau
+        if self._sf is not None:  # psi' = -C_b^n [0, 0, w_z] ds
+            fm[6:9, self._sf] = -c_bn[:, 2] * float(w_c[:, 2] @ dt) / total
         self._extra *= np.exp(-total * self._inv_tau)
         fm *= total
         phi = np.eye(self.n_states) + fm + 0.5 * fm @ fm
