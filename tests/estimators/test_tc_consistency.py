@@ -82,8 +82,16 @@ def test_karamat_position_is_consistent_in_the_canyon(canyon):
     assert max(nse.values()) < 10.0, nse
 
 
-@pytest.mark.xfail(strict=True, reason="riss3d_tc_ekf reports the azimuth state at a standstill, "
-                   "which drifts from the heading by up to tens of degrees while its sigma "
-                   "stays below one (docs/reproduction_karamat2015.md, Consistency)")
-def test_karamat_yaw_is_consistent_on_the_quickstart(quickstart):
-    assert _nse(quickstart, "riss3d_tc_ekf")["yaw"] < 10.0
+def test_karamat_heading_is_consistent_on_the_quickstart(quickstart):
+    """Through the final stop: the heading reported at a standstill is the last direction of
+    travel turned by the azimuth state (it was the azimuth state, tens of degrees off)."""
+    nse = _nse(quickstart, "riss3d_tc_ekf")
+    assert nse["yaw"] < 10.0 and nse["n"] < 10.0 and nse["e"] < 10.0, nse
+
+
+@pytest.mark.xfail(strict=True, reason="riss3d_tc_ekf's height is the integral of v_o sin p "
+                   "with p from the forward accelerometer (eqs. 2, 6, 9): the quickstart IMU's "
+                   "70 mg bias, which the model cannot tell from tilt, drifts it beyond its "
+                   "covariance (docs/reproduction_karamat2015.md, Consistency)")
+def test_karamat_height_is_consistent_on_the_quickstart(quickstart):
+    assert _nse(quickstart, "riss3d_tc_ekf")["d"] < 10.0
