@@ -46,19 +46,44 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   the rows of every sigma point with ``constraints.body_velocity_points``. It is stacked with
   the GPS measurements at each GPS epoch and applied alone at 1 Hz when an expected GPS epoch
   has not come half an interval after its time (complete outages).
-* Not printed: P0, Q, R. P0: ``initial_position_std`` per axis (10 m), 0.5 m/s, 1 deg roll and
-  pitch, 3 deg yaw, the bias priors of an automotive MEMS IMU (10 mg, 0.2 deg/s), cb and d taken
-  from the first GPS epoch's residuals with 30 m and 3 m/s. Q: white noise of the IMU (config
-  ``accel_noise``, ``gyro_noise``, velocity and angle random walks of the automotive MEMS
-  preset), small bias random walks, and the receiver-clock model of a TCXO
-  (``gnss_model.clock_noise``). R: the receiver's reported pseudorange and pseudorange-rate
-  1-sigma of each signal (``pseudorange_std``, ``pseudorange_rate_std``); the config's
-  ``pseudorange_std`` (3 m) and ``range_rate_std`` (0.1 m/s) when the stream lacks them; white,
-  as the paper treats them, unless ``pseudorange_correlation_time`` (s) names the correlation
-  time of the pseudorange errors, which scales their sigma by
-  ``gnss_model.correlated_noise_inflation`` (a receiver's errors are correlated over its carrier
-  smoothing and longer: with white R the filters' position NEES is 40-90 on open sky,
-  docs/reproduction_chan.md).
+* Not printed: P0, Q, R. Two settings, ``tuning``:
+
+  - ``paper`` (what the reproduction, ``simulator/reproduce/chan.py``, uses, so that its
+    figures do not move): P0 ``initial_position_std`` per axis (10 m), 0.5 m/s, 1 deg roll and
+    pitch, 3 deg yaw, the bias priors of an automotive MEMS IMU (10 mg, 0.2 deg/s), cb and d
+    from the first GPS epoch's residuals with 30 m and 3 m/s; Q 3x the automotive preset's
+    white noise, small bias random walks, the TCXO clock (``gnss_model.clock_noise``); R the
+    receiver's reported 1-sigma of each signal (the config's ``pseudorange_std``, 3 m, and
+    ``range_rate_std``, 0.1 m/s, when the stream lacks them), white, as the paper treats
+    them; no gate (``PAPER_TUNING``).
+  - ``datasheet`` (the default): what a user knows from the dataset's datasheet
+    (``toolbox.sensor_datasheet``): the noise densities; the bias priors are the turn-on
+    biases (the accelerometers' with their scale factor and misalignment under 1 g), the bias
+    walks the rate random walk with the bias instability; the gyro and accelerometer scale
+    factors and misalignments times the rate and the non-gravity specific force as extra
+    white noise over ``SCALE_FACTOR_TIME_S`` (a constant scale-factor error adds up over a
+    turn, which a white Q only approximates). The receiver's pseudorange errors are
+    correlated in time (docs/gnss-errors.md), so R white at 1 Hz made the filters 10-1000x
+    over-confident (position NEES 40-1989). Modelled as states instead: one Gauss-Markov
+    ionosphere state (the broadcast model's relative residual, a row of the broadcast delay
+    I on every pseudorange; prior sqrt((scale - 1)^2 + (scale residual)^2) of the receiver
+    datasheet's ``iono_scale``, ``iono_residual``; 30 min) and one range-error state per
+    satellite (``toolbox.range_bias``, 16 channels, 30 min: the signal-in-space error and the
+    satellite's own share of the ionosphere field, ``IONO_FIELD_OWN_SHARE``); R keeps the
+    rest of the reported variance (tracking noise and multipath after the carrier smoothing),
+    scaled by the correlated-noise inflation of the datasheet's ``carrier_smoothing``
+    (``gnss_model.correlated_noise_inflation``). A chi-square gate (1 dof, probability
+    ``gate_probability``, 0.999) drops each pseudorange whose innovation is not plausible
+    against H P H^T plus its reported (uninflated) variance: the NLOS delays of a street
+    canyon, tens of metres, which no reported sigma contains (Groves 2013, section 17.3.1;
+    the EKF keeps that satellite's range rate, the UKF drops both rows).
+
+  Each of the ``TUNED_KEYS`` given as a number in the config overrides the setting's value.
+  The antenna lever arm is the datasheet's ``antenna_lever_arm`` unless ``lever_arm`` is given.
+  The solution's attitude sigmas are those of roll, pitch and yaw
+  (``nav_error.euler_covariance``; the psi-frame sigmas were written as roll and pitch before,
+  which misstated the tilt sigmas by the heading's rotation), and ``nis_gnss``,
+  ``nis_gnss_dof`` give the NIS of each GNSS update's rows (SPEC section 8).
 * The EKF (eqs. 4-6): position error rate dr' = dv as printed (eq. 4), velocity and attitude error
   equations in the psi convention of ``nav_error`` (eq. 5: -[f^n x] psi - C_b^n dba
   - (2 w_ie + w_en) x dv - (2 dw_ie + dw_en) x v; eq. 6: psi' = -w_in x psi - C_b^n dbg - dw_in,
@@ -66,8 +91,10 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   The nominal state is propagated by the toolbox strapdown (``strapdown.propagate``), the
   covariance at 10 Hz with Phi = I + F dt + (F dt)^2 / 2; closed loop (errors fed back after each
   update). Measurements linearised at the nominal state (the "linearised model given in [2]"):
-  the pseudorange rows carry the lever arm's attitude term, the range-rate rows only -los on the
-  velocity error and 1 on the drift (the lever arm's rate term is below the noise).
+  the pseudorange rows carry the lever arm's attitude term, the range-rate rows -los on the
+  velocity error, 1 on the drift and the lever arm's velocity C_b^n (w x l) terms in attitude and
+  gyro bias (a 1.5 m mast on a body rolling at 0.1 rad/s moves 0.15 m/s, five times the
+  Doppler noise; left out before).
 * The UKF runs on the toolbox's sigma-point driver (``estimators.toolbox.ukf``, symmetric set)
   with this module's ``boxplus``/``boxminus`` on an 18-number nominal state (position, velocity,
   quaternion, biases, clock); the whole point set moves through one compiled call per batch of
@@ -84,9 +111,11 @@ import numpy as np
 from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
-from estimators.toolbox import constraints, gnss_model, nav_error
+from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.range_bias import RangeBiasChannels
+from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import (
@@ -115,6 +144,41 @@ PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Veh
 COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
 NHC_POINTS = ("rear_axle", "imu")
+IONO = 17  # the ionosphere-residual state, after the 17 (datasheet tuning)
+GATE_PROBABILITY = 0.999  # chi-square gate of each pseudorange innovation (1 dof: 10.8)
+PSEUDORANGE_STD_FLOOR = 0.1  # m, what is left of a pseudorange's variance at least
+
+
+# the values chosen for the reproduction (the paper prints no P0, Q or R): ``tuning: paper``
+PAPER_TUNING = {
+    "accel_bias_std": 10 * MILLI_G,  # m/s^2, prior
+    "gyro_bias_std": 0.2 * DEG_S,  # rad/s, prior
+    "accel_noise": 0.1 * MILLI_G_RT_HZ * 3,  # m/s^2/sqrt(Hz), velocity random walk (3x datasheet:
+    "gyro_noise": 0.005 * DEG_S_RT_HZ * 3,  # rad/s/sqrt(Hz) unmodelled scale factors, vibration)
+    "accel_bias_walk": 1e-4,  # m/s^2/sqrt(s)
+    "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
+    "gyro_scale_factor": 0.0,  # 1-sigma, with the misalignment: rate-proportional gyro noise
+    "accel_scale_factor": 0.0,  # the same for the accelerometers, on the non-gravity force
+    "gyro_z_scale_factor_std": 0.0,  # prior of a z-gyro scale-factor state (0: no state)
+    # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
+    "pseudorange_correlation_time": 0.0,
+    "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
+    "range_bias_channels": 0,  # per-satellite range-error states (0: none)
+}
+TUNINGS = ("datasheet", "paper")
+TUNED_KEYS = tuple(PAPER_TUNING)
+STANDARD_GRAVITY = 9.80665  # m/s^2
+SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
+RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
+RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
+# the share of the ionosphere field's 1-sigma that differs between satellites: their pierce
+# points on the 350 km shell lie up to about a thousand km apart and the field's correlation
+# is exp(-d^2 / (2 L^2)), L = 1000 km (docs/gnss-errors.md): about 0.75 at a typical 750 km,
+# so sqrt(1 - 0.75) of it is each satellite's own, the rest common (the ionosphere state)
+IONO_FIELD_OWN_SHARE = 0.5
+SIS_ERROR_M = 0.5  # m: the signal-in-space error without a receiver datasheet (IS-GPS-200 URA)
+IONO_CORRELATION_TIME_S = 1800.0  # s: the broadcast ionosphere residual's (docs/gnss-errors.md)
+KLOBUCHAR_RESIDUAL = 0.5  # the broadcast model leaves about half the delay (Klobuchar 1987)
 
 
 DEFAULTS = {
@@ -122,21 +186,16 @@ DEFAULTS = {
     "nhc_std": None,  # m/s, body y and z velocity; None: from the car's physics (docstring)
     "nhc_point": "rear_axle",  # where the NHC holds: rear_axle (the datasheet's) or imu
     "nhc_rate": 1.0,  # Hz, NHC alone when GPS is missing
-    "lever_arm": [0.0, 0.0, 0.0],  # IMU to GPS antenna, body FRD, m
+    "lever_arm": None,  # IMU to GPS antenna, body FRD, m; None: the datasheet's (else zero)
     "initial_position_std": 10.0,  # m per axis
     "initial_velocity_std": 0.5,  # m/s
     "initial_attitude_std": [1.0, 1.0, 3.0],  # deg roll, pitch, yaw
-    "accel_bias_std": 10 * MILLI_G,  # m/s^2, prior
-    "gyro_bias_std": 0.2 * DEG_S,  # rad/s, prior
-    "accel_noise": 0.1 * MILLI_G_RT_HZ * 3,  # m/s^2/sqrt(Hz), velocity random walk (3x datasheet:
-    "gyro_noise": 0.005 * DEG_S_RT_HZ * 3,  # rad/s/sqrt(Hz) unmodelled scale factors, vibration)
-    "accel_bias_walk": 1e-4,  # m/s^2/sqrt(s)
-    "gyro_bias_walk": 1e-5,  # rad/s/sqrt(s)
+    "tuning": "datasheet",  # datasheet | paper: where the None keys below come from
+    **dict.fromkeys(TUNED_KEYS),  # None: from ``tuning`` (module docstring); a number fixes it
     "pseudorange_std": 3.0,  # m, when the stream reports none
     "range_rate_std": 0.1,  # m/s, when the stream reports none
-    # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
-    "pseudorange_correlation_time": 0.0,
     "gnss_interval": 1.0,  # s, the epoch interval the correlation is counted in
+    "gate_probability": None,  # pseudorange gate; None: 0.999 (datasheet), off (paper)
 }
 CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ekf`
     "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
@@ -158,6 +217,10 @@ CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ek
     "pseudorange_correlation_time": ("s", "correlation time of the pseudorange errors (0: "
                                           "white, as the paper treats them)"),
     "gnss_interval": ("s", "the epoch interval the correlation is counted in"),
+    "tuning": ("", "datasheet: the null keys from the manifest's datasheet (default); paper: "
+                   "the reproduction's values"),
+    "gate_probability": ("", "pseudorange chi-square gate; null: 0.999 (datasheet), off "
+                             "(paper)"),
 }
 
 
@@ -167,7 +230,7 @@ class _TightlyCoupled(Estimator):
 
     needs = ("imu", "gnss_raw")
     paper = PAPER
-    output_columns = (*NAV_COLUMNS, *STD_COLUMNS, *SENSOR_COLUMNS)
+    output_columns = (*NAV_COLUMNS, *STD_COLUMNS, *SENSOR_COLUMNS, "nis_gnss", "nis_gnss_dof")
     defaults = DEFAULTS
     config_help = CONFIG_HELP
 
@@ -177,13 +240,45 @@ class _TightlyCoupled(Estimator):
         self._gyro_idx = [imu[c] for c in ("gyro_x", "gyro_y", "gyro_z")]
         self._accel_idx = [imu[c] for c in ("accel_x", "accel_y", "accel_z")]
         self._increments = self.imu_output == "increment"
-        self._lever = np.asarray(cfg["lever_arm"], dtype=float)
-        self._pr_inflation = gnss_model.correlated_noise_inflation(
-            cfg["pseudorange_correlation_time"], cfg["gnss_interval"])
         if cfg["nhc_point"] not in NHC_POINTS:
             raise InputError(f"config of {self.name}: nhc_point must be one of "
                              f"{', '.join(NHC_POINTS)}, got {cfg['nhc_point']!r}")
+        if cfg["tuning"] not in TUNINGS:
+            raise InputError(f"config of {self.name}: tuning must be one of "
+                             f"{', '.join(TUNINGS)}, got {cfg['tuning']!r}")
         site = Installation.from_datasheet(self.datasheet)
+        lever = cfg["lever_arm"] if cfg["lever_arm"] is not None else site.antenna
+        self._lever = np.zeros(3) if lever is None else np.asarray(lever, dtype=float)
+        self.tuning = self._tuning(cfg)
+        sheet = ImuDatasheet.from_datasheet(self.datasheet)
+        self._triad_misalignment = (sheet.accel.misalignment
+                                    if sheet is not None and cfg["tuning"] == "datasheet"
+                                    else 0.0)
+        tun = self.tuning
+        self._pr_inflation = gnss_model.correlated_noise_inflation(
+            tun["pseudorange_correlation_time"], cfg["gnss_interval"])
+        self._iono = tun["iono_scale_std"] > 0.0
+        self.n_states = N_STATES + int(self._iono)
+        n_channels = int(tun["range_bias_channels"])
+        self._channels = (RangeBiasChannels(self.n_states, n_channels, RANGE_BIAS_TIME_S)
+                          if n_channels > 0 else None)
+        self.n_states += n_channels
+        # the z gyro's scale-factor error: the last state (a car turns about z: a constant
+        # error adds up over every turn one way, 11 deg over the garage's six helix turns at
+        # 0.5 %, which no white Q describes)
+        self._sf = self.n_states if tun["gyro_z_scale_factor_std"] > 0.0 else None
+        self.n_states += int(self._sf is not None)
+        gnss = self.datasheet.get("gnss") or {}
+        self._sis = float(gnss.get("sis_error", SIS_ERROR_M))
+        self._iono_field = _iono_residual(gnss)[1]
+        # 1 / correlation time of the states after the 17 (Gauss-Markov), 1/s
+        self._inv_tau = np.r_[np.full(int(self._iono), 1.0 / IONO_CORRELATION_TIME_S),
+                              np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S),
+                              np.zeros(int(self._sf is not None))]
+        gate = cfg["gate_probability"]
+        if gate is None and cfg["tuning"] == "datasheet":
+            gate = GATE_PROBABILITY
+        self._gate_p = gate
         self._nhc_point = site.rear_axle if cfg["nhc_point"] == "rear_axle" else None
         self._nhc_physics = (constraints.NonholonomicNoise(site.wheelbase or 2.7)
                              if cfg["nhc_std"] is None and self._nhc_point is not None
@@ -191,20 +286,55 @@ class _TightlyCoupled(Estimator):
         self._t_imu: float | None = None
         self._w_prev = np.zeros(3)
         self._f_prev = np.zeros(3)
+        self._rate_sq = np.zeros(3)  # sum of w^2 dt per body axis since the last Q
+        self._force_sq = np.zeros(3)  # the same of the specific force less 1 g down
         self._clock_started = False
         self._t_update = self.initial.t
         self._next_nhc = np.inf
         self._buf_w: list[np.ndarray] = []
         self._buf_f: list[np.ndarray] = []
         self._buf_dt: list[float] = []
-        p0 = np.zeros(N_STATES)
+        self.nis_gnss = np.nan  # NIS of the last GNSS update and its dof (NaN between them)
+        self.nis_gnss_dof = np.nan
+        p0 = np.zeros(self.n_states)
         p0[0:3] = cfg["initial_position_std"]
         p0[3:6] = cfg["initial_velocity_std"]
         p0[6:9] = np.radians(cfg["initial_attitude_std"])
-        p0[9:12] = cfg["accel_bias_std"]
-        p0[12:15] = cfg["gyro_bias_std"]
+        p0[9:12] = tun["accel_bias_std"]
+        p0[12:15] = tun["gyro_bias_std"]
         p0[15:17] = CLOCK_INIT_STD
+        if self._iono:
+            p0[IONO] = tun["iono_scale_std"]
+        if self._sf is not None:
+            p0[self._sf] = tun["gyro_z_scale_factor_std"]
         self._p0 = np.diag(p0**2)
+
+    def _tuning(self, cfg: dict) -> dict:
+        """P0, Q and R figures: the config's numbers where given, else those of ``tuning``:
+        ``paper`` (``PAPER_TUNING``) or ``datasheet`` (module docstring; the paper's values
+        when the dataset has no IMU datasheet)."""
+        base = dict(PAPER_TUNING)
+        sheet = ImuDatasheet.from_datasheet(self.datasheet)
+        if cfg["tuning"] == "datasheet" and sheet is not None:
+            g, a = sheet.gyro, sheet.accel
+            gravity = STANDARD_GRAVITY
+            gnss = self.datasheet.get("gnss") or {}
+            base.update(
+                accel_noise=a.noise_density, gyro_noise=g.noise_density,
+                # the accelerometers' scale factor and misalignment under gravity act as a bias
+                accel_bias_std=float(np.sqrt(a.bias**2 + (gravity * a.scale_factor) ** 2
+                                             + (gravity * a.misalignment) ** 2)),
+                gyro_bias_std=g.bias, accel_bias_walk=a.bias_walk, gyro_bias_walk=g.bias_walk,
+                gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
+                accel_scale_factor=float(np.hypot(a.scale_factor, a.misalignment)),
+                gyro_z_scale_factor_std=g.scale_factor,
+                pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
+                iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
+                iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
+        tuned = {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
+        tuned["iono_common"] = min(base.get("iono_common", tuned["iono_scale_std"]),
+                                   tuned["iono_scale_std"])
+        return tuned
 
     # -- inputs --------------------------------------------------------------------------------
     def _imu_sample(self, t: float, row: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -215,24 +345,73 @@ class _TightlyCoupled(Estimator):
             w, f = w / dt, f / dt
         return w, f, dt
 
-    def process_noise(self, dt: float) -> np.ndarray:
+    def process_noise(self, dt: float, c_bn: np.ndarray) -> np.ndarray:
         """Discrete Q over ``dt`` (s) on the tangent/error state (white accelerometer and gyro
-        noise, bias random walks, the receiver clock)."""
-        cfg = self.config
-        q = np.zeros((N_STATES, N_STATES))
-        q[3:6, 3:6] = np.eye(3) * cfg["accel_noise"] ** 2 * dt
-        q[6:9, 6:9] = np.eye(3) * cfg["gyro_noise"] ** 2 * dt
-        q[9:12, 9:12] = np.eye(3) * cfg["accel_bias_walk"] ** 2 * dt
-        q[12:15, 12:15] = np.eye(3) * cfg["gyro_bias_walk"] ** 2 * dt
+        noise, bias random walks, the receiver clock, the ionosphere state), with the gyro
+        scale-factor and misalignment errors of the rates turned since the last call
+        (``gyro_scale_factor`` s: PSD s^2 w^2 ``SCALE_FACTOR_TIME_S`` per body axis, rotated
+        by the attitude C_b^n), and the accelerometers' on the specific force less the 1 g
+        of a level car (under gravity alone the error is constant: a bias the states
+        carry)."""
+        tun = self.tuning
+        q = np.zeros((self.n_states, self.n_states))
+        q_accel = np.full(3, tun["accel_noise"] ** 2 * dt)
+        q_accel += tun["accel_scale_factor"] ** 2 * SCALE_FACTOR_TIME_S * self._force_sq
+        self._force_sq = np.zeros(3)
+        q[3:6, 3:6] = (c_bn * q_accel) @ c_bn.T
+        q_gyro = np.full(3, tun["gyro_noise"] ** 2 * dt)
+        sf2 = np.full(3, tun["gyro_scale_factor"] ** 2)
+        if self._sf is not None:  # the state carries the z axis's scale factor
+            sf2[2] = max(sf2[2] - tun["gyro_z_scale_factor_std"] ** 2, 0.0)
+        q_gyro += sf2 * SCALE_FACTOR_TIME_S * self._rate_sq
+        self._rate_sq = np.zeros(3)
+        q[6:9, 6:9] = (c_bn * q_gyro) @ c_bn.T
+        q[9:12, 9:12] = np.eye(3) * tun["accel_bias_walk"] ** 2 * dt
+        q[12:15, 12:15] = np.eye(3) * tun["gyro_bias_walk"] ** 2 * dt
         q[15:17, 15:17] = gnss_model.clock_noise(dt)
+        if self._iono:
+            q[IONO, IONO] = (tun["iono_scale_std"] ** 2
+                             * (1.0 - np.exp(-2.0 * dt / IONO_CORRELATION_TIME_S)))
+        if self._channels is not None:
+            ch = slice(self._channels.first, self._channels.first + self._channels.n)
+            q[ch, ch] = np.diag(self._channels.transition(dt)[1])
         return q
 
     def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
+        """R of an epoch's pseudoranges and range rates: the receiver's reported variances
+        (the config's when the stream has none), less what states carry: the ionosphere
+        residual common to the satellites (``_iono_residual``) and each satellite's slowly
+        varying error (``_range_bias_sigma``); the rest (tracking noise and multipath after the
+        carrier smoothing) scaled by the correlated-noise inflation of
+        ``pseudorange_correlation_time``."""
         cfg = self.config
-        pr = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std, cfg["pseudorange_std"])
-        pr = pr * self._pr_inflation
+        var = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
+                       cfg["pseudorange_std"]) ** 2
+        if self._iono:
+            var = var - (self.tuning["iono_common"] * _iono_delay(ep)) ** 2
+        if self._channels is not None:
+            var = var - self._range_bias_sigma(ep) ** 2
+        var = np.maximum(var, PSEUDORANGE_STD_FLOOR**2)
+        var = var * self._pr_inflation**2
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
-        return np.diag(np.concatenate([pr, rr]) ** 2)
+        return np.diag(np.concatenate([var, rr**2]))
+
+    def _range_bias_sigma(self, ep: gnss_model.RawEpoch) -> np.ndarray:
+        """Prior 1-sigma (m) of each satellite's range-error state: the signal-in-space error
+        and the satellite's own share of the ionosphere field, sqrt(sis^2 + (s field I)^2),
+        s = ``IONO_FIELD_OWN_SHARE``, I the broadcast delay (``_iono_residual``)."""
+        return np.hypot(self._sis, IONO_FIELD_OWN_SHARE * self._iono_field * _iono_delay(ep))
+
+    def _channel_rows(self, ep: gnss_model.RawEpoch, t: float, p: np.ndarray
+                      ) -> tuple[gnss_model.RawEpoch, np.ndarray, np.ndarray]:
+        """The epoch's satellites that have a range-error channel, their state indices and
+        which of them are new to their channel (reset in ``p``); without channels, the epoch
+        and empty index arrays."""
+        if self._channels is None:
+            return ep, np.zeros(0, dtype=int), np.zeros(0, dtype=bool)
+        idx, new = self._channels.assign(ep.sv, t, self._range_bias_sigma(ep), p)
+        keep = idx >= 0
+        return gnss_model.select(ep, keep), idx[keep], new[keep]
 
     def _nhc_noise(self, c_bn: np.ndarray, v: np.ndarray, rate: np.ndarray, f: np.ndarray,
                    pos: np.ndarray) -> np.ndarray:
@@ -276,14 +455,41 @@ class _TightlyCoupled(Estimator):
 
     def _output(self, pos: np.ndarray, v: np.ndarray, q: np.ndarray, biases: np.ndarray,
                 clock: np.ndarray, p: np.ndarray) -> np.ndarray:
+        """A solution row; the attitude sigmas are those of the Euler angles
+        (``nav_error.euler_covariance`` of the psi block) with the datasheet's accelerometer
+        misalignment added (the filter finds the attitude of the accelerometer triad, whose
+        misalignment to the car's body no measurement observes); the NIS of the last GNSS
+        update is written once, NaN in the rows after it."""
         roll, pitch, yaw = quat_to_euler(q)
-        std = np.sqrt(np.maximum(np.diag(p)[:9], 0.0))
+        std = np.sqrt(np.maximum(np.diag(p)[:6], 0.0))
+        p_euler = nav_error.euler_covariance(roll, pitch, yaw, p[6:9, 6:9])
+        std_att = np.sqrt(np.maximum(np.diag(p_euler), 0.0) + self._triad_misalignment**2)
+        nis = (self.nis_gnss, self.nis_gnss_dof)
+        self.nis_gnss = self.nis_gnss_dof = np.nan
         return np.concatenate([[np.degrees(pos[0]), np.degrees(pos[1]), pos[2], *v, roll, pitch,
-                                yaw], std, biases, clock])
+                                yaw], std, std_att, biases, clock, nis])
+
+    def _gate(self, nu: np.ndarray, s_diag: np.ndarray) -> np.ndarray:
+        """Which of m pseudorange innovations ``nu`` (variances ``s_diag``) pass the chi-square
+        gate of one degree of freedom at ``gate_probability`` (all when it is off): a
+        non-line-of-sight delay of tens of metres fails it (Groves 2013, section 17.3.1).
+        The variance is H P H^T plus the reported (not inflated) R: the correlated-noise
+        inflation sets an epoch's weight in the long run, the innovation of one epoch is
+        distributed with the error's own variance."""
+        if self._gate_p is None:
+            return np.ones(len(nu), dtype=bool)
+        return gating.rows_passing(nu, s_diag, float(self._gate_p))
+
+    def _record_nis(self, nu: np.ndarray, s: np.ndarray) -> None:
+        """NIS nu^T S^-1 nu of the GNSS rows of an update and its dof (SPEC section 8)."""
+        self.nis_gnss = gating.normalised_innovation_squared(nu, s)
+        self.nis_gnss_dof = float(len(nu))
 
     def inertial_step(self, w: np.ndarray, f: np.ndarray, dt: float) -> None:
         """Buffer the IMU interval ending now (its start sample first); the filters integrate
         a buffer in one compiled call."""
+        self._rate_sq += w**2 * dt
+        self._force_sq += (f + np.array([0.0, 0.0, STANDARD_GRAVITY])) ** 2 * dt
         if not self._buf_dt:
             self._buf_w, self._buf_f = [self._w_prev], [self._f_prev]
         self._buf_w.append(w)
@@ -304,6 +510,25 @@ class _TightlyCoupled(Estimator):
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         raise NotImplementedError
+
+
+def _iono_residual(receiver: dict) -> tuple[float, float]:
+    """The broadcast ionosphere's relative residual from the receiver's datasheet: the true
+    delay is ``iono_scale`` (1 + ``iono_residual`` g) times the broadcast model's, g a field
+    over the sky (docs/gnss-errors.md), so the residual is (scale - 1) + scale residual g.
+    Returns its part common to the satellites, |scale - 1|, and the 1-sigma of the field's,
+    scale residual (``KLOBUCHAR_RESIDUAL`` and 0 without a datasheet)."""
+    if "iono_scale" not in receiver:
+        return KLOBUCHAR_RESIDUAL, 0.0
+    scale, residual = float(receiver["iono_scale"]), float(receiver.get("iono_residual", 0.0))
+    return abs(scale - 1.0), scale * residual
+
+
+def _iono_delay(ep: gnss_model.RawEpoch) -> np.ndarray:
+    """The broadcast ionosphere delay of each satellite (m; 0 where the stream has none)."""
+    if ep.iono is None:
+        return np.zeros(len(ep.sv))
+    return np.nan_to_num(ep.iono)
 
 
 def _antenna_ecef(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, lever: np.ndarray,
@@ -343,7 +568,8 @@ N_NOMINAL = 18
 
 
 @njit(cache=True)
-def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray) -> None:
+def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
+                      sf_col: int) -> None:
     """Integrate every point (rows of x, the ``TcUkf`` nominal layout) in place through the
     buffered IMU intervals: one RK4 step of Chan eqs. 1-3 per interval, bias-corrected rates at
     its start (row j of w, f), end (row j + 1) and their mean at its middle; cb' = d."""
@@ -359,6 +585,9 @@ def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarra
             for a in range(3):
                 rates[0, a] = w[j, a] - x[i, 13 + a]
                 rates[2, a] = w[j + 1, a] - x[i, 13 + a]
+                if a == 2 and sf_col >= 0:  # the z gyro reads (1 + s) times the rate
+                    rates[0, a] /= 1.0 + x[i, sf_col]
+                    rates[2, a] /= 1.0 + x[i, sf_col]
                 rates[1, a] = 0.5 * (rates[0, a] + rates[2, a])
                 rates[3, a] = f[j, a] - x[i, 10 + a]
                 rates[5, a] = f[j + 1, a] - x[i, 10 + a]
@@ -374,7 +603,7 @@ def _boxminus(xs: np.ndarray, ref: np.ndarray, rm: float, rt: float) -> np.ndarr
     displacement (m), velocity, the rotation vector of q_i * conj(q_ref) (the NED-frame attitude
     error of ``nav_error``), biases, clock."""
     k = xs.shape[0]
-    out = np.empty((k, N_STATES))
+    out = np.empty((k, ref.shape[0] - 1))
     lat0, lon0, h0 = ref[0], ref[1], ref[2]
     a2, b2, c2, d2 = ref[6], -ref[7], -ref[8], -ref[9]
     for i in range(k):
@@ -393,7 +622,7 @@ def _boxminus(xs: np.ndarray, ref: np.ndarray, rm: float, rt: float) -> np.ndarr
         out[i, 6], out[i, 7], out[i, 8] = x * scale, y * scale, z * scale
         for j in range(3):
             out[i, 3 + j] = xs[i, 3 + j] - ref[3 + j]
-        for j in range(8):  # biases and clock
+        for j in range(ref.shape[0] - 10):  # biases, clock (and the ionosphere state)
             out[i, 9 + j] = xs[i, 10 + j] - ref[10 + j]
     return out
 
@@ -405,7 +634,7 @@ def boxplus(x: np.ndarray, dx: np.ndarray) -> np.ndarray:
     if np.ndim(dx) == 1:
         return boxplus(x, dx[None, :])[0]
     d_lat, d_lon, d_h = geodetic_rates(x[0], x[2], dx[:, 0:3])
-    out = np.empty((len(dx), N_NOMINAL))
+    out = np.empty((len(dx), len(x)))
     out[:, 0], out[:, 1], out[:, 2] = x[0] + d_lat, x[1] + d_lon, x[2] + d_h
     out[:, VEL] = x[VEL] + dx[:, 3:6]
     out[:, QUAT] = quat_multiply(rotvec_to_quat(dx[:, 6:9]), x[QUAT])
@@ -419,11 +648,14 @@ def boxminus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
     return _boxminus(np.ascontiguousarray(xs), x, float(rm), float(rt))
 
 
-def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray
-        ) -> np.ndarray:
-    """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook)."""
+def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
+        inv_tau: np.ndarray, sf_col: int) -> np.ndarray:
+    """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook); the
+    Gauss-Markov states after the nominal 18 decay with their 1 / correlation times
+    ``inv_tau``."""
     points = np.ascontiguousarray(points)
-    _propagate_points(points, w, f, dt)
+    _propagate_points(points, w, f, dt, sf_col)
+    points[:, N_NOMINAL:] *= np.exp(-float(dt.sum()) * inv_tau)
     return points
 
 
@@ -445,26 +677,29 @@ class TcUkf(_TightlyCoupled):
     def setup(self) -> None:
         super().setup()
         init = self.initial
-        x0 = np.zeros(N_NOMINAL)
+        x0 = np.zeros(N_NOMINAL + self.n_states - N_STATES)
         x0[POS], x0[VEL], x0[QUAT] = init.position, init.velocity, init.quaternion
         self.ukf = SigmaPointFilter(x0, self._p0, points="symmetric",
                                     alpha=self.config["alpha"], beta=self.config["beta"],
                                     boxplus=boxplus, boxminus=boxminus)
         self._propagated = False  # points moved since the covariance was last formed
+        self._channel = np.zeros(0, dtype=int)  # range-error states of the epoch's satellites
 
     # -- propagation ---------------------------------------------------------------------------
     def _flush(self) -> None:
         """Move the sigma points (drawn at the last update) through the buffered IMU samples;
         the driver sets the mean (paper steps 2-3)."""
         if self._buf_dt:
-            self.ukf.propagate(_fx, *self._take_buffer())
+            sf_col = -1 if self._sf is None else self._sf + 1  # nominal: tangent index + 1
+            self.ukf.propagate(_fx, *self._take_buffer(), self._inv_tau, sf_col)
             self._propagated = True
 
     def _predict(self, t: float) -> None:
         """Covariance of the propagated points plus Q over the interval (paper step 3)."""
         self._flush()
         if self._propagated:
-            self.ukf.covariance(self.process_noise(t - self._t_update))
+            self.ukf.covariance(self.process_noise(t - self._t_update,
+                                                   quat_to_dcm(self.ukf.x[QUAT])))
             self._t_update = t
             self._propagated = False
 
@@ -494,6 +729,10 @@ class TcUkf(_TightlyCoupled):
             r, v, _ = _antenna_ecef(pts[:, POS], pts[:, VEL], c_bn, self._lever, w_eb)
             pr, rate, _ = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, pts[:, 16],
                                              pts[:, 17])
+            if self._iono:
+                pr = pr + pts[:, N_NOMINAL, None] * _iono_delay(ep)[None, :]
+            if self._channels is not None:  # nominal index: tangent + 1 (the quaternion's 4)
+                pr = pr + pts[:, self._channel + 1]
             parts += [pr, rate]
         if nhc:
             rate = self._w_prev[None, :] - pts[:, BG]
@@ -506,12 +745,37 @@ class TcUkf(_TightlyCoupled):
         if ep is None and not nhc:
             return
         self._predict(t)
+        if ep is not None:
+            ep, self._channel, new = self._channel_rows(ep, t, self.ukf.p)
+            self.ukf.x[self._channel[new] + 1] = 0.0
+            self.ukf.sigma = None  # drawn from the reset channels
+            if len(ep.sv) == 0:
+                ep = None
+                if not nhc:
+                    return
+        if ep is not None and self._gate_p is not None:
+            ep = self._gated(ep)
         z = [] if ep is None else [ep.pseudorange, ep.range_rate]
         if nhc:
             z.append(np.zeros(2))
         # the driver draws the points of N(x_bar, P^xx + Q), P^xy without R, P -= K P^yy K^T
-        self.ukf.update(self._observe, np.concatenate(z), self.measurement_noise(ep, nhc), ep,
-                        nhc)
+        nu, p_yy = self.ukf.update(self._observe, np.concatenate(z),
+                                   self.measurement_noise(ep, nhc), ep, nhc)
+        if ep is not None:
+            k = 2 * len(ep.sv)
+            self._record_nis(nu[:k], p_yy[:k, :k])
+
+    def _gated(self, ep: gnss_model.RawEpoch) -> gnss_model.RawEpoch:
+        """The epoch without the pseudoranges that fail the gate (``_gate``), their
+        innovations' variances from the sigma points drawn for the update (a satellite that
+        fails keeps no row here, its range rate included)."""
+        m = len(ep.sv)
+        z_hat, p_zz = self.ukf.predict_measurement(self._observe, ep, False)
+        s_pr = (np.diag(p_zz)[:m]
+                + np.diag(self._measurement_noise(ep))[:m] / self._pr_inflation**2)
+        keep = self._gate(ep.pseudorange - z_hat[:m], s_pr)
+        self._channel = self._channel[keep]
+        return gnss_model.select(ep, keep)
 
     def measurement_noise(self, ep: gnss_model.RawEpoch | None, nhc: bool) -> np.ndarray:
         """R of an update at the current state: the epoch's pseudoranges and range rates
@@ -593,6 +857,7 @@ class TcEkf(_TightlyCoupled):
         self._ba = np.zeros(3)
         self._bg = np.zeros(3)
         self._clock = np.zeros(2)
+        self._extra = np.zeros(self.n_states - N_STATES)  # ionosphere, range-error estimates
         self._err = ErrorState(self._p0)
         self._dth_prev = np.zeros(3)
         self._dv_prev = np.zeros(3)
@@ -613,16 +878,26 @@ class TcEkf(_TightlyCoupled):
         else:
             w_c = 0.5 * (w[1:] + w[:-1]) - self._bg
             f_c = 0.5 * (f[1:] + f[:-1]) - self._ba
+        if self._sf is not None:  # the z gyro reads (1 + s) times the rate
+            w_c[:, 2] /= 1.0 + self._extra[-1]
         dth, dv = w_c * dt[:, None], f_c * dt[:, None]
         self._q, self._v, self._pos = _strapdown_block(self._q, self._v, self._pos, dth, dv,
                                                        self._dth_prev, self._dv_prev, dt)
         self._dth_prev, self._dv_prev = dth[-1], dv[-1]
         total = float(dt.sum())
         self._clock[0] += self._clock[1] * total
-        fm = error_dynamics(self._pos, self._v, quat_to_dcm(self._q), dv.sum(axis=0) / total)
+        c_bn = quat_to_dcm(self._q)
+        fm = np.zeros((self.n_states, self.n_states))
+        fm[:N_STATES, :N_STATES] = error_dynamics(self._pos, self._v, c_bn,
+                                                  dv.sum(axis=0) / total)
+        extra = np.arange(N_STATES, self.n_states)  # first-order Gauss-Markov states
+        fm[extra, extra] = -self._inv_tau
+        if self._sf is not None:  # psi' = -C_b^n [0, 0, w_z] ds
+            fm[6:9, self._sf] = -c_bn[:, 2] * float(w_c[:, 2] @ dt) / total
+        self._extra *= np.exp(-total * self._inv_tau)
         fm *= total
-        phi = np.eye(N_STATES) + fm + 0.5 * fm @ fm
-        self._err.predict(phi, self.process_noise(total))
+        phi = np.eye(self.n_states) + fm + 0.5 * fm @ fm
+        self._err.predict(phi, self.process_noise(total, c_bn))
 
     def start_clock(self, t: float, ep: gnss_model.RawEpoch) -> None:
         if len(ep.sv) == 0:
@@ -634,8 +909,14 @@ class TcEkf(_TightlyCoupled):
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         self._flush()
         nhc = bool(self.config["nhc"])
+        n = self.n_states
         dz, rows, noise = [], [], []
         c_bn = quat_to_dcm(self._q)
+        if ep is not None:
+            ep, channel, new = self._channel_rows(ep, t, self._err.p)
+            self._extra[channel[new] - N_STATES] = 0.0
+            if len(ep.sv) == 0:
+                ep = None
         if ep is not None:
             w_eb = self._w_prev - self._bg - _earth_rate_body(c_bn, self._pos[0])
             r, v, c_ne = _antenna_ecef(self._pos, self._v, c_bn, self._lever, w_eb)
@@ -643,19 +924,36 @@ class TcEkf(_TightlyCoupled):
                                                self._clock[1])
             u = los @ c_ne  # lines of sight in NED, (m, 3)
             m = len(pr)
-            h_pr = np.zeros((m, N_STATES))
+            h_pr = np.zeros((m, n))
             h_pr[:, 0:3] = -u
             h_pr[:, 6:9] = u @ skew(c_bn @ self._lever)
             h_pr[:, 15] = 1.0
-            h_rr = np.zeros((m, N_STATES))
+            if self._iono:
+                iono = _iono_delay(ep)
+                pr = pr + self._extra[IONO - N_STATES] * iono
+                h_pr[:, IONO] = iono
+            if self._channels is not None:
+                pr = pr + self._extra[channel - N_STATES]
+                h_pr[np.arange(m), channel] = 1.0
+            h_rr = np.zeros((m, n))
             h_rr[:, 3:6] = -u
             h_rr[:, 16] = 1.0
-            dz += [pr - ep.pseudorange, rate - ep.range_rate]
-            rows += [h_pr, h_rr]
-            noise.append(self._measurement_noise(ep))
+            # the antenna's lever-arm velocity C_b^n (w_eb x l): psi turns it, the gyro-bias
+            # error changes w (Groves eq. 14.110's lever-arm term, linearised)
+            _, v_lever = gnss_model.antenna_offset(c_bn, self._lever, w_eb)
+            h_rr[:, 6:9] = u @ skew(v_lever)
+            h_rr[:, 12:15] = -u @ (c_bn @ skew(self._lever))
+            r_gnss = self._measurement_noise(ep)
+            dz_pr = pr - ep.pseudorange
+            s_pr = (np.einsum("ij,jk,ik->i", h_pr, self._err.p, h_pr)
+                    + np.diag(r_gnss)[:m] / self._pr_inflation**2)
+            keep = np.concatenate([self._gate(dz_pr, s_pr), np.ones(m, dtype=bool)])
+            dz.append(np.concatenate([dz_pr, rate - ep.range_rate])[keep])
+            rows.append(np.vstack([h_pr, h_rr])[keep])
+            noise.append(r_gnss[np.ix_(keep, keep)])
         if nhc:
             rate = self._w_prev - self._bg
-            z_nhc, h_nhc = constraints.nonholonomic(self._q, self._v, N_STATES, rate,
+            z_nhc, h_nhc = constraints.nonholonomic(self._q, self._v, n, rate,
                                                     self._nhc_point, slice(12, 15))
             dz.append(z_nhc)
             rows.append(h_nhc)
@@ -663,12 +961,16 @@ class TcEkf(_TightlyCoupled):
                                          self._pos))
         if not dz:
             return
-        self._err.update(np.concatenate(dz), np.vstack(rows), _block_diagonal(noise))
+        s = self._err.update(np.concatenate(dz), np.vstack(rows), _block_diagonal(noise))
+        if ep is not None:  # closed loop: the error estimate was zero, the innovation is -dz
+            k = len(dz[0])
+            self._record_nis(dz[0], s[:k, :k])
         dx = self._err.feedback()
         self._q, self._v, self._pos = nav_error.correct(self._q, self._v, self._pos, dx[0:9])
         self._ba = self._ba - dx[9:12]
         self._bg = self._bg - dx[12:15]
         self._clock = self._clock - dx[15:17]
+        self._extra -= dx[N_STATES:]
 
     def solution(self, t: float) -> np.ndarray:
         self._flush()

@@ -80,7 +80,23 @@ update the estimated errors are removed from the navigation state and sensor-err
 The Gauss-Markov tilt and odometer-acceleration corrections decay as their models do.
 
 The Gauss-Markov parameters are images lost from our copy of the paper; chosen here from the
-IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md).
+IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md). That is
+``tuning: paper``, which the reproduction (``simulator/reproduce/karamat2015.py``) names so that
+its figures do not move. ``tuning: datasheet`` (the default) takes what a user knows of the
+dataset's sensors (``toolbox.sensor_datasheet``): the gyro and accelerometer bias priors are
+their turn-on biases (the accelerometers' with scale factor and misalignment under 1 g), the
+biases' Gauss-Markov driving noise the datasheet's bias walk, the azimuth's white noise the
+gyro's noise density plus its scale factor and misalignment times the turn rate over
+``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
+correlated-noise inflation of the receiver's carrier smoothing
+(``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
+``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
+of a canyon. ``nis_gnss`` and ``nis_gnss_dof`` give the NIS of each GNSS update (SPEC section
+8). At a standstill the reported heading is the last direction of travel turned by the
+azimuth state since (the azimuth state itself was reported before, tens of degrees off). No
+velocity, roll or pitch sigma is written: the mechanisation recomputes the velocity from the
+odometer and the tilt from the accelerometers at every step (eqs. 2-6), so the covariance of
+the velocity and tilt states does not describe the reported values.
 
 Public names
 ------------
@@ -94,10 +110,11 @@ import math
 import numpy as np
 
 from estimators.base import Estimator
-from estimators.toolbox import gnss_model
+from estimators.toolbox import gating, gnss_model
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from simulator.earth import (
     OMEGA_E_RAD_S,
     geodetic_to_ecef,
@@ -112,6 +129,7 @@ from simulator.units import DEG, DEG_RT_H, MILLI_G
 STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
 _I = {name: i for i, name in enumerate(STATES)}
+SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``chan``)
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
 
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
@@ -245,9 +263,12 @@ class RissTcEkf(Estimator):
     # ABS wheel at 10 Hz quantises the speed in steps of 0.43 m/s)
     # nhc_point: where the velocity lies along the body (eqs. 4-6): rear_axle (the datasheet's)
     # or imu
+    # tuning: datasheet (P0, Q and R from the dataset's datasheet; module docstring) or paper
+    # (the IMU300CC figures of Table 1, white R); gate_probability: the pseudoranges' chi-square
+    # gate (None: 0.999 with the datasheet tuning, off with the paper's)
     defaults = {"model": "enhanced", "coupling": "tight", "tilt_window": 2.0,
                 "accel_update_interval": 1.0, "odometer_speed_noise": 0.2,
-                "nhc_point": "rear_axle"}
+                "nhc_point": "rear_axle", "tuning": "datasheet", "gate_probability": None}
     config_help = {
         "model": ("", "enhanced (eqs. 1-58) or simplified, the earlier model"),
         "coupling": ("", "tight (pseudoranges and rates) or loose (position and velocity fixes)"),
@@ -255,10 +276,15 @@ class RissTcEkf(Estimator):
         "accel_update_interval": ("s", "time between the accelerometer updates of eqs. 50-58"),
         "odometer_speed_noise": ("m/s", "1-sigma white noise of one odometer speed sample"),
         "nhc_point": ("", "where the velocity lies along the body: rear_axle or imu"),
+        "tuning": ("", "datasheet: noise from the manifest's datasheet (default); paper: the "
+                       "reproduction's values"),
+        "gate_probability": ("", "chi-square gate on each pseudorange (e.g. 0.999); none: "
+                                 "the tuning's default"),
     }
     output_columns = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                       "std_n", "std_e", "std_d", "std_yaw",
-                      "gyro_bias_z", "accel_bias_x", "accel_bias_y", "clock_bias", "clock_drift")
+                      "gyro_bias_z", "accel_bias_x", "accel_bias_y", "clock_bias", "clock_drift",
+                      "nis_gnss", "nis_gnss_dof")
 
     def setup(self) -> None:
         cfg = self.config
@@ -269,8 +295,11 @@ class RissTcEkf(Estimator):
             problems.append(f"coupling must be tight or loose, got {cfg['coupling']!r}")
         if cfg["nhc_point"] not in ("rear_axle", "imu"):
             problems.append(f"nhc_point must be rear_axle or imu, got {cfg['nhc_point']!r}")
+        if cfg["tuning"] not in ("datasheet", "paper"):
+            problems.append(f"tuning must be datasheet or paper, got {cfg['tuning']!r}")
         if problems:
             raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
+        p0_sigma, q_white, gm = self._tuning(cfg["tuning"])
         self._enhanced = cfg["model"] == "enhanced"
         self._tight = cfg["coupling"] == "tight"
         self._n = len(STATES) if self._enhanced else SIMPLIFIED_STATES
@@ -289,12 +318,13 @@ class RissTcEkf(Estimator):
         rear = Installation.from_datasheet(self.datasheet).rear_axle
         self._arm = -rear if rear is not None and cfg["nhc_point"] == "rear_axle" else None
         self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
+        self._heading_offset = 0.0  # direction of travel minus azimuth state, while moving
         d_e, d_n, _, _ = self._arm_offset()
         self._lat, self._lon = self._moved(-d_n, -d_e)  # the rear axle at the start (at rest)
-        self._filter = ErrorState(np.diag([_P0_SIGMA[s] ** 2 for s in STATES[:self._n]]))
-        self._q_white = np.array([_Q_WHITE.get(s, 0.0) for s in STATES[:self._n]])
-        self._gm = [(_I[s], sig, tau) for s, (sig, tau) in GM_PARAMETERS.items()
-                    if _I[s] < self._n]
+        self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n]]))
+        self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
+        self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n]
+        self.nis_gnss = self.nis_gnss_dof = math.nan
         self._gm_index = np.array([g[0] for g in self._gm])
         self._noise_cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         # sums over the IMU samples of the current odometer interval
@@ -317,6 +347,34 @@ class RissTcEkf(Estimator):
         if "gnss_fix" in self.columns:
             g = self.columns["gnss_fix"]
             self._fix_cols = [g[k] for k in ("lat", "lon", "alt", "vn", "ve", "vd", "fix")]
+
+    def _tuning(self, tuning: str) -> tuple[dict, dict, dict]:
+        """P0 sigmas, white densities and Gauss-Markov models of ``tuning`` (``paper``: the
+        module's Table 1 figures; ``datasheet``: the dataset's IMU and receiver datasheet,
+        module docstring; the paper's when the dataset has none)."""
+        p0, q_white, gm = dict(_P0_SIGMA), dict(_Q_WHITE), dict(GM_PARAMETERS)
+        self._pr_inflation, self._gate_p = 1.0, self.config["gate_probability"]
+        self._sf_psd = 0.0  # (rad/s)^2 s per (rad/s)^2 of turn rate: the gyro scale factor's
+        sheet = ImuDatasheet.from_datasheet(self.datasheet)
+        if tuning != "datasheet" or sheet is None:
+            return p0, q_white, gm
+        g, a = sheet.gyro, sheet.accel
+        gravity = 9.80665
+        accel_bias = math.sqrt(a.bias**2 + (gravity * a.scale_factor) ** 2
+                               + (gravity * a.misalignment) ** 2)
+        p0.update(bz=g.bias, bx=accel_bias, by=accel_bias)
+        q_white["A"] = g.noise_density**2
+        self._sf_psd = (g.scale_factor**2 + g.misalignment**2) * SCALE_FACTOR_TIME_S
+        # a Gauss-Markov bias whose driving noise 2 sigma^2 / tau is the datasheet's walk
+        for name, walk in (("bz", g.bias_walk), ("bx", a.bias_walk), ("by", a.bias_walk)):
+            tau = gm[name][1]
+            gm[name] = (walk * math.sqrt(tau / 2.0), tau)
+        receiver = self.datasheet.get("gnss") or {}
+        self._pr_inflation = gnss_model.correlated_noise_inflation(
+            float(receiver.get("carrier_smoothing") or 0.0), 1.0)
+        if self._gate_p is None:
+            self._gate_p = 0.999
+        return p0, q_white, gm
 
     # --- inputs -----------------------------------------------------------------------------
     def on_imu(self, t: float, row: np.ndarray) -> None:
@@ -460,11 +518,15 @@ class RissTcEkf(Estimator):
 
     def _heading(self) -> float:
         """The direction of travel: the horizontal velocity's direction (against it while
-        reversing) when moving, else the azimuth state."""
+        reversing) when moving; at a standstill the last one, turned since by the azimuth
+        state (the azimuth state itself drifts from the heading by up to tens of degrees,
+        module docstring)."""
         if abs(self._vo) > 1.0 and math.hypot(self._ve, self._vn) > 0.5:
             sign = 1.0 if self._vo > 0.0 else -1.0
-            return math.atan2(sign * self._ve, sign * self._vn)
-        return self._az
+            heading = math.atan2(sign * self._ve, sign * self._vn)
+            self._heading_offset = float(wrap_angle(heading - self._az))
+            return heading
+        return float(wrap_angle(self._az + self._heading_offset))
 
     def _noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Gauss-Markov transition factors and the discrete process noise Q_d over ``dt``
@@ -498,6 +560,9 @@ class RissTcEkf(Estimator):
         phi_gm, q_d = self._noise(dt)
         idx = self._gm_index
         phi[idx, idx] = phi_gm
+        if self._sf_psd:
+            q_d = q_d.copy()
+            q_d[_I["A"], _I["A"]] += self._sf_psd * wz_c**2 * dt
         self._filter.predict(phi, q_d)
 
     # --- measurement updates ------------------------------------------------------------------
@@ -553,14 +618,21 @@ class RissTcEkf(Estimator):
         dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
         var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
         var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
-        r = np.diag(np.concatenate([var_pr, var_rate]))
+        r = np.diag(np.concatenate([var_pr * self._pr_inflation**2, var_rate]))
         # the mechanised velocity carries the white noise of the last odometer speed: it enters
         # every predicted rate through the forward axis, so R gains sigma^2 g g^T
         forward = np.array([math.cos(self._az), math.sin(self._az), 0.0]) * math.cos(self._pitch)
         forward[2] = -math.sin(self._pitch)
         g = d_ned @ forward
         r[m:, m:] += self.config["odometer_speed_noise"] ** 2 * np.outer(g, g)
-        self._filter.update(dz, h, r)
+        keep = np.ones(2 * m, dtype=bool)
+        if self._gate_p is not None:  # each pseudorange against H P H^T + its reported R
+            p = self._filter.p
+            s_pr = np.einsum("ij,jk,ik->i", h[:m], p, h[:m]) + var_pr
+            keep[:m] = gating.rows_passing(dz[:m], s_pr, self._gate_p)
+        s = self._filter.update(dz[keep], h[keep], r[np.ix_(keep, keep)])
+        self.nis_gnss = gating.normalised_innovation_squared(dz[keep], s)
+        self.nis_gnss_dof = float(keep.sum())
         self._feedback()
 
     def _feedback(self) -> None:
@@ -632,7 +704,13 @@ class RissTcEkf(Estimator):
                 vn_i, ve_i, -self._vu, self._roll, self._pitch, self._heading(),
                 math.sqrt(p[i["N"], i["N"]]), math.sqrt(p[i["E"], i["E"]]),
                 math.sqrt(p[i["h"], i["h"]]), math.sqrt(p[i["A"], i["A"]]),
-                -self._bz, accel[0], accel[1], *clock]
+                -self._bz, accel[0], accel[1], *clock, *self._take_nis()]
+
+    def _take_nis(self) -> tuple[float, float]:
+        """The NIS of the last GNSS update and its dof, once (NaN in the rows after it)."""
+        out = (self.nis_gnss, self.nis_gnss_dof)
+        self.nis_gnss = self.nis_gnss_dof = math.nan
+        return out
 
 
 def _asin(x: float) -> float:

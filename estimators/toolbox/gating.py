@@ -20,7 +20,7 @@ updating only when it passes.
 Public functions
 ----------------
 chi2_threshold, innovation_covariance, normalised_innovation_squared, passes_gate,
-threshold_variance.
+rows_passing, threshold_variance.
 """
 
 from __future__ import annotations
@@ -68,6 +68,13 @@ def passes_gate(nu: np.ndarray, s: np.ndarray, probability: float = 0.999) -> bo
     (d^2 <= chi-square quantile with len(nu) degrees of freedom)."""
     nu = np.atleast_1d(nu)
     return normalised_innovation_squared(nu, s) <= chi2_threshold(nu.size, probability)
+
+
+def rows_passing(nu: np.ndarray, s_diag: np.ndarray, probability: float = 0.999) -> np.ndarray:
+    """Boolean mask of the rows whose own innovation passes a one-degree-of-freedom gate:
+    nu_i^2 <= chi2_1(probability) S_ii, for ``nu`` (m,) and the variances ``s_diag`` (m,)
+    (the per-measurement outlier test of Groves 2013, section 17.3.1)."""
+    return np.asarray(nu, float) ** 2 <= chi2_threshold(1, probability) * np.asarray(s_diag)
 
 
 def threshold_variance(statistic: float, threshold: float, sigma_nominal: float,

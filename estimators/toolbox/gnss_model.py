@@ -38,14 +38,14 @@ The constants (speed of light, the GPS Earth rotation rate) are imported from th
 
 Public names
 ------------
-RawEpoch, single_frequency, raw_epoch, predict, los_jacobians, antenna_offset, clock_transition,
-clock_noise, correlated_noise_inflation, TCXO_H0, TCXO_H_MINUS2.
+RawEpoch, single_frequency, raw_epoch, select, predict, los_jacobians, antenna_offset,
+clock_transition, clock_noise, correlated_noise_inflation, TCXO_H0, TCXO_H_MINUS2.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -66,7 +66,9 @@ class RawEpoch:
     sv : satellite numbers; sat_pos, sat_vel : (m, 3) satellite ECEF state at transmission
     (frame of transmission), m and m/s; pseudorange : corrected pseudorange rho_c, m;
     range_rate : corrected pseudorange rate rho_dot_c, m/s; pseudorange_std, range_rate_std : the
-    receiver's reported 1-sigma (NaN when the stream has none).
+    receiver's reported 1-sigma (NaN when the stream has none); iono : the broadcast
+    ionosphere delay removed from the pseudorange, m; elevation : rad; cn0 : dB-Hz (each NaN
+    when the stream lacks the column).
     """
 
     sv: np.ndarray
@@ -76,6 +78,9 @@ class RawEpoch:
     range_rate: np.ndarray
     pseudorange_std: np.ndarray
     range_rate_std: np.ndarray
+    iono: np.ndarray | None = None
+    elevation: np.ndarray | None = None
+    cn0: np.ndarray | None = None
 
 
 L1_BAND_HZ = (1559e6, 1592e6)  # the L1/E1/B1 band (B1I 1561.098, L1/E1 1575.42 MHz)
@@ -110,7 +115,15 @@ def raw_epoch(block: np.ndarray, columns: Mapping[str, int]) -> RawEpoch:
         pseudorange=c("pseudorange") + c("sat_clock") - c("iono") - c("tropo"),
         range_rate=c("pseudorange_rate") + c("sat_clock_drift"),
         pseudorange_std=optional("pseudorange_std"),
-        range_rate_std=optional("pseudorange_rate_std"))
+        range_rate_std=optional("pseudorange_rate_std"),
+        iono=optional("iono"), elevation=optional("elevation"), cn0=optional("cn0"))
+
+
+def select(epoch: RawEpoch, keep: np.ndarray) -> RawEpoch:
+    """The epoch's satellites where the boolean mask ``keep`` (m,) is true (an innovation
+    gate's survivors, for instance)."""
+    return RawEpoch(*(None if v is None else v[keep]
+                      for v in (getattr(epoch, f.name) for f in fields(RawEpoch))))
 
 
 def _rotate_z(vec: np.ndarray, theta: np.ndarray) -> np.ndarray:

@@ -12,11 +12,13 @@ Errors are estimate minus truth, as in the NED-frame INS error states of Groves 
 
 The 9-vector dx = [dr, dv, psi] is the navigation block of an error state; ``correct`` removes
 estimated errors from a solution (closed-loop feedback, or open-loop output) and ``perturb``
-adds them (initial errors, tests).
+adds them (initial errors, tests). ``euler_covariance`` turns the covariance of psi into that of
+the roll, pitch and yaw errors a solution reports (its ``std_roll ... std_yaw`` columns, which
+the scores compare with Euler-angle errors).
 
 Public names
 ------------
-NAV_ERROR_STATES, perturb, correct, euler_error_jacobian.
+NAV_ERROR_STATES, perturb, correct, euler_error_jacobian, euler_covariance.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import math
 
 import numpy as np
 
-from simulator.earth import geodetic_rates, quat_multiply, rotvec_to_quat
+from simulator.earth import euler_to_dcm, geodetic_rates, quat_multiply, rotvec_to_quat
 
 NAV_ERROR_STATES = ("dr_n", "dr_e", "dr_d", "dv_n", "dv_e", "dv_d", "psi_n", "psi_e", "psi_d")
 
@@ -74,3 +76,12 @@ def euler_error_jacobian(c_bn: np.ndarray) -> np.ndarray:
     cp = math.sqrt(max(1.0 - sp * sp, 1e-12))
     m = np.array([[1.0, sr * sp / cp, cr * sp / cp], [0.0, cr, -sr], [0.0, sr / cp, cr / cp]])
     return m @ c_bn.T
+
+
+def euler_covariance(roll: float, pitch: float, yaw: float, p_psi: np.ndarray) -> np.ndarray:
+    """Covariance (3, 3) of the ZYX Euler-angle errors [d roll, d pitch, d yaw] (rad^2) of an
+    attitude whose NED-frame error psi has covariance ``p_psi`` (3, 3): J P J^T with J
+    ``euler_error_jacobian`` (the roll and pitch of a level car are psi_n and psi_e rotated by
+    the yaw, not psi_n and psi_e themselves). Singular at pitch +-90 deg."""
+    jac = euler_error_jacobian(euler_to_dcm(roll, pitch, yaw))
+    return jac @ p_psi @ jac.T

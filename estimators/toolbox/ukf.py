@@ -259,6 +259,25 @@ class SigmaPointFilter:
         self.propagate(fx, *args, q=q)
         self.covariance(None if self.augment else q)
 
+    def predict_measurement(self, hx: Callable[..., np.ndarray], *args
+                            ) -> tuple[np.ndarray, np.ndarray]:
+        """Mean (m,) and covariance (m, m, without R) of ``hx(X, *args)`` over the points the
+        next ``update`` uses (drawn now if stale), to screen measurements before it (an
+        innovation gate, for instance)."""
+        self._points_for_update()
+        zs = np.atleast_2d(hx(self.sigma, *args))
+        z_hat = self._wm @ zs
+        d = zs - z_hat
+        return z_hat, (self._wc[:, None] * d).T @ d
+
+    def _points_for_update(self) -> None:
+        if self._p_stale:
+            raise RuntimeError("call covariance() after propagate() and before update()")
+        if self.sigma is None:
+            saved, self.augment = self.augment, False
+            self.draw()
+            self.augment = saved
+
     def update(self, hx: Callable[..., np.ndarray], z: np.ndarray, r: np.ndarray, *args,
                z_residual: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
                ) -> tuple[np.ndarray, np.ndarray]:
@@ -268,12 +287,7 @@ class SigmaPointFilter:
         without noise. ``z_residual(Z, z)`` gives Z - z for rows Z (default: subtraction).
         Returns the innovation (m,) and its covariance P_yy (m, m).
         """
-        if self._p_stale:
-            raise RuntimeError("call covariance() after propagate() and before update()")
-        if self.sigma is None:
-            saved, self.augment = self.augment, False
-            self.draw()
-            self.augment = saved
+        self._points_for_update()
         minus_z = z_residual or _euclid_minus
         zs = np.atleast_2d(hx(self.sigma, *args))
         # the measurement mean taken as one step from the central point's (exact if linear)

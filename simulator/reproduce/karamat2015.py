@@ -68,7 +68,9 @@ UNDER_M = 12.0  # section 4.3.1: "the maximum position error is always less than
 BIAS_AT_S = 300.0  # section 4.3.3: the gyro bias converges in about 300 s
 BIAS_WITHIN_DEG_S = 0.05  # issue 15: within 0.05 deg/s of the truth by then
 TRUE_BIAS_SMOOTH_S = 20.0
-VARIANTS = {"tight": {}, "loose": {"coupling": "loose"}, "simplified": {"model": "simplified"}}
+# the paper's P0 and Q (its Table 1 figures) and white R: ``tuning: paper``
+VARIANTS = {"tight": {"tuning": "paper"}, "loose": {"coupling": "loose", "tuning": "paper"},
+            "simplified": {"model": "simplified", "tuning": "paper"}}
 
 
 def protocol_overrides(loops: int, site_offset_s: float | None = None) -> list[str]:

@@ -1,0 +1,97 @@
+"""The tightly coupled filters with their default (datasheet) tuning know their own error: per
+axis of position, velocity and attitude, the mean of (error / sigma)^2 after the first 60 s of
+a shipped drive stays below 10 (a consistent filter gives 1; one seed's mean of a constant
+error is a chi-square(1) draw, so a single drive may sit well below 1 on an axis), and the
+mean over the axes is not that of a filter ten times too cautious (above 0.3). The errors come
+from the truth, which the filters never see. Figures over seeds: docs/reproduction_chan.md and
+docs/reproduction_karamat2015.md, section "Consistency"."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from simulator.dataset.generate import generate_dataset
+from simulator.dataset.io import open_dataset
+from simulator.replay import run_estimator
+from simulator.scenario import load_scenario
+from simulator.scoring.align import solution_errors
+from tests.conftest import REPO
+
+AXES = (("err_n", "std_n"), ("err_e", "std_e"), ("err_d", "std_d"),
+        ("err_vn", "std_vn"), ("err_ve", "std_ve"), ("err_vd", "std_vd"),
+        ("err_roll", "std_roll"), ("err_pitch", "std_pitch"), ("err_yaw", "std_yaw"))
+SETTLE_S = 60.0  # the first minute is left out (convergence from the initial uncertainty)
+
+
+def _nse(dataset, entry) -> dict[str, float]:
+    """Mean (error / sigma)^2 per axis the solution has a sigma for, after ``SETTLE_S``."""
+    solution, _ = run_estimator(dataset, entry, show_progress=False)
+    e = solution_errors(dataset.read("truth"), solution).errors
+    e = e[e["t"] >= e["t"].iloc[0] + SETTLE_S]
+    return {err[4:]: float(np.nanmean((e[err] / e[std]) ** 2)) for err, std in AXES
+            if std in e}
+
+
+@pytest.fixture(scope="module")
+def quickstart(tmp_path_factory):
+    """The README's quickstart drive (tunnel outage, a BMI-class IMU with a 1 deg/s turn-on
+    gyro bias and 70 mg accelerometer bias)."""
+    sc = load_scenario(REPO / "scenarios" / "quickstart.yaml", seed=1)
+    return open_dataset(generate_dataset(sc, tmp_path_factory.mktemp("q") / "d",
+                                         show_progress=False))
+
+
+@pytest.fixture(scope="module")
+def canyon(tmp_path_factory):
+    """The SUMO city canyon (NLOS ranges of tens of metres), shortened as in CI."""
+    sc = load_scenario(REPO / "scenarios" / "sumo_city_canyon.yaml",
+                       ["trajectory.max_duration=150"], seed=1)
+    return open_dataset(generate_dataset(sc, tmp_path_factory.mktemp("c") / "d",
+                                         show_progress=False))
+
+
+def _assert_consistent(nse: dict[str, float]) -> None:
+    assert len(nse) == 9, nse
+    assert max(nse.values()) < 10.0, nse
+    assert np.mean(list(nse.values())) > 0.3, nse
+
+
+@pytest.mark.parametrize("drive", ["quickstart", "canyon"])
+def test_tc_ekf_is_consistent(drive, request):
+    _assert_consistent(_nse(request.getfixturevalue(drive), "tc_ekf"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("drive", ["quickstart", "canyon"])
+def test_tc_ukf_is_consistent(drive, request):
+    _assert_consistent(_nse(request.getfixturevalue(drive), "tc_ukf"))
+
+
+def test_paper_tuning_claims_far_more_than_it_has(quickstart):
+    """The reproduction's setting (white pseudoranges, an automotive-grade bias prior on a
+    1 deg/s IMU) against the datasheet's: the down axis is 10x over-confident, as measured
+    before the datasheet tuning."""
+    paper = _nse(quickstart, {"name": "tc_ekf", "config": {"tuning": "paper"}})
+    assert paper["d"] > 10.0
+
+
+def test_karamat_position_is_consistent_in_the_canyon(canyon):
+    nse = _nse(canyon, "riss3d_tc_ekf")
+    assert {"n", "e", "d", "yaw"} <= set(nse)
+    assert max(nse.values()) < 10.0, nse
+
+
+def test_karamat_heading_is_consistent_on_the_quickstart(quickstart):
+    """Through the final stop: the heading reported at a standstill is the last direction of
+    travel turned by the azimuth state (it was the azimuth state, tens of degrees off)."""
+    nse = _nse(quickstart, "riss3d_tc_ekf")
+    assert nse["yaw"] < 10.0 and nse["n"] < 10.0 and nse["e"] < 10.0, nse
+
+
+@pytest.mark.xfail(strict=True, reason="riss3d_tc_ekf's height is the integral of v_o sin p "
+                   "with p from the forward accelerometer (eqs. 2, 6, 9): the quickstart IMU's "
+                   "70 mg bias, which the model cannot tell from tilt, drifts it beyond its "
+                   "covariance (docs/reproduction_karamat2015.md, Consistency)")
+def test_karamat_height_is_consistent_on_the_quickstart(quickstart):
+    assert _nse(quickstart, "riss3d_tc_ekf")["d"] < 10.0
