@@ -217,6 +217,9 @@ CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ek
     "pseudorange_correlation_time": ("s", "correlation time of the pseudorange errors (0: "
                                           "white, as the paper treats them)"),
     "gnss_interval": ("s", "the epoch interval the correlation is counted in"),
+    "gyro_scale_factor": ("", "gyro scale-factor and misalignment error, 1-sigma: "
+                              "rate-proportional gyro noise"),
+    "range_bias_channels": ("", "per-satellite range-error states (0: none)"),
     "tuning": ("", "datasheet: the null keys from the manifest's datasheet (default); paper: "
                    "the reproduction's values"),
     "gate_probability": ("", "pseudorange chi-square gate; null: 0.999 (datasheet), off "
