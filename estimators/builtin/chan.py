@@ -220,6 +220,10 @@ CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ek
     "gyro_scale_factor": ("", "gyro scale-factor and misalignment error, 1-sigma: "
                               "rate-proportional gyro noise"),
     "range_bias_channels": ("", "per-satellite range-error states (0: none)"),
+    "accel_scale_factor": ("", "accelerometer scale-factor error, 1-sigma: noise on the "
+                               "non-gravity force"),
+    "gyro_z_scale_factor_std": ("", "prior of a z-gyro scale-factor state (0: no state)"),
+    "iono_scale_std": ("", "1-sigma of the ionosphere-residual state (0: no such state)"),
     "tuning": ("", "datasheet: the null keys from the manifest's datasheet (default); paper: "
                    "the reproduction's values"),
     "gate_probability": ("", "pseudorange chi-square gate; null: 0.999 (datasheet), off "
