@@ -384,7 +384,7 @@ def write_solution(frame: pd.DataFrame, path: str | Path, force: bool = False,
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     units = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
     metadata = None if uses_gnss is None else {USES_GNSS_KEY: "true" if uses_gnss else "false"}
-    with atomic_output_file(path, force, inputs) as tmp:
+    with atomic_output_file(path, force, inputs, "parquet") as tmp:
         write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns}, metadata)
 
 

@@ -9,6 +9,7 @@ CampaignOptions, CampaignResult, run_campaign.
 
 from __future__ import annotations
 
+import json
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,8 +31,8 @@ from simulator.campaign.store import (
 )
 from simulator.campaign.summary import summarise
 from simulator.campaign.worker import STATUS_OK, execute_run, failed_rows
+from simulator.outputs import refuse_inside, replace_file
 from simulator.progress import progress
-from simulator.scoring.evaluate import write_scores
 
 SUMMARY_FILE = "summary.json"
 DATASETS = "datasets"  # sub-folder of the kept datasets (--keep-datasets)
@@ -74,11 +75,12 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
     Raises
     ------
     InputError
-        ``out`` cannot be used (another campaign without ``force``, or a campaign that another
-        process is running into it), or the scheduler does not answer; nothing is written
-        then.
+        ``out`` cannot be used (another campaign without ``force``, a campaign that another
+        process is running into it, or a folder holding the scenario's files), or the
+        scheduler does not answer; nothing is written then.
     """
     out = Path(out)
+    refuse_inside(out, plan.base.input_files)  # --force would remove the scenario
     fingerprint, record = plan.fingerprint(), plan.record()
     check_campaign_dir(out, record, fingerprint, options.force)  # refused: nothing written
     with campaign_lock(out):
@@ -109,7 +111,8 @@ def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerp
               "sweep": plan.sweep_values(),
               "labels": plan.labels, "fingerprint": fingerprint}
     summary = summarise(runs, plan.labels, [p.values for p in plan.points], header)
-    write_scores(summary, out / SUMMARY_FILE, force=True)  # the campaign owns its folder
+    text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
+    replace_file(out / SUMMARY_FILE, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     write_campaign_report(out, runs, summary)
     return CampaignResult(runs, len(todo), len(tasks) - len(todo))
 

@@ -198,7 +198,7 @@ def _validate(path: Path, overrides: list[str], seed: int | None, swept: dict[st
     """Load a sweep point. Its problems name the sweep point (the scenario without it is
     valid), and those on a swept key come from ``--sweep``, not ``--set``."""
     try:
-        return load_scenario(path, overrides, seed)
+        return load_scenario(path, overrides, seed, import_plugins=True)
     except InputError as exc:
         where = ", ".join(f"{k}={v}" for k, v in swept.items())
         problems = []
@@ -229,7 +229,7 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
         a scenario without estimators.
     """
     path = Path(path)
-    base = load_scenario(path, overrides, seed)
+    base = load_scenario(path, overrides, seed, import_plugins=True)
     if not base.data["estimators"]:
         raise InputError([Problem(str(path), None, "estimators", "the scenario names no "
                                   "estimator: a campaign scores estimators; add some")])

@@ -90,7 +90,7 @@ def failed_rows(task: RunTask, error: str) -> list[dict[str, Any]]:
 def _score_all(task: RunTask, dataset_dir: Path) -> list[dict[str, Any]]:
     labels = entry_labels(task.scenario.data["estimators"])
     try:
-        dataset = pipeline.generate(task.scenario, dataset_dir, force=True)
+        dataset = pipeline.generate(task.scenario, dataset_dir, force=True, honour_lock=False)
     except Exception:
         return failed_rows(task, traceback.format_exc())
     rows = []

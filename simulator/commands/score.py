@@ -67,9 +67,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
                                   "FILE... and/or -e NAME...")])
     dataset = open_dataset(args.dataset)
+    inputs = [dataset.path, *args.solution]
     with contextlib.ExitStack() as stack:
         report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force,
-                                                            [dataset.path]))
+                                                            inputs))
                       if args.report else None)
         solutions = _from_files(args.solution, dataset)
         for label, solved in pipeline.run_estimators(dataset,
@@ -81,7 +82,7 @@ def run(args: argparse.Namespace) -> int:
         ev = pipeline.score(dataset, solutions)
         print_scores(ev)
         if args.json:
-            write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])
+            write_scores(ev.scores(), Path(args.json), args.force, inputs)
             print(f"wrote {args.json}")
         if report_dir is not None:
             write_report(report_dir, ev, f"Scores on {dataset.path.name}")

@@ -19,7 +19,7 @@ from simulator.earth import geodetic_to_ecef
 from simulator.errors import InputError, Problem
 from simulator.gnss.nmea import write_nmea
 from simulator.gnss.rinex_writer import write_rinex_nav, write_rinex_obs
-from simulator.outputs import atomic_output_file
+from simulator.outputs import atomic_output_file, check_output_file
 from simulator.timebase import gps_to_utc, leap_seconds
 
 
@@ -53,8 +53,10 @@ def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
     name = Path(dataset.path).resolve().name
     obs, nav = out / f"{name}.obs", out / f"{name}.nav"
     iono = dataset.manifest.get("sensors", {}).get("gnss", {}).get("broadcast_iono", {})
-    with (atomic_output_file(obs, force, [dataset.path]) as obs_tmp,
-          atomic_output_file(nav, force, [dataset.path]) as nav_tmp):
+    for path in (obs, nav):  # both refused before either is begun
+        check_output_file(path, force, [dataset.path], "rinex")
+    with (atomic_output_file(obs, force, [dataset.path], "rinex") as obs_tmp,
+          atomic_output_file(nav, force, [dataset.path], "rinex") as nav_tmp):
         write_rinex_obs(obs_tmp, dataset.read("gnss_raw"), week, tow, approx)
         write_rinex_nav(nav_tmp, dataset.read("gnss_nav"), leap_seconds(gps_to_utc(week, tow)),
                         iono.get("alpha"), iono.get("beta"))
@@ -68,6 +70,6 @@ def export_nmea(dataset: Dataset, path: str | Path, force: bool = False,
     _need(dataset, "gnss_fix", option)
     week, tow = _gps_start(dataset)
     raw = dataset.read("gnss_raw") if dataset.has("gnss_raw") else pd.DataFrame()
-    with atomic_output_file(path, force, [dataset.path]) as tmp:
+    with atomic_output_file(path, force, [dataset.path], "nmea") as tmp:
         write_nmea(tmp, dataset.read("gnss_fix"), raw, week, tow)
     return Path(path)

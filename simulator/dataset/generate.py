@@ -258,12 +258,13 @@ def stream_units(scenario: dict) -> dict[str, dict[str, str]]:
 
 
 def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
-                     show_progress: bool = True) -> Path:
+                     show_progress: bool = True, honour_lock: bool = True) -> Path:
     """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
     ``force``). Returns ``out_dir``. Each stream no fault changes is written while the others are
-    made."""
+    made. The scenario's files are inputs: never written over; ``honour_lock=False`` only for a
+    campaign's own runs, writing into the folder it holds."""
     out_dir = Path(out_dir)
-    with (atomic_output_dir(out_dir, force) as tmp,
+    with (atomic_output_dir(out_dir, force, scenario.input_files, honour_lock) as tmp,
           DatasetWriter(tmp, stream_units(scenario.data)) as writer):
         generated = generate_streams(scenario, show_progress, frames=False,
                                      on_final=writer.write)

@@ -7,6 +7,7 @@ Scenario, load_scenario, validate_data.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 from dataclasses import dataclass
 from pathlib import Path
@@ -37,6 +38,24 @@ class Scenario:
     @property
     def seed(self) -> int:
         return self.data["seed"]
+
+    @property
+    def input_files(self) -> list[Path]:
+        """The scenario file and every file its resolved data names (a SUMO network, a recorded
+        drive, a navigation file: made absolute at validation): what an output must not touch."""
+        found = [Path(self.path)]
+        stack: list[Any] = [self.data]
+        while stack:
+            node = stack.pop()
+            if isinstance(node, dict):
+                stack.extend(node.values())
+            elif isinstance(node, list):
+                stack.extend(node)
+            elif isinstance(node, str) and node.startswith("/") and len(node) < 4096:
+                with contextlib.suppress(OSError, ValueError):
+                    if Path(node).is_file():
+                        found.append(Path(node))
+        return found
 
 
 def _validate(data: Any, file: str, lines: dict | None = None,
