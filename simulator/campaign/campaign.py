@@ -31,10 +31,13 @@ from simulator.campaign.store import (
 )
 from simulator.campaign.summary import summarise
 from simulator.campaign.worker import STATUS_OK, execute_run, failed_rows
+from simulator.errors import InputError, Problem
 from simulator.outputs import refuse_inside, replace_file
 from simulator.progress import progress
 
 SUMMARY_FILE = "summary.json"
+# runs one campaign plans over all sweep points (its task list, about 2 kB a task, is in memory)
+MAX_TASKS = 1_000_000
 DATASETS = "datasets"  # sub-folder of the kept datasets (--keep-datasets)
 
 
@@ -80,6 +83,13 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
         scheduler does not answer; nothing is written then.
     """
     out = Path(out)
+    tasks = options.runs * len(plan.points)
+    if tasks > MAX_TASKS:
+        raise InputError([Problem("landnav campaign", None, "--runs",
+                                  f"{options.runs:,} runs x {len(plan.points):,} sweep points is "
+                                  f"{tasks:,} runs, more than one campaign plans "
+                                  f"({MAX_TASKS:,}); split the sweep or the seeds into "
+                                  "several campaigns")])
     refuse_inside(out, plan.base.input_files)  # --force would remove the scenario
     fingerprint, record = plan.fingerprint(), plan.record()
     check_campaign_dir(out, record, fingerprint, options.force)  # refused: nothing written
