@@ -23,6 +23,7 @@ RunResult, Solutions.
 
 from __future__ import annotations
 
+import multiprocessing
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,6 +36,7 @@ from simulator import scenario as scenarios
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
+from simulator.isolated import needs_isolation, run_isolated
 from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
 from simulator.scenario import Scenario
@@ -88,20 +90,29 @@ def generate(scenario: Scenario, out_dir: str | Path, force: bool = False,
 
 
 def estimate(dataset: Dataset, entry: Mapping[str, Any] | str,
-             show_progress: bool = False) -> tuple[pd.DataFrame, dict]:
+             show_progress: bool = False, time_limit_s: float | None = None
+             ) -> tuple[pd.DataFrame, dict]:
     """Replay ``dataset`` causally into one estimator (a scenario ``estimators:`` entry: a name,
     ``module:Class``, or a mapping with ``name``, ``label``, ``init`` and ``config``); its
-    solution table and run information (``simulator.replay.run_estimator``)."""
+    solution table and run information (``simulator.replay.run_estimator``).
+
+    An estimator that is not a built-in, or any with ``time_limit_s``, runs in a child process
+    (``simulator.isolated``): one that exits, crashes or runs past the limit is an InputError.
+    Inside a daemonic process (a campaign's worker, which may not have children) it runs here,
+    and the caller bounds it (``simulator.campaign.worker``)."""
+    if needs_isolation(entry, time_limit_s) and not multiprocessing.current_process().daemon:
+        return run_isolated(dataset.path, entry, time_limit_s)
     return run_estimator(dataset, entry, show_progress=show_progress)
 
 
 def run_estimators(dataset: Dataset, entries: Iterable[Mapping[str, Any] | str],
-                   show_progress: bool = False) -> Solutions:
+                   show_progress: bool = False, time_limit_s: float | None = None
+                   ) -> Solutions:
     """Every estimator entry over ``dataset``, keyed by label; two entries with one label are
     refused (give a label)."""
     out: Solutions = {}
     for i, entry in enumerate(entries):
-        frame, info = estimate(dataset, entry, show_progress)
+        frame, info = estimate(dataset, entry, show_progress, time_limit_s)
         if info["label"] in out:
             raise InputError(f"estimators.{i}: label {info['label']!r} is used twice; give a "
                              "label")

@@ -39,7 +39,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("scenario", ("simulator.scenario",)),
     ("dataset", ("simulator.dataset",)),
     ("estimators", ("estimators",)),
-    ("replay", ("simulator.replay",)),
+    ("replay", ("simulator.replay", "simulator.isolated")),
     ("scoring", ("simulator.scoring",)),
     ("pipeline", ("simulator.pipeline",)),
     ("campaign", ("simulator.campaign",)),

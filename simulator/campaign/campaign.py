@@ -9,6 +9,7 @@ CampaignOptions, CampaignResult, run_campaign.
 
 from __future__ import annotations
 
+import functools
 import json
 import traceback
 from dataclasses import dataclass
@@ -53,6 +54,7 @@ class CampaignOptions:
     keep_datasets: bool = False
     retry_failed: bool = False
     show_progress: bool = True
+    time_limit_s: float | None = None  # per estimator of a run
 
 
 @dataclass(frozen=True)
@@ -108,7 +110,8 @@ def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerp
         init_campaign_dir(out, record, fingerprint, options.force)
         done = done_parts(out, options.retry_failed)
         todo = [t for t in tasks if t.part not in done]
-        finished = completed(executor, in_flight, execute_run, todo)
+        run = functools.partial(execute_run, time_limit_s=options.time_limit_s)
+        finished = completed(executor, in_flight, run, todo)
         for task, future in progress(finished, "runs", options.show_progress, len(todo)):
             try:
                 rows = future.result()

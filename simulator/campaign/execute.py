@@ -11,7 +11,7 @@ that were under way in the pool, and a new pool takes the next runs.
 
 Public functions
 ----------------
-open_executor, completed.
+open_executor, completed, watch_parent.
 """
 
 from __future__ import annotations
@@ -19,8 +19,12 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import multiprocessing
+import os
 import re
+import signal
 import socket
+import threading
+import time
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
@@ -28,6 +32,26 @@ from simulator.errors import InputError, Problem
 
 T = TypeVar("T")
 _WORKER_MODULE = "simulator.campaign.worker"  # preloaded by the forkserver
+
+
+PARENT_POLL_S = 0.5  # how often a worker checks that the campaign's process still runs
+
+
+def watch_parent(campaign_pid: int) -> None:
+    """In a worker process: a thread that ends the worker when the campaign's process is gone
+    (killed with SIGKILL, say, which leaves it no chance to stop its workers), so no worker
+    outlives the campaign it computes for."""
+    def watch() -> None:
+        while True:
+            time.sleep(PARENT_POLL_S)
+            try:
+                os.kill(campaign_pid, 0)
+            except ProcessLookupError:
+                os.kill(os.getpid(), signal.SIGKILL)  # nobody is left to receive its results
+            except PermissionError:  # the pid was reused by another user's process
+                os.kill(os.getpid(), signal.SIGKILL)
+
+    threading.Thread(target=watch, name="landnav-parent-watch", daemon=True).start()
 
 
 class _RenewingPool(cf.Executor):
@@ -43,7 +67,8 @@ class _RenewingPool(cf.Executor):
         self.pool = self._new()
 
     def _new(self) -> cf.ProcessPoolExecutor:
-        return cf.ProcessPoolExecutor(self.workers, mp_context=self.context)
+        return cf.ProcessPoolExecutor(self.workers, mp_context=self.context,
+                                      initializer=watch_parent, initargs=(os.getpid(),))
 
     def __exit__(self, kind: type | None, *rest: object) -> bool:
         if kind is None:
@@ -100,13 +125,7 @@ def open_executor(workers: int, scheduler: str | None, timeout_s: float
             yield executor, workers
         return
     _check_scheduler(scheduler, timeout_s)
-    from distributed import Client
-
-    try:
-        client = Client(scheduler, timeout=timeout_s, set_as_default=False)
-    except (OSError, ValueError, TypeError) as exc:
-        raise InputError([Problem("--scheduler", None, scheduler, f"no Dask scheduler answers "
-                                  f"within {timeout_s:g} s ({exc})")]) from None
+    client = _connect(scheduler, timeout_s)
     try:
         slots = max(1, sum(client.nthreads().values()))
         yield client.get_executor(pure=False), 2 * slots
@@ -130,6 +149,31 @@ def _check_scheduler(address: str, timeout_s: float) -> None:
     except OSError as exc:
         raise InputError([Problem("--scheduler", None, address, f"nothing answers there "
                                   f"within {timeout_s:g} s ({exc.strerror or exc})")]) from None
+
+
+def _connect(scheduler: str, timeout_s: float) -> Any:
+    """A Dask client of ``scheduler``, made in a helper thread that is given ``timeout_s``: a
+    port that answers but is not a Dask scheduler never completes the handshake, and the
+    client's own timeout does not cover that wait."""
+    from distributed import Client
+
+    made: dict[str, Any] = {}
+
+    def connect() -> None:
+        try:
+            made["client"] = Client(scheduler, timeout=timeout_s, set_as_default=False)
+        except Exception as exc:  # reported below, in the caller's thread
+            made["error"] = exc
+
+    thread = threading.Thread(target=connect, name="landnav-dask-connect", daemon=True)
+    thread.start()
+    thread.join(timeout_s)
+    if "client" in made:
+        return made["client"]
+    reason = (f"{type(made['error']).__name__}: {made['error']}" if "error" in made
+              else "it does not answer as a Dask scheduler")
+    raise InputError([Problem("--scheduler", None, scheduler, f"no Dask scheduler answers "
+                              f"within {timeout_s:g} s ({reason})")])
 
 
 def completed(executor: cf.Executor, in_flight: int, fn: Callable[[T], Any], tasks: Iterable[T]

@@ -5,15 +5,15 @@ from __future__ import annotations
 import argparse
 import sys
 
-import yaml
-
 from estimators.registry import entry_problems
 from simulator import pipeline
 from simulator.commands import SUMMARIES
+from simulator.commands.options import check_time_limit
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 from simulator.replay import write_solution
 from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
+from simulator.scenario.yamlio import load_value
 from simulator.schema import INVALID, Context
 
 
@@ -37,6 +37,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "(m/s), attitude_error=[roll,pitch,yaw] (deg), heading_error=DEG")
     p.add_argument("--label", default=None, help="solution label (default: the name)")
     p.add_argument("--force", action="store_true", help="overwrite an existing SOLUTION file")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="stop the estimator after this long (it then runs in its own process, "
+                        "as every estimator that is not a built-in does) and exit 2")
     p.set_defaults(run=run)
 
 
@@ -48,10 +51,7 @@ def _pairs(items: list[str], option: str) -> dict:
         if not sep or not key.strip():
             problems.append(Problem(option, None, text, "expected key=value"))
             continue
-        try:
-            out[key.strip()] = yaml.safe_load(raw) if raw.strip() else ""
-        except yaml.YAMLError:
-            out[key.strip()] = raw
+        out[key.strip()] = load_value(raw, f"{option} {key.strip()}")
     if problems:
         raise InputError(problems)
     return out
@@ -76,8 +76,10 @@ def _entry(args: argparse.Namespace) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     entry = _entry(args)
+    check_time_limit(args.time_limit, "estimate")
     dataset = open_dataset(args.dataset)
-    solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty())
+    solution, info = pipeline.estimate(dataset, entry, show_progress=sys.stderr.isatty(),
+                                       time_limit_s=args.time_limit)
     write_solution(solution, args.output, args.force, [dataset.path],
                    uses_gnss=info["uses_gnss"])
     print(f"wrote {args.output} ({info['label']}: {len(solution)} rows) in "
