@@ -25,7 +25,8 @@ path and the reason; and remove their temporaries on any error, interruption inc
 Public functions
 ----------------
 atomic_output_dir, atomic_output_file, refuse_inside, refuse_locked, resolved, is_own_output,
-private_temp_dir, open_lock_file, replace_file, real_subfolder, check_output_file.
+private_temp_dir, open_lock_file, replace_file, real_subfolder, check_output_file,
+make_parent, os_problem.
 """
 
 from __future__ import annotations
@@ -41,7 +42,7 @@ import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 
 OWNER_FILE = ".landnav-owner"  # inside a claimed temporary folder: the writer's process id
 MARKER_FILE = ".landnav-output"  # inside every folder written here: what --force may replace
@@ -53,7 +54,8 @@ def _problem(path: Path | str, message: str) -> InputError:
     return InputError([Problem(str(path), None, "", message)])
 
 
-def _os_problem(path: Path | str, exc: OSError) -> InputError:
+def os_problem(path: Path | str, exc: OSError) -> InputError:
+    """A file-system error writing ``path`` as one message with the reason."""
     reason = exc.strerror or str(exc)
     if exc.errno == errno.ENOSPC:
         reason = "no space left on the device"
@@ -89,7 +91,7 @@ def open_lock_file(path: Path) -> int:
         if exc.errno == errno.ELOOP:
             raise _problem(path, "is a symbolic link; a lock file is never followed: remove "
                                  "it") from None
-        raise _os_problem(path, exc) from None
+        raise os_problem(path, exc) from None
     info = os.fstat(fd)
     if not stat.S_ISREG(info.st_mode) or info.st_nlink != 1:
         os.close(fd)
@@ -223,13 +225,14 @@ def _refuse_existing(path: Path, force: bool, want_dir: bool, kind: str | None =
                              "what landnav wrote: remove it yourself or name another output")
 
 
-def _make_parent(path: Path) -> None:
+def make_parent(path: Path) -> None:
+    """Make the folder ``path`` goes into; InputError naming what is in the way."""
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
         raise _problem(path, f"cannot be created: {path.parent} is a file, not a folder") from None
     except OSError as exc:
-        raise _os_problem(path.parent, exc) from None
+        raise os_problem(path.parent, exc) from None
 
 
 def _pid_alive(pid: int) -> bool:
@@ -267,7 +270,7 @@ def _claim(tmp: Path, out_dir: Path, claimed: list[Path]) -> None:
             shutil.rmtree(stale, ignore_errors=True)
             continue
         except OSError as exc:
-            raise _os_problem(out_dir, exc) from None
+            raise os_problem(out_dir, exc) from None
         _write_new(tmp / OWNER_FILE, str(os.getpid()))
         return
     raise _problem(out_dir, "another landnav is writing it; wait for it or name another output")
@@ -287,7 +290,7 @@ def private_temp_dir(parent: Path, name: str) -> Iterator[Path]:
     try:
         folder = Path(tempfile.mkdtemp(prefix=f".{name}.tmp-", dir=parent))
     except OSError as exc:
-        raise _os_problem(parent / name, exc) from None
+        raise os_problem(parent / name, exc) from None
     try:
         yield folder
     finally:
@@ -303,6 +306,7 @@ def check_output_file(path: Path | str, force: bool, inputs: Iterable[Path | str
 
 def _check_target(path: Path, force: bool, want_dir: bool, inputs: Iterable[Path | str],
                   kind: str | None, honour_lock: bool) -> None:
+    refuse_undecodable(path, "output's name")
     refuse_inside(path, inputs)
     if honour_lock:
         refuse_locked(path)
@@ -326,7 +330,7 @@ def atomic_output_dir(out_dir: Path | str, force: bool, inputs: Iterable[Path | 
     out_dir = Path(out_dir)
     inputs = list(inputs)
     _check_target(out_dir, force, True, inputs, None, honour_lock)
-    _make_parent(out_dir)
+    make_parent(out_dir)
     tmp = out_dir.parent / f".{out_dir.name}.tmp"
     claimed: list[Path] = []
     try:
@@ -344,7 +348,7 @@ def atomic_output_dir(out_dir: Path | str, force: bool, inputs: Iterable[Path | 
         for folder in claimed:
             shutil.rmtree(folder, ignore_errors=True)
         if isinstance(exc, OSError):
-            raise _os_problem(out_dir, exc) from None
+            raise os_problem(out_dir, exc) from None
         raise
 
 
@@ -363,7 +367,7 @@ def atomic_output_file(path: Path | str, force: bool, inputs: Iterable[Path | st
     path = Path(path)
     inputs = list(inputs)
     _check_target(path, force, False, inputs, kind, True)
-    _make_parent(path)
+    make_parent(path)
     with private_temp_dir(path.parent, path.name) as folder:
         tmp = folder / path.name
         try:
@@ -383,7 +387,7 @@ def atomic_output_file(path: Path | str, force: bool, inputs: Iterable[Path | st
                     _refuse_existing(path, force, want_dir=False)  # no hard links here
                     os.replace(tmp, path)
         except OSError as exc:
-            raise _os_problem(path, exc) from None
+            raise os_problem(path, exc) from None
 
 
 def replace_file(path: Path, write: Callable[[Path], object]) -> None:

@@ -33,7 +33,7 @@ from simulator.campaign.store import (
 from simulator.campaign.summary import summarise
 from simulator.campaign.worker import STATUS_OK, execute_run, failed_rows
 from simulator.errors import InputError, Problem
-from simulator.outputs import refuse_inside, replace_file
+from simulator.outputs import os_problem, refuse_inside, replace_file
 from simulator.progress import progress
 
 SUMMARY_FILE = "summary.json"
@@ -98,7 +98,10 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
     with campaign_lock(out):
         # checked again: another campaign may have written the folder in between
         check_campaign_dir(out, record, fingerprint, options.force)
-        return _run_locked(plan, out, options, fingerprint, record)
+        try:
+            return _run_locked(plan, out, options, fingerprint, record)
+        except OSError as exc:  # no space, a read-only volume: the finished runs stay
+            raise os_problem(out, exc) from None
 
 
 def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerprint: str,

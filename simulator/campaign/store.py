@@ -30,7 +30,7 @@ from simulator.campaign.plan import PLAN_FORMAT
 from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, score_unit
 from simulator.dataset.parquet import read_table, write_table
 from simulator.errors import InputError, Problem
-from simulator.outputs import open_lock_file, real_subfolder, replace_file
+from simulator.outputs import make_parent, open_lock_file, real_subfolder, replace_file
 
 CAMPAIGN_FILE = "campaign.json"
 PARTS = "parts"  # sub-folder with one Parquet file per finished run
@@ -67,7 +67,7 @@ def campaign_lock(out: Path) -> Iterator[None]:
     except ImportError:  # not POSIX
         yield
         return
-    out.parent.mkdir(parents=True, exist_ok=True)
+    make_parent(out)
     path = out.parent / f".{out.name}.lock"
     while True:
         fd = open_lock_file(path)  # never through a link planted at that name
@@ -109,6 +109,9 @@ def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -
         ``out`` is a file, a folder that is not a campaign, or a campaign of another plan
         without ``force`` (naming what differs).
     """
+    if out.is_symlink() and not out.exists():
+        raise InputError([Problem(str(out), None, "", "is a dangling symbolic link; remove it "
+                                  "or choose another -o DIR")])
     if out.exists() and not out.is_dir():
         raise InputError([Problem(str(out), None, "", "exists and is not a directory")])
     if not out.exists() or not any(out.iterdir()):

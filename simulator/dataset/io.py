@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from simulator import columns as col
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 from simulator.tables import Table, column, n_rows
 
 if TYPE_CHECKING:
@@ -264,7 +264,13 @@ _MANIFEST_FIELDS = {  # key path -> the JSON types it may have
     ("origin", "lon"): (int, float),
     ("origin", "alt"): (int, float),
     ("utc_start",): (str,),
+    ("scenario",): (dict,),
+    ("scenario", "sensors"): (dict,),
+    ("sensors",): (dict,),
+    ("sensors", "gnss", "broadcast_iono"): (dict,),
+    ("datasheet",): (dict,),
 }
+_MAPPINGS_OF_MAPPINGS = (("scenario", "sensors"), ("sensors",))  # each entry is a mapping
 
 
 def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
@@ -277,10 +283,18 @@ def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
         if node is None:  # optional here; a command that needs it asks Dataset.field
             continue
         if isinstance(node, bool) or not isinstance(node, types):
-            kinds = " or ".join("an integer" if t is int else "a number" if t is float
-                                else "text" for t in types)
+            kinds = " or ".join({int: "an integer", float: "a number", dict: "a mapping"}
+                                .get(t, "text") for t in types)
             problems.append(Problem(where, None, ".".join(keys),
                                     f"not {kinds} (got {node!r})"))
+    for keys in _MAPPINGS_OF_MAPPINGS:
+        node = manifest
+        for key in keys:
+            node = node.get(key) if isinstance(node, dict) else None
+        for name, entry in (node.items() if isinstance(node, dict) else ()):
+            if entry is not None and not isinstance(entry, dict):
+                problems.append(Problem(where, None, ".".join((*keys, str(name))),
+                                        f"not a mapping (got {entry!r})"))
     streams = manifest.get("streams")
     if not isinstance(streams, dict):
         return [*problems, Problem(where, None, "streams", "missing or malformed")]
@@ -304,6 +318,7 @@ def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
 def open_dataset(path: str | Path) -> Dataset:
     """Open a dataset directory; raise InputError if it is not a landnav dataset."""
     path = Path(path)
+    refuse_undecodable(path, "dataset's name")
     manifest_path = path / "manifest.json"
     if not path.is_dir():
         raise InputError([Problem(str(path), None, "", "no such dataset directory")])

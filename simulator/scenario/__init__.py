@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from simulator.drive import Drive, build_drive
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 from simulator.scenario.spec import SCENARIO_FIELD
 from simulator.scenario.yamlio import apply_overrides, read_yaml
 from simulator.schema import INVALID, Context
@@ -90,6 +90,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
         With every problem as ``file:line: key.path: message``.
     """
     path = Path(path)
+    refuse_undecodable(path, "scenario's name")
     data, lines = read_yaml(path)
     if not isinstance(data, dict):
         raise InputError([Problem(str(path), 1, "", "a scenario is a mapping of keys (name, "

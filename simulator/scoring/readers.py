@@ -46,7 +46,7 @@ import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 from simulator.replay import USES_GNSS_KEY, solution_problems
 from simulator.scoring.align import solution_errors
 from simulator.timebase import GPS_EPOCH, SECONDS_PER_WEEK, leap_seconds
@@ -271,6 +271,7 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
         inconvertible unit.
     """
     path = Path(path)
+    refuse_undecodable(path, "solution file's name")
     if not path.is_file():
         raise _problem(path, "no such solution file")
     size = path.stat().st_size
