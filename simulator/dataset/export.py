@@ -9,6 +9,7 @@ export_rinex, export_nmea.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +21,7 @@ from simulator.errors import InputError, Problem
 from simulator.gnss.nmea import write_nmea
 from simulator.gnss.rinex_writer import write_rinex_nav, write_rinex_obs
 from simulator.outputs import atomic_output_file, check_output_file
-from simulator.timebase import gps_to_utc, leap_seconds
+from simulator.timebase import SECONDS_PER_WEEK, gps_to_utc, leap_seconds
 
 
 def _need(dataset: Dataset, name: str, option: str) -> None:
@@ -31,9 +32,53 @@ def _need(dataset: Dataset, name: str, option: str) -> None:
 
 
 def _gps_start(dataset: Dataset) -> tuple[int, float]:
-    """GPS week and time of week (s) of ``t = 0``."""
-    return (int(dataset.field("gps_time_start", "week")),
-            float(dataset.field("gps_time_start", "tow")))
+    """GPS week and time of week (s) of ``t = 0``: a week from 0 (the GPS epoch) on, a time
+    of week in [0, 604800) s."""
+    week = int(dataset.field("gps_time_start", "week"))
+    tow = float(dataset.field("gps_time_start", "tow"))
+    where = str(dataset.path / "manifest.json")
+    if not 0 <= week <= MAX_GPS_WEEK:
+        raise InputError([Problem(where, None, "gps_time_start.week", f"{week} is not a GPS "
+                                  f"week (0, the GPS epoch 1980-01-06, to {MAX_GPS_WEEK})")])
+    if not 0.0 <= tow < SECONDS_PER_WEEK:
+        raise InputError([Problem(where, None, "gps_time_start.tow", f"{tow!r} is not a time "
+                                  f"of week in [0, {SECONDS_PER_WEEK:g}) s")])
+    return week, tow
+
+
+# what each exported column may hold, in its SI unit: the RINEX and NMEA fields have fixed
+# widths and ranges; a missing value (NaN) is written as an empty field
+MAX_GPS_WEEK = 11_000  # 2190: the latest start a scenario may give
+_RANGES = {
+    "gnss_raw": {"sv": (1, 99), "pseudorange": (0.0, 1e9), "doppler": (-1e8, 1e8),
+                 "cn0": (0.0, 99.0), "elevation": (-math.pi / 2, math.pi / 2),
+                 "azimuth": (-2 * math.pi, 2 * math.pi)},
+    "gnss_fix": {"lat": (-90.0, 90.0), "lon": (-180.0, 180.0), "alt": (-1e5, 1e6),
+                 "speed": (0.0, 1e4), "course": (-2 * math.pi, 2 * math.pi),
+                 "hdop": (0.0, 1e3), "vdop": (0.0, 1e3), "num_sats": (0, 99), "fix": (0, 9)},
+}
+MAX_NAV_MAGNITUDE = 1e99  # a RINEX D19.12 field holds a two-digit exponent
+
+
+def _read_checked(dataset: Dataset, name: str) -> pd.DataFrame:
+    """A GNSS stream whose every exported value fits its field (module note above)."""
+    frame = dataset.read(name)
+    path = str(dataset.path / dataset.manifest["streams"][name]["file"])
+    checks = _RANGES.get(name) or {c: (-MAX_NAV_MAGNITUDE, MAX_NAV_MAGNITUDE)
+                                   for c in frame.columns if c != "sv"
+                                   and pd.api.types.is_numeric_dtype(frame[c])}
+    for column, (low, high) in checks.items():
+        if column not in frame:
+            continue
+        values = frame[column].to_numpy(dtype=float)
+        bad = ~((values >= low) & (values <= high))
+        bad &= ~np.isnan(values) if name in _RANGES else True
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            raise InputError([Problem(path, None, column, f"row {i} holds {values[i]!r}, "
+                                      f"outside [{low:g}, {high:g}]: it cannot be exported "
+                                      f"({int(bad.sum())} such row(s))")])
+    return frame
 
 
 def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
@@ -57,9 +102,9 @@ def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
         check_output_file(path, force, [dataset.path], "rinex")
     with (atomic_output_file(obs, force, [dataset.path], "rinex") as obs_tmp,
           atomic_output_file(nav, force, [dataset.path], "rinex") as nav_tmp):
-        write_rinex_obs(obs_tmp, dataset.read("gnss_raw"), week, tow, approx)
-        write_rinex_nav(nav_tmp, dataset.read("gnss_nav"), leap_seconds(gps_to_utc(week, tow)),
-                        iono.get("alpha"), iono.get("beta"))
+        write_rinex_obs(obs_tmp, _read_checked(dataset, "gnss_raw"), week, tow, approx)
+        write_rinex_nav(nav_tmp, _read_checked(dataset, "gnss_nav"),
+                        leap_seconds(gps_to_utc(week, tow)), iono.get("alpha"), iono.get("beta"))
     return obs, nav
 
 
@@ -69,7 +114,8 @@ def export_nmea(dataset: Dataset, path: str | Path, force: bool = False,
     satellites of ``gnss_raw`` when the dataset has it) into ``path``; the path."""
     _need(dataset, "gnss_fix", option)
     week, tow = _gps_start(dataset)
-    raw = dataset.read("gnss_raw") if dataset.has("gnss_raw") else pd.DataFrame()
+    raw = _read_checked(dataset, "gnss_raw") if dataset.has("gnss_raw") else pd.DataFrame()
+    fix = _read_checked(dataset, "gnss_fix")
     with atomic_output_file(path, force, [dataset.path], "nmea") as tmp:
-        write_nmea(tmp, dataset.read("gnss_fix"), raw, week, tow)
+        write_nmea(tmp, fix, raw, week, tow)
     return Path(path)

@@ -49,10 +49,16 @@ def _d19(value: float) -> str:
     return f"{value:19.12E}".replace("E", "D")
 
 
+def _obs(value: float) -> str:
+    """An observation field (F14.3); blank when the value is missing (RINEX 3.04 5.1)."""
+    return f"{value:14.3f}" if np.isfinite(value) else " " * 14
+
+
 def signal_strength_indicator(cn0_dbhz: np.ndarray) -> np.ndarray:
     """RINEX signal strength indicator 1-9 from C/N0 (RINEX 3.04 section 5.7: 1 below 12 dB-Hz,
     one step per 6 dB, 9 at 54 dB-Hz and above)."""
-    return np.clip(np.floor(np.asarray(cn0_dbhz) / 6.0), 1, 9).astype(int)
+    level = np.floor(np.nan_to_num(np.asarray(cn0_dbhz, dtype=float), nan=0.0) / 6.0)
+    return np.clip(level, 1, 9).astype(int)
 
 
 def _gps_datetime(week: int, seconds: float) -> dt.datetime:
@@ -111,7 +117,9 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
                      f"{stamp.minute:02d}{seconds:11.7f}  0{len(epoch):3d}")
         for sv, pr, dop, cn0, s in epoch[["sv", "pseudorange", "doppler", "cn0",
                                            "ssi"]].itertuples(index=False):
-            lines.append(f"G{int(sv):02d}{pr:14.3f} {s:1d}{dop:14.3f} {s:1d}{cn0:14.3f}  ")
+            strength = f"{s:1d}" if np.isfinite(cn0) else " "
+            lines.append(f"G{int(sv):02d}{_obs(pr)} {strength}{_obs(dop)} {strength}"
+                         f"{_obs(cn0)}  ")
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
     return path
 
