@@ -73,7 +73,7 @@ def main(argv: list[str] | None = None) -> int:
     command = _command_name(argv)
     args = build_parser(command if command in SUMMARIES else None).parse_args(argv)
     if sys.stdout is None:  # started with its standard output closed: what it says is lost
-        sys.stdout = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 (to the end)
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 (open to the end)
     try:
         code = _run(args)
         sys.stdout.flush()

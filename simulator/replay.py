@@ -46,6 +46,7 @@ from simulator.earth import (
 from simulator.errors import InputError, Problem, Terminated
 from simulator.outputs import atomic_output_file
 from simulator.progress import progress
+from simulator.threads import one_blas_thread
 
 STREAM_ORDER = ("imu", "odometer", "baro", "mag", "gnss_fix", "gnss_raw")
 SPAN_MARGIN_S = 1.0  # how far a stream's times may reach beyond the truth's
@@ -226,6 +227,7 @@ def _units(dataset: Dataset, name: str) -> dict[str, str]:
     return units
 
 
+@one_blas_thread
 def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                   show_progress: bool = True) -> tuple[pd.DataFrame, dict]:
     """Replay a dataset causally into one estimator.

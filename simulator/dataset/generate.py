@@ -40,6 +40,7 @@ from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.base import sample_times
 from simulator.stochastic import stream_rng
 from simulator.tables import Table, as_frames, column
+from simulator.threads import one_blas_thread
 from simulator.trajectory.kinematics import Kinematics
 from simulator.vehicle.params import vehicle_parameters
 from simulator.vehicle.suspension import axle_distances
@@ -69,6 +70,7 @@ class Generated:
     truth_keys: dict[str, dict] = field(default_factory=dict)  # sensor -> {key: nominal}
 
 
+@one_blas_thread
 def generate_streams(scenario: Scenario | dict, show_progress: bool = True, frames: bool = True,
                      on_final: Callable[[str, Table], None] | None = None) -> Generated:
     """Truth table, every configured sensor's streams, and the events table.

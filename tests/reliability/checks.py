@@ -17,8 +17,10 @@ def tree(root: Path) -> dict[str, tuple[int, int]]:
     return out
 
 
-def refused(args: list[str], capsys, watch: list[Path], words: str) -> str:
-    """Run ``landnav ARGS``; assert it is refused as above; the printed text."""
+def refused(args: list[str], capsys, watch: list[Path], words: str,
+            prefix: str = "error:") -> str:
+    """Run ``landnav ARGS``; assert it is refused as above (one line starting with ``prefix``:
+    ``validate`` prints its problems as ``file:line: ...``); the printed text."""
     before = {str(w): tree(w) for w in watch}
     code = main(args)
     out = capsys.readouterr()
@@ -26,7 +28,7 @@ def refused(args: list[str], capsys, watch: list[Path], words: str) -> str:
     assert code == 2, text
     assert "Traceback" not in text
     assert words in text, text
-    errors = [line for line in text.splitlines() if line.startswith("error:")]
+    errors = [line for line in text.splitlines() if line.startswith(prefix)]
     assert len(errors) == 1, text
     assert {str(w): tree(w) for w in watch} == before
     return text
