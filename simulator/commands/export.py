@@ -7,7 +7,7 @@ from __future__ import annotations
 import argparse
 
 from simulator.commands import SUMMARIES
-from simulator.dataset.export import export_nmea, export_rinex
+from simulator.dataset.export import check_export, export_nmea, export_rinex
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError, Problem
 
@@ -31,6 +31,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError([Problem("landnav export", None, "", "nothing to do: give --rinex DIR "
                                   "and/or --nmea FILE")])
     dataset = open_dataset(args.dataset)
+    check_export(dataset, args.rinex, args.nmea, args.force)  # refused before anything is written
     if args.rinex:
         obs, nav = export_rinex(dataset, args.rinex, args.force, option="--rinex")
         print(f"wrote {obs} and {nav}")

@@ -75,10 +75,32 @@ def _read_checked(dataset: Dataset, name: str) -> pd.DataFrame:
         bad &= ~np.isnan(values) if name in _RANGES else True
         if bad.any():
             i = int(np.flatnonzero(bad)[0])
-            raise InputError([Problem(path, None, column, f"row {i} holds {values[i]!r}, "
+            raise InputError([Problem(path, None, column, f"row {i} holds {values[i]:g}, "
                                       f"outside [{low:g}, {high:g}]: it cannot be exported "
                                       f"({int(bad.sum())} such row(s))")])
     return frame
+
+
+def check_export(dataset: Dataset, rinex_dir: str | Path | None, nmea_path: str | Path | None,
+                 force: bool = False) -> None:
+    """Everything ``export_rinex`` and ``export_nmea`` would refuse, checked before either
+    writes: the streams, the GPS start, every exported value, the output names."""
+    _gps_start(dataset)  # refuses a week or a time of week out of range
+    names = []
+    if rinex_dir is not None:
+        _need(dataset, "gnss_raw", "--rinex")
+        _need(dataset, "gnss_nav", "--rinex")
+        names += ["gnss_raw", "gnss_nav"]
+        base = Path(dataset.path).resolve().name
+        for suffix in ("obs", "nav"):
+            check_output_file(Path(rinex_dir) / f"{base}.{suffix}", force, [dataset.path],
+                              "rinex")
+    if nmea_path is not None:
+        _need(dataset, "gnss_fix", "--nmea")
+        names += ["gnss_fix", *(["gnss_raw"] if dataset.has("gnss_raw") else [])]
+        check_output_file(nmea_path, force, [dataset.path], "nmea")
+    for name in dict.fromkeys(names):
+        _read_checked(dataset, name)
 
 
 def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,

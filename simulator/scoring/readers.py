@@ -286,6 +286,7 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
         frame, notes, uses_gnss = _parquet(path)
     elif kind == "csv":
         frame = _csv(path)
+        _refuse_text(path, frame, [c for c in frame.columns if c in _UNITS], offset=1)
     elif kind == "pos":
         frame, notes = _pos(path, gps_start)
     else:
@@ -300,8 +301,9 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
 def _refuse_text(path: Path, frame: pd.DataFrame, columns: list[str] | None = None,
                  offset: int = 0) -> None:
     """Refuse a cell of ``frame``'s ``columns`` (all by default) that is not a number (empty
-    cells are missing values), naming its column and row (``offset`` + row index: the file's
-    line, where known); numbers written as text become numbers, in place."""
+    cells are missing values), naming its column and the file's line (``offset``: the lines
+    before the first row; 0 when there are no lines, as in Parquet: then the row); numbers
+    written as text become numbers, in place."""
     for name in frame.columns if columns is None else columns:
         values = frame[name]
         if pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(
@@ -315,8 +317,8 @@ def _refuse_text(path: Path, frame: pd.DataFrame, columns: list[str] | None = No
         bad = numbers.isna() & values.notna() & (values.astype(str).str.strip() != "")
         if bad.any():
             i = int(np.flatnonzero(bad.to_numpy())[0])
-            raise _problem(path, f"row {i + offset + 1}: {values.iloc[i]!r} is not a number",
-                           name)
+            where = f"line {i + offset + 1}" if offset else f"row {i}"
+            raise _problem(path, f"{where}: {values.iloc[i]!r} is not a number", name)
         frame[name] = numbers
 
 
