@@ -183,3 +183,52 @@ def test_signal_during_generation_leaves_nothing(tmp_path, sig, code, command):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
     rerun = _landnav([command, str(scenario), "-o", "out"], tmp_path)
     assert rerun.wait(timeout=300) == 0, rerun.communicate()
+
+
+def test_names_that_are_not_utf8(dataset, tmp_path, capsys):
+    bad = os.fsdecode(b"out\xff")
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO)
+    refused(["generate", str(scenario), "-o", str(tmp_path / bad)], capsys, [tmp_path],
+            "is not valid UTF-8 text")
+    refused(["estimate", str(dataset), "-e", "gnss_only", "-o",
+             str(tmp_path / f"{bad}.parquet")], capsys, [tmp_path], "is not valid UTF-8 text")
+
+
+@pytest.mark.parametrize("stdout, code", [("full", 2), ("closed", 0)])
+def test_full_or_closed_standard_output(tmp_path, stdout, code):
+    """A full standard output is one message (the dataset itself is written); a closed one
+    loses only what would be printed."""
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    argv = [sys.executable, "-m", "simulator.cli", "generate", str(scenario), "-o",
+            str(tmp_path / "ds")]
+    if stdout == "full":
+        with open("/dev/full", "w") as full:
+            done = subprocess.run(argv, env=env, stdout=full, stderr=subprocess.PIPE,
+                                  text=True, timeout=300)
+    else:
+        done = subprocess.run(argv, env=env, stderr=subprocess.PIPE, text=True, timeout=300,
+                              preexec_fn=lambda: os.close(1))
+    assert done.returncode == code, done.stderr
+    assert "Traceback" not in done.stderr
+    if code == 2:
+        assert done.stderr.count("error:") == 1 and "standard output" in done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds", "s.yaml"]
+
+
+def test_thread_settings_leave_the_bytes_unchanged(tmp_path):
+    """The same dataset with OpenBLAS on one and on two threads (before, three truth rows of
+    this drive differed by 3e-17)."""
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text((REPO / "scenarios" / "quickstart.yaml").read_text())
+    for threads in ("1", "2"):
+        env = {**os.environ, "PYTHONPATH": str(REPO), "OPENBLAS_NUM_THREADS": threads}
+        subprocess.run([sys.executable, "-m", "simulator.cli", "generate", str(scenario), "-o",
+                        str(tmp_path / threads)], env=env, check=True, capture_output=True,
+                       timeout=600)
+    files = sorted(p.name for p in (tmp_path / "1").glob("*.parquet"))
+    assert files == sorted(p.name for p in (tmp_path / "2").glob("*.parquet"))
+    for name in files:
+        assert (tmp_path / "1" / name).read_bytes() == (tmp_path / "2" / name).read_bytes(), name
