@@ -232,3 +232,17 @@ def test_thread_settings_leave_the_bytes_unchanged(tmp_path):
     assert files == sorted(p.name for p in (tmp_path / "2").glob("*.parquet"))
     for name in files:
         assert (tmp_path / "1" / name).read_bytes() == (tmp_path / "2" / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("where, words", [
+    ("under a file", "is a file, not a folder"), ("dangling link", "dangling symbolic link"),
+    ("/proc", "cannot write here")])
+def test_campaign_outputs_that_cannot_be_written(tmp_path, capsys, where, words):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO + "estimators: [gnss_only]\n")
+    (tmp_path / "f").write_text("x")
+    (tmp_path / "dangling").symlink_to(tmp_path / "nowhere")
+    out = {"under a file": tmp_path / "f" / "mc", "dangling link": tmp_path / "dangling",
+           "/proc": Path("/proc/landnav-mc")}[where]
+    refused(["campaign", str(scenario), "--runs", "1", "--workers", "1", "-o", str(out)],
+            capsys, [tmp_path], words)
