@@ -30,8 +30,12 @@ from simulator.errors import InputError, Problem
 
 def needs_isolation(entry: Mapping[str, Any] | str, time_limit_s: float | None) -> bool:
     """Whether to replay ``entry`` in a child: any estimator that is not a built-in (the
-    user's or a third party's code), and any with a time limit."""
+    user's or a third party's code), and any with a time limit; but never a class of the
+    running program itself (``__main__:Class``, as a notebook defines one), which a child
+    cannot import."""
     name = entry if isinstance(entry, str) else entry["name"]
+    if name.partition(":")[0] == "__main__":
+        return False
     return time_limit_s is not None or name not in BUILTINS
 
 
