@@ -47,6 +47,7 @@ from simulator.errors import InputError, Problem, refuse_undecodable
 OWNER_FILE = ".landnav-owner"  # inside a claimed temporary folder: the writer's process id
 MARKER_FILE = ".landnav-output"  # inside every folder written here: what --force may replace
 _SNIFF_BYTES = 65536  # how much of an existing file is read to recognise its kind
+_JSON_BYTES = 16 * 1024**2  # a JSON file landnav wrote (scores, manifest) is read whole up to this
 _NOFOLLOW = getattr(os, "O_NOFOLLOW", 0)
 
 
@@ -130,13 +131,21 @@ def refuse_locked(path: Path | str) -> None:
             os.close(fd)
 
 
-def _head(path: Path) -> bytes:
+def _head(path: Path, size: int = _SNIFF_BYTES) -> bytes:
+    """The first ``size`` bytes of ``path`` (empty when it cannot be read; never a link)."""
     try:
         fd = os.open(path, os.O_RDONLY | _NOFOLLOW)
     except OSError:
         return b""
     try:
-        return os.read(fd, _SNIFF_BYTES)
+        chunks, left = [], size
+        while left > 0:
+            chunk = os.read(fd, min(left, 1 << 20))
+            if not chunk:
+                break
+            chunks.append(chunk)
+            left -= len(chunk)
+        return b"".join(chunks)
     finally:
         os.close(fd)
 
@@ -146,7 +155,7 @@ def _landnav_json(path: Path) -> bool:
     if path.is_symlink() or not path.is_file():
         return False
     try:
-        value = json.loads(_head(path).decode("utf-8"))
+        value = json.loads(_head(path, _JSON_BYTES).decode("utf-8"))
     except ValueError:
         return False
     return isinstance(value, dict) and str(value.get("format", "")).startswith("landnav-")
@@ -155,7 +164,7 @@ def _landnav_json(path: Path) -> bool:
 def _scores_json(path: Path) -> bool:
     """A JSON object of scores keyed by label (``landnav score --json``), or empty."""
     try:
-        value = json.loads(_head(path).decode("utf-8"))
+        value = json.loads(_head(path, _JSON_BYTES).decode("utf-8"))
     except ValueError:
         return False
     return isinstance(value, dict) and all(isinstance(v, dict) and "horizontal" in v
