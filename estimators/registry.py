@@ -31,6 +31,7 @@ ENTRY_POINT_GROUP = "landnav.estimators"
 BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
+    "gnss_wls": "estimators.builtin.gnss_wls:GnssWls",
     "dr2d_drm1_ekf": "estimators.builtin.cho2006:Drm1Ekf",
     "dr2d_drm2_ekf": "estimators.builtin.cho2006:Drm2Ekf",
     "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",

@@ -16,7 +16,7 @@ import sys
 import threading
 from types import FrameType
 
-from simulator.commands import SUMMARIES
+from simulator.commands import MODULES, SUMMARIES
 from simulator.errors import InputError, Terminated
 
 DESCRIPTION = """\
@@ -45,7 +45,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND", required=True)
     for name, summary in SUMMARIES.items():
         if command in (None, name):
-            importlib.import_module(f"simulator.commands.{name}").add_parser(sub)
+            module = MODULES.get(name, name)
+            importlib.import_module(f"simulator.commands.{module}").add_parser(sub)
         else:
             sub.add_parser(name, help=summary)
     return parser

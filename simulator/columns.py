@@ -137,4 +137,5 @@ REQUIRED = {
     "truth_gnss": ("t", "sv"),
     "truth_sensors": ("t",),
 }
-TEXT_COLUMNS = ("zone", "kind", "detail")  # every other column of a stream is numeric
+# every other column of a stream is numeric
+TEXT_COLUMNS = ("zone", "kind", "detail", "system", "signal")

@@ -188,12 +188,28 @@ def _landnav_parquet(path: Path) -> bool:
 _NMEA = re.compile(rb"^\$[A-Z]{5},")
 
 
+def _parquet_columns(path: Path) -> set[str]:
+    """The column names of a Parquet file (empty when it is not one)."""
+    if not _head(path, 4).startswith(b"PAR1"):
+        return set()
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        return set(pq.read_schema(path).names)
+    except (pa.ArrowException, OSError):
+        return set()
+
+
 def _file_kinds() -> dict:
     return {
         "parquet": _landnav_parquet,
         "json": _scores_json,
         "nmea": lambda p: bool(_NMEA.match(_head(p))),
         "rinex": lambda p: _head(p)[60:80].startswith(b"RINEX VERSION / TYPE"),
+        "mcap": lambda p: _head(p, 8) == b"\x89MCAP0\r\n",
+        "twin-scenario": lambda p: _head(p).startswith(b"# The twin of "),
+        "twin-drive": lambda p: {"t", "lat", "lon", "alt"} <= _parquet_columns(p),
     }
 
 
@@ -201,7 +217,7 @@ def is_own_output(path: Path, kind: str | None = None) -> bool:
     """Whether ``path`` is something landnav wrote, that ``--force`` may replace: a folder that
     is empty, carries the marker, or holds a landnav manifest (a dataset, a campaign, a run's
     ``dataset/``); a file of the writer's ``kind`` (``parquet``, ``json``, ``nmea``,
-    ``rinex``)."""
+    ``rinex``, ``mcap``, ``twin-scenario``, ``twin-drive``)."""
     if path.is_dir():
         try:
             if not any(path.iterdir()):

@@ -118,6 +118,10 @@ class _Stream:
     """One stream as a float64 array, with the message times and how to index messages."""
 
     def __init__(self, name: str, frame: pd.DataFrame, units: dict[str, str], where: Path):
+        if "system" in frame and not pd.api.types.is_numeric_dtype(frame["system"]):
+            # the rows reach an estimator as numbers: the RINEX system letter as its code point
+            # (G 71, R 82, E 69, C 67, J 74), ``system_code``
+            frame = frame.assign(system_code=frame["system"].astype(str).str[:1].map(ord))
         numeric = [c for c in frame.columns if pd.api.types.is_numeric_dtype(frame[c])]
         if "t" not in numeric:
             raise InputError([Problem(str(where), None, name, "no numeric time column t")])
@@ -188,10 +192,22 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
                                   f"({label}) needs the {s!r} stream, which the dataset does "
                                   f"not have (it has: {', '.join(dataset.stream_names)})")
                           for s in missing])
-    names = [s for s in dict.fromkeys((*cls.needs, *cls.uses)) if dataset.has(s)]
+    # a recording's stream that lacks what estimators need (comma2k19's raw GNSS has no
+    # satellite positions: the manifest's ``lacks``) refuses the estimators that need it and
+    # is left out for those that would only use it
+    lacks = dataset.manifest.get("lacks") or {}
+    lacking = [s for s in cls.needs if s in lacks]
+    if lacking:
+        raise InputError([Problem(str(dataset.path), None, "", f"estimator {cls.name!r} "
+                                  f"({label}) needs the {s!r} stream, and this recording's {s} "
+                                  f"lacks {lacks[s]}") for s in lacking])
+    names = [s for s in dict.fromkeys((*cls.needs, *cls.uses))
+             if dataset.has(s) and s not in lacks]
     names.sort(key=_stream_rank)  # scoring-only streams were refused by get_estimator
     streams = [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
-    if dataset.has("truth"):
+    # a generated dataset's streams lie within its truth; a recording's reference may cover
+    # less than its sensors did (the solution-row bound still holds its gaps)
+    if dataset.has("truth") and dataset.manifest.get("reference") is not True:
         truth_t = dataset.read("truth", ["t"])["t"].to_numpy(dtype=float)
         span = (truth_t[0], truth_t[-1]) if len(truth_t) else (0.0, 0.0)
         for stream in streams:

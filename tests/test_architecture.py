@@ -37,7 +37,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("sensors", ("simulator.sensors",)),
     ("faults", ("simulator.faults",)),
     ("scenario", ("simulator.scenario",)),
-    ("dataset", ("simulator.dataset",)),
+    ("dataset", ("simulator.dataset", "simulator.recordings")),
     ("estimators", ("estimators",)),
     ("replay", ("simulator.replay", "simulator.isolated")),
     ("scoring", ("simulator.scoring",)),

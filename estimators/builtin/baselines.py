@@ -58,8 +58,10 @@ class GnssOnly(Estimator):
         self._t_fix: float | None = None
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        # a fix without a horizontal velocity is not used; one without a vertical velocity
+        # (a recording that does not log it) holds its height and writes vd as NaN
         if not (row[self._fix] > 0 and all(math.isfinite(row[i]) for i in (*self._pos,
-                                                                              *self._vel))):
+                                                                              *self._vel[:2]))):
             return
         self._t_fix = t
         lat, lon, alt = (float(row[i]) for i in self._pos)
@@ -75,7 +77,8 @@ class GnssOnly(Estimator):
             return None
         dt = t - self._t_fix
         return [math.degrees(self._lat + self._lat_rate * dt),
-                math.degrees(self._lon + self._lon_rate * dt), self._alt - self._vd * dt,
+                math.degrees(self._lon + self._lon_rate * dt),
+                self._alt - (self._vd * dt if math.isfinite(self._vd) else 0.0),
                 self._vn, self._ve, self._vd, math.nan, math.nan, math.nan]
 
 

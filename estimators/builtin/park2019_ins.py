@@ -148,8 +148,11 @@ class ParkInsOdometer(Estimator):
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
         values = row[self._fix_idx]
-        if row[self._fix] < 2 or not np.isfinite(values).all():
+        if row[self._fix] < 2 or not np.isfinite(values[:3]).all():
             return
+        # a receiver (or a recording) may leave a velocity component out (NaN): those rows
+        # are not used
+        keep = np.r_[np.ones(3, dtype=bool), np.isfinite(values[3:6])]
         ins = self.ins
         ins.flush()
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
@@ -158,9 +161,10 @@ class ParkInsOdometer(Estimator):
         if self._fix_states:  # the fix is the antenna plus its correlated error
             dz_p += ins.extra[:3]
             h_p[:, 15:18] = np.eye(3)
-        dz_v, h_v = aiding.gnss_velocity(ins.v, values[3:6], n, ins.q, ins.mean_rate,
-                                         self._antenna)
-        ins.update(np.concatenate([dz_p, dz_v]), np.vstack([h_p, h_v]), self._r_fix)
+        dz_v, h_v = aiding.gnss_velocity(ins.v, np.nan_to_num(values[3:6]), n, ins.q,
+                                         ins.mean_rate, self._antenna)
+        ins.update(np.concatenate([dz_p, dz_v])[keep], np.vstack([h_p, h_v])[keep],
+                   self._r_fix[np.ix_(keep, keep)])
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
         ins = self.ins

@@ -9,4 +9,6 @@ strapdown     NED quaternion INS mechanisation
 gauss_markov  first-order Gauss-Markov and Van Loan discretisation
 nav_error     the [dr, dv, psi] navigation error convention
 constraints   non-holonomic and height pseudo-measurements
+ambiguity     integer ambiguity resolution: LAMBDA (decorrelation and search), ratio test,
+              bootstrapped success rate, partial fixing
 """

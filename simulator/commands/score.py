@@ -80,6 +80,9 @@ def run(args: argparse.Namespace) -> int:
                                           "solution file's stem and an estimator's name")])
             solutions[label] = solved
         ev = pipeline.score(dataset, solutions)
+        if dataset.manifest.get("reference") is True:
+            print(f"scored against a reference, not an exact truth: "
+                  f"{dataset.manifest.get('reference_source', 'the recording reference')}")
         print_scores(ev)
         if args.json:
             write_scores(ev.scores(), Path(args.json), args.force, inputs)

@@ -1,0 +1,179 @@
+"""``gnss_wls``: epoch-by-epoch weighted least squares on the raw pseudoranges and pseudorange
+rates, the snapshot baseline of every pseudorange method (Misra & Enge, *Global Positioning
+System*, 2nd ed., sections 6.1-6.2; Groves 2013, section 9.4.1).
+
+Each epoch's corrected pseudoranges (``toolbox.gnss_model.raw_epoch``: broadcast satellite
+clock, ionosphere and troposphere applied) give the antenna's ECEF position and one receiver
+clock bias per satellite system and frequency band (the inter-system offsets, GLONASS's and
+BeiDou's time systems, and a receiver's delay between bands) by Gauss-Newton iterations of the
+linearised model rho = |R r_s - r| + cb_sys (``gnss_model.predict``, with the Sagnac
+rotation), from the last solution or, at the first epoch, from the Earth's centre; while the
+weighted residuals fail the chi-square test (false alarm 1e-3) the worst is excluded (fault
+detection and exclusion). The pseudorange rates then give the velocity and one clock
+drift. Weights: the receiver's reported 1-sigma where the stream carries it
+(``pseudorange_std``, ``pseudorange_rate_std``), else a C/N0 model, sigma^2 = a^2 + b^2
+10^(-C/N0 / 10) with a = 0.5 m and b = 300 m (dB-Hz; the form of RTKLIB's and of Android's
+uncertainty models); satellites below ``elevation_mask`` (deg, where the stream has the
+elevation) or unhealthy are left out, and an epoch needs four plus one per extra system.
+
+The std columns are the square roots of the diagonal of (H^T W H)^-1 rotated to NED, so they
+are as honest as the weights. Roll, pitch and yaw are NaN (a receiver does not know them).
+``clock_bias`` is GPS's clock bias (m; of its lowest band, else of the first system
+tracked), ``clock_drift`` the drift (m/s).
+
+Public classes
+--------------
+GnssWls.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.stats import chi2
+
+from estimators.base import Estimator
+from estimators.toolbox.gnss_model import predict, raw_epoch
+from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
+
+C_N0_FLOOR_M = 0.5      # a: the sigma of a strong signal, m
+C_N0_SCALE_M = 300.0    # b: sigma^2 = a^2 + b^2 10^(-C/N0/10), m
+ITERATIONS = 8
+BAND_HZ = 50e6  # carriers within 25 MHz share a band: L1/E1/G1 (FDMA) apart from B1I, L5/E5a
+CONVERGED_M = 1e-4
+FDE_FALSE_ALARM = 1e-3  # false-alarm probability of the residual test
+
+OUTPUT_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
+                  "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd",
+                  "clock_bias", "clock_drift", "num_sats")
+
+
+class GnssWls(Estimator):
+    """Snapshot weighted least squares on pseudoranges and pseudorange rates."""
+
+    name = "gnss_wls"
+    needs = ("gnss_raw",)
+    paper = "baseline: epoch-by-epoch weighted least squares (Misra & Enge 2011, 6.1-6.2)"
+    initialises_itself = True
+    output_rate_hz = 1.0
+    defaults = {"elevation_mask": 10.0}
+    output_columns = OUTPUT_COLUMNS
+
+    def setup(self) -> None:
+        self._cols = self.columns["gnss_raw"]
+        self._pos = np.zeros(3)
+        self._row: list[float] | None = None
+        self._t = math.nan
+        self._mask = math.radians(float(self.config["elevation_mask"]))
+
+    def on_gnss_raw(self, t: float, block: np.ndarray) -> None:
+        cols = self._cols
+        if "health" in cols:
+            block = block[block[:, cols["health"]] == 0]
+        if "elevation" in cols:
+            elevation = block[:, cols["elevation"]]
+            block = block[~(elevation < self._mask)]  # NaN elevations are kept
+        # one clock bias per system and frequency band: systems keep their own time, and a
+        # receiver's code delay differs between bands (a phone's L1 and L5: tens of metres)
+        systems = (block[:, cols["system_code"]] if "system_code" in cols
+                   else np.zeros(len(block)))
+        if "frequency" in cols:
+            systems = systems * 1000.0 + np.round(block[:, cols["frequency"]] / BAND_HZ)
+        ep = raw_epoch(block, cols)
+        ok = np.isfinite(ep.pseudorange) & np.isfinite(ep.sat_pos).all(axis=1)
+        labels, system_index = np.unique(systems[ok], return_inverse=True)
+        n_clock = len(labels)
+        # the clock written out: GPS's (its lowest band) where GPS is tracked
+        gps = np.flatnonzero(labels // 1000 == ord("G"))
+        reference_clock = int(gps[0]) if gps.size else 0
+        if ok.sum() < 3 + n_clock:
+            self._row = None
+            return
+        sat_pos, sat_vel = ep.sat_pos[ok], ep.sat_vel[ok]
+        rho = ep.pseudorange[ok]
+        cn0 = block[:, cols["cn0"]][ok] if "cn0" in cols else None
+        sigma = _sigma(ep.pseudorange_std[ok], cn0, C_N0_FLOOR_M)
+        weight = 1.0 / sigma**2
+        clock_cols = np.zeros((len(rho), n_clock))
+        clock_cols[np.arange(len(rho)), system_index] = 1.0
+        used = np.ones(len(rho), dtype=bool)
+        while True:
+            x, h, residual = _solve(self._pos, sat_pos[used], sat_vel[used], rho[used],
+                                    clock_cols[used], weight[used])
+            dof = int(used.sum()) - h.shape[1]
+            wssr = float(np.sum(weight[used] * residual**2))
+            # fault detection and exclusion: drop the worst measurement while the weighted
+            # residuals fail the chi-square test (Misra & Enge 2011, section 6.6)
+            if dof < 2 or wssr <= chi2.ppf(1.0 - FDE_FALSE_ALARM, dof):
+                break
+            worst = np.flatnonzero(used)[np.argmax(weight[used] * residual**2)]
+            used[worst] = False
+        cov_pos = np.linalg.inv(h.T @ (h * weight[used][:, None]))
+        self._pos = x[:3]
+        lat, lon, alt = ecef_to_geodetic(x[:3])
+        c_ne = ned_to_ecef_matrix(lat, lon)
+        std_ned = np.sqrt(np.diag(c_ne.T @ cov_pos[:3, :3] @ c_ne))
+
+        rate = ep.range_rate[ok]
+        good = np.isfinite(rate)
+        vel = np.full(3, np.nan)
+        std_vel = np.full(3, np.nan)
+        drift = math.nan
+        if good.sum() >= 4:
+            rate_sigma = _sigma(ep.range_rate_std[ok][good], None, 0.05)
+            w_rate = 1.0 / rate_sigma**2
+            _, predicted_rate, los = predict(sat_pos[good], sat_vel[good], x[:3], np.zeros(3))
+            h_rate = np.hstack([-los, np.ones((good.sum(), 1))])
+            sol = _wls(h_rate, rate[good] - predicted_rate, w_rate)
+            cov_vel = np.linalg.inv(h_rate.T @ (h_rate * w_rate[:, None]))
+            vel = c_ne.T @ sol[:3]
+            std_vel = np.sqrt(np.diag(c_ne.T @ cov_vel[:3, :3] @ c_ne))
+            drift = float(sol[3])
+        self._row = [math.degrees(float(lat)), math.degrees(float(lon)), float(alt),
+                     *vel, math.nan, math.nan, math.nan, *std_ned, *std_vel,
+                     float(x[3 + reference_clock]), drift, float(used.sum())]
+        self._t = t
+
+    def solution(self, t: float) -> list[float] | None:
+        if self._row is None or abs(t - self._t) > 1e-6:
+            return None
+        return self._row
+
+
+def _solve(start: np.ndarray, sat_pos: np.ndarray, sat_vel: np.ndarray, rho: np.ndarray,
+           clock_cols: np.ndarray, weight: np.ndarray
+           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Gauss-Newton WLS of position and clocks; the state (NaN for the clock of a band with no
+    measurement left), the design matrix and the residuals at the solution."""
+    keep = clock_cols.any(axis=0)  # a band whose every measurement was excluded
+    clock_cols = clock_cols[:, keep]
+    x = np.concatenate([start, np.zeros(clock_cols.shape[1])])
+    for _ in range(ITERATIONS):
+        geometric, _, los = predict(sat_pos, sat_vel, x[:3], np.zeros(3))
+        residual = rho - geometric - clock_cols @ x[3:]
+        h = np.hstack([-los, clock_cols])
+        dx = _wls(h, residual, weight)
+        x += dx
+        if np.linalg.norm(dx[:3]) < CONVERGED_M:
+            break
+    geometric, _, los = predict(sat_pos, sat_vel, x[:3], np.zeros(3))
+    residual = rho - geometric - clock_cols @ x[3:]
+    full = np.full(3 + keep.size, np.nan)  # NaN for a band with no measurement left
+    full[:3] = x[:3]
+    full[3:][keep] = x[3:]
+    return full, np.hstack([-los, clock_cols]), residual
+
+
+def _sigma(reported: np.ndarray, cn0: np.ndarray | None, floor: float) -> np.ndarray:
+    """1-sigma per measurement: the receiver's report where finite and positive, else the
+    C/N0 model (or ``floor`` without C/N0)."""
+    model = (np.sqrt(C_N0_FLOOR_M**2 + C_N0_SCALE_M**2 * 10.0 ** (-cn0 / 10.0))
+             if cn0 is not None else np.full(len(reported), floor))
+    return np.where(np.isfinite(reported) & (reported > 0), reported, model)
+
+
+def _wls(h: np.ndarray, residual: np.ndarray, weight: np.ndarray) -> np.ndarray:
+    """The weighted least-squares solution of h dx = residual."""
+    hw = h * weight[:, None]
+    return np.linalg.solve(h.T @ hw, hw.T @ residual)

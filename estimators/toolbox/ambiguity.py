@@ -1,0 +1,267 @@
+"""Integer ambiguity resolution: the LAMBDA method, its validation and partial fixing.
+
+Given float ambiguities ``a`` (cycles) with covariance ``Q``, the integer least-squares (ILS)
+problem is ``min_z (a - z)^T Q^-1 (a - z)`` over integer vectors z. The LAMBDA method (Teunissen
+1995; de Jonge & Tiberius 1996, LGR series no. 12) solves it in two steps, written here after the
+modified form MLAMBDA of Chang, Yang & Zhou (J. Geodesy 79, 552-565, 2005):
+
+* **Reduction** (``decorrelate``): ``Q = L^T D L`` (L unit lower triangular, D diagonal,
+  factorised from the last row up; Chang et al. eq. 3), then integer Gauss transformations
+  (their section 3.1, eq. 9) and symmetric permutations (eqs. 11-14, applied when
+  ``D[j] + L[j+1, j]^2 D[j+1] < D[j+1]``) give a unimodular Z with ``Z^T Q Z = L'^T D' L'``,
+  nearly diagonal and with the conditional variances in ``D'`` as close to decreasing order as
+  the reduction allows: the transformed ambiguities are decorrelated.
+* **Search** (``search``): a depth-first enumeration of the integer lattice in the decorrelated
+  space from the last (most precise) component to the first, visiting each level's integers in
+  the Schnorr-Euchner zig-zag order about its conditional estimate and shrinking the search
+  ellipsoid as candidates are found (Chang et al. section 4, Algorithm SEARCH), so the ``m``
+  best candidates are exact ILS solutions.
+
+Validation and partial fixing: ``ratio`` is the ratio test (second-best squared norm over best,
+accepted at or above a threshold such as 3; Euler & Schaffrin 1991, as used by RTKLIB),
+``bootstrap_success_rate`` the integer bootstrapping success rate of the decorrelated problem,
+a sharp lower bound of the ILS success rate (Teunissen 1998, J. Geodesy 72, eq. 14:
+``prod_i (2 Phi(1 / (2 sqrt(D_i))) - 1)``), and ``resolve`` fixes the largest subset of
+decorrelated ambiguities whose bootstrapped success rate reaches a threshold and whose ratio
+test passes (partial ambiguity resolution, Teunissen, Joosten & Tiberius 1999, ION GPS).
+
+Public names
+------------
+decorrelate, search, ils, ratio, bootstrap_success_rate, resolve, Resolution.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.special import erf
+
+
+def _ltdl(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``Q = L^T diag(d) L`` with L unit lower triangular, factorised from the last row up
+    (Chang et al. 2005, eq. 3; de Jonge & Tiberius 1996, section 3.3)."""
+    a = np.array(q, dtype=float, copy=True)
+    n = a.shape[0]
+    low = np.zeros((n, n))
+    d = np.zeros(n)
+    for i in range(n - 1, -1, -1):
+        d[i] = a[i, i]
+        if not d[i] > 0.0:
+            raise np.linalg.LinAlgError("ambiguity covariance is not positive definite")
+        row = a[i, : i + 1] / np.sqrt(d[i])
+        a[:i, :i] -= np.outer(row[:i], row[:i])
+        low[i, : i + 1] = row / row[i]
+    return low, d
+
+
+def decorrelate(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The LAMBDA reduction of an ambiguity covariance.
+
+    Parameters
+    ----------
+    q : (n, n) symmetric positive-definite covariance of the float ambiguities (cycles^2).
+
+    Returns
+    -------
+    z : (n, n) integer unimodular matrix; the decorrelated ambiguities are ``z.T @ a``.
+    low : (n, n) unit lower-triangular factor and d : (n,) conditional variances of the
+        decorrelated covariance, ``z.T @ q @ z = low.T @ diag(d) @ low``.
+    """
+    low, d = _ltdl(q)
+    n = d.size
+    z = np.eye(n)
+    j = n - 2
+    k = n - 2
+    while j >= 0:
+        if j <= k:
+            for i in range(j + 1, n):
+                mu = np.round(low[i, j])
+                if mu != 0.0:  # integer Gauss transformation, Chang et al. eq. 9
+                    low[i:, j] -= mu * low[i:, i]
+                    z[:, j] -= mu * z[:, i]
+        delta = d[j] + low[j + 1, j] ** 2 * d[j + 1]
+        if delta + 1e-6 < d[j + 1]:  # permutation of j and j+1, Chang et al. eqs. 11-14
+            eta = d[j] / delta
+            lam = d[j + 1] * low[j + 1, j] / delta
+            d[j] = eta * d[j + 1]
+            d[j + 1] = delta
+            upper = low[j, :j].copy()
+            lower = low[j + 1, :j].copy()
+            low[j, :j] = -low[j + 1, j] * upper + lower
+            low[j + 1, :j] = eta * upper + lam * lower
+            low[j + 1, j] = lam
+            low[j + 2 :, [j, j + 1]] = low[j + 2 :, [j + 1, j]]
+            z[:, [j, j + 1]] = z[:, [j + 1, j]]
+            k = j
+            j = n - 2
+        else:
+            j -= 1
+    return z, low, d
+
+
+def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
+           candidates: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """The ``candidates`` integer vectors nearest to ``z_float`` in the metric
+    ``(z_float - z)^T (low^T diag(d) low)^-1 (z_float - z)`` (Chang et al. 2005, Algorithm SEARCH).
+
+    Returns
+    -------
+    z_int : (candidates, n) integer vectors, best first; norms : (candidates,) their squared
+        distances, increasing. With fewer lattice points than asked (impossible in practice),
+        the missing rows are NaN.
+    """
+    n = d.size
+    best = np.full((candidates, n), np.nan)
+    norms = np.full(candidates, np.inf)
+    found = 0
+    worst = 0
+    max_dist = np.inf
+    cond = np.zeros(n)      # conditional estimates zb_k
+    z = np.zeros(n)
+    step = np.zeros(n)
+    dist = np.zeros(n)
+    s = np.zeros((n, n))    # s[k, :k+1]: accumulated corrections of levels above k
+    k = n - 1
+    cond[k] = z_float[k]
+    z[k] = np.round(cond[k])
+    y = cond[k] - z[k]
+    step[k] = 1.0 if y > 0.0 else -1.0
+    while True:
+        new_dist = dist[k] + y * y / d[k]
+        if new_dist < max_dist:
+            if k != 0:
+                k -= 1
+                dist[k] = new_dist
+                s[k, : k + 1] = s[k + 1, : k + 1] + (z[k + 1] - cond[k + 1]) * low[k + 1, : k + 1]
+                cond[k] = z_float[k] + s[k, k]
+                z[k] = np.round(cond[k])
+                y = cond[k] - z[k]
+                step[k] = 1.0 if y > 0.0 else -1.0
+            else:
+                if found < candidates:
+                    if found == 0 or new_dist > norms[worst]:
+                        worst = found
+                    best[found] = z
+                    norms[found] = new_dist
+                    found += 1
+                    if found == candidates:
+                        max_dist = norms[worst]
+                else:
+                    best[worst] = z
+                    norms[worst] = new_dist
+                    worst = int(np.argmax(norms))
+                    max_dist = norms[worst]
+                z[0] += step[0]
+                y = cond[0] - z[0]
+                step[0] = -step[0] - np.sign(step[0])
+        else:
+            if k == n - 1:
+                break
+            k += 1
+            z[k] += step[k]
+            y = cond[k] - z[k]
+            step[k] = -step[k] - np.sign(step[k])
+    order = np.argsort(norms)
+    return best[order], norms[order]
+
+
+def ils(a_float: np.ndarray, q: np.ndarray,
+        candidates: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """Integer least-squares solutions of float ambiguities by LAMBDA.
+
+    Parameters
+    ----------
+    a_float : (n,) float ambiguities (cycles); q : (n, n) their covariance (cycles^2).
+    candidates : how many of the best integer vectors to return (2 for the ratio test).
+
+    Returns
+    -------
+    a_int : (candidates, n) integer vectors (as floats), best first; norms : (candidates,) their
+        squared distances ``(a - a_int)^T Q^-1 (a - a_int)``, increasing.
+    """
+    a_float = np.asarray(a_float, dtype=float)
+    z, low, d = decorrelate(q)
+    shift = np.floor(a_float)  # search on the fractional part, add the integers back after
+    z_float = z.T @ (a_float - shift)
+    z_int, norms = search(z_float, low, d, candidates)
+    a_int = np.linalg.solve(z.T, z_int.T).T
+    return np.round(a_int) + shift, norms
+
+
+def ratio(norms: np.ndarray) -> float:
+    """The ratio test statistic: second-best over best squared norm (inf if the best is 0)."""
+    if norms[0] <= 0.0:
+        return float("inf")
+    return float(norms[1] / norms[0])
+
+
+def bootstrap_success_rate(d: np.ndarray) -> float:
+    """Integer bootstrapping success rate from the conditional variances of a decorrelated
+    problem (Teunissen 1998, eq. 14); a lower bound of the ILS success rate."""
+    d = np.asarray(d, dtype=float)
+    return float(np.prod(erf(1.0 / (2.0 * np.sqrt(2.0 * d)))))
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Outcome of ``resolve``.
+
+    ``fixed``: whether any ambiguity was fixed; ``a_fixed``: (n,) the float ambiguities
+    conditioned on the fixed subset (integers where the subset fixes all, the full vector in
+    any case; equal to the float input when nothing is fixed); ``q_fixed``: (n, n) its
+    covariance; ``n_fixed``: how many decorrelated ambiguities were fixed; ``ratio``: the ratio
+    test statistic of the accepted subset (or of the full set when nothing is fixed);
+    ``success_rate``: the bootstrapped success rate of the accepted subset.
+    """
+
+    fixed: bool
+    a_fixed: np.ndarray
+    q_fixed: np.ndarray
+    n_fixed: int
+    ratio: float
+    success_rate: float
+
+
+def resolve(a_float: np.ndarray, q: np.ndarray, ratio_threshold: float = 3.0,
+            min_success_rate: float = 0.999, min_fixed: int = 4) -> Resolution:
+    """Full, then partial, ambiguity resolution with validation.
+
+    The decorrelated ambiguities are fixed from the most precise (last) one upward: the largest
+    subset ``z[p:]`` whose bootstrapped success rate reaches ``min_success_rate`` is searched
+    (ILS on that subset, conditioned on nothing else), and accepted when its ratio test reaches
+    ``ratio_threshold``; if not, the subset shrinks by one until fewer than ``min_fixed``
+    remain. The accepted integers ``z_s`` constrain the whole vector by the conditional
+    (least-squares) update ``a = a_float - Q_{a z_s} Q_{z_s}^-1 (z_s_float - z_s)``, ``Q_a|z =
+    Q - Q_{a z_s} Q_{z_s}^-1 Q_{z_s a}`` (Teunissen 1995, eq. 9 of the fixed solution).
+    """
+    a_float = np.asarray(a_float, dtype=float)
+    q = np.asarray(q, dtype=float)
+    n = a_float.size
+    z, low, d = decorrelate(q)
+    shift = np.floor(a_float)
+    z_float_all = z.T @ (a_float - shift)
+    q_z = z.T @ q @ z
+    last_ratio = 0.0
+    for start in range(n - min_fixed + 1 if n >= min_fixed else 0):
+        sub = slice(start, n)
+        rate = bootstrap_success_rate(d[sub])
+        if rate < min_success_rate:
+            continue
+        low_s, d_s = _ltdl(q_z[sub, sub])
+        z_int, norms = search(z_float_all[sub], low_s, d_s, 2)
+        last_ratio = ratio(norms)
+        if last_ratio < ratio_threshold:
+            continue
+        z_sel = z[:, sub]  # a -> z_s = z_sel^T a
+        cross = q @ z_sel
+        gain = np.linalg.solve(q_z[sub, sub], cross.T).T
+        a_fixed = a_float - gain @ (z_float_all[sub] - z_int[0])
+        q_fixed = q - gain @ cross.T
+        if start == 0:
+            a_fixed = np.round(a_fixed)
+            q_fixed = np.zeros_like(q)
+        return Resolution(True, a_fixed, 0.5 * (q_fixed + q_fixed.T), n - start, last_ratio,
+                          rate)
+    return Resolution(False, a_float.copy(), q.copy(), 0, last_ratio,
+                      bootstrap_success_rate(d))

@@ -1,0 +1,56 @@
+"""Real recordings as landnav datasets (SPEC section 9): each reader maps a recording's streams
+to landnav's files and columns (units and frames converted and stated, timing kept) and puts its
+reference trajectory in place of the truth; ``common.write_recording`` writes the dataset.
+
+Modules
+-------
+common      the reference as truth, the datasheet of the recording's sensors, writing
+comma2k19   comma2k19 segments (phone IMU, CAN speed, u-blox raw GNSS, comma's pose)
+gsdc        Google Smartphone Decimeter Challenge traces (device_gnss.csv, ground_truth.csv)
+smartloc    TU Chemnitz smartLoc traces (u-blox raw measurements, reference, NLOS labels)
+twin        a dataset's twin scenario
+
+Public names
+------------
+KINDS, import_recording.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+from simulator.recordings.common import Recording, write_recording
+
+
+def _comma2k19(sources: list[str]) -> Recording:
+    from simulator.recordings.comma2k19 import read_comma2k19
+
+    return read_comma2k19(sources)
+
+
+def _smartloc(sources: list[str]) -> Recording:
+    from simulator.recordings.smartloc import read_smartloc
+
+    return read_smartloc(sources)
+
+
+def _gsdc(sources: list[str]) -> Recording:
+    from simulator.recordings.gsdc import read_gsdc
+
+    return read_gsdc(sources)
+
+
+KINDS: dict[str, tuple[Callable[[list[str]], Recording], str]] = {
+    "comma2k19": (_comma2k19, "a comma2k19 segment folder (processed_log/, global_pose/)"),
+    "gsdc": (_gsdc, "a Google Smartphone Decimeter Challenge trace: device_gnss.csv and "
+                    "ground_truth.csv (or the folder holding them)"),
+    "smartloc": (_smartloc, "a TU Chemnitz smartLoc CSV (u-blox raw, reference, NLOS labels)"),
+}
+
+
+def import_recording(kind: str, sources: list[str], out_dir: str | Path,
+                     force: bool = False) -> Path:
+    """Read a recording of ``kind`` from ``sources`` and write it as a dataset at ``out_dir``."""
+    reader, _ = KINDS[kind]
+    return write_recording(reader([str(s) for s in sources]), out_dir, force, sources)
