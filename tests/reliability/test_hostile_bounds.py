@@ -6,6 +6,8 @@ file's bounds. Each is one message, exit 2, no traceback, nothing written."""
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
@@ -113,3 +115,15 @@ def test_dataset_times_shifted_or_scaled(copy_dataset, tmp_path, capsys, change,
     _shift(ds, "imu", change)
     refused(["estimate", str(ds), "-e", "dead_reckoning", "-o", str(tmp_path / "s.parquet")],
             capsys, [ds.parent], words)
+
+
+def test_a_gap_in_a_recordings_times(copy_dataset, tmp_path, capsys):
+    """A recording (its truth a reference that may cover less than its streams) whose last
+    fix comes 1e8 s late: refused for the solution rows it would ask for, not allocated."""
+    ds = copy_dataset()
+    manifest = json.loads((ds / "manifest.json").read_text())
+    manifest["reference"] = True
+    (ds / "manifest.json").write_text(json.dumps(manifest))
+    _shift(ds, "gnss_fix", lambda t: np.r_[t[:-1], t[-1] + 1e8])
+    refused(["estimate", str(ds), "-e", "gnss_only", "-o", str(tmp_path / "s.parquet")],
+            capsys, [ds.parent], "solution rows, more than one replay may hold")
