@@ -30,7 +30,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("core", ("simulator", "simulator.earth", "simulator.units", "simulator.columns",
               "simulator.errors", "simulator.schema", "simulator.tables", "simulator.timebase",
               "simulator.progress", "simulator.stochastic", "simulator.outputs",
-              "simulator.threads", "simulator.geoid")),
+              "simulator.threads", "simulator.geoid", "simulator.datasheet")),
     ("trajectory", ("simulator.trajectory", "simulator.vehicle", "simulator.environment")),
     ("drive", ("simulator.drive",)),
     ("gnss", ("simulator.gnss",)),
