@@ -11,7 +11,7 @@ that were under way in the pool, and a new pool takes the next runs.
 
 Public functions
 ----------------
-open_executor, completed, watch_parent.
+open_executor, completed.
 """
 
 from __future__ import annotations
@@ -21,37 +21,16 @@ import contextlib
 import multiprocessing
 import os
 import re
-import signal
 import socket
 import threading
-import time
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
 from simulator.errors import InputError, Problem
+from simulator.isolated import watch_parent
 
 T = TypeVar("T")
 _WORKER_MODULE = "simulator.campaign.worker"  # preloaded by the forkserver
-
-
-PARENT_POLL_S = 0.5  # how often a worker checks that the campaign's process still runs
-
-
-def watch_parent(campaign_pid: int) -> None:
-    """In a worker process: a thread that ends the worker when the campaign's process is gone
-    (killed with SIGKILL, say, which leaves it no chance to stop its workers), so no worker
-    outlives the campaign it computes for."""
-    def watch() -> None:
-        while True:
-            time.sleep(PARENT_POLL_S)
-            try:
-                os.kill(campaign_pid, 0)
-            except ProcessLookupError:
-                os.kill(os.getpid(), signal.SIGKILL)  # nobody is left to receive its results
-            except PermissionError:  # the pid was reused by another user's process
-                os.kill(os.getpid(), signal.SIGKILL)
-
-    threading.Thread(target=watch, name="landnav-parent-watch", daemon=True).start()
 
 
 class _RenewingPool(cf.Executor):
