@@ -23,7 +23,6 @@ RunResult, Solutions.
 
 from __future__ import annotations
 
-import multiprocessing
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -90,17 +89,17 @@ def generate(scenario: Scenario, out_dir: str | Path, force: bool = False,
 
 
 def estimate(dataset: Dataset, entry: Mapping[str, Any] | str,
-             show_progress: bool = False, time_limit_s: float | None = None
-             ) -> tuple[pd.DataFrame, dict]:
+             show_progress: bool = False, time_limit_s: float | None = None,
+             isolate: bool = True) -> tuple[pd.DataFrame, dict]:
     """Replay ``dataset`` causally into one estimator (a scenario ``estimators:`` entry: a name,
     ``module:Class``, or a mapping with ``name``, ``label``, ``init`` and ``config``); its
     solution table and run information (``simulator.replay.run_estimator``).
 
     An estimator that is not a built-in, or any with ``time_limit_s``, runs in a child process
     (``simulator.isolated``): one that exits, crashes or runs past the limit is an InputError.
-    Inside a daemonic process (a campaign's worker, which may not have children) it runs here,
-    and the caller bounds it (``simulator.campaign.worker``)."""
-    if needs_isolation(entry, time_limit_s) and not multiprocessing.current_process().daemon:
+    ``isolate=False`` runs it here: a campaign's worker, itself a process of its own whose
+    death fails only its run, bounds it with its own timer (``simulator.campaign.worker``)."""
+    if isolate and needs_isolation(entry, time_limit_s):
         return run_isolated(dataset.path, entry, time_limit_s)
     return run_estimator(dataset, entry, show_progress=show_progress)
 

@@ -103,7 +103,7 @@ def _score_all(task: RunTask, dataset_dir: Path, time_limit_s: float | None
     for label, entry in zip(labels, task.scenario.data["estimators"], strict=True):
         try:
             with time_limit(time_limit_s, label):
-                frame, info = pipeline.estimate(dataset, entry)
+                frame, info = pipeline.estimate(dataset, entry, isolate=False)
             scores = pipeline.score(dataset, {label: (frame, info)}).scores()[label]
             rows.append(_row(task, label, STATUS_OK, flatten_scores(scores)))
         except Exception:
