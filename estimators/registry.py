@@ -32,6 +32,8 @@ BUILTINS = {
     "gnss_only": "estimators.builtin.baselines:GnssOnly",
     "dead_reckoning": "estimators.builtin.baselines:DeadReckoning",
     "gnss_wls": "estimators.builtin.gnss_wls:GnssWls",
+    "fgo_lc": "estimators.builtin.fgo:FgoLooselyCoupled",
+    "fgo_tc": "estimators.builtin.fgo:FgoTightlyCoupled",
     "dr2d_drm1_ekf": "estimators.builtin.cho2006:Drm1Ekf",
     "dr2d_drm2_ekf": "estimators.builtin.cho2006:Drm2Ekf",
     "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",

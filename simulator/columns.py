@@ -5,9 +5,9 @@ Parquet field metadata. Extra columns a model adds must be declared here too.
 
 Public names
 ------------
-TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV, BARO, MAG, EVENTS, TRUTH_GNSS, STREAMS,
-IMU_AXES, SOLUTION, SOLUTION_STD, SENSOR_ERRORS, TRUTH_SENSORS, DATASET_FORMAT, REQUIRED,
-TEXT_COLUMNS.
+TRUTH, IMU, ODOMETER, GNSS_FIX, GNSS_RAW, GNSS_NAV_KEPLER, GNSS_NAV, BARO, MAG, EVENTS,
+TRUTH_GNSS, STREAMS, IMU_AXES, SOLUTION, SOLUTION_STD, SOLUTION_NIS, SENSOR_ERRORS,
+TRUTH_SENSORS, SOLUTION_FIX, DATASET_FORMAT, REQUIRED, TEXT_COLUMNS.
 """
 
 from __future__ import annotations
@@ -38,7 +38,9 @@ GNSS_FIX = {
 }
 
 GNSS_RAW = {
-    "t": "s", "sv": "1", "pseudorange": "m", "pseudorange_rate": "m/s", "doppler": "Hz",
+    # system: the RINEX letter (G, E, C, R, J); sv is the PRN (GLONASS: slot) within it
+    "t": "s", "sv": "1", "system": "", "pseudorange": "m", "pseudorange_rate": "m/s",
+    "doppler": "Hz",
     "cn0": "dB-Hz", "sat_x": "m", "sat_y": "m", "sat_z": "m",
     "sat_vx": "m/s", "sat_vy": "m/s", "sat_vz": "m/s",
     "sat_clock": "m", "sat_clock_drift": "m/s", "iono": "m", "tropo": "m",
@@ -58,7 +60,7 @@ GNSS_RAW = {
 # (multipath and code_noise as the receiver delivers them, after its carrier smoothing;
 # code_noise then holds the smoothing's ionosphere divergence too: simulator.gnss.errors)
 TRUTH_GNSS = {
-    "t": "s", "sv": "1", "tracked": "1", "los": "1", "nlos": "1",
+    "t": "s", "sv": "1", "system": "", "tracked": "1", "los": "1", "nlos": "1",
     "elevation": "rad", "azimuth": "rad", "range": "m", "range_rate": "m/s",
     "receiver_clock": "m", "receiver_clock_drift": "m/s",
     "iono_true": "m", "tropo_true": "m", "iono_true_rate": "m/s", "tropo_true_rate": "m/s",
@@ -66,14 +68,24 @@ TRUTH_GNSS = {
     "rate_noise": "m/s", "antenna_x": "m", "antenna_y": "m", "antenna_z": "m",
 }
 
-# broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of GPS week
-# ``week`` (toc may fall just outside [0, 604800) when the clock epoch is in the adjacent week)
-GNSS_NAV = {
+# broadcast Keplerian parameters (IS-GPS-200 Table 20-III); toe and toc in seconds of week
+# ``week`` of the system's time (GPS; BDT for BeiDou; toc may fall just outside [0, 604800)
+# when the clock epoch is in the adjacent week)
+GNSS_NAV_KEPLER = {
     "sv": "1", "week": "1", "toe": "s", "toc": "s",
     "af0": "s", "af1": "s/s", "af2": "s/s^2", "tgd": "s", "iode": "1", "health": "1",
     "sqrt_a": "m^0.5", "e": "1", "i0": "rad", "omega0": "rad", "omega": "rad", "m0": "rad",
     "delta_n": "rad/s", "omega_dot": "rad/s", "idot": "rad/s",
     "cuc": "rad", "cus": "rad", "crc": "m", "crs": "m", "cic": "rad", "cis": "rad",
+}
+# every system's broadcast parameters: the Keplerian ones (GPS, QZSS, Galileo, BeiDou), the
+# system letter, the second group delay (Galileo BGD E5b/E1, BeiDou TGD2), Galileo's data
+# source, and GLONASS's state vector at t_b (PZ-90) with its frequency channel
+# (simulator.gnss.navfiles says what each holds per system)
+GNSS_NAV = {
+    "system": "", **GNSS_NAV_KEPLER, "tgd2": "s", "data_source": "1",
+    "glo_x": "m", "glo_y": "m", "glo_z": "m", "glo_vx": "m/s", "glo_vy": "m/s", "glo_vz": "m/s",
+    "glo_ax": "m/s^2", "glo_ay": "m/s^2", "glo_az": "m/s^2", "glo_channel": "1",
 }
 
 BARO = {"t": "s", "pressure": "Pa", "altitude": "m"}
@@ -88,6 +100,11 @@ SOLUTION_STD = {
     "std_n": "m", "std_e": "m", "std_d": "m", "std_vn": "m/s", "std_ve": "m/s", "std_vd": "m/s",
     "std_roll": "rad", "std_pitch": "rad", "std_yaw": "rad",
 }
+# optional: the normalised innovation squared of the GNSS update applied at a row (v^T S^-1 v)
+# and its degrees of freedom (the number of measurements); NaN on rows without an update
+SOLUTION_NIS = {"nis_gnss": "1", "nis_gnss_dof": "1"}
+# the integer-ambiguity status of a relative (RTK) solution: 0 none, 1 float, 2 fixed
+SOLUTION_FIX = {"fix_status": "1"}
 
 # estimated sensor errors (SPEC section 7), the same names in a solution and in
 # truth_sensors.parquet: IMU errors on the unit's own axes (FRD), measured minus true; scale
@@ -130,7 +147,7 @@ REQUIRED = {
     "gnss_raw": ("t", "sv", "pseudorange", "pseudorange_rate", "doppler", "cn0", "sat_x",
                  "sat_y", "sat_z", "sat_vx", "sat_vy", "sat_vz", "sat_clock", "sat_clock_drift",
                  "iono", "tropo", "elevation", "azimuth"),
-    "gnss_nav": tuple(GNSS_NAV),
+    "gnss_nav": tuple(GNSS_NAV_KEPLER),
     "baro": ("t", "pressure"),
     "mag": ("t", "mag_x", "mag_y", "mag_z"),
     "events": tuple(EVENTS),

@@ -8,10 +8,14 @@ d^2 / R, below 1e-5 m for offsets of a few metres.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pytest
+from matplotlib.figure import Figure
 
 from estimators.base import Estimator
 from simulator import columns as col
@@ -87,3 +91,19 @@ class HoldStart(Estimator):
         lat, lon, alt = self.initial.position
         return [np.degrees(lat), np.degrees(lon), alt, *self.initial.velocity,
                 *self.initial.attitude]
+
+
+@contextmanager
+def saved_figures() -> Iterator[dict[str, Figure]]:
+    """Every matplotlib figure saved inside the block, by the stem of the file it was saved to,
+    so that a test can read a plot's axes, ticks and legend."""
+    figures: dict[str, Figure] = {}
+    original = Figure.savefig
+
+    def keep(self: Figure, path, *args, **kwargs):
+        figures[Path(str(path)).name.split(".png")[0].lstrip(".")] = self
+        return original(self, path, *args, **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(Figure, "savefig", keep)
+        yield figures

@@ -41,7 +41,7 @@ LAYERS: list[tuple[str, tuple[str, ...]]] = [
     ("estimators", ("estimators",)),
     ("replay", ("simulator.replay", "simulator.isolated")),
     ("scoring", ("simulator.scoring",)),
-    ("pipeline", ("simulator.pipeline",)),
+    ("pipeline", ("simulator.pipeline", "simulator.comparison")),
     ("campaign", ("simulator.campaign",)),
     ("reproduce", ("simulator.reproduce",)),
     ("commands", ("simulator.commands", "simulator.cli")),

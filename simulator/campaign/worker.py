@@ -4,7 +4,8 @@ of the scenario, score each solution (SPEC section 8) and return one flat row pe
 Any exception inside the run is caught and recorded: a failed dataset fails every estimator's
 row, a failed estimator (or its scoring) fails its own row; the row's ``error`` holds the
 traceback. The scores are flattened into ``group.key`` columns; ``outages`` becomes the mean of
-each per-outage score over the run's outages and ``outages.count``.
+each per-outage score over the run's outages (NaN when one outage lacks it), ``outages.count``
+and ``outages.missing``.
 
 Public names
 ------------
@@ -33,25 +34,61 @@ STATUS_FAILED = "failed"
 RUN_COLUMNS = ("run_id", "seed", "label", "status")  # the leading columns of runs.parquet
 # bookkeeping, not performance
 _SKIPPED = {"rows", "nees.expected", "outages.start", "degraded.start", "degraded.kind"}
+_SKIPPED_KEYS = {"nees_expected", "epochs", "updates"}  # at any depth (``consistency``, ``nis``)
+_BLOCK_GROUPS = {"consistency"}  # groups of sub-groups: a sub-group that is None has no columns
 # unit of a flattened score column, by column or else by group (SPEC section 8)
 _UNITS = {"horizontal": "m", "vertical": "m", "velocity": "m/s", "attitude": "deg",
           "runtime.seconds": "s", "coverage.longest_gap": "s",
           **{f"{group}.{key}": unit for group in ("outages", "degraded")
              for key, unit in (("duration", "s"), ("distance", "m"), ("max_horizontal", "m"),
-                               ("end_horizontal", "m"), ("end_percent", "%"))}}
+                               ("end_horizontal", "m"), ("end_percent", "%"),
+                               ("coverage.longest_gap", "s"))}}
 
 
 def _number(x: Any) -> float:
     return float("nan") if x is None else float(x)
 
 
+def _window_mean(entries: list[dict], key: str) -> float:
+    """The mean of a per-window score over a run's windows, NaN when any window lacks it (a
+    window where the solution was silent is never averaged away); ``end_percent`` is taken
+    over the windows with a distance (it is undefined for a stationary one)."""
+    if key == "end_percent":
+        entries = [e for e in entries if (e.get("distance") or 0.0) > 0.0]
+    values = np.array([_number(e.get(key)) for e in entries])
+    return float(values.mean()) if values.size else float("nan")
+
+
+def _flatten_windows(group: str, entries: list[dict]) -> dict[str, float]:
+    """A window list as ``group.count``, ``group.missing`` (windows without an end error) and
+    the mean of each per-window score, nested ones (``coverage``) as ``group.coverage.fraction``.
+    """
+    out = {f"{group}.count": float(len(entries)),
+           f"{group}.missing": float(sum(e.get("end_horizontal") is None for e in entries))}
+    keys = dict.fromkeys(k for entry in entries for k in entry)
+    for key in keys:
+        if f"{group}.{key}" in _SKIPPED:
+            continue
+        nested = [e.get(key) for e in entries if isinstance(e.get(key), dict)]
+        if nested:
+            for sub in dict.fromkeys(k for n in nested for k in n):
+                out[f"{group}.{key}.{sub}"] = _window_mean(
+                    [{sub: (e.get(key) or {}).get(sub)} for e in entries], sub)
+        else:
+            out[f"{group}.{key}"] = _window_mean(entries, key)
+    return out
+
+
 def flatten_scores(scores: dict) -> dict[str, float]:
     """Scores of one solution (SPEC section 8) as ``{"horizontal.rms": value, ...}``.
 
-    Missing values are NaN. The ``outages`` and ``degraded`` lists become ``outages.count`` and,
-    for each per-window score, its mean over the windows that have it (NaN when none has); a
-    solution without GNSS has no outage columns. Nested groups (``sensor_errors``) flatten to
-    ``sensor_errors.gyro_bias_z.rms``.
+    Missing values are NaN. The ``outages`` and ``degraded`` lists become ``outages.count``,
+    ``outages.missing`` (the windows without an end error) and, for each per-window score, its
+    mean over the windows, NaN when any window lacks it; a solution without GNSS has no outage
+    columns. Nested groups flatten to ``sensor_errors.gyro_bias_z.rms``,
+    ``consistency.position.nse.n``; a list of numbers (``rtk.refix_times``) to its mean (NaN
+    when one is missing), ``.count`` and ``.missing``; bookkeeping (``rows``, expected values,
+    epoch counts) is left out.
     """
     out: dict[str, float] = {}
     for group, value in scores.items():
@@ -59,19 +96,20 @@ def flatten_scores(scores: dict) -> dict[str, float]:
             continue
         if isinstance(value, dict):
             for k, v in value.items():
-                if isinstance(v, dict):
-                    out.update(flatten_scores({f"{group}.{k}": v}))
-                elif f"{group}.{k}" not in _SKIPPED:
-                    out[f"{group}.{k}"] = _number(v)
-        elif isinstance(value, list):
-            out[f"{group}.count"] = float(len(value))
-            keys = dict.fromkeys(k for entry in value for k in entry)
-            for key in keys:
-                if f"{group}.{key}" in _SKIPPED:
+                if (k in _SKIPPED_KEYS or f"{group}.{k}" in _SKIPPED
+                        or (v is None and group in _BLOCK_GROUPS)):
                     continue
-                values = np.array([_number(e.get(key)) for e in value])
-                values = values[np.isfinite(values)]
-                out[f"{group}.{key}"] = float(values.mean()) if values.size else float("nan")
+                if isinstance(v, dict | list):
+                    out.update(flatten_scores({f"{group}.{k}": v}))
+                else:
+                    out[f"{group}.{k}"] = _number(v)
+        elif isinstance(value, list) and all(isinstance(e, dict) for e in value):
+            out.update(_flatten_windows(group, value))
+        elif isinstance(value, list):  # numbers, None where missing (``rtk.refix_times``)
+            numbers = [{"value": v} for v in value]
+            out.update({f"{group}.count": float(len(value)),
+                        f"{group}.missing": float(sum(v is None for v in value)),
+                        group: _window_mean(numbers, "value")})
     return out
 
 

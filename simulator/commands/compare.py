@@ -1,5 +1,5 @@
 """``landnav compare DATASET DATASET [--report DIR]``: the statistics of two datasets' streams
-side by side, a real recording and its twin (``simulator.scoring.compare``)."""
+side by side, a real recording and its twin (``simulator.comparison``)."""
 
 from __future__ import annotations
 
@@ -30,7 +30,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from simulator.dataset.io import open_dataset
     from simulator.outputs import atomic_output_dir
-    from simulator.scoring.compare import compare_datasets, write_comparison
+    from simulator.comparison import compare_datasets, write_comparison
 
     first, second = open_dataset(args.first), open_dataset(args.second)
     estimator = None if args.estimator == "none" else args.estimator

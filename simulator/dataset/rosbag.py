@@ -50,7 +50,7 @@ column: ``carrier_phase`` without phase tracking).
 
 Public names
 ------------
-export_mcap, fix_uere_m, GNSS_MSG_DEFINITIONS, UNKNOWN_VARIANCE.
+export_mcap, GNSS_MSG_DEFINITIONS, UNKNOWN_VARIANCE.
 """
 
 from __future__ import annotations
@@ -66,6 +66,7 @@ import numpy as np
 import pandas as pd
 
 from simulator.dataset.io import Dataset
+from simulator.datasheet import fix_uere_m
 from simulator.earth import (
     OMEGA_E_RAD_S,
     ecef_to_ned,
@@ -130,14 +131,6 @@ def _typestore() -> Any:
         types.update(get_types_from_msg(text, name))
     store.register(types)
     return store
-
-
-def fix_uere_m(gnss: Mapping[str, Any]) -> float:
-    """User equivalent range error of a receiver preset, m: the root sum square of its
-    signal-in-space, residual ionosphere and troposphere, multipath and tracking-noise terms
-    (Misra & Enge, *Global Positioning System*, 2nd ed., section 6.1: sigma_pos = DOP x UERE)."""
-    terms = ("sis_error", "iono_residual", "tropo_residual", "multipath", "tracking_noise")
-    return float(math.sqrt(sum(float(gnss.get(k) or 0.0) ** 2 for k in terms)))
 
 
 def _ned_to_enu_attitude(roll: np.ndarray, pitch: np.ndarray, yaw: np.ndarray) -> np.ndarray:

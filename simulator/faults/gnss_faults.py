@@ -109,13 +109,19 @@ def _refix(streams, intervals, context) -> None:
     fix.loc[mask, list(new.columns)] = new.to_numpy()[mask[upto]]
 
 
+def _keys(frame) -> list[str]:
+    """The columns naming one measurement: epoch, system (when the stream has several) and
+    satellite."""
+    return ["t", "system", "sv"] if "system" in frame.columns else ["t", "sv"]
+
+
 def _set_tracked(streams, rows_dropped) -> None:
     """Mark dropped measurements as not tracked in the truth table."""
     if "truth_gnss" not in streams or rows_dropped.empty:
         return
     truth = streams["truth_gnss"]
-    key = truth.set_index(["t", "sv"]).index
-    dropped = rows_dropped.set_index(["t", "sv"]).index
+    key = truth.set_index(_keys(rows_dropped)).index
+    dropped = rows_dropped.set_index(_keys(rows_dropped)).index
     truth.loc[key.isin(dropped), "tracked"] = 0
 
 
@@ -135,7 +141,7 @@ def _gnss_satellite_limit(streams, intervals, params, context) -> None:
         elevation = raw["elevation"].where(healthy, -np.inf)
         rank = elevation.groupby(raw["t"]).rank(ascending=False, method="first").to_numpy()
         lost = inside & ((rank > params["count"]) | ~healthy)
-    _set_tracked(streams, raw.loc[lost, ["t", "sv"]])
+    _set_tracked(streams, raw.loc[lost, _keys(raw)])
     streams["gnss_raw"] = raw.loc[~lost].reset_index(drop=True)
     _refix(streams, intervals, context)
 
@@ -153,14 +159,15 @@ def _gnss_multipath(streams, intervals, params, context) -> None:
     epochs = np.unique(t)
     dt_s = float(np.min(np.diff(epochs))) if len(epochs) > 1 else 1.0
     error = np.zeros(len(raw))
+    satellite = raw[_keys(raw)[1:]].astype(str).agg("".join, axis=1).to_numpy()
     for start, end in intervals:
         inside = (t >= start) & (t < end)
         if not inside.any():
             continue
         first = t[inside].min()
         at_start = raw.loc[inside & (t == first)].sort_values("elevation", kind="stable")
-        for sv in at_start["sv"].to_numpy()[:params["satellites"]]:
-            rows = np.flatnonzero(inside & (raw["sv"].to_numpy() == sv))
+        for sat in satellite[at_start.index.to_numpy()][:params["satellites"]]:
+            rows = np.flatnonzero(inside & (satellite == sat))
             steps = np.rint((t[rows] - first) / dt_s).astype(int)
             series = gauss_markov(steps.max() + 1, dt_s, np.array([params["sigma"]]),
                                   params["correlation_time"], context.rng)[:, 0]
@@ -168,8 +175,8 @@ def _gnss_multipath(streams, intervals, params, context) -> None:
     raw["pseudorange"] = raw["pseudorange"].to_numpy() + error
     if "truth_gnss" in streams:
         truth = streams["truth_gnss"]
-        extra = pd.Series(error, index=pd.MultiIndex.from_arrays([t, raw["sv"].to_numpy()]))
-        key = pd.MultiIndex.from_arrays([truth["t"].to_numpy(), truth["sv"].to_numpy()])
+        extra = pd.Series(error, index=pd.MultiIndex.from_frame(raw[_keys(raw)]))
+        key = pd.MultiIndex.from_frame(truth[_keys(raw)])
         truth["multipath"] = truth["multipath"].to_numpy() + extra.reindex(key).fillna(
             0.0).to_numpy()
     _refix(streams, intervals, context)

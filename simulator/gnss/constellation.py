@@ -1,5 +1,7 @@
-"""The GPS constellations landnav ships, as broadcast Keplerian elements (a navigation table)
-for any date: the real constellation of a broadcast almanac (the default sky,
+"""The skies landnav ships, as broadcast records (a navigation table) for any date: with
+``sky_navigation``, the drive's sky of every enabled system, Galileo, BeiDou and GLONASS from
+their nominal constellations (``simulator.gnss.nominal``) or all from a navigation file. For
+GPS, the real constellation of a broadcast almanac (the default sky,
 ``almanac_gps_navigation``) and the nominal 24 baseline slots of the GPS SPS Performance
 Standard, optionally with expandable slots split into their fore/aft pairs.
 
@@ -51,8 +53,9 @@ particular day's sky names that day's navigation file.
 
 Public names
 ------------
-NOMINAL_SLOTS, EXPANDABLE_SLOTS, AFT_PRN, ALMANAC_FILE, ALMANAC_WEEK, nominal_slots,
-nominal_gps_navigation, almanac_gps_navigation.
+NOMINAL_SLOTS, EXPANDABLE_SLOTS, AFT_PRN, ALMANAC_FILE, ALMANAC_WEEK, NOMINAL_SYSTEMS, GPS_SKIES,
+nominal_slots, nominal_gps_navigation, almanac_gps_navigation, missing_systems, QZSS_WITHOUT_FILE,
+sky_navigation.
 
 References
 ----------
@@ -75,9 +78,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from simulator import columns as col
 from simulator.gnss.constants import MU_GPS_M3_S2, OMEGA_E_DOT_RAD_S, SECONDS_PER_WEEK
-from simulator.gnss.navfiles import read_yuma
+from simulator.gnss.navfiles import read_navigation, read_yuma
+from simulator.gnss.nominal import (
+    circular_records,
+    nominal_beidou_navigation,
+    nominal_galileo_navigation,
+    nominal_glonass_navigation,
+)
+from simulator.gnss.timesystems import SYSTEM_LETTERS, SYSTEMS
 from simulator.timebase import GPS_EPOCH, utc_to_gps
 
 if TYPE_CHECKING:
@@ -162,8 +171,6 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     pandas.DataFrame
         The navigation table (``simulator.columns.GNSS_NAV``).
     """
-    import pandas as pd
-
     slots = nominal_slots(expanded)
     week, tow = utc_to_gps(utc)
     first = np.floor(tow / interval_s) * interval_s
@@ -176,22 +183,9 @@ def nominal_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     node_lon = (raan0[:, None] - GHA_EPOCH_RAD
                 - (OMEGA_E_DOT_RAD_S - RAAN_RATE_RAD_S) * since[None, :])
     arg_lat = arg_lat0[:, None] + MEAN_MOTION_RAD_S * since[None, :]
-    toe_week = np.floor(toe_abs / SECONDS_PER_WEEK)
-    toe = toe_abs - toe_week * SECONDS_PER_WEEK
-    n_slot, n_toe = node_lon.shape
-    nav = pd.DataFrame(0.0, index=range(n_slot * n_toe), columns=list(col.GNSS_NAV))
-    nav["sv"] = np.repeat(slots["prn"].to_numpy(), n_toe)
-    nav["week"] = np.tile(toe_week, n_slot).astype(int)
-    nav["toe"] = nav["toc"] = np.tile(toe, n_slot)
-    nav["iode"] = np.tile(np.arange(n_toe) % 256, n_slot)
-    nav["health"] = 0
-    nav["sqrt_a"] = (MU_GPS_M3_S2 / MEAN_MOTION_RAD_S**2) ** (1.0 / 6.0)
-    nav["i0"] = INCLINATION_RAD
-    # broadcast convention: node longitude at toe = omega0 - omega_e * toe (IS-GPS-200 20-IV)
-    nav["omega0"] = np.angle(np.exp(1j * (node_lon + OMEGA_E_DOT_RAD_S * toe[None, :]))).ravel()
-    nav["m0"] = np.angle(np.exp(1j * arg_lat)).ravel()  # omega = 0: M0 is the arg. of latitude
-    nav["omega_dot"] = RAAN_RATE_RAD_S
-    nav = nav.astype({"sv": int, "week": int, "iode": int, "health": int})
+    a_m = (MU_GPS_M3_S2 / MEAN_MOTION_RAD_S**2) ** (1.0 / 3.0)
+    nav = circular_records("G", slots["prn"].to_numpy(), node_lon, arg_lat, toe_abs, a_m,
+                           INCLINATION_RAD, RAAN_RATE_RAD_S)
     return nav
 
 
@@ -258,4 +252,64 @@ def almanac_gps_navigation(utc: dt.datetime, span_s: float = 86400.0,
     nav["toe"] = nav["toc"] = new_toe
     nav["iode"] = np.tile(np.arange(n_toe) % 256, len(alm))
     nav.attrs.update(kind="almanac", source=Path(path).name, epoch_shift_s=float(shift_s))
+    return nav
+
+
+# the nominal constellation of each system without a shipped almanac (``simulator.gnss.nominal``)
+NOMINAL_SYSTEMS = {"E": nominal_galileo_navigation, "C": nominal_beidou_navigation,
+                   "R": nominal_glonass_navigation}
+GPS_SKIES = ("gps-almanac", "nominal-gps")  # the GPS skies known by name
+
+
+def missing_systems(nav: pd.DataFrame, systems: Iterable[str], source: str) -> str | None:
+    """What is wrong when ``nav`` (read from ``source``) lacks some of ``systems`` (scenario
+    names ``gps``, ``galileo``, ...), or None."""
+    have = set(nav["system"]) if "system" in nav.columns else {"G"}
+    lacking = [name for name in systems if SYSTEMS[name] not in have]
+    if not lacking:
+        return None
+    names = ", ".join(sorted(SYSTEM_LETTERS[s] for s in have))
+    return f"{source}: no {', '.join(lacking)} navigation record (the file has {names})"
+
+
+QZSS_WITHOUT_FILE = "qzss needs a navigation file that has it (no nominal QZSS constellation)"
+
+
+def sky_navigation(source: str, systems: Iterable[str], utc: dt.datetime, span_s: float,
+                   expanded: Iterable[str] = (), reference_week: int | None = None
+                   ) -> pd.DataFrame:
+    """The navigation table of a drive's sky: the records of ``systems`` (scenario names).
+
+    ``source`` is a named GPS sky (``gps-almanac``, ``nominal-gps``: GPS from it, Galileo,
+    BeiDou and GLONASS from their nominal constellations, ``simulator.gnss.nominal``) or a
+    RINEX navigation file / YUMA almanac, which must hold every system asked for.
+
+    Raises
+    ------
+    ValueError
+        Naming the file and the systems it lacks (or QZSS with a named sky: QZSS has no
+        nominal constellation here).
+    """
+    import pandas as pd
+
+    systems = list(systems)
+    if source not in GPS_SKIES:
+        nav = read_navigation(source, reference_week=reference_week)
+        problem = missing_systems(nav, systems, source)
+        if problem:
+            raise ValueError(problem)
+        attrs = dict(nav.attrs)
+        nav = nav[nav["system"].isin([SYSTEMS[s] for s in systems])].reset_index(drop=True)
+        nav.attrs.update(attrs)
+        return nav
+    if "qzss" in systems:
+        raise ValueError(QZSS_WITHOUT_FILE)
+    parts = []
+    if "gps" in systems:
+        parts.append(almanac_gps_navigation(utc, span_s) if source == "gps-almanac"
+                     else nominal_gps_navigation(utc, span_s + 7200.0, expanded=expanded))
+    parts += [NOMINAL_SYSTEMS[SYSTEMS[s]](utc, span_s) for s in systems if s != "gps"]
+    attrs = dict(parts[0].attrs) if "gps" in systems else {"kind": "ephemeris"}
+    nav = pd.concat(parts, ignore_index=True)
+    nav.attrs.update(attrs)
     return nav

@@ -82,6 +82,7 @@ def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np
         ``tau`` (S, s): signal flight time, solving c tau = |R(omega_e tau) r_s(t - tau) - r_r|;
         ``pos``, ``vel`` (S + (3,)): satellite state at transmission in the ECEF frame of
         transmission; ``clock_s``, ``clock_drift_s_s`` (S): broadcast satellite clock;
+        ``system_time_offset_s`` (S): its system's time minus GPS time (``ephemeris``);
         ``range`` (S, m): c tau, the geometric range including the Sagnac term;
         ``range_rate`` (S, m/s): its exact time derivative (with d tau/dt and the rotation's
         own rate); ``tau_rate`` (S): d tau / dt; ``los`` (S + (3,)): unit vector from antenna
@@ -104,7 +105,8 @@ def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np
     los_rate = (v_rel - np.einsum("...k,...k->...", los, v_rel)[..., None] * los) / rng[..., None]
     return {"tau": rng / C_M_S, "pos": state["pos"], "vel": state["vel"], "los_rate": los_rate,
             "clock_s": state["clock_s"], "clock_drift_s_s": state["clock_drift_s_s"],
-            "range": rng, "range_rate": rate, "los": los, "tau_rate": rate / C_M_S}
+            "system_time_offset_s": state["system_time_offset_s"], "range": rng,
+            "range_rate": rate, "los": los, "tau_rate": rate / C_M_S}
 
 
 def look_angles(los: np.ndarray, los_rate: np.ndarray, lat_rad: np.ndarray, lon_rad: np.ndarray

@@ -127,9 +127,12 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
 def write_rinex_nav(path: str | Path, nav: pd.DataFrame, leap_s: int,
                     iono_alpha: list[float] | None = None,
                     iono_beta: list[float] | None = None) -> Path:
-    """Write the navigation table as a RINEX 3.04 GPS navigation file (records as they are,
-    with the ionosphere coefficients in IONOSPHERIC CORR when given)."""
+    """Write the GPS records of the navigation table as a RINEX 3.04 GPS navigation file
+    (records as they are, with the ionosphere coefficients in IONOSPHERIC CORR when given);
+    other systems' records are not written."""
     path = Path(path)
+    if "system" in nav.columns:
+        nav = nav[nav["system"] == "G"]
     lines = [
         _label("     3.04           N: GNSS NAV DATA    G: GPS", "RINEX VERSION / TYPE"),
         _label(f"{PROGRAM:<20}{PROGRAM:<20}{_stamp()}", "PGM / RUN BY / DATE"),

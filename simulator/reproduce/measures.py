@@ -20,8 +20,8 @@ Public names
 ------------
 errors, horizontal_error, outage_scores, moving_off, outages, longest_outage,
 inside_windows, at_time, spread_text, count_text, paired_wins, win_rate_text, count_verdict,
-median_verdict, needed_count, column, least_count, paired_verdict, position_error_3d,
-satellite_windows, window_values.
+median_verdict, needed_count, column, missing_count, least_count, paired_verdict,
+position_error_3d, satellite_windows, window_values.
 """
 
 from __future__ import annotations
@@ -40,10 +40,10 @@ from simulator.scoring.evaluate import score_solutions
 from simulator.scoring.metrics import OUTAGE_KIND
 
 __all__ = ["at_time", "column", "count_text", "count_verdict", "errors", "horizontal_error",
-           "inside_windows", "least_count", "longest_outage", "median_verdict", "moving_off",
-           "needed_count", "outage_scores", "outages", "paired_verdict", "paired_wins",
-           "position_error_3d", "satellite_windows", "spread_text", "win_rate_text",
-           "window_values"]
+           "inside_windows", "least_count", "longest_outage", "median_verdict",
+           "missing_count", "moving_off", "needed_count", "outage_scores", "outages",
+           "paired_verdict", "paired_wins", "position_error_3d", "satellite_windows",
+           "spread_text", "win_rate_text", "window_values"]
 
 
 # -- against the truth ----------------------------------------------------------------------
@@ -102,18 +102,35 @@ def inside_windows(t: np.ndarray, windows: np.ndarray) -> np.ndarray:
 def column(tables: dict[str, pd.DataFrame] | pd.DataFrame, name: str,
            experiment: str | None = None) -> np.ndarray:
     """The per-seed values of figure ``name`` (of ``experiment`` when given a mapping of
-    experiment tables), seeds without it left out."""
+    experiment tables), one per seed that ran, in seed order: NaN where the seed has no figure
+    (e.g. the scorer's none for a solution silent at an outage's end), counted by the texts
+    and verdicts below, never dropped (two columns stay paired seed by seed)."""
     table = tables[experiment] if experiment is not None else tables
-    return table[name].dropna().to_numpy(float) if name in table else np.array([])
+    return table[name].to_numpy(float) if name in table else np.array([])
+
+
+def missing_count(*values: Sequence[float] | np.ndarray) -> int:
+    """Seeds (positions) where any of the equally long ``values`` has no figure (NaN)."""
+    present = np.ones(len(values[0]), dtype=bool)
+    for v in values:
+        present &= np.isfinite(np.asarray(v, float))
+    return int((~present).sum())
+
+
+def _without(missing: int) -> str:
+    return f", {missing} without a figure" if missing else ""
 
 
 def spread_text(values: Sequence[float] | np.ndarray, unit: str = "", digits: int = 3) -> str:
     """Median, interquartile range and extremes over seeds: ``median 17.8 m (IQR 12.1-25.0,
-    range 9.0-31.2; 10 seeds)``."""
+    range 9.0-31.2; 10 seeds)``, the seeds without a figure (NaN) counted:
+    ``...; 8 seeds, 2 without a figure)``."""
     v = np.asarray(values, float)
+    missing = missing_count(v)
     v = v[np.isfinite(v)]
     if not len(v):
-        return "no figure (every seed failed)"
+        return f"no figure (none of {missing} seeds has one)" if missing else \
+            "no figure (every seed failed)"
     q1, med, q3 = np.percentile(v, [25, 50, 75])
     u = f" {unit}" if unit else ""
 
@@ -121,7 +138,7 @@ def spread_text(values: Sequence[float] | np.ndarray, unit: str = "", digits: in
         return f"{x:.{digits}g}"
 
     return (f"median {f(med)}{u} (IQR {f(q1)}-{f(q3)}, range {f(v.min())}-{f(v.max())}; "
-            f"{len(v)} seeds)")
+            f"{len(v)} seeds{_without(missing)})")
 
 
 def count_text(successes: int, n: int) -> str:
@@ -137,10 +154,11 @@ def paired_wins(a: np.ndarray, b: np.ndarray) -> tuple[int, int]:
     return int(np.sum(a[ok] < b[ok])), int(ok.sum())
 
 
-def win_rate_text(wins: int, n: int, who: str) -> str:
-    """``dr3d_ekf better in 5/10 seeds (50 %)``."""
+def win_rate_text(wins: int, n: int, who: str, missing: int = 0) -> str:
+    """``dr3d_ekf better in 5/10 seeds (50 %)``, and ``, 2 without a figure`` for the seeds
+    that could not be compared."""
     rate = f" ({100 * wins / n:.0f} %)" if n else ""
-    return f"{who} better in {wins}/{n} seeds{rate}"
+    return f"{who} better in {wins}/{n} seeds{rate}{_without(missing)}"
 
 
 # -- verdicts -------------------------------------------------------------------------------
@@ -170,15 +188,18 @@ def median_verdict(values: Iterable[float], bound: float, better: str, no_effect
     """The verdict on "the median of ``what`` is ``better`` (``"above"`` or ``"below"``) than
     ``bound``", with ``no_effect`` the value meaning no effect at all (module docstring)."""
     v = np.asarray(list(values), float)
+    missing = missing_count(v)
     v = v[np.isfinite(v)]
     if not len(v):
         return Verdict("not shown", measured, "no seed produced the figure")
     med = float(np.median(v))
+    over = f" over {len(v)} seeds{_without(missing)}" if missing else ""
     sign = 1.0 if better == "above" else -1.0
     if sign * (med - bound) >= 0:
-        return Verdict("shown", measured, f"median {what} {med:.3g} is {better} {bound:g}")
+        return Verdict("shown", measured,
+                       f"median {what} {med:.3g} is {better} {bound:g}{over}")
     status = "partly" if sign * (med - no_effect) > 0 else "not shown"
-    reason = f"median {what} {med:.3g} is not {better} {bound:g}"
+    reason = f"median {what} {med:.3g} is not {better} {bound:g}{over}"
     return Verdict(status, measured, f"{reason}. {analysis}".strip())
 
 
@@ -193,7 +214,8 @@ def outage_scores(dataset: Dataset, solution: pd.DataFrame) -> list[dict]:
 def least_count(per: Mapping[str, np.ndarray], passes: Callable[[np.ndarray], np.ndarray]
                 ) -> tuple[int, int]:
     """For a claim over several groups of per-seed values (filters, true values): the smallest
-    number of seeds passing ``passes`` in any group, and the smallest number of seeds."""
+    number of seeds passing ``passes`` in any group, and the smallest number of seeds (a seed
+    without a figure, NaN, is counted and fails any comparison)."""
     return (min(int(np.sum(passes(v))) for v in per.values()),
             min(len(v) for v in per.values()))
 
@@ -201,11 +223,13 @@ def least_count(per: Mapping[str, np.ndarray], passes: Callable[[np.ndarray], np
 def paired_verdict(mine: np.ndarray, theirs: np.ndarray, names: tuple[str, str],
                    fraction: float, unit: str, what: str, analysis: str = "") -> Verdict:
     """The verdict on "``names[0]``'s figure is smaller than ``names[1]``'s in at least
-    ``fraction`` of the seeds" (paired per seed), with both spreads and the win rate."""
+    ``fraction`` of the seeds" (paired per seed), with both spreads and the win rate. A seed
+    where either figure is missing counts as one where the claim is not met (never dropped)."""
     wins, n = paired_wins(mine, theirs)
-    measured = (f"{win_rate_text(wins, n, names[0])}; {names[0]} {spread_text(mine, unit)}; "
-                f"{names[1]} {spread_text(theirs, unit)}")
-    return count_verdict(wins, n, fraction, measured, what, analysis)
+    missing = missing_count(mine, theirs)
+    measured = (f"{win_rate_text(wins, n, names[0], missing)}; {names[0]} "
+                f"{spread_text(mine, unit)}; {names[1]} {spread_text(theirs, unit)}")
+    return count_verdict(wins, n + missing, fraction, measured, what, analysis)
 
 
 # -- partial-outage windows (Chan, Karamat) ----------------------------------------------------

@@ -127,8 +127,10 @@ def _beats(tables: Mapping[str, pd.DataFrame], other: str, analysis: str = "",
         mine = m.column(tables, f"dr3d_ekf.{key}", experiment)
         theirs = m.column(tables, f"{other}.{key}", experiment)
         wins, n = m.paired_wins(mine, theirs)
-        counts.append((wins, n))
-        parts.append(f"{key.split('_')[0]}: {m.win_rate_text(wins, n, 'dr3d_ekf')}, dr3d_ekf "
+        missing = m.missing_count(mine, theirs)  # a seed without both figures is no win
+        counts.append((wins, n + missing))
+        parts.append(f"{key.split('_')[0]}: {m.win_rate_text(wins, n, 'dr3d_ekf', missing)}, "
+                     f"dr3d_ekf "
                      f"{m.spread_text(mine, 'm')} vs {other} {m.spread_text(theirs, 'm')}")
     wins, n = min(counts)
     what = " and ".join(k.split("_")[0] for k in keys)
@@ -140,8 +142,9 @@ def _flat(tables: Mapping[str, pd.DataFrame], other: str, analysis: str = "") ->
     parts, inside = [], []
     for key in ("exit_horizontal_m", "max_horizontal_m"):
         ratio = (tables["flat_garage"][f"dr3d_ekf.{key}"]
-                 / tables["flat_garage"][f"{other}.{key}"]).dropna()
-        med = float(np.median(ratio)) if len(ratio) else math.nan
+                 / tables["flat_garage"][f"{other}.{key}"]).to_numpy(float)
+        finite = ratio[np.isfinite(ratio)]  # the seeds without one are counted in the text
+        med = float(np.median(finite)) if len(finite) else math.nan
         inside.append(FLAT_RATIO[0] <= med <= FLAT_RATIO[1])
         parts.append(f"{key.split('_')[0]} ratio dr3d_ekf / {other} {m.spread_text(ratio)}")
     measured = "; ".join(parts)
@@ -210,9 +213,11 @@ def _judge_ins_nhc(tables: Mapping[str, pd.DataFrame]) -> Verdict:
         with_nhc = m.column(tables, "nhc.max_horizontal_m", k)
         without = m.column(tables, "no_nhc.max_horizontal_m", k)
         wins, n = m.paired_wins(with_nhc, without)
-        better.append(bool(len(with_nhc) and np.median(with_nhc) < np.median(without)))
+        missing = m.missing_count(with_nhc, without)
+        better.append(bool(n and np.nanmedian(with_nhc) < np.nanmedian(without)))
         parts.append(f"{k}: max error with NHC {m.spread_text(with_nhc, 'm')}, odometer only "
-                     f"{m.spread_text(without, 'm')}; {m.win_rate_text(wins, n, 'with NHC')}")
+                     f"{m.spread_text(without, 'm')}; "
+                     f"{m.win_rate_text(wins, n, 'with NHC', missing)}")
     measured = "; ".join(parts)
     if all(better):
         return Verdict("shown", measured, "the median garage error is smaller with the NHC in "

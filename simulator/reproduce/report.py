@@ -114,7 +114,10 @@ def _panel(ax: object, key: str, e: ExperimentResult) -> None:
         ax.plot(x, row.to_numpy(float), marker="o", linestyle="none", alpha=0.7,
                 label=f"seed {seed}")
     ax.set_yscale("symlog", linthresh=1e-2)
-    ax.set_xticks(x, columns, rotation=30, ha="right", fontsize=7)
+    # a seed without a figure has no point: its count is in the tick, never silently dropped
+    missing = table[columns].isna().sum()
+    ax.set_xticks(x, [f"{c} ({missing[c]} missing)" if missing[c] else c for c in columns],
+                  rotation=30, ha="right", fontsize=7)
     ax.set_title(f"{key} ({e.experiment.scenario}): per-seed figures", fontsize=9)
     ax.grid(True, alpha=0.3)
     if len(e.table) <= 12:

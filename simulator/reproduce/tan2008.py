@@ -52,22 +52,23 @@ def _end(tables: Mapping[str, pd.DataFrame], label: str) -> pd.Series:
 
 def _judge_constraints(tables: Mapping[str, pd.DataFrame]) -> Verdict:
     free, constrained = _end(tables, "free"), _end(tables, "constraints")
-    cut = (1.0 - constrained / free).dropna()
+    cut = 1.0 - constrained / free  # NaN where a seed has no end error: counted, not dropped
     wins, n = m.paired_wins(constrained.to_numpy(), free.to_numpy())
     measured = (f"cut {m.spread_text(100 * cut, '%')}; end error free "
                 f"{m.spread_text(free, 'm')}, with NHC + height "
                 f"{m.spread_text(constrained, 'm')}; "
-                f"{m.win_rate_text(wins, n, 'constrained')}")
+                f"{m.win_rate_text(wins, n, 'constrained', m.missing_count(constrained, free))}")
     return m.median_verdict(cut, CUT_AT_LEAST, "above", 0.0, measured,
                             "cut of the outage-end error")
 
 
 def _judge_magnetometer(tables: Mapping[str, pd.DataFrame]) -> Verdict:
     full, constrained = _end(tables, "full"), _end(tables, "constraints")
-    ratio = (full / constrained).dropna()
+    ratio = full / constrained
     wins, n = m.paired_wins(full.to_numpy(), constrained.to_numpy())
+    missing = m.missing_count(full, constrained)
     measured = (f"ratio with / without magnetometer {m.spread_text(ratio)}; "
-                f"{m.win_rate_text(wins, n, 'with magnetometer')}")
+                f"{m.win_rate_text(wins, n, 'with magnetometer', missing)}")
     return m.median_verdict(ratio, MAG_AT_MOST, "below", MAG_AT_MOST, measured,
                             "ratio with / without the magnetometer")
 

@@ -57,7 +57,9 @@ class SolutionErrors:
     errors : DataFrame
         One row per solution row inside the truth span: ``t`` (s), ``err_n, err_e, err_d`` (m),
         ``err_h`` (m), ``err_vn, err_ve, err_vd`` (m/s), ``err_roll, err_pitch, err_yaw`` (rad),
-        the solution's own ``std_*`` columns when it has them, and ``err_<name>`` for each
+        the solution's own ``std_*`` columns, ``nis_gnss, nis_gnss_dof`` and ``fix_status``
+        when it has them,
+        and ``err_<name>`` for each
         sensor-error column of the solution that the truth sensors table also has.
     total_rows : int
         Rows of the solution.
@@ -144,7 +146,7 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame,
     for name, key in zip(ERR_ATT, _ATT, strict=True):
         true_angle = interp(np.unwrap(truth[key].to_numpy(float)))
         out[name] = wrap_angle(sol[key].to_numpy(float) - true_angle)
-    for name in col.SOLUTION_STD:
+    for name in (*col.SOLUTION_STD, *col.SOLUTION_NIS, *col.SOLUTION_FIX):
         if name in sol:
             out[name] = sol[name].to_numpy(float)
     if truth_sensors is not None and len(truth_sensors):

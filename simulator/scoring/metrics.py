@@ -16,12 +16,16 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   included. A solution that stops during an outage is charged here as well as in ``outages``;
 * ``outages`` (only for solutions that use GNSS; ``None`` for one that never does, such as
   odometer/gyro dead reckoning): one entry per ``gnss_outage`` row of the events table, over
-  the solution rows with t_start <= t < t_end (the epoch at t_end already has GNSS again):
-  ``start`` (s), ``duration`` (s), ``distance`` (m travelled by the truth), ``max_horizontal``,
-  ``end_horizontal`` (the error of the last scored row before t_end) and ``end_percent``
-  (end_horizontal as a percentage of distance; ``None`` for a stationary outage) and
-  ``coverage`` (the share of the outage within 1.5 output periods of a row). An outage in
-  which the solution has no row gets ``None`` entries and coverage 0 (never left out);
+  the solution rows with t_start <= t < t_end (the epoch at t_end already has GNSS again, and
+  the replay's row at t_end follows that update): ``start`` (s), ``duration`` (s),
+  ``distance`` (m travelled by the truth), ``max_horizontal`` (over the window's rows),
+  ``end_horizontal`` (the error at the window's end time: the error of the window's last row,
+  which must lie at most ``END_TOLERANCE_S`` = 1 s before t_end, else ``None``: a solution
+  silent at the end of an outage has no end error), ``end_percent`` (end_horizontal as a
+  percentage of distance; ``None`` without an end error or for a stationary outage) and
+  ``coverage`` {fraction, longest_gap} (the share of the window within 1.5 output periods of
+  a row, and its longest stretch without a row, s). An outage in which the solution has no row
+  gets ``None`` entries, coverage 0 and the whole window as its gap (never left out);
 * ``degraded`` (like ``outages``): one entry per window where GNSS is limited but not gone,
   the events of kinds ``gnss_satellite_limit`` and ``gnss_multipath`` and the zones whose sky
   is ``canyon``, with ``kind`` (the event kind, or ``canyon``) and ``satellites`` (the median
@@ -32,12 +36,17 @@ Per solution (metres, m/s, degrees for attitude; ``None`` where nothing could be
   docs/solution-format.md that the dataset's ``truth_sensors`` also has: the RMS of the
   solution minus the true value over the rows where both are finite, and the last such error,
   in the column's own unit (rad/s, m/s^2, dimensionless, m, m/s);
-* ``nees`` (only when the solution has ``std_*`` columns): the mean normalised estimation error
-  squared of each 3-axis group, e^T P^-1 e with the diagonal covariance of the 1-sigma columns
+* ``nees`` (only when the solution has ``std_*`` columns): over the whole drive, the mean
+  normalised estimation error squared of each 3-axis group, e^T P^-1 e with the diagonal
+  covariance of the 1-sigma columns
   (``position``: std_n/e/d, ``velocity``: std_vn/ve/vd, ``attitude``: std_roll/pitch/yaw;
   ``None`` for a group whose three columns are not all present), and ``expected`` = 3, its value
   for a consistent estimator (Bar-Shalom, Li and Kirubarajan 2001, section 5.4); the file gives
   no cross-covariances, so P is taken diagonal;
+* ``rtk`` (only when the solution has ``fix_status``): ``simulator.scoring.rtk``.
+* ``consistency`` (only when the solution has ``std_*`` columns) and ``nis`` (only when it has
+  ``nis_gnss`` and ``nis_gnss_dof``): ``simulator.scoring.consistency``, after the solution's
+  first ``CONSISTENCY_SKIP_S`` = 60 s;
 * ``runtime`` {seconds, realtime_factor} when the estimator ran inside landnav;
 * ``rows`` {total, outside_truth, position, velocity, attitude}: rows in the solution, rows
   dropped outside the truth's time span, and rows with the whole group (a position row: finite
@@ -78,15 +87,16 @@ from simulator.scoring.align import (
     sensor_error_name,
 )
 from simulator.scoring.align import solution_errors as _solution_errors
+from simulator.scoring.consistency import AXES, BLOCKS, block_nees, consistency_scores, nis_scores
+from simulator.scoring.rtk import rtk_scores
 
 OUTAGE_KIND = "gnss_outage"  # events.parquet kind of a stretch without any GNSS measurement
 DEGRADED_KINDS = ("gnss_satellite_limit", "gnss_multipath")  # fault kinds that limit GNSS
 CANYON = "canyon"  # the kind of a degraded window made by a zone with an urban-canyon sky
 COVERAGE_PERIODS = 1.5  # a moment is covered when a row lies within this many output periods
+END_TOLERANCE_S = 1.0  # a window's end error needs a row at most this long before its end, s
 NEES_DOF = 3  # degrees of freedom of each NEES group (three axes)
 _STD = tuple(col.SOLUTION_STD)
-_NEES_GROUPS = {"position": (ERR_POS, _STD[0:3]), "velocity": (ERR_VEL, _STD[3:6]),
-                "attitude": (ERR_ATT, _STD[6:9])}
 
 
 def _number(x: float) -> float | None:
@@ -144,24 +154,36 @@ def _coverage(t_valid: np.ndarray, t_end: float) -> dict:
     return {"fraction": float(min(covered / span, 1.0)), "longest_gap": longest}
 
 
+def _window_coverage(t_valid: np.ndarray, t_start: float, t_end: float) -> dict:
+    """``coverage`` {fraction, longest_gap} of one window: the share of [t_start, t_end] within
+    1.5 output periods of a row, and the longest stretch of it without a row (s), from the
+    window's start to its first row and from its last row to its end included."""
+    duration = t_end - t_start
+    if duration <= 0:
+        return {"fraction": 1.0, "longest_gap": 0.0}
+    inside = t_valid[(t_valid > t_start) & (t_valid < t_end)]
+    longest = float(np.diff(np.concatenate(([t_start], inside, [t_end]))).max())
+    fraction = _covered(t_valid, _reach(t_valid), t_start, t_end) / duration
+    return {"fraction": float(min(fraction, 1.0)), "longest_gap": longest}
+
+
 def _window_scores(t_start: float, t_end: float, t: np.ndarray, h: np.ndarray,
                    truth: pd.DataFrame) -> dict:
     """``start, duration, distance, max_horizontal, end_horizontal, end_percent, coverage`` of
     one window over the scored rows (times ``t``, horizontal errors ``h``) with
-    t_start <= t < t_end; ``coverage`` is the share of the window within 1.5 output periods of a
-    row (as the solution's ``coverage``), so that a solution that stops early in a window is
-    seen to."""
+    t_start <= t < t_end (module docstring): the end error is the window's last row's, None
+    when that row lies more than ``END_TOLERANCE_S`` before the end."""
     travelled = np.interp([t_start, t_end], truth["t"].to_numpy(float),
                           truth["distance"].to_numpy(float))
     distance = float(travelled[1] - travelled[0])
-    inside = h[(t >= t_start) & (t < t_end)]
-    end = _number(inside[-1]) if inside.size else None
-    duration = t_end - t_start
-    covered = _covered(t, _reach(t), t_start, t_end) / duration if duration > 0 else 1.0
-    return {"start": float(t_start), "duration": float(duration), "distance": distance,
+    rows = (t >= t_start) & (t < t_end)
+    inside, t_inside = h[rows], t[rows]
+    end = (_number(inside[-1]) if inside.size and t_end - t_inside[-1] <= END_TOLERANCE_S
+           else None)
+    return {"start": float(t_start), "duration": float(t_end - t_start), "distance": distance,
             "max_horizontal": _max(inside), "end_horizontal": end,
             "end_percent": None if end is None or distance <= 0 else 100.0 * end / distance,
-            "coverage": covered}
+            "coverage": _window_coverage(t, t_start, t_end)}
 
 
 def degraded_windows(events: pd.DataFrame, canyon_zones: set[str] | frozenset[str] = frozenset()
@@ -196,14 +218,10 @@ def _sensor_errors(e: pd.DataFrame) -> dict:
 
 def _nees(errors: pd.DataFrame) -> dict:
     out: dict = {}
-    for group, (err_names, std_names) in _NEES_GROUPS.items():
-        if not set(std_names) <= set(errors.columns):
-            out[group] = None
-            continue
-        e = errors[list(err_names)].to_numpy(float)
-        s = errors[list(std_names)].to_numpy(float)
-        ok = np.isfinite(e).all(axis=1) & np.isfinite(s).all(axis=1) & (s > 0).all(axis=1)
-        out[group] = _number(np.mean(np.sum((e[ok] / s[ok]) ** 2, axis=1))) if ok.any() else None
+    for block in BLOCKS:
+        nees = block_nees(errors, block)
+        has = all(AXES[axis][1] in errors for axis in block.axes)
+        out[block.name] = _number(np.nanmean(nees)) if has and np.isfinite(nees).any() else None
     out["expected"] = float(NEES_DOF)
     return out
 
@@ -262,6 +280,16 @@ def score_errors(errors: SolutionErrors, truth: pd.DataFrame, events: pd.DataFra
         scores["sensor_errors"] = sensor_errors
     if any(name in e.columns for name in _STD):
         scores["nees"] = _nees(e)
+        scores["consistency"] = consistency_scores(e)
+    nis = nis_scores(e)
+    if nis is not None:
+        scores["nis"] = nis
+    if "fix_status" in e.columns:
+        error_3d = np.sqrt(np.sum(e[list(ERR_POS)].to_numpy(float) ** 2, axis=1))
+        outages = events.loc[events["kind"] == OUTAGE_KIND].sort_values("t_start")
+        scores["rtk"] = rtk_scores(e["t"].to_numpy(float), error_3d,
+                                   e["fix_status"].to_numpy(float),
+                                   list(zip(outages["t_start"], outages["t_end"], strict=True)))
     if runtime is not None:
         scores["runtime"] = {"seconds": _number(runtime["runtime_s"]),
                              "realtime_factor": _number(runtime["realtime_factor"])}

@@ -12,14 +12,21 @@ limits, multipath, canyon zones) of the events table.
 * ``position_errors``: north, east and down errors against time, with the solution's +-3 sigma
   (``std_n, std_e, std_d``) as a band where it has them;
 * ``attitude_errors``: roll, pitch and yaw errors (deg), +-3 sigma where ``std_roll...`` exist;
-* ``nees``: the per-epoch normalised estimation error squared of position (and of velocity and
-  attitude where the solution has their sigmas), log scale, with the two-sided 95 % bounds of
-  the chi-square distribution with 3 degrees of freedom (0.216, 9.35) that a consistent
-  estimator's NEES stays within 95 % of the time (Bar-Shalom, Li, Kirubarajan 2001, section
-  5.4.2);
+  the legend names every solution (also one without roll, and one without any attitude as
+  "not estimated"); the y-range of each error panel
+  follows the errors (at most ``BAND_RANGE`` times the largest error), so a huge sigma band
+  does not flatten them;
+* ``nees``: one panel per consistency block (position, velocity, attitude; horizontal and yaw
+  of 2-D solutions), the per-epoch normalised estimation error squared of every solution with
+  that block's sigmas, log scale, with the two-sided 95 % band of the chi-square distribution
+  of the block's dimension (0.216-9.35 for 3) that a consistent estimator's NEES stays within
+  95 % of the time (Bar-Shalom, Li, Kirubarajan 2001, section 5.4.2); the first
+  ``CONSISTENCY_SKIP_S`` of each solution, not judged, are shaded grey;
 * ``altitude``: the altitude of the truth and of every solution against time (a parking helix
   shows as its staircase of floors);
-* ``horizontal_cdf``: the empirical CDF of the horizontal error, logarithmic error axis;
+* ``horizontal_cdf``: the empirical CDF of the horizontal error, logarithmic error axis from
+  the smallest 1st percentile of the solutions' errors, but not below ``CDF_FLOOR_M`` (a
+  solution equal to the truth has errors of 1e-8 m that say nothing);
 * ``gnss_sky`` (datasets with raw GNSS): a sky plot of the tracked satellites' tracks, and the
   number of satellites, HDOP/VDOP and C/N0 against time, every other fault hatched grey; with
   the dataset's ``truth_gnss`` also how many of the tracked signals were NLOS and the C/N0 of
@@ -39,22 +46,31 @@ import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from scipy.stats import chi2
+from matplotlib.lines import Line2D
+from matplotlib.ticker import FuncFormatter
 
-from simulator.scoring.align import ERR_ATT, ERR_H, ERR_POS, ERR_VEL, local_ned
+from simulator.scoring.align import ERR_ATT, ERR_H, ERR_POS, local_ned
+from simulator.scoring.consistency import (
+    CONSISTENCY_SKIP_S,
+    Block,
+    block_nees,
+    chi2_band,
+    consistency_blocks,
+)
 from simulator.scoring.evaluate import Evaluation
-from simulator.scoring.metrics import DEGRADED_KINDS, NEES_DOF, OUTAGE_KIND, degraded_windows
+from simulator.scoring.metrics import DEGRADED_KINDS, OUTAGE_KIND, degraded_windows
 
 MAX_WINDOW_PANELS = 6  # zoomed map panels, the longest windows first
 NEES_FLOOR = 1e-2  # lower end of the NEES plot's axis
+CDF_FLOOR_M = 0.01  # the CDF's error axis never starts below 1 cm
+BAND_RANGE = 3.0  # an error panel's y-range shows sigma bands up to this many times the errors
+_ERROR_MARGIN = 1.5  # an error panel's y-range is at least this many times the largest error
 # a window's panel shows its whole path unless that is over ZOOM_RATIO times the largest error
 # in it; then it zooms on the window's end (+-3 times that error, at least 10 m)
 ZOOM_RATIO = 20.0
 _OUTAGE_COLOUR, _DEGRADED_COLOUR = "tab:red", "tab:orange"
 _DPI = 110
-_NEES_BOUNDS = chi2.ppf([0.025, 0.975], NEES_DOF)  # two-sided 95 % bounds of one epoch's NEES
-_STD_POS, _STD_VEL, _STD_ATT = ("std_n", "std_e", "std_d"), ("std_vn", "std_ve", "std_vd"), \
-    ("std_roll", "std_pitch", "std_yaw")
+_STD_POS, _STD_ATT = ("std_n", "std_e", "std_d"), ("std_roll", "std_pitch", "std_yaw")
 
 
 def _gaps(t: np.ndarray, *values: np.ndarray) -> list[np.ndarray]:
@@ -184,29 +200,55 @@ def _worst_error(ev: Evaluation, a: float, b: float) -> float:
     return worst
 
 
+def _y_limit(errors: list[np.ndarray], bands: list[np.ndarray]) -> float | None:
+    """Half the y-range of an error panel: ``_ERROR_MARGIN`` times the largest error, or the
+    largest band if wider, but never over ``BAND_RANGE`` times the largest error (None without
+    a non-zero error)."""
+    largest = max((float(np.nanmax(np.abs(e))) for e in errors if np.isfinite(e).any()),
+                  default=0.0)
+    if largest <= 0:
+        return None
+    band = max((float(np.nanmax(b)) for b in bands if np.isfinite(b).any()), default=0.0)
+    return min(max(_ERROR_MARGIN * largest, band), BAND_RANGE * largest)
+
+
 def _error_panels(ev: Evaluation, path: Path, names: tuple[str, ...], stds: tuple[str, ...],
                   titles: tuple[str, ...], scale: float, unit: str, heading: str) -> None:
     fig = Figure(figsize=(9, 7.5), layout="constrained")
     axes = fig.subplots(3, 1, sharex=True)
     colours = {label: f"C{i}" for i, label in enumerate(ev.results)}
+    legend: dict[str, object] = {}  # label -> handle, over every panel
     for ax, name, std, title in zip(axes, names, stds, titles, strict=True):
         _shade(ax, ev)
+        drawn, bands = [], []
         for label, r in ev.results.items():
             e = r.errors.errors
             sigma = e[std].to_numpy(float) if std in e else np.full(len(e), np.nan)
             t, value, sigma = _gaps(e["t"], scale * e[name].to_numpy(float), sigma)
             if not np.isfinite(value).any():
                 continue
+            drawn.append(value)
             ax.plot(t, value, lw=1.0, color=colours[label], label=label)
             if np.isfinite(sigma).any():
                 bound = 3.0 * scale * sigma
+                bands.append(bound)
                 ax.fill_between(t, -bound, bound, color=colours[label], alpha=0.15, lw=0,
                                 label=f"{label} ±3σ")
+        limit = _y_limit(drawn, bands)
+        if limit is not None:
+            ax.set_ylim(-limit, limit)
+        handles, labels = ax.get_legend_handles_labels()
+        for handle, label in zip(handles, labels, strict=True):
+            legend.setdefault(label, handle)
         ax.set(ylabel=f"{title} ({unit})")
         ax.grid(alpha=0.3)
+    for label in ev.results:  # a solution with none of the axes is named as such
+        if label not in legend:
+            legend[f"{label}: not estimated"] = Line2D([], [], color=colours[label], ls=":")
     axes[0].set_title(heading)
-    if axes[0].get_legend_handles_labels()[0]:  # nothing to list when no solution has the axis
-        axes[0].legend(loc="upper left", fontsize="x-small", ncol=3)
+    if legend:  # nothing to list when no solution has any of the axes
+        axes[0].legend(list(legend.values()), list(legend), loc="upper left", fontsize="x-small",
+                       ncol=3)
     axes[-1].set_xlabel("t (s)")
     _save(fig, path)
 
@@ -221,33 +263,51 @@ def plot_attitude_errors(ev: Evaluation, path: Path) -> None:
                   180.0 / math.pi, "deg", "attitude errors (solution - truth), ±3σ where given")
 
 
+def _nees_blocks(ev: Evaluation) -> dict[str, tuple[Block, list[str]]]:
+    """Block name -> (block, labels of the solutions with an NEES of it), in block order."""
+    out: dict[str, tuple[Block, list[str]]] = {}
+    for label, r in ev.results.items():
+        e = r.errors.errors
+        for block in consistency_blocks(e):
+            if np.isfinite(block_nees(e, block)).any():
+                out.setdefault(block.name, (block, []))[1].append(label)
+    order = ("position", "horizontal", "velocity", "attitude", "yaw")
+    return {name: out[name] for name in order if name in out}
+
+
 def has_std(ev: Evaluation) -> bool:
-    """Whether any solution has the three position standard deviations (a NEES plot)."""
-    return any(set(_STD_POS) <= set(r.errors.errors.columns) for r in ev.results.values())
+    """Whether any solution has the sigmas of a consistency block (a NEES plot)."""
+    return bool(_nees_blocks(ev))
 
 
 def plot_nees(ev: Evaluation, path: Path) -> None:
-    fig = Figure(figsize=(10, 4.5), layout="constrained")
-    ax = fig.add_subplot()
-    _shade(ax, ev)
-    for label, r in ev.results.items():
-        e = r.errors.errors
-        for group, errs, stds in (("position", ERR_POS, _STD_POS), ("velocity", ERR_VEL, _STD_VEL),
-                                  ("attitude", ERR_ATT, _STD_ATT)):
-            if not set(stds) <= set(e.columns):
-                continue
-            nees = np.sum((e[list(errs)].to_numpy(float) / e[list(stds)].to_numpy(float)) ** 2,
-                          axis=1)
-            ax.plot(*_gaps(e["t"], nees), lw=0.8, label=f"{label} {group}")
-    for bound in _NEES_BOUNDS:
-        ax.axhline(bound, color="black", ls="--", lw=1.0)
-    ax.set_yscale("log")
-    # an estimator started from the truth has NEES near 0 at first: the axis starts at 1e-2
-    ax.set_ylim(bottom=NEES_FLOOR)
-    ax.set(xlabel="t (s)", ylabel="NEES",
-           title=f"NEES per epoch; dashed: 95 % chi-square bounds, {NEES_DOF} dof "
-                 f"({_NEES_BOUNDS[0]:.3g}, {_NEES_BOUNDS[1]:.3g})")
-    fig.legend(loc="outside right upper", fontsize="x-small")
+    blocks = _nees_blocks(ev)
+    fig = Figure(figsize=(10, 2.4 + 2.2 * len(blocks)), layout="constrained")
+    axes = np.atleast_1d(fig.subplots(len(blocks), 1, sharex=True, squeeze=False)).ravel()
+    colours = {label: f"C{i}" for i, label in enumerate(ev.results)}
+    for ax, (block, labels) in zip(axes, blocks.values(), strict=True):
+        _shade(ax, ev)
+        low, high = chi2_band(block.dim)
+        ax.axhspan(low, high, color="tab:green", alpha=0.12, lw=0,
+                   label=f"95 % chi-square band, {block.dim} dof")
+        for label in labels:
+            e = ev.results[label].errors.errors
+            ax.plot(*_gaps(e["t"], block_nees(e, block)), lw=0.8, color=colours[label],
+                    label=label)
+            t0 = float(e["t"].iloc[0])
+            ax.axvspan(t0, t0 + CONSISTENCY_SKIP_S, color="grey", alpha=0.08, lw=0)
+        ax.axhline(block.dim, color="black", ls=":", lw=1.0)
+        ax.set_yscale("log")
+        # an estimator started from the truth has NEES near 0 at first: the axis starts at 1e-2
+        ax.set_ylim(bottom=NEES_FLOOR)
+        ax.set(ylabel=f"{block.name} NEES")
+        ax.set_title(f"{block.name} ({', '.join(block.axes)}): band {low:.3g} - {high:.3g}, "
+                     f"expected {block.dim} (dotted)", fontsize="small")
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(loc="upper left", fontsize="x-small", ncol=4)
+    fig.suptitle(f"NEES per epoch, log scale; grey: each solution's first "
+                            f"{CONSISTENCY_SKIP_S:g} s, not judged")
+    axes[-1].set_xlabel("t (s)")
     _save(fig, path)
 
 
@@ -267,11 +327,22 @@ def plot_altitude(ev: Evaluation, path: Path) -> None:
 def plot_horizontal_cdf(ev: Evaluation, path: Path) -> None:
     fig = Figure(figsize=(6.5, 4), layout="constrained")
     ax = fig.add_subplot()
+    first_percentiles, largest = [], 0.0
     for label, r in ev.results.items():
         h = np.sort(r.errors.errors[ERR_H].to_numpy(float))
         h = h[np.isfinite(h) & (h > 0)]
         ax.step(h, np.arange(1, h.size + 1) / max(h.size, 1), where="post", label=label)
+        if h.size:
+            first_percentiles.append(float(np.percentile(h, 1.0)))
+            largest = max(largest, float(h[-1]))
     ax.set_xscale("log")
+    left = max(CDF_FLOOR_M, min(first_percentiles, default=CDF_FLOOR_M))
+    if left < largest:  # (a solution on the truth to 1 cm keeps the automatic axis)
+        ax.set_xlim(left=left)
+    # plain numbers, the minor ticks labelled at 2 and 5 only (they overlap otherwise)
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
+    ax.xaxis.set_minor_formatter(FuncFormatter(
+        lambda x, _: f"{x:g}" if f"{x:.0e}"[0] in "25" else ""))
     ax.set(xlabel="horizontal error (m, log scale)", ylabel="fraction of epochs",
            ylim=(0, 1.02), title="CDF of horizontal error")
     ax.grid(alpha=0.3, which="both")

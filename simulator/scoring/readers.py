@@ -183,6 +183,9 @@ def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[s
         out[name] = np.nan
     if "sdn(m)" in table:
         out["std_n"], out["std_e"], out["std_d"] = table["sdn(m)"], table["sde(m)"], table["sdu(m)"]
+    # the quality flag as SPEC section 8's fix status: Q = 1 fixed (2), Q = 2 float (1), else
+    # none (0: single point, DGPS, dead reckoning)
+    out["fix_status"] = np.select([table["Q"] == 1, table["Q"] == 2], [2, 1], 0)
     return out, notes
 
 

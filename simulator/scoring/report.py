@@ -1,9 +1,11 @@
 """The scoring report: ``report.md`` with the metrics of every solution side by side, one table
-per GNSS outage and degraded window, the estimated sensor errors, and the PNG plots of
-``simulator.scoring.plots`` in ``plots/``: the map and its zooms on each window, north/east/down
-and attitude errors with +-3 sigma, NEES against its chi-square bounds (solutions with standard
-deviations), altitude, the log-scale CDF of the horizontal error, and the sky, satellite count,
-DOP and C/N0 of a dataset with raw GNSS.
+per GNSS outage and degraded window (each solution's end error beside its coverage of the
+window), the consistency of every solution with standard deviations (NEES per block, the share
+inside the 95 % band, (e/sigma)^2 per axis, NIS), the estimated sensor errors, and the PNG plots
+of ``simulator.scoring.plots`` in ``plots/``: the map and its zooms on each window,
+north/east/down and attitude errors with +-3 sigma, NEES per block against its chi-square band,
+altitude, the log-scale CDF of the horizontal error, and the sky, satellite count, DOP and C/N0
+of a dataset with raw GNSS.
 
 Numbers are printed with three decimals; a missing value prints as ``-``.
 
@@ -18,6 +20,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from simulator.scoring.consistency import CONSISTENCY_SKIP_S
 from simulator.scoring.evaluate import Evaluation
 from simulator.scoring.metrics import OUTAGE_KIND, degraded_windows
 
@@ -38,9 +41,9 @@ _TABLE_ROWS = [
     ("attitude", "yaw_rms", "yaw RMS (deg)"),
     ("coverage", "fraction", "coverage (fraction of the drive)"),
     ("coverage", "longest_gap", "longest gap without a row (s)"),
-    ("nees", "position", "position NEES (expected 3)"),
-    ("nees", "velocity", "velocity NEES (expected 3)"),
-    ("nees", "attitude", "attitude NEES (expected 3)"),
+    ("nees", "position", "position NEES, whole drive (expected 3)"),
+    ("nees", "velocity", "velocity NEES, whole drive (expected 3)"),
+    ("nees", "attitude", "attitude NEES, whole drive (expected 3)"),
     ("runtime", "seconds", "runtime (s)"),
     ("runtime", "realtime_factor", "real-time factor"),
     ("rows", "position", "rows scored (position)"),
@@ -72,13 +75,17 @@ def markdown_table(header: list[str], rows: list[list[str]]) -> list[str]:
 
 
 def text_table(scores: dict[str, dict]) -> str:
-    """A compact fixed-width table of the main scores, one line per label (m, m/s, deg)."""
+    """A compact fixed-width table of the main scores, one line per label (m, m/s, deg); the
+    worst outage end error is ``no-row`` when the solution has no end error at some outage (it
+    would otherwise be the worst of the outages it spoke at)."""
     header = ["label", *(title for _, _, title in _TEXT_COLUMNS), "worst_outage_end_%"]
     rows = []
     for label, s in scores.items():
-        ends = [o["end_percent"] for o in s["outages"] or () if o["end_percent"] is not None]
+        outages = s["outages"] or ()
+        ends = [o["end_percent"] for o in outages if o["end_percent"] is not None]
+        silent = any(o["end_horizontal"] is None for o in outages)
         rows.append([label, *(format_number(_value(s, g, k)) for g, k, _ in _TEXT_COLUMNS),
-                     format_number(max(ends) if ends else None)])
+                     "no-row" if silent else format_number(max(ends) if ends else None)])
     widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
     return "\n".join("  ".join(c.rjust(w) if i else c.ljust(w)
                                for i, (c, w) in enumerate(zip(r, widths, strict=True)))
@@ -100,18 +107,27 @@ def _metrics_lines(scores: dict[str, dict]) -> list[str]:
     return markdown_table(["metric", *scores], rows)
 
 
+def _end_cell(o: dict, key: str) -> str:
+    """An end error (or end %) cell: ``no row`` where the solution has no row within 1 s of
+    the window's end, so a silent solution never reads as a small error."""
+    if o and o.get(key) is None and o.get("end_horizontal") is None:
+        return "no row"
+    return format_number(o.get(key))
+
+
 def _window_lines(scores: dict[str, dict], group: str, n: int, empty: str) -> list[str]:
     """One row per outage (``group`` = outages) or degraded window: its span and distance,
-    then each solution's max, end and end-% error (``-`` where it has no row or no GNSS) and
-    the share of the window it covers."""
+    then each solution's end error beside the share of the window it covers, its end error as
+    % of the distance and its largest error (``-`` for a solution without GNSS, ``no row``
+    where it has no row within 1 s of the window's end)."""
     if not n:
         return [empty]
     header = ["#", "start (s)", "duration (s)", "distance (m)"]
     if group == "degraded":
         header[1:1] = ["kind", "satellites"]
     for label in scores:
-        header += [f"{label} max (m)", f"{label} end (m)", f"{label} end (%)",
-                   f"{label} coverage"]
+        header += [f"{label} end (m)", f"{label} coverage", f"{label} end (%)",
+                   f"{label} max (m)"]
     rows = []
     for i in range(n):
         entries = [s[group][i] if s.get(group) is not None else {} for s in scores.values()]
@@ -121,10 +137,44 @@ def _window_lines(scores: dict[str, dict], group: str, n: int, empty: str) -> li
         if group == "degraded":
             row[1:1] = [str(first.get("kind", "-")), format_number(first.get("satellites"))]
         for o in entries:
-            row += [format_number(o.get(k)) for k in ("max_horizontal", "end_horizontal",
-                                                       "end_percent", "coverage")]
+            row += [_end_cell(o, "end_horizontal"),
+                    format_number((o.get("coverage") or {}).get("fraction")),
+                    _end_cell(o, "end_percent") if o.get("distance") else "-",
+                    format_number(o.get("max_horizontal"))]
         rows.append(row)
-    return markdown_table(header, rows)
+    note = ("The end error is the error of the solution's last row in the window, if that row "
+            "lies within 1 s of the window's end; `no row` where it does not: a solution silent "
+            "at the end has no end error to rank it by (read its coverage beside it).")
+    return [note, "", *markdown_table(header, rows)]
+
+
+def _consistency_lines(scores: dict[str, dict]) -> list[str]:
+    """One row per solution and consistency block: NEES against its dimension, the share of
+    epochs inside the 95 % band, and each axis's mean (error / sigma)^2; then the NIS."""
+    rows = []
+    for label, s in scores.items():
+        for block, c in (s.get("consistency") or {}).items():
+            if c is None:
+                continue
+            axes = ", ".join(f"{axis} {format_number(v)}" for axis, v in c["nse"].items())
+            rows.append([label, block, format_number(c["nees"]),
+                         format_number(c["nees_expected"]), format_number(c["inside_95"]),
+                         axes])
+    if not rows:
+        return ["No solution writes standard deviations (`std_*` columns)."]
+    lines = [f"After each solution's first {CONSISTENCY_SKIP_S:g} s. NEES is the time average "
+             "of eᵀP⁻¹e (P diagonal from the 1-sigma columns), expected its dimension for a "
+             "consistent filter; `inside 95 %` the share of epochs inside the chi-square 95 % "
+             "band (0.95 for a consistent filter); `(e/σ)²` the mean per axis (1 when "
+             "consistent, above: overconfident, below: too cautious).", "",
+             *markdown_table(["solution", "block", "NEES", "expected", "inside 95 %",
+                              "(e/σ)² per axis"], rows)]
+    nis = [[label, format_number(s["nis"]["mean"]), format_number(s["nis"]["expected"]),
+            str(s["nis"]["updates"])] for label, s in scores.items() if s.get("nis")]
+    if nis:
+        lines += ["", "GNSS innovations (NIS, expected their dimension):", "",
+                  *markdown_table(["solution", "NIS", "expected", "updates"], nis)]
+    return lines
 
 
 def _sensor_lines(scores: dict[str, dict]) -> list[str]:
@@ -150,16 +200,17 @@ def _plots(ev: Evaluation) -> list[tuple[str, str, Callable[[Evaluation, Path], 
         out += [("position_errors", "North, east and down errors", plot.plot_position_errors),
                 ("attitude_errors", "Attitude errors", plot.plot_attitude_errors)]
         if plot.has_std(ev):
-            out.append(("nees", "NEES over time", plot.plot_nees))
+            out.append(("nees", "NEES over time, per block", plot.plot_nees))
     out.append(("altitude", "Altitude", plot.plot_altitude))
     if ev.results:
         out.append(("horizontal_cdf", "CDF of horizontal error", plot.plot_horizontal_cdf))
     dataset = ev.dataset
     if dataset is not None and dataset.has("gnss_raw"):
-        raw = dataset.read("gnss_raw", ["t", "sv", "cn0", "elevation", "azimuth"])
+        # a measurement is named by its epoch, system (several systems) and satellite
+        keys = ["t", "system", "sv"] if "system" in dataset.units("gnss_raw") else ["t", "sv"]
+        raw = dataset.read("gnss_raw", [*keys, "cn0", "elevation", "azimuth"])
         if dataset.has("truth_gnss"):  # which signals were NLOS, from the truth
-            raw = raw.merge(dataset.read("truth_gnss", ["t", "sv", "nlos"]), on=["t", "sv"],
-                            how="left")
+            raw = raw.merge(dataset.read("truth_gnss", [*keys, "nlos"]), on=keys, how="left")
         fix = (dataset.read("gnss_fix", ["t", "num_sats", "hdop", "vdop"])
                if dataset.has("gnss_fix") else None)
         if len(raw):
@@ -203,6 +254,7 @@ def write_report(directory: Path, ev: Evaluation, title: str, note: str | None =
                   "", "## Degraded GNSS windows", "",
                   *_window_lines(scores, "degraded", n_degraded,
                                  "The dataset has no degraded GNSS window."), "",
+                  "## Consistency", "", *_consistency_lines(scores), "",
                   "## Estimated sensor errors", "", *_sensor_lines(scores), ""]
     for name, heading, draw in _plots(ev):
         draw(ev, directory / PLOTS / f"{name}.png")

@@ -1,6 +1,7 @@
-"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the GPS
-satellites in view, and the receiver's own fixes computed from them, so that a fix degrades
-exactly when and how the measurements do.
+"""GNSS receiver: raw pseudorange, pseudorange-rate/Doppler and C/N0 measurements of the
+satellites in view (GPS, and with ``systems`` Galileo, BeiDou, GLONASS, QZSS, each on its
+primary signal: docs/gnss-systems.md), and the receiver's own fixes computed from them, so that
+a fix degrades exactly when and how the measurements do.
 
 Scenario block ``sensors.gnss`` (``GNSS_FIELD``): ``rate``, ``outputs`` (``fix``, ``raw``),
 ``constellation`` (``gps-almanac``, the default: the real GPS constellation of the shipped
@@ -89,13 +90,16 @@ from simulator.gnss.atmosphere import broadcast_delays
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.constellation import (
     EXPANDABLE_SLOTS,
-    almanac_gps_navigation,
-    nominal_gps_navigation,
+    GPS_SKIES,
+    QZSS_WITHOUT_FILE,
+    missing_systems,
+    sky_navigation,
 )
 from simulator.gnss.ephemeris import (
-    EPHEMERIS_MAX_AGE_S,
+    STATE_KEYS,
     ephemeris_arrays,
     gather,
+    primary_frequency_hz,
     satellite_state,
     select_ephemeris,
 )
@@ -112,6 +116,7 @@ from simulator.gnss.errors import (
 from simulator.gnss.fix import receiver_fixes
 from simulator.gnss.navfiles import read_navigation
 from simulator.gnss.receiver import cn0_model, look_angles, signal_geometry
+from simulator.gnss.timesystems import SYSTEMS
 from simulator.schema import INVALID, Context, ListOf, Number, Path, Record, Text, Vector
 from simulator.sensors.base import sample_times
 from simulator.sensors.presets import PresetSensor, fill_from_preset, known_preset
@@ -144,7 +149,7 @@ PRESETS: dict[str, dict] = {
 DEFAULT_IONO_ALPHA = [0.9313e-08, 0.1490e-07, -0.5960e-07, -0.1192e-06]
 DEFAULT_IONO_BETA = [0.8806e05, 0.4915e05, -0.1311e06, -0.3277e06]
 # the constellations known by name (anything else names a file)
-CONSTELLATIONS = ("gps-almanac", "nominal-gps")
+CONSTELLATIONS = GPS_SKIES
 ALMANAC_MAX_AGE_S = 7 * 86400.0  # a YUMA almanac file is used up to a week from its TOA
 # a zone the environment block does not describe, or describes in part: the schema's defaults
 _ZONE_DEFAULTS = ZONE_FIELD.check({}, ("environment", "zones", "*"), Context("defaults"))
@@ -201,6 +206,10 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
         return ctx.error(path + ("expanded_slots",), "only applies to constellation "
                                                      "'nominal-gps' (name it: the default is "
                                                      "'gps-almanac')")
+    if len(set(value["systems"])) < len(value["systems"]):
+        return ctx.error(path + ("systems",), "names a system more than once")
+    if source in CONSTELLATIONS and "qzss" in value["systems"]:
+        return ctx.error(path + ("systems",), QZSS_WITHOUT_FILE)
     if source not in CONSTELLATIONS:
         candidates = [FilePath(source)]
         if ctx.file and not FilePath(source).is_absolute():
@@ -212,9 +221,12 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
                              "existing RINEX navigation or YUMA almanac file")
         value["constellation"] = str(found[0].resolve())
         try:
-            read_navigation(found[0])
+            nav = read_navigation(found[0])
         except (ValueError, OSError) as exc:
             return ctx.error(path + ("constellation",), str(exc))
+        problem = missing_systems(nav, value["systems"], str(found[0]))
+        if problem:
+            return ctx.error(path + ("systems",), problem)
     if value["cn0_horizon"] > value["cn0_zenith"]:
         return ctx.error(path + ("cn0_horizon",), "must not exceed cn0_zenith")
     return value
@@ -232,6 +244,10 @@ GNSS_FIELD = Record(
                                   "2020-01-01, 31 satellites, re-epoched to the drive by whole "
                                   "ground-track repeats), 'nominal-gps' (the 24 SPS slots) or a "
                                   "RINEX navigation file or YUMA almanac"),
+        "systems": ListOf(Text(choices=list(SYSTEMS)), ["gps"], min_len=1,
+                          doc="satellite systems received: gps, galileo, beidou, glonass, "
+                              "qzss (from the named sky's nominal constellations, or from the "
+                              "navigation file, which must have them)"),
         "expanded_slots": ListOf(Text(choices=list(EXPANDABLE_SLOTS)), [],
                                  doc="expandable slots of 'nominal-gps' split into their fore/aft "
                                      "pairs (SPS PS 2008 Table 3.4-2); [B1, D2, F2] = 27 slots"),
@@ -278,18 +294,15 @@ class Gnss(PresetSensor):
 
     # -- inputs --------------------------------------------------------------------------------
     def navigation(self, truth: Kinematics) -> pd.DataFrame:
-        """The navigation table used for the drive (a named constellation or the named file)."""
+        """The navigation table used for the drive: the enabled systems of the named sky or of
+        the named file (``simulator.gnss.constellation.sky_navigation``)."""
         week0, _ = utc_to_gps(truth.utc_start)
-        if self.config["constellation"] == "gps-almanac":
-            nav = almanac_gps_navigation(truth.utc_start, truth.duration_s)
+        nav = sky_navigation(self.config["constellation"], self.config["systems"],
+                             truth.utc_start, truth.duration_s, self.config["expanded_slots"],
+                             reference_week=week0)
+        if self.config["constellation"] in CONSTELLATIONS:
             nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
-            return nav
-        if self.config["constellation"] == "nominal-gps":
-            nav = nominal_gps_navigation(truth.utc_start, truth.duration_s + 7200.0,
-                                         expanded=self.config["expanded_slots"])
-            nav.attrs.update(iono_alpha=DEFAULT_IONO_ALPHA, iono_beta=DEFAULT_IONO_BETA)
-            return nav
-        return read_navigation(self.config["constellation"], reference_week=week0)
+        return nav
 
     def antenna(self, truth: Kinematics, t: np.ndarray) -> dict[str, np.ndarray]:
         """Antenna ECEF position and velocity, geodetic position, and heading at times t."""
@@ -365,16 +378,18 @@ class Gnss(PresetSensor):
         return los, nlos, extra, loss
 
     def _check_coverage(self, idx: np.ndarray, t: np.ndarray, truth: Kinematics,
-                        max_age_s: float) -> None:
+                        max_age_s: float | None) -> None:
         """A navigation file that does not cover the drive is an input error, not a silent
         outage: at least four satellites need an ephemeris at every epoch."""
         short = (idx >= 0).sum(axis=0) < 4
         if short.any():
             raise InputError([Problem(
                 self.config["constellation"], None, "sensors.gnss.constellation",
-                f"fewer than four satellites have an ephemeris within {max_age_s / 3600:g} h "
-                "(half the broadcast fit interval; older records are not used) "
-                f"of the drive from t = {t[short][0]:g} s (the drive starts "
+                "fewer than four satellites have an ephemeris within "
+                + (f"{max_age_s / 3600:g} h" if max_age_s else "its validity (half the "
+                   "broadcast fit interval: GPS and Galileo 2 h, BeiDou and QZSS 1 h, GLONASS "
+                   "30 min; older records are not used)")
+                + f" of the drive from t = {t[short][0]:g} s (the drive starts "
                 f"{truth.utc_start:%Y-%m-%d %H:%M:%S} UTC); use a navigation file of that "
                 "day or 'nominal-gps'")])
 
@@ -389,10 +404,11 @@ class Gnss(PresetSensor):
         # an almanac describes the orbits for days (coarsely); an ephemeris only within its fit
         # interval. Unhealthy satellites are tracked and flagged; the fixes leave them out.
         almanac = nav.attrs.get("kind") == "almanac"
-        max_age = ALMANAC_MAX_AGE_S if almanac else EPHEMERIS_MAX_AGE_S
-        svs = np.unique(nav["sv"].to_numpy())
+        max_age = ALMANAC_MAX_AGE_S if almanac else None  # None: each system's own
+        sats = nav[["system", "sv"]].drop_duplicates().sort_values(["system", "sv"])
+        systems, svs = sats["system"].to_numpy(dtype=str), sats["sv"].to_numpy(dtype=int)
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
-                               healthy_only=False)
+                               healthy_only=False, system=systems[:, None])
         self._check_coverage(idx, t, truth, max_age)
         health = np.where(idx >= 0, gather(eph, idx)["health"], 0.0)
 
@@ -405,6 +421,14 @@ class Gnss(PresetSensor):
         day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
         geo = model = _signals_in_chunks(eph, idx, tow0 + t, ant, day_of_year, alpha, beta)
         el, az = geo["elevation"], geo["azimuth"]
+        # each satellite's primary signal (GPS L1 C/A, Galileo E1, BeiDou B1I, GLONASS G1 on
+        # its channel): its wavelength, and the L1 ionosphere scaled by 1/f^2 to it
+        channel = nav.groupby(["system", "sv"])["glo_channel"].first().loc[
+            list(zip(systems, svs, strict=True))].to_numpy()
+        wavelength = C_M_S / primary_frequency_hz(systems, channel)[:, None]
+        iono_scale = (wavelength / LAMBDA_L1_M) ** 2
+        model["iono"], model["iono_rate"] = model["iono"] * iono_scale, \
+            model["iono_rate"] * iono_scale
 
         # what the receiver tracks: the C/N0 fades with the motion (correlated like the
         # multipath), the receiver's estimate of it adds white noise
@@ -441,7 +465,9 @@ class Gnss(PresetSensor):
         iono_true_rate = model["iono_rate"] * err["iono_ratio"] + model["iono"] * ratio_rate
         tropo_true_rate = model["tropo_rate"] * (1.0 + err["tropo_zenith"] / model["zenith"])
         nlos_delay = np.where(nlos & ~los, extra, 0.0)
-        sat_clock = C_M_S * geo["clock_s"]
+        # the satellite clock against GPS time: the broadcast one (against its system's time)
+        # plus the broadcast system-time offset, as a receiver applying GGTO / tau_GPS has it
+        sat_clock = C_M_S * (geo["clock_s"] + geo["system_time_offset_s"])
         sat_drift = C_M_S * geo["clock_drift_s_s"]
         rx_clock = C_M_S * bias_s[None, :]
         rx_drift = C_M_S * drift_s_s[None, :]
@@ -452,10 +478,10 @@ class Gnss(PresetSensor):
         pr_std, rate_std = pseudorange_sigma(cfg, err, model["iono"], mapping, dt_s,
                                              np.linalg.norm(ant["v_ned"], axis=1))
 
-        table = _RowTable(t, svs)
+        table = _RowTable(t, svs, systems)
         raw = table(tracked, {
             "pseudorange": pseudorange, "pseudorange_rate": rate,
-            "doppler": -rate / LAMBDA_L1_M, "cn0": cn0,
+            "doppler": -rate / wavelength, "cn0": cn0,
             "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
             "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
             "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
@@ -491,7 +517,8 @@ CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fas
 COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
 BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
 # what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
-_KEPT = ("pos", "vel", "clock_s", "clock_drift_s_s", "range", "range_rate", "tau_rate",
+_KEPT = ("pos", "vel", "clock_s", "clock_drift_s_s", "system_time_offset_s", "range",
+         "range_rate", "tau_rate",
          "elevation", "azimuth", "iono", "tropo", "zenith", "iono_rate", "tropo_rate")
 
 
@@ -519,7 +546,7 @@ def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.
     n = len(t_gps)
     step = 1 if n < 2 else max(1, int(round(COARSE_STEP_S / (t_gps[1] - t_gps[0]))))
     cols = np.unique(np.concatenate([np.arange(0, n, step), [n - 1]]))
-    pos = satellite_state(gather(eph, idx[:, cols]), t_gps[None, cols])["pos"]
+    pos = satellite_state(gather(eph, idx[:, cols], STATE_KEYS), t_gps[None, cols])["pos"]
     lat, lon = ant["lat"][cols], ant["lon"][cols]
     up = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
     rel = pos - ant["pos"][None, cols]
@@ -536,33 +563,35 @@ def _signals_in_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.nd
     -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
     n_sat, n_ep = idx.shape
     first = {k: v[:1] for k, v in ant.items()}
-    shapes = _signals(gather(eph, idx[:1, :1]), t_gps[:1], first, day_of_year[:1], alpha, beta)
+    shapes = _signals(gather(eph, idx[:1, :1], STATE_KEYS), t_gps[:1], first, day_of_year[:1],
+                      alpha, beta)
     fill = {"elevation": -np.pi / 2, "zenith": 1.0}
     out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
     for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
         cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
         ant_c = {k: v[cols] for k, v in ant.items()}
         rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
-        part = _signals(gather(eph, idx[rows, cols]), t_gps[cols], ant_c, day_of_year[cols],
-                        alpha, beta)
+        part = _signals(gather(eph, idx[rows, cols], STATE_KEYS), t_gps[cols], ant_c,
+                        day_of_year[cols], alpha, beta)
         for key in _KEPT:
             out[key][rows, cols] = part[key]
     return out
 
 
 class _RowTable:
-    """Flattens (satellite, epoch) arrays into stream rows: epochs first, satellites in PRN
-    order within an epoch, only where a mask is set."""
+    """Flattens (satellite, epoch) arrays into stream rows: epochs first, satellites in system
+    and PRN order within an epoch, only where a mask is set."""
 
-    def __init__(self, t: np.ndarray, svs: np.ndarray):
-        self.t, self.svs = t, svs
+    def __init__(self, t: np.ndarray, svs: np.ndarray, systems: np.ndarray):
+        self.t, self.svs, self.systems = t, svs, systems
 
     def __call__(self, mask: np.ndarray, columns: dict[str, np.ndarray]) -> pd.DataFrame:
         import pandas as pd
 
         m = mask.T
         out = {"t": np.broadcast_to(self.t[:, None], m.shape)[m],
-               "sv": np.broadcast_to(self.svs[None, :], m.shape)[m]}
+               "sv": np.broadcast_to(self.svs[None, :], m.shape)[m],
+               "system": np.broadcast_to(self.systems[None, :], m.shape)[m]}
         for key, value in columns.items():
             out[key] = np.swapaxes(np.broadcast_to(value, mask.shape), 0, 1)[m]
         return pd.DataFrame(out)

@@ -146,9 +146,17 @@ def test_gnss_outage_scores_are_means_over_the_runs_outages(tmp_path):
     assert row["horizontal.rms"] == pytest.approx(expected["horizontal"]["rms"], rel=1e-12)
     outages = expected["outages"]
     assert row["outages.count"] == len(outages) == 2
+    # gnss_only stops 2 s after the last fix: silent at both outages' ends, so the run's end
+    # error is missing (NaN), never the mean of rows inside the outages
+    assert row["outages.missing"] == sum(o["end_horizontal"] is None for o in outages) == 2
     for key in ("max_horizontal", "end_horizontal", "end_percent", "duration", "distance"):
-        assert row[f"outages.{key}"] == pytest.approx(np.mean([o[key] for o in outages]),
-                                                      rel=1e-12)
+        values = [np.nan if o[key] is None else o[key] for o in outages]
+        assert row[f"outages.{key}"] == pytest.approx(np.mean(values), rel=1e-12, nan_ok=True)
+    assert np.isnan(row["outages.end_horizontal"])
+    # the summary counts both runs as missing the end error, and the report says so
+    end = _group(_summary(out), "gnss_only")["scores"]["outages.end_horizontal"]
+    assert end == {"mean": None, "median": None, "p95": None, "count": 0, "missing": 2}
+    assert "- / - / - (2 missing)" in (out / "report.md").read_text()
     assert (out / "plots" / "outage_end.png").is_file()
 
 
@@ -301,20 +309,51 @@ def test_a_run_whose_dataset_fails_fails_every_estimator(tmp_path):
     assert not any(k.startswith("horizontal.") for r in rows for k in r)
 
 
-def test_flatten_scores_means_over_outages():
+def test_flatten_scores_means_over_outages_and_counts_the_silent_ones():
     scores = {
         "horizontal": {"rms": 1.0, "mean": None}, "attitude": {"yaw_rms": 0.5},
         "outages": [
-            {"start": 10.0, "duration": 20.0, "max_horizontal": 2.0, "end_horizontal": None},
-            {"start": 50.0, "duration": 40.0, "max_horizontal": 6.0, "end_horizontal": 3.0}],
+            {"start": 10.0, "duration": 20.0, "distance": 0.0, "max_horizontal": 2.0,
+             "end_horizontal": 1.0, "end_percent": None,
+             "coverage": {"fraction": 1.0, "longest_gap": 0.1}},
+            {"start": 50.0, "duration": 40.0, "distance": 100.0, "max_horizontal": 6.0,
+             "end_horizontal": 3.0, "end_percent": 3.0,
+             "coverage": {"fraction": 0.5, "longest_gap": 20.1}},
+            {"start": 99.0, "duration": 30.0, "distance": 200.0, "max_horizontal": 7.0,
+             "end_horizontal": None, "end_percent": None,
+             "coverage": {"fraction": 0.0, "longest_gap": 30.0}}],
         "nees": {"position": 2.5, "expected": 3.0}, "rows": {"total": 10},
+        "consistency": {"position": {"nees": 2.5, "nees_expected": 3.0, "inside_95": 0.9,
+                                     "epochs": 100, "nse": {"n": 1.0, "e": 0.5, "d": 1.0}},
+                        "velocity": None},
     }
     flat = flatten_scores(scores)
     assert flat["horizontal.rms"] == 1.0 and np.isnan(flat["horizontal.mean"])
-    assert flat["outages.count"] == 2 and flat["outages.duration"] == 30.0
-    assert flat["outages.max_horizontal"] == 4.0 and flat["outages.end_horizontal"] == 3.0
-    assert flat["nees.position"] == 2.5
-    assert not {"nees.expected", "outages.start", "rows.total"} & set(flat)
+    assert flat["outages.count"] == 3 and flat["outages.duration"] == 30.0
+    assert flat["outages.max_horizontal"] == 5.0
+    # the silent third outage makes the run's mean end error missing, never 2.0 without it
+    assert np.isnan(flat["outages.end_horizontal"]) and flat["outages.missing"] == 1
+    assert np.isnan(flat["outages.end_percent"])  # the stationary first one is left out
+    assert flat["outages.coverage.fraction"] == 0.5
+    assert flat["outages.coverage.longest_gap"] == pytest.approx(50.2 / 3)
+    assert flat["nees.position"] == 2.5 and flat["consistency.position.nees"] == 2.5
+    assert flat["consistency.position.nse.e"] == 0.5
+    assert not any(k.startswith("consistency.velocity") for k in flat)  # no such block
+    assert not {"nees.expected", "outages.start", "rows.total", "consistency.position.epochs",
+                "consistency.position.nees_expected"} & set(flat)
+    scores["outages"][2].update(end_horizontal=9.0, end_percent=4.5)
+    flat = flatten_scores(scores)
+    assert flat["outages.end_horizontal"] == pytest.approx(13.0 / 3)
+    assert flat["outages.missing"] == 0
+    assert flat["outages.end_percent"] == pytest.approx(3.75)  # over the two that moved
+
+
+def test_flatten_scores_of_a_list_of_numbers_counts_the_missing_ones():
+    flat = flatten_scores({"rtk": {"fix_rate": 0.9, "refix_times": [1.0, None, 3.0]}})
+    assert flat["rtk.fix_rate"] == 0.9 and np.isnan(flat["rtk.refix_times"])
+    assert flat["rtk.refix_times.count"] == 3 and flat["rtk.refix_times.missing"] == 1
+    flat = flatten_scores({"rtk": {"refix_times": [1.0, 3.0]}})
+    assert flat["rtk.refix_times"] == 2.0 and flat["rtk.refix_times.missing"] == 0
 
 
 @pytest.mark.parametrize("extra, message", [

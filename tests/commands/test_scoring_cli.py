@@ -215,3 +215,30 @@ def test_run_with_a_bad_estimator_leaves_nothing(tmp_path, capsys):
     assert main(["run", str(_scenario(tmp_path, ["no_such_estimator"])), "-o", str(out)]) == 2
     assert "no_such_estimator" in capsys.readouterr().err
     assert not out.exists() and [p.name for p in tmp_path.iterdir()] == ["quickstart.yaml"]
+
+
+def test_solution_cut_off_at_an_outage_start_has_no_end_error(dataset, shifted, tmp_path,
+                                                               capsys):
+    """A solution that stops talking at an outage's start is not scored by its last row: its
+    end error is missing (null), its coverage of the outage and of the drive drops."""
+    a, b = OUTAGES[1]
+    shifted.loc[shifted["t"] < a].to_parquet(tmp_path / "silent.parquet")
+    shifted.to_parquet(tmp_path / "full.parquet")
+    assert main(["score", str(dataset), "--solution", str(tmp_path / "silent.parquet"),
+                 str(tmp_path / "full.parquet"), "--json", str(tmp_path / "s.json")]) == 0
+    scores = _strict_json(tmp_path / "s.json")
+    cut = scores["silent"]["outages"][1]
+    assert cut["end_horizontal"] is None and cut["end_percent"] is None
+    assert cut["max_horizontal"] is None  # no row inside the outage either
+    # the last row at a - 0.1 s covers 1.5 periods (0.15 s) past it: 0.05 s of the outage
+    assert cut["coverage"]["fraction"] == pytest.approx(0.05 / (b - a), abs=1e-9)
+    assert cut["coverage"]["longest_gap"] == pytest.approx(b - a, abs=1e-9)
+    assert scores["silent"]["coverage"]["fraction"] < 1.0
+    full = scores["full"]["outages"][1]
+    assert full["end_horizontal"] == pytest.approx(5.0, abs=1e-5)
+    assert full["coverage"]["fraction"] == pytest.approx(1.0)
+    # the printed table: its worst outage end is not the one outage it spoke at
+    lines = {line.split()[0]: line.split() for line in capsys.readouterr().out.splitlines()}
+    assert lines["silent"][-1] == "no-row"
+    assert float(lines["full"][-1]) == pytest.approx(
+        max(o["end_percent"] for o in scores["full"]["outages"]), abs=1e-3)

@@ -12,7 +12,8 @@ import pytest
 import yaml
 
 from simulator.cli import main
-from simulator.dataset.rosbag import UNKNOWN_VARIANCE, fix_uere_m
+from simulator.dataset.rosbag import UNKNOWN_VARIANCE
+from simulator.datasheet import fix_uere_m
 
 mcap_reader = pytest.importorskip("mcap.reader")
 mcap_ros2_decoder = pytest.importorskip("mcap_ros2.decoder")

@@ -29,8 +29,9 @@ def _need(path: Path) -> Path:
 
 
 def read_sp3_positions(path: Path) -> pd.DataFrame:
-    """Minimal SP3-a/c reader for the tests: epoch (GPS s since 1980-01-06), sv, x, y, z (m),
-    clock_s (the satellite clock, s; NaN where the file has none)."""
+    """Minimal SP3-a/c reader for the tests: epoch (GPS s since 1980-01-06), system (RINEX
+    letter; G where SP3-a writes none), sv, x, y, z (m), clock_s (the satellite clock, s; NaN
+    where the file has none)."""
     rows, epoch = [], None
     for line in path.read_text().splitlines():
         if line.startswith("* "):
@@ -38,12 +39,12 @@ def read_sp3_positions(path: Path) -> pd.DataFrame:
             stamp = dt.datetime(*(int(x) for x in f[:5]), int(float(f[5])))
             epoch = (stamp - GPS_EPOCH).total_seconds()
         elif line.startswith("P") and epoch is not None:
-            sv = line[1:4].strip().lstrip("G")
+            system = line[1] if line[1].isalpha() else "G"
             xyz = [float(line[4 + 14 * k: 18 + 14 * k]) * 1e3 for k in range(3)]
             clock_us = float(line[46:60] or "999999.999999")
-            rows.append((epoch, int(sv), *xyz,
+            rows.append((epoch, system, int(line[2:4]), *xyz,
                          np.nan if clock_us >= 999999.0 else clock_us * 1e-6))
-    return pd.DataFrame(rows, columns=["epoch", "sv", "x", "y", "z", "clock_s"])
+    return pd.DataFrame(rows, columns=["epoch", "system", "sv", "x", "y", "z", "clock_s"])
 
 
 @pytest.mark.parametrize("folder, nav_name, sp3_name", [

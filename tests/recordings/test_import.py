@@ -231,7 +231,7 @@ def test_the_twin_of_a_simulated_drive_reproduces_its_statistics(quickstart, tmp
     """Closure: the twin of a simulated dataset (same presets, same sky, the trajectory refitted
     from its truth, other random draws) matches it where the statistic is set by the models
     rather than by the draws."""
-    from simulator.scoring.compare import compare_datasets
+    from simulator.comparison import compare_datasets
 
     scenario = tmp_path / "twin.yaml"
     assert main(["twin", str(quickstart.path), "-o", str(scenario)]) == 0

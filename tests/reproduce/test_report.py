@@ -6,9 +6,10 @@ from __future__ import annotations
 import re
 
 import pandas as pd
+from matplotlib.figure import Figure
 
 from simulator.reproduce.paper import Claim, Experiment, Paper, Verdict
-from simulator.reproduce.report import summary_counts, write_report
+from simulator.reproduce.report import _panel, summary_counts, write_report
 from simulator.reproduce.runner import ExperimentResult, PaperResult, Settings
 
 
@@ -67,3 +68,13 @@ def test_html_is_self_contained(tmp_path):
     assert sources and all(s.startswith("data:image/png;base64,") for s in sources)
     assert "<link" not in page and "<script" not in page
     assert page.count("<table>") == page.count("</table>") == 5  # run, summary, 3 of the paper
+
+
+def test_per_seed_plot_counts_the_seeds_without_a_figure():
+    result = _result("p", ["shown"])
+    e = result.experiments["drive"]
+    e.table["b.end_m"] = [3.0, float("nan"), float("nan")]  # silent at two seeds' outage ends
+    e.table["c.none_m"] = float("nan")  # a figure the filter does not have at all
+    ax = Figure().add_subplot()
+    _panel(ax, "drive", e)
+    assert [t.get_text() for t in ax.get_xticklabels()] == ["a.error_m", "b.end_m (2 missing)"]

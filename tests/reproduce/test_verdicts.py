@@ -47,17 +47,37 @@ def test_median_verdict_below_a_bound():
     assert m.median_verdict([1.2, 1.3], 1.1, "below", 1.1, "x", "ratio").status == "not shown"
 
 
-def test_paired_wins_leave_out_seeds_missing_either_figure():
+def test_paired_wins_compare_seeds_with_both_figures_and_count_the_others():
     a = np.array([1.0, 5.0, np.nan, 2.0])
     b = np.array([2.0, 4.0, 1.0, np.nan])
     assert m.paired_wins(a, b) == (1, 2)
+    assert m.missing_count(a, b) == 2
     assert m.win_rate_text(1, 2, "a") == "a better in 1/2 seeds (50 %)"
+    assert m.win_rate_text(1, 2, "a", 2) == "a better in 1/2 seeds (50 %), 2 without a figure"
+    # the verdict counts the two seeds without both figures as seeds where a did not win
+    verdict = m.paired_verdict(a, b, ("a", "b"), 0.5, "m", "a beats b")
+    assert verdict.status == "not shown" and "in only 1/4 seeds" in verdict.reason
+    assert "2 without a figure" in verdict.measured
 
 
-def test_spread_text_gives_median_iqr_and_range():
+def test_spread_text_gives_median_iqr_and_range_and_counts_missing_seeds():
     text = m.spread_text([1.0, 2.0, 3.0, 4.0, 5.0], "m")
     assert text == "median 3 m (IQR 2-4, range 1-5; 5 seeds)"
-    assert m.spread_text([np.nan]) == "no figure (every seed failed)"
+    text = m.spread_text([1.0, np.nan, 3.0, np.nan, 2.0], "m")
+    assert text == "median 2 m (IQR 1.5-2.5, range 1-3; 3 seeds, 2 without a figure)"
+    assert m.spread_text([]) == "no figure (every seed failed)"
+    assert m.spread_text([np.nan, np.nan]) == "no figure (none of 2 seeds has one)"
+
+
+def test_column_keeps_seeds_without_a_figure_in_seed_order():
+    table = pd.DataFrame({"x.end_m": [1.0, np.nan, 3.0], "y.end_m": [np.nan, 2.0, 1.0]},
+                         index=[1, 2, 3])
+    x, y = m.column(table, "x.end_m"), m.column(table, "y.end_m")
+    np.testing.assert_array_equal(x, [1.0, np.nan, 3.0])
+    assert m.paired_wins(y, x) == (1, 1)  # seed 3 only: paired, not shifted
+    assert m.least_count({"x": x}, lambda v: v < 5.0) == (2, 3)  # a missing seed fails
+    verdict = m.median_verdict(x, 1.5, "above", 0.0, "x", "end")
+    assert verdict.status == "shown" and "over 2 seeds, 1 without a figure" in verdict.reason
 
 
 def test_windows_from_the_events_table():

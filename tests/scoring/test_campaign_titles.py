@@ -4,27 +4,20 @@ from __future__ import annotations
 
 import pandas as pd
 from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 
 from simulator.campaign import report
+from tests.scoring_helpers import saved_figures
 
 
-def test_long_titles_fit_inside_the_figure(tmp_path, monkeypatch):
-    figures: list[Figure] = []
-    original = Figure.savefig
-
-    def keep(self, *args, **kwargs):
-        figures.append(self)
-        return original(self, *args, **kwargs)
-
-    monkeypatch.setattr(Figure, "savefig", keep)
+def test_long_titles_fit_inside_the_figure(tmp_path):
     runs = pd.DataFrame({"label": ["a", "a", "b"], "status": ["ok"] * 3,
                          "outages.end_horizontal": [1.0, 2.0, 3.0]})
     summary = {"groups": [{"label": "a", "sweep": {}}, {"label": "b", "sweep": {}}],
                "sweep": {}}
     title = "horizontal error at the end of GNSS outages (m)"
-    report._box_plot(runs, summary, "outages.end_horizontal", title, tmp_path / "x.png")
-    fig = figures[0]
+    with saved_figures() as figures:
+        report._box_plot(runs, summary, "outages.end_horizontal", title, tmp_path / "x.png")
+    fig = figures["x"]
     canvas = FigureCanvasAgg(fig)
     canvas.draw()
     renderer = canvas.get_renderer()

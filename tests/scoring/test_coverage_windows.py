@@ -38,8 +38,9 @@ def test_solution_stopping_in_an_outage_gets_null_entries_and_less_coverage(trut
     assert second["max_horizontal"] is None and second["end_horizontal"] is None
     assert second["end_percent"] is None and second["duration"] == 30.0
     # the window is covered only 0.15 s past the last row at 119.9 s
-    assert first["coverage"] == pytest.approx(1.0)
-    assert second["coverage"] == pytest.approx(0.05 / 30.0, abs=1e-9)
+    assert first["coverage"] == pytest.approx({"fraction": 1.0, "longest_gap": 0.1})
+    assert second["coverage"] == pytest.approx({"fraction": 0.05 / 30.0, "longest_gap": 30.0},
+                                               abs=1e-9)
     # rows every 0.1 s cover 0.15 s either side; the last row is at 119.9 s
     last = float(stopped["t"].iloc[-1])
     expected = 1.0 - (t_end - last - 0.15) / t_end
@@ -58,7 +59,8 @@ def test_rows_missing_inside_an_outage_count_against_coverage(truth):
     assert s["coverage"]["longest_gap"] == pytest.approx(30.1, abs=1e-9)
     assert s["outages"][0]["max_horizontal"] is None
     # the row at 119.9 s reaches 0.05 s into the window, the row at 150 s 0.15 s back into it
-    assert s["outages"][0]["coverage"] == pytest.approx(0.2 / 30.0, abs=1e-9)
+    assert s["outages"][0]["coverage"] == pytest.approx(
+        {"fraction": 0.2 / 30.0, "longest_gap": 30.0}, abs=1e-9)
 
 
 def test_solution_without_gnss_has_no_outage_scores(truth):
@@ -123,3 +125,21 @@ def test_sensor_errors_of_true_values_are_zero_and_of_zeros_the_truth_rms(truth)
     expected = np.sqrt(np.mean(true_gz[inside] ** 2))
     assert zeros["gyro_bias_z"]["rms"] == pytest.approx(expected, rel=1e-12)
     assert zeros["gyro_bias_z"]["final"] == pytest.approx(-true_gz[inside][-1], rel=1e-12)
+
+
+def test_end_error_needs_a_row_within_one_second_of_the_end(truth):
+    """The end error is the window's last row's, if it lies at most 1 s before the end; the
+    row at the end itself (after GNSS returned) never stands for it."""
+    every_2s = truth.iloc[::200].reset_index(drop=True)  # rows at 0, 2, 4, ... s
+    t = every_2s["t"].to_numpy()
+    east = np.where(t < 150.0, 0.1 * t, 0.0)  # the row at 150 s is back on the truth
+    sol = offset_solution(every_2s, dpos=(0.0, east, 0.0))
+    far, near, at_row = score_solution(  # the outages come sorted by their start
+        truth, events((120.0, 149.0), (100.0, 111.5), (140.0, 148.0)), sol)["outages"]
+    assert near["end_horizontal"] == pytest.approx(0.1 * 148.0, abs=1e-5)  # 1 s before
+    assert near["max_horizontal"] == pytest.approx(0.1 * 148.0, abs=1e-5)
+    assert far["end_horizontal"] is None and far["end_percent"] is None  # 1.5 s before
+    assert far["max_horizontal"] == pytest.approx(0.1 * 110.0, abs=1e-5)
+    assert far["coverage"]["longest_gap"] == pytest.approx(2.0, abs=1e-9)  # between rows
+    # a row at 148 s, the window's end, but the window's own last row is 2 s before it
+    assert at_row["end_horizontal"] is None

@@ -10,6 +10,7 @@ from scipy.stats import chi2
 
 from simulator.replay import run_estimator
 from simulator.scoring import plots
+from simulator.scoring.consistency import chi2_band
 from simulator.scoring.evaluate import score_solutions
 from simulator.scoring.report import write_report
 from tests.scoring_helpers import offset_solution
@@ -31,14 +32,19 @@ def test_report_of_a_raw_gnss_dataset_has_every_plot(evaluation, tmp_path):
                     "map_windows", "nees", "position_errors"]
     assert sorted(re.findall(r"\]\(plots/(\w+)\.png\)", text)) == pngs
     assert "## Degraded GNSS windows" in text and "coverage (fraction of the drive)" in text
-    # the tunnel outage row: gnss_only has its last extrapolated row there
+    # the tunnel outage row: gnss_only stops extrapolating 2 s after its last fix, so it has
+    # no row at the outage's end; its coverage of the outage is printed beside it
     row = next(line for line in text.splitlines() if line.startswith("| 1 | 73.000"))
     assert row.count("|") == 4 + 2 * 4 + 1
+    gnss_cells = [c.strip() for c in row.split("|")[9:13]]
+    tunnel = evaluation.results["gnss_only"].scores["outages"][0]
+    assert gnss_cells[:3] == ["no row", f"{tunnel['coverage']['fraction']:.3f}", "no row"]
 
 
 def test_nees_bounds_are_the_chi_square_95_percent_quantiles():
-    assert plots._NEES_BOUNDS == pytest.approx([chi2.ppf(0.025, 3), chi2.ppf(0.975, 3)])
-    assert plots._NEES_BOUNDS == pytest.approx([0.2158, 9.348], abs=1e-3)  # published table
+    for dim in (1, 2, 3):
+        assert chi2_band(dim) == pytest.approx([chi2.ppf(0.025, dim), chi2.ppf(0.975, dim)])
+    assert chi2_band(3) == pytest.approx([0.2158, 9.348], abs=1e-3)  # published table
 
 
 def test_lines_break_where_rows_are_missing():

@@ -50,6 +50,9 @@ def test_report_has_every_plot_and_every_number(evaluation, tmp_path):
             assert format_number(value) in text
     shifted = evaluation.results["shifted"].scores
     assert format_number(shifted["nees"]["position"]) in text
+    position = shifted["consistency"]["position"]
+    row = next(line for line in text.splitlines() if line.startswith("| shifted | position |"))
+    assert format_number(position["nees"]) in row and format_number(position["inside_95"]) in row
     assert format_number(shifted["runtime"]["realtime_factor"]) in text
     # the per-outage table: one row per outage, the drifting solution's end error 0.02 t
     rows = [line for line in text.splitlines() if re.match(r"\| [12] \|", line)]

@@ -1,0 +1,60 @@
+"""``fgo_lc`` and ``fgo_tc``, the GTSAM fixed-lag smoothers, on the quickstart drive: the loosely
+coupled one estimates the IMU's turn-on biases (against truth_sensors), follows the truth and
+claims north and down sigmas of the size of its errors; the tightly coupled one follows the
+truth and the receiver clock."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gtsam")
+
+
+@pytest.fixture(scope="module")
+def solved(quickstart):
+    from simulator import pipeline
+
+    solutions = pipeline.run_estimators(quickstart, ["fgo_lc", "fgo_tc", "gnss_only"])
+    return quickstart, solutions, pipeline.score(quickstart, solutions).scores()
+
+
+def test_estimates_the_turn_on_biases(solved):
+    dataset, solutions, _ = solved
+    frame = solutions["fgo_lc"][0]
+    truth = dataset.read("truth_sensors")
+    late = frame["t"].to_numpy() > 100.0
+    for axis in "xyz":
+        true = np.interp(frame["t"], truth["t"], truth[f"gyro_bias_{axis}"])[late]
+        assert np.sqrt(np.mean((frame[f"gyro_bias_{axis}"].to_numpy()[late] - true) ** 2)) \
+            < np.radians(0.1)  # of turn-on biases up to 1.3 deg/s
+        true = np.interp(frame["t"], truth["t"], truth[f"accel_bias_{axis}"])[late]
+        assert np.sqrt(np.mean((frame[f"accel_bias_{axis}"].to_numpy()[late] - true) ** 2)) \
+            < 0.05  # m/s^2, of turn-on biases up to 1.2 m/s^2
+
+
+def test_follows_the_truth_with_honest_position_sigmas(solved):
+    dataset, solutions, scores = solved
+    assert scores["fgo_lc"]["horizontal"]["rms"] < scores["gnss_only"]["horizontal"]["rms"] + 0.3
+    assert scores["fgo_lc"]["attitude"]["yaw_rms"] < 2.0
+    frame = solutions["fgo_lc"][0]
+    truth = dataset.read("truth")
+    late = frame["t"].to_numpy() > 60.0
+    north = np.radians(frame["lat"] - np.interp(frame["t"], truth["t"], truth["lat"])) * 6.371e6
+    down = -(frame["alt"] - np.interp(frame["t"], truth["t"], truth["alt"]))
+    for error, sigma in ((north, frame["std_n"]), (down, frame["std_d"])):
+        nse = float(np.mean((error.to_numpy()[late] / sigma.to_numpy()[late]) ** 2))
+        assert 0.3 < nse < 3.0
+
+
+def test_tightly_coupled_follows_the_truth_and_the_clock(solved):
+    dataset, solutions, scores = solved
+    assert scores["fgo_tc"]["horizontal"]["rms"] < 1.0
+    frame = solutions["fgo_tc"][0]
+    truth = dataset.read("truth_sensors")
+    late = frame["t"].to_numpy() > 60.0
+    drift = frame["clock_drift"] - np.interp(frame["t"], truth["t"], truth["clock_drift"])
+    bias = frame["clock_bias"] - np.interp(frame["t"], truth["t"], truth["clock_bias"])
+    assert abs(np.mean(drift[late])) < 0.2      # m/s, of a drift of 80 m/s
+    # the clock takes the ionosphere left after the broadcast model, common to all satellites
+    assert abs(np.mean(bias[late])) < 15.0 and np.std(bias[late]) < 3.0
