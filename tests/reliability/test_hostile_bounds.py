@@ -15,7 +15,7 @@ import pytest
 
 from simulator.faults.base import in_intervals
 from tests.reliability.checks import refused
-from tests.reliability.drives import straight_drive
+from tests.reliability.drives import shared_dataset, shared_dataset_copy, straight_drive  # noqa: F401 (fixtures)
 
 GNSS = "  gnss: {rate: 1, outputs: [fix]}\n"
 

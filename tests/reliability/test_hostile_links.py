@@ -19,7 +19,10 @@ from simulator.cli import main
 from simulator.errors import InputError
 from simulator.outputs import real_subfolder
 from tests.reliability.checks import refused, tree
-from tests.reliability.drives import straight_drive
+from tests.reliability.drives import (
+    shared_dataset,  # noqa: F401 (fixtures)
+    straight_drive,
+)
 
 SCENARIO = straight_drive(60, sensors="  imu: {preset: ideal, rate: 20}\n"
                                       "  gnss: {rate: 1, outputs: [fix]}\n")

@@ -15,6 +15,7 @@ from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.earth import geodetic_to_ecef
 from tests.reliability.checks import refused
+from tests.reliability.drives import shared_dataset  # noqa: F401 (fixtures)
 
 
 def _csv(dataset: Path, path: Path, rows: slice = slice(None), **changes) -> Path:
