@@ -8,7 +8,7 @@ A third-party package registers an estimator in its ``pyproject.toml``::
 
 Public functions
 ----------------
-get_estimator, list_estimators, name_problems, entry_problems.
+get_estimator, list_estimators, is_plugin_path, name_problems, entry_problems.
 """
 
 from __future__ import annotations
@@ -108,6 +108,13 @@ def get_estimator(name: str) -> type[Estimator]:
     if problems:
         raise InputError(problems[0] if len(problems) == 1 else "; ".join(problems))
     return cls
+
+
+def is_plugin_path(entry: Mapping[str, Any] | str) -> bool:
+    """Whether an entry names its class as ``module:Class`` (the user's own code), not a
+    built-in or an installed entry point."""
+    name = entry if isinstance(entry, str) else entry["name"]
+    return name not in BUILTINS and ":" in name
 
 
 def name_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:

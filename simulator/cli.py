@@ -72,18 +72,26 @@ def _command_name(argv: list[str]) -> str | None:
 def main(argv: list[str] | None = None) -> int:
     """The ``landnav`` program (the console script): run one command, return its exit code.
     Output into a pipe closed early (``landnav ... | head -1``) ends it quietly with code 1, as
-    Python's documentation advises, instead of a traceback."""
+    Python's documentation advises, instead of a traceback; a full or failing standard output
+    is one message and code 2; a closed one loses what is printed."""
     for name, value in BLAS_THREADS.items():
         os.environ.setdefault(name, value)
     argv = sys.argv[1:] if argv is None else argv
     command = _command_name(argv)
     args = build_parser(command).parse_args(argv)
+    if sys.stdout is None:  # started with its standard output closed: what it says is lost
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 (open to the end)
     try:
         code = _run(args)
         sys.stdout.flush()
     except BrokenPipeError:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write
         return 1
+    except OSError as exc:  # the standard output is full or failing (the files are written)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print(f"error: cannot write to the standard output: {exc.strerror or exc}",
+              file=sys.stderr)
+        return 2
     return code
 
 

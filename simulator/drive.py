@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 from simulator.errors import InputError
 from simulator.schema import Context
+from simulator.threads import one_blas_thread
 from simulator.timebase import parse_utc
 from simulator.trajectory import PROFILE_BUILDERS
 from simulator.trajectory.kinematics import Kinematics, kinematics_from_profile, truth_grid
@@ -68,6 +69,7 @@ def build_profile(scenario: dict, ctx: Context | None = None) -> RoadProfile | N
         raise InputError(str(exc)) from None
 
 
+@one_blas_thread
 def build_drive(scenario: dict, profile: RoadProfile | None = None) -> Drive:
     """The drive of a resolved scenario (of its already built ``profile`` when given)."""
     profile = build_profile(scenario) if profile is None else profile

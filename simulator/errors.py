@@ -2,7 +2,7 @@
 
 Public classes
 --------------
-Problem, InputError, Terminated.
+Problem, InputError, Terminated, refuse_undecodable.
 """
 
 from __future__ import annotations
@@ -43,3 +43,15 @@ class Terminated(BaseException):
     """The process was asked to stop (SIGTERM). Raised in the main thread by the command line's
     handler so that, as with Ctrl-C, every ``with`` block unwinds and removes its temporaries;
     the command line then exits with 143 (128 + SIGTERM)."""
+
+
+def refuse_undecodable(path: object, what: str = "name") -> None:
+    """Raise InputError for a path whose name is not valid text (bytes that are not UTF-8 come
+    in as lone surrogates): the file formats, the manifest and the messages need text names."""
+    text = str(path)
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        shown = text.encode("utf-8", "backslashreplace").decode("ascii", "backslashreplace")
+        raise InputError([Problem(shown, None, "", f"the {what} is not valid UTF-8 text; "
+                                  "rename it")]) from None

@@ -17,8 +17,8 @@ or the whole job into one directory: ``pipeline.run(scenario, "runs/quick")``.
 
 Public names
 ------------
-load_scenario, generate, estimate, run_estimators, score, write_report, run, RunResult,
-Solutions.
+load_scenario, check_estimators, generate, estimate, run_estimators, score, write_report, run,
+RunResult, Solutions.
 """
 
 from __future__ import annotations
@@ -30,19 +30,21 @@ from typing import Any
 
 import pandas as pd
 
-from estimators.registry import entry_problems
+from estimators.registry import entry_problems, is_plugin_path, name_problems
 from simulator import scenario as scenarios
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
 from simulator.html_report import write_html_report
+from simulator.isolated import needs_isolation, run_isolated
 from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
 from simulator.scenario import Scenario
 from simulator.scoring import report
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
 
-__all__ = ["NO_ESTIMATOR", "RunResult", "Solutions", "estimate", "generate", "load_scenario",
+__all__ = ["NO_ESTIMATOR", "RunResult", "Solutions", "check_estimators", "estimate", "generate",
+           "load_scenario",
            "run", "run_estimators", "score", "write_report"]
 
 # label -> (solution table, run information: label, name, runtime_s, realtime_factor; None for
@@ -54,42 +56,63 @@ NO_ESTIMATOR = ("No estimator was named in the scenario (its `estimators:` list 
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None,
-                  seed: int | None = None) -> Scenario:
+                  seed: int | None = None, import_plugins: bool = False) -> Scenario:
     """Read, override and validate a scenario file (``simulator.scenario.load_scenario``), then
     check each estimator entry against its class: the class imports (through the registry) and
-    its ``config`` fits the class's defaults. Every problem is raised in one InputError."""
+    its ``config`` fits the class's defaults. A ``module:Class`` entry (the user's own code) is
+    checked for its form only, and imported only with ``import_plugins`` (``run``, a campaign,
+    ``validate --import-plugins``): validating a scenario runs no code it names. Every problem
+    is raised in one InputError."""
     scenario = scenarios.load_scenario(path, overrides, seed)
-    problems = [Problem(str(scenario.path), None, f"estimators.{i}.{key}", message)
-                for i, entry in enumerate(scenario.data["estimators"])
-                for key, message in entry_problems(entry)]
-    if problems:
-        raise InputError(problems)
+    check_estimators(scenario, import_plugins)
     return scenario
 
 
+def check_estimators(scenario: Scenario, import_plugins: bool = True) -> None:
+    """Raise InputError with the problems of the scenario's estimator entries (the class and
+    its ``config``); ``module:Class`` entries are imported only with ``import_plugins``."""
+    problems = [Problem(str(scenario.path), None, f"estimators.{i}.{key}", message)
+                for i, entry in enumerate(scenario.data["estimators"])
+                for key, message in (entry_problems(entry)
+                                     if import_plugins or not is_plugin_path(entry)
+                                     else name_problems(entry))]
+    if problems:
+        raise InputError(problems)
+
+
 def generate(scenario: Scenario, out_dir: str | Path, force: bool = False,
-             show_progress: bool = False) -> Dataset:
+             show_progress: bool = False, honour_lock: bool = True) -> Dataset:
     """Write a scenario's dataset into ``out_dir`` (atomically; an existing directory only with
-    ``force``) and open it."""
+    ``force``, and only one landnav wrote) and open it. ``honour_lock=False`` only for a
+    campaign's run writing into the campaign's own folder."""
     return open_dataset(generate_dataset(scenario, Path(out_dir), force=force,
-                                         show_progress=show_progress))
+                                         show_progress=show_progress, honour_lock=honour_lock))
 
 
 def estimate(dataset: Dataset, entry: Mapping[str, Any] | str,
-             show_progress: bool = False) -> tuple[pd.DataFrame, dict]:
+             show_progress: bool = False, time_limit_s: float | None = None,
+             isolate: bool = True) -> tuple[pd.DataFrame, dict]:
     """Replay ``dataset`` causally into one estimator (a scenario ``estimators:`` entry: a name,
     ``module:Class``, or a mapping with ``name``, ``label``, ``init`` and ``config``); its
-    solution table and run information (``simulator.replay.run_estimator``)."""
+    solution table and run information (``simulator.replay.run_estimator``).
+
+    An estimator that is not a built-in, or any with ``time_limit_s``, runs in a child process
+    (``simulator.isolated``): one that exits, crashes or runs past the limit is an InputError.
+    ``isolate=False`` runs it here: a campaign's worker, itself a process of its own whose
+    death fails only its run, bounds it with its own timer (``simulator.campaign.worker``)."""
+    if isolate and needs_isolation(entry, time_limit_s):
+        return run_isolated(dataset.path, entry, time_limit_s)
     return run_estimator(dataset, entry, show_progress=show_progress)
 
 
 def run_estimators(dataset: Dataset, entries: Iterable[Mapping[str, Any] | str],
-                   show_progress: bool = False) -> Solutions:
+                   show_progress: bool = False, time_limit_s: float | None = None
+                   ) -> Solutions:
     """Every estimator entry over ``dataset``, keyed by label; two entries with one label are
     refused (give a label)."""
     out: Solutions = {}
     for i, entry in enumerate(entries):
-        frame, info = estimate(dataset, entry, show_progress)
+        frame, info = estimate(dataset, entry, show_progress, time_limit_s)
         if info["label"] in out:
             raise InputError(f"estimators.{i}: label {info['label']!r} is used twice; give a "
                              "label")
@@ -129,7 +152,8 @@ def run(scenario: Scenario, out_dir: str | Path, force: bool = False,
     the report. A label that cannot name a file is refused before anything is written."""
     out = Path(out_dir)
     entries = scenario.data["estimators"]
-    with atomic_output_dir(out, force) as tmp:
+    check_estimators(scenario)  # the run imports them anyway: before anything is written
+    with atomic_output_dir(out, force, scenario.input_files) as tmp:
         dataset = generate(scenario, tmp / "dataset", show_progress=show_progress)
         (tmp / "solutions").mkdir()
         solutions = run_estimators(dataset, entries, show_progress)

@@ -47,8 +47,13 @@ from simulator.earth import (
 from simulator.errors import InputError, Problem, Terminated
 from simulator.outputs import atomic_output_file
 from simulator.progress import progress
+from simulator.threads import one_blas_thread
 
 STREAM_ORDER = ("imu", "odometer", "baro", "mag", "gnss_fix", "gnss_raw")
+SPAN_MARGIN_S = 1.0  # how far a stream's times may reach beyond the truth's
+# solution rows one replay may ask for (about 30 columns of 8 bytes each: 2.4 GB at most);
+# 28 h at 100 Hz, the longest drive a scenario may describe
+MAX_SOLUTION_ROWS = 10_000_000
 
 
 def _stream_rank(name: str) -> tuple[int, str]:
@@ -200,7 +205,21 @@ def _load_streams(dataset: Dataset, cls: type[Estimator], label: str) -> list[_S
     names = [s for s in dict.fromkeys((*cls.needs, *cls.uses))
              if dataset.has(s) and s not in lacks]
     names.sort(key=_stream_rank)  # scoring-only streams were refused by get_estimator
-    return [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
+    streams = [_Stream(s, dataset.read(s), _units(dataset, s), dataset.path) for s in names]
+    # a generated dataset's streams lie within its truth; a recording's reference may cover
+    # less than its sensors did (the solution-row bound still holds its gaps)
+    if dataset.has("truth") and dataset.manifest.get("reference") is not True:
+        truth_t = dataset.read("truth", ["t"])["t"].to_numpy(dtype=float)
+        span = (truth_t[0], truth_t[-1]) if len(truth_t) else (0.0, 0.0)
+        for stream in streams:
+            if len(stream.times) and (stream.times[0] < span[0] - SPAN_MARGIN_S
+                                      or stream.times[-1] > span[1] + SPAN_MARGIN_S):
+                raise InputError([Problem(str(dataset.path), None, stream.name,
+                                          f"times run from {stream.times[0]:.6g} s to "
+                                          f"{stream.times[-1]:.6g} s, outside the drive "
+                                          f"({span[0]:.6g} s to {span[1]:.6g} s in the truth): "
+                                          "shifted, or in another unit than seconds?")])
+    return streams
 
 
 def imu_output(dataset: Dataset) -> str | None:
@@ -225,6 +244,7 @@ def _units(dataset: Dataset, name: str) -> dict[str, str]:
     return units
 
 
+@one_blas_thread
 def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                   show_progress: bool = True) -> tuple[pd.DataFrame, dict]:
     """Replay a dataset causally into one estimator.
@@ -281,6 +301,13 @@ def run_estimator(dataset: Dataset, entry: Mapping[str, Any] | str, *,
                 raise
             raise failure from None
         gnss = [i for i, s in enumerate(streams) if s.name in GNSS_STREAMS]
+        rows = (t[-1] - t[0]) * float(cls.output_rate_hz) + np.isin(sid, gnss).sum()
+        if rows > MAX_SOLUTION_ROWS:
+            raise InputError([Problem(str(dataset.path), None, "", f"the streams span "
+                                      f"{t[-1] - t[0]:.6g} s: at {cls.output_rate_hz:g} Hz "
+                                      f"that is {rows:.3g} solution rows, more than one replay "
+                                      f"may hold ({MAX_SOLUTION_ROWS:,}); a gap in the times, "
+                                      "or a drive to split into shorter datasets")])
         out_t, upto = output_times(t, sid, gnss, float(cls.output_rate_hz))
         out = np.full((len(out_t), len(cls.output_columns)), np.nan)
         kept = np.zeros(len(out_t), dtype=bool)
@@ -403,7 +430,7 @@ def write_solution(frame: pd.DataFrame, path: str | Path, force: bool = False,
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     units = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
     metadata = None if uses_gnss is None else {USES_GNSS_KEY: "true" if uses_gnss else "false"}
-    with atomic_output_file(path, force, inputs) as tmp:
+    with atomic_output_file(path, force, inputs, "parquet") as tmp:
         write_table(frame, tmp, {c: units.get(c, "") for c in frame.columns}, metadata)
 
 

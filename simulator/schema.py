@@ -76,6 +76,11 @@ class Field:
         return self.check(self.default, path, ctx)
 
 
+# no scenario quantity comes near this in SI units (1e12 m is 7 astronomical units, 1e12 s is
+# 31 700 years); larger values only overflow the arithmetic
+MAX_MAGNITUDE = 1e12
+
+
 class Number(Field):
     """A real number in ``unit`` (SI), or a string with any unit of the same dimension.
 
@@ -114,6 +119,9 @@ class Number(Field):
             return x
         if x != x or x in (float("inf"), float("-inf")):
             return ctx.error(path, f"expected a finite number, got {value!r}")
+        if abs(x) > MAX_MAGNITUDE:
+            return ctx.error(path, f"{value!r} is beyond any value a scenario describes "
+                                   f"(|x| <= {MAX_MAGNITUDE:g} in SI units)")
         unit = f" {self.unit}" if self.unit else ""
         if self.min is not None and x < self.min:
             return ctx.error(path, f"{value!r} is below the minimum {self.min:g}{unit}")
@@ -181,6 +189,9 @@ class Boolean(Field):
         return value
 
 
+LATEST_TIME = dt.datetime(2200, 1, 1)  # the latest start a scenario may give
+
+
 class DateTime(Field):
     """An ISO 8601 UTC time, not before ``earliest`` (ISO text) if given; resolved to text
     ``YYYY-MM-DDTHH:MM:SS(.ffffff)Z``."""
@@ -201,7 +212,14 @@ class DateTime(Field):
         else:
             return ctx.error(path, f"expected an ISO 8601 UTC time, got {value!r}")
         if stamp.tzinfo is not None:
-            stamp = stamp.astimezone(dt.UTC).replace(tzinfo=None)
+            try:
+                stamp = stamp.astimezone(dt.UTC).replace(tzinfo=None)
+            except OverflowError:
+                stamp = dt.datetime.max
+        if stamp >= LATEST_TIME:
+            return ctx.error(path, f"{value!r} is after {LATEST_TIME.isoformat()}Z: a drive "
+                                   "starts before then (GPS weeks, leap seconds and the file "
+                                   "formats' year fields are defined up to there)")
         if self.earliest is not None and stamp < self.earliest:
             return ctx.error(path, f"{stamp.isoformat()}Z is before {self.earliest.isoformat()}Z"
                                    " (the GPS epoch: GPS time and broadcast orbits start there)")

@@ -9,6 +9,8 @@ CampaignOptions, CampaignResult, run_campaign.
 
 from __future__ import annotations
 
+import functools
+import json
 import traceback
 from dataclasses import dataclass
 from pathlib import Path
@@ -30,10 +32,13 @@ from simulator.campaign.store import (
 )
 from simulator.campaign.summary import summarise
 from simulator.campaign.worker import STATUS_OK, execute_run, failed_rows
+from simulator.errors import InputError, Problem
+from simulator.outputs import os_problem, refuse_inside, replace_file
 from simulator.progress import progress
-from simulator.scoring.evaluate import write_scores
 
 SUMMARY_FILE = "summary.json"
+# runs one campaign plans over all sweep points (its task list, about 2 kB a task, is in memory)
+MAX_TASKS = 1_000_000
 DATASETS = "datasets"  # sub-folder of the kept datasets (--keep-datasets)
 
 
@@ -49,6 +54,7 @@ class CampaignOptions:
     keep_datasets: bool = False
     retry_failed: bool = False
     show_progress: bool = True
+    time_limit_s: float | None = None  # per estimator of a run
 
 
 @dataclass(frozen=True)
@@ -74,17 +80,28 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
     Raises
     ------
     InputError
-        ``out`` cannot be used (another campaign without ``force``, or a campaign that another
-        process is running into it), or the scheduler does not answer; nothing is written
-        then.
+        ``out`` cannot be used (another campaign without ``force``, a campaign that another
+        process is running into it, or a folder holding the scenario's files), or the
+        scheduler does not answer; nothing is written then.
     """
     out = Path(out)
+    tasks = options.runs * len(plan.points)
+    if tasks > MAX_TASKS:
+        raise InputError([Problem("landnav campaign", None, "--runs",
+                                  f"{options.runs:,} runs x {len(plan.points):,} sweep points is "
+                                  f"{tasks:,} runs, more than one campaign plans "
+                                  f"({MAX_TASKS:,}); split the sweep or the seeds into "
+                                  "several campaigns")])
+    refuse_inside(out, plan.base.input_files)  # --force would remove the scenario
     fingerprint, record = plan.fingerprint(), plan.record()
     check_campaign_dir(out, record, fingerprint, options.force)  # refused: nothing written
     with campaign_lock(out):
         # checked again: another campaign may have written the folder in between
         check_campaign_dir(out, record, fingerprint, options.force)
-        return _run_locked(plan, out, options, fingerprint, record)
+        try:
+            return _run_locked(plan, out, options, fingerprint, record)
+        except OSError as exc:  # no space, a read-only volume: the finished runs stay
+            raise os_problem(out, exc) from None
 
 
 def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerprint: str,
@@ -96,7 +113,8 @@ def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerp
         init_campaign_dir(out, record, fingerprint, options.force)
         done = done_parts(out, options.retry_failed)
         todo = [t for t in tasks if t.part not in done]
-        finished = completed(executor, in_flight, execute_run, todo)
+        run = functools.partial(execute_run, time_limit_s=options.time_limit_s)
+        finished = completed(executor, in_flight, run, todo)
         for task, future in progress(finished, "runs", options.show_progress, len(todo)):
             try:
                 rows = future.result()
@@ -109,7 +127,8 @@ def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerp
               "sweep": plan.sweep_values(),
               "labels": plan.labels, "fingerprint": fingerprint}
     summary = summarise(runs, plan.labels, [p.values for p in plan.points], header)
-    write_scores(summary, out / SUMMARY_FILE, force=True)  # the campaign owns its folder
+    text = json.dumps(summary, indent=2, allow_nan=False) + "\n"
+    replace_file(out / SUMMARY_FILE, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     write_campaign_report(out, runs, summary)
     return CampaignResult(runs, len(todo), len(tasks) - len(todo))
 

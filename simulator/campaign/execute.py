@@ -19,12 +19,15 @@ from __future__ import annotations
 import concurrent.futures as cf
 import contextlib
 import multiprocessing
+import os
 import re
 import socket
+import threading
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
 from simulator.errors import InputError, Problem
+from simulator.isolated import watch_parent
 
 T = TypeVar("T")
 _WORKER_MODULE = "simulator.campaign.worker"  # preloaded by the forkserver
@@ -43,7 +46,8 @@ class _RenewingPool(cf.Executor):
         self.pool = self._new()
 
     def _new(self) -> cf.ProcessPoolExecutor:
-        return cf.ProcessPoolExecutor(self.workers, mp_context=self.context)
+        return cf.ProcessPoolExecutor(self.workers, mp_context=self.context,
+                                      initializer=watch_parent, initargs=(os.getpid(),))
 
     def __exit__(self, kind: type | None, *rest: object) -> bool:
         if kind is None:
@@ -100,13 +104,7 @@ def open_executor(workers: int, scheduler: str | None, timeout_s: float
             yield executor, workers
         return
     _check_scheduler(scheduler, timeout_s)
-    from distributed import Client
-
-    try:
-        client = Client(scheduler, timeout=timeout_s, set_as_default=False)
-    except (OSError, ValueError, TypeError) as exc:
-        raise InputError([Problem("--scheduler", None, scheduler, f"no Dask scheduler answers "
-                                  f"within {timeout_s:g} s ({exc})")]) from None
+    client = _connect(scheduler, timeout_s)
     try:
         slots = max(1, sum(client.nthreads().values()))
         yield client.get_executor(pure=False), 2 * slots
@@ -130,6 +128,31 @@ def _check_scheduler(address: str, timeout_s: float) -> None:
     except OSError as exc:
         raise InputError([Problem("--scheduler", None, address, f"nothing answers there "
                                   f"within {timeout_s:g} s ({exc.strerror or exc})")]) from None
+
+
+def _connect(scheduler: str, timeout_s: float) -> Any:
+    """A Dask client of ``scheduler``, made in a helper thread that is given ``timeout_s``: a
+    port that answers but is not a Dask scheduler never completes the handshake, and the
+    client's own timeout does not cover that wait."""
+    from distributed import Client
+
+    made: dict[str, Any] = {}
+
+    def connect() -> None:
+        try:
+            made["client"] = Client(scheduler, timeout=timeout_s, set_as_default=False)
+        except Exception as exc:  # reported below, in the caller's thread
+            made["error"] = exc
+
+    thread = threading.Thread(target=connect, name="landnav-dask-connect", daemon=True)
+    thread.start()
+    thread.join(timeout_s)
+    if "client" in made:
+        return made["client"]
+    reason = (f"{type(made['error']).__name__}: {made['error']}" if "error" in made
+              else "it does not answer as a Dask scheduler")
+    raise InputError([Problem("--scheduler", None, scheduler, f"no Dask scheduler answers "
+                              f"within {timeout_s:g} s ({reason})")])
 
 
 def completed(executor: cf.Executor, in_flight: int, fn: Callable[[T], Any], tasks: Iterable[T]

@@ -20,6 +20,7 @@ import dataclasses
 import hashlib
 import itertools
 import json
+import math
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -30,6 +31,7 @@ from simulator.errors import InputError, Problem
 from simulator.pipeline import load_scenario
 from simulator.scenario import Scenario
 
+MAX_SWEEP_POINTS = 1000  # points of the cartesian product of --sweep (each validated here)
 PLAN_FORMAT = "landnav-campaign/1"  # written into DIR/campaign.json
 _OPENING, _CLOSING = "[{(", "]})"
 
@@ -198,7 +200,7 @@ def _validate(path: Path, overrides: list[str], seed: int | None, swept: dict[st
     """Load a sweep point. Its problems name the sweep point (the scenario without it is
     valid), and those on a swept key come from ``--sweep``, not ``--set``."""
     try:
-        return load_scenario(path, overrides, seed)
+        return load_scenario(path, overrides, seed, import_plugins=True)
     except InputError as exc:
         where = ", ".join(f"{k}={v}" for k, v in swept.items())
         problems = []
@@ -229,7 +231,7 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
         a scenario without estimators.
     """
     path = Path(path)
-    base = load_scenario(path, overrides, seed)
+    base = load_scenario(path, overrides, seed, import_plugins=True)
     if not base.data["estimators"]:
         raise InputError([Problem(str(path), None, "estimators", "the scenario names no "
                                   "estimator: a campaign scores estimators; add some")])
@@ -240,6 +242,12 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
         if s.key in set_keys or s.key in [x.key for x in sweeps[:i]]:
             problems.append(Problem(str(path), "--sweep", s.key, "the key is also given by "
                                     "--set or another --sweep; give each key once"))
+    n_points = math.prod(len(s.texts) for s in sweeps)
+    if n_points > MAX_SWEEP_POINTS:
+        problems.append(Problem(str(path), "--sweep", ", ".join(s.key for s in sweeps),
+                                f"{n_points:,} sweep points, more than one campaign validates "
+                                f"({MAX_SWEEP_POINTS:,}: each is a whole scenario built and "
+                                "checked); sweep fewer values or split the campaign"))
     if problems:
         raise InputError(problems)
     for s in sweeps:  # each value alone first: one message per bad value

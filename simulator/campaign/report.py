@@ -16,9 +16,7 @@ write_campaign_report.
 
 from __future__ import annotations
 
-import os
 import textwrap
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +24,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from simulator.campaign.worker import STATUS_FAILED, STATUS_OK
+from simulator.outputs import real_subfolder, replace_file
 from simulator.scoring.report import PLOTS, format_number, markdown_table
 
 # (column, title) of the summary table and of the plots, in order
@@ -105,15 +104,6 @@ def _failure_lines(runs: pd.DataFrame, keys: list[str]) -> list[str]:
             *markdown_table(["run", "seed", *keys, "label", "error"], rows)]
 
 
-def _replace(path: Path, write: Callable[[Path], object]) -> None:
-    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
-
-
 def _group_runs(runs: pd.DataFrame, group: dict) -> pd.DataFrame:
     """The successful runs of one label and sweep point."""
     at = (runs["label"] == group["label"]) & (runs["status"] == STATUS_OK)
@@ -159,13 +149,13 @@ def _box_plot(runs: pd.DataFrame, summary: dict, column: str, title: str, path: 
            title=textwrap.fill(f"{title} over the runs (runs without a value: missing)",
                                int(8 * width_in)))
     ax.grid(axis="y", alpha=0.3)
-    _replace(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    replace_file(path, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
 
 def write_campaign_report(directory: Path, runs: pd.DataFrame, summary: dict) -> Path:
     """Write ``report.md`` and its plots into ``directory``; return the report's path."""
     directory = Path(directory)
-    (directory / PLOTS).mkdir(exist_ok=True)
+    real_subfolder(directory / PLOTS)
     keys = list(summary["sweep"])
     ok = int((runs["status"] == STATUS_OK).sum())
     first, n = summary["base_seed"], summary["runs"]
@@ -187,5 +177,5 @@ def write_campaign_report(directory: Path, runs: pd.DataFrame, summary: dict) ->
             lines += [f"## {title[0].upper()}{title[1:]}", "",
                       f"![{title}]({PLOTS}/{name}.png)", ""]
     path = directory / "report.md"
-    _replace(path, lambda tmp: tmp.write_text("\n".join(lines), encoding="utf-8"))
+    replace_file(path, lambda tmp: tmp.write_text("\n".join(lines), encoding="utf-8"))
     return path

@@ -30,6 +30,7 @@ from simulator.campaign.plan import PLAN_FORMAT
 from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, score_unit
 from simulator.dataset.parquet import read_table, write_table
 from simulator.errors import InputError, Problem
+from simulator.outputs import make_parent, open_lock_file, real_subfolder, replace_file
 
 CAMPAIGN_FILE = "campaign.json"
 PARTS = "parts"  # sub-folder with one Parquet file per finished run
@@ -66,36 +67,33 @@ def campaign_lock(out: Path) -> Iterator[None]:
     except ImportError:  # not POSIX
         yield
         return
-    out.parent.mkdir(parents=True, exist_ok=True)
+    make_parent(out)
     path = out.parent / f".{out.name}.lock"
     while True:
-        handle = open(path, "a+", encoding="utf-8")  # held across the yield
+        fd = open_lock_file(path)  # never through a link planted at that name
         try:
-            fcntl.flock(handle, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            handle.seek(0)
-            holder = handle.read().strip() or "?"
-            handle.close()
+            holder = os.read(fd, 32).decode(errors="replace").strip() or "?"
+            os.close(fd)
             raise InputError([Problem(str(out), None, "", f"another landnav campaign (process "
                                       f"{holder}) is writing this folder; wait for it to end "
                                       "or choose another -o DIR")]) from None
         try:
-            same = os.stat(path).st_ino == os.fstat(handle.fileno()).st_ino
+            same = os.stat(path, follow_symlinks=False).st_ino == os.fstat(fd).st_ino
         except FileNotFoundError:
             same = False
         if same:
             break
-        handle.close()  # the holder removed it between our open and our lock: take the new one
+        os.close(fd)  # the holder removed it between our open and our lock: take the new one
     try:
-        handle.seek(0)
-        handle.truncate()
-        handle.write(f"{os.getpid()}\n")
-        handle.flush()
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
         yield
     finally:
         path.unlink(missing_ok=True)
-        fcntl.flock(handle, fcntl.LOCK_UN)
-        handle.close()
+        fcntl.flock(fd, fcntl.LOCK_UN)
+        os.close(fd)
 
 
 def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -> None:
@@ -111,6 +109,9 @@ def check_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) -
         ``out`` is a file, a folder that is not a campaign, or a campaign of another plan
         without ``force`` (naming what differs).
     """
+    if out.is_symlink() and not out.exists():
+        raise InputError([Problem(str(out), None, "", "is a dangling symbolic link; remove it "
+                                  "or choose another -o DIR")])
     if out.exists() and not out.is_dir():
         raise InputError([Problem(str(out), None, "", "exists and is not a directory")])
     if not out.exists() or not any(out.iterdir()):
@@ -131,13 +132,13 @@ def init_campaign_dir(out: Path, record: dict, fingerprint: str, force: bool) ->
     """Create (or, with ``force``, recreate) the folder and write ``campaign.json``."""
     if force and out.exists():
         shutil.rmtree(out)
-    (out / PARTS).mkdir(parents=True, exist_ok=True)
+    out.mkdir(parents=True, exist_ok=True)
+    real_subfolder(out / PARTS)
     if _stored(out) is None:
         text = json.dumps({"format": PLAN_FORMAT, "fingerprint": fingerprint, **record},
                           indent=2, default=str)
-        tmp = out / f".{CAMPAIGN_FILE}.tmp-{os.getpid()}"
-        tmp.write_text(text + "\n", encoding="utf-8")
-        os.replace(tmp, out / CAMPAIGN_FILE)
+        replace_file(out / CAMPAIGN_FILE,
+                     lambda tmp: tmp.write_text(text + "\n", encoding="utf-8"))
 
 
 def _part_path(out: Path, part: str) -> Path:
@@ -162,12 +163,8 @@ def done_parts(out: Path, retry_failed: bool = False) -> set[str]:
 def write_frame(frame: pd.DataFrame, path: Path) -> None:
     """Write a runs table as Parquet (each score's unit in its field metadata) under a
     temporary name, then rename it into place."""
-    tmp = path.parent / f".{path.name}.tmp-{os.getpid()}"
-    try:
-        write_table(frame, tmp, {c: score_unit(c) for c in frame.columns})
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+    replace_file(path, lambda tmp: write_table(frame, tmp,
+                                               {c: score_unit(c) for c in frame.columns}))
 
 
 def write_part(out: Path, part: str, rows: list[dict]) -> None:

@@ -9,13 +9,18 @@ and ``outages.missing``.
 
 Public names
 ------------
-STATUS_OK, STATUS_FAILED, RUN_COLUMNS, flatten_scores, score_unit, execute_run, failed_rows.
+STATUS_OK, STATUS_FAILED, RUN_COLUMNS, flatten_scores, score_unit, execute_run, failed_rows,
+time_limit, TimeLimitExceeded.
 """
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import tempfile
+import threading
 import traceback
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -125,16 +130,18 @@ def failed_rows(task: RunTask, error: str) -> list[dict[str, Any]]:
             for label in entry_labels(task.scenario.data["estimators"])]
 
 
-def _score_all(task: RunTask, dataset_dir: Path) -> list[dict[str, Any]]:
+def _score_all(task: RunTask, dataset_dir: Path, time_limit_s: float | None
+               ) -> list[dict[str, Any]]:
     labels = entry_labels(task.scenario.data["estimators"])
     try:
-        dataset = pipeline.generate(task.scenario, dataset_dir, force=True)
+        dataset = pipeline.generate(task.scenario, dataset_dir, force=True, honour_lock=False)
     except Exception:
         return failed_rows(task, traceback.format_exc())
     rows = []
     for label, entry in zip(labels, task.scenario.data["estimators"], strict=True):
         try:
-            frame, info = pipeline.estimate(dataset, entry)
+            with time_limit(time_limit_s, label):
+                frame, info = pipeline.estimate(dataset, entry, isolate=False)
             scores = pipeline.score(dataset, {label: (frame, info)}).scores()[label]
             rows.append(_row(task, label, STATUS_OK, flatten_scores(scores)))
         except Exception:
@@ -142,12 +149,39 @@ def _score_all(task: RunTask, dataset_dir: Path) -> list[dict[str, Any]]:
     return rows
 
 
-def execute_run(task: RunTask) -> list[dict[str, Any]]:
+class TimeLimitExceeded(Exception):
+    """An estimator ran past the campaign's ``--time-limit``."""
+
+
+@contextlib.contextmanager
+def time_limit(seconds: float | None, label: str) -> Iterator[None]:
+    """Raise ``TimeLimitExceeded`` in the block after ``seconds`` (a SIGALRM timer: a local
+    worker runs its tasks in its main thread; elsewhere, as in a Dask worker's threads, there
+    is no limit)."""
+    if seconds is None or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def expire(signum: int, frame: object) -> None:
+        raise TimeLimitExceeded(f"estimator {label!r} did not finish within the time limit "
+                                f"of {seconds:g} s")
+
+    previous = signal.signal(signal.SIGALRM, expire)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
+def execute_run(task: RunTask, time_limit_s: float | None = None) -> list[dict[str, Any]]:
     """Run one campaign run; never raises for a failure inside the run.
 
     Parameters
     ----------
     task : the run (its scenario already carries the run's seed and sweep values).
+    time_limit_s : how long each estimator may run, s (None: no limit).
 
     Returns
     -------
@@ -155,6 +189,6 @@ def execute_run(task: RunTask) -> list[dict[str, Any]]:
     (none when failed) and ``error`` (the traceback, or "").
     """
     if task.keep is not None:
-        return _score_all(task, Path(task.keep))
+        return _score_all(task, Path(task.keep), time_limit_s)
     with tempfile.TemporaryDirectory(prefix="landnav-run-") as tmp:
-        return _score_all(task, Path(tmp) / "dataset")
+        return _score_all(task, Path(tmp) / "dataset", time_limit_s)

@@ -9,7 +9,7 @@ import os
 from pathlib import Path
 
 from simulator.commands import SUMMARIES
-from simulator.commands.options import add_scenario_options, worker_problems
+from simulator.commands.options import add_scenario_options, check_time_limit, worker_problems
 from simulator.errors import InputError, Problem
 
 
@@ -48,11 +48,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "otherwise)")
     p.add_argument("--retry-failed", action="store_true",
                    help="when resuming, compute the failed runs again")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="how long each estimator of a run may take; past it the run's row "
+                        "fails and the campaign goes on (local workers; default: no limit)")
     add_scenario_options(p)
     p.set_defaults(run=run)
 
 
 MAX_RUNS = 1_000_000  # seeds per sweep point one campaign plans (its task list is in memory)
+MAX_SCHEDULER_TIMEOUT_S = 3600.0
 
 
 def _check_counts(args: argparse.Namespace) -> int:
@@ -63,9 +67,10 @@ def _check_counts(args: argparse.Namespace) -> int:
                                 f"must be between 1 and {MAX_RUNS:,}, got {args.runs:,}; "
                                 "split a larger study into campaigns"))
     problems += worker_problems("campaign", args.workers, args.scheduler)
-    if args.scheduler_timeout <= 0:
+    if not 0 < args.scheduler_timeout <= MAX_SCHEDULER_TIMEOUT_S:  # nan and inf included
         problems.append(Problem("landnav campaign", None, "--scheduler-timeout",
-                                f"must be positive, got {args.scheduler_timeout}"))
+                                f"must be a number of seconds in (0, "
+                                f"{MAX_SCHEDULER_TIMEOUT_S:g}], got {args.scheduler_timeout}"))
     if problems:
         raise InputError(problems)
     return args.workers or os.cpu_count() or 1
@@ -76,11 +81,13 @@ def run(args: argparse.Namespace) -> int:
     from simulator.campaign.plan import plan_campaign
 
     workers = _check_counts(args)
+    check_time_limit(args.time_limit, "campaign")
     plan = plan_campaign(args.scenario, args.overrides, args.seed, args.sweep)
     options = CampaignOptions(
         runs=args.runs, workers=workers, scheduler=args.scheduler,
         scheduler_timeout_s=args.scheduler_timeout, force=args.force,
-        keep_datasets=args.keep_datasets, retry_failed=args.retry_failed)
+        keep_datasets=args.keep_datasets, retry_failed=args.retry_failed,
+        time_limit_s=args.time_limit)
     out = Path(args.output)
     result = run_campaign(plan, out, options)  # SIGTERM and Ctrl-C: the CLI's handlers
     n_runs = len(result.runs) // max(1, len(plan.labels))

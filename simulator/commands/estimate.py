@@ -28,11 +28,14 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "(m/s), attitude_error=[roll,pitch,yaw] (deg), heading_error=DEG")
     p.add_argument("--label", default=None, help="solution label (default: the name)")
     p.add_argument("--force", action="store_true", help="overwrite an existing SOLUTION file")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="stop the estimator after this long (it then runs in its own process, "
+                        "as every estimator that is not a built-in does) and exit 2")
     p.set_defaults(run=run)
 
 
 def _pairs(items: list[str], option: str) -> dict:
-    import yaml
+    from simulator.scenario.yamlio import load_value
 
     out: dict = {}
     problems = []
@@ -41,10 +44,7 @@ def _pairs(items: list[str], option: str) -> dict:
         if not sep or not key.strip():
             problems.append(Problem(option, None, text, "expected key=value"))
             continue
-        try:
-            out[key.strip()] = yaml.safe_load(raw) if raw.strip() else ""
-        except yaml.YAMLError:
-            out[key.strip()] = raw
+        out[key.strip()] = load_value(raw, f"{option} {key.strip()}")
     if problems:
         raise InputError(problems)
     return out
@@ -73,12 +73,15 @@ def _entry(args: argparse.Namespace) -> dict:
 
 def run(args: argparse.Namespace) -> int:
     from simulator import pipeline
+    from simulator.commands.options import check_time_limit
     from simulator.dataset.io import open_dataset
     from simulator.replay import write_solution
 
     entry = _entry(args)
+    check_time_limit(args.time_limit, "estimate")
     dataset = open_dataset(args.dataset)
-    solution, info = pipeline.estimate(dataset, entry, show_progress=True)
+    solution, info = pipeline.estimate(dataset, entry, show_progress=True,
+                                       time_limit_s=args.time_limit)
     write_solution(solution, args.output, args.force, [dataset.path],
                    uses_gnss=info["uses_gnss"])
     compiled = (f" (and {info['compile_s']:.1f} s compiling numba kernels, not counted)"

@@ -35,7 +35,7 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from simulator.dataset.export import export_nmea, export_rinex
+    from simulator.dataset.export import check_export, export_nmea, export_rinex
     from simulator.dataset.io import open_dataset
 
     if not args.rinex and not args.nmea and not args.mcap:
@@ -45,6 +45,8 @@ def run(args: argparse.Namespace) -> int:
         raise InputError([Problem("landnav export", None, "--solution",
                                   "solutions go into a ROS 2 bag: give --mcap FILE too")])
     dataset = open_dataset(args.dataset)
+    # refused before anything is written
+    check_export(dataset, args.rinex, args.nmea, args.force)
     if args.rinex:
         obs, nav = export_rinex(dataset, args.rinex, args.force, option="--rinex")
         base = obs.with_name(f"{obs.stem}_base.obs")

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from simulator.errors import Problem
+from simulator.errors import InputError, Problem
 
 
 def add_scenario_options(parser: argparse.ArgumentParser) -> None:
@@ -27,3 +27,14 @@ def worker_problems(command: str, workers: int | None, scheduler: str | None) ->
         return [Problem(f"landnav {command}", None, "--workers",
                         f"must be at least 1, got {workers}")]
     return []
+
+
+MAX_TIME_LIMIT_S = 7 * 86400.0
+
+
+def check_time_limit(seconds: float | None, command: str) -> None:
+    """Refuse a ``--time-limit`` that is not a number of seconds in (0, a week] (nan, inf)."""
+    if seconds is not None and not 0 < seconds <= MAX_TIME_LIMIT_S:
+        raise InputError([Problem(f"landnav {command}", None, "--time-limit",
+                                  f"must be a number of seconds in (0, {MAX_TIME_LIMIT_S:g}], "
+                                  f"got {seconds}")])

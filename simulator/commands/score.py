@@ -76,9 +76,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError([Problem(args.dataset, None, "", "nothing to score: give --solution "
                                   "FILE... and/or -e NAME...")])
     dataset = open_dataset(args.dataset)
+    inputs = [dataset.path, *args.solution]
     with contextlib.ExitStack() as stack:
         report_dir = (stack.enter_context(atomic_output_dir(Path(args.report), args.force,
-                                                            [dataset.path]))
+                                                            inputs))
                       if args.report else None)
         solutions = _from_files(args.solution, dataset)
         for label, solved in pipeline.run_estimators(dataset, dict.fromkeys(args.estimator),
@@ -93,7 +94,7 @@ def run(args: argparse.Namespace) -> int:
                   f"{dataset.manifest.get('reference_source', 'the recording reference')}")
         print_scores(ev)
         if args.json:
-            write_scores(ev.scores(), Path(args.json), args.force, [dataset.path])
+            write_scores(ev.scores(), Path(args.json), args.force, inputs)
             print(f"wrote {args.json}")
         if report_dir is not None:
             pipeline.write_report(report_dir, ev, f"Scores on {dataset.path.name}")

@@ -19,6 +19,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("scenarios", nargs="+", metavar="SCENARIO", help="YAML scenario file(s)")
     p.add_argument("--set", dest="overrides", action="append", default=[],
                    metavar="KEY.PATH=VALUE", help="override a value before validating")
+    p.add_argument("--import-plugins", action="store_true",
+                   help="also import each module:Class estimator (this runs its module's code) "
+                        "and check its config; without it such an entry is checked for its form "
+                        "only, and validating runs no code the scenario names")
     p.set_defaults(run=run)
 
 
@@ -28,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
     failed = False
     for path in args.scenarios:
         try:
-            scenario = load_scenario(path, args.overrides)
+            scenario = load_scenario(path, args.overrides, import_plugins=args.import_plugins)
         except InputError as exc:
             failed = True
             for problem in exc.problems:

@@ -40,6 +40,7 @@ from simulator.sensors import SENSOR_MODELS
 from simulator.sensors.base import sample_times
 from simulator.stochastic import stream_rng
 from simulator.tables import Table, as_frames, column
+from simulator.threads import one_blas_thread
 from simulator.trajectory.kinematics import Kinematics
 from simulator.vehicle.params import vehicle_parameters
 from simulator.vehicle.suspension import axle_distances
@@ -69,6 +70,7 @@ class Generated:
     truth_keys: dict[str, dict] = field(default_factory=dict)  # sensor -> {key: nominal}
 
 
+@one_blas_thread
 def generate_streams(scenario: Scenario | dict, show_progress: bool = True, frames: bool = True,
                      on_final: Callable[[str, Table], None] | None = None) -> Generated:
     """Truth table, every configured sensor's streams, and the events table.
@@ -263,12 +265,13 @@ def stream_units(scenario: dict) -> dict[str, dict[str, str]]:
 
 
 def generate_dataset(scenario: Scenario, out_dir: Path, force: bool = False,
-                     show_progress: bool = True) -> Path:
+                     show_progress: bool = True, honour_lock: bool = True) -> Path:
     """Generate a scenario's dataset into ``out_dir`` (atomically; refuses to overwrite without
     ``force``). Returns ``out_dir``. Each stream no fault changes is written while the others are
-    made."""
+    made. The scenario's files are inputs: never written over; ``honour_lock=False`` only for a
+    campaign's own runs, writing into the folder it holds."""
     out_dir = Path(out_dir)
-    with (atomic_output_dir(out_dir, force) as tmp,
+    with (atomic_output_dir(out_dir, force, scenario.input_files, honour_lock) as tmp,
           DatasetWriter(tmp, stream_units(scenario.data)) as writer):
         generated = generate_streams(scenario, show_progress, frames=False,
                                      on_final=writer.write)

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from simulator import columns as col
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 from simulator.tables import Table, column, n_rows
 
 if TYPE_CHECKING:
@@ -140,9 +140,12 @@ class Dataset:
         if name not in self.manifest["streams"]:
             raise InputError([Problem(str(self.path), None, "", f"the dataset has no {name!r} "
                                       f"stream (it has: {', '.join(self.stream_names)})")])
-        path = self.path / self.manifest["streams"][name]["file"]
+        entry = self.manifest["streams"][name]
+        path = self.path / entry["file"]
         frame = _parquet().read_table(path, columns)
-        problem = stream_problem(name, frame, columns)
+        problem = (stream_problem(name, frame, columns)
+                   or _unit_problem(name, _parquet().read_units(path))
+                   or _rate_problem(frame, entry.get("rate_hz")))
         if problem:
             raise InputError([Problem(str(path), None, "", f"corrupt {name} stream: {problem}")])
         return frame
@@ -166,7 +169,8 @@ def stream_problem(name: str, frame: pd.DataFrame, columns: list[str] | None = N
                    ) -> str | None:
     """What is wrong with a stream table read from a dataset, or None: a required column
     missing, a column that should be numeric and is not, times that are not finite or run
-    backwards, an IMU sample with no value."""
+    backwards, an IMU or truth without samples, an IMU sample with no value or beyond any
+    IMU's range."""
     from pandas.api.types import is_numeric_dtype
 
     wanted = col.REQUIRED.get(name, ())
@@ -193,12 +197,61 @@ def stream_problem(name: str, frame: pd.DataFrame, columns: list[str] | None = N
         reversed_rows = frame["t_end"].to_numpy(float) < frame["t_start"].to_numpy(float)
         if reversed_rows.any():
             return f"row {_first(reversed_rows)} ends before it starts"
+    if name in ("imu", "truth") and columns is None and len(frame) == 0:
+        return "no samples"
     if name == "imu":
         axes = frame[[a for a in col.IMU_AXES if a in frame]].to_numpy(dtype=float)
         bad = ~np.isfinite(axes).all(axis=1)
         if bad.any():
             return (f"{int(bad.sum())} sample(s) have no value, the first at row {_first(bad)} "
                     f"(t = {frame['t'].iloc[_first(bad)]:.6f} s); an IMU log has none")
+        return _imu_range_problem(frame)
+    return None
+
+
+# largest magnitude an IMU sample may have: above every MEMS full scale (4000 deg/s, 200 g),
+# in rad/s and m/s^2 (increments, per sample, are smaller still)
+IMU_LIMITS = {"gyro": 100.0, "accel": 2000.0}
+
+
+def _imu_range_problem(frame: pd.DataFrame) -> str | None:
+    for axis in col.IMU_AXES:
+        if axis not in frame:
+            continue
+        values = np.abs(frame[axis].to_numpy(dtype=float))
+        limit = IMU_LIMITS[axis.partition("_")[0]]
+        if len(values) and values.max() > limit:
+            i = int(values.argmax())
+            return (f"{axis} = {frame[axis].iloc[i]:.6g} at row {i} is beyond any IMU's range "
+                    f"(|{axis}| <= {limit:g} in SI units)")
+    return None
+
+
+def _unit_problem(name: str, units: dict[str, str]) -> str | None:
+    """A column whose unit in the file differs from SPEC's (an IMU may also hold increments)."""
+    declared = col.STREAMS.get(name, (None, {}))[1]
+    for c, unit in units.items():
+        allowed = {declared.get(c)}
+        if name == "imu":
+            allowed.add(col.IMU_INCREMENT_UNITS.get(c))
+        if unit and c in declared and unit not in allowed:
+            return (f"column {c} is in {unit!r}; the dataset format has it in "
+                    f"{declared[c]!r} (convert it)")
+    return None
+
+
+def _rate_problem(frame: pd.DataFrame, rate_hz: object) -> str | None:
+    """Times that do not advance at the manifest's rate (times in milliseconds, say)."""
+    if not isinstance(rate_hz, (int, float)) or rate_hz <= 0 or "t" not in frame \
+            or len(frame) < 10:
+        return None
+    step = float(np.median(np.diff(frame["t"].to_numpy(dtype=float))))
+    # the manifest's rate is the mean over the stream (dropouts lower it): a factor of ten
+    # either way is another unit, not gaps
+    if not 0.1 <= step * rate_hz <= 10.0:
+        return (f"times advance by {step:.6g} per sample where the manifest's rate "
+                f"{rate_hz:g} Hz means {1 / rate_hz:.6g} s: times in another unit than "
+                "seconds?")
     return None
 
 
@@ -213,7 +266,13 @@ _MANIFEST_FIELDS = {  # key path -> the JSON types it may have
     ("origin", "lon"): (int, float),
     ("origin", "alt"): (int, float),
     ("utc_start",): (str,),
+    ("scenario",): (dict,),
+    ("scenario", "sensors"): (dict,),
+    ("sensors",): (dict,),
+    ("sensors", "gnss", "broadcast_iono"): (dict,),
+    ("datasheet",): (dict,),
 }
+_MAPPINGS_OF_MAPPINGS = (("scenario", "sensors"), ("sensors",))  # each entry is a mapping
 
 
 def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
@@ -226,10 +285,18 @@ def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
         if node is None:  # optional here; a command that needs it asks Dataset.field
             continue
         if isinstance(node, bool) or not isinstance(node, types):
-            kinds = " or ".join("an integer" if t is int else "a number" if t is float
-                                else "text" for t in types)
+            kinds = " or ".join({int: "an integer", float: "a number", dict: "a mapping"}
+                                .get(t, "text") for t in types)
             problems.append(Problem(where, None, ".".join(keys),
                                     f"not {kinds} (got {node!r})"))
+    for keys in _MAPPINGS_OF_MAPPINGS:
+        node = manifest
+        for key in keys:
+            node = node.get(key) if isinstance(node, dict) else None
+        for name, entry in (node.items() if isinstance(node, dict) else ()):
+            if entry is not None and not isinstance(entry, dict):
+                problems.append(Problem(where, None, ".".join((*keys, str(name))),
+                                        f"not a mapping (got {entry!r})"))
     streams = manifest.get("streams")
     if not isinstance(streams, dict):
         return [*problems, Problem(where, None, "streams", "missing or malformed")]
@@ -253,6 +320,7 @@ def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
 def open_dataset(path: str | Path) -> Dataset:
     """Open a dataset directory; raise InputError if it is not a landnav dataset."""
     path = Path(path)
+    refuse_undecodable(path, "dataset's name")
     manifest_path = path / "manifest.json"
     if not path.is_dir():
         raise InputError([Problem(str(path), None, "", "no such dataset directory")])

@@ -465,7 +465,7 @@ def export_mcap(dataset: Dataset, path: str | Path, force: bool = False,
                                   "neither an imu nor a gnss_fix stream; nothing to export")])
     solutions = dict(solutions or {})
     if out.suffix == ".mcap":
-        with atomic_output_file(out, force, [dataset.path]) as tmp_file:
+        with atomic_output_file(out, force, [dataset.path], "mcap") as tmp_file:
             with tempfile.TemporaryDirectory(dir=Path(tmp_file).parent,
                                              prefix=f".{out.stem}.bag-") as work:
                 bag = Path(work) / out.stem

@@ -69,9 +69,14 @@ def fault_kind(name: str, params: dict[str, Field], streams: tuple[str, ...], do
 
 
 def in_intervals(t: np.ndarray, intervals: list[tuple[float, float]]) -> np.ndarray:
-    """Boolean mask of the times inside any of the half-open intervals [start, end)."""
+    """Boolean mask of the times inside any of the half-open intervals [start, end): with the
+    intervals sorted by start, ``t`` is inside one exactly when the latest end among those
+    starting at or before ``t`` lies after it (one binary search per time, whatever the number
+    of intervals)."""
     t = np.asarray(t, dtype=float)
-    mask = np.zeros(t.shape, dtype=bool)
-    for start, end in intervals:
-        mask |= (t >= start) & (t < end)
-    return mask
+    if not intervals:
+        return np.zeros(t.shape, dtype=bool)
+    bounds = np.asarray(sorted(intervals), dtype=float)
+    latest_end = np.maximum.accumulate(bounds[:, 1])
+    k = np.searchsorted(bounds[:, 0], t, side="right") - 1
+    return (k >= 0) & (t < latest_end[np.maximum(k, 0)])

@@ -77,6 +77,13 @@ def trigger_problems(fault: dict, path: Path, ctx: Context, duration_s: float,
             ctx.error(path + ("distance",), f"starts at {lo:g} m, beyond the drive's end "
                       f"({length_m:.1f} m travelled)")
     if trigger == "random":
+        expected = fault["random"]["rate"] * duration_s
+        if expected > MAX_RANDOM_EVENTS:
+            ctx.error(path + ("random", "rate"),
+                      f"{fault['random']['rate']:.3g} events/s over the {duration_s:.1f} s drive "
+                      f"is about {expected:.3g} events, more than one fault may draw "
+                      f"({MAX_RANDOM_EVENTS:,}); lower the rate (e.g. \"30 /h\") or use a "
+                      "start/duration window")
         dist = fault["random"]["duration"]
         kind = dist["distribution"]
         if kind in ("fixed", "exponential") and dist["mean"] is None:
@@ -84,6 +91,11 @@ def trigger_problems(fault: dict, path: Path, ctx: Context, duration_s: float,
         if kind == "uniform" and (dist["min"] is None or dist["max"] is None
                                   or dist["max"] <= dist["min"]):
             ctx.error(path + ("random", "duration"), "a uniform duration needs min < max")
+
+
+# events one random fault may draw over a drive (each is a row of the events table and an
+# interval every stream is masked with); a fault every second of a 28 h drive is 100 800
+MAX_RANDOM_EVENTS = 200_000
 
 
 def fault_intervals(fault: dict, truth, rng: np.random.Generator) -> list[tuple[float, float]]:

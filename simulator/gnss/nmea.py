@@ -62,9 +62,14 @@ def _num(value: float, digits: int) -> str:
     return f"{value:.{digits}f}" if np.isfinite(value) else ""
 
 
+def _count(value: float, digits: int = 2) -> str:
+    """A whole-number field, zero-padded; empty when the value is missing."""
+    return f"{int(round(value)):0{digits}d}" if np.isfinite(value) else ""
+
+
 def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[str]:
     hms = stamp.strftime("%H%M%S") + f".{stamp.microsecond // 10000:02d}"
-    has_fix = int(fix["fix"]) > 0
+    has_fix = bool(np.isfinite(fix["fix"]) and fix["fix"] > 0)
     lat, ns = _latlon(fix["lat"], "NS", 2)
     lon, ew = _latlon(fix["lon"], "EW", 3)
     knots = fix["speed"] * KNOTS_PER_M_S
@@ -74,7 +79,7 @@ def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[
     mode = "A" if has_fix else "N"
     out = [
         _sentence("GPGGA", hms, lat, ns, lon, ew, "1" if has_fix else "0",
-                  f"{int(fix['num_sats']):02d}", _num(hdop, 1),
+                  _count(fix["num_sats"]), _num(hdop, 1),
                   _num(fix["alt"] - fix["separation"], 2), "M", _num(fix["separation"], 2),
                   "M" if has_fix else "", "", ""),
         _sentence("GPRMC", hms, "A" if has_fix else "V", lat, ns, lon, ew,
@@ -85,7 +90,8 @@ def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[
     # GSA lists the satellites the fix used: not the unhealthy ones GSV shows in view
     healthy = sats[sats["health"] == 0] if "health" in sats else sats
     used = [f"{int(sv):02d}" for sv in healthy["sv"]][:12] if has_fix else []
-    out.append(_sentence("GPGSA", "A", {0: "1", 1: "2"}.get(int(fix["fix"]), "3"),
+    out.append(_sentence("GPGSA", "A", "3" if has_fix and fix["fix"] > 1 else "2" if has_fix
+                         else "1",
                          *(used + [""] * (12 - len(used))), _num(pdop, 1), _num(hdop, 1),
                          _num(vdop, 1)))
     n_msg = max(1, -(-len(sats) // _SV_PER_GSV))
@@ -93,8 +99,8 @@ def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[
     for k in range(n_msg):
         fields = ["GPGSV", str(n_msg), str(k + 1), f"{len(sats):02d}"]
         for sv, el, az, cn0 in rows[k * _SV_PER_GSV:(k + 1) * _SV_PER_GSV]:
-            fields += [f"{int(sv):02d}", f"{int(round(np.degrees(el))):02d}",
-                       f"{int(round(np.degrees(az))) % 360:03d}", f"{int(round(cn0)):02d}"]
+            fields += [f"{int(sv):02d}", _count(np.degrees(el)),
+                       _count(np.degrees(az) % 360, 3), _count(cn0)]
         out.append(_sentence(*fields))
     return out
 

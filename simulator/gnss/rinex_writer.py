@@ -51,10 +51,16 @@ def _d19(value: float) -> str:
     return f"{value:19.12E}".replace("E", "D")
 
 
+def _obs(value: float) -> str:
+    """An observation field (F14.3); blank when the value is missing (RINEX 3.04 5.1)."""
+    return f"{value:14.3f}" if np.isfinite(value) else " " * 14
+
+
 def signal_strength_indicator(cn0_dbhz: np.ndarray) -> np.ndarray:
     """RINEX signal strength indicator 1-9 from C/N0 (RINEX 3.04 section 5.7: 1 below 12 dB-Hz,
     one step per 6 dB, 9 at 54 dB-Hz and above)."""
-    return np.clip(np.floor(np.asarray(cn0_dbhz) / 6.0), 1, 9).astype(int)
+    level = np.floor(np.nan_to_num(np.asarray(cn0_dbhz, dtype=float), nan=0.0) / 6.0)
+    return np.clip(level, 1, 9).astype(int)
 
 
 def _gps_datetime(week: int, seconds: float) -> dt.datetime:

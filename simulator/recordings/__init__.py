@@ -71,4 +71,4 @@ def import_recording(kind: str, sources: list[str], out_dir: str | Path,
         recording = _rinex([str(s) for s in sources], reference)
     else:
         recording = reader([str(s) for s in sources])
-    return write_recording(recording, out_dir, force)
+    return write_recording(recording, out_dir, force, sources)

@@ -18,6 +18,7 @@ Recording, reference_truth, write_recording, gnss_gap_events.
 from __future__ import annotations
 
 import datetime as dt
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -113,7 +114,8 @@ def _resolved_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
     return validate_data(data, "<recording sensors>")["sensors"]
 
 
-def write_recording(recording: Recording, out_dir: str | Path, force: bool = False) -> Path:
+def write_recording(recording: Recording, out_dir: str | Path, force: bool = False,
+                    sources: Iterable[str | Path] = ()) -> Path:
     """Write a recording as a dataset (atomically; an existing ``out_dir`` only with
     ``force``). The manifest says ``"reference": true``, where the reference came from, what
     each stream lacks and the conversions made."""
@@ -153,7 +155,8 @@ def write_recording(recording: Recording, out_dir: str | Path, force: bool = Fal
     if "imu" in streams:
         described["imu"] = {"imu_output": "rate"}
     out_dir = Path(out_dir)
-    with atomic_output_dir(out_dir, force) as tmp, DatasetWriter(tmp, units) as writer:
+    with (atomic_output_dir(out_dir, force, sources) as tmp,  # a recording is never written over
+          DatasetWriter(tmp, units) as writer):
         writer.finish(manifest, {k: _table(k, v) for k, v in streams.items()}, described)
     return out_dir
 

@@ -89,8 +89,8 @@ def write_twin(dataset: Dataset, scenario_path: str | Path, force: bool = False)
         drive.to_parquet(Path(check) / log.name, index=False)
         (Path(check) / out.name).write_text(text, encoding="utf-8")
         load_scenario(Path(check) / out.name)
-    with (atomic_output_file(log, force, [dataset.path]) as log_tmp,
-          atomic_output_file(out, force, [dataset.path]) as out_tmp):
+    with (atomic_output_file(log, force, [dataset.path], "twin-drive") as log_tmp,
+          atomic_output_file(out, force, [dataset.path], "twin-scenario") as out_tmp):
         drive.to_parquet(log_tmp, index=False)
         Path(out_tmp).write_text(text, encoding="utf-8")
     return out

@@ -7,13 +7,14 @@ Scenario, load_scenario, validate_data.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from simulator.drive import Drive, build_drive
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 from simulator.scenario.spec import SCENARIO_FIELD
 from simulator.scenario.yamlio import apply_overrides, read_yaml
 from simulator.schema import INVALID, Context
@@ -37,6 +38,24 @@ class Scenario:
     @property
     def seed(self) -> int:
         return self.data["seed"]
+
+    @property
+    def input_files(self) -> list[Path]:
+        """The scenario file and every file its resolved data names (a SUMO network, a recorded
+        drive, a navigation file: made absolute at validation): what an output must not touch."""
+        found = [Path(self.path)]
+        stack: list[Any] = [self.data]
+        while stack:
+            node = stack.pop()
+            if isinstance(node, dict):
+                stack.extend(node.values())
+            elif isinstance(node, list):
+                stack.extend(node)
+            elif isinstance(node, str) and node.startswith("/") and len(node) < 4096:
+                with contextlib.suppress(OSError, ValueError):
+                    if Path(node).is_file():
+                        found.append(Path(node))
+        return found
 
 
 def _validate(data: Any, file: str, lines: dict | None = None,
@@ -71,6 +90,7 @@ def load_scenario(path: str | Path, overrides: list[str] | None = None,
         With every problem as ``file:line: key.path: message``.
     """
     path = Path(path)
+    refuse_undecodable(path, "scenario's name")
     data, lines = read_yaml(path)
     if not isinstance(data, dict):
         raise InputError([Problem(str(path), 1, "", "a scenario is a mapping of keys (name, "

@@ -81,7 +81,7 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     profile = build_profile(value, ctx)
     if profile is not None:
         ctx.built["profile"] = profile
-        _check_job_size(traj["rate"], profile.duration_s, path, ctx)
+        _check_job_size(value, profile.duration_s, path, ctx)
         check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
                      float(profile.distance_of_time(profile.duration_s)))
     labels: set[str] = set()
@@ -123,20 +123,36 @@ def _check_base(sensors: dict, path: Path, ctx: Context) -> None:
                                     f"multiple of the base's {base['rate']:g} Hz")
 
 
-# Truth samples one generation may hold: about 750 bytes each with every sensor on (an hour at
-# 100 Hz peaks near 300 MB), so this bound keeps a job under about 8 GB.
-MAX_TRUTH_SAMPLES = 10_000_000
+# What one generation holds, measured with /usr/bin/time -v on `landnav generate` of a straight
+# drive with every sensor (IMU 100 Hz, odometer, barometer, magnetometer, GNSS fix and raw at
+# 1 Hz, 31 satellites): peak RSS 233 MB at 10 min, 347 MB at 30 min, 527 MB at 60 min, so
+# 0.35 GB per drive hour (1 kB per truth sample at 100 Hz) over 0.17 GB; the same 10 min with
+# GNSS at 10 Hz peaked at 323 MB: 17 kB per GNSS epoch of the constellation.
+BYTES_PER_TRUTH_SAMPLE = 1000
+BYTES_PER_GNSS_EPOCH = 17_000
+MAX_TRUTH_SAMPLES = 10_000_000  # about 28 h at 100 Hz: 10 GB
+MAX_JOB_BYTES = 10e9
 
 
-def _check_job_size(rate_hz: float, duration_s: float, path: Path, ctx: Context) -> None:
+def _check_job_size(value: dict, duration_s: float, path: Path, ctx: Context) -> None:
+    rate_hz = value["trajectory"]["rate"]
     samples = rate_hz * duration_s
+    gnss = value["sensors"].get("gnss")
+    epochs = gnss["rate"] * duration_s if isinstance(gnss, dict) else 0.0
+    job_bytes = samples * BYTES_PER_TRUTH_SAMPLE + epochs * BYTES_PER_GNSS_EPOCH
     if samples > MAX_TRUTH_SAMPLES:
         hours = MAX_TRUTH_SAMPLES / rate_hz / 3600
         ctx.error(path + ("trajectory",),
                   f"the drive lasts {duration_s / 3600:.4g} h: at {rate_hz:g} Hz that is "
-                  f"{samples:.3g} truth samples (about {samples * 750 / 1e9:.3g} GB), more than "
+                  f"{samples:.3g} truth samples (about {job_bytes / 1e9:.3g} GB), more than "
                   f"one job may hold ({MAX_TRUTH_SAMPLES:.0e}); split it into drives of at most "
                   f"{hours:.3g} h, or lower trajectory.rate")
+    elif job_bytes > MAX_JOB_BYTES:
+        ctx.error(path + ("sensors", "gnss", "rate"),
+                  f"the drive lasts {duration_s / 3600:.4g} h: its {samples:.3g} truth samples "
+                  f"and {epochs:.3g} GNSS epochs at {gnss['rate']:g} Hz need about "
+                  f"{job_bytes / 1e9:.3g} GB, more than one job may hold "
+                  f"({MAX_JOB_BYTES / 1e9:.3g} GB); lower sensors.gnss.rate or split the drive")
 
 
 def _zones_used(value: dict) -> set[str] | None:

@@ -9,7 +9,7 @@ left as its text, for the schema to report with every other problem of the file.
 
 Public functions
 ----------------
-read_yaml, apply_overrides.
+read_yaml, apply_overrides, load_value.
 """
 
 from __future__ import annotations
@@ -109,12 +109,9 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
         raise InputError([Problem(file, None, "", "file not found")]) from None
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError([Problem(file, None, "", f"cannot read the file: {exc}")]) from None
-    # libyaml's parser when PyYAML has it (several times faster), the pure-Python one otherwise
-    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)(text)
+    lines: dict[tuple, int] = {}
     try:
-        node = loader.get_single_node()
-        lines: dict[tuple, int] = {}
-        data = {} if node is None else _construct(node, loader, (), lines, file, _Budget())
+        data = _bounded_load(text, file, lines, {})
     except yaml.MarkedYAMLError as exc:
         mark = exc.problem_mark or exc.context_mark
         line = mark.line + 1 if mark is not None else None
@@ -125,9 +122,30 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
     except RecursionError:  # the pure-Python parser (no libyaml) recurses once per level
         raise InputError([Problem(file, None, "", f"malformed YAML: nested more than "
                                   f"{MAX_DEPTH} levels deep")]) from None
+    return data, lines
+
+
+def _bounded_load(text: str, file: str, lines: dict, empty: Any) -> Any:
+    """YAML text built within ``MAX_NODES`` and ``MAX_DEPTH`` (``empty`` for no document)."""
+    # libyaml's parser when PyYAML has it (several times faster), the pure-Python one otherwise
+    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)(text)
+    try:
+        node = loader.get_single_node()
+        return empty if node is None else _construct(node, loader, (), lines, file, _Budget())
     finally:
         loader.dispose()
-    return data, lines
+
+
+def load_value(raw: str, where: str) -> Any:
+    """A ``KEY=VALUE`` option's value read as YAML within the same bounds as a file (aliases,
+    nesting); text that is not YAML stays text, a value beyond the bounds is an InputError."""
+    try:
+        value = _bounded_load(raw, where, {}, None) if raw.strip() else ""
+    except (yaml.YAMLError, ValueError, RecursionError):
+        value = raw
+    if isinstance(value, str) and _PLAIN_FLOAT.match(value.strip()):
+        value = float(value)
+    return value
 
 
 def apply_overrides(data: Any, overrides: list[str], file: str) -> tuple[Any, set[tuple]]:
@@ -144,12 +162,15 @@ def apply_overrides(data: Any, overrides: list[str], file: str) -> tuple[Any, se
             continue
         key, raw = text.split("=", 1)
         try:
-            value = yaml.safe_load(raw) if raw.strip() else ""
-        except (yaml.YAMLError, ValueError):
-            value = raw
-        if isinstance(value, str) and _PLAIN_FLOAT.match(value.strip()):
-            value = float(value)
+            value = load_value(raw, f"--set {key}")
+        except InputError as exc:
+            problems.extend(Problem(file, "--set", key, p.message) for p in exc.problems)
+            continue
         parts: list[Any] = [int(p) if p.lstrip("-").isdigit() else p for p in key.split(".")]
+        if len(parts) > MAX_DEPTH:
+            problems.append(Problem(file, "--set", key[:80] + "...",
+                                    f"the key path is more than {MAX_DEPTH} levels deep"))
+            continue
         if not all(str(p) for p in parts):
             problems.append(Problem(file, "--set", key, "empty part in the key path"))
             continue

@@ -105,5 +105,5 @@ def write_scores(scores: dict, path: Path, force: bool = False,
     move it into place; an existing file is replaced only with ``force``, a path inside one of
     ``inputs`` is refused."""
     text = json.dumps(scores, indent=2, allow_nan=False) + "\n"
-    with atomic_output_file(path, force, inputs) as tmp:
+    with atomic_output_file(path, force, inputs, "json") as tmp:
         tmp.write_text(text, encoding="utf-8")

@@ -46,12 +46,16 @@ import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, refuse_undecodable
 from simulator.replay import USES_GNSS_KEY, solution_problems
 from simulator.scoring.align import solution_errors
 from simulator.timebase import GPS_EPOCH, SECONDS_PER_WEEK, leap_seconds
 
 MAX_MEDIAN_HORIZONTAL_M = 100e3  # a solution whose median horizontal error exceeds it is refused
+# a solution file larger than this is refused before it is read (10 million rows of a text
+# solution are about 1.5 GB; a replay asks for at most 10 million rows)
+MAX_SOLUTION_BYTES = 2 * 1024**3
+MIN_EARTH_RADIUS_M = 6.3e6  # an ECEF position nearer the Earth's centre is no position
 _UNITS = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
 _ANGLE_UNITS = {"deg": math.pi / 180.0, "degree": math.pi / 180.0, "degrees": math.pi / 180.0,
                 "rad": 1.0, "radian": 1.0, "radians": 1.0}
@@ -134,25 +138,40 @@ def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[s
         raise _problem(path, f"rows do not have the {width} fields the header names "
                              "(latitude/longitude in degrees-minutes-seconds cannot be read; "
                              "write degrees)")
-    table = pd.DataFrame([r[2:] for r in rows], columns=names[1:]).apply(pd.to_numeric)
+    table = pd.DataFrame([r[2:] for r in rows], columns=names[1:])
+    _refuse_text(path, table, offset=len(lines) - len(rows))
+    table = table.apply(pd.to_numeric)
     first = [r[0] for r in rows]
     if "/" in first[0]:
-        stamps = pd.to_datetime([f"{r[0]} {r[1]}" for r in rows], format="%Y/%m/%d %H:%M:%S.%f")
+        try:
+            stamps = pd.to_datetime([f"{r[0]} {r[1]}" for r in rows],
+                                    format="%Y/%m/%d %H:%M:%S.%f")
+        except (ValueError, OverflowError) as exc:
+            raise _problem(path, f"a time is not a date and time YYYY/MM/DD hh:mm:ss.sss "
+                                 f"({exc})") from None
         seconds = _gps_seconds(pd.Series(stamps), system == "UTC")
     else:
-        week = np.array(first, dtype=float)
-        seconds = week * SECONDS_PER_WEEK + np.array([r[1] for r in rows], dtype=float)
+        clock = pd.DataFrame({"week": first, "seconds": [r[1] for r in rows]})
+        _refuse_text(path, clock, offset=len(lines) - len(rows))
+        seconds = (clock["week"].astype(float).to_numpy() * SECONDS_PER_WEEK
+                   + clock["seconds"].astype(float).to_numpy())
         if system == "UTC":
             raise _problem(path, "UTC given as week and seconds is not an RTKLIB output; use "
                                  "GPST or a date")
     out = pd.DataFrame({"t": seconds - (gps_start[0] * SECONDS_PER_WEEK + gps_start[1])})
+    notes = [f"{path}: RTKLIB {system} solution, {len(out)} rows"]
     if "latitude(deg)" in table:
         out["lat"], out["lon"] = table["latitude(deg)"], table["longitude(deg)"]
         out["alt"] = table["height(m)"]
     elif "x-ecef(m)" in table:
-        lat, lon, alt = ecef_to_geodetic(table[["x-ecef(m)", "y-ecef(m)", "z-ecef(m)"]]
-                                         .to_numpy(float))
+        xyz = table[["x-ecef(m)", "y-ecef(m)", "z-ecef(m)"]].to_numpy(float)
+        lat, lon, alt = ecef_to_geodetic(xyz)
         out["lat"], out["lon"], out["alt"] = np.degrees(lat), np.degrees(lon), alt
+        centre = np.linalg.norm(xyz, axis=1) < MIN_EARTH_RADIUS_M
+        if centre.any():  # RTKLIB's "no solution" rows: no position, not one 6370 km off
+            out.loc[centre, ["lat", "lon", "alt"]] = np.nan
+            notes.append(f"{path}: {int(centre.sum())} row(s) at the Earth's centre "
+                         "(x, y, z = 0: no solution) have no position")
     else:
         raise _problem(path, "neither latitude(deg)/longitude(deg)/height(m) nor x/y/z-ecef(m) "
                              "columns (east/north/up relative positions cannot be scored)")
@@ -167,7 +186,7 @@ def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[s
     # the quality flag as SPEC section 8's fix status: Q = 1 fixed (2), Q = 2 float (1), else
     # none (0: single point, DGPS, dead reckoning)
     out["fix_status"] = np.select([table["Q"] == 1, table["Q"] == 2], [2, 1], 0)
-    return out, [f"{path}: RTKLIB {system} solution, {len(out)} rows"]
+    return out, notes
 
 
 def _float(value: object) -> float:
@@ -181,6 +200,7 @@ def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[
     start_date = (GPS_EPOCH + dt.timedelta(seconds=gps_start[0] * SECONDS_PER_WEEK
                                            + gps_start[1])).date()
     gga, rmc = [], {}
+    untimed = 0
     date = start_date
     with path.open("rb") as stream:
         for _, msg in NMEAReader(stream, quitonerror=0):
@@ -190,11 +210,14 @@ def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[
                 date = msg.date
                 if msg.status == "A":
                     rmc[(date, msg.time)] = (_float(msg.spd), _float(msg.cog))
+            elif msg.msgID == "GGA" and msg.quality and msg.lat != "" and not msg.time:
+                untimed += 1
             elif msg.msgID == "GGA" and msg.quality and msg.lat != "":
                 gga.append((date, msg.time, msg.lat, msg.lon,
                              _float(msg.alt) + (_float(msg.sep) if msg.sep != "" else 0.0)))
     if not gga:
-        return pd.DataFrame(columns=list(col.SOLUTION)), []
+        return pd.DataFrame(columns=list(col.SOLUTION)), (
+            [f"{path}: {untimed} GGA sentence(s) without a time left out"] if untimed else [])
     stamps = pd.Series([dt.datetime.combine(d, tm) for d, tm, *_ in gga])
     seconds = _gps_seconds(stamps, utc=True)
     speed_course = np.array([rmc.get((d, tm), (np.nan, np.nan)) for d, tm, *_ in gga],
@@ -207,7 +230,10 @@ def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[
                         "ve": speed * np.sin(course), "vd": np.nan})
     for name in _ATTITUDE:
         out[name] = np.nan
-    return out, [f"{path}: NMEA GGA/RMC solution, {len(out)} rows (UTC times)"]
+    notes = [f"{path}: NMEA GGA/RMC solution, {len(out)} rows (UTC times)"]
+    if untimed:
+        notes.append(f"{path}: {untimed} GGA sentence(s) without a time left out")
+    return out, notes
 
 
 def _kind(path: Path) -> str:
@@ -218,7 +244,8 @@ def _kind(path: Path) -> str:
         return suffix[1:]
     if suffix in _NMEA_SUFFIXES:
         return "nmea"
-    head = path.read_bytes()[:4]
+    with path.open("rb") as stream:
+        head = stream.read(4)  # never the whole file
     if head == b"PAR1":
         return "parquet"
     return {b"%": "pos", b"$": "nmea"}.get(head[:1], "csv")
@@ -247,8 +274,14 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
         inconvertible unit.
     """
     path = Path(path)
+    refuse_undecodable(path, "solution file's name")
     if not path.is_file():
         raise _problem(path, "no such solution file")
+    size = path.stat().st_size
+    if size > MAX_SOLUTION_BYTES:
+        raise _problem(path, f"{size / 1e9:.3g} GB, more than a solution file may be "
+                             f"({MAX_SOLUTION_BYTES / 1e9:.3g} GB, about 10 million rows); "
+                             "score it in parts")
     kind = _kind(path)
     notes: list[str] = []
     uses_gnss = True
@@ -256,14 +289,40 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
         frame, notes, uses_gnss = _parquet(path)
     elif kind == "csv":
         frame = _csv(path)
+        _refuse_text(path, frame, [c for c in frame.columns if c in _UNITS], offset=1)
     elif kind == "pos":
         frame, notes = _pos(path, gps_start)
     else:
         frame, notes = _nmea(path, gps_start)
+    _refuse_text(path, frame, [c for c in frame.columns if c in _UNITS])
     problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     return frame, notes, uses_gnss
+
+
+def _refuse_text(path: Path, frame: pd.DataFrame, columns: list[str] | None = None,
+                 offset: int = 0) -> None:
+    """Refuse a cell of ``frame``'s ``columns`` (all by default) that is not a number (empty
+    cells are missing values), naming its column and the file's line (``offset``: the lines
+    before the first row; 0 when there are no lines, as in Parquet: then the row); numbers
+    written as text become numbers, in place."""
+    for name in frame.columns if columns is None else columns:
+        values = frame[name]
+        if pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(
+                values.dtype):
+            continue
+        if not (pd.api.types.is_object_dtype(values.dtype)
+                or pd.api.types.is_string_dtype(values.dtype)):
+            raise _problem(path, f"column {name} holds {values.dtype} values, not numbers "
+                                 "(times are seconds since the dataset's start)", name)
+        numbers = pd.to_numeric(values, errors="coerce")
+        bad = numbers.isna() & values.notna() & (values.astype(str).str.strip() != "")
+        if bad.any():
+            i = int(np.flatnonzero(bad.to_numpy())[0])
+            where = f"line {i + offset + 1}" if offset else f"row {i}"
+            raise _problem(path, f"{where}: {values.iloc[i]!r} is not a number", name)
+        frame[name] = numbers
 
 
 def _cause(frame: pd.DataFrame, truth: pd.DataFrame) -> str:
@@ -285,7 +344,8 @@ def _cause(frame: pd.DataFrame, truth: pd.DataFrame) -> str:
 def check_solution(path: str | Path, frame: pd.DataFrame, truth: pd.DataFrame) -> None:
     """Refuse a solution that cannot be scored against this truth, naming the likely cause.
 
-    Refused: no rows; no row within the truth's time span; attitude values beyond 2 pi
+    Refused: no rows; negative standard deviations; no row, or a single one, with a position
+    within the truth's time span; attitude values beyond 2 pi
     (degrees where radians are due); a median horizontal error over
     ``MAX_MEDIAN_HORIZONTAL_M``.
 
@@ -297,6 +357,12 @@ def check_solution(path: str | Path, frame: pd.DataFrame, truth: pd.DataFrame) -
     path = Path(path)
     if len(frame) == 0:
         raise _problem(path, "the solution has no rows")
+    for name in col.SOLUTION_STD:
+        values = frame[name].to_numpy(float) if name in frame else np.zeros(0)
+        if np.any(values < 0):
+            raise _problem(path, f"{name} has negative values (row "
+                                 f"{int(np.flatnonzero(values < 0)[0])}): a standard "
+                                 "deviation is never negative", name)
     t = frame["t"].to_numpy(float)
     t0, t1 = float(truth["t"].iloc[0]), float(truth["t"].iloc[-1])
     if t[-1] < t0 or t[0] > t1:
@@ -314,6 +380,9 @@ def check_solution(path: str | Path, frame: pd.DataFrame, truth: pd.DataFrame) -
     h = h[np.isfinite(h)]
     if h.size == 0:
         raise _problem(path, "no row within the truth's time span has a finite position")
+    if h.size < 2:
+        raise _problem(path, "only one row within the truth's time span has a position: "
+                             "scores need at least two")
     median = float(np.median(h))
     if median > MAX_MEDIAN_HORIZONTAL_M:
         raise _problem(path, f"median horizontal error {median / 1e3:.0f} km (over "

@@ -14,7 +14,7 @@ from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.errors import InputError
 from simulator.pipeline import load_scenario
-from simulator.replay import read_solution
+from simulator.replay import read_solution, run_estimator
 from tests.scoring_helpers import horizontal_error
 from tests.synthetic import write_synthetic
 
@@ -120,7 +120,8 @@ def test_bad_config_and_init(dataset, tmp_path, capsys):
 
 def test_scenario_validation_checks_estimator_names(tmp_path):
     """The scenario checks names from the registry's name table (with their line); the
-    pipeline's loader then checks each entry against its class (import, config)."""
+    pipeline's loader then checks each entry against its class (import, config), a
+    ``module:Class`` entry only when asked to import plug-ins."""
     scenario = tmp_path / "s.yaml"
     scenario.write_text(textwrap.dedent("""\
         start: {lat: 37.5, lon: 127.0, heading: 0}
@@ -139,7 +140,7 @@ def test_scenario_validation_checks_estimator_names(tmp_path):
     assert "estimators.2" not in text and "estimators.3" not in text  # names that exist
     scenario.write_text(scenario.read_text().replace("  - kalmann\n", ""))
     with pytest.raises(InputError) as info:
-        load_scenario(scenario)
+        load_scenario(scenario, import_plugins=True)  # a module:Class is imported only so
     text = str(info.value)
     assert "estimators.1.config: config key 'max_extrapolation'" in text
     assert ("estimators.2.name: estimator 'no_such_module:Filter': cannot import module "
@@ -162,6 +163,8 @@ def test_generated_dataset_round_trip(tmp_path, capsys):
     assert main(["generate", str(REPO / "scenarios" / "quickstart.yaml"), "-o", str(data)]) == 0
     out = tmp_path / "rec.parquet"
     assert main(["estimate", str(data), "-e", "tests.recording:Recorder", "-o", str(out)]) == 0
+    # the CLI replays a plug-in in a child process: the recorder is inspected from a replay here
+    run_estimator(open_dataset(data), "tests.recording:Recorder", show_progress=False)
     imu = open_dataset(data).read("imu").to_numpy(dtype=float)
     seen = np.array([row for stream, _, row in Recorder.last.seen if stream == "imu"])
     np.testing.assert_array_equal(seen, imu)

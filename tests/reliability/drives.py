@@ -1,9 +1,16 @@
 """The short straight drive the hostile-input tests start from, as scenario text, and its
-dataset generated through the command line."""
+dataset generated through the command line; the small dataset several cases share (IMU,
+odometer, GNSS fix and raw; 100 m) as the fixtures ``dataset`` and ``copy_dataset``
+(``shared_dataset``, ``shared_dataset_copy``), imported by the modules that use them: a
+second conftest.py would shadow the tests' own ``conftest`` module."""
 
 from __future__ import annotations
 
+import shutil
+from collections.abc import Callable
 from pathlib import Path
+
+import pytest
 
 from simulator.cli import main
 
@@ -30,3 +37,21 @@ def generated_dataset(root: Path, scenario_text: str) -> Path:
     (root / "s.yaml").write_text(scenario_text)
     assert main(["generate", str(root / "s.yaml"), "-o", str(root / "ds")]) == 0
     return root / "ds"
+
+
+SHARED = straight_drive(100, sensors="  imu: {preset: ideal, rate: 50}\n  odometer: {rate: 10}\n"
+                                     "  gnss: {rate: 1, outputs: [fix, raw]}\n")
+
+
+@pytest.fixture(scope="session", name="dataset")
+def shared_dataset(tmp_path_factory) -> Path:
+    return generated_dataset(tmp_path_factory.mktemp("shared"), SHARED)
+
+
+@pytest.fixture(name="copy_dataset")
+def shared_dataset_copy(dataset, tmp_path) -> Callable[[], Path]:
+    def copy() -> Path:
+        target = tmp_path / "copy" / "ds"
+        shutil.copytree(dataset, target)
+        return target
+    return copy

@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import os
 import sys
+import time
 
 import numpy as np
 
@@ -74,3 +76,14 @@ class AllNan(_Base):
 
 class OneMegahertz(_Base):
     output_rate_hz = 1e6
+
+
+class LeavesTheProcess(_Base):
+    def on_imu(self, t, row):
+        os._exit(0)  # the hostile case itself: the process ends without unwinding
+
+
+class NeverReturns(_Base):
+    def on_imu(self, t, row):
+        while True:
+            time.sleep(0.01)

@@ -1,17 +1,21 @@
 """SIGTERM and SIGINT to a campaign whose worker is stuck in an estimator: the campaign ends
 promptly with 143 / 130 and a message, its worker processes are stopped, nothing but finished
 runs is left (no lock file, no temporary), and a rerun completes with nothing lost or
-duplicated."""
+duplicated. SIGKILL of the campaign ends its workers too; a stuck run fails at --time-limit;
+a port that does not answer as a Dask scheduler is refused at --scheduler-timeout."""
 
 from __future__ import annotations
 
 import os
 import signal
+import socket
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
+import pandas as pd
 import pytest
 import yaml
 
@@ -65,3 +69,86 @@ def test_signal_stops_a_campaign_with_a_stuck_worker(tmp_path, sig, code):
     assert rerun.returncode == 0, rerun.stderr
     assert "2 result(s) ok, 0 failed" in rerun.stdout
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mc", "tiny.yaml"]
+
+
+def _descendants(pid: int) -> set[int]:
+    """Every process below ``pid`` (from /proc: parent ids)."""
+    parents = {}
+    for entry in Path("/proc").iterdir():
+        if entry.name.isdigit():
+            try:
+                stat = (entry / "stat").read_text()
+            except OSError:
+                continue
+            parents[int(entry.name)] = int(stat.rsplit(")", 1)[1].split()[1])
+    found, frontier = set(), {pid}
+    while frontier:
+        frontier = {p for p, parent in parents.items() if parent in frontier} - found
+        found |= frontier
+    return found
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux's /proc")
+def test_workers_end_with_a_killed_campaign(tmp_path):
+    flag = tmp_path / "stuck"
+    flag.write_text("")
+    argv = [sys.executable, "-m", "simulator.cli", "campaign", str(_scenario(tmp_path, flag)),
+            "--runs", "2", "--workers", "1", "-o", "mc"]
+    proc = subprocess.Popen(argv, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(REPO)},
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 120
+    while not (tmp_path / "mc" / "campaign.json").exists():
+        assert proc.poll() is None and time.monotonic() < deadline
+        time.sleep(0.05)
+    time.sleep(1.0)  # the worker is inside the stuck estimator
+    workers = _descendants(proc.pid)
+    assert workers
+    proc.kill()  # SIGKILL: the campaign cannot stop its workers itself
+    proc.wait()
+    deadline = time.monotonic() + 30  # a hang, not a speed check: they end within a second
+    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(_alive(p) for p in workers)
+
+
+def test_campaign_time_limit_fails_the_stuck_run_and_goes_on(tmp_path):
+    flag = tmp_path / "stuck"
+    flag.write_text("")
+    argv = [sys.executable, "-m", "simulator.cli", "campaign", str(_scenario(tmp_path, flag)),
+            "--runs", "1", "--workers", "1", "-o", "mc", "--time-limit", "2"]
+    done = subprocess.run(argv, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(REPO)},
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode == 0, done.stderr
+    assert "0 result(s) ok, 1 failed" in done.stdout
+    runs = pd.read_parquet(tmp_path / "mc" / "runs.parquet")
+    assert "did not finish within the time limit of 2 s" in runs["error"].iloc[0]
+
+
+def test_a_port_that_is_not_a_dask_scheduler(tmp_path):
+    """A server that accepts connections and says nothing: refused after --scheduler-timeout
+    (before, the Dask client waited on without end)."""
+    server = socket.create_server(("127.0.0.1", 0))
+    held = []
+    accept = threading.Thread(target=lambda: held.append(server.accept()), daemon=True)
+    accept.start()
+    scenario = _scenario(tmp_path, tmp_path / "never")
+    argv = [sys.executable, "-m", "simulator.cli", "campaign", str(scenario), "--runs", "1",
+            "-o", "mc", "--scheduler", f"tcp://127.0.0.1:{server.getsockname()[1]}",
+            "--scheduler-timeout", "2"]
+    try:
+        done = subprocess.run(argv, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(REPO)},
+                              capture_output=True, text=True, timeout=120)
+    finally:
+        server.close()
+    assert done.returncode == 2, done.stderr
+    assert "no Dask scheduler answers within 2 s" in done.stderr
+    assert "Traceback" not in done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.yaml"]

@@ -96,6 +96,30 @@ CORRUPTIONS: dict[str, tuple[Callable[[Path], None], str]] = {
                           "corrupt manifest"),
     "manifest a list": (lambda ds: (ds / "manifest.json").write_text("[]"),
                         "not a landnav-dataset/1 manifest"),
+    "imu empty": (lambda ds: _rewrite(ds / "imu.parquet", lambda t: t.slice(0, 0)),
+                  "corrupt imu stream: no samples"),
+    "imu sample of 1e300": (lambda ds: _rewrite(ds / "imu.parquet", lambda t: _set_column(
+        t, "accel_x", np.r_[t.column("accel_x").to_numpy()[:-1], 1e300])),
+        "accel_x = 1e+300 at row"),
+    "imu unit deg/s": (lambda ds: _rewrite(ds / "imu.parquet", lambda t: t.cast(pa.schema([
+        f.with_metadata({"unit": "deg/s" if f.name.startswith("gyro") else
+                         (f.metadata or {}).get(b"unit", b"").decode()}) for f in t.schema]))),
+        "column gyro_x is in 'deg/s'"),
+    "scenario sensors as text": (lambda ds: _manifest(
+        ds, lambda m: m["scenario"].update(sensors="imu")),
+        "scenario.sensors: not a mapping"),
+    "broadcast ionosphere as text": (lambda ds: _manifest(
+        ds, lambda m: m["sensors"]["gnss"].update(broadcast_iono="x")),
+        "sensors.gnss.broadcast_iono: not a mapping"),
+    "gps week -5": (lambda ds: _manifest(ds, lambda m: m["gps_time_start"].update(week=-5)),
+                    "-5 is not a GPS week"),
+    "gnss_fix latitude 1e300": (lambda ds: _rewrite(ds / "gnss_fix.parquet", lambda t: _set_column(
+        t, "lat", np.r_[1e300, t.column("lat").to_numpy()[1:]])),
+        "row 0 holds 1e+300, outside [-90, 90]"),
+    "gnss_raw pseudorange infinite": (lambda ds: _rewrite(ds / "gnss_raw.parquet",
+                                                          lambda t: _set_column(
+        t, "pseudorange", np.r_[np.inf, t.column("pseudorange").to_numpy()[1:]])),
+        "it cannot be exported"),
 }
 # which command reads which stream
 COMMANDS = {
@@ -111,7 +135,10 @@ READS = {
     "imu samples without value": ("estimate",), "truth time backwards": ("score",),
     "events without t_end": ("score",), "gnss_fix course missing": ("score",),
     "gps week as text": ("export",), "origin lat as list": ("export",),
-    "not a parquet file": ("estimate",),
+    "not a parquet file": ("estimate",), "imu empty": ("estimate",),
+    "imu sample of 1e300": ("estimate",), "imu unit deg/s": ("estimate",),
+    "broadcast ionosphere as text": ("export",), "gps week -5": ("export",),
+    "gnss_fix latitude 1e300": ("export",), "gnss_raw pseudorange infinite": ("export",),
 }
 
 

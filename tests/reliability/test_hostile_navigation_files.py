@@ -16,6 +16,7 @@ start: {{utc: 2020-01-02T00:00:00Z, lat: 37.5, lon: 127.0}}
 trajectory:
   kind: segments
   segments:
+    - accelerate: {{to_speed: 5, accel: 1.5}}
     - straight: {{length: 10}}
 sensors:
   gnss: {{constellation: {nav}}}

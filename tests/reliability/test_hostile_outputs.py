@@ -15,20 +15,12 @@ from pathlib import Path
 import pytest
 
 from simulator.cli import main
+from tests.reliability.checks import refused
 from tests.reliability.drives import straight_drive
 
 REPO = Path(__file__).resolve().parents[2]
 SCENARIO = straight_drive(200, sensors="  imu: {preset: ideal, rate: 50}\n"
                                        "  gnss: {rate: 1, outputs: [fix, raw]}\n")
-
-
-def _tree(root: Path) -> dict[str, tuple[int, int]]:
-    """Every path under ``root`` with its size and modification time."""
-    out = {}
-    for path in sorted(root.rglob("*")):
-        stat = path.lstat()
-        out[str(path.relative_to(root))] = (stat.st_size, stat.st_mtime_ns)
-    return out
 
 
 @pytest.fixture(scope="module")
@@ -47,40 +39,26 @@ def solution(dataset, tmp_path) -> Path:
     return path
 
 
-def _refused(args: list[str], capsys, watch: list[Path], words: str) -> str:
-    before = {str(w): _tree(w) for w in watch}
-    code = main(args)
-    out = capsys.readouterr()
-    text = out.err + out.out
-    assert code == 2, text
-    assert "Traceback" not in text
-    assert words in text, text
-    errors = [line for line in text.splitlines() if line.startswith("error:")]
-    assert len(errors) == 1, text
-    assert {str(w): _tree(w) for w in watch} == before
-    return text
-
-
 def test_estimate_refuses_to_overwrite(dataset, solution, capsys):
-    _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(solution)], capsys,
+    refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(solution)], capsys,
              [solution.parent, dataset], "already exists; use --force")
 
 
 def test_estimate_never_writes_into_the_dataset(dataset, capsys):
     for target in (dataset / "imu.parquet", dataset / "new.parquet"):
-        _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(target), "--force"],
+        refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(target), "--force"],
                  capsys, [dataset], "is inside the input")
 
 
 def test_export_nmea_never_overwrites_the_manifest(dataset, capsys):
-    _refused(["export", str(dataset), "--nmea", str(dataset / "manifest.json"), "--force"],
+    refused(["export", str(dataset), "--nmea", str(dataset / "manifest.json"), "--force"],
              capsys, [dataset], "is inside the input")
 
 
 def test_score_json_refuses_to_overwrite(dataset, solution, tmp_path, capsys):
     target = tmp_path / "scores.json"
     target.write_text("{}")
-    _refused(["score", str(dataset), "--solution", str(solution), "--json", str(target)],
+    refused(["score", str(dataset), "--solution", str(solution), "--json", str(target)],
              capsys, [tmp_path, dataset], "already exists; use --force")
     assert main(["score", str(dataset), "--solution", str(solution), "--json", str(target),
                  "--force"]) == 0
@@ -91,7 +69,7 @@ def test_export_rinex_refuses_existing_files_and_writes_both_or_none(dataset, tm
     out = tmp_path / "rinex"
     out.mkdir()
     (out / f"{dataset.name}.nav").write_text("mine")
-    _refused(["export", str(dataset), "--rinex", str(out)], capsys, [tmp_path, dataset],
+    refused(["export", str(dataset), "--rinex", str(out)], capsys, [tmp_path, dataset],
              "already exists")
     assert sorted(p.name for p in out.iterdir()) == [f"{dataset.name}.nav"]
 
@@ -109,7 +87,7 @@ def test_output_is_a_folder_or_file_of_the_wrong_kind(dataset, solution, tmp_pat
         "--rinex": ["export", str(dataset), "--rinex", str(a_file)],
         "-o": ["estimate", str(dataset), "-e", "gnss_only", "-o", str(a_file / "x.parquet")],
     }[option]
-    _refused(args, capsys, [tmp_path, dataset], str(folder if option in ("--json", "--nmea")
+    refused(args, capsys, [tmp_path, dataset], str(folder if option in ("--json", "--nmea")
                                                        else a_file))
 
 
@@ -123,7 +101,7 @@ def test_unwritable_parent(dataset, tmp_path, capsys, where):
     target = Path("/proc/landnav-test.parquet") if where == "/proc" or os.geteuid() == 0 \
         else locked / "s.parquet"
     try:
-        _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(target)],
+        refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(target)],
                  capsys, [tmp_path], "cannot write here")
     finally:
         locked.chmod(0o700)
@@ -132,7 +110,7 @@ def test_unwritable_parent(dataset, tmp_path, capsys, where):
 def test_dangling_symlink_as_output(dataset, tmp_path, capsys):
     link = tmp_path / "dangling.parquet"
     link.symlink_to(tmp_path / "nowhere" / "x.parquet")
-    _refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(link)], capsys,
+    refused(["estimate", str(dataset), "-e", "gnss_only", "-o", str(link)], capsys,
              [tmp_path], "dangling symbolic link")
 
 
@@ -140,7 +118,7 @@ def test_generate_under_an_existing_file(tmp_path, capsys):
     scenario = tmp_path / "s.yaml"
     scenario.write_text(SCENARIO)
     (tmp_path / "f").write_text("x")
-    _refused(["generate", str(scenario), "-o", str(tmp_path / "f" / "ds")], capsys, [tmp_path],
+    refused(["generate", str(scenario), "-o", str(tmp_path / "f" / "ds")], capsys, [tmp_path],
              "is a file, not a folder")
 
 
@@ -150,7 +128,7 @@ def test_a_claimed_folder_is_refused_and_a_stale_claim_taken_over(tmp_path, caps
     claim = tmp_path / ".ds.tmp"
     claim.mkdir()
     (claim / ".landnav-owner").write_text(str(os.getpid()))  # a live process holds it
-    _refused(["generate", str(scenario), "-o", str(tmp_path / "ds")], capsys, [tmp_path],
+    refused(["generate", str(scenario), "-o", str(tmp_path / "ds")], capsys, [tmp_path],
              f"process {os.getpid()}")
     dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
                           capture_output=True, text=True).stdout.strip()
@@ -205,3 +183,66 @@ def test_signal_during_generation_leaves_nothing(tmp_path, sig, code, command):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["s.yaml"]
     rerun = _landnav([command, str(scenario), "-o", "out"], tmp_path)
     assert rerun.wait(timeout=300) == 0, rerun.communicate()
+
+
+def test_names_that_are_not_utf8(dataset, tmp_path, capsys):
+    bad = os.fsdecode(b"out\xff")
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO)
+    refused(["generate", str(scenario), "-o", str(tmp_path / bad)], capsys, [tmp_path],
+            "is not valid UTF-8 text")
+    refused(["estimate", str(dataset), "-e", "gnss_only", "-o",
+             str(tmp_path / f"{bad}.parquet")], capsys, [tmp_path], "is not valid UTF-8 text")
+
+
+@pytest.mark.parametrize("stdout, code", [("full", 2), ("closed", 0)])
+def test_full_or_closed_standard_output(tmp_path, stdout, code):
+    """A full standard output is one message (the dataset itself is written); a closed one
+    loses only what would be printed."""
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO)
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
+    argv = [sys.executable, "-m", "simulator.cli", "generate", str(scenario), "-o",
+            str(tmp_path / "ds")]
+    if stdout == "full":
+        with open("/dev/full", "w") as full:
+            done = subprocess.run(argv, env=env, stdout=full, stderr=subprocess.PIPE,
+                                  text=True, timeout=300)
+    else:
+        done = subprocess.run(argv, env=env, stderr=subprocess.PIPE, text=True, timeout=300,
+                              preexec_fn=lambda: os.close(1))
+    assert done.returncode == code, done.stderr
+    assert "Traceback" not in done.stderr
+    if code == 2:
+        assert done.stderr.count("error:") == 1 and "standard output" in done.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["ds", "s.yaml"]
+
+
+def test_thread_settings_leave_the_bytes_unchanged(tmp_path):
+    """The same dataset with OpenBLAS on one and on two threads (before, three truth rows of
+    this drive differed by 3e-17)."""
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text((REPO / "scenarios" / "quickstart.yaml").read_text())
+    for threads in ("1", "2"):
+        env = {**os.environ, "PYTHONPATH": str(REPO), "OPENBLAS_NUM_THREADS": threads}
+        subprocess.run([sys.executable, "-m", "simulator.cli", "generate", str(scenario), "-o",
+                        str(tmp_path / threads)], env=env, check=True, capture_output=True,
+                       timeout=600)
+    files = sorted(p.name for p in (tmp_path / "1").glob("*.parquet"))
+    assert files == sorted(p.name for p in (tmp_path / "2").glob("*.parquet"))
+    for name in files:
+        assert (tmp_path / "1" / name).read_bytes() == (tmp_path / "2" / name).read_bytes(), name
+
+
+@pytest.mark.parametrize("where, words", [
+    ("under a file", "is a file, not a folder"), ("dangling link", "dangling symbolic link"),
+    ("/proc", "cannot write here")])
+def test_campaign_outputs_that_cannot_be_written(tmp_path, capsys, where, words):
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(SCENARIO + "estimators: [gnss_only]\n")
+    (tmp_path / "f").write_text("x")
+    (tmp_path / "dangling").symlink_to(tmp_path / "nowhere")
+    out = {"under a file": tmp_path / "f" / "mc", "dangling link": tmp_path / "dangling",
+           "/proc": Path("/proc/landnav-mc")}[where]
+    refused(["campaign", str(scenario), "--runs", "1", "--workers", "1", "-o", str(out)],
+            capsys, [tmp_path], words)

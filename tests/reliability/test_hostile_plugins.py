@@ -25,6 +25,8 @@ CASES = {
     "CallsExit": "called sys.exit(0); an estimator must return, not exit",
     "AllNan": "gave no solution row with a position",
     "OneMegahertz": "output_rate_hz must be a number in (0, 1000] Hz",
+    "LeavesTheProcess": "ended its process (exit code 0)",
+    "NeverReturns": "did not finish within the time limit of 3 s",
 }
 
 
@@ -36,7 +38,8 @@ def dataset(tmp_path_factory) -> Path:
 @pytest.mark.parametrize("cls", list(CASES))
 def test_misbehaving_plugin(dataset, tmp_path, capsys, cls):
     out = tmp_path / "sol.parquet"
-    code = main(["estimate", str(dataset), "-e", f"hostile_plugins:{cls}", "-o", str(out)])
+    code = main(["estimate", str(dataset), "-e", f"hostile_plugins:{cls}", "-o", str(out),
+                 "--time-limit", "3"])
     printed = capsys.readouterr()
     text = printed.err + printed.out
     assert code == 2, text

@@ -1,0 +1,34 @@
+"""What every hostile case asserts: exit 2, one message with the words expected, no traceback,
+and the watched folders unchanged (every path with its size and modification time)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from simulator.cli import main
+
+
+def tree(root: Path) -> dict[str, tuple[int, int]]:
+    """Every path under ``root`` (links not followed) with its size and modification time."""
+    out = {}
+    for path in sorted(root.rglob("*")):
+        stat = path.lstat()
+        out[str(path.relative_to(root))] = (stat.st_size, stat.st_mtime_ns)
+    return out
+
+
+def refused(args: list[str], capsys, watch: list[Path], words: str,
+            prefix: str = "error:") -> str:
+    """Run ``landnav ARGS``; assert it is refused as above (one line starting with ``prefix``:
+    ``validate`` prints its problems as ``file:line: ...``); the printed text."""
+    before = {str(w): tree(w) for w in watch}
+    code = main(args)
+    out = capsys.readouterr()
+    text = out.err + out.out
+    assert code == 2, text
+    assert "Traceback" not in text
+    assert words in text, text
+    errors = [line for line in text.splitlines() if line.startswith(prefix)]
+    assert len(errors) == 1, text
+    assert {str(w): tree(w) for w in watch} == before
+    return text
