@@ -125,10 +125,13 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
     return data, lines
 
 
-def _bounded_load(text: str, file: str, lines: dict, empty: Any) -> Any:
-    """YAML text built within ``MAX_NODES`` and ``MAX_DEPTH`` (``empty`` for no document)."""
-    # libyaml's parser when PyYAML has it (several times faster), the pure-Python one otherwise
-    loader = getattr(yaml, "CSafeLoader", yaml.SafeLoader)(text)
+def _bounded_load(text: str, file: str, lines: dict, empty: Any, fast: bool = True) -> Any:
+    """YAML text built within ``MAX_NODES`` and ``MAX_DEPTH`` (``empty`` for no document).
+    ``fast``: libyaml's parser when PyYAML has it (several times faster), else the pure-Python
+    one, which also reads flow mappings without a space after the colon (``{fixed:[1,2]}``,
+    as ``yaml.safe_load`` does; libyaml refuses them)."""
+    loader_class = getattr(yaml, "CSafeLoader", yaml.SafeLoader) if fast else yaml.SafeLoader
+    loader = loader_class(text)
     try:
         node = loader.get_single_node()
         return empty if node is None else _construct(node, loader, (), lines, file, _Budget())
@@ -140,7 +143,7 @@ def load_value(raw: str, where: str) -> Any:
     """A ``KEY=VALUE`` option's value read as YAML within the same bounds as a file (aliases,
     nesting); text that is not YAML stays text, a value beyond the bounds is an InputError."""
     try:
-        value = _bounded_load(raw, where, {}, None) if raw.strip() else ""
+        value = _bounded_load(raw, where, {}, None, fast=False) if raw.strip() else ""
     except (yaml.YAMLError, ValueError, RecursionError):
         value = raw
     if isinstance(value, str) and _PLAIN_FLOAT.match(value.strip()):
