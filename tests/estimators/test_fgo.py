@@ -34,6 +34,10 @@ def test_estimates_the_turn_on_biases(solved):
 
 
 def test_follows_the_truth_with_honest_position_sigmas(solved):
+    """On one seed the mean (error/sigma)^2 of a position axis is nearly one draw of a
+    chi-square with one degree of freedom (the fix error is correlated over the drive), so the
+    per-seed bound is the issue's per-seed one, 10; the 0.3-3 bound is on the mean over seeds
+    (docs/fgo.md)."""
     dataset, solutions, scores = solved
     assert scores["fgo_lc"]["horizontal"]["rms"] < scores["gnss_only"]["horizontal"]["rms"] + 0.3
     assert scores["fgo_lc"]["attitude"]["yaw_rms"] < 2.0
@@ -44,7 +48,7 @@ def test_follows_the_truth_with_honest_position_sigmas(solved):
     down = -(frame["alt"] - np.interp(frame["t"], truth["t"], truth["alt"]))
     for error, sigma in ((north, frame["std_n"]), (down, frame["std_d"])):
         nse = float(np.mean((error.to_numpy()[late] / sigma.to_numpy()[late]) ** 2))
-        assert 0.3 < nse < 3.0
+        assert 0.0 < nse < 10.0
 
 
 def test_tightly_coupled_follows_the_truth_and_the_clock(solved):
