@@ -253,6 +253,11 @@ def _rinex_record(lines: list[str], i: int, version: float, file_system: str, at
             found = _numbers(more)
             values += found + [0.0] * (4 - len(found))  # blank trailing fields read as zero
         sv = int(parts[0])
+    if i + 1 + n_more > len(lines):
+        raise ValueError(f"the record of {system}{sv:02d} ends after {len(lines) - i} of its "
+                         f"{n_more + 1} lines")
+    if version < 3 and len(_numbers(line[22:])) < 3:
+        raise ValueError("its first line does not hold the clock's three numbers")
     if system == "R":
         rows.append(_glonass_record(sv, epoch, values, _leap(attrs, epoch)))
     else:
