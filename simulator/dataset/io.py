@@ -105,7 +105,9 @@ class DatasetWriter:
         for name, table in streams.items():
             rows = n_rows(table)
             rate = None
-            if "t" in table and rows > 1 and name not in ("gnss_raw", "truth_gnss"):
+            # one row per satellite and signal: no rate (the epochs' rate is the receiver's)
+            if "t" in table and rows > 1 and name not in ("gnss_raw", "truth_gnss",
+                                                           "gnss_base_raw", "truth_gnss_base"):
                 t = column(table, "t")
                 rate = round(float((rows - 1) / (t[-1] - t[0])), 6)
             manifest["streams"][name] = {"file": self.file_name(name), "rows": rows,
