@@ -118,6 +118,7 @@ from estimators.toolbox.range_bias import RangeBiasChannels
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
+from simulator.datasheet import iono_residual_fractions
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -520,15 +521,12 @@ class _TightlyCoupled(Estimator):
 
 
 def _iono_residual(receiver: dict) -> tuple[float, float]:
-    """The broadcast ionosphere's relative residual from the receiver's datasheet: the true
-    delay is ``iono_scale`` (1 + ``iono_residual`` g) times the broadcast model's, g a field
-    over the sky (docs/gnss-errors.md), so the residual is (scale - 1) + scale residual g.
-    Returns its part common to the satellites, |scale - 1|, and the 1-sigma of the field's,
-    scale residual (``KLOBUCHAR_RESIDUAL`` and 0 without a datasheet)."""
+    """The broadcast ionosphere's relative residual from the receiver's datasheet
+    (``simulator.datasheet.iono_residual_fractions``): its part common to the satellites and
+    the 1-sigma of the field's (``KLOBUCHAR_RESIDUAL`` and 0 without a datasheet)."""
     if "iono_scale" not in receiver:
         return KLOBUCHAR_RESIDUAL, 0.0
-    scale, residual = float(receiver["iono_scale"]), float(receiver.get("iono_residual", 0.0))
-    return abs(scale - 1.0), scale * residual
+    return iono_residual_fractions(receiver)
 
 
 def _iono_delay(ep: gnss_model.RawEpoch) -> np.ndarray:

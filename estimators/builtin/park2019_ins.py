@@ -94,7 +94,7 @@ from estimators.toolbox.datasheet import (
     odometer_delay_s,
     odometer_speed_sigma,
 )
-from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise, ins_noise
+from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
 from estimators.toolbox.installation import Installation
 from simulator.earth import quat_to_dcm
 from simulator.errors import InputError
@@ -181,6 +181,8 @@ class ParkInsOdometer(Estimator):
         self._rear = site.rear_axle if self.config["nhc_point"] == "rear_axle" else None
         self._slip = (NonholonomicNoise(site.wheelbase or 2.7) if self._rear is not None
                       else None)
+        # the odometer's own point (the datasheet tuning): the speed along the path it counts
+        self._odo_point = site.odometer if self._sheet else None
         n_rows = 3 if self.config["nhc"] else 1
         self._r_odo = np.eye(n_rows) * self.R_ODOMETER
         self._r_fix = np.zeros((6, 6))
@@ -193,14 +195,13 @@ class ParkInsOdometer(Estimator):
         (``fix_error_model``; the states' size is set again at the first fix from its DOPs)
         and odometer (its speed quantisation and latency, ``odometer_speed_sigma``)."""
         imu = imu_error_model(self.datasheet)
-        noise = ins_noise(imu)
         p0 = self.P0_SIGMA.copy()
         p0[9:12], p0[12:15] = imu.accel_bias_initial, imu.gyro_bias_initial
         self._fix_model = fix_error_model(self.datasheet)
         self._odo_sigma = odometer_speed_sigma(self.datasheet)
         self._odo_still_sigma = odometer_speed_sigma(self.datasheet, 0.0)
         self._odo_delay = odometer_delay_s(self.datasheet)
-        return noise, p0, self._fix_model.correlated_sigma(1.0, 2.0), self._fix_model.correlated_tau
+        return imu, p0, self._fix_model.correlated_sigma(1.0, 2.0), self._fix_model.correlated_tau
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         self.ins.add_imu(t, row)
@@ -245,6 +246,9 @@ class ParkInsOdometer(Estimator):
         speed = float(row[self._speed])
         dz, h = aiding.odometer(ins.q, ins.v, speed, self.config["nhc"], ins.n_states,
                                 ins.mean_rate, self._rear)
+        if self._odo_point is not None:
+            dz[:1], h[:1] = aiding.odometer(ins.q, ins.v, speed, False, ins.n_states,
+                                            ins.mean_rate, self._odo_point)
         r = self._r_odo
         scale_sigma = self.ODOMETER_SCALE_SIGMA
         if self._scale_col is not None:  # the odometer reads (1 + k) v: dz = v_x - speed / (1 + k)

@@ -13,23 +13,17 @@ that tunes itself "from the datasheet" means the same thing.
   ``InsFilter`` adds (s dx)^2 to the bias's process noise over each interval
   (``InsNoise.gyro_scale_sigma``, ``accel_scale_sigma``; the gyro's g-sensitivity times the
   change of specific force likewise).
-* ``fix_error_model``: the position error of a receiver's fix, per unit DOP, split by time
-  behaviour (the user range error budget of Kaplan & Hegarty 2017, section 10.2, with the
-  receiver's own parameters):
+* ``fix_error_model``: the position error of a receiver's fix, per unit DOP, from the one
+  receiver error budget (``simulator.datasheet.range_error_budget``), split by time behaviour:
 
   - correlated over the drive (``correlated_sigma``, correlation time ``CORRELATED_TAU_S``):
-    signal in space (``sis_error``), the ionosphere's residual after the broadcast model
-    (``iono_scale`` - 1 plus its variation ``iono_scale`` x ``iono_residual``, times the
-    Klobuchar model's night-time vertical delay of 5 ns (IS-GPS-200 20.3.3.5.2.5, its
-    smallest value, so a lower bound of the day's) and the obliquity at 30 deg elevation,
-    1.77) and the troposphere's residual (``tropo_residual`` of a 2.3 m zenith delay, same
-    obliquity). Per axis: north and east HDOP / sqrt(2), down VDOP times that range error.
-  - the rest, code tracking noise (``tracking_noise``, lowered by the Hatch filter to
-    1 / sqrt(2N - 1), N = ``carrier_smoothing`` x ``rate`` epochs) and multipath
-    (``multipath``): correlated over the carrier-smoothing time T, so given to the filter as
-    the white noise of the same low-frequency spectrum, variance 2 sigma^2 T / dt at the fix
-    interval dt (Brown & Hwang, 4th ed., section 2.9: a first-order Gauss-Markov process's PSD
-    at zero frequency is 2 sigma^2 T).
+    signal in space, the ionosphere's and the troposphere's residuals. Per axis: north and
+    east HDOP / sqrt(2), down VDOP times that range error.
+  - the rest, code tracking noise after the Hatch filter and multipath: correlated over the
+    carrier-smoothing time T, so given to the filter as the white noise of the same
+    low-frequency spectrum, variance 2 sigma^2 T / dt at the fix interval dt (Brown & Hwang,
+    4th ed., section 2.9: a first-order Gauss-Markov process's PSD at zero frequency is
+    2 sigma^2 T).
   - velocity: 0.05 m/s per range rate (u-blox NEO-M8 data sheet; the ``automotive`` FLL's
     0.024-0.08 m/s at 45-35 dB-Hz, docs/gnss-errors.md) times the DOP.
 
@@ -56,32 +50,22 @@ from typing import Any
 
 import numpy as np
 
-C_M_S = 299_792_458.0  # speed of light, m/s
-KLOBUCHAR_NIGHT_DELAY_M = 5e-9 * C_M_S  # the broadcast model's constant night-time term, m
-OBLIQUITY_30_DEG = 1.77  # Klobuchar's obliquity factor 1 + 16 (0.53 - E)^3 at E = 30 deg
-TROPO_ZENITH_DELAY_M = 2.3  # sea-level zenith delay of a standard atmosphere, m
+from estimators.toolbox.ins_filter import InsNoise
+from simulator.datasheet import range_error_budget
+
 CORRELATED_TAU_S = 1800.0  # ionosphere and ephemeris residuals change over tens of minutes
 RANGE_RATE_SIGMA_M_S = 0.05  # a car receiver's range-rate noise (u-blox NEO-M8: 0.05 m/s)
 DEFAULT_BIAS_TAU_S = 600.0  # correlation time of the in-run bias when the sheet gives none
 
 
 @dataclass(frozen=True)
-class ImuErrorModel:
-    """Per axis, SI units: white noise densities (per sqrt(Hz)), in-run Gauss-Markov bias sigma
-    and correlation time, turn-on bias 1-sigma, scale-factor 1-sigma (misalignment included)
-    and the gyro's g-sensitivity (rad/s per m/s^2)."""
+class ImuErrorModel(InsNoise):
+    """The filter's IMU noise (``ins_filter.InsNoise``: per axis, SI units, white noise
+    densities, in-run Gauss-Markov bias sigma and correlation time, scale-factor 1-sigma with
+    misalignment, the gyro's g-sensitivity) and the turn-on bias 1-sigma a filter's P0 takes."""
 
-    accel_noise: float
-    gyro_noise: float
-    accel_bias_sigma: float
-    gyro_bias_sigma: float
-    accel_bias_tau: float
-    gyro_bias_tau: float
-    accel_bias_initial: float
-    gyro_bias_initial: float
-    accel_scale_sigma: float
-    gyro_scale_sigma: float
-    gyro_g_sensitivity: float
+    accel_bias_initial: float = 0.0
+    gyro_bias_initial: float = 0.0
 
 
 def _value(group: Mapping[str, Any], key: str) -> float:
@@ -156,28 +140,16 @@ def _axes(hdop: float, vdop: float) -> np.ndarray:
 
 
 def fix_error_model(datasheet: Mapping[str, Any]) -> FixErrorModel:
-    """The fix error budget (module docstring) from the datasheet's ``gnss`` block; a block
+    """The fix error model (module docstring) from the datasheet's ``gnss`` block; a block
     without these keys (an ``ideal`` receiver) gives a 0.1 m floor."""
     gnss = datasheet.get("gnss") or {}
-
-    def key(name: str, default: float = 0.0) -> float:
-        v = gnss.get(name)
-        return default if v is None else float(v)
-
-    iono_scale = key("iono_scale", 1.0)
-    iono = ((abs(iono_scale - 1.0) + iono_scale * key("iono_residual"))
-            * KLOBUCHAR_NIGHT_DELAY_M * OBLIQUITY_30_DEG)
-    tropo = key("tropo_residual") * TROPO_ZENITH_DELAY_M * OBLIQUITY_30_DEG
-    correlated = math.sqrt(key("sis_error") ** 2 + iono**2 + tropo**2)
-    rate = key("rate", 1.0)
-    smoothing = key("carrier_smoothing")
-    n_smooth = max(smoothing * rate, 1.0)
-    noise = key("tracking_noise") / math.sqrt(2.0 * n_smooth - 1.0)
-    white = math.hypot(noise, key("multipath"))
-    if smoothing > 0:  # the white noise of the smoothed error's low-frequency spectrum
-        white *= math.sqrt(2.0 * smoothing * rate)
-    return FixErrorModel(correlated_range=max(correlated, 0.1), white_range=max(white, 0.1),
-                         correlated_tau=CORRELATED_TAU_S, range_rate=RANGE_RATE_SIGMA_M_S)
+    budget = range_error_budget(gnss)
+    white = budget.smoothed
+    if budget.smoothing_s > 0:  # the white noise of the smoothed error's low-frequency spectrum
+        white *= math.sqrt(2.0 * budget.smoothing_s * float(gnss.get("rate") or 1.0))
+    return FixErrorModel(correlated_range=max(budget.correlated_m(), 0.1),
+                         white_range=max(white, 0.1), correlated_tau=CORRELATED_TAU_S,
+                         range_rate=RANGE_RATE_SIGMA_M_S)
 
 
 ODOMETER_FLOOR_M_S = 0.05  # wheel motion the body does not share, m/s (chosen)

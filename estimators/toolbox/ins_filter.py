@@ -18,7 +18,7 @@ closed loop, and decayed by exp(-dt / tau) between updates (the process's expect
 
 Public names
 ------------
-InsNoise, InsFilter, ins_noise.
+InsNoise, InsFilter.
 """
 
 from __future__ import annotations
@@ -31,7 +31,6 @@ from numba import njit
 
 from estimators.base import InitialState
 from estimators.toolbox import nav_error
-from estimators.toolbox.datasheet import ImuErrorModel
 from estimators.toolbox.gating import innovation_covariance, passes_gate
 from estimators.toolbox.ins_error import BA, BG, N_STATES, discretise, noise_psd, system_matrix
 from estimators.toolbox.kalman import ErrorState
@@ -69,16 +68,6 @@ class InsNoise:
     accel_scale_sigma: float = 0.0
     gyro_scale_sigma: float = 0.0
     gyro_g_sensitivity: float = 0.0
-
-
-def ins_noise(imu: ImuErrorModel) -> InsNoise:
-    """The ``InsNoise`` of an IMU's datasheet error model (``toolbox.datasheet``)."""
-    return InsNoise(accel_noise=imu.accel_noise, gyro_noise=imu.gyro_noise,
-                    accel_bias_sigma=imu.accel_bias_sigma, gyro_bias_sigma=imu.gyro_bias_sigma,
-                    accel_bias_tau=imu.accel_bias_tau, gyro_bias_tau=imu.gyro_bias_tau,
-                    accel_scale_sigma=imu.accel_scale_sigma,
-                    gyro_scale_sigma=imu.gyro_scale_sigma,
-                    gyro_g_sensitivity=imu.gyro_g_sensitivity)
 
 
 @njit(cache=True)

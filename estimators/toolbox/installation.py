@@ -14,6 +14,11 @@ is mounted.
   are written. (The car's body pitches and rolls on its suspension: that is the vehicle
   frame's own attitude, which the strapdown tracks, not a mounting.)
 * ``wheelbase``: m; None when unknown.
+* ``odometer``: the point whose travelled distance the odometer counts, from the IMU (body FRD,
+  m): the truth's road-following centre of gravity, -``imu_position`` of the datasheet's
+  ``vehicle`` block (the simulated odometer counts the distance along the road profile,
+  ``simulator.sensors.odometer``, which is that point's path, docs/vehicle.md; in a turn of radius R it runs faster than the rear axle by
+  1 / sqrt(1 - (l_r / R)^2), 1 % in an 11 m helix); None without a vehicle block.
 
 Public names
 ------------
@@ -46,6 +51,7 @@ class Installation:
     antenna: np.ndarray | None = None
     mounting: np.ndarray | None = None
     wheelbase: float | None = None
+    odometer: np.ndarray | None = None
 
     @classmethod
     def from_datasheet(cls, datasheet: Mapping[str, Any]) -> Installation:
@@ -54,7 +60,9 @@ class Installation:
         gnss = datasheet.get("gnss") or {}
         mount = _vector((datasheet.get("imu") or {}).get("mounting"))
         rear = vehicle.get("rear_axle")
+        cog = vehicle.get("imu_position")
         return cls(rear_axle=None if rear is None else np.asarray(rear, dtype=float),
+                   odometer=None if cog is None else -np.asarray(cog, dtype=float),
                    antenna=_vector(gnss.get("antenna_lever_arm")),
                    mounting=None if mount is None else euler_to_dcm(*np.radians(mount)),
                    wheelbase=vehicle.get("wheelbase"))

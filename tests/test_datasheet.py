@@ -1,0 +1,67 @@
+"""The one receiver error budget (``simulator.datasheet``) against what it is read from: the
+ionosphere fractions against the receiver simulation's own reported pseudorange variance, the
+budget of the ``automotive`` preset against its terms worked by hand, and the consumers (the
+filters' fix model, the exported UERE) against the budget."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from estimators.toolbox.datasheet import fix_error_model
+from simulator.datasheet import (
+    KLOBUCHAR_NIGHT_SLANT_M,
+    fix_uere_m,
+    iono_residual_fractions,
+    range_error_budget,
+)
+from simulator.gnss.errors import pseudorange_sigma
+from simulator.sensors.gnss import PRESETS
+
+AUTOMOTIVE = PRESETS["automotive"]
+
+
+def test_iono_fractions_are_the_simulation_reported_ionosphere_variance():
+    """With every other term zero, the simulated receiver reports sigma = sqrt(common^2 +
+    field^2) x the broadcast delay (simulator.gnss.errors.pseudorange_sigma)."""
+    common, field = iono_residual_fractions(AUTOMOTIVE)
+    assert (common, field) == (0.5, 1.5 * 0.2)
+    cfg = {**AUTOMOTIVE, "tropo_residual": 0.0, "sis_error": 0.0, "carrier_smoothing": 0.0,
+           "dll_bandwidth": 1.0, "multipath_distance": 10.0, "multipath_correlation_time": 1.0}
+    zeros = np.zeros((2, 3))
+    terms = {"code_sigma": zeros, "multipath_sigma": zeros, "rate_sigma": zeros + 0.05}
+    iono = np.array([[4.0, 6.0, 9.0], [3.0, 5.0, 8.0]])
+    sigma, _ = pseudorange_sigma(cfg, terms, iono, np.ones((2, 3)), 1.0, np.ones(3))
+    np.testing.assert_allclose(sigma, math.hypot(common, field) * iono, rtol=1e-12)
+
+
+def test_automotive_budget_worked_by_hand():
+    b = range_error_budget(AUTOMOTIVE)
+    assert b.sis == 0.5
+    # the Klobuchar night floor, 5 ns x c = 1.4990 m, at the 30 deg obliquity 1.77
+    assert math.isclose(KLOBUCHAR_NIGHT_SLANT_M, 2.6532, rel_tol=1e-4)
+    assert math.isclose(b.ionosphere, 0.8 * 2.6532, rel_tol=1e-4)
+    assert math.isclose(b.troposphere, 0.05 * 2.0)
+    # code noise 1 m after a 100-epoch Hatch filter, 1 / sqrt(199), and 0.3 m multipath
+    assert math.isclose(b.smoothed, math.hypot(1.0 / math.sqrt(199.0), 0.3))
+    assert math.isclose(b.correlated_m(), math.sqrt(0.25 + (0.8 * 2.6532) ** 2 + 0.01),
+                        rel_tol=1e-4)
+    assert math.isclose(b.correlated_m(ionosphere=False), math.sqrt(0.26))
+
+
+def test_consumers_read_the_one_budget():
+    b = range_error_budget(AUTOMOTIVE)
+    model = fix_error_model({"gnss": AUTOMOTIVE})
+    assert model.correlated_range == b.correlated_m()
+    # the smoothed error's white equivalent at 1 Hz: sigma sqrt(2 T / dt), T = 100 s
+    assert math.isclose(model.white_range, b.smoothed * math.sqrt(200.0))
+    assert fix_uere_m(AUTOMOTIVE) == math.hypot(b.correlated_m(), b.smoothed)
+
+
+def test_an_ideal_receiver_has_no_error_and_the_filters_keep_a_floor():
+    ideal = PRESETS["ideal"]
+    assert fix_uere_m(ideal) == 0.0
+    assert iono_residual_fractions({}) == (0.0, 0.0)
+    model = fix_error_model({"gnss": ideal})
+    assert model.correlated_range == 0.1 and model.white_range == 0.1
