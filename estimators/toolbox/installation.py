@@ -17,8 +17,9 @@ is mounted.
 * ``odometer``: the point whose travelled distance the odometer counts, from the IMU (body FRD,
   m): the truth's road-following centre of gravity, -``imu_position`` of the datasheet's
   ``vehicle`` block (the simulated odometer counts the distance along the road profile,
-  ``simulator.sensors.odometer``, which is that point's path, docs/vehicle.md; in a turn of radius R it runs faster than the rear axle by
-  1 / sqrt(1 - (l_r / R)^2), 1 % in an 11 m helix); None without a vehicle block.
+  ``simulator.sensors.odometer``, which is that point's path, docs/vehicle.md; in a turn of
+  radius R it runs faster than the rear axle by 1 / sqrt(1 - (l_r / R)^2), 1 % in an 11 m
+  helix); None without a vehicle block.
 
 Public names
 ------------
