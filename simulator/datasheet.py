@@ -7,7 +7,11 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
   times the broadcast model's, g a unit-variance field over the sky (docs/gnss-errors.md), so
   the residual is (scale - 1) + scale residual g: a part common to every satellite,
   |scale - 1|, and the field's 1-sigma, scale residual. A tightly coupled filter scales these
-  by each satellite's own broadcast delay.
+  by each satellite's own broadcast delay. Of the field, ``IONO_FIELD_OWN_SHARE`` of its
+  1-sigma is each satellite's own and the rest common: the pierce points of one epoch's
+  satellites on the 350 km shell lie up to about a thousand km apart, and the field's
+  correlation is exp(-d^2 / (2 L^2)), L = 1000 km (docs/gnss-errors.md): about 0.75 at a
+  typical 750 km, so sqrt(1 - 0.75) = 0.5 of it is each satellite's own.
 * ``range_error_budget``: a fix's user range error, split by time behaviour (Kaplan & Hegarty
   2017, section 10.2; Misra & Enge 2011, section 6.1: a fix's 1-sigma is DOP x UERE):
 
@@ -31,7 +35,7 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
 Public names
 ------------
 iono_residual_fractions, RangeErrorBudget, range_error_budget, fix_uere_m,
-KLOBUCHAR_NIGHT_SLANT_M, TROPO_MAPPING_30_DEG.
+KLOBUCHAR_NIGHT_SLANT_M, TROPO_MAPPING_30_DEG, IONO_FIELD_OWN_SHARE.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ from typing import Any
 C_M_S = 299_792_458.0  # speed of light, m/s
 KLOBUCHAR_NIGHT_SLANT_M = 5e-9 * C_M_S * 1.77  # the broadcast model's night floor at 30 deg, m
 TROPO_MAPPING_30_DEG = 2.0  # slant / zenith troposphere at 30 deg elevation (1 / sin 30 deg)
+IONO_FIELD_OWN_SHARE = 0.5  # the share of the field's 1-sigma that differs between satellites
 
 
 def _value(gnss: Mapping[str, Any], key: str, default: float = 0.0) -> float:

@@ -118,7 +118,7 @@ from estimators.toolbox.range_bias import RangeBiasChannels
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
-from simulator.datasheet import iono_residual_fractions
+from simulator.datasheet import IONO_FIELD_OWN_SHARE, iono_residual_fractions
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -172,11 +172,6 @@ STANDARD_GRAVITY = 9.80665  # m/s^2
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
 RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
 RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
-# the share of the ionosphere field's 1-sigma that differs between satellites: their pierce
-# points on the 350 km shell lie up to about a thousand km apart and the field's correlation
-# is exp(-d^2 / (2 L^2)), L = 1000 km (docs/gnss-errors.md): about 0.75 at a typical 750 km,
-# so sqrt(1 - 0.75) of it is each satellite's own, the rest common (the ionosphere state)
-IONO_FIELD_OWN_SHARE = 0.5
 SIS_ERROR_M = 0.5  # m: the signal-in-space error without a receiver datasheet (IS-GPS-200 URA)
 IONO_CORRELATION_TIME_S = 1800.0  # s: the broadcast ionosphere residual's (docs/gnss-errors.md)
 KLOBUCHAR_RESIDUAL = 0.5  # the broadcast model leaves about half the delay (Klobuchar 1987)
