@@ -83,7 +83,7 @@ class FilterPyPeer:
         self.t_imu = imu["t"].to_numpy()
         self.w = imu[["gyro_x", "gyro_y", "gyro_z"]].to_numpy()
         self.f = imu[["accel_x", "accel_y", "accel_z"]].to_numpy()
-        raw = ds.read("gnss_raw")
+        raw = ds.read("gnss_raw").select_dtypes("number")  # the signal names are text
         self.raw_cols = {c: i for i, c in enumerate(raw.columns)}
         self.raw = raw.to_numpy(dtype=float)
         init = initial_state(ds.read("truth"), float(self.t_imu[0]), None)
