@@ -157,12 +157,14 @@ def main() -> None:
     parser.add_argument("--minutes", type=float, default=60.0)
     parser.add_argument("--peer-minutes", type=float, default=10.0)
     parser.add_argument("--peer-only", action="store_true", help="time only the FilterPy peer")
+    parser.add_argument("--no-peer", action="store_true", help="time only landnav's filters")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         warm = drive(Path(tmp) / "warm", 2.0)
         for name in ("tc_ekf", "tc_ukf"):
             time_landnav(warm, name)  # compiles the kernels
-        FilterPyPeer(warm).run(5.0)
+        if not args.no_peer:
+            FilterPyPeer(warm).run(5.0)
         ds = drive(Path(tmp) / "hour", args.minutes)
         duration = float(ds.read("truth")["t"].iloc[-1])
         sats = ds.read("gnss_raw").groupby("t").size()
@@ -172,6 +174,8 @@ def main() -> None:
             runtime, factor, cpu = time_landnav(ds, name)
             print(f"landnav {name}: wall {runtime:.2f} s, {factor:.0f} x real time; CPU "
                   f"{cpu:.2f} s, {duration / cpu:.0f} x")
+        if args.no_peer:
+            return
         peer_s = min(args.peer_minutes * 60.0, duration)
         peer = FilterPyPeer(ds)
         cpu = time.process_time()

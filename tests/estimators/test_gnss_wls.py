@@ -70,15 +70,15 @@ def test_a_faulty_pseudorange_is_excluded():
 
 def test_sigmas_match_errors_with_a_common_ionosphere_part():
     """The automotive receiver's ionosphere residual: |1.5 - 1| of each broadcast delay common
-    to the satellites, 1.5 x 0.2 a field of which sqrt(0.75) is common too (simulator.
-    datasheet); each satellite's own half of the field and 0.5 m white. Errors drawn from
-    that covariance, 400 epochs: the mean (error / sigma)^2 per axis is 1 within 0.3 (a mean
-    of 400 chi-square(1) draws has a standard deviation of 0.07). Read as independent (no
-    datasheet), the horizontal sigmas are over twice the errors."""
+    to the satellites (simulator.datasheet), the field 1.5 x 0.2 of it and 0.5 m each
+    satellite's own. Errors drawn from that covariance, 400 epochs: the mean (error / sigma)^2
+    per axis is 1 within 0.3 (a mean of 400 chi-square(1) draws has a standard deviation of
+    0.07). Read as independent (no datasheet), the horizontal sigmas are over 1.4 times the
+    errors (mean (error / sigma)^2 under 0.5)."""
     rx = geodetic_to_ecef(np.radians(48.0), np.radians(11.0), 500.0).ravel()
     clean = _epoch(rx, {ord("G"): 0.0, ord("E"): 0.0})
     iono = np.linspace(3.0, 9.0, len(clean))
-    common = np.hypot(0.5, np.sqrt(0.75) * 0.3) * iono
+    common = 0.5 * iono
     clean[:, COLUMNS.index("iono")] = iono
     clean[:, COLUMNS.index("pseudorange")] += iono  # the broadcast delay, which it removes
     clean[:, COLUMNS.index("pseudorange_std")] = np.hypot(0.5, np.hypot(0.5, 0.3) * iono)
@@ -89,7 +89,7 @@ def test_sigmas_match_errors_with_a_common_ionosphere_part():
     ratios = {True: [], False: []}
     for _ in range(400):
         block = clean.copy()
-        own = rng.normal(size=len(block)) * np.hypot(0.5, 0.5 * 0.3 * iono)
+        own = rng.normal(size=len(block)) * np.hypot(0.5, 0.3 * iono)
         block[:, COLUMNS.index("pseudorange")] += own + common * rng.normal()
         for with_sheet in (True, False):
             est = _estimator(sheet if with_sheet else None)
@@ -101,7 +101,7 @@ def test_sigmas_match_errors_with_a_common_ionosphere_part():
                                       / [row["std_n"], row["std_e"], row["std_d"]])
     nse = np.mean(np.square(ratios[True]), axis=0)
     assert np.all(np.abs(nse - 1.0) < 0.3), nse
-    assert np.all(np.mean(np.square(ratios[False]), axis=0)[:2] < 0.25)
+    assert np.all(np.mean(np.square(ratios[False]), axis=0)[:2] < 0.5)
 
 
 def test_on_the_quickstart_drive(quickstart):
