@@ -184,9 +184,10 @@ class BodyMotion:
             start, stop, _ = j.indices(len(self.t) - 1)
             values = weights[0].T @ self.nodes[:, start:stop]
             values += weights[1].T @ self.nodes[:, start + 1:stop + 1]
-        else:
-            values = weights[0].T @ self.nodes.take(j, axis=1)
-            values += weights[1].T @ self.nodes.take(j + 1, axis=1)
+        else:  # whole samples gathered (rows of nodes.T), handed to the product transposed
+            rows = self.nodes.T
+            values = weights[0].T @ rows.take(j, axis=0).T
+            values += weights[1].T @ rows.take(j + 1, axis=0).T
         return {name + suffix: values[i + k * order]
                 for order, suffix in enumerate(("", "_rate", "_accel"))
                 for i, name in enumerate(CHANNELS)}
