@@ -478,6 +478,9 @@ class Gnss(PresetSensor):
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
+        corrections = nav.attrs.get("time_corrections") or {}
+        if corrections:  # the file's system time offsets, for its RINEX export
+            self.drawn["time_corrections"] = {k: list(v) for k, v in corrections.items()}
         new_year = dt.datetime(truth.utc_start.year, 1, 1)
         day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
         # each satellite's system and GLONASS frequency channel (the signals' frequencies)
