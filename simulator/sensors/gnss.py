@@ -489,7 +489,10 @@ class Gnss(PresetSensor):
         return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "systems": systems,
                 "channel": np.nan_to_num(channel.astype(float)), "t_gps": tow0 + t,
                 "health": np.where(idx >= 0, gathered["health"], 0.0),
-                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0), "alpha": alpha,
+                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0),
+                "tgd2_s": np.where(idx >= 0, gathered["tgd2"], 0.0),
+                "primary_delay_s": np.where(idx >= 0, gathered["group_delay"], 0.0),
+                "alpha": alpha,
                 "beta": beta, "day_of_year": day_of_year}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:

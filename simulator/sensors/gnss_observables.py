@@ -21,9 +21,11 @@ Measurement model of signal s at frequency f (lambda = c / f), in metres, gamma_
                   + T + sis + m_carrier_s + nlos_delay + phase_noise_s
                   + lambda (ambiguity + half_cycle)
 
-(``sat_clock_s`` = c (dt_sv - k_s T_GD) the clock a user of the signal applies, ``group_delay_s``
-= c k_s T_GD, ``simulator.gnss.signals.group_delay_factor``; the carrier carries no hardware
-delay). The carrier phase has RINEX's sign: it grows with the range, as the pseudorange does.
+(``sat_clock_s`` = c (dt_sv - G_s) the clock a user of the signal applies, ``group_delay_s`` =
+c G_s the code's group delay against the broadcast clock's reference, per system and signal
+from T_GD, BGD or TGD1/TGD2: ``simulator.gnss.signals.signal_group_delay_s``; the carrier
+carries no hardware delay). The carrier phase has RINEX's sign: it grows with the range, as
+the pseudorange does.
 
 Public names
 ------------
@@ -81,9 +83,9 @@ from simulator.gnss.receiver import (
 from simulator.gnss.signals import (
     PRIMARY_SIGNAL,
     carrier_frequency_hz,
-    group_delay_factor,
     iono_factor,
     signal,
+    signal_group_delay_s,
 )
 from simulator.gnss.timesystems import SYSTEMS
 from simulator.stochastic import gauss_markov
@@ -248,10 +250,10 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     sat_clock = C_M_S * (geo["clock_s"] + geo["system_time_offset_s"])
     sat_drift = C_M_S * geo["clock_drift_s_s"]
     system_of = sky["systems"]
-    # GPS and QZSS: the other signals' group delays from T_GD (signals.group_delay_factor);
-    # the other systems' clocks are their primary signal's, used for all their signals
-    gps_like = np.isin(system_of, ("G", "J"))[:, None]
-    tgd_m = np.where(gps_like, C_M_S * sky["tgd_s"], 0.0)
+    # the broadcast clock's reference (the ionosphere-free pair, without the primary signal's
+    # group delay): the carrier's clock; each code's own group delay is taken from it
+    # (signals.signal_group_delay_s)
+    reference_clock = sat_clock + C_M_S * sky["primary_delay_s"]
     nlos_delay = np.where(nlos & ~los, extra, 0.0)
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
@@ -297,8 +299,9 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         iono_s = k_iono * iono_true
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
-        group_delay = group_delay_factor(letter, code) * tgd_m
-        sat_clock_s = sat_clock + tgd_m - group_delay
+        group_delay = C_M_S * signal_group_delay_s(letter, code, sky["primary_delay_s"],
+                                                   sky["tgd_s"], sky["tgd2_s"])
+        sat_clock_s = reference_clock - group_delay
         pseudorange = (rng_m + rx_clock - sat_clock_s + iono_s + tropo_true + err["sis"]
                        + terms["multipath"] + nlos_delay + terms["code_noise"])
         rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
@@ -336,7 +339,7 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
                                        spec.pilot) if scale > 0 else np.zeros(el.shape))
             arcs = phase_arcs(rng, tracked_s, draw_slips(rng, chance, tracked_s), reflected,
                               dt_s, spec.pilot, spec.frame_s)
-            phase_m = (rng_m + rx_clock - (sat_clock + tgd_m) - iono_s + tropo_true
+            phase_m = (rng_m + rx_clock - reference_clock - iono_s + tropo_true
                        + err["sis"] + carrier_mp + nlos_delay + phase_noise)
             raw.update(carrier_phase=phase_m / lam + arcs.ambiguity + arcs.half,
                        lli=arcs.lli, lock_time=arcs.lock_time)

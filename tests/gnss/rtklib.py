@@ -72,15 +72,28 @@ def single_point(obs: Path, nav: Path, systems_mask: int = 61) -> dict[str, np.n
     return {"pos": pos, "clock": clock, "sat": sat}
 
 
-def kinematic(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path
-              ) -> dict[str, np.ndarray]:
+SYSTEM_MASKS = {"G": 1, "R": 4, "E": 8, "J": 16, "C": 32}  # RTKLIB's pos1-navsys bits
+
+
+def kinematic(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path,
+              systems: str | None = None) -> dict[str, np.ndarray]:
     """Run rnx2rtkp kinematic (``-p 2 -f 2 -m 15 -h -v 3 -e -y 2 -r X Y Z``) and read the
     solution: ``tow`` (s), ``xyz`` (n, 3, m), ``q`` (1 fixed, 2 float), and the residual lines
     ``sat`` as a dict of arrays (tow, frequency 1/2, elevation deg, code and carrier residual m,
-    valid) restricted to the fixed epochs."""
+    valid) restricted to the fixed epochs. ``systems`` (RINEX letters, e.g. ``"GEC"``) goes
+    to ``pos1-navsys`` in an options file (rnx2rtkp 2.4.3's ``-sys`` falls through its switch
+    and enables every later system); without it, rnx2rtkp's default GPS + GLONASS. The other
+    options are RTKLIB's defaults: frequency index 2 is GPS L2, Galileo E5b, BeiDou B2I."""
     exe = need_rnx2rtkp()
-    cmd = [exe, "-p", "2", "-f", "2", "-m", "15", "-h", "-v", "3", "-e", "-y", "2", "-r",
-           *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base), str(nav)]
+    options = []
+    if systems is not None:
+        conf = Path(str(out) + ".conf")
+        conf.write_text(f"pos1-navsys={sum(SYSTEM_MASKS[s] for s in systems)}\n"
+                        "out-timeform=tow\n")  # an options file resets rnx2rtkp's own
+        options = ["-k", str(conf)]
+    cmd = [exe, *options, "-p", "2", "-f", "2", "-m", "15", "-h", "-v", "3", "-e", "-y", "2",
+           "-r", *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base),
+           str(nav)]
     subprocess.run(cmd, check=True, capture_output=True, timeout=600)
     rows = [line.split() for line in out.read_text().splitlines()
             if line and not line.startswith("%")]
