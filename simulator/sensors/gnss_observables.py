@@ -142,12 +142,13 @@ def _rows(t: np.ndarray, svs: np.ndarray, rows: np.ndarray, mask: np.ndarray,
 
 
 def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFrame:
-    """The pieces' rows in one table, in the order of their keys."""
+    """The pieces' rows in one table, in the order of their keys (each column its own new
+    array: the table takes them as they are, without copying them into blocks)."""
     import pandas as pd
 
     order = np.argsort(np.concatenate([p["_key"] for p in pieces]), kind="stable")
     return pd.DataFrame({name: np.concatenate([p[name] for p in pieces])[order]
-                         for name in names})
+                         for name in names}, copy=False)
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
