@@ -146,3 +146,29 @@ def test_rtklib_single_point_from_the_written_file_agrees_with_our_satellites(tm
     assert {r[3][0] for r in solved["sat"]} == {"G", "E", "C", "R"}
     assert error.max() < 0.01 and residual.max() < 0.01
     assert np.abs(solved["clock"][:, 1:]).max() < 0.05
+
+
+def test_export_of_a_drive_on_a_real_file_keeps_its_time_corrections(tmp_path):
+    """``landnav export --rinex`` of a drive whose sky is refdata 1e's file writes the records
+    the receiver used, of every system asked for, and the file's TIME SYSTEM CORR lines (the
+    offsets its satellite clocks were computed with)."""
+    import yaml
+
+    from simulator.cli import main
+
+    src = _need(REF / "gnss/multignss_2023-03-14_gnss_lib_py/BRDM00DLR_S_20230730000_01D_MN.rnx")
+    scenario = {"name": "real-sky", "seed": 1,
+                "start": {"utc": "2023-03-14T01:40:00Z", "lat": 40.0, "lon": 130.0, "alt": 50.0,
+                          "heading": 0.0},
+                "trajectory": {"kind": "segments", "segments": [{"stop": {"duration": 10}}]},
+                "sensors": {"gnss": {"rate": 1, "preset": "geodetic", "outputs": ["raw"],
+                                     "constellation": str(src),
+                                     "systems": ["gps", "galileo", "beidou", "glonass"]}}}
+    (tmp_path / "s.yaml").write_text(yaml.safe_dump(scenario))
+    assert main(["generate", str(tmp_path / "s.yaml"), "-o", str(tmp_path / "ds")]) == 0
+    assert main(["export", str(tmp_path / "ds"), "--rinex", str(tmp_path / "rinex")]) == 0
+    back = read_rinex_nav(tmp_path / "rinex" / "ds.nav")
+    source = read_rinex_nav(src)
+    assert set(back["system"]) == {"G", "E", "C", "R"}
+    for label in ("GAGP", "GLGP"):
+        assert back.attrs["time_corrections"][label] == source.attrs["time_corrections"][label]
