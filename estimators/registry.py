@@ -8,7 +8,7 @@ A third-party package registers an estimator in its ``pyproject.toml``::
 
 Public functions
 ----------------
-get_estimator, list_estimators, is_plugin_path, name_problems, entry_problems.
+get_estimator, list_estimators, is_plugin_path, name_problems, entry_problems, plugin_file.
 """
 
 from __future__ import annotations
@@ -61,14 +61,20 @@ def list_estimators() -> list[str]:
     return [*BUILTINS, *plugins]
 
 
+def _search_path() -> list[str]:
+    """``sys.path``, with the current directory first when it is not there: a module:Class of
+    the user's own is found from the current directory, as ``python -m`` finds it (a console
+    script's sys.path starts with its bin directory instead)."""
+    if os.getcwd() not in sys.path and "" not in sys.path:
+        return [os.getcwd(), *sys.path]
+    return sys.path
+
+
 def _import_target(target: str, what: str) -> type:
     module_name, _, attr = target.partition(":")
     if not module_name or not attr:
         raise InputError(f"{what}: expected module:Class, got {target!r}")
-    # a module:Class of the user's own is found from the current directory, as `python -m`
-    # finds it (a console script's sys.path starts with its bin directory instead)
-    if os.getcwd() not in sys.path and "" not in sys.path:
-        sys.path.insert(0, os.getcwd())
+    sys.path[:] = _search_path()
     try:
         module = importlib.import_module(module_name)
     except Exception as exc:  # a plug-in's own failure, reported as its message
@@ -144,3 +150,31 @@ def entry_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:
         return [("name", p.message) for p in exc.problems]
     config = None if isinstance(entry, str) else entry.get("config")
     return [("config", message) for message in config_problems(cls, config)]
+
+
+def plugin_file(name: str) -> str | None:
+    """The file of the module an estimator name refers to (a built-in, an entry point, or
+    ``module:Class``), found the way an import would find it but without running any of its
+    code (nor its packages' ``__init__``); None when it is not found."""
+    from importlib.machinery import PathFinder
+
+    if name in BUILTINS:
+        module = BUILTINS[name].partition(":")[0]
+    elif ":" in name:
+        module = name.partition(":")[0]
+    else:
+        entry = _entry_points().get(name)
+        if entry is None:
+            return None
+        module = entry.module
+    locations: list[str] | None = _search_path()
+    spec = None
+    parts = module.split(".")
+    for i in range(len(parts)):
+        if locations is None or not all(parts):
+            return None
+        spec = PathFinder.find_spec(".".join(parts[:i + 1]), locations)
+        if spec is None:
+            return None
+        locations = spec.submodule_search_locations
+    return spec.origin if spec is not None else None
