@@ -12,7 +12,10 @@ folder, renamed there when complete. Its standard output is its standard error f
 so a plug-in's prints (Python's or a C library's) go to landnav's standard error, never into
 landnav's results. On its standard output it sends one byte once its own work is ready (the
 dataset open, landnav's modules imported) and closes it before any plug-in code runs: the time
-limit counts from that byte, not from the interpreter's start. A child that ends without an
+limit counts from that byte, not from the interpreter's start, and counts the child's own time:
+the wall time less the time it waited for a CPU that other processes held (Linux's
+``/proc/PID/schedstat``; elsewhere the wall time), so that a loaded machine slows a plug-in
+without stopping it. A child that ends without an
 answer, or is still running at the limit, is one ``InputError`` naming the estimator and its
 file. When the child has ended, every process left in its group (a plug-in's forks) is killed;
 the child ends itself and its group when landnav's process is gone (``watch_parent``).
@@ -134,9 +137,20 @@ def _serve() -> None:
     _write_answer(Path(folder), _ANSWER, answer)
 
 
-def _waited(pid: int, timeout_s: float | None) -> bool:
-    """Whether the child ``pid`` ended within ``timeout_s`` (None: waits for it), leaving it
-    unreaped: its id, and so its process group's, stays taken until ``_end`` kills the group."""
+def _runqueue_wait_s(pid: int) -> float:
+    """How long the main thread of process ``pid`` has waited for a CPU held by other
+    processes, s (Linux's ``/proc/PID/schedstat``; 0 where it cannot be read)."""
+    try:
+        return int(Path(f"/proc/{pid}/schedstat").read_text().split()[1]) / 1e9
+    except (OSError, IndexError, ValueError):
+        return 0.0
+
+
+def _waited(pid: int, limit_s: float | None) -> bool:
+    """Whether the child ``pid`` ended within ``limit_s`` of its own time (None: waits for it),
+    leaving it unreaped: its id, and so its process group's, stays taken until ``_end`` kills
+    the group. Its own time is the wall time less the time it waited for a CPU (a loaded
+    machine slows a plug-in; it does not make it run past its limit)."""
     ended = threading.Event()
 
     def wait() -> None:
@@ -145,7 +159,15 @@ def _waited(pid: int, timeout_s: float | None) -> bool:
         ended.set()
 
     threading.Thread(target=wait, name="landnav-isolated-wait", daemon=True).start()
-    return ended.wait(timeout_s)
+    if limit_s is None:
+        return ended.wait()
+    start, waited_before = time.monotonic(), _runqueue_wait_s(pid)
+    while True:
+        used = time.monotonic() - start - (_runqueue_wait_s(pid) - waited_before)
+        if used >= limit_s:
+            return ended.is_set()
+        if ended.wait(max(limit_s - used, 0.05)):  # its own time grows at most as fast
+            return True
 
 
 def _end(child: subprocess.Popen) -> None:

@@ -27,9 +27,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="run directory (default: runs/<scenario name>)")
     p.add_argument("--force", action="store_true", help="overwrite an existing DIR")
     p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
-                   help="how long each estimator may take to import and check, then to run "
-                        "(it then runs in its own process, as every estimator that is not a "
-                        "built-in does); past it the run stops with exit 2 and writes nothing")
+                   help="how long each estimator may take to run (default: no limit; it "
+                        "then runs in its own process, as every estimator that is not a "
+                        "built-in does), and the plug-ins to be imported and checked "
+                        "(default 120 s); past it the run stops with exit 2 and writes nothing")
     add_scenario_options(p)
     p.set_defaults(run=run)
 

@@ -19,6 +19,8 @@ import pandas as pd
 import pytest
 import yaml
 
+from tests.reliability.checks import alive
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -88,14 +90,6 @@ def _descendants(pid: int) -> set[int]:
     return found
 
 
-def _alive(pid: int) -> bool:
-    try:
-        state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
-    except OSError:
-        return False
-    return state != "Z"
-
-
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux's /proc")
 def test_workers_end_with_a_killed_campaign(tmp_path):
     flag = tmp_path / "stuck"
@@ -114,22 +108,24 @@ def test_workers_end_with_a_killed_campaign(tmp_path):
     proc.kill()  # SIGKILL: the campaign cannot stop its workers itself
     proc.wait()
     deadline = time.monotonic() + 30  # a hang, not a speed check: they end within a second
-    while any(_alive(p) for p in workers) and time.monotonic() < deadline:
+    while any(alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.1)
-    assert not any(_alive(p) for p in workers)
+    assert not any(alive(p) for p in workers)
 
 
 def test_campaign_time_limit_fails_the_stuck_run_and_goes_on(tmp_path):
+    """The limit also bounds importing and checking the estimator before the runs: 10 s, as
+    importing this test module takes about 3 s of CPU (pytest, matplotlib)."""
     flag = tmp_path / "stuck"
     flag.write_text("")
     argv = [sys.executable, "-m", "simulator.cli", "campaign", str(_scenario(tmp_path, flag)),
-            "--runs", "1", "--workers", "1", "-o", "mc", "--time-limit", "2"]
+            "--runs", "1", "--workers", "1", "-o", "mc", "--time-limit", "10"]
     done = subprocess.run(argv, cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(REPO)},
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr
     assert "0 result(s) ok, 1 failed" in done.stdout
     runs = pd.read_parquet(tmp_path / "mc" / "runs.parquet")
-    assert "did not finish within the time limit of 2 s" in runs["error"].iloc[0]
+    assert "did not finish within the time limit of 10 s" in runs["error"].iloc[0]
 
 
 def test_a_port_that_is_not_a_dask_scheduler(tmp_path):
