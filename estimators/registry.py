@@ -17,6 +17,7 @@ import importlib
 import os
 import sys
 from collections.abc import Mapping
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from estimators.base import Estimator, check_estimator_class, config_problems
@@ -153,11 +154,10 @@ def entry_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:
 
 
 def plugin_file(name: str) -> str | None:
-    """The file of the module an estimator name refers to (a built-in, an entry point, or
-    ``module:Class``), found the way an import would find it but without running any of its
-    code (nor its packages' ``__init__``); None when it is not found."""
-    from importlib.machinery import PathFinder
-
+    """The source file of the module an estimator name refers to (a built-in, an entry point,
+    or ``module:Class``), looked for along the import path as an import would, without running
+    any of its code (nor its packages' ``__init__``); None when there is no such ``.py`` file
+    (not found, a compiled module, a zip archive)."""
     if name in BUILTINS:
         module = BUILTINS[name].partition(":")[0]
     elif ":" in name:
@@ -167,14 +167,12 @@ def plugin_file(name: str) -> str | None:
         if entry is None:
             return None
         module = entry.module
-    locations: list[str] | None = _search_path()
-    spec = None
-    parts = module.split(".")
-    for i in range(len(parts)):
-        if locations is None or not all(parts):
-            return None
-        spec = PathFinder.find_spec(".".join(parts[:i + 1]), locations)
-        if spec is None:
-            return None
-        locations = spec.submodule_search_locations
-    return spec.origin if spec is not None else None
+    *packages, last = module.split(".")
+    folders = [Path(p or os.curdir) for p in _search_path()]
+    for part in packages:  # a package, or the folders of a namespace package
+        folders = [f / part for f in folders if (f / part).is_dir()]
+    for folder in folders:
+        for candidate in (folder / f"{last}.py", folder / last / "__init__.py"):
+            if candidate.is_file():
+                return str(candidate.resolve())
+    return None
