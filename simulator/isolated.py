@@ -10,9 +10,10 @@ then ends it. It reads the request on its standard input and writes its answer (
 found, or the pickled solution table and run information) to a file in a private temporary
 folder, renamed there when complete. Its standard output is its standard error from the start,
 so a plug-in's prints (Python's or a C library's) go to landnav's standard error, never into
-landnav's results. On its standard output it sends one byte once its own work is ready (the
-dataset open, landnav's modules imported) and closes it before any plug-in code runs: the time
-limit counts from that byte, not from the interpreter's start, and counts the child's own time:
+landnav's results. On its standard output (the control channel) it sends one byte once its
+own work is ready (the dataset open, landnav's modules imported), before any plug-in code runs,
+and later why it could not write its answer (a full disk), if so: the time limit counts from
+that byte, not from the interpreter's start, and counts the child's own time:
 the wall time less the time it waited for a CPU that other processes held (Linux's
 ``/proc/PID/schedstat``; elsewhere the wall time), so that a loaded machine slows a plug-in
 without stopping it. A child that ends without an
@@ -110,7 +111,7 @@ def _serve() -> None:
     """The child: read the request, answer into its folder (module docstring)."""
     parent_pid, path, folder, request = pickle.load(sys.stdin.buffer)
     sys.stdout.flush()
-    control = os.dup(1)  # not inherited by the processes a plug-in starts
+    control = os.dup(1)  # the control channel, not inherited by the processes a plug-in starts
     os.dup2(2, 1)  # everything written to the standard output goes to the standard error
     watch_parent(parent_pid, whole_group=True)
     sys.path[:] = path
@@ -118,7 +119,6 @@ def _serve() -> None:
 
     def started() -> None:
         os.write(control, _STARTED)
-        os.close(control)
 
     try:
         if kind == "check":
@@ -134,7 +134,12 @@ def _serve() -> None:
             answer = ("ok", run_estimator(dataset, entry, show_progress=False))
     except InputError as exc:
         answer = ("error", exc.problems)
-    _write_answer(Path(folder), _ANSWER, answer)
+    try:
+        _write_answer(Path(folder), _ANSWER, answer)
+    except OSError as exc:  # a full disk: said on the control channel, read by the parent
+        os.write(control, f"cannot hand its answer back through {folder}: "
+                          f"{exc.strerror or exc}".encode())
+        sys.exit(1)
 
 
 def _runqueue_wait_s(pid: int) -> float:
@@ -191,12 +196,23 @@ def _child(request: tuple) -> Iterator[tuple[subprocess.Popen, Path, bool]]:
     try:
         with child.stdin:
             child.stdin.write(pickle.dumps((os.getpid(), list(sys.path), str(folder), request)))
-        with child.stdout:
-            started = child.stdout.read(1) == _STARTED  # b"" if it ended before
+        # b"" if it ended before; unbuffered: what follows is read by _said
+        started = os.read(child.stdout.fileno(), 1) == _STARTED
         yield child, folder, started
     finally:
         _end(child)
+        child.stdout.close()
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def _said(child: subprocess.Popen) -> str:
+    """What an ended child said on its control channel after its first byte (why it wrote no
+    answer), "" when nothing."""
+    os.set_blocking(child.stdout.fileno(), False)  # a plug-in's fork may hold it open
+    try:
+        return os.read(child.stdout.fileno(), 2000).decode("utf-8", "replace")
+    except BlockingIOError:
+        return ""
 
 
 def _answer(folder: Path, name: str) -> Any:
@@ -249,8 +265,9 @@ def check_entries(entries: Sequence[Entry], time_limit_s: float | None = None
             what = (f"importing it and checking its config did not finish within {limit:g} s; "
                     "it was stopped (a plug-in's module must not wait or loop when imported; "
                     "--time-limit sets this bound)" if not finished else
-                    f"{_ended(child, start)} while being imported and checked, without an "
-                    "answer; a plug-in's module must not exit or crash when imported")
+                    _said(child) or f"{_ended(child, start)} while being imported and "
+                    "checked, without an answer; a plug-in's module must not exit or crash when "
+                    "imported")
             answer = ("ok", [[] for _ in unique])
             answer[1][at] = [("name", f"{_where(unique[at])}: {what}")]
     status, checked = answer
@@ -280,8 +297,9 @@ def run_isolated(dataset_path: str | Path, entry: Entry,
                                       "the limit with --time-limit if it is only slow)")])
         answer = _answer(folder, _ANSWER)
         if answer is None:
-            raise InputError([Problem(_where(entry), None, "", f"{_ended(child, start)} without "
-                                      "a solution; an estimator must return, not exit")])
+            raise InputError([Problem(_where(entry), None, "", _said(child) or (
+                f"{_ended(child, start)} without a solution; an estimator must return, not "
+                "exit"))])
     status, value = answer
     if status == "error":
         raise InputError(value)
