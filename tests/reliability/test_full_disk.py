@@ -47,8 +47,8 @@ CASES = {
     "estimate a plug-in": (lambda ds: ["estimate", str(ds), "-e",
                                        "tests.reliability.hostile_plugins:Holds", "-o",
                                        "out.parquet"], 2_000),
-    "report": (lambda ds: ["score", str(ds), "--solution", "sol.parquet", "--report", "out"],
-               20_000),
+    "report": (lambda ds: ["score", str(ds), "--solution", "sol.parquet", "--report", "out",
+                           "--json", "out.json"], 20_000),  # both or neither
 }
 
 
