@@ -52,6 +52,7 @@ def test_the_time_limit_holds_on_dask_workers(cluster, tmp_path, capsys):
     assert "2 result(s) ok, 2 failed" in capsys.readouterr().out
 
 
+@pytest.mark.slow  # about 10 s of CPU: two worker restarts
 def test_a_worker_killed_mid_run_fails_that_run_only(cluster, tmp_path, capsys):
     scenario = _scenario(tmp_path, f"[{{name: '{PLUGINS}:KillsItsWorker', label: kills}}]")
     out = tmp_path / "mc"

@@ -39,6 +39,7 @@ def _landnav_on_a_full_disk(args: list[str], cwd: Path, max_file_bytes: int
                           preexec_fn=cap, capture_output=True, text=True, timeout=600)
 
 
+SLOW = pytest.mark.slow  # each case about 4 s of CPU (a landnav process); two run by default
 CASES = {
     "generate": (lambda ds: ["generate", "s.yaml", "-o", "out"], 20_000),
     "run": (lambda ds: ["run", "s.yaml", "-o", "out"], 20_000),
@@ -53,7 +54,8 @@ CASES = {
 
 
 @pytest.mark.skipif(not hasattr(resource, "RLIMIT_FSIZE"), reason="needs RLIMIT_FSIZE")
-@pytest.mark.parametrize("case", list(CASES))
+@pytest.mark.parametrize("case", [pytest.param(c, marks=SLOW) if c in ("run", "estimate", "report")
+                                  else c for c in CASES])
 def test_a_full_disk_leaves_nothing_and_one_message(dataset, tmp_path, case):
     args, limit = CASES[case]
     if case == "report":

@@ -114,7 +114,7 @@ FORKS = ("import os, subprocess, sys, time\n"
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux's /proc")
-@pytest.mark.parametrize("command", ["estimate", "run"])
+@pytest.mark.parametrize("command", ["estimate", pytest.param("run", marks=pytest.mark.slow)])
 def test_processes_a_plugin_starts_end_with_it(dataset, tmp_path, monkeypatch, capsys,
                                                command):
     """A plug-in that starts a process and forks itself at import: the command completes and
