@@ -247,11 +247,13 @@ class InsFilter:
         if len(self.extra):
             self.extra *= np.exp(-dt / self._extra_tau)
 
-    def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> None:
-        """Measurement update with dz = h(nominal) - z; in closed loop the errors are fed back."""
-        self.kf.update(dz, h, r)
+    def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Measurement update with dz = h(nominal) - z; in closed loop the errors are fed back.
+        Returns the innovation covariance H P H^T + R."""
+        s = self.kf.update(dz, h, r)
         if self.kf.closed_loop:
             self._remove(self.kf.feedback())
+        return s
 
     def gated_update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray,
                      probability: float = 0.999, max_rejected: int = 5) -> bool:
