@@ -41,7 +41,8 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   epoch (Blewitt 1990: the ionosphere moves it by millimetres per second), or its
   double-differenced phase innovation against the INS prediction exceeds
   ``slip_sigmas`` times its sigma and ``slip_cycles`` cycles (a reference that fails with most
-  of its group resets the reference). A phase whose half cycle is unresolved is not used.
+  of its group resets the reference). A phase whose half cycle is still unresolved (LLI bit
+  1) is used, its double differences searched as integers of half cycles.
 * **Integer ambiguities**: after each update the double-differenced float ambiguities a = D x_a
   (covariance D P D^T) are resolved by LAMBDA with the ratio test and partial fixing
   (``toolbox.ambiguity.resolve``: Chang, Yang & Zhou 2005; ``ratio_threshold``,
@@ -91,6 +92,9 @@ from simulator.errors import InputError
 from simulator.gnss.constants import C_M_S
 
 G0 = 9.80665  # m/s^2
+EARTH_RADIUS_M = 6_371_000.0  # the ionosphere's thin-shell model (Klobuchar's)
+IONO_SHELL_M = 350_000.0
+SATELLITES_PER_SYSTEM = 14  # above a 10 deg mask: GPS 8-12, Galileo 6-10, BeiDou MEO 6-10
 F_L1_HZ = 1575.42e6
 ODOMETER_SCALE_SIGMA = 0.03  # unmodelled odometer scale error, 1-sigma (as ins_odo_ekf's)
 HALF_CYCLE = 2  # LLI bit 1: half-cycle ambiguity unresolved
@@ -103,15 +107,18 @@ DEFAULTS = {
     "base_code_std": 0.3,
     "phase_std": 0.003,
     "base_phase_std": 0.002,
-    "baseline_ppm": 1.0,
-    "code_correlation_time": None,
-    "code_inflation_interval": 1.0,
+    "iono_ppm": 1.5,
+    "iono_correlation_time": 600.0,
+    "code_correlation_time": 0.0,
+    "phase_correlation_time": 0.4,
+    "gnss_interval": 0.1,
     "gate_probability": 0.999,
-    "ambiguity_states": 64,
+    "ambiguity_states": None,
     "ambiguity_std": 30.0,
     "ratio_threshold": 3.0,
     "min_success_rate": 0.999,
     "min_fixed": 4,
+    "fixed_position_std": 0.05,
     "hold": True,
     "hold_std": 0.01,
     "slip_geometry_free": 0.05,
@@ -122,6 +129,7 @@ DEFAULTS = {
     "initial_velocity_std": 0.2,
     "initial_attitude_std": [1.0, 1.0, 3.0],
     "odometer": True,
+    "odometer_rate": 10.0,
     "nhc": True,
     "nhc_point": "rear_axle",
     "lever_arm": None,
@@ -133,18 +141,25 @@ CONFIG_HELP = {
     "base_code_std": ("m", "base pseudorange 1-sigma at zenith"),
     "phase_std": ("m", "rover carrier-phase 1-sigma at zenith"),
     "base_phase_std": ("m", "base carrier-phase 1-sigma at zenith"),
-    "baseline_ppm": ("", "single-difference ionosphere and troposphere residual, parts per "
-                         "million of the baseline, 1-sigma at zenith"),
-    "code_correlation_time": ("s", "correlation time of the rover's code errors; null: the "
-                                   "datasheet's carrier_smoothing"),
-    "code_inflation_interval": ("s", "interval the code's correlated-noise inflation is "
-                                     "counted at"),
+    "iono_ppm": ("", "single-difference ionosphere on L1, parts per million of the baseline, "
+                     "1-sigma in the vertical (times the obliquity factor)"),
+    "iono_correlation_time": ("s", "correlation time of the single-difference ionosphere "
+                                   "states"),
+    "code_correlation_time": ("s", "correlation time of the code errors the weights count "
+                                   "(0: white; null: the rover datasheet's carrier_smoothing)"),
+    "phase_correlation_time": ("s", "correlation time of the carrier-phase errors the "
+                                    "weights count (multipath along the road, 0: white)"),
+    "gnss_interval": ("s", "the epoch interval the correlations are counted at"),
     "gate_probability": ("", "chi-square gate of each double-differenced code row"),
-    "ambiguity_states": ("", "single-difference ambiguity slots (signals tracked at once)"),
+    "ambiguity_states": ("", "single-difference ambiguity slots (signals tracked at once); "
+                             "null: 14 satellites per system times its signals, from the "
+                             "datasheet"),
     "ambiguity_std": ("cycles", "1-sigma of a new ambiguity state"),
     "ratio_threshold": ("", "LAMBDA ratio test: second-best over best squared norm"),
     "min_success_rate": ("", "bootstrapped success rate a fixed subset must reach"),
     "min_fixed": ("", "fewest double-differenced ambiguities a fix may hold"),
+    "fixed_position_std": ("m", "a fix counts (and is written) when its position 1-sigma "
+                                "is at most this on every axis"),
     "hold": ("", "fix and hold: a full fix constrains the float ambiguities"),
     "hold_std": ("cycles", "1-sigma of the hold's ambiguity measurements"),
     "slip_geometry_free": ("m", "geometry-free phase jump between epochs taken as a slip"),
@@ -155,6 +170,8 @@ CONFIG_HELP = {
     "initial_velocity_std": ("m/s", "initial velocity uncertainty per axis, 1-sigma"),
     "initial_attitude_std": ("deg", "initial roll, pitch, yaw uncertainty, 1-sigma"),
     "odometer": ("", "odometer speed updates (when the dataset has an odometer)"),
+    "odometer_rate": ("Hz", "odometer updates per second at most (the samples between are "
+                            "not used)"),
     "nhc": ("", "non-holonomic constraint with the odometer updates"),
     "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
     "lever_arm": ("m", "IMU to GNSS antenna, body FRD; null: the datasheet's"),
@@ -243,23 +260,30 @@ class RtkInsEkf(Estimator):
         lever = cfg["lever_arm"] if cfg["lever_arm"] is not None else site.antenna
         self._lever = np.zeros(3) if lever is None else np.asarray(lever, dtype=float)
         imu = imu_error_model(self.datasheet)
-        n_slots = int(cfg["ambiguity_states"])
+        n_slots, n_iono = self._state_pool()
         p0 = np.r_[[cfg["initial_position_std"]] * 3, [cfg["initial_velocity_std"]] * 3,
                    np.radians(cfg["initial_attitude_std"]),
                    np.broadcast_to(imu.accel_bias_initial, 3),
                    np.broadcast_to(imu.gyro_bias_initial, 3)]
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
                              p0, ins_noise(imu), mounting=site.mounting,
-                             extra_sigma=np.zeros(n_slots), extra_tau=np.full(n_slots, np.inf))
+                             extra_sigma=np.zeros(n_slots + n_iono),
+                             extra_tau=np.r_[np.full(n_slots, np.inf),
+                                             np.full(n_iono, cfg["iono_correlation_time"])])
         gnss = self.datasheet.get("gnss") or {}
         corr = cfg["code_correlation_time"]
         if corr is None:
             corr = float(gnss.get("carrier_smoothing") or 0.0)
         self._code_inflation = gnss_model.correlated_noise_inflation(
-            float(corr), float(cfg["code_inflation_interval"]))
+            float(corr), float(cfg["gnss_interval"]))
+        self._phase_inflation = gnss_model.correlated_noise_inflation(
+            float(cfg["phase_correlation_time"]), float(cfg["gnss_interval"]))
         self._mask = math.radians(cfg["elevation_mask"])
         self._slot: dict[int, int] = {}
         self._free = list(range(n_slots - 1, -1, -1))
+        self._iono_slot: dict[int, int] = {}  # satellite key -> extra-state index
+        self._iono_free = list(range(n_slots + n_iono - 1, n_slots - 1, -1))
+        self._iono_seen: dict[int, float] = {}
         self._held: set[int] = set()
         self._last_seen: dict[int, float] = {}
         self._half: set[int] = set()
@@ -272,9 +296,12 @@ class RtkInsEkf(Estimator):
         self._n_fixed = 0
         self._fixed_dx: np.ndarray | None = None  # the fix's correction of the nav errors
         self._fixed_p: np.ndarray | None = None
+        self._phase_rows: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._pending = np.zeros(0, dtype=bool)  # half cycle unresolved, per signal
         self.nis_gnss = np.nan
         self.nis_gnss_dof = np.nan
         self._odo = cfg["odometer"] and "odometer" in self.columns
+        self._next_odometer = -np.inf
         if self._odo:
             self._speed = self.columns["odometer"]["speed"]
             self._odo_sigma = odometer_speed_sigma(self.datasheet)
@@ -283,6 +310,20 @@ class RtkInsEkf(Estimator):
             self._rear = site.rear_axle if cfg["nhc_point"] == "rear_axle" else None
             self._slip_model = (NonholonomicNoise(site.wheelbase or 2.7)
                                 if self._rear is not None else None)
+
+    def _state_pool(self) -> tuple[int, int]:
+        """How many ambiguity and ionosphere states to hold: ``ambiguity_states`` (and half
+        as many satellites), or ``SATELLITES_PER_SYSTEM`` per system of the datasheet's
+        receiver and as many ambiguities per satellite as the system has signals."""
+        given = self.config["ambiguity_states"]
+        if given is not None:
+            return int(given), max(int(given) // 2, 1)
+        gnss = self.datasheet.get("gnss") or {}
+        signals = gnss.get("signals") or {}
+        systems = gnss.get("systems") or list(signals) or ["gps"]
+        per_system = [len(signals.get(system) or ()) or 2 for system in systems]
+        return (SATELLITES_PER_SYSTEM * sum(per_system),
+                SATELLITES_PER_SYSTEM * len(per_system))
 
     def _base_position(self) -> np.ndarray:
         """The base antenna's ECEF position (m): ``base_position`` or the datasheet's."""
@@ -309,8 +350,9 @@ class RtkInsEkf(Estimator):
         self._base = (t, block)
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
-        if not self._odo:
+        if not self._odo or t < self._next_odometer - 1e-6:
             return
+        self._next_odometer = t + 1.0 / self.config["odometer_rate"]
         ins = self.ins
         ins.flush()
         speed = float(row[self._speed])
@@ -346,11 +388,12 @@ class RtkInsEkf(Estimator):
         if len(rover.keys) == 0:
             return
         self.ins.flush()
-        phase_ok = (np.isfinite(rover.phase) & np.isfinite(base.phase)
-                    & ((rover.lli | base.lli) & HALF_CYCLE == 0))
+        phase_ok = np.isfinite(rover.phase) & np.isfinite(base.phase)
+        self._pending = ((rover.lli | base.lli) & HALF_CYCLE) != 0
         slots = self._assign_slots(rover, base, phase_ok)
         for key in rover.keys:
             self._last_seen[int(key)] = t
+        self._iono = self._assign_iono(t, rover)
         self._update(rover, base, slots)
         self._resolve(rover, slots)
         self._status_t = t
@@ -389,6 +432,36 @@ class RtkInsEkf(Estimator):
         for key in stale:
             self._release(key)
             del self._last_seen[key]
+        for sat in [k for k, seen in self._iono_seen.items() if t - seen > max_gap]:
+            index = self._iono_slot.pop(sat)
+            self.ins.set_extra_sigma(index, 0.0)
+            self.ins.extra[index] = 0.0
+            self._iono_free.append(index)
+            del self._iono_seen[sat]
+
+    def _assign_iono(self, t: float, rover: _Epoch) -> np.ndarray:
+        """The extra-state index (after the 15) of each signal's satellite's single-difference
+        ionosphere (-1: none free); a new satellite's starts at zero with 1-sigma ``iono_ppm``
+        of the baseline times the thin-shell obliquity (350 km) at its elevation."""
+        ins = self.ins
+        baseline = float(np.linalg.norm(geodetic_to_ecef(*ins.pos) - self._base_xyz))
+        sats = rover.keys // 10_000
+        out = np.full(len(sats), -1, dtype=np.int64)
+        for i, sat in enumerate(sats.tolist()):
+            index = self._iono_slot.get(sat)
+            if index is None:
+                if not self._iono_free:
+                    continue
+                index = self._iono_free.pop()
+                self._iono_slot[sat] = index
+                ratio = EARTH_RADIUS_M * math.cos(rover.elevation[i]) / (
+                    EARTH_RADIUS_M + IONO_SHELL_M)
+                sigma = self.config["iono_ppm"] * 1e-6 * baseline / math.sqrt(1.0 - ratio**2)
+                ins.set_extra_sigma(index, max(sigma, 1e-4))
+                ins.extra[index] = 0.0
+            self._iono_seen[sat] = t
+            out[i] = index
+        return out
 
     def _release(self, key: int) -> None:
         """Forget a signal's ambiguity (its slot is given back, its state zeroed)."""
@@ -442,9 +515,9 @@ class RtkInsEkf(Estimator):
             rover_std = cfg["code_std"] * self._code_inflation
             base_std = cfg["base_code_std"]
         else:
-            rover_std, base_std = cfg["phase_std"], cfg["base_phase_std"]
-        atmosphere = cfg["baseline_ppm"] * 1e-6 * baseline * rover.gamma
-        return (rover_std**2 + base_std**2 + atmosphere**2) / sin_el**2
+            rover_std = cfg["phase_std"] * self._phase_inflation
+            base_std = cfg["base_phase_std"] * self._phase_inflation
+        return (rover_std**2 + base_std**2) / sin_el**2
 
     def _rows(self, rover: _Epoch, base: _Epoch, slots: np.ndarray
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
@@ -470,6 +543,13 @@ class RtkInsEkf(Estimator):
             h[:, 0:3] = -du
             h[:, 6:9] = du @ arm
             dz = d @ (sd_range[idx] - observed[idx])
+            # the single-difference ionosphere: the code delayed, the phase advanced
+            sign = 1.0 if code else -1.0
+            for rows_of, iono in ((sig, self._iono[sig]), (refs, self._iono[refs])):
+                have = iono >= 0
+                g = sign * rover.gamma[rows_of[have]] * (1.0 if rows_of is sig else -1.0)
+                h[np.flatnonzero(have), N_STATES + iono[have]] += g
+                dz[have] += g * ins.extra[iono[have]]
             if not code:
                 lam = rover.wavelength[sig]
                 a = ins.extra[slots[sig]] - ins.extra[slots[refs]]
@@ -491,6 +571,7 @@ class RtkInsEkf(Estimator):
         """One update with the epoch's DD code (gated) and phase rows; phase innovations the
         INS did not predict are slips (their states reset, the rows formed again)."""
         ins = self.ins
+        self._phase_rows = None
         for _ in range(2):
             dz_c, h_c, r_c, dz_p, h_p, r_p, sig, refs = self._rows(rover, base, slots)
             s_p = np.einsum("ij,jk,ik->i", h_p, ins.kf.p, h_p) + np.diag(r_p)
@@ -541,7 +622,7 @@ class RtkInsEkf(Estimator):
         self._ratio = np.nan
         self._n_fixed = 0
         self._status = 1.0
-        rows = getattr(self, "_phase_rows", None)
+        rows = self._phase_rows
         if rows is None or len(rows[0]) == 0:
             return
         sig, refs, slots = rows
@@ -553,9 +634,12 @@ class RtkInsEkf(Estimator):
             return
         ins = self.ins
         n_amb = ins.n_states - N_STATES
+        # a double difference with a half cycle still unresolved is an integer number of
+        # half cycles
+        scale = np.where(self._pending[sig] | self._pending[refs], 2.0, 1.0)
         d = np.zeros((len(sig), n_amb))
-        d[np.arange(len(sig)), slots[sig]] = 1.0
-        d[np.arange(len(sig)), slots[refs]] = -1.0
+        d[np.arange(len(sig)), slots[sig]] = scale
+        d[np.arange(len(sig)), slots[refs]] = -scale
         a = d @ ins.extra
         amb = slice(N_STATES, ins.n_states)
         p = ins.kf.p
@@ -570,8 +654,11 @@ class RtkInsEkf(Estimator):
             return
         p_xa = p[:N_STATES, amb] @ d.T
         gain = np.linalg.solve(q_a, p_xa.T).T  # P_xa Q_a^-1
+        fixed_p = p[:N_STATES, :N_STATES] - gain @ (q_a - res.q_fixed) @ gain.T
+        if np.max(np.diag(fixed_p)[:3]) > cfg["fixed_position_std"] ** 2:
+            return  # a partial fix that leaves the position a float one
         self._fixed_dx = gain @ (a - res.a_fixed)
-        self._fixed_p = p[:N_STATES, :N_STATES] - gain @ (q_a - res.q_fixed) @ gain.T
+        self._fixed_p = fixed_p
         self._status = 2.0
         self._n_fixed = res.n_fixed
         if cfg["hold"] and res.n_fixed == len(a):
