@@ -37,12 +37,18 @@ SHORTENED: dict[str, list[str]] = {
     # (it needs ../shared); here 300 s on the nominal constellation
     "geonet_baseline_twin": ["trajectory.segments.0.stop.duration=300",
                              "sensors.gnss.constellation=nominal-gps"],
+    # the straights 10 x shorter, both tunnels kept (20 min -> 4 min); the 20 minutes run in
+    # tests/estimators/test_rtk_ins.py --runslow
+    "rtk_open_road": [f"trajectory.segments.{i}.straight.length={n}"
+                      for i, n in ((2, 300), (4, 200), (6, 250), (8, 300), (10, 200),
+                                   (12, 220))],
 }
 
 # zones a (shortened) run must pass through: the library scenarios are what their comments say
 EXPECTED_ZONES: dict[str, set[str]] = {
     "highway_long": {"underpass", "tunnel"},
     "sumo_city_canyon": {"downtown"},
+    "rtk_open_road": {"tunnel"},
 }
 
 

@@ -229,8 +229,9 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
     odometer's ``scale_factor``, replaced by the nominal value a user assumes), the values so
     replaced in ``truth_parameters``; a base station's block carries its ``surveyed_position``
     {lat, lon, alt, x, y, z}, the antenna position a user of a base knows), ``timing`` (how
-    each stream is stamped and its effective delay) and ``knowledge`` (which keys a real user would know, and which are truth that only
-    scoring may read: the resolved ``scenario``, the drawn ``sensors``, ...).
+    each stream is stamped and its effective delay) and ``knowledge`` (which keys a real user
+    would know, and which are truth that only scoring may read: the resolved ``scenario``, the
+    drawn ``sensors``, ...).
     """
     data = scenario.data
     truth = generated.truth
