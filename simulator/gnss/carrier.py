@@ -77,13 +77,14 @@ def slip_probability(sigma_cycles: np.ndarray, stress_cycles: np.ndarray, bandwi
     return -np.expm1(-np.exp(np.log(dt_s) - log_t))
 
 
-def draw_slips(rng: np.random.Generator, probability: np.ndarray, tracked: np.ndarray
+def draw_slips(uniform: np.ndarray, probability: np.ndarray, tracked: np.ndarray
                ) -> np.ndarray:
     """Epochs (bool, shape of ``tracked``) at which a cycle slip occurred since the previous
-    epoch, within continuous tracking: a Bernoulli draw of ``probability`` per epoch."""
+    epoch, within continuous tracking: a Bernoulli draw of ``probability`` per epoch from
+    ``uniform``, U(0, 1) draws of that shape."""
     before = np.zeros_like(tracked)
     before[:, 1:] = tracked[:, :-1]
-    return tracked & before & (rng.random(tracked.shape) < probability)
+    return tracked & before & (uniform < probability)
 
 
 @dataclass
