@@ -149,7 +149,8 @@ CONFIG_HELP = {
                                    "(0: white; null: the rover datasheet's carrier_smoothing)"),
     "phase_correlation_time": ("s", "correlation time of the carrier-phase errors the "
                                     "weights count (multipath along the road, 0: white)"),
-    "gnss_interval": ("s", "the epoch interval the correlations are counted at"),
+    "gnss_interval": ("s", "the epoch interval the correlations are counted at (the "
+                           "rover's; set it for a receiver at another rate than 10 Hz)"),
     "gate_probability": ("", "chi-square gate of each double-differenced code row"),
     "ambiguity_states": ("", "single-difference ambiguity slots (signals tracked at once); "
                              "null: 14 satellites per system times its signals, from the "
