@@ -79,7 +79,7 @@ from estimators.toolbox import double_difference as ddiff
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import imu_error_model, odometer_delay_s, odometer_speed_sigma
 from estimators.toolbox.ins_error import N_STATES
-from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, ins_noise
+from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter
 from estimators.toolbox.installation import Installation
 from simulator.earth import (
     geodetic_to_ecef,
@@ -267,7 +267,7 @@ class RtkInsEkf(Estimator):
                    np.broadcast_to(imu.accel_bias_initial, 3),
                    np.broadcast_to(imu.gyro_bias_initial, 3)]
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
-                             p0, ins_noise(imu), mounting=site.mounting,
+                             p0, imu, mounting=site.mounting,
                              extra_sigma=np.zeros(n_slots + n_iono),
                              extra_tau=np.r_[np.full(n_slots, np.inf),
                                              np.full(n_iono, cfg["iono_correlation_time"])])
