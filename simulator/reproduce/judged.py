@@ -9,7 +9,7 @@ once and the report still shows the word at every value.
 
 Public names
 ------------
-paired, one_sample, untestable, sweep, nees_figures, effect_text.
+paired, one_sample, worst, untestable, sweep, nees_figures, effect_text.
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from simulator.reproduce.evidence import (
 from simulator.reproduce.paper import Claim, Verdict
 from simulator.scoring.consistency import consistency_scores
 
-__all__ = ["effect_text", "nees_figures", "one_sample", "paired", "sweep", "untestable"]
+__all__ = ["effect_text", "nees_figures", "one_sample", "paired", "sweep", "untestable", "worst"]
 
 Magnitude = Callable[[Evidence], "bool | None"]
 
@@ -136,3 +136,14 @@ def nees_figures(label: str, errors: pd.DataFrame) -> dict[str, float]:
     if not out:
         out[f"{label}.nees_position"] = math.nan
     return out
+
+
+def worst(verdicts: Sequence[Verdict]) -> Verdict:
+    """Several verdicts of one claim (its several printed values) as one: the worst word with
+    its evidence, every figure and reason, every per-seed list."""
+    order = {"shown": 0, "partly": 1, "not shown": 2}
+    bad = max(verdicts, key=lambda v: order[v.status])
+    per_seed = {k: v for verdict in verdicts for k, v in (verdict.per_seed or {}).items()}
+    return Verdict(bad.status, " / ".join(v.measured for v in verdicts),
+                   " / ".join(v.reason for v in verdicts), evidence=bad.evidence,
+                   per_seed=per_seed)
