@@ -268,7 +268,7 @@ CONDITIONS = ("a synthetic drive (the paper's Seoul campus log is not available)
               "automotive body (suspension, side slip), the automotive MEMS IMU preset (the paper "
               "names a 'low grade IMU'), the nominal GPS constellation (9 satellites in view; the "
               "partial-outage faults keep the highest ones), a TCXO clock; P0, Q, R and the NHC "
-              "noise are landnav's choices (not printed)")
+              "noise are landnav's choices (not printed)",)
 
 PARTIAL_OUTAGES = Experiment("partial_outages", "chan_partial_outages.yaml", NHC_PAIR,
                              measure_windows,
@@ -300,13 +300,13 @@ PAPER = Paper(
               "22.6 % vs 54.4 % (Table 1)", CONDITIONS, judge_four_smaller),
         Claim("complete_outages", "In complete 60 s outages (straight and loops) the NHC cuts "
               "the mean 3-D error by at least 40 %", "54.4 % (Table 1, Figures 3-4)",
-              CONDITIONS + "; three outages at fixed times, loops of 40 m radius",
+              (*CONDITIONS, "three outages at fixed times, loops of 40 m radius"),
               _cut(0, 40.0, WHY_SLIP, "complete_outages")),
         Claim("initial_error_settling", "From 100 m of position error on each axis both "
               "filters are below 10 m within 10 s, the UKF no later than the EKF + 1 s",
               "the UKF converges faster than the EKF (Figure 2; no time printed)",
-              CONDITIONS + "; the 100 m are on north, east, down (the paper's on ECEF X, Y, Z: "
-              "the same 173 m); both filters are told their 100 m uncertainty",
+              (*CONDITIONS, "the 100 m are on north, east, down (the paper's on ECEF X, Y, Z: "
+              "the same 173 m); both filters are told their 100 m uncertainty"),
               judge_settling),
         Claim("nominal_rms_ratio", "On a nominal drive the UKF's RMS 3-D error is 0.8 to 1.05 "
               "times the EKF's", "the UKF slightly better than the EKF (Figure 1)", CONDITIONS,

@@ -242,7 +242,7 @@ CONDITIONS = ("a synthetic drive of sixteen identical loops whose ten sites are 
               "suspension; docs/reproduction_karamat2015.md gives the rigid body's too), the "
               "IMU300CC preset with an assumed in-run Gauss-Markov bias, a 10 Hz ABS wheel-speed "
               "odometer (the paper: OBD-II), the highest satellites kept; the Gauss-Markov "
-              "parameters (printed as lost images) chosen from Table 1")
+              "parameters (printed as lost images) chosen from Table 1",)
 
 PAPER = Paper(
     key="karamat2015",
@@ -259,19 +259,19 @@ PAPER = Paper(
         Claim("tight_beats_loose", "The tightly coupled filter beats coupling: loose in at "
               "least 80 % of the windows with 1-3 satellites (issue 15)",
               "TC better than LC in every case (Figures 8, 16; LC-LKF 57 % worse with 0)",
-              CONDITIONS + "; the loose variant is the same filter on the receiver's fixes",
+              (*CONDITIONS, "the loose variant is the same filter on the receiver's fixes"),
               judge_tight_beats_loose),
         Claim("enhanced_gain_0", "The enhanced model beats the earlier one with no satellite",
               "16 % better than TC-LKF (section 4.3.1)",
-              CONDITIONS + "; the earlier model is this EKF with its eleven earlier states",
+              (*CONDITIONS, "the earlier model is this EKF with its eleven earlier states"),
               partial(judge_gain, counts=(0,), least=0.16)),
         Claim("enhanced_gain_overall", "The enhanced model beats the earlier one in overall "
               "maximum horizontal error", "40 % (section 5)",
-              CONDITIONS + "; the earlier model is this EKF with its eleven earlier states",
+              (*CONDITIONS, "the earlier model is this EKF with its eleven earlier states"),
               partial(judge_gain, counts=COUNTS, least=0.40)),
         Claim("gyro_bias_300_s", "The vertical-gyro bias estimate is within 0.05 deg/s of the "
               "truth by 300 s", "converges to about -0.24 deg/s in about 300 s (section 4.3.3, "
-              "Figure 13)", CONDITIONS + "; the true bias is drawn from Table 1's 2 deg/s",
+              "Figure 13)", (*CONDITIONS, "the true bias is drawn from Table 1's 2 deg/s"),
               judge_gyro_bias),
     ),
 )

@@ -238,7 +238,7 @@ def _judge_open_sky(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 CONDITIONS = ("simulated garage after the paper's description (helical ramps down and up, 15 % "
               "ramps, exit away from the entry, 4.5 min without GNSS) instead of the paper's "
               "Seoul drive; SMI130 with the calibrated accelerometer offset at 20 Hz, drawn per "
-              "seed; automotive vehicle body (suspension, side slip)")
+              "seed; automotive vehicle body (suspension, side slip)",)
 DR2D_ANALYSIS = ("Both DR filters' heading error is dominated by the z-gyro scale factor "
                  "(0.5 % 1-sigma, about 5 deg over the helix turns), which neither filter "
                  "estimates; with it set to zero as a diagnostic dr3d_ekf wins 10/10 "
@@ -276,11 +276,11 @@ PAPER = Paper(
               "The same garage made flat with a perfect odometer: the advantage over "
               "dr2d_odo_ekf disappears (median ratio of exit and max error in 0.7-1.3)",
               "sections III-E and IV-B: the gain comes from the 3-D geometry and the odometer "
-              "scale factor (no number)", CONDITIONS + "; helices and ramps levelled",
+              "scale factor (no number)", (*CONDITIONS, "helices and ramps levelled"),
               lambda t: _flat(t, "dr2d_odo_ekf")),
         Claim("flat_no_advantage_ins",
               "The same against ins_odo_ekf (median ratio in 0.7-1.3)",
-              "sections III-E and IV-B (no number)", CONDITIONS + "; helices and ramps levelled",
+              "sections III-E and IV-B (no number)", (*CONDITIONS, "helices and ramps levelled"),
               lambda t: _flat(t, "ins_odo_ekf", INS_FLAT_ANALYSIS)),
         Claim("height_change",
               "dr3d_ekf's height change through the garage is within 2 m of the true one, "
@@ -294,25 +294,25 @@ PAPER = Paper(
               _judge_scale),
         Claim("working_filters",
               "All three filters have horizontal RMS under 5 m outside the outages, every seed",
-              "not printed", CONDITIONS, _judge_rms),
+              "not printed", CONDITIONS, _judge_rms, kind="check"),
         Claim("ins_working",
               "ins_odo_ekf on the automotive body is under 5 m RMS outside the outages of "
               "Park's garage and parking_garage.yaml, every seed",
-              "not printed", "NHC at the rear axle (the datasheet's installation geometry), "
-              "its noise from the bicycle model's tyre slip; parking_garage.yaml has a 100 Hz "
-              "IMU", _judge_ins_working),
+              "not printed", ("NHC at the rear axle (the datasheet's installation geometry), "
+                              "its noise from the bicycle model's tyre slip; parking_garage.yaml "
+                              "has a 100 Hz IMU",), _judge_ins_working, kind="check"),
         Claim("ins_uses_nhc",
               "ins_odo_ekf's NHC lowers its median garage error (automotive body, both garages)",
               "section II-A, eqs. 12-14: the NHC bounds the INS error (no number)",
-              "NHC at the rear axle", _judge_ins_nhc),
+              ("NHC at the rear axle",), _judge_ins_nhc, kind="check"),
         Claim("multilevel_beats_both",
               "Multilevel garage (not an issue-14 criterion): dr3d_ekf beats dr2d_odo_ekf and "
               "ins_odo_ekf on exit error in >= 8 of 10 seeds (paired)",
               "Table 3, area 2 (182 s): INS/GPS/odometer 24.20 m, 2-D DR 9.60 m; the proposed "
               "filter smaller (its column is lost from our copy)",
-              "simulated multilevel garage (four-floor helix up, rooftop lap, helix down; the "
-              "real geometry is not published), 203 s without GNSS instead of 182 s; sensors "
-              "as in the underground garage",
+              ("simulated multilevel garage (four-floor helix up, rooftop lap, helix down; the "
+               "real geometry is not published), 203 s without GNSS instead of 182 s; sensors "
+               "as in the underground garage",),
               lambda t: _worst(_beats(t, "dr2d_odo_ekf", MULTILEVEL_ANALYSIS, "multilevel_garage",
                                       ("exit_horizontal_m",)),
                                _beats(t, "ins_odo_ekf", "", "multilevel_garage",
@@ -321,17 +321,17 @@ PAPER = Paper(
               "Curved tunnel, 159 s without GNSS (not an issue-14 criterion): dr3d_ekf's error "
               "at the exit is smaller than dr2d_odo_ekf's in >= 8 of 10 seeds (paired)",
               "Fig. 18: error after the exit 1.91 m (3-D DR/GPS) vs 5.74 m (2-D DR/GPS)",
-              "simulated 2.6 km tunnel with a gentle S-curve and a 3 % climb (the real "
-              "geometry is not published); error at the last epoch before GNSS returns, "
-              "against the truth (the paper used a map)",
+              ("simulated 2.6 km tunnel with a gentle S-curve and a 3 % climb (the real "
+               "geometry is not published); error at the last epoch before GNSS returns, "
+               "against the truth (the paper used a map)",),
               lambda t: _beats(t, "dr2d_odo_ekf", TUNNEL_ANALYSIS, "curved_tunnel",
                                ("exit_horizontal_m",))),
         Claim("open_sky_bounded",
               "Open-sky 40 s blockage on an interchange ramp: dr3d_ekf's horizontal error stays "
               "under 7 m, every seed",
               "Figs. 14-15: the 3-D DR/GPS stays within 7 m of the GPS position",
-              "simulated interchange loop ramp (8 % grade, 270 deg) in open sky, GNSS blocked "
-              "for 40 s by a fault; errors against the truth (the paper: against GPS); sensors "
-              "as in the garage; automotive vehicle body",
+              ("simulated interchange loop ramp (8 % grade, 270 deg) in open sky, GNSS blocked "
+               "for 40 s by a fault; errors against the truth (the paper: against GPS); sensors "
+               "as in the garage; automotive vehicle body",),
               _judge_open_sky),
     ))
