@@ -197,7 +197,7 @@ def _judge_situation3(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 
 CONDITIONS = ("simulated drive of about 165 s in the paper's spirit (its Fig. 6 profile is not "
               "printed); Crossbow DMU-300CC errors drawn per seed at 100 Hz averaged to the "
-              "10 Hz DR; landnav's GPS receiver instead of MATLAB's; no body lean")
+              "10 Hz DR; landnav's GPS receiver instead of MATLAB's; no body lean",)
 PAPER = Paper(
     key="cho2006",
     title="Performance Enhancement of Low-Cost Land Navigation System for Location-Based "
@@ -224,13 +224,13 @@ PAPER = Paper(
               "Stand-alone DRM2 dead reckoning beats DRM1 120 s after GNSS is lost on a curved "
               "drive in >= 8 of 10 seeds (paired)",
               "Fig. 12 (van test, no figures): only DRM2 keeps the trajectory's shape",
-              "simulated curved drive with two 4 % slopes and a 150 s outage instead of the "
-              "paper's van drive; DMU-300CC errors drawn per seed", _judge_drm2_beats_drm1),
+              ("simulated curved drive with two 4 % slopes and a 150 s outage instead of the "
+               "paper's van drive; DMU-300CC errors drawn per seed",), _judge_drm2_beats_drm1),
         Claim("situation1_scale_factor",
               "Situation I (fixed scale factors of eq. 36): the z-gyro scale factor is "
               "estimated within 0.02 by 100 s, every seed, both filters",
               "Fig. 7(d): the SPKF estimates the z-gyro scale factor faster than the EKF",
-              CONDITIONS + "; scale factors fixed at eq. 36's values",
+              (*CONDITIONS, "scale factors fixed at eq. 36's values"),
               _judge_scale_factor),
         Claim("situation3_outage",
               "Situation III (GPS outage 75-90 s; not an issue-14 criterion): the SPKF's error "

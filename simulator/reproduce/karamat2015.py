@@ -34,8 +34,8 @@ NEES of every label.
 The rule: ``simulator.reproduce.evidence``. A printed value (Table 2, the pitch and roll RMS) is
 shown when landnav's per-seed figure is significantly below twice the paper's and its median
 not below half of it (``FACTOR``); a printed gain ("16 %", "63 %") is shown when landnav's gain
-is significantly positive and the paper's figure lies in its 95 % interval widened by
-``GAIN_TOLERANCE_PCT`` points. Figures and analysis: docs/reproduction_karamat2015.md.
+is significantly positive and its median within ``GAIN_TOLERANCE_PCT`` points of the
+paper's. Figures and analysis: docs/reproduction_karamat2015.md.
 
 Public names
 ------------
@@ -58,7 +58,7 @@ import yaml
 from simulator.dataset.io import Dataset
 from simulator.reproduce import judged
 from simulator.reproduce import measures as m
-from simulator.reproduce.evidence import Evidence
+from simulator.reproduce.evidence import Magnitude
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 from simulator.scoring.align import ERR_ATT, ERR_POS, ERR_VEL
 
@@ -278,11 +278,13 @@ def gain(figures: pd.DataFrame, counts: Iterable[int], better: str = "tight",
                  / np.mean([seed_maxima(figures, worse, c).mean() for c in counts]))
 
 
-def _gain_ok(paper_pct: float) -> judged.Magnitude:
-    def ok(ev: Evidence) -> bool:  # the evidence of a ratio better / worse
-        low, high = 100.0 * (1.0 - ev.ci_high), 100.0 * (1.0 - ev.ci_low)
-        return low - GAIN_TOLERANCE_PCT <= paper_pct <= high + GAIN_TOLERANCE_PCT
-    return ok
+def _gain_magnitude(paper_pct: float) -> Magnitude:
+    """A printed gain as a bound on the median ratio better / worse: the paper's gain +-
+    ``GAIN_TOLERANCE_PCT`` points."""
+    return Magnitude(f"the paper's {paper_pct:g} % gain +- {GAIN_TOLERANCE_PCT:g} points, a "
+                     f"ratio of {1 - paper_pct / 100:.2f} +- {GAIN_TOLERANCE_PCT / 100:g}",
+                     1.0 - (paper_pct + GAIN_TOLERANCE_PCT) / 100.0,
+                     1.0 - (paper_pct - GAIN_TOLERANCE_PCT) / 100.0)
 
 
 def judge_gain(tables: Mapping[str, pd.DataFrame], experiment: str, better: str, worse: str,
@@ -290,12 +292,10 @@ def judge_gain(tables: Mapping[str, pd.DataFrame], experiment: str, better: str,
     """``better``'s mean window maximum below ``worse``'s (paired ratio per seed), by the
     paper's ``paper_pct`` where printed."""
     table = tables[experiment]
-    text = (f"the paper's {paper_pct:g} % inside landnav's interval of the gain +- "
-            f"{GAIN_TOLERANCE_PCT:g} points" if paper_pct is not None else "")
     return judged.paired(seed_maxima(table, better, counts), seed_maxima(table, worse, counts),
                          names=(better, worse), unit="m", kind="ratio",
-                         magnitude=_gain_ok(paper_pct) if paper_pct is not None else None,
-                         magnitude_text=text, analysis=analysis)
+                         magnitude=_gain_magnitude(paper_pct) if paper_pct is not None
+                         else None, analysis=analysis)
 
 
 def judge_overall(tables: Mapping[str, pd.DataFrame], worse: str, paper_pct: float) -> Verdict:
@@ -306,9 +306,8 @@ def judge_overall(tables: Mapping[str, pd.DataFrame], worse: str, paper_pct: flo
     overall = 0.5 * (kingston + toronto)
     return judged.one_sample(
         overall, name="overall gain", threshold=0.0, better="higher", unit="%",
-        magnitude=lambda ev: abs(ev.effect - paper_pct) <= GAIN_TOLERANCE_PCT
-        or ev.ci_low - GAIN_TOLERANCE_PCT <= paper_pct <= ev.ci_high + GAIN_TOLERANCE_PCT,
-        magnitude_text=f"{paper_pct:g} % inside the interval +- {GAIN_TOLERANCE_PCT:g} points")
+        magnitude=judged.around(f"the paper's {paper_pct:g} % +- {GAIN_TOLERANCE_PCT:g} points",
+                                paper_pct, GAIN_TOLERANCE_PCT))
 
 
 def judge_value(tables: Mapping[str, pd.DataFrame], experiment: str,
@@ -320,8 +319,8 @@ def judge_value(tables: Mapping[str, pd.DataFrame], experiment: str,
         v = m.column(tables, column, experiment)
         verdicts.append(judged.one_sample(
             v, name=f"{name} (paper {paper:g})", threshold=FACTOR * paper, better="lower",
-            unit=unit, magnitude=lambda ev, p=paper: ev.effect + FACTOR * p >= p / FACTOR,
-            magnitude_text=f"the median not below 1/{FACTOR:g} of the paper's"))
+            unit=unit, magnitude=Magnitude(f"the median not below 1/{FACTOR:g} of the paper's",
+                                           low=paper / FACTOR)))
     return judged.worst(verdicts)
 
 

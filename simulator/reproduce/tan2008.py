@@ -75,7 +75,7 @@ def _judge_magnetometer(tables: Mapping[str, pd.DataFrame]) -> Verdict:
 
 CONDITIONS = ("simulated 12-minute drive with the BP3010 unit's errors drawn per seed instead "
               "of the paper's Hanoi drive; the paper prints no error figure, so issue 14's "
-              "criteria are tested; the drive is cut 20 s after the outage in --quick")
+              "criteria are tested; the drive is cut 20 s after the outage in --quick",)
 PAPER = Paper(
     key="tan2008",
     title="Land-vehicle MEMS INS/GPS positioning during GPS signal blockage periods",
