@@ -41,12 +41,13 @@ Public names
 PAPER, PARTIAL_OUTAGES, COMPLETE_OUTAGES, COMPLETE_OUTAGES_CONSUMER, INITIAL_ERROR,
 INITIAL_ERROR_LATE, LEVER_ARM, HISTORY_STEP_S, short_partial_overrides,
 short_complete_overrides, measure_windows, measure_initial_error, table1, settle_time,
-run_filter.
+run_filter, figures.
 """
 
 from __future__ import annotations
 
 import json
+import re
 from collections.abc import Mapping
 from dataclasses import replace
 from functools import partial
@@ -54,16 +55,18 @@ from functools import partial
 import numpy as np
 import pandas as pd
 import yaml
+from matplotlib.figure import Figure
 
 from simulator.dataset.io import Dataset
 from simulator.replay import run_estimator
-from simulator.reproduce import judged
+from simulator.reproduce import judged, seed_plots
 from simulator.reproduce import measures as m
 from simulator.reproduce.evidence import Magnitude
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 from simulator.scoring.align import ERR_POS
 
 __all__ = ["COMPLETE_OUTAGES", "COMPLETE_OUTAGES_CONSUMER", "HISTORY_STEP_S", "INITIAL_ERROR",
+           "figures",
            "INITIAL_ERROR_LATE", "LEVER_ARM", "PAPER", "PARTIAL_OUTAGES",
            "measure_initial_error", "measure_windows", "run_filter", "settle_time",
            "short_complete_overrides", "short_partial_overrides", "table1"]
@@ -446,3 +449,66 @@ PAPER = Paper(
                           "paper; Figures 1-2 are its evidence and are judged above"),
     ),
 )
+
+
+def _window_history(table: pd.DataFrame, label: str, count: int) -> pd.DataFrame:
+    """Per seed, the 3-D error ``s`` s into a window averaged over the seed's windows with
+    ``count`` satellites: columns ``t{s}``."""
+    keys = sorted({c.split(".")[0] for c in table.columns if re.fullmatch(r"w\d+\.satellites", c)})
+    out: dict[str, list[float]] = {}
+    for _, row in table.iterrows():
+        mine = [k for k in keys if row.get(f"{k}.satellites") == count]
+        times = sorted({c.rsplit(".t", 1)[1] for k in mine for c in table.columns
+                        if c.startswith(f"{label}.{k}.t")})
+        for s in times:
+            out.setdefault(f"t{s}", []).append(float(np.nanmean(
+                [row[f"{label}.{k}.t{s}"] for k in mine if f"{label}.{k}.t{s}" in row])))
+    return pd.DataFrame(out)
+
+
+def figures(histories: Mapping[str, pd.DataFrame], tables: Mapping[str, pd.DataFrame]
+            ) -> list[tuple[str, Figure]]:
+    """The paper's Figures 2, 4 and 5 in its layout, drawn from every seed (a thin line per
+    seed, the median in bold), and the position NEES of every filter (a dot per seed)."""
+    out = []
+    complete = [k for k in ("complete_outages", "complete_outages_consumer") if k in tables]
+    if complete:
+        fig, axes = seed_plots.new_figure(len(complete))
+        for ax, key in zip(axes, complete, strict=True):
+            for label, color in ((NHC, "C0"), (NO_NHC, "C3")):
+                seed_plots.seed_lines(ax, _window_history(tables[key], label, 0), r"t(\d+)",
+                                      label, color)
+            ax.set(title=key.replace("_", " "), xlabel="time into the outage (s)",
+                   ylabel="3-D position error (m)")
+            ax.legend(fontsize=7)
+        out.append(("Figure 4 layout: 3-D position error in the complete 60 s outages, mean "
+                    "over the three outages of each seed (automotive and consumer IMU)", fig))
+    if "partial_outages" in tables:
+        counts = (0, 1, 2, 3, 4)
+        fig, axes = seed_plots.new_figure(len(counts), width_in=3.2)
+        for ax, c in zip(axes, counts, strict=True):
+            for label, color in ((NHC, "C0"), (NO_NHC, "C3")):
+                seed_plots.seed_lines(ax, _window_history(tables["partial_outages"], label, c),
+                                      r"t(\d+)", label, color)
+            ax.set(title=f"{c} satellite(s)", xlabel="time into the window (s)",
+                   ylabel="3-D position error (m)")
+        axes[0].legend(fontsize=7)
+        out.append(("Figure 5 layout: 3-D position error in the partial outages, per satellite "
+                    "count, with and without the NHC", fig))
+    late = [(k, p, unit) for k, p, unit in (("initial_error", r"{}\.t(\d+)", "3-D error (m)"),
+                                             ("initial_error_late", r"{}\.yaw_t(\d+)",
+                                              "heading error (deg)")) if k in tables]
+    if late:
+        fig, axes = seed_plots.new_figure(len(late))
+        for ax, (key, pattern, unit) in zip(axes, late, strict=True):
+            for label, color in (("tc_ukf_init", "C0"), ("tc_ekf_init", "C1")):
+                seed_plots.seed_lines(ax, tables[key], pattern.format(label), label, color)
+            ax.set(title=key.replace("_", " "), xlabel="time after the first GNSS epoch (s)",
+                   ylabel=unit, yscale="symlog")
+            ax.legend(fontsize=7)
+        out.append(("Figure 2 layout: from 100 m per axis (left, GNSS from the start) and from "
+                    "100 m and 60 deg of heading error with GNSS after 30 s (right)", fig))
+    return out + seed_plots.nees_figure(tables)
+
+
+PAPER = replace(PAPER, figures=figures)

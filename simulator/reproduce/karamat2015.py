@@ -42,27 +42,29 @@ Public names
 PAPER, PROTOCOL, PROTOCOL_5MG, NATURAL, ABLATION, VARIANTS, ABLATION_VARIANTS, COUNTS, LOOP_S,
 SITE1_OFFSET_S, NATURAL_DURATIONS_S, protocol_overrides, natural_overrides, measure_protocol,
 measure_outages, true_gyro_bias_z, window_maxima, seed_maxima, window_wins, gains, gain,
-site_reversals.
+site_reversals, figures.
 """
 
 from __future__ import annotations
 
 import json
 from collections.abc import Iterable, Mapping
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
 import pandas as pd
 import yaml
+from matplotlib.figure import Figure
 
 from simulator.dataset.io import Dataset
-from simulator.reproduce import judged
+from simulator.reproduce import judged, seed_plots
 from simulator.reproduce import measures as m
 from simulator.reproduce.evidence import Magnitude
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 from simulator.scoring.align import ERR_ATT, ERR_POS, ERR_VEL
 
-__all__ = ["ABLATION", "ABLATION_VARIANTS", "COUNTS", "LOOP_S", "NATURAL",
+__all__ = ["ABLATION", "ABLATION_VARIANTS", "COUNTS", "figures", "LOOP_S", "NATURAL",
            "NATURAL_DURATIONS_S", "PAPER", "PROTOCOL", "PROTOCOL_5MG", "SITE1_OFFSET_S",
            "VARIANTS", "gain", "gains", "measure_outages", "measure_protocol", "natural_overrides",
            "protocol_overrides", "seed_maxima", "site_reversals", "true_gyro_bias_z",
@@ -587,3 +589,55 @@ PAPER = Paper(
                           ("simplified", "any of its additions (the earlier model)"))],
     ),
 )
+
+
+def figures(histories: Mapping[str, pd.DataFrame], tables: Mapping[str, pd.DataFrame]
+            ) -> list[tuple[str, Figure]]:
+    """The paper's Figure 8 (mean window maximum per satellite count, TC-EKF against the
+    earlier filters), Figure 16 (the natural outages), Figure 13 (the gyro-bias error over
+    time) and Table 2 in its layout, from every seed, and every filter's position NEES."""
+    out = []
+    if "partial_outages" in tables:
+        table = tables["partial_outages"]
+        labels = [v for v in ("tight", "simplified", "lc", "loose")
+                  if f"{v}.sats0.mean_max_h_m" in table]
+        fig, axes = seed_plots.new_figure(len(COUNTS), width_in=3.2)
+        for ax, c in zip(axes, COUNTS, strict=True):
+            seed_plots.seed_bars(ax, {v: seed_maxima(table, v, c) for v in labels})
+            ax.axhline(UNDER_M, color="k", lw=0.8, ls="--")
+            ax.set(title=f"{c} satellite(s)", ylabel="mean window maximum (m)")
+        out.append(("Figure 8 layout: the average maximum horizontal error of the 60 s windows "
+                    "per satellite count (tight = TC-EKF, simplified = TC-LKF stand-in, lc = "
+                    "LC-LKF stand-in; dashed: 12 m)", fig))
+        fig, axes = seed_plots.new_figure(1)
+        seed_plots.seed_lines(axes[0], table, r"tight\.gyro_bias_error_t(\d+)_deg_s", "tight",
+                              "C0")
+        axes[0].axhline(0.0, color="k", lw=0.8)
+        axes[0].set(xlabel="time (s)", ylabel="gyro-bias estimate - truth (deg/s)")
+        out.append(("Figure 13 layout: the vertical-gyro bias estimate's error", fig))
+        groups = {f"{a} ({TABLE2[block][a][1]:g})": m.column(table, TABLE2[block][a][0])
+                  for block in TABLE2 for a in TABLE2[block]}
+        fig, axes = seed_plots.new_figure(1, width_in=8.0)
+        seed_plots.seed_bars(axes[0], groups)
+        axes[0].set(ylabel="RMS in the 0-satellite windows (m, deg, m/s)", yscale="log")
+        out.append(("Table 2 layout: RMS errors in the full 60 s outages, the paper's average "
+                    "in brackets", fig))
+    if "natural_outages" in tables:
+        table = tables["natural_outages"]
+        keys = sorted({c.split(".")[1] for c in table.columns
+                       if c.startswith("tight.w") and c.endswith(".max_h_m")})
+        fig, axes = seed_plots.new_figure(1, width_in=8.0)
+        for k, label in enumerate(v for v in ("tight", "simplified", "lc")
+                                  if f"{v}.sats0.mean_max_h_m" in table):
+            values = table[[f"{label}.{w}.max_h_m" for w in keys]].to_numpy(float)
+            axes[0].plot(np.arange(len(keys)) + 0.2 * k, np.median(values, axis=0), "o-",
+                         label=f"{label} (median over seeds)")
+        durations = [f"{table[f'{w}.duration_s'].iloc[0]:.0f} s" for w in keys]
+        axes[0].set_xticks(range(len(keys)), durations)
+        axes[0].set(xlabel="outage", ylabel="maximum horizontal error (m)", yscale="log")
+        axes[0].legend(fontsize=7)
+        out.append(("Figure 16 layout: maximum horizontal error of each natural outage", fig))
+    return out + seed_plots.nees_figure(tables)
+
+
+PAPER = replace(PAPER, figures=figures)

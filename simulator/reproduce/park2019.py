@@ -35,26 +35,28 @@ Public names
 PAPER, GARAGE, FLAT, SCALE_097, OPEN_SKY, OPEN_SKY_CONVENTIONAL, MULTILEVEL, TUNNEL,
 INS_PARK_GARAGE, INS_PARKING_GARAGE, GARAGE_ABLATION, GARAGE_SF_025, GARAGE_SF_010, GARAGE_HELIX,
 GARAGE_INS_1HZ, PAPER_FILTERS, FLAT_PERFECT, SHORT, SAME_HANDED_STEEP, HISTORY_STEP_S,
-garage_figures.
+garage_figures, figures.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
 from simulator.dataset.io import Dataset
-from simulator.reproduce import judged
+from simulator.reproduce import judged, seed_plots
 from simulator.reproduce import measures as m
 from simulator.reproduce.evidence import Magnitude
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict
 from simulator.scoring.align import ERR_ATT
 
-__all__ = ["FLAT", "FLAT_PERFECT", "GARAGE", "GARAGE_ABLATION", "GARAGE_HELIX",
+__all__ = ["FLAT", "FLAT_PERFECT", "figures", "GARAGE", "GARAGE_ABLATION", "GARAGE_HELIX",
            "GARAGE_INS_1HZ", "GARAGE_SF_010", "GARAGE_SF_025", "HISTORY_STEP_S",
            "INS_PARKING_GARAGE", "INS_PARK_GARAGE", "MULTILEVEL", "OPEN_SKY",
            "OPEN_SKY_CONVENTIONAL", "PAPER",
@@ -472,3 +474,51 @@ PAPER = Paper(
               "section II-A, eqs. 12-14: the NHC bounds the INS error (no number)",
               ["NHC at the rear axle"], _judge_ins_nhc, kind="check"),
     ))
+
+
+LAYOUTS = (("Fig. 15", "open_sky", "open_sky_conventional"), ("Fig. 16", "garage", None),
+           ("Fig. 17", "multilevel_garage", None), ("Fig. 18", "curved_tunnel", None))
+COLORS = {"dr3d_ekf": "C0", "dr2d_odo_ekf": "C1", "ins_odo_ekf": "C3", "riss3d": "C2"}
+
+
+def figures(histories: Mapping[str, pd.DataFrame], tables: Mapping[str, pd.DataFrame]
+            ) -> list[tuple[str, Figure]]:
+    """The paper's Figures 15-18 as horizontal error against time in each outage (every seed
+    a thin line, the median in bold), Fig. 19's height change and Table 3's garage error under
+    the swept gyro scale factor and helices (a dot per seed), every filter's NEES."""
+    out = []
+    shown = [(fig_no, key, extra) for fig_no, key, extra in LAYOUTS if key in tables]
+    if shown:
+        fig, axes = seed_plots.new_figure(len(shown))
+        for ax, (fig_no, key, extra) in zip(axes, shown, strict=True):
+            for table in (tables[key], tables.get(extra)):
+                if table is None:
+                    continue
+                for label, color in COLORS.items():
+                    seed_plots.seed_lines(ax, table, rf"{label}\.h(\d+)", label, color)
+            ax.set(title=f"{fig_no}: {key.replace('_', ' ')}", xlabel="time into the outage (s)",
+                   ylabel="horizontal error (m)", yscale="symlog")
+            ax.legend(fontsize=6)
+        out.append(("Figs. 15-18 layout: horizontal error against the truth through each GNSS "
+                    "outage", fig))
+    if "garage" in tables:
+        table = tables["garage"]
+        fig, axes = seed_plots.new_figure(2)
+        seed_plots.seed_bars(axes[0], {f: m.column(table, f"{f}.height_change_error_m")
+                                       for f in ("dr3d_ekf", "ins_odo_ekf")})
+        axes[0].set(title="Fig. 19: height change error (paper 1.22 vs 22.34 m)",
+                    ylabel="|estimated - true height change| (m)", yscale="log")
+        sweeps = {f"{f} {value}": m.column(tables[key], f"{f}.exit_horizontal_m")
+                  for value, key in (("0.5 %", "garage"), ("0.25 %", "garage_gyro_sf_025"),
+                                     ("0.1 %", "garage_gyro_sf_010"),
+                                     ("same-handed 8.7 %", "garage_same_handed_steep"))
+                  if key in tables for f in ("dr3d_ekf", "dr2d_odo_ekf")}
+        seed_plots.seed_bars(axes[1], sweeps)
+        axes[1].set(title="Table 3 area 1: exit error by gyro scale factor and helices",
+                    ylabel="horizontal error at the exit (m)")
+        out.append(("Fig. 19 and Table 3 layout: the height change through the garage, and the "
+                    "garage exit error under the swept conditions", fig))
+    return out + seed_plots.nees_figure(tables)
+
+
+PAPER = replace(PAPER, figures=figures)

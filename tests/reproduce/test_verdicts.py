@@ -97,13 +97,16 @@ def test_windows_from_the_events_table():
 
 
 def test_park_flat_ratio_judge():
-    seeds = pd.Index([1, 2, 3], name="seed")
-    flat = pd.DataFrame({"dr3d_ekf.exit_horizontal_m": [10.0, 10.0, 10.0],
-                         "dr3d_ekf.max_horizontal_m": [10.0, 10.0, 10.0],
-                         "dr2d_odo_ekf.exit_horizontal_m": [9.0, 11.0, 10.0],
-                         "dr2d_odo_ekf.max_horizontal_m": [20.0, 20.0, 20.0]}, index=seeds)
+    """Six seeds: exit ratios near 1 but the max ratio 0.5 (an advantage left): not shown;
+    both within 0.3 of 1 in every seed: shown."""
+    seeds = pd.Index(range(1, 7), name="seed")
+    flat = pd.DataFrame({"dr3d_ekf.exit_horizontal_m": [10.0] * 6,
+                         "dr3d_ekf.max_horizontal_m": [10.0] * 6,
+                         "dr2d_odo_ekf.exit_horizontal_m": [9.0, 11.0, 10.0, 9.5, 10.5, 10.0],
+                         "dr2d_odo_ekf.max_horizontal_m": [20.0] * 6}, index=seeds)
     claim = next(c for c in park2019.PAPER.claims if c.key == "flat_no_advantage_2d")
-    assert claim.judge({"flat_garage": flat}).status == "partly"  # exit 1.0, max 0.5
+    assert claim.kind == "check"
+    assert claim.judge({"flat_garage": flat}).status == "not shown"
     flat["dr2d_odo_ekf.max_horizontal_m"] = 11.0
     assert claim.judge({"flat_garage": flat}).status == "shown"
 
