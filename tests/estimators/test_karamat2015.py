@@ -196,3 +196,19 @@ def test_full_drive_all_sites(full_drive):
 def test_full_drive_gyro_bias_converged(full_drive):
     """Section 4.3.3 on the whole drive's seed: the bias error at 300 s below 0.05 deg/s."""
     assert abs(full_drive["tight.gyro_bias_error_300s_deg_s"].iloc[0]) < 0.05
+
+
+def test_frozen_states_are_never_corrected(tmp_path):
+    """``frozen_states`` (the ablation of the enhanced model's states): with the accelerometer
+    biases frozen their estimates stay exactly zero through a loop with GNSS, while the full
+    model moves them; an unknown state name is refused."""
+    ds = one_loop(tmp_path / "d")
+    frozen, _ = run_estimator(ds, {"name": "riss3d_tc_ekf", "config": {
+        "tuning": "paper", "frozen_states": ["bx", "by"]}}, show_progress=False)
+    full, _ = run_estimator(ds, {"name": "riss3d_tc_ekf", "config": {"tuning": "paper"}},
+                            show_progress=False)
+    assert (frozen[["accel_bias_x", "accel_bias_y"]].to_numpy() == 0.0).all()
+    assert np.abs(full["accel_bias_x"].to_numpy()).max() > 1e-4
+    with pytest.raises(InputError, match="frozen_states must be among r, p, bx, by, vo"):
+        run_estimator(ds, {"name": "riss3d_tc_ekf", "label": None, "init": None,
+                           "config": {"frozen_states": ["bz"]}}, show_progress=False)
