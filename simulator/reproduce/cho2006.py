@@ -277,25 +277,29 @@ def _variant(claim: Claim, key: str, variant: str, judge, extra: tuple[str, ...]
                  kind=claim.kind, variant_of=claim.key, variant=variant)
 
 
-S1_Z = Claim("situation1_z_scale_faster",
-             "Situation I: the SPKF estimates the z-gyro scale factor faster than the EKF",
-             "Fig. 7(d): 'The scale factor error of the z-axis gyro in the SPKF is estimated "
-             "faster than that in the EKF' (curves, no time printed)",
-             (*CONDITIONS, SCALE_WORDS, "scale factors fixed at eq. 36's values"),
-             paired("situation1", "spkf", "ekf", "z_scale_converge_s", "s",
-                    "SPKF converges sooner"))
-S1_HEADING = Claim("situation1_heading",
-                   "Situation I: the EKF's heading error is larger than the SPKF's",
-                   "Fig. 7(b): 'This phenomenon causes the larger heading error in the EKF "
-                   "than in the SPKF'", (*CONDITIONS, "heading RMS from moving off to the end"),
-                   paired("situation1", "spkf", "ekf", "heading_rms_deg", "deg",
-                          "SPKF heading error smaller"))
-S1_POSITION = Claim("situation1_position",
-                    "Situation I: the EKF's position error is larger than the SPKF's",
-                    "Fig. 7(a): 'The position error in the EKF is larger than that in the "
-                    "SPKF'", (*CONDITIONS, "horizontal RMS from moving off to the end"),
-                    paired("situation1", "spkf", "ekf", "horizontal_rms_m", "m",
-                           "SPKF position error smaller"))
+def _spkf_vs_ekf(key: str, text: str, paper_figure: str, measure_words: str, experiment: str,
+                 figure: str, unit: str, what: str) -> Claim:
+    """A paper claim that the simplex SPKF's ``figure`` is smaller than the EKF's."""
+    return Claim(key, text, paper_figure, (*CONDITIONS, measure_words),
+                 paired(experiment, "spkf", "ekf", figure, unit, what))
+
+
+S1_Z = _spkf_vs_ekf("situation1_z_scale_faster",
+                    "Situation I: the SPKF estimates the z-gyro scale factor faster than the EKF",
+                    "Fig. 7(d): 'The scale factor error of the z-axis gyro in the SPKF is "
+                    "estimated faster than that in the EKF' (curves, no time printed)",
+                    f"{SCALE_WORDS}; scale factors fixed at eq. 36's values", "situation1",
+                    "z_scale_converge_s", "s", "SPKF converges sooner")
+S1_HEADING = _spkf_vs_ekf("situation1_heading",
+                          "Situation I: the EKF's heading error is larger than the SPKF's",
+                          "Fig. 7(b): 'This phenomenon causes the larger heading error in the "
+                          "EKF than in the SPKF'", "heading RMS from moving off to the end",
+                          "situation1", "heading_rms_deg", "deg", "SPKF heading error smaller")
+S1_POSITION = _spkf_vs_ekf("situation1_position",
+                           "Situation I: the EKF's position error is larger than the SPKF's",
+                           "Fig. 7(a): 'The position error in the EKF is larger than that in "
+                           "the SPKF'", "horizontal RMS from moving off to the end",
+                           "situation1", "horizontal_rms_m", "m", "SPKF position error smaller")
 S1_ACCEL = Claim("situation1_accel_scale_slower",
                  "Situation I: the SPKF's accelerometer scale-factor error decreases more "
                  "slowly than the EKF's",
@@ -312,22 +316,20 @@ S2_SPKF = Claim("situation2_spkf_converges_140",
                 "Fig. 8: 'the errors of SPKF converge to the neighbor of 0 with time'",
                 (*CONDITIONS, CONVERGE_WORDS),
                 converged("situation2", ("spkf_m140",), "the SPKF converges"))
-S3 = Claim("situation3_position",
-           "Situation III (GPS blocked 75-90 s): the EKF's position error grows more than the "
-           "SPKF's in the blockage",
-           "Fig. 9: 'the position and heading errors of the EKF increase more than that of the "
-           "SPKF in the blockage section'",
-           (*CONDITIONS, "growth: largest horizontal error in the outage minus its value at "
-                         "the outage's start"),
-           paired("situation3", "spkf", "ekf", "outage_growth_m", "m",
-                  "SPKF error grows less"))
-S3_HEADING = Claim("situation3_heading",
-                   "Situation III: the EKF's heading error grows more than the SPKF's in the "
-                   "blockage", "Fig. 9 (as above)",
-                   (*CONDITIONS, "growth: largest absolute heading error in the outage minus "
-                                 "its value at the outage's start"),
-                   paired("situation3", "spkf", "ekf", "outage_heading_growth_deg", "deg",
-                          "SPKF heading error grows less"))
+S3 = _spkf_vs_ekf("situation3_position",
+                  "Situation III (GPS blocked 75-90 s): the EKF's position error grows more "
+                  "than the SPKF's in the blockage",
+                  "Fig. 9: 'the position and heading errors of the EKF increase more than that "
+                  "of the SPKF in the blockage section'",
+                  "growth: largest horizontal error in the outage minus its value at the "
+                  "outage's start", "situation3", "outage_growth_m", "m",
+                  "SPKF error grows less")
+S3_HEADING = _spkf_vs_ekf("situation3_heading",
+                          "Situation III: the EKF's heading error grows more than the SPKF's in "
+                          "the blockage", "Fig. 9 (as above)",
+                          "growth: largest absolute heading error in the outage minus its value "
+                          "at the outage's start", "situation3", "outage_heading_growth_deg",
+                          "deg", "SPKF heading error grows less")
 
 PAPER = Paper(
     key="cho2006",
