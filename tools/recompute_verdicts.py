@@ -16,7 +16,7 @@ For each claim with evidence it recomputes, from the per-seed values named by th
   it is not met, not shown otherwise;
 
 and checks that the stored figures and word are those; a claim without evidence must be "not
-shown" (or "not testable", with its reason and without values); the summary's tallies of paper
+shown" (or "not testable", with its reason and without evidence); the summary's tallies of paper
 claims and checks (apart) must match the claims.
 
 Usage::
@@ -66,8 +66,8 @@ def recompute(claim: dict, alpha: float) -> tuple[str, list[str]]:
     problems = []
     e = claim["evidence"]
     if claim["untestable"]:
-        if claim["per_seed"] or e is not None or claim["kind"] != "paper":
-            problems.append("an untestable claim has values, evidence or is not a paper claim")
+        if e is not None or claim["kind"] != "paper":
+            problems.append("an untestable claim has evidence or is not a paper claim")
         return UNTESTABLE, problems
     if e is None:
         return "not shown", problems

@@ -33,7 +33,7 @@ the word follows from the per-seed values alone and an independent script can re
 
 Public names
 ------------
-Evidence, Magnitude, paired_evidence, one_sample_evidence, verdict_word, evidence_text,
+Evidence, Magnitude, Better, paired_evidence, one_sample_evidence, verdict_word, evidence_text,
 ALPHA, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED.
 """
 
@@ -47,7 +47,7 @@ from typing import Literal
 import numpy as np
 from scipy.stats import binomtest
 
-__all__ = ["ALPHA", "BOOTSTRAP_RESAMPLES", "BOOTSTRAP_SEED", "Evidence", "Magnitude",
+__all__ = ["ALPHA", "BOOTSTRAP_RESAMPLES", "BOOTSTRAP_SEED", "Better", "Evidence", "Magnitude",
            "evidence_text", "one_sample_evidence", "paired_evidence", "verdict_word"]
 
 ALPHA = 0.05  # significance of the one-sided sign test

@@ -38,7 +38,7 @@ from simulator.scoring.evaluate import score_solutions
 from simulator.scoring.metrics import OUTAGE_KIND
 
 __all__ = ["at_time", "column", "count_text", "count_verdict", "errors", "evidence_verdict",
-           "horizontal_error", "inside_windows", "least_count", "longest_outage",
+           "horizontal_error", "inside_windows", "least_count", "listed", "longest_outage",
            "median_verdict", "missing_count", "moving_off", "needed_count", "outage_scores",
            "outages", "paired_judgement", "paired_verdict", "paired_wins", "position_error_3d",
            "satellite_windows", "spread_text", "threshold_judgement", "win_rate_text",
@@ -171,7 +171,7 @@ def _with(reason: str, analysis: str) -> str:
     return f"{reason}. {analysis}".strip() if analysis else reason
 
 
-def _listed(values: Sequence[float] | np.ndarray) -> list[float | None]:
+def listed(values: Sequence[float] | np.ndarray) -> list[float | None]:
     """Per-seed values for ``Verdict.per_seed``: floats, None where a seed has none."""
     return [float(v) if np.isfinite(v) else None for v in np.asarray(values, float)]
 
@@ -189,7 +189,7 @@ def evidence_verdict(evidence: ev.Evidence, per_seed: Mapping[str, Sequence[floa
     if magnitude is not None:
         reason += f"; magnitude ({magnitude.text}) {'met' if ok else 'not met'}"
     return Verdict(status, measured, _with(reason, analysis if status != "shown" else ""),
-                   evidence, {k: _listed(v) for k, v in per_seed.items()}, magnitude,
+                   evidence, {k: listed(v) for k, v in per_seed.items()}, magnitude,
                    compared)
 
 

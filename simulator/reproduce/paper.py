@@ -75,6 +75,8 @@ class Experiment:
     # the time histories of the run's first seed for the paper's figures: a module-level
     # function of the dataset and the solutions giving a table with a "t" column (s)
     history: Callable[[Dataset, Mapping[str, pd.DataFrame]], pd.DataFrame] | None = None
+    # seeds of a run without --quick when more than the run's: where a verdict sits at an edge
+    full_runs: int | None = None
 
 
 @dataclass(frozen=True)
@@ -121,8 +123,9 @@ class Claim:
     ``kind``: "paper" for what the paper claims (quoted with its figure or table, judged as the
     paper states it), "check" for landnav's own checks (a filter works, a control); the report
     tallies the two apart. ``conditions`` lists every condition of the experiment that differs
-    from the paper. A paper claim landnav cannot test has no ``judge`` and says why in
-    ``untestable``. A claim judged again under another value of a deciding condition names the
+    from the paper. A paper claim landnav cannot test says why in ``untestable``; its ``judge``,
+    if any, only gives landnav's figure for it (the word is "not testable", never one from
+    evidence). A claim judged again under another value of a deciding condition names the
     default claim in ``variant_of`` and the value in ``variant`` ("fix noise 1.5 m"); the
     summary tallies the default rows only."""
 
@@ -143,8 +146,8 @@ class Claim:
             raise TypeError(f"claim {self.key}: conditions is a tuple of strings")
         if self.kind not in ("paper", "check"):
             raise ValueError(f"claim {self.key}: kind is 'paper' or 'check', got {self.kind!r}")
-        if self.untestable and (self.judge is not None or self.kind != "paper"):
-            raise ValueError(f"claim {self.key}: an untestable paper claim has no judge")
+        if self.untestable and self.kind != "paper":
+            raise ValueError(f"claim {self.key}: only a paper claim can be untestable")
         if not self.untestable and self.judge is None:
             raise ValueError(f"claim {self.key}: a testable claim needs a judge")
         if bool(self.variant_of) != bool(self.variant):

@@ -54,8 +54,7 @@ def summary_counts(results: Sequence[PaperResult], kind: str = "paper"
     out = {}
     for r in results:
         claims = [c for c in r.paper.claims if c.kind == kind and not c.variant_of]
-        words = [r.verdicts[c.key].status if c.key in r.verdicts else UNTESTABLE
-                 for c in claims]
+        words = [UNTESTABLE if c.untestable else r.verdicts[c.key].status for c in claims]
         out[r.paper.key] = {w: words.count(w) for w in (*STATUSES, UNTESTABLE)
                             if w != UNTESTABLE or kind == "paper"}
     return out
@@ -105,7 +104,9 @@ def _claim_rows(result: PaperResult, claims: Sequence[Claim]) -> list[list[str]]
         if claim.variant:
             head = f"**{claim.key}** ({claim.variant}): {claim.text}"
         if claim.untestable:
-            rows.append([head, claim.paper_figure, "not tested", conditions, "none",
+            figure = result.verdicts[claim.key].measured if claim.key in result.verdicts \
+                else "not tested"
+            rows.append([head, claim.paper_figure, figure, conditions, "none",
                          f"**{UNTESTABLE}**: {claim.untestable}"])
             continue
         v = result.verdicts[claim.key]

@@ -79,9 +79,12 @@ def _claim(paper: str, claim: Claim, verdict: Verdict | None) -> dict:
            "variant_of": claim.variant_of, "variant": claim.variant, "statement": claim.text,
            "paper_figure": claim.paper_figure, "conditions": list(claim.conditions),
            "untestable": claim.untestable}
-    if verdict is None:
-        return {**out, "per_seed": {}, "evidence": None, "magnitude": None,
-                "verdict": UNTESTABLE, "measured": "", "reason": claim.untestable}
+    if verdict is None or claim.untestable:
+        return {**out, "per_seed": {} if verdict is None else {
+                    k: [_number(x) for x in v] for k, v in verdict.per_seed.items()},
+                "evidence": None, "magnitude": None, "verdict": UNTESTABLE,
+                "measured": "" if verdict is None else verdict.measured,
+                "reason": claim.untestable}
     magnitude = verdict.magnitude
     return {**out,
             "per_seed": {k: [_number(x) for x in v] for k, v in verdict.per_seed.items()},

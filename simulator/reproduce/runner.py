@@ -62,6 +62,14 @@ def seeds_of(runs: int) -> list[int]:
     return list(range(1, runs + 1))
 
 
+def experiment_seeds(experiment: Experiment, seeds: Sequence[int], quick: bool) -> list[int]:
+    """The seeds an experiment runs: the run's, or 1..``experiment.full_runs`` without
+    ``quick`` when that is more (an experiment whose verdicts sit at an edge)."""
+    if quick or not experiment.full_runs or experiment.full_runs <= len(seeds):
+        return list(seeds)
+    return seeds_of(experiment.full_runs)
+
+
 def experiment_overrides(experiment: Experiment, quick: bool,
                          extra: Sequence[str] = ()) -> list[str]:
     """The --set overrides of an experiment: its own, then the quick ones, then ``extra``."""
@@ -166,10 +174,14 @@ def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict
     (``ruled``)."""
     out = {}
     for claim in paper.claims:
-        if claim.untestable:
+        if claim.judge is None:
             continue
         try:
-            out[claim.key] = ruled(claim.judge(tables))
+            verdict = claim.judge(tables)
+            # an untestable claim's judge gives landnav's figure only: no evidence, no word
+            out[claim.key] = (replace(verdict, status="not shown", evidence=None,
+                                      magnitude=None, compared=())
+                              if claim.untestable else ruled(verdict))
         except Exception as exc:  # noqa: BLE001 - the report says why, the others are judged
             out[claim.key] = Verdict("not shown", "no figure",
                                      f"could not be judged: {type(exc).__name__}: {exc}")
@@ -227,7 +239,7 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
     seeds = seeds_of(runs or (QUICK_SEEDS if quick else FULL_SEEDS))
     tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)),
                    seed == seeds[0] and e.history is not None)
-             for p in loaded for e in p.experiments for seed in seeds]
+             for p in loaded for e in p.experiments for seed in experiment_seeds(e, seeds, quick)]
     figures: dict[tuple[str, str], dict[int, dict[str, float]]] = {}
     histories: dict[tuple[str, str], pd.DataFrame] = {}
     failures: dict[tuple[str, str], dict[int, str]] = {}

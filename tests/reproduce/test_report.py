@@ -153,3 +153,20 @@ def test_per_seed_plot_counts_the_seeds_without_a_figure():
     ax = Figure().add_subplot()
     _panel(ax, "drive", e)
     assert [t.get_text() for t in ax.get_xticklabels()] == ["a.error_m", "b.end_m (2 missing)"]
+
+
+def test_the_pages_tables_are_written_from_results_json(tmp_path):
+    results = [_result("first", ["shown", "partly"], ["shown"])]
+    path = write_results(tmp_path / RESULTS_FILE, results, SETTINGS)
+    page = tmp_path / "page.md"
+    page.write_text("intro\n<!-- claims: first -->\nold\n<!-- end of claims -->\n"
+                    "<!-- summary -->\nold\n<!-- end of summary -->\nend\n")
+    run = subprocess.run([sys.executable, str(REPOSITORY / "tools" / "reproduction_tables.py"),
+                          str(path), str(page)], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    text = page.read_text()
+    assert "old" not in text and text.startswith("intro\n") and text.endswith("end\n")
+    assert "| `first_claim1`: claim 1 of first \\| with a pipe | Table 1: 1.1 m |" in text
+    assert "6 of 6 seeds in the paper's direction" in text and "**partly**" in text
+    assert "**landnav's checks**" in text and "commit abc" in text
+    assert "| first | 1 / 1 / 0 / 1 | 1 / 0 / 0 |" in text

@@ -7,8 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from simulator.reproduce import cho2006, park2019, tan2008
 from simulator.reproduce import measures as m
-from simulator.reproduce import park2019, tan2008
 from simulator.reproduce.paper import SCENARIO_DIR
 from simulator.reproduce.papers import PAPERS, load_paper, paper_keys
 from simulator.reproduce.runner import judge
@@ -94,6 +94,32 @@ def test_windows_from_the_events_table():
     t = np.array([5.0, 10.0, 19.9, 20.0, 60.0, 110.0])
     np.testing.assert_array_equal(m.inside_windows(t, m.outages(events)),
                                   [False, True, True, False, True, False])
+
+
+def test_cho_and_tan_judges_follow_the_rule_on_synthetic_seeds():
+    """Ten seeds: the SPKF converges in 9 at -140 deg (p = 11/1024: shown), the EKF stays above
+    3 deg in 8 (p = 0.055: not shown); Tan's constraints win 10 of 10 (shown), the magnetometer
+    5 of 10 (not shown)."""
+    seeds = pd.Index(range(1, 11), name="seed")
+    s2 = pd.DataFrame({"spkf_m140.heading_rms_deg": [0.5] * 9 + [10.0],
+                       "ekf_m140.heading_rms_deg": [20.0] * 8 + [1.0] * 2}, index=seeds)
+    verdicts = judge(cho2006.PAPER, {"situation2": s2})
+    assert verdicts["situation2_spkf_converges_140"].status == "shown"
+    assert verdicts["situation2_ekf_diverges_140"].status == "not shown"
+    assert verdicts["situation2_spkf_converges_140"].evidence.wins == 9
+    outage = pd.DataFrame({f"{label}.{figure}": np.arange(10.0) + offset
+                           for label, offset in (("free", 100.0), ("constraints", 10.0),
+                                                 ("full", 10.0), ("closed", 0.0),
+                                                 ("no_standstill", 5.0))
+                           for figure in ("end_horizontal_m", "max_horizontal_m",
+                                          "standstill_heading_deg")}, index=seeds)
+    outage["full.end_horizontal_m"] = outage["constraints.end_horizontal_m"] + [-1.0, 1.0] * 5
+    outage["outage.distance_m"] = 700.0
+    verdicts = judge(tan2008.PAPER, {"outage": outage})
+    assert verdicts["constraints_reduce_outage_error"].status == "shown"
+    assert verdicts["magnetometer_reduces_outage_error"].status == "not shown"
+    assert verdicts["small_error_70_s"].evidence is None
+    assert "median 700 m (IQR 700-700" in verdicts["small_error_70_s"].measured
 
 
 def test_park_flat_ratio_judge():
