@@ -184,7 +184,8 @@ def settle_time(t: np.ndarray, error: np.ndarray, bound_m: float = SETTLE_BOUND_
 def measure_initial_error(dataset: Dataset, solutions: Mapping[str, pd.DataFrame]) -> Figures:
     """Per label, from the first GNSS epoch (the end of the dataset's first outage when it
     starts at the drive's start, else the first solution row): ``LABEL.settle_s``
-    (``settle_time`` below 10 m; the time left in the drive when it never settles), ``LABEL.early_rms_3d_m`` (RMS 3-D error over the first
+    (``settle_time`` below 10 m; the time left in the drive when it never settles),
+    ``LABEL.early_rms_3d_m`` (RMS 3-D error over the first
     ``EARLY_S`` s), ``LABEL.early_rms_yaw_deg`` (the heading's, deg), ``LABEL.yaw_settle_s``
     (until the heading error stays below ``YAW_SETTLE_DEG``), ``LABEL.rms_3d_m`` (RMS over
     the drive),
