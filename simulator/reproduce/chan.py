@@ -62,6 +62,7 @@ from simulator.replay import run_estimator
 from simulator.reproduce import judged, seed_plots
 from simulator.reproduce import measures as m
 from simulator.reproduce.evidence import Magnitude
+from simulator.reproduce.histories import error_history
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 from simulator.scoring.align import ERR_POS
 
@@ -372,7 +373,8 @@ PARTIAL_OUTAGES = Experiment("partial_outages", "chan_partial_outages.yaml", NHC
                              measure_windows,
                              quick_overrides=tuple(short_partial_overrides(0)))
 COMPLETE_OUTAGES = Experiment("complete_outages", "chan_complete_outages.yaml", NHC_PAIR,
-                              measure_windows, quick_overrides=tuple(short_complete_overrides()))
+                              measure_windows, quick_overrides=tuple(short_complete_overrides()),
+                              history=error_history)
 COMPLETE_OUTAGES_CONSUMER = Experiment(
     "complete_outages_consumer", "chan_complete_outages.yaml", NHC_PAIR, measure_windows,
     overrides=("sensors.imu.preset=consumer",), quick_overrides=tuple(short_complete_overrides()))
@@ -513,7 +515,8 @@ def figures(histories: Mapping[str, pd.DataFrame], tables: Mapping[str, pd.DataF
             ax.legend(fontsize=7)
         out.append(("Figure 2 layout: from 100 m per axis (left, GNSS from the start) and from "
                     "100 m and 60 deg of heading error with GNSS after 30 s (right)", fig))
-    return out + seed_plots.nees_figure(tables)
+    return (out + seed_plots.nees_figure(tables)
+            + seed_plots.nees_history_figure(histories))
 
 
 PAPER = replace(PAPER, figures=figures)

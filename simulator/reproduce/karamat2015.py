@@ -62,6 +62,7 @@ from simulator.dataset.io import Dataset
 from simulator.reproduce import judged, seed_plots
 from simulator.reproduce import measures as m
 from simulator.reproduce.evidence import Magnitude
+from simulator.reproduce.histories import error_history
 from simulator.reproduce.paper import Claim, Experiment, Figures, Paper, Verdict, scenario_path
 from simulator.scoring.align import ERR_ATT, ERR_POS, ERR_VEL
 
@@ -430,7 +431,7 @@ NATURAL = Experiment(
     "natural_outages", SCENARIO,
     {label: {"name": "riss3d_tc_ekf", "config": VARIANTS[label]}
      for label in ("tight", "simplified", "lc")},
-    measure_outages, overrides=tuple(natural_overrides()),
+    measure_outages, overrides=tuple(natural_overrides()), history=error_history,
     quick_overrides=("trajectory.segments.0.repeat.times=2", "faults=" + json.dumps(
         [{"kind": "gnss_outage", "start": NATURAL_START_S, "duration": 60.0},
          {"kind": "gnss_outage", "start": NATURAL_START_S + 180.0, "duration": 300.0}])))
@@ -631,7 +632,8 @@ def figures(histories: Mapping[str, pd.DataFrame], tables: Mapping[str, pd.DataF
         axes[0].set(xlabel="outage", ylabel="maximum horizontal error (m)", yscale="log")
         axes[0].legend(fontsize=7)
         out.append(("Figure 16 layout: maximum horizontal error of each natural outage", fig))
-    return out + seed_plots.nees_figure(tables)
+    return (out + seed_plots.nees_figure(tables)
+            + seed_plots.nees_history_figure(histories))
 
 
 PAPER = replace(PAPER, figures=figures)

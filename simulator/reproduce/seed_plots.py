@@ -5,7 +5,7 @@ papers (``Paper.figures``).
 
 Public names
 ------------
-history_columns, seed_lines, seed_bars, new_figure, nees_figure.
+history_columns, seed_lines, seed_bars, new_figure, nees_figure, nees_history_figure.
 """
 
 from __future__ import annotations
@@ -17,7 +17,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-__all__ = ["history_columns", "nees_figure", "new_figure", "seed_bars", "seed_lines"]
+from simulator.reproduce.histories import labels_of, nees_panel
+
+__all__ = ["history_columns", "nees_figure", "nees_history_figure", "new_figure", "seed_bars",
+           "seed_lines"]
 
 
 def new_figure(panels: int, width_in: float = 4.2, height_in: float = 3.0
@@ -76,3 +79,15 @@ def nees_figure(tables: Mapping[str, pd.DataFrame]) -> list[tuple[str, Figure]]:
     axes[0].set(ylabel="mean position NEES", yscale="log")
     return [("Position NEES of every filter, a dot per seed (a consistent filter: 3, or 2 for a "
              "2-D one, dotted)", fig)]
+
+
+def nees_history_figure(histories: Mapping[str, pd.DataFrame]) -> list[tuple[str, Figure]]:
+    """The position NEES of every filter against time on the first seed of each experiment
+    with a history (``histories.nees_panel``: the one-epoch chi-square 95 % band dashed)."""
+    if not histories:
+        return []
+    fig, axes = new_figure(len(histories), width_in=5.0)
+    for ax, (key, history) in zip(axes, histories.items(), strict=True):
+        nees_panel(ax, history, labels_of(history), key.replace("_", " "))
+    return [("Position NEES against time, first seed (grey: GNSS outages; dashed: the "
+             "one-epoch chi-square 95 % band)", fig)]

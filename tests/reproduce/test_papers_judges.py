@@ -8,7 +8,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from simulator.reproduce import chan, judged, karamat2015, park2019
+from simulator.reproduce import chan, judged, karamat2015, park2019, seed_plots
 from simulator.reproduce.evidence import verdict_word
 
 PAPERS = (chan.PAPER, karamat2015.PAPER, park2019.PAPER)
@@ -98,3 +98,12 @@ def test_paper_figures_draw_from_the_per_seed_tables():
     captions = [c for c, _ in karamat2015.figures({}, {"partial_outages": karamat})]
     assert [c.split(" layout")[0] for c in captions] == ["Figure 8", "Figure 13", "Table 2"]
     assert np.isfinite(karamat2015.seed_maxima(karamat, "tight", 0)).all()
+
+
+def test_nees_history_figure_draws_one_panel_per_history():
+    history = pd.DataFrame({"t": np.arange(10.0), "gnss_outage": [0.0] * 5 + [1.0] * 5,
+                            "tight.nees_position": np.linspace(1.0, 9.0, 10),
+                            "tight.nees_dof": 3.0})
+    ((caption, fig),) = seed_plots.nees_history_figure({"a": history, "b": history})
+    assert caption.startswith("Position NEES against time") and len(fig.axes) == 2
+    assert seed_plots.nees_history_figure({}) == []
