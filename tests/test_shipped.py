@@ -37,12 +37,18 @@ SHORTENED: dict[str, list[str]] = {
     # (it needs ../shared); here 300 s on the nominal constellation
     "geonet_baseline_twin": ["trajectory.segments.0.stop.duration=300",
                              "sensors.gnss.constellation=nominal-gps"],
+    # the 20-minute RTK drives with every straight 300 m (about 4 min; the whole drives run
+    # through RTKLIB in tests/gnss/test_rtk_drive.py with --runslow)
+    "rtk_open_sky": [f"trajectory.segments.{i}.straight.length=300" for i in (2, 4, 6, 8, 10)],
+    "rtk_canyon_tunnel": [f"trajectory.segments.{i}.straight.length=300"
+                          for i in (2, 4, 5, 7, 8, 9, 11, 13)],
 }
 
 # zones a (shortened) run must pass through: the library scenarios are what their comments say
 EXPECTED_ZONES: dict[str, set[str]] = {
     "highway_long": {"underpass", "tunnel"},
     "sumo_city_canyon": {"downtown"},
+    "rtk_canyon_tunnel": {"downtown", "tunnel"},
 }
 
 
