@@ -17,7 +17,8 @@ Public names
 errors, horizontal_error, outage_scores, moving_off, outages, longest_outage,
 inside_windows, at_time, spread_text, count_text, paired_wins, win_rate_text, evidence_verdict,
 paired_judgement, threshold_judgement, count_verdict, median_verdict, needed_count, column,
-missing_count, least_count, paired_verdict, position_error_3d, satellite_windows, window_values.
+missing_count, least_count, listed, paired_verdict, position_error_3d, satellite_windows,
+window_values.
 """
 
 from __future__ import annotations

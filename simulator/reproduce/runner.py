@@ -244,6 +244,7 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
     histories: dict[tuple[str, str], pd.DataFrame] = {}
     failures: dict[tuple[str, str], dict[int, str]] = {}
     start, cpu = time.monotonic(), 0.0
+    software = version()  # the code the tasks run: read before they start
     with atomic_output_dir(Path(out), force) as tmp:
         with open_executor(workers, scheduler, SCHEDULER_TIMEOUT_S) as (executor, in_flight):
             for task, future in progress(completed(executor, in_flight, _execute, tasks),
@@ -280,7 +281,7 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
         if failed:
             pd.DataFrame(failed).to_parquet(tmp / "failures.parquet")
         settings = Settings(tuple(seeds), quick, None if scheduler else workers, scheduler,
-                            time.monotonic() - start, cpu, version())
+                            time.monotonic() - start, cpu, software)
         write_results(tmp / RESULTS_FILE, results, settings)
         write_report(tmp, results, settings)
     return results

@@ -80,10 +80,10 @@ def test_a_failing_run_is_reported_with_its_error():
 
 
 def test_quick_run_of_every_paper(tmp_path, capsys):
-    """The CI run: every registered paper, 3 seeds, shortened drives (measured: 47 s of CPU in
-    the runs for Cho, Tan and Park, 107 s with Chan and Karamat; this test 84 s wall at load 3,
-    385 s at load 20). The report names each paper and every claim with a figure and a
-    word."""
+    """The CI run: every registered paper, 3 seeds, shortened drives (measured: 130 s of CPU
+    in the runs for Cho and Tan, whose situations now run at two or three fix-noise levels).
+    The report names each paper and every claim with a figure and a word, and the independent
+    script recomputes every word from results.json."""
     out = tmp_path / "repro"
     assert main(["reproduce", "--quick", "--workers", "2", "-o", str(out)]) == 0
     md = (out / "report.md").read_text()

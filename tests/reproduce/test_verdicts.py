@@ -140,7 +140,12 @@ def test_park_flat_ratio_judge():
 def test_a_judge_without_its_figures_is_not_shown_with_the_reason():
     verdicts = judge(tan2008.PAPER, {"outage": pd.DataFrame(index=pd.Index([], name="seed"))})
     assert all(v.status == "not shown" for v in verdicts.values())
-    assert all("could not be judged" in v.reason for v in verdicts.values())
+    testable = [c.key for c in tan2008.PAPER.claims if not c.untestable]
+    # either the judge could not read its figures or its evidence has no seed
+    assert all("could not be judged" in verdicts[key].reason
+               or verdicts[key].evidence.n == 0 for key in testable)
+    # the untestable claim's figure says it has none
+    assert "no figure" in verdicts["small_error_70_s"].measured
 
 
 def test_every_registered_paper_loads_with_unique_keys_and_module_level_measures():
