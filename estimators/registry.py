@@ -35,6 +35,7 @@ BUILTINS = {
     "gnss_wls": "estimators.builtin.gnss_wls:GnssWls",
     "fgo_lc": "estimators.builtin.fgo:FgoLooselyCoupled",
     "fgo_tc": "estimators.builtin.fgo:FgoTightlyCoupled",
+    "rtk_ins_ekf": "estimators.builtin.rtk_ins:RtkInsEkf",
     "dr2d_drm1_ekf": "estimators.builtin.cho2006:Drm1Ekf",
     "dr2d_drm2_ekf": "estimators.builtin.cho2006:Drm2Ekf",
     "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",

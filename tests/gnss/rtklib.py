@@ -119,3 +119,19 @@ def residual_std_by_band(sat: dict[str, np.ndarray], frequency: int, kind: str) 
         sel = (sat["frequency"] == frequency) & (sat["elevation"] >= lo) & (sat["elevation"] < hi)
         out.append(np.std(sat[kind][sel]) if sel.sum() > 2 else np.nan)
     return np.array(out)
+
+
+def kinematic_solution(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path
+                       ) -> float:
+    """Run rnx2rtkp kinematic with the options of ``kinematic`` (``-p 2 -f 2 -m 15 -h``,
+    the base at ``base_xyz``), writing its latitude-longitude-height solution to ``out`` (a
+    ``.pos`` file ``landnav score`` reads); returns the CPU seconds rnx2rtkp took."""
+    import resource
+
+    exe = need_rnx2rtkp()
+    cmd = [exe, "-p", "2", "-f", "2", "-m", "15", "-h", "-r",
+           *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base), str(nav)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, check=True, capture_output=True, timeout=1800)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
