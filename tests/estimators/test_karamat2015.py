@@ -120,21 +120,25 @@ def test_every_variant_is_a_working_filter(protocol):
             assert np.median(_maxima(protocol, label, count)) < 20.0, (label, count)
 
 
-@pytest.mark.parametrize("count", [
-    3, 2,
-    pytest.param(1, marks=pytest.mark.xfail(strict=True, reason=(
-        "not shown at one satellite: mean window maximum 13.1 m over the ten seeds (per seed "
-        "4.7-30.4 m, so the mean's sampling spread is about 2.6 m); 11.8 m before session 6's "
-        "signal-in-space change, which also changed every later random draw: the claim sat "
-        "within one sampling spread of its bound either way; docs/reproduction_karamat2015.md"))),
-    0,
-])
-def test_mean_window_maximum_under_12_m(protocol, count):
+ONE_SATELLITE_NOT_SHOWN = (
+    "not shown at one satellite: mean window maximum 13.1 m over the ten seeds (per seed "
+    "4.7-30.4 m, so the mean's sampling spread is about 2.6 m); 11.8 m before session 6's "
+    "signal-in-space change, which also changed every later random draw: the claim sat "
+    "within one sampling spread of its bound either way; docs/reproduction_karamat2015.md")
+
+
+@pytest.mark.parametrize("count", [3, 2, 1, 0])
+def test_mean_window_maximum_under_12_m(protocol, count, request):
     """Karamat et al. section 4.3.1: 'on average, the maximum position error is always less
     than 12 m, irrespective of the number of visible satellites' (measured means on the
     automotive body: 3.1, 5.9, 13.1, 10.2 m at 3, 2, 1, 0 satellites; session 5: 3.2, 5.6,
-    11.8, 9.8 m)."""
-    assert _maxima(protocol, "tight", count).mean() < 12.0
+    11.8, 9.8 m). At one satellite an expected failure over the ten seeds; seeds 1-3 draw a
+    mean under 12 m."""
+    if count == 1 and len(protocol) == len(SEEDS):
+        request.applymarker(pytest.mark.xfail(strict=True, reason=ONE_SATELLITE_NOT_SHOWN))
+    mean = _maxima(protocol, "tight", count).mean()
+    print(f"tight mean window maximum, {count} satellites, {len(protocol)} seeds: {mean:.1f} m")
+    assert mean < 12.0
 
 
 @pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 20 of the 30 "
