@@ -116,9 +116,11 @@ def garage(quick, seeds, tmp_path_factory) -> pd.DataFrame:
 
 
 @pytest.fixture(scope="module")
-def flat_garage(quick, seeds, tmp_path_factory) -> pd.DataFrame:
-    """The same garage made flat with a perfect odometer (``park2019.FLAT_PERFECT``)."""
-    return run_experiment(park2019.FLAT, seeds, tmp_path_factory.mktemp("flat"), quick)
+def flat_garage(quick, tmp_path_factory) -> pd.DataFrame:
+    """The same garage made flat with a perfect odometer (``park2019.FLAT_PERFECT``), ten seeds
+    in every run: its claim is a median of per-seed ratios that spread from 0.5 to 2.6, which
+    three seeds do not pin (seeds 1-3 give medians of 2.13 and 0.51 on the shortened drive)."""
+    return run_experiment(park2019.FLAT, SEEDS, tmp_path_factory.mktemp("flat"), quick)
 
 
 def _column(table: pd.DataFrame, name: str, key: str) -> np.ndarray:
@@ -148,15 +150,16 @@ def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
     return pytest.param(name, marks=marks)
 
 
-@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf", DR2D_NOT_SHOWN, strict=True),
-                                   _case("ins_odo_ekf")])
+@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf")])
 def test_dr3d_beats_the_baselines_in_the_garage(garage, quick, other, request):
     """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
     least 8 of 10 seeds (paired per seed; 3 of 3 on three seeds). Against ins_odo_ekf an expected
     failure on the shortened drive only (its short open-road stretches leave the INS less to
-    drift over)."""
+    drift over); against dr2d_odo_ekf an expected failure over ten seeds (seeds 1-3: 3 of 3)."""
     if other == "ins_odo_ekf" and quick:
         request.applymarker(pytest.mark.xfail(strict=True, reason=INS_NOT_SHOWN))
+    if other == "dr2d_odo_ekf" and len(garage) == len(SEEDS):
+        request.applymarker(pytest.mark.xfail(strict=True, reason=DR2D_NOT_SHOWN))
     for key in ("exit_horizontal_m", "max_horizontal_m"):
         wins = _column(garage, "dr3d_ekf", key) < _column(garage, other, key)
         assert wins.sum() >= needed_count(0.8, len(wins)), (key, wins.sum())
