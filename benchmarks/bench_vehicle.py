@@ -1,6 +1,6 @@
 """Benchmark: the one-hour drive of ``bench_truth`` generated with the full vehicle model (the
-default, ``automotive``) against the rigid body (``vehicle: rigid``). Issue 13's goal: at most 1.5
-times the rigid time.
+default, ``automotive``) against the rigid body (``vehicle: rigid``). Goal: at most 1.3 times the
+rigid time, whole process (``process``).
 
 Run:  python benchmarks/bench_vehicle.py [increment|rate] [ROUNDS] [process]
 (figures in BENCHMARKS.md)

@@ -8,7 +8,7 @@ A third-party package registers an estimator in its ``pyproject.toml``::
 
 Public functions
 ----------------
-get_estimator, list_estimators, is_plugin_path, name_problems, entry_problems.
+get_estimator, list_estimators, is_plugin_path, name_problems, entry_problems, plugin_file.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import importlib
 import os
 import sys
 from collections.abc import Mapping
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from estimators.base import Estimator, check_estimator_class, config_problems
@@ -34,6 +35,7 @@ BUILTINS = {
     "gnss_wls": "estimators.builtin.gnss_wls:GnssWls",
     "fgo_lc": "estimators.builtin.fgo:FgoLooselyCoupled",
     "fgo_tc": "estimators.builtin.fgo:FgoTightlyCoupled",
+    "rtk_ins_ekf": "estimators.builtin.rtk_ins:RtkInsEkf",
     "dr2d_drm1_ekf": "estimators.builtin.cho2006:Drm1Ekf",
     "dr2d_drm2_ekf": "estimators.builtin.cho2006:Drm2Ekf",
     "dr2d_drm2_spkf": "estimators.builtin.cho2006:Drm2Spkf",
@@ -61,14 +63,20 @@ def list_estimators() -> list[str]:
     return [*BUILTINS, *plugins]
 
 
+def _search_path() -> list[str]:
+    """``sys.path``, with the current directory first when it is not there: a module:Class of
+    the user's own is found from the current directory, as ``python -m`` finds it (a console
+    script's sys.path starts with its bin directory instead)."""
+    if os.getcwd() not in sys.path and "" not in sys.path:
+        return [os.getcwd(), *sys.path]
+    return sys.path
+
+
 def _import_target(target: str, what: str) -> type:
     module_name, _, attr = target.partition(":")
     if not module_name or not attr:
         raise InputError(f"{what}: expected module:Class, got {target!r}")
-    # a module:Class of the user's own is found from the current directory, as `python -m`
-    # finds it (a console script's sys.path starts with its bin directory instead)
-    if os.getcwd() not in sys.path and "" not in sys.path:
-        sys.path.insert(0, os.getcwd())
+    sys.path[:] = _search_path()
     try:
         module = importlib.import_module(module_name)
     except Exception as exc:  # a plug-in's own failure, reported as its message
@@ -144,3 +152,28 @@ def entry_problems(entry: Mapping[str, Any] | str) -> list[tuple[str, str]]:
         return [("name", p.message) for p in exc.problems]
     config = None if isinstance(entry, str) else entry.get("config")
     return [("config", message) for message in config_problems(cls, config)]
+
+
+def plugin_file(name: str) -> str | None:
+    """The source file of the module an estimator name refers to (a built-in, an entry point,
+    or ``module:Class``), looked for along the import path as an import would, without running
+    any of its code (nor its packages' ``__init__``); None when there is no such ``.py`` file
+    (not found, a compiled module, a zip archive)."""
+    if name in BUILTINS:
+        module = BUILTINS[name].partition(":")[0]
+    elif ":" in name:
+        module = name.partition(":")[0]
+    else:
+        entry = _entry_points().get(name)
+        if entry is None:
+            return None
+        module = entry.module
+    *packages, last = module.split(".")
+    folders = [Path(p or os.curdir) for p in _search_path()]
+    for part in packages:  # a package, or the folders of a namespace package
+        folders = [f / part for f in folders if (f / part).is_dir()]
+    for folder in folders:
+        for candidate in (folder / f"{last}.py", folder / last / "__init__.py"):
+            if candidate.is_file():
+                return str(candidate.resolve())
+    return None

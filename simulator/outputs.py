@@ -32,6 +32,7 @@ make_parent, os_problem.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import errno
 import json
 import os
@@ -374,7 +375,20 @@ def atomic_output_dir(out_dir: Path | str, force: bool, inputs: Iterable[Path | 
             shutil.rmtree(folder, ignore_errors=True)
         if isinstance(exc, OSError):
             raise os_problem(out_dir, exc) from None
+        if isinstance(exc, InputError):  # a problem inside: named by the output, not its draft
+            raise _named_by(exc, tmp, out_dir) from None
         raise
+
+
+def _named_by(exc: InputError, draft: Path, out_dir: Path) -> InputError:
+    """``exc`` with the files under ``draft`` named by where they were to be, in ``out_dir``."""
+    problems = []
+    for p in exc.problems:
+        file = Path(p.file)
+        if file == draft or draft in file.parents:
+            p = dataclasses.replace(p, file=str(out_dir / file.relative_to(draft)))
+        problems.append(p)
+    return InputError(problems)
 
 
 @contextlib.contextmanager

@@ -17,33 +17,34 @@ or the whole job into one directory: ``pipeline.run(scenario, "runs/quick")``.
 
 Public names
 ------------
-load_scenario, check_estimators, generate, estimate, run_estimators, score, write_report, run,
-RunResult, Solutions.
+load_scenario, check_estimators, estimator_problems, generate, estimate, run_estimators, score,
+write_report, run, RunResult, Solutions.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-from estimators.registry import entry_problems, is_plugin_path, name_problems
+from estimators.registry import entry_problems, name_problems
 from simulator import scenario as scenarios
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.errors import InputError, Problem
 from simulator.html_report import write_html_report
-from simulator.isolated import needs_isolation, run_isolated
+from simulator.isolated import check_entries, needs_isolation, run_isolated
 from simulator.outputs import atomic_output_dir
 from simulator.replay import run_estimator, write_solution
 from simulator.scenario import Scenario
 from simulator.scoring import report
 from simulator.scoring.evaluate import Evaluation, score_solutions, write_scores
 
-__all__ = ["NO_ESTIMATOR", "RunResult", "Solutions", "check_estimators", "estimate", "generate",
+__all__ = ["NO_ESTIMATOR", "RunResult", "Solutions", "check_estimators", "estimate",
+           "estimator_problems", "generate",
            "load_scenario",
            "run", "run_estimators", "score", "write_report"]
 
@@ -56,26 +57,46 @@ NO_ESTIMATOR = ("No estimator was named in the scenario (its `estimators:` list 
 
 
 def load_scenario(path: str | Path, overrides: list[str] | None = None,
-                  seed: int | None = None, import_plugins: bool = False) -> Scenario:
+                  seed: int | None = None, import_plugins: bool = False,
+                  time_limit_s: float | None = None) -> Scenario:
     """Read, override and validate a scenario file (``simulator.scenario.load_scenario``), then
-    check each estimator entry against its class: the class imports (through the registry) and
-    its ``config`` fits the class's defaults. A ``module:Class`` entry (the user's own code) is
-    checked for its form only, and imported only with ``import_plugins`` (``run``, a campaign,
-    ``validate --import-plugins``): validating a scenario runs no code it names. Every problem
-    is raised in one InputError."""
+    check each estimator entry against its class (``check_estimators``). An estimator that is
+    not a built-in (the user's or a third party's code) is checked for its name only, and
+    imported only with ``import_plugins`` (``run``, a campaign, ``validate --import-plugins``),
+    then in a child process bounded by ``time_limit_s``: validating a scenario runs no code it
+    names. Every problem is raised in one InputError."""
     scenario = scenarios.load_scenario(path, overrides, seed)
-    check_estimators(scenario, import_plugins)
+    check_estimators(scenario, import_plugins, time_limit_s)
     return scenario
 
 
-def check_estimators(scenario: Scenario, import_plugins: bool = True) -> None:
-    """Raise InputError with the problems of the scenario's estimator entries (the class and
-    its ``config``); ``module:Class`` entries are imported only with ``import_plugins``."""
-    problems = [Problem(str(scenario.path), None, f"estimators.{i}.{key}", message)
-                for i, entry in enumerate(scenario.data["estimators"])
-                for key, message in (entry_problems(entry)
-                                     if import_plugins or not is_plugin_path(entry)
-                                     else name_problems(entry))]
+def estimator_problems(scenario_list: Sequence[Scenario], import_plugins: bool = True,
+                       time_limit_s: float | None = None) -> list[list[Problem]]:
+    """The problems of each scenario's estimator entries: the class imports and its
+    ``config`` fits the class's defaults. An entry that is not a built-in is imported only with
+    ``import_plugins``, and then in one child process for all of them (equal entries checked
+    once), which may take ``time_limit_s`` (``simulator.isolated.check_entries``); without,
+    only its name is checked."""
+    where = [(k, str(s.path), i) for k, s in enumerate(scenario_list)
+             for i in range(len(s.data["estimators"]))]
+    entries = [entry for s in scenario_list for entry in s.data["estimators"]]
+    if import_plugins:
+        checked = check_entries(entries, time_limit_s)
+    else:
+        checked = [name_problems(entry) if needs_isolation(entry, None)
+                   else entry_problems(entry) for entry in entries]
+    out: list[list[Problem]] = [[] for _ in scenario_list]
+    for (k, path, i), found in zip(where, checked, strict=True):
+        out[k] += [Problem(path, None, f"estimators.{i}.{key}", message)
+                   for key, message in found]
+    return out
+
+
+def check_estimators(scenario: Scenario, import_plugins: bool = True,
+                     time_limit_s: float | None = None) -> None:
+    """Raise InputError with the problems of the scenario's estimator entries
+    (``estimator_problems``)."""
+    problems = estimator_problems([scenario], import_plugins, time_limit_s)[0]
     if problems:
         raise InputError(problems)
 
@@ -98,7 +119,7 @@ def estimate(dataset: Dataset, entry: Mapping[str, Any] | str,
 
     An estimator that is not a built-in, or any with ``time_limit_s``, runs in a child process
     (``simulator.isolated``): one that exits, crashes or runs past the limit is an InputError.
-    ``isolate=False`` runs it here: a campaign's worker, itself a process of its own whose
+    ``isolate=False`` runs it here: a local campaign worker, itself a process of its own whose
     death fails only its run, bounds it with its own timer (``simulator.campaign.worker``)."""
     if isolate and needs_isolation(entry, time_limit_s):
         return run_isolated(dataset.path, entry, time_limit_s)
@@ -146,17 +167,20 @@ class RunResult:
 
 
 def run(scenario: Scenario, out_dir: str | Path, force: bool = False,
-        show_progress: bool = False) -> RunResult:
+        show_progress: bool = False, time_limit_s: float | None = None) -> RunResult:
     """The main job into one directory, written under a temporary name and renamed when
     complete: the dataset, every estimator the scenario names, their solutions, the scores and
-    the report. A label that cannot name a file is refused before anything is written."""
+    the report. A label that cannot name a file is refused before anything is written; each
+    estimator (its import and check, then its replay) may take ``time_limit_s`` (``estimate``).
+    """
     out = Path(out_dir)
     entries = scenario.data["estimators"]
-    check_estimators(scenario)  # the run imports them anyway: before anything is written
+    # the run imports them anyway: before anything is written
+    check_estimators(scenario, time_limit_s=time_limit_s)
     with atomic_output_dir(out, force, scenario.input_files) as tmp:
         dataset = generate(scenario, tmp / "dataset", show_progress=show_progress)
         (tmp / "solutions").mkdir()
-        solutions = run_estimators(dataset, entries, show_progress)
+        solutions = run_estimators(dataset, entries, show_progress, time_limit_s)
         for i, label in enumerate(solutions):
             if Path(label).name != label or label.startswith("."):
                 raise InputError([Problem(str(scenario.path), None, f"estimators.{i}.label",

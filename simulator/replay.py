@@ -3,8 +3,10 @@
 The replay reads only the streams the estimator ``needs`` and ``uses`` (never ``truth*`` or
 ``events``), merges them by timestamp and hands the estimator one message at a time in time order.
 Messages with equal times come in the fixed stream order ``imu, odometer, baro, mag, gnss_fix,
-gnss_raw`` (then any other stream, alphabetically): the inertial step ending at ``t`` is taken
-before the measurements valid at ``t`` are applied. A ``gnss_raw`` message is one whole epoch.
+gnss_base_raw, gnss_raw`` (then any other stream, alphabetically): the inertial step ending at
+``t`` is taken before the measurements valid at ``t`` are applied, and a base station's epoch
+before the rover's of the same time. A ``gnss_raw`` or ``gnss_base_raw`` message is one whole
+epoch.
 
 Solutions are asked for (``solution(T)``) at the ticks ``t0 + k / output_rate_hz`` from the first
 message time ``t0``, at every GNSS epoch and at the last message time, each once every message
@@ -49,7 +51,8 @@ from simulator.outputs import atomic_output_file
 from simulator.progress import progress
 from simulator.threads import one_blas_thread
 
-STREAM_ORDER = ("imu", "odometer", "baro", "mag", "gnss_fix", "gnss_raw")
+STREAM_ORDER = ("imu", "odometer", "baro", "mag", "gnss_fix", "gnss_base_raw", "gnss_raw")
+EPOCH_STREAMS = ("gnss_raw", "gnss_base_raw")  # one message per epoch: its satellites' rows
 SPAN_MARGIN_S = 1.0  # how far a stream's times may reach beyond the truth's
 # solution rows one replay may ask for (about 30 columns of 8 bytes each: 2.4 GB at most);
 # 28 h at 100 Hz, the longest drive a scenario may describe
@@ -132,7 +135,7 @@ class _Stream:
         self.columns = {c: i for i, c in enumerate(numeric)}
         self.units = {c: units.get(c, "") for c in numeric}
         t = self.data[:, self.columns["t"]]  # increasing: checked when the dataset is read
-        if name == "gnss_raw":  # one message per epoch: a 2-D block of its satellites
+        if name in EPOCH_STREAMS:  # one message per epoch: a 2-D block of its satellites
             starts = np.flatnonzero(np.r_[True, np.diff(t) > 0])
             bounds = np.r_[starts, len(t)]
             self.times = t[starts]

@@ -215,7 +215,7 @@ def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generat
 
 
 def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarray,
-                 rng: np.random.Generator) -> np.ndarray:
+                 rng: np.random.Generator, columns: np.ndarray | None = None) -> np.ndarray:
     """Stationary first-order Gauss-Markov process, exact discretisation (Gelb 1974, Table 3.8-1).
 
     x[k+1] = exp(-dt/tau) x[k] + sigma sqrt(1 - exp(-2 dt/tau)) w[k], x[0] ~ N(0, sigma^2).
@@ -226,6 +226,8 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     dt_s : sample interval, s.
     sigma : stationary standard deviation per axis, shape (m,).
     tau_s : correlation time, s: one for all axes or one per axis, shape (m,).
+    columns : the axes wanted (indices), optional: the draws are made for all m axes (the
+        random stream is the same) and only these are filtered and returned, shape (n, k).
 
     Returns
     -------
@@ -235,6 +237,10 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
     drive = rng.standard_normal((n, sigma.size))
     drive[0] = rng.standard_normal(sigma.size)  # the stationary state x[0] / sigma
+    if columns is not None:
+        drive, sigma = drive[:, columns], sigma[columns]
+        if np.ndim(phi):  # one correlation time per axis
+            phi, q_unit = np.asarray(phi)[columns], np.asarray(q_unit)[columns]
     drive[0] /= np.sqrt(q_unit)  # which the filter's gain_in turns back into N(0, 1)
     return ar1_filter(drive, phi, overwrite=True, gain_in=np.sqrt(q_unit), gain_out=sigma)
 

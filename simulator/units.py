@@ -41,6 +41,7 @@ PERCENT_RT_H = PERCENT / 60.0  # %/sqrt(h), 1/sqrt(s)
 HPA = 100.0  # hPa, Pa
 MICRO_T = 1e-6  # uT, T
 MILLI = 1e-3  # the prefix m (mrad, ms)
+KM_H = 1.0 / 3.6  # km/h, m/s
 
 
 class UnitError(ValueError):

@@ -42,11 +42,16 @@ class Counting(HoldStart):
 
 class Stuck(HoldStart):
     """Never returns from its first IMU message while the file ``config["stuck_while"]`` exists:
-    a worker stuck in an endless loop."""
+    a worker stuck in an endless loop. Once stuck, it makes the file ``STUCK_WHILE.inside`` (a
+    test waits for it, not for a time that assumes an idle machine)."""
 
     name = "stuck"
     defaults = {"stuck_while": ""}
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
-        while os.path.exists(self.config["stuck_while"]):
+        flag = self.config["stuck_while"]
+        if os.path.exists(flag):
+            with open(f"{flag}.inside", "a", encoding="utf-8"):
+                pass
+        while os.path.exists(flag):
             time.sleep(0.05)

@@ -79,6 +79,11 @@ accelerometer update (eqs. 50-58; ``model: enhanced``) once a second. Closed loo
 update the estimated errors are removed from the navigation state and sensor-error estimates.
 The Gauss-Markov tilt and odometer-acceleration corrections decay as their models do.
 
+``frozen_states`` (an ablation, empty by default) holds named states of the enhanced model at
+zero: no initial uncertainty, no process noise, so no update moves them; with ``bx, by`` the
+enhanced model runs without its accelerometer-bias states, which the reproduction uses to
+attribute the enhanced model's gain to the states that give it (docs/reproduction_karamat2015.md).
+
 The Gauss-Markov parameters are images lost from our copy of the paper; chosen here from the
 IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md). That is
 ``tuning: paper``, which the reproduction (``simulator/reproduce/karamat2015.py``) names so that
@@ -268,7 +273,8 @@ class RissTcEkf(Estimator):
     # gate (None: 0.999 with the datasheet tuning, off with the paper's)
     defaults = {"model": "enhanced", "coupling": "tight", "tilt_window": 2.0,
                 "accel_update_interval": 1.0, "odometer_speed_noise": 0.2,
-                "nhc_point": "rear_axle", "tuning": "datasheet", "gate_probability": None}
+                "nhc_point": "rear_axle", "tuning": "datasheet", "gate_probability": None,
+                "frozen_states": ()}
     config_help = {
         "model": ("", "enhanced (eqs. 1-58) or simplified, the earlier model"),
         "coupling": ("", "tight (pseudoranges and rates) or loose (position and velocity fixes)"),
@@ -280,6 +286,8 @@ class RissTcEkf(Estimator):
                        "reproduction's values"),
         "gate_probability": ("", "chi-square gate on each pseudorange (e.g. 0.999); none: "
                                  "the tuning's default"),
+        "frozen_states": ("", "states of the enhanced model (r, p, bx, by, vo) held at zero: "
+                              "no initial uncertainty and no process noise (an ablation)"),
     }
     output_columns = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                       "std_n", "std_e", "std_d", "std_yaw",
@@ -297,9 +305,17 @@ class RissTcEkf(Estimator):
             problems.append(f"nhc_point must be rear_axle or imu, got {cfg['nhc_point']!r}")
         if cfg["tuning"] not in ("datasheet", "paper"):
             problems.append(f"tuning must be datasheet or paper, got {cfg['tuning']!r}")
+        extra = STATES[SIMPLIFIED_STATES:]
+        frozen = list(cfg["frozen_states"] or ())
+        if any(name not in extra for name in frozen):
+            problems.append(f"frozen_states must be among {', '.join(extra)}, got {frozen!r}")
         if problems:
             raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
         p0_sigma, q_white, gm = self._tuning(cfg["tuning"])
+        for name in frozen:  # a state without uncertainty or noise is never corrected
+            p0_sigma[name], q_white[name] = 0.0, 0.0
+            if name in gm:
+                gm[name] = (0.0, gm[name][1])
         self._enhanced = cfg["model"] == "enhanced"
         self._tight = cfg["coupling"] == "tight"
         self._n = len(STATES) if self._enhanced else SIMPLIFIED_STATES

@@ -24,8 +24,9 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
   1.03). (A first version with 0.1 m/s alone trusted the odometer over GPS: on Park's garage
   drive, true scale factor 1.03, its errors with GPS were 6-10 m against a claimed 0.5 m.)
   Park does not say at what rate; here at every odometer sample (10 Hz), so that it also aids
-  during outages, which is the point of the comparison in Park's Table 3. With ``nhc: false``
-  only the forward (odometer) row is used.
+  during outages, which is the point of the comparison in Park's Table 3; ``odometer_period``
+  (s) spaces the updates (1: once a second, the GPS rate, the other reading of
+  "sequentially"). With ``nhc: false`` only the forward (odometer) row is used.
 * Where the constraint holds (issue 14; Park is silent, his IMU sat in a car whose geometry is
   not printed): at the rear axle, where the wheels do not steer (the kinematic bicycle model),
   not at the IMU, which in a turn moves sideways at the yaw rate times its distance ahead of
@@ -113,7 +114,8 @@ class ParkInsOdometer(Estimator):
     needs = ("imu", "odometer", "gnss_fix")
     paper = "Park et al. 2019 (IEEE Access), eqs. 1-14: INS/GPS/odometer EKF with NHC"
     defaults = {"tuning": "datasheet", "nhc": True, "nhc_point": "rear_axle",
-                "fix_error_states": False, "odometer_scale_state": False}
+                "fix_error_states": False, "odometer_scale_state": False,
+                "odometer_period": 0.0}
     config_help = {
         "tuning": ("", "datasheet: noise from the manifest's datasheet (default); paper: the "
                        "values chosen for the reproduction of Park et al."),
@@ -121,6 +123,8 @@ class ParkInsOdometer(Estimator):
         "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
         "fix_error_states": ("", "three Gauss-Markov states of the GNSS fix's correlated error"),
         "odometer_scale_state": ("", "an odometer scale-factor state"),
+        "odometer_period": ("s", "least time between two odometer updates (0: every sample; "
+                                 "1: once a second, at the GPS rate)"),
     }
     output_columns = SOLUTION_COLUMNS
 
@@ -144,6 +148,7 @@ class ParkInsOdometer(Estimator):
             raise InputError(f"ins_odo_ekf: config tuning must be one of {', '.join(TUNINGS)}, "
                              f"got {self.config['tuning']!r}")
         self._sheet = self.config["tuning"] == "datasheet"
+        self._t_odometer = -np.inf  # time of the last odometer update
         site = Installation.from_datasheet(self.datasheet)
         gnss = self.datasheet.get("gnss") or {}
         if self._sheet:
@@ -240,6 +245,9 @@ class ParkInsOdometer(Estimator):
             ins.gated_update(dz_v[rows], h_v[rows], r_v, GATE_PROBABILITY)
 
     def on_odometer(self, t: float, row: np.ndarray) -> None:
+        if t < self._t_odometer + self.config["odometer_period"] - 1e-6:
+            return
+        self._t_odometer = t
         ins = self.ins
         ins.flush()
         speed = float(row[self._speed])

@@ -71,7 +71,7 @@ def body_velocity(q: np.ndarray, v_ned: np.ndarray, n_states: int = 9,
     h[:, 6:9] = c_nb @ skew(v_ned)
     if lever_arm is not None:
         r = np.asarray(lever_arm, dtype=float)
-        v_b = v_b + np.cross(rate_body, r)
+        v_b = v_b + skew(rate_body) @ r  # w x r (np.cross costs 2 us of checks per call)
         if gyro_bias is not None:
             h[:, gyro_bias] = skew(r)
     return v_b, h

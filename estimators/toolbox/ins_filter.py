@@ -190,8 +190,6 @@ class InsFilter:
             2 * noise.gyro_bias_sigma**2 / noise.gyro_bias_tau)
         extra = np.arange(N_STATES, self.n_states)
         self._gqg[extra, extra] = 2 * extra_sigma**2 / self._extra_tau
-        self._f = np.zeros((self.n_states, self.n_states))
-        self._f[extra, extra] = -1.0 / self._extra_tau
 
     def set_extra_sigma(self, index: int, sigma: float) -> None:
         """Reset the steady-state 1-sigma of extra state ``index`` (0 = the first after the
@@ -230,9 +228,10 @@ class InsFilter:
         c_bn = quat_to_dcm(self.q)
         f_body = c_bn.T @ (self._sums[0:3] / dt)
         n = self.noise
-        self._f[:N_STATES, :N_STATES] = system_matrix(self.pos[0], self.pos[2], self.v, c_bn,
-                                                      f_body, n.accel_bias_tau, n.gyro_bias_tau)
-        phi, q_d = discretise(self._f, self._gqg, dt)
+        f_nav = system_matrix(self.pos[0], self.pos[2], self.v, c_bn, f_body,
+                              n.accel_bias_tau, n.gyro_bias_tau)
+        # the extra states are uncoupled scalars: the transition is block diagonal
+        phi, q_d = discretise(f_nav, self._gqg[:N_STATES, :N_STATES], dt)
         if self.mean_rate_dt > 0 and (n.accel_scale_sigma or n.gyro_scale_sigma
                                       or n.gyro_g_sensitivity):
             d_rate, d_force = rate - self.mean_rate, f_body - self.mean_force
@@ -243,15 +242,24 @@ class InsFilter:
         self.mean_rate = rate
         self.mean_rate_dt = dt
         self.mean_force = f_body
-        self.kf.predict(phi, q_d)
+        if len(self.extra):
+            f_extra = -dt / self._extra_tau
+            phi_extra = 1.0 + f_extra + 0.5 * f_extra * f_extra
+            g_extra = np.diag(self._gqg)[N_STATES:]
+            q_extra = 0.5 * dt * (phi_extra * phi_extra * g_extra + g_extra)
+            self.kf.predict_blocks(phi, q_d, phi_extra, q_extra)
+        else:
+            self.kf.predict(phi, q_d)
         if len(self.extra):
             self.extra *= np.exp(-dt / self._extra_tau)
 
-    def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> None:
-        """Measurement update with dz = h(nominal) - z; in closed loop the errors are fed back."""
-        self.kf.update(dz, h, r)
+    def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+        """Measurement update with dz = h(nominal) - z; in closed loop the errors are fed back.
+        Returns the innovation covariance H P H^T + R."""
+        s = self.kf.update(dz, h, r)
         if self.kf.closed_loop:
             self._remove(self.kf.feedback())
+        return s
 
     def gated_update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray,
                      probability: float = 0.999, max_rejected: int = 5) -> bool:

@@ -28,7 +28,7 @@ from typing import Any
 import yaml
 
 from simulator.errors import InputError, Problem
-from simulator.pipeline import load_scenario
+from simulator.pipeline import estimator_problems, load_scenario
 from simulator.scenario import Scenario
 
 MAX_SWEEP_POINTS = 1000  # points of the cartesian product of --sweep (each validated here)
@@ -195,25 +195,45 @@ def _column_values(sweep: Sweep) -> list[Any]:
     return list(sweep.texts)
 
 
+def _at_point(problems: list[Problem], swept: dict[str, str]) -> list[Problem]:
+    """Problems of a sweep point, naming it (the scenario without it is valid); those on a
+    swept key come from ``--sweep``, not ``--set``."""
+    where = ", ".join(f"{k}={v}" for k, v in swept.items())
+    out = []
+    for p in problems:
+        on_key = any(p.key_path == k or p.key_path.startswith(k + ".")
+                     or k.startswith(p.key_path + ".") for k in swept)
+        out.append(dataclasses.replace(
+            p, line="--sweep" if on_key else p.line, message=f"{p.message} (--sweep {where})"))
+    return out
+
+
 def _validate(path: Path, overrides: list[str], seed: int | None, swept: dict[str, str]
               ) -> Scenario:
-    """Load a sweep point. Its problems name the sweep point (the scenario without it is
-    valid), and those on a swept key come from ``--sweep``, not ``--set``."""
+    """Load a sweep point (its plug-ins checked by name: ``_check_plugins`` imports them)."""
     try:
-        return load_scenario(path, overrides, seed, import_plugins=True)
+        return load_scenario(path, overrides, seed)
     except InputError as exc:
-        where = ", ".join(f"{k}={v}" for k, v in swept.items())
-        problems = []
-        for p in exc.problems:
-            on_key = any(p.key_path == k or p.key_path.startswith(k + ".")
-                         or k.startswith(p.key_path + ".") for k in swept)
-            problems.append(dataclasses.replace(
-                p, line="--sweep" if on_key else p.line, message=f"{p.message} (--sweep {where})"))
-        raise InputError(problems) from None
+        raise InputError(_at_point(exc.problems, swept)) from None
+
+
+def _check_plugins(base: Scenario, points: list[SweepPoint], scenarios: list[Scenario],
+                   time_limit_s: float | None) -> None:
+    """Import and check every estimator entry of the base scenario and of each sweep point, in
+    one bounded child process for the plug-ins (``pipeline.estimator_problems``)."""
+    found = estimator_problems([base, *scenarios], True, time_limit_s)
+    problems = found[0] or [p for point, at in zip(points, found[1:], strict=True)
+                            for p in _at_point(at, _swept(point))]
+    if problems:
+        raise InputError(problems)
+
+
+def _swept(point: SweepPoint) -> dict[str, str]:
+    return dict(a.split("=", 1) for a in point.overrides)
 
 
 def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
-                  sweep_texts: list[str]) -> CampaignPlan:
+                  sweep_texts: list[str], time_limit_s: float | None = None) -> CampaignPlan:
     """Validate the scenario, every sweep value and every sweep point.
 
     Parameters
@@ -222,6 +242,8 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
     overrides : ``--set`` key=value strings.
     seed : ``--seed`` (the base seed; None keeps the scenario's).
     sweep_texts : the ``--sweep`` options as written.
+    time_limit_s : how long importing and checking the plug-in estimators may take, s (None:
+        ``simulator.isolated.CHECK_LIMIT_S``).
 
     Raises
     ------
@@ -231,7 +253,7 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
         a scenario without estimators.
     """
     path = Path(path)
-    base = load_scenario(path, overrides, seed, import_plugins=True)
+    base = load_scenario(path, overrides, seed)
     if not base.data["estimators"]:
         raise InputError([Problem(str(path), None, "estimators", "the scenario names no "
                                   "estimator: a campaign scores estimators; add some")])
@@ -266,4 +288,5 @@ def plan_campaign(path: str | Path, overrides: list[str], seed: int | None,
                 base.data["estimators"]):
             raise InputError([Problem(str(path), "--sweep", ", ".join(swept), "a sweep may not "
                                       "change the estimators or their labels")])
+    _check_plugins(base, points, scenarios, time_limit_s)
     return CampaignPlan(base, sweeps, tuple(points), tuple(scenarios))

@@ -140,8 +140,7 @@ def _score_all(task: RunTask, dataset_dir: Path, time_limit_s: float | None
     rows = []
     for label, entry in zip(labels, task.scenario.data["estimators"], strict=True):
         try:
-            with time_limit(time_limit_s, label):
-                frame, info = pipeline.estimate(dataset, entry, isolate=False)
+            frame, info = _estimate(dataset, entry, label, time_limit_s)
             scores = pipeline.score(dataset, {label: (frame, info)}).scores()[label]
             rows.append(_row(task, label, STATUS_OK, flatten_scores(scores)))
         except Exception:
@@ -155,10 +154,9 @@ class TimeLimitExceeded(Exception):
 
 @contextlib.contextmanager
 def time_limit(seconds: float | None, label: str) -> Iterator[None]:
-    """Raise ``TimeLimitExceeded`` in the block after ``seconds`` (a SIGALRM timer: a local
-    worker runs its tasks in its main thread; elsewhere, as in a Dask worker's threads, there
-    is no limit)."""
-    if seconds is None or threading.current_thread() is not threading.main_thread():
+    """Raise ``TimeLimitExceeded`` in the block after ``seconds`` (a SIGALRM timer: call it
+    in the main thread only)."""
+    if seconds is None:
         yield
         return
 
@@ -173,6 +171,17 @@ def time_limit(seconds: float | None, label: str) -> Iterator[None]:
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)
+
+
+def _estimate(dataset: Any, entry: Any, label: str, time_limit_s: float | None
+              ) -> tuple[Any, dict]:
+    """One estimator of a run within ``time_limit_s``: here under a timer in a local worker
+    (its main thread runs the tasks); in a child process that is killed at the limit in a
+    thread of a Dask worker, where no timer signal can reach the estimator."""
+    if time_limit_s is not None and threading.current_thread() is not threading.main_thread():
+        return pipeline.estimate(dataset, entry, time_limit_s=time_limit_s)
+    with time_limit(time_limit_s, label):
+        return pipeline.estimate(dataset, entry, isolate=False)
 
 
 def execute_run(task: RunTask, time_limit_s: float | None = None) -> list[dict[str, Any]]:

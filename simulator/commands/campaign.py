@@ -50,7 +50,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="when resuming, compute the failed runs again")
     p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
                    help="how long each estimator of a run may take; past it the run's row "
-                        "fails and the campaign goes on (local workers; default: no limit)")
+                        "fails and the campaign goes on (default: no limit); also the bound on "
+                        "importing and checking the plug-ins before the runs (default 120 s)")
     add_scenario_options(p)
     p.set_defaults(run=run)
 
@@ -82,7 +83,7 @@ def run(args: argparse.Namespace) -> int:
 
     workers = _check_counts(args)
     check_time_limit(args.time_limit, "campaign")
-    plan = plan_campaign(args.scenario, args.overrides, args.seed, args.sweep)
+    plan = plan_campaign(args.scenario, args.overrides, args.seed, args.sweep, args.time_limit)
     options = CampaignOptions(
         runs=args.runs, workers=workers, scheduler=args.scheduler,
         scheduler_timeout_s=args.scheduler_timeout, force=args.force,

@@ -30,7 +30,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="overwrite an existing SOLUTION file")
     p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
                    help="stop the estimator after this long (it then runs in its own process, "
-                        "as every estimator that is not a built-in does) and exit 2")
+                        "as every estimator that is not a built-in does) and exit 2; also the "
+                        "bound on importing and checking a plug-in (default 120 s)")
     p.set_defaults(run=run)
 
 
@@ -51,8 +52,9 @@ def _pairs(items: list[str], option: str) -> dict:
 
 
 def _entry(args: argparse.Namespace) -> dict:
-    """The command-line options as a scenario estimator entry, validated like one."""
-    from estimators.registry import entry_problems
+    """The command-line options as a scenario estimator entry, validated like one (a plug-in
+    imported and checked in a child process, within ``--time-limit``)."""
+    from simulator.isolated import check_entries
     from simulator.scenario.spec import ESTIMATOR_ENTRY_FIELD
     from simulator.schema import INVALID, Context
 
@@ -65,7 +67,7 @@ def _entry(args: argparse.Namespace) -> dict:
     if ctx.problems or resolved is INVALID:
         raise InputError(ctx.problems)
     problems = [Problem("command line", None, f"estimator.{key}", message)
-                for key, message in entry_problems(resolved)]
+                for key, message in check_entries([resolved], args.time_limit)[0]]
     if problems:
         raise InputError(problems)
     return resolved
@@ -77,8 +79,8 @@ def run(args: argparse.Namespace) -> int:
     from simulator.dataset.io import open_dataset
     from simulator.replay import write_solution
 
-    entry = _entry(args)
     check_time_limit(args.time_limit, "estimate")
+    entry = _entry(args)
     dataset = open_dataset(args.dataset)
     solution, info = pipeline.estimate(dataset, entry, show_progress=True,
                                        time_limit_s=args.time_limit)

@@ -63,8 +63,15 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
             "claim is then judged from the figures over seeds with one word (shown, partly, "
             "not shown) and the reason, beside the paper's own figure and the conditions that "
             "differ.\n\n"
+            "Each word follows from the per-seed values by one rule: shown when the "
+            "one-sided sign test in the paper's direction gives p < 0.05 and the magnitude "
+            "the paper prints (if any) is met, partly when only the magnitude is not, not "
+            "shown otherwise; the papers' claims and landnav's own checks are counted apart."
+            "\n\n"
             "Writes DIR/report.md (with DIR/plots/), DIR/report.html (self-contained: plots "
-            "embedded), DIR/figures/PAPER/EXPERIMENT.parquet (index seed, one column per "
+            "embedded), DIR/results.json (every claim's per-seed values, evidence and word; "
+            "tools/recompute_verdicts.py recomputes the words from it), "
+            "DIR/figures/PAPER/EXPERIMENT.parquet (index seed, one column per "
             "figure) and DIR/failures.parquet when a run failed (the others go on; the report "
             "names the seed and the error). Nothing is written until the run is complete.\n\n"
             f"Papers (all when none is named): {', '.join(paper_keys())}; `landnav "
@@ -80,7 +87,8 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="paper keys (default: every registered paper)")
     p.add_argument("--runs", type=int, default=None, metavar="N",
                    help=f"seeds 1..N per experiment (default {FULL_SEEDS}; {QUICK_SEEDS} with "
-                        "--quick)")
+                        "--quick); without --quick an experiment whose verdicts sit at an "
+                        "edge runs more (its full_runs, e.g. 20)")
     p.add_argument("--quick", action="store_true",
                    help="shortened drives (each experiment's quick overrides) and 3 seeds "
                         "unless --runs says otherwise: a check in minutes, not the paper's "
@@ -115,6 +123,8 @@ def _check(args: argparse.Namespace) -> int:
 
 
 def run(args: argparse.Namespace) -> int:
+    from simulator.reproduce.paper import STATUSES
+    from simulator.reproduce.results import UNTESTABLE
     from simulator.reproduce.runner import reproduce
 
     workers = _check(args)
@@ -123,10 +133,15 @@ def run(args: argparse.Namespace) -> int:
     results = reproduce(args.papers, args.runs, args.quick, out, workers, args.scheduler,
                         show_progress=True, force=args.force or empty_dir)
     for r in results:
-        words = [v.status for v in r.verdicts.values()]
         failed = sum(len(e.failures) for e in r.experiments.values())
-        print(f"{r.paper.key}: {len(words)} claims: {words.count('shown')} shown, "
-              f"{words.count('partly')} partly, {words.count('not shown')} not shown"
+        parts = []
+        for kind, name in (("paper", "paper claims"), ("check", "checks")):
+            words = [UNTESTABLE if c.untestable else r.verdicts[c.key].status
+                     for c in r.paper.claims if c.kind == kind and not c.variant_of]
+            counts = ", ".join(f"{words.count(w)} {w}" for w in (*STATUSES, UNTESTABLE)
+                               if words.count(w))
+            parts.append(f"{len(words)} {name}" + (f" ({counts})" if counts else ""))
+        print(f"{r.paper.key}: {'; '.join(parts)}"
               + (f"; {failed} run(s) failed" if failed else ""))
-    print(f"report: {out / 'report.md'} and {out / 'report.html'}")
+    print(f"report: {out / 'report.md'}, {out / 'report.html'} and {out / 'results.json'}")
     return 0

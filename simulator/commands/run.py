@@ -26,17 +26,25 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("-o", "--output", metavar="DIR",
                    help="run directory (default: runs/<scenario name>)")
     p.add_argument("--force", action="store_true", help="overwrite an existing DIR")
+    p.add_argument("--time-limit", type=float, default=None, metavar="SECONDS",
+                   help="how long each estimator may take to run (default: no limit; it "
+                        "then runs in its own process, as every estimator that is not a "
+                        "built-in does), and the plug-ins to be imported and checked "
+                        "(default 120 s); past it the run stops with exit 2 and writes nothing")
     add_scenario_options(p)
     p.set_defaults(run=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from simulator import pipeline
+    from simulator.commands.options import check_time_limit
     from simulator.scoring.report import print_scores
 
+    check_time_limit(args.time_limit, "run")
     scenario = pipeline.load_scenario(args.scenario, args.overrides, args.seed)
     out = Path(args.output) if args.output else Path("runs") / scenario.name
-    result = pipeline.run(scenario, out, args.force, show_progress=True)
+    result = pipeline.run(scenario, out, args.force, show_progress=True,
+                          time_limit_s=args.time_limit)
     if scenario.data["estimators"]:
         print_scores(result.evaluation)
     else:

@@ -93,11 +93,11 @@ def run(args: argparse.Namespace) -> int:
             print(f"scored against a reference, not an exact truth: "
                   f"{dataset.manifest.get('reference_source', 'the recording reference')}")
         print_scores(ev)
+        if report_dir is not None:  # first: a report that fails (a full disk) leaves no JSON
+            pipeline.write_report(report_dir, ev, f"Scores on {dataset.path.name}")
         if args.json:
             write_scores(ev.scores(), Path(args.json), args.force, inputs)
             print(f"wrote {args.json}")
-        if report_dir is not None:
-            pipeline.write_report(report_dir, ev, f"Scores on {dataset.path.name}")
     if args.report:
         print(f"wrote {Path(args.report) / 'report.md'} and report.html")
     return 0

@@ -116,7 +116,8 @@ def _receiver_clock(dataset: Dataset, stream: str) -> pd.Series | None:
 def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
                  option: str = "export_rinex") -> tuple[Path, Path]:
     """Write ``DIR/NAME.obs`` (every signal of ``gnss_raw``: C, L, D, S) and ``DIR/NAME.nav``
-    (the broadcast elements of ``gnss_nav`` and the broadcast ionosphere), ``NAME`` the dataset
+    (the broadcast records of every system of ``gnss_nav``, the broadcast ionosphere and the
+    navigation file's system time offsets), ``NAME`` the dataset
     folder's name, and, when the dataset has a base station, ``DIR/NAME_base.obs`` (its
     ``gnss_base_raw``, APPROX POSITION its true position); the paths of the first two. The
     files are made before any is moved into place (never an ``.obs`` without its ``.nav``); an
@@ -131,7 +132,8 @@ def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
     out = Path(directory)
     name = Path(dataset.path).resolve().name
     obs, nav = out / f"{name}.obs", out / f"{name}.nav"
-    iono = dataset.manifest.get("sensors", {}).get("gnss", {}).get("broadcast_iono", {})
+    drawn = dataset.manifest.get("sensors", {}).get("gnss", {})
+    iono = drawn.get("broadcast_iono", {})
     base = out / f"{name}_base.obs" if dataset.has("gnss_base_raw") else None
     for path in (obs, nav, *([base] if base is not None else [])):  # refused before any begins
         check_output_file(path, force, [dataset.path], "rinex")
@@ -148,7 +150,8 @@ def export_rinex(dataset: Dataset, directory: str | Path, force: bool = False,
         write_rinex_obs(obs_tmp, _read_checked(dataset, "gnss_raw"), week, tow, approx,
                         receiver_clock_m=_receiver_clock(dataset, "truth_gnss"))
         write_rinex_nav(nav_tmp, _read_checked(dataset, "gnss_nav"),
-                        leap_seconds(gps_to_utc(week, tow)), iono.get("alpha"), iono.get("beta"))
+                        leap_seconds(gps_to_utc(week, tow)), iono.get("alpha"), iono.get("beta"),
+                        drawn.get("time_corrections"))
     return obs, nav
 
 

@@ -227,14 +227,19 @@ def build_manifest(scenario: Scenario, generated: Generated) -> dict:
     Besides the SPEC keys: ``datasheet`` (each sensor's parameters as a user knows them: the
     datasheet and nominal values, with the scenario keys that set a true value, such as the
     odometer's ``scale_factor``, replaced by the nominal value a user assumes), the values so
-    replaced in ``truth_parameters``, ``timing`` (how each stream is stamped and its effective
-    delay) and ``knowledge`` (which keys a real user would know, and which are truth that only
-    scoring may read: the resolved ``scenario``, the drawn ``sensors``, ...).
+    replaced in ``truth_parameters``; a base station's block carries its ``surveyed_position``
+    {lat, lon, alt, x, y, z}, the antenna position a user of a base knows), ``timing`` (how
+    each stream is stamped and its effective delay) and ``knowledge`` (which keys a real user
+    would know, and which are truth that only scoring may read: the resolved ``scenario``, the
+    drawn ``sensors``, ...).
     """
     data = scenario.data
     truth = generated.truth
     datasheet, true_values = _datasheet(data, generated.truth_keys)
     base = generated.drawn.get("gnss_base", {}).get("position")
+    if base is not None and "gnss_base" in datasheet:
+        # a base station's antenna is surveyed: its position is what a user of it knows
+        datasheet["gnss_base"]["surveyed_position"] = dict(base)
     return {
         "knowledge": KNOWLEDGE,
         "datasheet": datasheet,

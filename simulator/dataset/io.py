@@ -272,6 +272,7 @@ _MANIFEST_FIELDS = {  # key path -> the JSON types it may have
     ("scenario", "sensors"): (dict,),
     ("sensors",): (dict,),
     ("sensors", "gnss", "broadcast_iono"): (dict,),
+    ("sensors", "gnss", "time_corrections"): (dict,),
     ("datasheet",): (dict,),
 }
 _MAPPINGS_OF_MAPPINGS = (("scenario", "sensors"), ("sensors",))  # each entry is a mapping

@@ -35,7 +35,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.special import i0e
 
 LLI_LOST_LOCK = 1  # RINEX 3.04: lost lock between the previous and this observation
 LLI_HALF_CYCLE = 2  # RINEX 3.04: half-cycle ambiguity / slip possible
@@ -68,6 +67,8 @@ def slip_probability(sigma_cycles: np.ndarray, stress_cycles: np.ndarray, bandwi
     (thermal jitter plus a third of the dynamic stress, Kaplan & Hegarty's rule of thumb); a
     data channel's Costas loop has rho / 4 (its slips are half cycles). Computed in logs: T
     exceeds any float for a strong signal."""
+    from scipy.special import i0e  # imported on first use: a drive without GNSS never pays for it
+
     sigma_rad = 2.0 * np.pi * (np.asarray(sigma_cycles) + np.asarray(stress_cycles) / 3.0)
     rho = 1.0 / np.maximum(sigma_rad, 1e-9) ** 2
     if not pilot:
@@ -77,13 +78,14 @@ def slip_probability(sigma_cycles: np.ndarray, stress_cycles: np.ndarray, bandwi
     return -np.expm1(-np.exp(np.log(dt_s) - log_t))
 
 
-def draw_slips(rng: np.random.Generator, probability: np.ndarray, tracked: np.ndarray
+def draw_slips(uniform: np.ndarray, probability: np.ndarray, tracked: np.ndarray
                ) -> np.ndarray:
     """Epochs (bool, shape of ``tracked``) at which a cycle slip occurred since the previous
-    epoch, within continuous tracking: a Bernoulli draw of ``probability`` per epoch."""
+    epoch, within continuous tracking: a Bernoulli draw of ``probability`` per epoch from
+    ``uniform``, U(0, 1) draws of that shape."""
     before = np.zeros_like(tracked)
     before[:, 1:] = tracked[:, :-1]
-    return tracked & before & (rng.random(tracked.shape) < probability)
+    return tracked & before & (uniform < probability)
 
 
 @dataclass

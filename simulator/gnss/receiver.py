@@ -32,6 +32,7 @@ from simulator.gnss.constants import C_M_S, CHIP_L1CA_M, OMEGA_E_DOT_RAD_S
 from simulator.gnss.ephemeris import satellite_state
 
 _LIGHT_TIME_ITERATIONS = 4  # fixed-point steps on tau: 1e-12 s after four from 0.075 s
+_FIRST_TAU_S = 0.075  # the flight time the steps start from (MEO to GEO: 0.064-0.13 s)
 
 
 def rotate_to_reception_frame(vec: np.ndarray, tau_s: np.ndarray) -> np.ndarray:
@@ -89,10 +90,14 @@ def signal_geometry(eph: dict[str, np.ndarray], t_rx_s: np.ndarray, rx_pos_m: np
         to satellite, ECEF of reception; ``los_rate`` (S + (3,), 1/s): its time derivative.
     """
     t_rx = np.broadcast_to(np.asarray(t_rx_s, dtype=float), eph["toe_s"].shape)
-    tau = np.full(t_rx.shape, 0.075)
+    tau = np.full(t_rx.shape, _FIRST_TAU_S)
+    # the fixed-point steps move the satellite along its velocity at t - 0.075 s: within
+    # |a| dtau^2 / 2 of its orbit (0.1 mm for a MEO, 0.3 mm for a GEO 0.055 s further), so tau
+    # converges within 1e-12 s, and the orbit is evaluated once more, exactly, at t - tau
+    first = satellite_state(eph, t_rx - tau)
     for _ in range(_LIGHT_TIME_ITERATIONS):
-        state = satellite_state(eph, t_rx - tau)
-        rel = rotate_to_reception_frame(state["pos"], tau) - rx_pos_m[None, :, :]
+        moved = first["pos"] + first["vel"] * (_FIRST_TAU_S - tau)[..., None]
+        rel = rotate_to_reception_frame(moved, tau) - rx_pos_m[None, :, :]
         tau = np.linalg.norm(rel, axis=-1) / C_M_S
     state = satellite_state(eph, t_rx - tau)
     rel = rotate_to_reception_frame(state["pos"], tau) - rx_pos_m[None, :, :]

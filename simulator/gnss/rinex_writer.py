@@ -1,8 +1,10 @@
 """RINEX 3.04 writers: an observation file (per signal: pseudorange, carrier phase with its
-loss-of-lock indicator, Doppler, C/N0) from the ``gnss_raw`` stream and a GPS navigation file
-from the ``gnss_nav`` stream.
+loss-of-lock indicator, Doppler, C/N0) from the ``gnss_raw`` stream and a navigation file of
+every system (GPS, Galileo, BeiDou, GLONASS, QZSS; mixed) from the ``gnss_nav`` stream.
 
-Epochs are written in GPS time (the dataset's ``t`` plus the GPS time of ``t = 0``); values are
+Observation epochs are written in GPS time (the dataset's ``t`` plus the GPS time of ``t = 0``,
+plus the receiver's clock error when given); navigation records in each system's time (GPST,
+GST, BDT, QZSST; GLONASS in UTC); values are
 rounded to the formats' resolution (F14.3 for observations, D19.12 for navigation parameters).
 
 Public functions
@@ -12,7 +14,8 @@ write_rinex_obs, write_rinex_nav, signal_strength_indicator.
 References
 ----------
 RINEX 3.04 (IGS/RTCM-SC104, 2018): Table A2 (observation header), A3 (observation data record),
-A5 (navigation header), A6 (GPS navigation data record); section 5.7 (signal strength
+A5 (navigation header), A6 (GPS), A8 (Galileo), A10 (GLONASS), A12 (QZSS) and A14 (BeiDou)
+navigation data records; section 5.7 (signal strength
 indicator from C/N0).
 """
 
@@ -25,22 +28,32 @@ import numpy as np
 import pandas as pd
 
 from simulator.gnss.constants import C_M_S, SECONDS_PER_WEEK
+from simulator.gnss.timesystems import BDS_WEEK_OFFSET
 from simulator.timebase import GPS_EPOCH, gps_to_utc, leap_seconds
 
 PROGRAM = "landnav"
 _SYSTEM_NAMES = {"G": "GPS", "E": "GALILEO", "C": "BEIDOU", "R": "GLONASS", "J": "QZSS"}
-# the order of the 28 numbers after the clock epoch of a GPS record (RINEX 3.04 Table A6),
-# with the fields the navigation table does not hold written as the constant beside them
-_NAV_ORDER = (
-    ("af0", "af1", "af2"),
+# the numbers of each system's Keplerian record after the clock epoch, a tuple per line
+# (RINEX 3.04 Tables A6 GPS, A8 Galileo, A12 QZSS, A14 BeiDou); a field the navigation table
+# does not hold is written as the constant in its place
+_ORBIT_LINES = (
     ("iode", "crs", "delta_n", "m0"),
     ("cuc", "e", "cus", "sqrt_a"),
     ("toe", "cic", "omega0", "cis"),
     ("i0", "crc", "omega", "omega_dot"),
-    ("idot", 0.0, "week", 0.0),  # L2 codes, L2 P data flag
-    (2.0, "health", "tgd", "iode"),  # SV accuracy (m), IODC = IODE
-    ("toe", 4.0),  # transmission time (taken as toe), fit interval (h)
 )
+_LAST_LINES = {
+    # IDOT, L2 codes, week, L2 P flag; URA (m), health, T_GD, IODC (= IODE); transmission
+    # time (taken as toe), fit interval (h; QZSS: the flag, 0 = 2 h)
+    "G": (("idot", 0.0, "week", 0.0), (2.0, "health", "tgd", "iode"), ("toe", 4.0)),
+    "J": (("idot", 0.0, "week", 0.0), (2.0, "health", "tgd", "iode"), ("toe", 0.0)),
+    # IDOT, data sources, GAL week, spare; SISA (m), health, BGD E5a/E1, BGD E5b/E1;
+    # transmission time
+    "E": (("idot", "data_source", "week", 0.0), (3.12, "health", "tgd", "tgd2"), ("toe",)),
+    # IDOT, spare, BDT week, spare; URA (m), SatH1, TGD1, TGD2; transmission time, AODC
+    "C": (("idot", 0.0, "week", 0.0), (2.0, "health", "tgd", "tgd2"), ("toe", "iode")),
+}
+NAV_SYSTEMS = ("G", "E", "C", "R", "J")  # the order of the records in a written file
 
 
 def _label(text: str, label: str) -> str:
@@ -49,6 +62,11 @@ def _label(text: str, label: str) -> str:
 
 def _d19(value: float) -> str:
     return f"{value:19.12E}".replace("E", "D")
+
+
+def _d(value: float, width: int, digits: int) -> str:
+    """A Dw.d field (TIME SYSTEM CORR: a0 D17.10, a1 D16.9)."""
+    return f"{value:{width}.{digits}E}".replace("E", "D")
 
 
 def _obs(value: float) -> str:
@@ -201,30 +219,88 @@ def write_rinex_obs(path: str | Path, raw: pd.DataFrame, gps_week: int, gps_tow_
     return path
 
 
+def _epoch(stamp: dt.datetime) -> str:
+    return (f"{stamp.year:4d} {stamp.month:02d} {stamp.day:02d} {stamp.hour:02d} "
+            f"{stamp.minute:02d} {stamp.second:02d}")
+
+
+def _kepler_lines(rec: dict) -> list[str]:
+    """One GPS, Galileo, BeiDou or QZSS record: the clock epoch in the system's own time (BDT
+    for BeiDou, whose week 0 began with GPS week 1356, so that its week and seconds give the
+    calendar reading as GPS ones do) and the broadcast orbit lines."""
+    system = rec["system"]
+    week = int(rec["week"]) + (BDS_WEEK_OFFSET if system == "C" else 0)
+    head = f"{system}{int(rec['sv']):02d} {_epoch(_gps_datetime(week, float(rec['toc'])))}"
+    groups = [[rec[k] if isinstance(k, str) else k for k in line]
+              for line in (*_ORBIT_LINES, *_LAST_LINES[system])]
+    clock = (rec["af0"], rec["af1"], rec["af2"])
+    return [head + "".join(_d19(v) for v in clock)] + [
+        "    " + "".join(_d19(v) for v in group) for group in groups]
+
+
+def _glonass_lines(rec: dict, leap_s: int) -> list[str]:
+    """One GLONASS record (RINEX 3.04 Table A10): t_b in UTC, -tau_n, +gamma_n, the message
+    frame time (taken as t_b, seconds of the UTC week), then X, Y, Z in km with velocity,
+    lunisolar acceleration and health, frequency channel, age (0)."""
+    utc_s = int(rec["week"]) * SECONDS_PER_WEEK + float(rec["toe"]) - leap_s
+    stamp = GPS_EPOCH + dt.timedelta(seconds=utc_s)
+    frame = utc_s - np.floor(utc_s / SECONDS_PER_WEEK) * SECONDS_PER_WEEK
+    km = {k: rec[k] / 1e3 for k in ("glo_x", "glo_y", "glo_z", "glo_vx", "glo_vy", "glo_vz",
+                                    "glo_ax", "glo_ay", "glo_az")}
+    groups = ((km["glo_x"], km["glo_vx"], km["glo_ax"], rec["health"]),
+              (km["glo_y"], km["glo_vy"], km["glo_ay"], rec["glo_channel"]),
+              (km["glo_z"], km["glo_vz"], km["glo_az"], 0.0))
+    return [f"R{int(rec['sv']):02d} {_epoch(stamp)}"
+            + "".join(_d19(v) for v in (rec["af0"], rec["af1"], frame))] + [
+        "    " + "".join(_d19(v) for v in group) for group in groups]
+
+
 def write_rinex_nav(path: str | Path, nav: pd.DataFrame, leap_s: int,
                     iono_alpha: list[float] | None = None,
-                    iono_beta: list[float] | None = None) -> Path:
-    """Write the GPS records of the navigation table as a RINEX 3.04 GPS navigation file
-    (records as they are, with the ionosphere coefficients in IONOSPHERIC CORR when given);
-    other systems' records are not written."""
+                    iono_beta: list[float] | None = None,
+                    time_corrections: dict | None = None) -> Path:
+    """Write the navigation table as a RINEX 3.04 navigation file: every GPS, Galileo,
+    BeiDou, QZSS and GLONASS record as it is (a mixed file, ``M``, when there are several
+    systems), with the GPS ionosphere coefficients in IONOSPHERIC CORR and the system time
+    offsets in TIME SYSTEM CORR when given.
+
+    Parameters
+    ----------
+    nav : pandas.DataFrame
+        The navigation table (``simulator.gnss.navfiles``; without ``system``, GPS records).
+    leap_s : int
+        GPS - UTC (s): the LEAP SECONDS line and the UTC epochs of the GLONASS records.
+    time_corrections : dict, optional
+        ``TIME SYSTEM CORR`` label -> (a0 s, a1 s/s, reference seconds of week, week), as the
+        reader's ``attrs["time_corrections"]``.
+
+    A record's epoch is written to the whole second (RINEX: I2 seconds); the reader of this
+    module's files (``read_rinex_nav``) gives back every value to the D19.12 resolution.
+    """
     path = Path(path)
-    if "system" in nav.columns:
-        nav = nav[nav["system"] == "G"]
+    if "system" not in nav.columns:
+        nav = nav.assign(system="G")
+    nav = nav[nav["system"].isin(NAV_SYSTEMS)]
+    present = [s for s in NAV_SYSTEMS if (nav["system"] == s).any()]
+    kind = (f"{present[0]}: {_SYSTEM_NAMES[present[0]]}" if len(present) == 1
+            else "M: MIXED")
     lines = [
-        _label("     3.04           N: GNSS NAV DATA    G: GPS", "RINEX VERSION / TYPE"),
+        _label(f"     3.04           N: GNSS NAV DATA    {kind}", "RINEX VERSION / TYPE"),
         _label(f"{PROGRAM:<20}{PROGRAM:<20}{_stamp()}", "PGM / RUN BY / DATE"),
     ]
     for name, coeffs in (("GPSA", iono_alpha), ("GPSB", iono_beta)):
         if coeffs is not None:
             text = name + " " + "".join(f"{c:12.4E}".replace("E", "D") for c in coeffs)
             lines.append(_label(text, "IONOSPHERIC CORR"))
+    for label, (a0, a1, t_ref, week) in (time_corrections or {}).items():
+        text = f"{label:<4} {_d(a0, 17, 10)}{_d(a1, 16, 9)} {int(t_ref):6d} {int(week):4d}"
+        lines.append(_label(text, "TIME SYSTEM CORR"))
     lines += [_label(f"{leap_s:6d}", "LEAP SECONDS"), _label("", "END OF HEADER")]
-    for rec in nav.sort_values(["sv", "week", "toe"], kind="stable").to_dict("records"):
-        toc = _gps_datetime(int(rec["week"]), float(rec["toc"]))
-        values = [[rec[k] if isinstance(k, str) else k for k in group] for group in _NAV_ORDER]
-        lines.append(f"G{int(rec['sv']):02d} {toc.year:4d} {toc.month:02d} {toc.day:02d} "
-                     f"{toc.hour:02d} {toc.minute:02d} {toc.second:02d}"
-                     + "".join(_d19(v) for v in values[0]))
-        lines += ["    " + "".join(_d19(v) for v in group) for group in values[1:]]
+    order = {s: i for i, s in enumerate(NAV_SYSTEMS)}
+    nav = nav.assign(_order=nav["system"].map(order)).sort_values(
+        ["_order", "sv", "week", "toe"], kind="stable")
+    for rec in nav.to_dict("records"):
+        lines += (_glonass_lines(rec, leap_s) if rec["system"] == "R"
+                  else _kepler_lines(rec))
     path.write_text("\n".join(lines) + "\n", encoding="ascii")
     return path

@@ -9,7 +9,7 @@ so that a constellation plugs in by (system, sv, signal, frequency).
 Public names
 ------------
 Signal, SIGNALS, PRESET_SIGNALS, PRIMARY_SIGNAL, signal, carrier_frequency_hz,
-iono_factor, group_delay_factor, default_signals.
+iono_factor, group_delay_factor, signal_group_delay_s, default_signals.
 
 References
 ----------
@@ -17,9 +17,9 @@ IS-GPS-200N (2022) 3.3.1.1 (L1 = 154 f0, L2 = 120 f0, f0 = 10.23 MHz), 20.3.3.3.
 P(Y) group delay gamma T_GD, gamma = (f_L1 / f_L2)^2), Table 3-Va (minimum received powers:
 L1 C/A -158.5 dBW, L2 P(Y) -161.5 dBW); IS-GPS-705J (L5 = 115 f0; I5 and Q5 -157.9 dBW each).
 Galileo OS SIS ICD 2.1 (2023) 2.3 (E1 1575.42, E5a 1176.45, E5b 1207.14 MHz; E1-C, E5a-Q and
-E5b-Q pilots) and 5.1.5 (BGD). BeiDou ICD B1I 3.0 (1561.098 MHz, 2.046 Mchip/s) and B2a 1.0
-(1176.45 MHz pilot). GLONASS ICD 5.1 (2008) 3.3.1.1 (G1 1602 + k 0.5625 MHz, G2 1246 + k
-0.4375 MHz). RINEX 3.04 (2018) section 5.1 and Table 4 (observation codes).
+E5b-Q pilots) and 5.1.5 (BGD). BeiDou ICD B1I 3.0 (1561.098 MHz, 2.046 Mchip/s; 5.2.4.10
+TGD1, TGD2) and B2a 1.0 (1176.45 MHz pilot). GLONASS ICD 5.1 (2008) 3.3.1.1 (G1 1602 + k
+0.5625 MHz, G2 1246 + k 0.4375 MHz). RINEX 3.04 (2018) section 5.1 and Table 4 (observation codes).
 Ionosphere: first-order delay 40.3 TEC / f^2 (m, TEC in electrons/m^2), the code delayed and
 the phase advanced by it (Misra & Enge 2011, *Global Positioning System*, 2nd ed., eq. 5.14;
 Hofmann-Wellenhof, Lichtenegger & Wasle 2008, *GNSS*, eq. 5.72).
@@ -136,18 +136,53 @@ def iono_factor(frequency_hz: np.ndarray) -> np.ndarray:
 
 
 def group_delay_factor(system: str, code: str) -> float:
-    """The multiple of the broadcast group delay (GPS T_GD) a signal's code carries, so that
-    the satellite clock a user of that signal applies is dt_sv - factor T_GD: 1 on L1 and gamma
-    = (f_L1 / f_L2)^2 on L2 (IS-GPS-200 20.3.3.3.3.2). L5 without the CNAV ISCs takes the same
-    frequency law, (f_L1 / f_L5)^2 (the group delay difference of a dispersive hardware path;
-    ISC_L5 = 0). The other systems' terms (BGD, TGD1/2, GLONASS tau_n) are applied by their
-    orbit modules' clocks: factor 0 here."""
+    """The multiple of GPS/QZSS T_GD a signal's code carries, so that the satellite clock a
+    user of that signal applies is dt_sv - factor T_GD: 1 on L1 and gamma = (f_L1 / f_L2)^2
+    on L2 (IS-GPS-200 20.3.3.3.3.2). L5 without the CNAV ISCs takes the same frequency law,
+    (f_L1 / f_L5)^2 (the group delay difference of a dispersive hardware path; ISC_L5 = 0).
+    0 for the other systems (``signal_group_delay_s`` has their terms)."""
     term = signal(system, code).group_delay
     if term == "tgd_l1":
         return 1.0
     if term in ("tgd_l2", "tgd_l5"):
         return float(iono_factor(signal(system, code).frequency_hz))
     return 0.0
+
+
+def signal_group_delay_s(system: str, code: str, primary_s: np.ndarray, tgd_s: np.ndarray,
+                         tgd2_s: np.ndarray) -> np.ndarray:
+    """The group delay of signal ``code``'s ranging code against the broadcast clock's
+    reference, s: a user of the signal applies dt_sv - this (dt_sv the clock polynomial with
+    the relativistic term), as each interface document has it.
+
+    - GPS, QZSS: ``group_delay_factor`` x T_GD (``tgd_s``).
+    - Galileo (OS SIS ICD 2.1, 5.1.5): the clock is for the E1,E5b (I/NAV) or E1,E5a (F/NAV)
+      ionosphere-free pair, and E1 carries the BGD of that pair (``primary_s``: BGD(E1,E5b)
+      or BGD(E1,E5a), what ``satellite_state`` subtracts). On the pair's other signal the ICD
+      gives (f_E1 / f_E5x)^2 BGD(E1,E5x). E1 being the same signal whichever clock is used,
+      dt_FNAV - BGD(E1,E5a) = dt_INAV - BGD(E1,E5b), so on E5x against either clock the delay is
+      ``primary_s`` + ((f_E1 / f_E5x)^2 - 1) BGD(E1,E5x): with E5x of the clock's own pair it
+      is the ICD's formula, with the other pair the same formula moved to that clock.
+      ``tgd_s`` is BGD(E1,E5a), ``tgd2_s`` BGD(E1,E5b).
+    - BeiDou (BDS SIS ICD B1I 3.0, 5.2.4.10: the clock refers to B3I): TGD1 on B1I
+      (``tgd_s``), TGD2 on B2I (``tgd2_s``); B2a has no term in the D1/D2 messages (its
+      TGD_B2ap is broadcast in B-CNAV only): 0.
+    - GLONASS: no group delay in the broadcast G1/G2 record: 0.
+    """
+    spec = signal(system, code)
+    term = spec.group_delay
+    if system in ("G", "J"):
+        return group_delay_factor(system, code) * np.asarray(tgd_s, dtype=float)
+    if term == "bgd_e1":
+        return np.asarray(primary_s, dtype=float)
+    if term in ("bgd_e5a", "bgd_e5b"):
+        bgd = tgd_s if term == "bgd_e5a" else tgd2_s
+        return primary_s + (float(iono_factor(spec.frequency_hz)) - 1.0) * np.asarray(bgd)
+    if term == "tgd_b1i":
+        return np.asarray(tgd_s, dtype=float)
+    if term == "tgd_b2i":
+        return np.asarray(tgd2_s, dtype=float)
+    return np.zeros(np.shape(primary_s))
 
 
 def default_signals(preset: str, systems: list[str]) -> dict[str, list[str]]:

@@ -6,22 +6,19 @@ Errors against the truth are those of the scorer (``simulator.scoring.align.solu
 ECEF difference resolved in the NED frame of the true position, angles wrapped), so a claim's
 figure and ``landnav score`` never disagree.
 
-Verdict words (``simulator.reproduce.paper.Verdict``), the choice made here:
-
-* a count criterion ("in at least 9 of 10 seeds") is scaled to the seeds run: at least
-  ``ceil(fraction x n)`` of n. **shown** when met; **partly** when at least half of the seeds
-  succeed but fewer than the criterion asks (the effect is there, not as reliably as claimed);
-  **not shown** below half;
-* a median criterion ("cut by at least 30 %") is judged on the median over seeds: **shown** when
-  the median meets it; **partly** when the median is on the claimed side of no effect but short
-  of the bound; **not shown** otherwise.
+Verdict words follow one rule (``simulator.reproduce.evidence``): a claim's per-seed values give
+the evidence (paired effect, bootstrap interval, sign test in the paper's direction) and the word
+follows from it. ``paired_judgement`` and ``threshold_judgement`` build such a verdict with its
+per-seed values; ``count_verdict``, ``median_verdict`` and ``paired_verdict`` express the older
+count and median criteria through the same rule (the count or median bound is the magnitude).
 
 Public names
 ------------
 errors, horizontal_error, outage_scores, moving_off, outages, longest_outage,
-inside_windows, at_time, spread_text, count_text, paired_wins, win_rate_text, count_verdict,
-median_verdict, needed_count, column, missing_count, least_count, paired_verdict,
-position_error_3d, satellite_windows, window_values.
+inside_windows, at_time, spread_text, count_text, paired_wins, win_rate_text, evidence_verdict,
+paired_judgement, threshold_judgement, count_verdict, median_verdict, needed_count, column,
+missing_count, least_count, listed, paired_verdict, position_error_3d, satellite_windows,
+window_values.
 """
 
 from __future__ import annotations
@@ -29,21 +26,24 @@ from __future__ import annotations
 import json
 import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
+from typing import Literal
 
 import numpy as np
 import pandas as pd
 
 from simulator.dataset.io import Dataset
+from simulator.reproduce import evidence as ev
 from simulator.reproduce.paper import Verdict
 from simulator.scoring.align import ERR_H, ERR_POS, solution_errors
 from simulator.scoring.evaluate import score_solutions
 from simulator.scoring.metrics import OUTAGE_KIND
 
-__all__ = ["at_time", "column", "count_text", "count_verdict", "errors", "horizontal_error",
-           "inside_windows", "least_count", "longest_outage", "median_verdict",
-           "missing_count", "moving_off", "needed_count", "outage_scores", "outages",
-           "paired_verdict", "paired_wins", "position_error_3d", "satellite_windows",
-           "spread_text", "win_rate_text", "window_values"]
+__all__ = ["at_time", "column", "count_text", "count_verdict", "errors", "evidence_verdict",
+           "horizontal_error", "inside_windows", "least_count", "listed", "longest_outage",
+           "median_verdict", "missing_count", "moving_off", "needed_count", "outage_scores",
+           "outages", "paired_judgement", "paired_verdict", "paired_wins", "position_error_3d",
+           "satellite_windows", "spread_text", "threshold_judgement", "win_rate_text",
+           "window_values"]
 
 
 # -- against the truth ----------------------------------------------------------------------
@@ -168,39 +168,76 @@ def needed_count(fraction: float, n: int) -> int:
     return math.ceil(fraction * n - 1e-9)
 
 
+def _with(reason: str, analysis: str) -> str:
+    return f"{reason}. {analysis}".strip() if analysis else reason
+
+
+def listed(values: Sequence[float] | np.ndarray) -> list[float | None]:
+    """Per-seed values for ``Verdict.per_seed``: floats, None where a seed has none."""
+    return [float(v) if np.isfinite(v) else None for v in np.asarray(values, float)]
+
+
+def evidence_verdict(evidence: ev.Evidence, per_seed: Mapping[str, Sequence[float] | np.ndarray],
+                     measured: str, what: str, magnitude: ev.Magnitude | None = None,
+                     analysis: str = "", compared: tuple[str, ...] = ()) -> Verdict:
+    """The verdict the documented rule gives (``evidence.verdict_word``) on ``evidence``, with
+    the per-seed values it came from (``compared`` names the ones the evidence compares: by
+    default the first one or two of ``per_seed``), the evidence in words and, when the claim is
+    not shown, ``analysis``."""
+    ok = magnitude.holds(evidence) if magnitude is not None else None
+    status = ev.verdict_word(evidence, magnitude_ok=ok)
+    reason = f"{what}: {ev.evidence_text(evidence)}"
+    if magnitude is not None:
+        reason += f"; magnitude ({magnitude.text}) {'met' if ok else 'not met'}"
+    return Verdict(status, measured, _with(reason, analysis if status != "shown" else ""),
+                   evidence, {k: listed(v) for k, v in per_seed.items()}, magnitude,
+                   compared)
+
+
+def paired_judgement(per_seed: Mapping[str, Sequence[float] | np.ndarray], a: str, b: str, *,
+                     better: ev.Better, kind: Literal["difference", "ratio"], unit: str,
+                     what: str, magnitude: ev.Magnitude | None = None,
+                     analysis: str = "") -> Verdict:
+    """The verdict on "``a`` is better than ``b``" (entries of ``per_seed``, paired per seed):
+    both spreads, the evidence and the rule's word."""
+    evidence = ev.paired_evidence(per_seed[a], per_seed[b], better=better, kind=kind, unit=unit)
+    measured = f"{a} {spread_text(per_seed[a], unit)}; {b} {spread_text(per_seed[b], unit)}"
+    return evidence_verdict(evidence, per_seed, measured, what, magnitude, analysis, (a, b))
+
+
+def threshold_judgement(per_seed: Mapping[str, Sequence[float] | np.ndarray], name: str, *,
+                        threshold: float, better: ev.Better, unit: str, what: str,
+                        magnitude: ev.Magnitude | None = None, analysis: str = "") -> Verdict:
+    """The verdict on "``name``'s values are better than ``threshold``" (``better``: lower or
+    higher), seed by seed: the spread, the evidence and the rule's word."""
+    evidence = ev.one_sample_evidence(per_seed[name], threshold=threshold, better=better,
+                                      unit=unit)
+    measured = f"{name} {spread_text(per_seed[name], unit)}"
+    return evidence_verdict(evidence, per_seed, measured, what, magnitude, analysis, (name,))
+
+
 def count_verdict(successes: int, n: int, fraction: float, measured: str, what: str,
                   analysis: str = "") -> Verdict:
-    """The verdict on "``what`` in at least ``fraction`` of the seeds" (module docstring);
-    ``analysis`` is added to the reason when the claim is not (fully) shown."""
-    need = needed_count(fraction, n)
-    if n == 0:
-        return Verdict("not shown", measured, "no seed produced the figure")
-    if successes >= need:
-        return Verdict("shown", measured, f"{what} in {successes}/{n} seeds; the criterion "
-                                          f"asks for {need}/{n}")
-    status = "partly" if successes >= n / 2 else "not shown"
-    reason = f"{what} in only {successes}/{n} seeds; the criterion asks for {need}/{n}"
-    return Verdict(status, measured, f"{reason}. {analysis}".strip())
+    """The verdict on "``what``" from how many of ``n`` seeds meet it: the sign test on the
+    per-seed indicators (1 met, 0 not) against one half (``fraction``, the old count criterion,
+    is no longer the rule; kept for the callers' signature)."""
+    indicators = np.array([1.0] * successes + [0.0] * (n - successes))
+    evidence = ev.one_sample_evidence(indicators, threshold=0.5, better="higher")
+    return evidence_verdict(evidence, {f"{what} (1 met, 0 not; seeds in any order)": indicators},
+                            measured, f"{what} in {successes}/{n} seeds", None, analysis)
 
 
 def median_verdict(values: Iterable[float], bound: float, better: str, no_effect: float,
                    measured: str, what: str, analysis: str = "") -> Verdict:
-    """The verdict on "the median of ``what`` is ``better`` (``"above"`` or ``"below"``) than
-    ``bound``", with ``no_effect`` the value meaning no effect at all (module docstring)."""
+    """The verdict on "``what`` is ``better`` (``"above"`` or ``"below"``) than ``no_effect``,
+    by at least ``bound`` in the median": the sign test of the per-seed values against
+    ``no_effect``, the magnitude the median against ``bound``."""
     v = np.asarray(list(values), float)
-    missing = missing_count(v)
-    v = v[np.isfinite(v)]
-    if not len(v):
-        return Verdict("not shown", measured, "no seed produced the figure")
-    med = float(np.median(v))
-    over = f" over {len(v)} seeds{_without(missing)}" if missing else ""
-    sign = 1.0 if better == "above" else -1.0
-    if sign * (med - bound) >= 0:
-        return Verdict("shown", measured,
-                       f"median {what} {med:.3g} is {better} {bound:g}{over}")
-    status = "partly" if sign * (med - no_effect) > 0 else "not shown"
-    reason = f"median {what} {med:.3g} is not {better} {bound:g}{over}"
-    return Verdict(status, measured, f"{reason}. {analysis}".strip())
+    side: ev.Better = "higher" if better == "above" else "lower"
+    evidence = ev.one_sample_evidence(v, threshold=no_effect, better=side)
+    magnitude = (ev.Magnitude(f"median {better} {bound:g}", low=bound) if better == "above"
+                 else ev.Magnitude(f"median {better} {bound:g}", high=bound))
+    return evidence_verdict(evidence, {what: v}, measured, what, magnitude, analysis)
 
 
 def outage_scores(dataset: Dataset, solution: pd.DataFrame) -> list[dict]:
@@ -222,14 +259,12 @@ def least_count(per: Mapping[str, np.ndarray], passes: Callable[[np.ndarray], np
 
 def paired_verdict(mine: np.ndarray, theirs: np.ndarray, names: tuple[str, str],
                    fraction: float, unit: str, what: str, analysis: str = "") -> Verdict:
-    """The verdict on "``names[0]``'s figure is smaller than ``names[1]``'s in at least
-    ``fraction`` of the seeds" (paired per seed), with both spreads and the win rate. A seed
-    where either figure is missing counts as one where the claim is not met (never dropped)."""
-    wins, n = paired_wins(mine, theirs)
-    missing = missing_count(mine, theirs)
-    measured = (f"{win_rate_text(wins, n, names[0], missing)}; {names[0]} "
-                f"{spread_text(mine, unit)}; {names[1]} {spread_text(theirs, unit)}")
-    return count_verdict(wins, n + missing, fraction, measured, what, analysis)
+    """The verdict on "``names[0]``'s figure is smaller than ``names[1]``'s" (paired per seed,
+    ``paired_judgement``; ``fraction``, the old count criterion, is no longer the rule). A seed
+    where either figure is missing counts as one where the claim is not met."""
+    return paired_judgement({names[0]: mine, names[1]: theirs}, names[0], names[1],
+                            better="lower", kind="difference", unit=unit, what=what,
+                            analysis=analysis)
 
 
 # -- partial-outage windows (Chan, Karamat) ----------------------------------------------------

@@ -14,23 +14,27 @@ the README's commands make; an installation without the folder is told so.
 
 Public names
 ------------
-Figures, Experiment, Verdict, Claim, Paper, STATUSES, SCENARIO_DIR, scenario_path.
+Figures, Experiment, Verdict, Claim, ClaimKind, Paper, STATUSES, SCENARIO_DIR, scenario_path.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Literal
+from typing import TYPE_CHECKING, Literal
 
 import pandas as pd
 
 from simulator.dataset.io import Dataset
 from simulator.errors import InputError, Problem
+from simulator.reproduce.evidence import Evidence, Magnitude
 
-__all__ = ["SCENARIO_DIR", "STATUSES", "Claim", "Experiment", "Figures", "Paper", "Verdict",
-           "scenario_path"]
+if TYPE_CHECKING:  # annotations only: the paper modules import no plotting library
+    from matplotlib.figure import Figure
+
+__all__ = ["SCENARIO_DIR", "STATUSES", "Claim", "ClaimKind", "Experiment", "Figures", "Paper",
+           "Verdict", "scenario_path"]
 
 SCENARIO_DIR = Path(__file__).resolve().parents[2] / "scenarios"
 
@@ -68,27 +72,86 @@ class Experiment:
     measure: Callable[[Dataset, Mapping[str, pd.DataFrame]], Figures]
     overrides: tuple[str, ...] = ()        # --set overrides of the full run
     quick_overrides: tuple[str, ...] = ()  # shortened drive for --quick (added to overrides)
+    # the time histories of the run's first seed for the paper's figures: a module-level
+    # function of the dataset and the solutions giving a table with a "t" column (s)
+    history: Callable[[Dataset, Mapping[str, pd.DataFrame]], pd.DataFrame] | None = None
+    # seeds of a run without --quick when more than the run's: where a verdict sits at an edge
+    full_runs: int | None = None
 
 
 @dataclass(frozen=True)
 class Verdict:
-    """The one word on a claim, landnav's figure(s) in words, and why."""
+    """The one word on a claim, landnav's figure(s) in words, why, and the evidence it follows
+    from (``simulator.reproduce.evidence``).
+
+    ``per_seed`` holds the named per-seed values the verdict came from (one list per name, in
+    seed order, None where a seed has no value). When ``evidence`` is given, ``compared`` names
+    the entries of ``per_seed`` it was computed from: ``(a, b)`` of a paired claim (``a`` the
+    side the paper calls better), ``(values,)`` of a claim against a fixed value; by default the
+    first one or two entries. ``magnitude`` is the paper's printed magnitude as a bound on the
+    effect (None when the paper prints none). ``status`` must be the word the documented rule
+    gives (``evidence.verdict_word``): the runner refuses any other."""
 
     status: Literal["shown", "partly", "not shown"]
     measured: str  # "median 17.8 % (IQR 12-25), 7/10 seeds"
     reason: str    # why this word; for partly / not shown the analysis in a sentence or two
+    evidence: Evidence | None = None
+    per_seed: Mapping[str, list[float | None]] = field(default_factory=dict)
+    magnitude: Magnitude | None = None
+    compared: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.evidence is None:
+            return
+        names = list(self.per_seed)
+        compared = self.compared or tuple(names[:1 if self.evidence.threshold is not None
+                                                else 2])
+        unknown = [c for c in compared if c not in self.per_seed]
+        if unknown or len(compared) != (1 if self.evidence.threshold is not None else 2):
+            raise ValueError(f"a verdict's evidence must name its per-seed values: compared "
+                             f"{compared}, per_seed has {names}")
+        object.__setattr__(self, "compared", compared)
+
+
+ClaimKind = Literal["paper", "check"]
 
 
 @dataclass(frozen=True)
 class Claim:
-    """A claim of the paper (or the issue's criterion for it) and how to judge it."""
+    """A claim of the paper, or one of landnav's own checks and controls, and how to judge it.
+
+    ``kind``: "paper" for what the paper claims (quoted with its figure or table, judged as the
+    paper states it), "check" for landnav's own checks (a filter works, a control); the report
+    tallies the two apart. ``conditions`` lists every condition of the experiment that differs
+    from the paper. A paper claim landnav cannot test says why in ``untestable``; its ``judge``,
+    if any, only gives landnav's figure for it (the word is "not testable", never one from
+    evidence). A claim judged again under another value of a deciding condition names the
+    default claim in ``variant_of`` and the value in ``variant`` ("fix noise 1.5 m"); the
+    summary tallies the default rows only."""
 
     key: str
-    text: str          # the claim as the paper makes it / the issue's criterion
+    text: str          # the claim as the paper makes it (a check: what landnav checks)
     paper_figure: str  # the number(s) the paper prints, with table / figure / section
-    conditions: str    # what differs (simulated vs real data, metric, drive, sensor)
-    judge: Callable[[Mapping[str, pd.DataFrame]], Verdict]
+    conditions: tuple[str, ...]  # every condition that differs from the paper
+    judge: Callable[[Mapping[str, pd.DataFrame]], Verdict] | None = None
     # judge: experiment key -> DataFrame (index seed, columns figure names) -> Verdict
+    kind: ClaimKind = field(default="paper", kw_only=True)
+    untestable: str = field(default="", kw_only=True)  # why the paper claim cannot be tested
+    variant_of: str = field(default="", kw_only=True)  # key of the default claim of a sweep
+    variant: str = field(default="", kw_only=True)     # the swept condition's value, in words
+
+    def __post_init__(self) -> None:
+        if isinstance(self.conditions, str) or not all(isinstance(c, str)
+                                                       for c in self.conditions):
+            raise TypeError(f"claim {self.key}: conditions is a tuple of strings")
+        if self.kind not in ("paper", "check"):
+            raise ValueError(f"claim {self.key}: kind is 'paper' or 'check', got {self.kind!r}")
+        if self.untestable and self.kind != "paper":
+            raise ValueError(f"claim {self.key}: only a paper claim can be untestable")
+        if not self.untestable and self.judge is None:
+            raise ValueError(f"claim {self.key}: a testable claim needs a judge")
+        if bool(self.variant_of) != bool(self.variant):
+            raise ValueError(f"claim {self.key}: variant_of and variant go together")
 
 
 @dataclass(frozen=True)
@@ -100,3 +163,7 @@ class Paper:
     citation: str
     experiments: tuple[Experiment, ...]
     claims: tuple[Claim, ...]
+    # figures in the layout of the paper's own: (experiment key -> the first seed's history,
+    # experiment key -> per-seed figures) -> [(caption, matplotlib Figure)]
+    figures: Callable[[Mapping[str, pd.DataFrame], Mapping[str, pd.DataFrame]],
+                      list[tuple[str, Figure]]] | None = None

@@ -12,13 +12,16 @@ The output folder (written under a temporary name and renamed when complete,
 ``simulator.outputs.atomic_output_dir``)::
 
     DIR/report.md, DIR/report.html
+    DIR/results.json                        every claim: kind, statement, conditions, per-seed
+                                            values, evidence, verdict (simulator.reproduce.results)
     DIR/figures/PAPER/EXPERIMENT.parquet   index seed, one column per figure
+    DIR/figures/PAPER/EXPERIMENT.history.parquet   the first seed's time histories
     DIR/failures.parquet                    paper, experiment, seed, error (failed tasks only)
 
 Public names
 ------------
-Settings, ExperimentResult, PaperResult, run_experiment, reproduce, seeds_of, QUICK_SEEDS,
-FULL_SEEDS.
+Settings, ExperimentResult, PaperResult, run_experiment, reproduce, judge, ruled, seeds_of,
+QUICK_SEEDS, FULL_SEEDS.
 """
 
 from __future__ import annotations
@@ -30,7 +33,7 @@ import tempfile
 import time
 import traceback
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from importlib.metadata import PackageNotFoundError
 from importlib.metadata import version as dist_version
 from pathlib import Path
@@ -42,12 +45,14 @@ from simulator.outputs import atomic_output_dir
 from simulator.pipeline import estimate, generate, load_scenario
 from simulator.progress import progress
 from simulator.reproduce import FULL_SEEDS, QUICK_SEEDS
+from simulator.reproduce.evidence import verdict_word
 from simulator.reproduce.paper import SCENARIO_DIR, Experiment, Paper, Verdict, scenario_path
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.report import write_report
+from simulator.reproduce.results import RESULTS_FILE, write_results
 
-__all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings",
-           "reproduce", "run_experiment", "seeds_of"]
+__all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings", "judge",
+           "reproduce", "ruled", "run_experiment", "seeds_of"]
 
 SCHEDULER_TIMEOUT_S = 10.0
 
@@ -57,6 +62,14 @@ def seeds_of(runs: int) -> list[int]:
     return list(range(1, runs + 1))
 
 
+def experiment_seeds(experiment: Experiment, seeds: Sequence[int], quick: bool) -> list[int]:
+    """The seeds an experiment runs: the run's, or 1..``experiment.full_runs`` without
+    ``quick`` when that is more (an experiment whose verdicts sit at an edge)."""
+    if quick or not experiment.full_runs or experiment.full_runs <= len(seeds):
+        return list(seeds)
+    return seeds_of(experiment.full_runs)
+
+
 def experiment_overrides(experiment: Experiment, quick: bool,
                          extra: Sequence[str] = ()) -> list[str]:
     """The --set overrides of an experiment: its own, then the quick ones, then ``extra``."""
@@ -64,16 +77,21 @@ def experiment_overrides(experiment: Experiment, quick: bool,
 
 
 def measure_seed(experiment: Experiment, seed: int, overrides: Sequence[str],
-                 work: Path) -> dict[str, float]:
+                 work: Path, with_history: bool = False
+                 ) -> tuple[dict[str, float], pd.DataFrame | None]:
     """One seed of an experiment in-process: generate the dataset under ``work``, replay every
-    entry, measure, delete the dataset; the seed's figures."""
+    entry, measure, delete the dataset; the seed's figures and, when ``with_history`` and the
+    experiment has one, its time histories (``Experiment.history``)."""
     scenario = load_scenario(scenario_path(experiment.scenario), list(overrides), seed)
     with tempfile.TemporaryDirectory(dir=work, prefix=f"{experiment.key}-{seed}-") as tmp:
         dataset = generate(scenario, Path(tmp) / "dataset")
         solutions = {label: estimate(dataset, {**entry, "label": label})[0]
                      for label, entry in experiment.entries.items()}
-        return {name: math.nan if value is None else float(value)  # None: the scorer's "none"
-                for name, value in experiment.measure(dataset, solutions).items()}
+        figures = {name: math.nan if value is None else float(value)  # None: scorer's "none"
+                   for name, value in experiment.measure(dataset, solutions).items()}
+        history = (experiment.history(dataset, solutions)
+                   if with_history and experiment.history is not None else None)
+        return figures, history
 
 
 def run_experiment(experiment: Experiment, seeds: Sequence[int], work: Path,
@@ -81,7 +99,7 @@ def run_experiment(experiment: Experiment, seeds: Sequence[int], work: Path,
     """An experiment over ``seeds`` in this process (the claim tests use it): a table with index
     ``seed`` and one column per figure. Errors propagate."""
     overrides = experiment_overrides(experiment, quick, extra_overrides)
-    rows = {seed: measure_seed(experiment, seed, overrides, work) for seed in seeds}
+    rows = {seed: measure_seed(experiment, seed, overrides, work)[0] for seed in seeds}
     return _table(rows)
 
 
@@ -97,17 +115,21 @@ class _Task:
     experiment: str
     seed: int
     overrides: tuple[str, ...]
+    with_history: bool = False
 
 
-def _execute(task: _Task) -> tuple[dict[str, float] | None, str | None, float]:
-    """A task on a worker: (figures, None, CPU seconds) or (None, the error's traceback, ...)."""
+def _execute(task: _Task) -> tuple[tuple[dict[str, float], pd.DataFrame | None] | None,
+                                   str | None, float]:
+    """A task on a worker: ((figures, history), None, CPU seconds) or (None, the error's
+    traceback, CPU seconds)."""
     start = time.process_time()
     try:
         paper = load_paper(task.paper)
         experiment = next(e for e in paper.experiments if e.key == task.experiment)
         with tempfile.TemporaryDirectory(prefix="landnav-reproduce-") as work:
-            figures = measure_seed(experiment, task.seed, task.overrides, Path(work))
-        return figures, None, time.process_time() - start
+            result = measure_seed(experiment, task.seed, task.overrides, Path(work),
+                                  task.with_history)
+        return result, None, time.process_time() - start
     except Exception:  # reported per seed in the report, the run goes on
         return None, traceback.format_exc(limit=8), time.process_time() - start
 
@@ -119,11 +141,13 @@ class ExperimentResult:
     experiment: Experiment
     table: pd.DataFrame
     failures: dict[int, str] = field(default_factory=dict)
+    history: pd.DataFrame | None = None  # the first seed's time histories (Experiment.history)
 
 
 @dataclass
 class PaperResult:
-    """A paper, its experiments' results and the verdict on each claim (claim key ->)."""
+    """A paper, its experiments' results and the verdict on each claim (claim key ->; an
+    untestable claim has none)."""
 
     paper: Paper
     experiments: dict[str, ExperimentResult]
@@ -144,16 +168,38 @@ class Settings:
 
 
 def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict]:
-    """Every claim of a paper judged on its experiments' tables; a judge that raises (figures
-    missing because seeds failed) gives ``not shown`` with the error as its reason."""
+    """Every testable claim of a paper judged on its experiments' tables; a judge that raises
+    (figures missing because seeds failed) gives ``not shown`` with the error as its reason,
+    and a word that does not follow from its evidence by the rule is replaced by the rule's
+    (``ruled``)."""
     out = {}
     for claim in paper.claims:
+        if claim.judge is None:
+            continue
         try:
-            out[claim.key] = claim.judge(tables)
+            verdict = claim.judge(tables)
+            # an untestable claim's judge gives landnav's figure only: no evidence, no word
+            out[claim.key] = (replace(verdict, status="not shown", evidence=None,
+                                      magnitude=None, compared=())
+                              if claim.untestable else ruled(verdict))
         except Exception as exc:  # noqa: BLE001 - the report says why, the others are judged
             out[claim.key] = Verdict("not shown", "no figure",
                                      f"could not be judged: {type(exc).__name__}: {exc}")
     return out
+
+
+def ruled(verdict: Verdict) -> Verdict:
+    """``verdict`` if its word is the one the documented rule gives on its evidence
+    (``evidence.verdict_word``; without evidence only "not shown" follows), else the rule's
+    word with the judge's in the reason."""
+    e, magnitude = verdict.evidence, verdict.magnitude
+    word = verdict_word(e, magnitude_ok=magnitude.holds(e) if e and magnitude else None)
+    if word == verdict.status:
+        return verdict
+    why = ("it has no per-seed evidence" if e is None
+           else "it does not follow from its evidence")
+    return replace(verdict, status=word, reason=f"{verdict.reason} [the judge's word "
+                                                f"'{verdict.status}' is not the rule's: {why}]")
 
 
 def version() -> str:
@@ -191,11 +237,14 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
         for experiment in paper.experiments:
             scenario_path(experiment.scenario)
     seeds = seeds_of(runs or (QUICK_SEEDS if quick else FULL_SEEDS))
-    tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)))
-             for p in loaded for e in p.experiments for seed in seeds]
+    tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)),
+                   seed == seeds[0] and e.history is not None)
+             for p in loaded for e in p.experiments for seed in experiment_seeds(e, seeds, quick)]
     figures: dict[tuple[str, str], dict[int, dict[str, float]]] = {}
+    histories: dict[tuple[str, str], pd.DataFrame] = {}
     failures: dict[tuple[str, str], dict[int, str]] = {}
     start, cpu = time.monotonic(), 0.0
+    software = version()  # the code the tasks run: read before they start
     with atomic_output_dir(Path(out), force) as tmp:
         with open_executor(workers, scheduler, SCHEDULER_TIMEOUT_S) as (executor, in_flight):
             for task, future in progress(completed(executor, in_flight, _execute, tasks),
@@ -209,18 +258,22 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
                 if result is None:
                     failures.setdefault(key, {})[task.seed] = error or "unknown error"
                 else:
-                    figures.setdefault(key, {})[task.seed] = result
+                    figures.setdefault(key, {})[task.seed] = result[0]
+                    if result[1] is not None:
+                        histories[key] = result[1]
         results = []
         for paper in loaded:
             experiments = {}
             for experiment in paper.experiments:
                 key = (paper.key, experiment.key)
                 table = _table(figures.get(key, {}))
-                experiments[experiment.key] = ExperimentResult(experiment, table,
-                                                               failures.get(key, {}))
+                experiments[experiment.key] = ExperimentResult(
+                    experiment, table, failures.get(key, {}), histories.get(key))
                 path = tmp / "figures" / paper.key / f"{experiment.key}.parquet"
                 path.parent.mkdir(parents=True, exist_ok=True)
                 table.to_parquet(path)
+                if key in histories:
+                    histories[key].to_parquet(path.with_suffix(".history.parquet"))
             verdicts = judge(paper, {k: r.table for k, r in experiments.items()})
             results.append(PaperResult(paper, experiments, verdicts))
         failed = [{"paper": p, "experiment": e, "seed": s, "error": err}
@@ -228,6 +281,7 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
         if failed:
             pd.DataFrame(failed).to_parquet(tmp / "failures.parquet")
         settings = Settings(tuple(seeds), quick, None if scheduler else workers, scheduler,
-                            time.monotonic() - start, cpu, version())
+                            time.monotonic() - start, cpu, software)
+        write_results(tmp / RESULTS_FILE, results, settings)
         write_report(tmp, results, settings)
     return results

@@ -14,7 +14,9 @@ read_yaml, apply_overrides, load_value.
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 from pathlib import Path as FsPath
 from typing import Any
 
@@ -24,6 +26,7 @@ from simulator.errors import InputError, Problem
 
 MAX_NODES = 200_000  # values built from one file, aliases expanded; a scenario has a few thousand
 MAX_DEPTH = 64  # nesting of mappings and lists
+MAX_FILE_BYTES = 64 * 2**20  # a scenario's text (the largest shipped one has a few kB)
 
 # a number in scientific notation without the sign or dot YAML 1.1's float pattern requires
 _PLAIN_FLOAT = re.compile(r"^[-+]?(?:[0-9]+(?:\.[0-9]*)?|\.[0-9]+)[eE][-+]?[0-9]+$")
@@ -94,6 +97,25 @@ def _construct_collection(node: yaml.Node, loader: yaml.SafeLoader, path: tuple,
             for i, item in enumerate(node.value)]
 
 
+def _read_text(path: str | FsPath, file: str) -> str:
+    """The text of a regular file of at most ``MAX_FILE_BYTES``: a device (``/dev/zero``), a
+    named pipe (which would wait for a writer) or a folder is refused, opened without waiting
+    and without reading it."""
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            raise InputError([Problem(file, None, "", "not a regular file (a device, a pipe or "
+                                      "a folder); give the scenario's YAML file")])
+        with os.fdopen(fd, "rb", closefd=False) as stream:
+            data = stream.read(MAX_FILE_BYTES + 1)
+    finally:
+        os.close(fd)
+    if len(data) > MAX_FILE_BYTES:
+        raise InputError([Problem(file, None, "", f"larger than a scenario may be "
+                                  f"({MAX_FILE_BYTES / 2**20:g} MiB); is it the right file?")])
+    return data.decode("utf-8")
+
+
 def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
     """Read a YAML file; return its content and a map from key path to line number (1-based).
 
@@ -104,7 +126,7 @@ def read_yaml(path: str | FsPath) -> tuple[Any, dict[tuple, int]]:
     """
     file = str(path)
     try:
-        text = FsPath(path).read_text(encoding="utf-8")
+        text = _read_text(path, file)
     except FileNotFoundError:
         raise InputError([Problem(file, None, "", "file not found")]) from None
     except (OSError, UnicodeDecodeError) as exc:

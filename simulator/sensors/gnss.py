@@ -478,6 +478,9 @@ class Gnss(PresetSensor):
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
+        corrections = nav.attrs.get("time_corrections") or {}
+        if corrections:  # the file's system time offsets, for its RINEX export
+            self.drawn["time_corrections"] = {k: list(v) for k, v in corrections.items()}
         new_year = dt.datetime(truth.utc_start.year, 1, 1)
         day_of_year = (truth.utc_start - new_year).total_seconds() / 86400.0 + 1.0 + t / 86400.0
         # each satellite's system and GLONASS frequency channel (the signals' frequencies)
@@ -486,7 +489,10 @@ class Gnss(PresetSensor):
         return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "systems": systems,
                 "channel": np.nan_to_num(channel.astype(float)), "t_gps": tow0 + t,
                 "health": np.where(idx >= 0, gathered["health"], 0.0),
-                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0), "alpha": alpha,
+                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0),
+                "tgd2_s": np.where(idx >= 0, gathered["tgd2"], 0.0),
+                "primary_delay_s": np.where(idx >= 0, gathered["group_delay"], 0.0),
+                "alpha": alpha,
                 "beta": beta, "day_of_year": day_of_year}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:

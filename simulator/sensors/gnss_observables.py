@@ -21,9 +21,11 @@ Measurement model of signal s at frequency f (lambda = c / f), in metres, gamma_
                   + T + sis + m_carrier_s + nlos_delay + phase_noise_s
                   + lambda (ambiguity + half_cycle)
 
-(``sat_clock_s`` = c (dt_sv - k_s T_GD) the clock a user of the signal applies, ``group_delay_s``
-= c k_s T_GD, ``simulator.gnss.signals.group_delay_factor``; the carrier carries no hardware
-delay). The carrier phase has RINEX's sign: it grows with the range, as the pseudorange does.
+(``sat_clock_s`` = c (dt_sv - G_s) the clock a user of the signal applies, ``group_delay_s`` =
+c G_s the code's group delay against the broadcast clock's reference, per system and signal
+from T_GD, BGD or TGD1/TGD2: ``simulator.gnss.signals.signal_group_delay_s``; the carrier
+carries no hardware delay). The carrier phase has RINEX's sign: it grows with the range, as
+the pseudorange does.
 
 Public names
 ------------
@@ -81,9 +83,9 @@ from simulator.gnss.receiver import (
 from simulator.gnss.signals import (
     PRIMARY_SIGNAL,
     carrier_frequency_hz,
-    group_delay_factor,
     iono_factor,
     signal,
+    signal_group_delay_s,
 )
 from simulator.gnss.timesystems import SYSTEMS
 from simulator.stochastic import gauss_markov
@@ -123,29 +125,30 @@ class Observed:
     shared: Shared
 
 
-def _rows(t: np.ndarray, svs: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray],
-          order: int, n_signals: int) -> dict[str, np.ndarray]:
-    """(satellite, epoch) arrays as stream columns where ``mask`` (a text value fills its
-    column), with a sort key ``_key`` putting epochs first, then satellites in PRN order, then
-    signals in the receiver's order."""
+def _rows(t: np.ndarray, svs: np.ndarray, rows: np.ndarray, mask: np.ndarray,
+          columns: dict[str, np.ndarray], order: int, n_signals: int) -> dict[str, np.ndarray]:
+    """(satellite, epoch) arrays of the satellites ``rows`` (of ``svs``) as stream columns
+    where ``mask`` (a text value fills its column), with a sort key ``_key`` putting epochs
+    first, then satellites in PRN order, then signals in the receiver's order."""
     ep, sat = np.nonzero(mask.T)
-    out = {"t": t[ep], "sv": svs[sat]}
+    out = {"t": t[ep], "sv": svs[rows[sat]]}
     for key, value in columns.items():
         if isinstance(value, str):
             out[key] = np.full(len(ep), value, dtype=object)
         else:
             out[key] = np.broadcast_to(value, mask.shape)[sat, ep]
-    out["_key"] = (ep.astype(np.int64) * len(svs) + sat) * n_signals + order
+    out["_key"] = (ep.astype(np.int64) * len(svs) + rows[sat]) * n_signals + order
     return out
 
 
 def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFrame:
-    """The pieces' rows in one table, in the order of their keys."""
+    """The pieces' rows in one table, in the order of their keys (each column its own new
+    array: the table takes them as they are, without copying them into blocks)."""
     import pandas as pd
 
     order = np.argsort(np.concatenate([p["_key"] for p in pieces]), kind="stable")
     return pd.DataFrame({name: np.concatenate([p[name] for p in pieces])[order]
-                         for name in names})
+                         for name in names}, copy=False)
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
@@ -248,10 +251,10 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     sat_clock = C_M_S * (geo["clock_s"] + geo["system_time_offset_s"])
     sat_drift = C_M_S * geo["clock_drift_s_s"]
     system_of = sky["systems"]
-    # GPS and QZSS: the other signals' group delays from T_GD (signals.group_delay_factor);
-    # the other systems' clocks are their primary signal's, used for all their signals
-    gps_like = np.isin(system_of, ("G", "J"))[:, None]
-    tgd_m = np.where(gps_like, C_M_S * sky["tgd_s"], 0.0)
+    # the broadcast clock's reference (the ionosphere-free pair, without the primary signal's
+    # group delay): the carrier's clock; each code's own group delay is taken from it
+    # (signals.signal_group_delay_s)
+    reference_clock = sat_clock + C_M_S * sky["primary_delay_s"]
     nlos_delay = np.where(nlos & ~los, extra, 0.0)
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
@@ -261,90 +264,120 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     reflected = _switches(nlos & ~los)  # a switch between direct and reflected: lock lost
     scale = cfg["tracking_noise"]
 
-    def unit_gm(tau_s: float) -> np.ndarray:
-        return gauss_markov(n_ep, dt_s, np.ones(n_sat), tau_s, rng).T
+    # per-satellite arrays each signal uses, taken on its system's rows only (the other rows
+    # of a signal are never measured); the random draws are made for every row, in the same
+    # order, so that the streams do not depend on this
+    per_satellite = {
+        "el": el, "az": az, "signal_cn0": signal_cn0, "cn0": cn0, "tracked": tracked,
+        "visible": visible, "have": have, "los": los, "nlos_only": nlos & ~los,
+        "reflected": reflected, "range": rng_m, "range_rate": geo["range_rate"],
+        "tau_rate": geo["tau_rate"], "pos": geo["pos"], "vel": geo["vel"],
+        "sat_drift": sat_drift, "reference_clock": reference_clock, "iono_true": iono_true,
+        "iono_true_rate": iono_true_rate, "tropo_true": tropo_true,
+        "tropo_true_rate": tropo_true_rate, "model_iono": model["iono"],
+        "model_tropo": model["tropo"], "mapping": mapping, "sis": err["sis"],
+        "nlos_delay": nlos_delay, "multipath_unit": err["multipath_unit"],
+        "quadrature": quadrature, "multipath_sigma": err["multipath_sigma"],
+        "code_sigma": err["code_sigma"], "code_noise": err["code_noise"],
+        "rate_sigma": err["rate_sigma"], "rate_noise": err["rate_noise"],
+        "los_jerk": los_jerk, "health": sky["health"].astype(np.int64),
+        "primary_delay_s": sky["primary_delay_s"], "tgd_s": sky["tgd_s"],
+        "tgd2_s": sky["tgd2_s"], "channel": sky["channel"]}
+    views: dict[str, dict[str, np.ndarray]] = {}
+
+    def unit_gm(tau_s: float, rows: np.ndarray) -> np.ndarray:
+        return gauss_markov(n_ep, dt_s, np.ones(n_sat), tau_s, rng, columns=rows).T
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     raw_pieces, truth_pieces = [], []
     for order, (letter, code) in enumerate(codes):  # one pass per signal, vectorised
         spec = signal(letter, code)
-        rows_here = (system_of == letter)[:, None]
-        # per satellite (GLONASS: its FDMA channel); the other systems' rows are not used
-        freq = np.where(rows_here, carrier_frequency_hz(letter, code, sky["channel"])[:, None],
-                        F_L1_HZ)
+        sel = np.flatnonzero(system_of == letter)
+        if letter not in views:
+            views[letter] = {k: np.asarray(v)[sel] for k, v in per_satellite.items()}
+        v = views[letter]
+        shape = (len(sel), n_ep)
+        # per satellite (GLONASS: its FDMA channel)
+        freq = carrier_frequency_hz(letter, code, v["channel"])[:, None]
         lam = C_M_S / freq
         k_iono = iono_factor(freq)
         if code == PRIMARY_SIGNAL[letter]:  # the error terms drawn for the primary signals
-            cn0_true, cn0_out, tracked_s = signal_cn0, cn0, tracked & rows_here
-            code_sigma, code_noise = err["code_sigma"], err["code_noise"]
-            rate_sigma, rate_noise = err["rate_sigma"], err["rate_noise"]
+            cn0_true, cn0_out, tracked_s = v["signal_cn0"], v["cn0"], v["tracked"]
+            code_sigma, code_noise = v["code_sigma"], v["code_noise"]
+            rate_sigma, rate_noise = v["rate_sigma"], v["rate_noise"]
         else:
-            cn0_true = signal_cn0 + spec.cn0_offset_db
-            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(el.shape)
-            tracked_s = visible & rows_here & (cn0_out >= cfg["cn0_threshold"])
+            cn0_true = v["signal_cn0"] + spec.cn0_offset_db
+            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(el.shape)[sel]
+            tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
             if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
-                tracked_s &= tracked
+                tracked_s &= v["tracked"]
             code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
                                              cfg["correlator_spacing"], cfg["integration_time"]
                                              ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
-            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]))
+            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel)
             rate_sigma = scale * lam * fll_sigma_hz(cn0_true, cfg["fll_bandwidth"],
                                                     cfg["integration_time"])
-            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]))
+            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel)
         code_mp, carrier_mp = reflection_multipath(
-            err["multipath_unit"], quadrature, err["multipath_sigma"], cfg["multipath_delay"],
+            v["multipath_unit"], v["quadrature"], v["multipath_sigma"], cfg["multipath_delay"],
             freq - F_L1_HZ, lam)
-        iono_s = k_iono * iono_true
+        iono_s = k_iono * v["iono_true"]
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
-        group_delay = group_delay_factor(letter, code) * tgd_m
-        sat_clock_s = sat_clock + tgd_m - group_delay
-        pseudorange = (rng_m + rx_clock - sat_clock_s + iono_s + tropo_true + err["sis"]
-                       + terms["multipath"] + nlos_delay + terms["code_noise"])
-        rate = (geo["range_rate"] + rx_drift - sat_drift * (1.0 - geo["tau_rate"])
-                + tropo_true_rate - k_iono * iono_true_rate + rate_noise)
+        group_delay = C_M_S * signal_group_delay_s(letter, code, v["primary_delay_s"],
+                                                   v["tgd_s"], v["tgd2_s"])
+        sat_clock_s = v["reference_clock"] - group_delay
+        pseudorange = (v["range"] + rx_clock - sat_clock_s + iono_s + v["tropo_true"]
+                       + v["sis"] + terms["multipath"] + v["nlos_delay"] + terms["code_noise"])
+        rate = (v["range_rate"] + rx_drift - v["sat_drift"] * (1.0 - v["tau_rate"])
+                + v["tropo_true_rate"] - k_iono * v["iono_true_rate"] + rate_noise)
         pr_std, rate_std = pseudorange_sigma(
-            cfg, {"code_sigma": code_sigma, "multipath_sigma": err["multipath_sigma"],
-                  "rate_sigma": rate_sigma}, k_iono * model["iono"], mapping, dt_s, speed)
+            cfg, {"code_sigma": code_sigma, "multipath_sigma": v["multipath_sigma"],
+                  "rate_sigma": rate_sigma}, k_iono * v["model_iono"], v["mapping"], dt_s,
+            speed)
         raw = {"system": letter, "signal": code, "frequency": freq,
                "pseudorange": pseudorange, "pseudorange_rate": rate, "doppler": -rate / lam,
-               "cn0": cn0_out, "sat_x": geo["pos"][..., 0], "sat_y": geo["pos"][..., 1],
-               "sat_z": geo["pos"][..., 2], "sat_vx": geo["vel"][..., 0],
-               "sat_vy": geo["vel"][..., 1], "sat_vz": geo["vel"][..., 2],
-               "sat_clock": sat_clock_s, "sat_clock_drift": sat_drift,
-               "iono": k_iono * model["iono"], "tropo": model["tropo"], "elevation": el,
-               "azimuth": az, "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
-               "health": sky["health"].astype(np.int64), "group_delay": group_delay}
+               "cn0": cn0_out, "sat_x": v["pos"][..., 0], "sat_y": v["pos"][..., 1],
+               "sat_z": v["pos"][..., 2], "sat_vx": v["vel"][..., 0],
+               "sat_vy": v["vel"][..., 1], "sat_vz": v["vel"][..., 2],
+               "sat_clock": sat_clock_s, "sat_clock_drift": v["sat_drift"],
+               "iono": k_iono * v["model_iono"], "tropo": v["model_tropo"], "elevation": v["el"],
+               "azimuth": v["az"], "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
+               "health": v["health"], "group_delay": group_delay}
         truth = {"system": letter, "signal": code, "frequency": freq,
-                 "tracked": tracked_s.astype(np.int8), "los": los.astype(np.int8),
-                 "nlos": (nlos & ~los).astype(np.int8), "elevation": el, "azimuth": az,
-                 "range": rng_m, "range_rate": geo["range_rate"],
+                 "tracked": tracked_s.astype(np.int8), "los": v["los"].astype(np.int8),
+                 "nlos": v["nlos_only"].astype(np.int8), "elevation": v["el"],
+                 "azimuth": v["az"], "range": v["range"], "range_rate": v["range_rate"],
                  "receiver_clock": rx_clock[None, :], "receiver_clock_drift": rx_drift[None, :],
-                 "iono_true": iono_s, "tropo_true": tropo_true,
-                 "iono_true_rate": k_iono * iono_true_rate, "tropo_true_rate": tropo_true_rate,
-                 "sis_error": err["sis"], "multipath": terms["multipath"],
-                 "nlos_delay": nlos_delay, "code_noise": terms["code_noise"],
+                 "iono_true": iono_s, "tropo_true": v["tropo_true"],
+                 "iono_true_rate": k_iono * v["iono_true_rate"],
+                 "tropo_true_rate": v["tropo_true_rate"],
+                 "sis_error": v["sis"], "multipath": terms["multipath"],
+                 "nlos_delay": v["nlos_delay"], "code_noise": terms["code_noise"],
                  "rate_noise": rate_noise, "antenna_x": ant["pos"][None, :, 0],
                  "antenna_y": ant["pos"][None, :, 1], "antenna_z": ant["pos"][None, :, 2],
                  "group_delay": group_delay}
         if cfg["carrier_phase"]:
             sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
                                                     cfg["integration_time"])
-            phase_noise = lam * sigma_cycles * rng.standard_normal(el.shape)
-            stress = dynamic_stress_cycles(los_jerk, lam, cfg["pll_bandwidth"])
+            phase_noise = lam * sigma_cycles * rng.standard_normal(el.shape)[sel]
+            stress = dynamic_stress_cycles(v["los_jerk"], lam, cfg["pll_bandwidth"])
             chance = (slip_probability(sigma_cycles, stress, cfg["pll_bandwidth"], dt_s,
-                                       spec.pilot) if scale > 0 else np.zeros(el.shape))
-            arcs = phase_arcs(rng, tracked_s, draw_slips(rng, chance, tracked_s), reflected,
-                              dt_s, spec.pilot, spec.frame_s)
-            phase_m = (rng_m + rx_clock - (sat_clock + tgd_m) - iono_s + tropo_true
-                       + err["sis"] + carrier_mp + nlos_delay + phase_noise)
+                                       spec.pilot) if scale > 0 else np.zeros(shape))
+            slips = draw_slips(rng.random(el.shape)[sel], chance, tracked_s)
+            arcs = phase_arcs(rng, tracked_s, slips, v["reflected"], dt_s, spec.pilot,
+                              spec.frame_s)
+            phase_m = (v["range"] + rx_clock - v["reference_clock"] - iono_s
+                       + v["tropo_true"] + v["sis"] + carrier_mp + v["nlos_delay"]
+                       + phase_noise)
             raw.update(carrier_phase=phase_m / lam + arcs.ambiguity + arcs.half,
                        lli=arcs.lli, lock_time=arcs.lock_time)
             truth.update(ambiguity=arcs.ambiguity, half_cycle=arcs.half,
                          cycle_slip=arcs.cycle_slip, arc=arcs.arc, carrier_multipath=carrier_mp,
                          phase_noise=phase_noise)
-        raw_pieces.append(_rows(t, svs, tracked_s, raw, order, len(codes)))
-        truth_pieces.append(_rows(t, svs, have & rows_here & (el > 0), truth, order, len(codes)))
+        raw_pieces.append(_rows(t, svs, sel, tracked_s, raw, order, len(codes)))
+        truth_pieces.append(_rows(t, svs, sel, v["have"] & (v["el"] > 0), truth, order,
+                                  len(codes)))
     raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0]]
     truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0]]
     return Observed(raw=_sorted(raw_pieces, raw_names), truth=_sorted(truth_pieces, truth_names),

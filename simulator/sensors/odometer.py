@@ -67,7 +67,7 @@ from simulator.sensors.presets import PresetSensor, preset_sensor_field
 from simulator.stochastic import random_walk
 from simulator.tables import ColumnTable
 from simulator.trajectory.kinematics import Kinematics
-from simulator.units import MILLI, PERCENT, PERCENT_RT_H, to_si
+from simulator.units import KM_H, MILLI, PERCENT, PERCENT_RT_H
 
 ODOMETER_PRESETS: dict[str, dict] = {
     "ideal": {},
@@ -81,8 +81,8 @@ ODOMETER_PRESETS: dict[str, dict] = {
     # tyre growth 0.2 % at 30 m/s (assumed, see the module docstring); unsigned plus direction
     "automotive": {"rate": 50.0, "scale_factor": 0.991, "scale_drift": 0.1 * PERCENT_RT_H,
                    "ticks_per_meter": 48 / (np.pi * 0.65), "latency": 20 * MILLI,
-                   "tooth_timing": True, "min_speed": to_si("2 km/h", "m/s"),
-                   "speed_resolution": to_si("0.01 km/h", "m/s"),
+                   "tooth_timing": True, "min_speed": 2 * KM_H,
+                   "speed_resolution": 0.01 * KM_H,
                    "speed_scale": 0.2 * PERCENT / 30.0, "signed": False},
 }
 

@@ -330,9 +330,10 @@ class Kinematics:
             return pos
         return _displaced(pos, self._motion(np.clip(t, 0.0, self.duration_s))["offset"])
 
-    def _road_position(self, t: np.ndarray, i: np.ndarray | None = None) -> np.ndarray:
+    def _road_position(self, t: np.ndarray,
+                       i: np.ndarray | slice | None = None) -> np.ndarray:
         """``position`` of the road-following point; ``i``: the integration interval of each
-        time when known (else searched)."""
+        time when known (an index array, or a slice for a run of intervals; else searched)."""
         nodes = self._t_int
         t = np.clip(np.atleast_1d(np.asarray(t, float)), 0.0, nodes[-1])
         out = np.empty((3,) + t.shape)  # component by component, handed out as (n, 3)
@@ -341,8 +342,9 @@ class Kinematics:
             return out.T
         if i is None:
             i = np.clip(np.searchsorted(nodes, t, side="right") - 1, 0, len(nodes) - 2)
-        start = nodes.take(i)
-        h = nodes.take(i + 1) - start
+        this, after = _at_and_after(i)
+        start = nodes[this]
+        h = nodes[after] - start
         u = (t - start) / h
         u2 = u * u
         u3 = u2 * u
@@ -350,8 +352,8 @@ class Kinematics:
         value_start, value_end = 2 * u3 - 3 * u2 + 1, -2 * u3 + 3 * u2
         rate_start, rate_end = (u3 - 2 * u2 + u) * h, (u3 - u2) * h
         for column, (values, rates) in enumerate(zip(self._lla, self._lla_rates, strict=True)):
-            out[column] = (value_start * values.take(i) + rate_start * rates.take(i)
-                           + value_end * values.take(i + 1) + rate_end * rates.take(i + 1))
+            out[column] = (value_start * values[this] + rate_start * rates[this]
+                           + value_end * values[after] + rate_end * rates[after])
         return out.T
 
     # -- the truth columns ------------------------------------------------------------------
@@ -420,10 +422,12 @@ class Kinematics:
         integration nodes (no search)."""
         j = np.asarray(j, dtype=np.intp)
         h = 1.0 / self.rate_hz
+        run = len(j) > 0 and j[-1] - j[0] == len(j) - 1 and bool((np.diff(j) == 1).all())
 
         def piece(rows: slice) -> dict[str, np.ndarray]:
-            jj = j[rows]
-            t = np.minimum(self.t_grid.take(jj) + u * h, self.duration_s)
+            # a run of intervals (every sample of a vibrating drive) as slices: views, no gathers
+            jj = slice(j[0] + rows.start, j[0] + min(rows.stop, len(j))) if run else j[rows]
+            t = np.minimum(self.t_grid[jj] + u * h, self.duration_s)
             body = None if self.body is None else self.body.inside(jj, u)
             motion = self._motion_piece(t, body)
             pos = self._road_position(t, jj)
@@ -520,6 +524,13 @@ def _by_pieces(evaluate: Callable[[slice], dict[str, np.ndarray]],
         for key, value in piece.items():
             out[key][rows] = value
     return out
+
+
+def _at_and_after(i: np.ndarray | slice) -> tuple[np.ndarray | slice, np.ndarray | slice]:
+    """Indices i and i + 1, as slices for a slice (views) and as arrays for an index array."""
+    if isinstance(i, slice):
+        return i, slice(i.start + 1, i.stop + 1)
+    return i, i + 1
 
 
 def _road_velocity(motion: dict[str, np.ndarray]) -> np.ndarray:

@@ -179,15 +179,15 @@ class BodyMotion:
         power = np.arange(3)[:, None] - np.arange(3)[None, :]  # d - o
         weights = [np.kron(basis[:, 3 * end:3 * end + 3].T * h ** power, np.eye(k))
                    for end in (0, 1)]
-        rows = self.nodes.T  # (n, 18), C-ordered
+        # (18, m) products, so that each channel is a contiguous row for the arithmetic after
         if isinstance(j, slice):
             start, stop, _ = j.indices(len(self.t) - 1)
-            values = rows[start:stop] @ weights[0]
-            values += rows[start + 1:stop + 1] @ weights[1]
-        else:
-            values = rows.take(j, axis=0) @ weights[0]
-            values += rows.take(j + 1, axis=0) @ weights[1]
-        values = values.T
+            values = weights[0].T @ self.nodes[:, start:stop]
+            values += weights[1].T @ self.nodes[:, start + 1:stop + 1]
+        else:  # whole samples gathered (rows of nodes.T), handed to the product transposed
+            rows = self.nodes.T
+            values = weights[0].T @ rows.take(j, axis=0).T
+            values += weights[1].T @ rows.take(j + 1, axis=0).T
         return {name + suffix: values[i + k * order]
                 for order, suffix in enumerate(("", "_rate", "_accel"))
                 for i, name in enumerate(CHANNELS)}

@@ -40,7 +40,7 @@ Integration: the state equation x' = A x + B u is diagonalised, A = V diag(lambd
 mode is propagated exactly for an input linear between samples ("first-order hold"; the road
 heights at the wheels are sampled on the truth grid), y_k+1 = e^(lambda h) y_k + b (p u_k +
 q u_k+1). The recursion runs in blocks with numpy (``stochastic.ar1_filter`` with the modes'
-complex factors, ``_modal_recursion``), never sample by sample.
+complex factors), never sample by sample.
 
 Public names
 ------------
@@ -196,22 +196,26 @@ def simulate(model: FullCar, u: np.ndarray, h: float) -> np.ndarray:
     i0 = (e - 1) / lam
     i1 = h * i0 - (h * e / lam - (e - 1) / lam**2)
     now, after = (i0 - i1 / h)[:, None] * modal_b, (i1 / h)[:, None] * modal_b
-    forced = np.empty((len(lam), u.shape[1]), dtype=complex)
-    forced.real[:, 1:] = now.real @ u[:, :-1] + after.real @ u[:, 1:]
-    forced.imag[:, 1:] = now.imag @ u[:, :-1] + after.imag @ u[:, 1:]
-    forced[:, 0] = -(modal_b @ u[:, 0]) / lam  # the static equilibrium of u_0
-    y = _modal_recursion(e, forced)
+    # the modes sample by sample, (n, modes) complex, seen as (n, 2 modes) real (real and
+    # imaginary parts interleaved): each product with the series is one real matrix product
+    forced = np.empty((u.shape[1], len(lam)), dtype=complex)
+    forced[0] = -(modal_b @ u[:, 0]) / lam  # the static equilibrium of u_0
+    pairs = forced[1:].view(float)
+    np.matmul(u[:, :-1].T, _interleaved(now.T), out=pairs)
+    pairs += u[:, 1:].T @ _interleaved(after.T)
+    y = ar1_filter(forced, e, overwrite=True)  # y_k = e y_k-1 + forced_k, in place
     # positions and rates of the body are states; accelerations are rows of A x + B u
     rows = np.r_[0:N_BODY, N_DOF:N_DOF + N_BODY]
     accel = slice(N_DOF, N_DOF + N_BODY)
     gain = np.vstack([vec[rows], vec[accel] * lam]) * weight
-    out = gain.real @ y.real - gain.imag @ y.imag
+    out = _interleaved(np.conj(gain)) @ y.view(float).T  # Re(gain y), (15, n)
     out[2 * N_BODY:] += b[accel] @ u
     return out
 
 
-def _modal_recursion(factor: np.ndarray, forced: np.ndarray) -> np.ndarray:
-    """y_0 = forced_0, y_k = factor y_k-1 + forced_k along each row (mode; |factor| < 1):
-    ``stochastic.ar1_filter`` with the complex factors, in blocks, without a loop over the
-    samples."""
-    return ar1_filter(np.ascontiguousarray(forced.T), factor, overwrite=True).T
+def _interleaved(m: np.ndarray) -> np.ndarray:
+    """A complex matrix (k, modes) as a real one (k, 2 modes), the real and imaginary parts of
+    each mode side by side: for a real x (n, k), x @ result is the complex x @ m seen as
+    interleaved parts; for complex y (n, modes) seen so, result @ y.T is Re(m y^T) when m is
+    given conjugated."""
+    return np.ascontiguousarray(m).view(float)

@@ -115,9 +115,10 @@ def test_nhc_cut_in_complete_outages(tmp_path_factory):
 def test_initial_error_and_nominal_accuracy(tmp_path_factory, seeds):
     """Figures 1 and 2 on the chan_initial_error drive: settling from 100 m per axis, and the
     UKF/EKF RMS ratio on the same drive without the initial error."""
-    figures = chan.initial_error_figures(run_experiment(
-        chan.INITIAL_ERROR, seeds, tmp_path_factory.mktemp("chan_initial")))
-    ukf, ekf, ratios = figures["ukf_settle"], figures["ekf_settle"], figures["ratio"]
+    table = run_experiment(chan.INITIAL_ERROR, seeds, tmp_path_factory.mktemp("chan_initial"))
+    ukf = table["tc_ukf_init.settle_s"].to_numpy()
+    ekf = table["tc_ekf_init.settle_s"].to_numpy()
+    ratios = (table["tc_ukf.rms_3d_m"] / table["tc_ekf.rms_3d_m"]).to_numpy()
     print("settling below 10 m (s): UKF", ukf, "EKF", ekf)
     print(f"nominal RMS ratio UKF/EKF: median {np.median(ratios):.3f}, "
           f"[{min(ratios):.3f}, {max(ratios):.3f}]")

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from estimators.base import InitialState
+from estimators.builtin import park2019_ins
 from estimators.builtin.park2019_ins import ParkInsOdometer
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
@@ -127,3 +128,36 @@ def test_the_antenna_lever_arm_is_taken_from_the_datasheet(tmp_path):
         errors.append(float(np.sqrt(np.mean(d_n**2 + d_e**2))))
     print(f"horizontal RMS with the lever arm {errors[0]:.3f} m, without {errors[1]:.3f} m")
     assert errors[0] < 0.1 and errors[1] > 0.5, errors
+
+
+def test_odometer_period_spaces_the_odometer_updates(tmp_path, monkeypatch):
+    """``odometer_period``: with 0 every 10 Hz odometer sample is an update, with 1 s one per
+    second (the GPS rate); counted at the odometer measurement model."""
+    data = {"name": "odo", "seed": 1, "vehicle": "rigid",
+            "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5, "lon": 127.0, "alt": 40.0,
+                      "heading": 0.0},
+            "trajectory": {"kind": "segments", "segments": [
+                {"accelerate": {"to_speed": 10.0, "accel": 1.0}}, {"straight": {"length": 200}}]},
+            "sensors": {"imu": {"preset": "ideal", "rate": 100},
+                        "odometer": {"preset": "ideal", "rate": 10},
+                        "gnss": {"preset": "ideal", "rate": 1, "outputs": ["fix"]}}}
+    scenario = Scenario(tmp_path / "odo.yaml", validate_data(data, "odo.yaml"), [])
+    ds = open_dataset(generate_dataset(scenario, tmp_path / "odo", show_progress=False))
+    calls = []
+    original = park2019_ins.aiding.odometer
+
+    def counted(*args, **kwargs):
+        calls.append(1)
+        return original(*args, **kwargs)
+
+    monkeypatch.setattr(park2019_ins.aiding, "odometer", counted)
+    counts = []
+    for period in (0.0, 1.0):
+        calls.clear()
+        run_estimator(ds, {"name": "ins_odo_ekf", "config": {"tuning": "paper",
+                                                              "odometer_period": period}},
+                      show_progress=False)
+        counts.append(len(calls))
+    duration = ds.read("odometer")["t"].iloc[-1] - ds.read("odometer")["t"].iloc[0]
+    assert counts[0] == pytest.approx(10 * duration, abs=2)
+    assert counts[1] == pytest.approx(duration, abs=2)

@@ -1,9 +1,10 @@
 """Tan et al. 2008 (``ins_lkf``) on its 70 s outage (``scenarios/tan2008_outage.yaml``), paired
-per seed: the velocity (NHC) and height constraints cut the horizontal
-error at the end of the outage by at least 30 % against the same filter without them, and the
-calibrated magnetometer heading does not make it worse by more than 10 % (issue 14). The default run
-cuts the drive 20 s after the outage (the claim is about the outage's end) and takes seeds 1-3;
-``--runslow`` adds the ten seeds on the cut drive and on the full 12-minute drive."""
+per seed through the reproduction's experiment (``simulator.reproduce.tan2008``): the velocity
+(NHC) and height constraints reduce the horizontal error at the end of the outage against the
+same filter without them (the paper's claim as it states it, no magnitude printed), and the
+unaided open-loop solution drifts far beyond GPS noise. The CI run takes three seeds on the
+drive cut 20 s after the outage; ``--runslow`` judges the claim by the report's rule on ten
+seeds."""
 
 from __future__ import annotations
 
@@ -11,46 +12,35 @@ import numpy as np
 import pytest
 
 from simulator.reproduce import tan2008
-from simulator.reproduce.measures import spread_text as spread
-from simulator.reproduce.runner import run_experiment
-from tests.conftest import seed_sets
-
-SEEDS = range(1, 11)
+from simulator.reproduce.runner import judge, run_experiment
 
 
-def _end_errors(quick: bool, work, seeds=SEEDS) -> dict[str, np.ndarray]:
-    """The outage-end error of each configuration per seed (``simulator.reproduce.tan2008``;
-    ``quick``: the drive cut 20 s after the outage)."""
-    table = run_experiment(tan2008.OUTAGE, seeds, work, quick=quick)
-    return {label: table[f"{label}.end_horizontal_m"].to_numpy() for label in
-            tan2008.OUTAGE.entries}
+@pytest.fixture(scope="module")
+def short_runs(tmp_path_factory):
+    return run_experiment(tan2008.OUTAGE, range(1, 4), tmp_path_factory.mktemp("tan"),
+                          quick=True)
 
 
-def _check(end: dict[str, np.ndarray]) -> None:
-    cut = 1.0 - end["constraints"] / end["free"]
-    mag = end["full"] / end["constraints"]
-    print(f"end-of-outage error, m: free {spread(end['free'])}, constraints "
-          f"{spread(end['constraints'])}, with magnetometer {spread(end['full'])}")
-    print(f"cut by NHC + height: {spread(cut)}; magnetometer ratio: {spread(mag)}")
-    assert np.median(cut) >= 0.30, f"constraints cut the end error by {spread(cut)}"
-    assert np.median(mag) <= 1.10, f"magnetometer aiding ratio {spread(mag)}"
-
-
-@pytest.fixture(scope="module", params=seed_sets(SEEDS))
-def short_runs(request, tmp_path_factory) -> dict[str, np.ndarray]:
-    return _end_errors(True, tmp_path_factory.mktemp("tan"), request.param)
-
-
-def test_constraints_and_magnetometer_on_the_70_s_outage(short_runs):
-    _check(short_runs)
+def test_constraints_reduce_the_outage_end_error_on_every_seed(short_runs):
+    constrained = short_runs["constraints.end_horizontal_m"].to_numpy()
+    free = short_runs["free.end_horizontal_m"].to_numpy()
+    assert np.all(constrained < free), (constrained, free)
 
 
 def test_outage_error_is_that_of_the_open_loop_ins_without_aiding(short_runs):
     """Without aiding, the open-loop error estimate is never updated in the outage: the output
     is the free inertial solution, which drifts far more than GPS noise over 70 s."""
-    assert np.all(short_runs["free"] > 10.0)
+    assert np.all(short_runs["free.end_horizontal_m"] > 10.0)
+
+
+def test_the_outage_is_70_s_of_driving(short_runs):
+    """The scorer's outage distance: 70 s at the scenario's 8-12 m/s with a turn."""
+    distance = short_runs["outage.distance_m"].to_numpy()
+    assert np.all((distance > 70 * 7.0) & (distance < 70 * 12.5)), distance
 
 
 @pytest.mark.slow
-def test_constraints_and_magnetometer_full_length(tmp_path):
-    _check(_end_errors(False, tmp_path))
+def test_constraints_claim_is_shown_on_ten_seeds(tmp_path):
+    table = run_experiment(tan2008.OUTAGE, range(1, 11), tmp_path, quick=True)
+    verdict = judge(tan2008.PAPER, {"outage": table})["constraints_reduce_outage_error"]
+    assert verdict.status == "shown", verdict.reason

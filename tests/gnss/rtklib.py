@@ -6,6 +6,7 @@ at a given position), its solutions and the double-difference residuals it write
 
 from __future__ import annotations
 
+import datetime as dt
 import shutil
 import subprocess
 from pathlib import Path
@@ -25,15 +26,74 @@ def need_rnx2rtkp() -> str:
     return path
 
 
-def kinematic(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path
-              ) -> dict[str, np.ndarray]:
+def code_observations(path: Path, rx_xyz_m: np.ndarray, start_gpst: dt.datetime,
+                      seconds: np.ndarray, sats: list[tuple[str, int]],
+                      pseudorange_m: np.ndarray, glonass_channels: dict[int, int]) -> None:
+    """A minimal RINEX 3.04 observation file for single-point tests: one code observable per
+    system (C1C, BeiDou C2I), epochs ``start_gpst`` + ``seconds``, row i of ``pseudorange_m``
+    for satellite ``sats[i]``, the GLONASS slots' channels in GLONASS SLOT / FRQ #."""
+    def label(text: str, name: str) -> str:
+        return f"{text:<60}{name}"
+
+    lines = [label("     3.04           OBSERVATION DATA    M", "RINEX VERSION / TYPE"),
+             label("landnav", "PGM / RUN BY / DATE"), label("TEST", "MARKER NAME"),
+             label("".join(f"{x:14.4f}" for x in rx_xyz_m), "APPROX POSITION XYZ")]
+    lines += [label(f"{s}    1 {'C2I' if s == 'C' else 'C1C'}", "SYS / # / OBS TYPES")
+              for s in "GERJC"]
+    slots = [(n, glonass_channels[n]) for s, n in sats if s == "R"]
+    lines += [label(f"{len(slots):3d} " + "".join(f"R{n:02d} {k:2d} " for n, k in slots),
+                    "GLONASS SLOT / FRQ #"), label("", "END OF HEADER")]
+    for k, sec in enumerate(seconds):
+        at = start_gpst + dt.timedelta(seconds=float(sec))
+        lines.append(f"> {at.year:4d} {at.month:02d} {at.day:02d} {at.hour:02d} "
+                     f"{at.minute:02d}{at.second + at.microsecond / 1e6:11.7f}  0{len(sats):3d}")
+        lines += [f"{s}{n:02d}{pseudorange_m[i, k]:14.3f}  " for i, (s, n) in enumerate(sats)]
+    path.write_text("\n".join(lines) + "\n")
+
+
+def single_point(obs: Path, nav: Path, systems_mask: int = 61) -> dict[str, np.ndarray]:
+    """Run rnx2rtkp single-point on L1 without atmosphere (``pos1-navsys`` = ``systems_mask``,
+    61: GPS, Galileo, QZSS, BeiDou, GLONASS) and read its status file: ``pos`` (epochs solved,
+    ECEF m), ``clock`` ($CLK: receiver clock and inter-system biases, ns) and ``sat`` ($SAT
+    rows as text fields: tow, sat, az, el, code residual, ...)."""
+    exe = need_rnx2rtkp()
+    conf = obs.with_suffix(".conf")
+    conf.write_text("pos1-posmode=single\npos1-frequency=l1\npos1-elmask=5\npos1-ionoopt=off\n"
+                    f"pos1-tropopt=off\npos1-navsys={systems_mask}\nout-solformat=xyz\n")
+    out = obs.with_suffix(".pos")
+    subprocess.run([exe, "-k", str(conf), "-y", "2", "-o", str(out), str(obs), str(nav)],
+                   check=True, capture_output=True, timeout=600)
+    status = Path(str(out) + ".stat").read_text().splitlines()
+    pos = np.array([[float(x) for x in line.split(",")[4:7]] for line in status
+                    if line.startswith("$POS") and line.split(",")[3] != "0"]).reshape(-1, 3)
+    clock = np.array([[float(x) for x in line.split(",")[5:9]] for line in status
+                      if line.startswith("$CLK")]).reshape(-1, 4)
+    sat = [line.split(",") for line in status if line.startswith("$SAT")]
+    return {"pos": pos, "clock": clock, "sat": sat}
+
+
+SYSTEM_MASKS = {"G": 1, "R": 4, "E": 8, "J": 16, "C": 32}  # RTKLIB's pos1-navsys bits
+
+
+def kinematic(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path,
+              systems: str | None = None) -> dict[str, np.ndarray]:
     """Run rnx2rtkp kinematic (``-p 2 -f 2 -m 15 -h -v 3 -e -y 2 -r X Y Z``) and read the
     solution: ``tow`` (s), ``xyz`` (n, 3, m), ``q`` (1 fixed, 2 float), and the residual lines
     ``sat`` as a dict of arrays (tow, frequency 1/2, elevation deg, code and carrier residual m,
-    valid) restricted to the fixed epochs."""
+    valid) restricted to the fixed epochs. ``systems`` (RINEX letters, e.g. ``"GEC"``) goes
+    to ``pos1-navsys`` in an options file (rnx2rtkp 2.4.3's ``-sys`` falls through its switch
+    and enables every later system); without it, rnx2rtkp's default GPS + GLONASS. The other
+    options are RTKLIB's defaults: frequency index 2 is GPS L2, Galileo E5b, BeiDou B2I."""
     exe = need_rnx2rtkp()
-    cmd = [exe, "-p", "2", "-f", "2", "-m", "15", "-h", "-v", "3", "-e", "-y", "2", "-r",
-           *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base), str(nav)]
+    options = []
+    if systems is not None:
+        conf = Path(str(out) + ".conf")
+        conf.write_text(f"pos1-navsys={sum(SYSTEM_MASKS[s] for s in systems)}\n"
+                        "out-timeform=tow\n")  # an options file resets rnx2rtkp's own
+        options = ["-k", str(conf)]
+    cmd = [exe, *options, "-p", "2", "-f", "2", "-m", "15", "-h", "-v", "3", "-e", "-y", "2",
+           "-r", *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base),
+           str(nav)]
     subprocess.run(cmd, check=True, capture_output=True, timeout=600)
     rows = [line.split() for line in out.read_text().splitlines()
             if line and not line.startswith("%")]
@@ -59,3 +119,19 @@ def residual_std_by_band(sat: dict[str, np.ndarray], frequency: int, kind: str) 
         sel = (sat["frequency"] == frequency) & (sat["elevation"] >= lo) & (sat["elevation"] < hi)
         out.append(np.std(sat[kind][sel]) if sel.sum() > 2 else np.nan)
     return np.array(out)
+
+
+def kinematic_solution(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path
+                       ) -> float:
+    """Run rnx2rtkp kinematic with the options of ``kinematic`` (``-p 2 -f 2 -m 15 -h``,
+    the base at ``base_xyz``), writing its latitude-longitude-height solution to ``out`` (a
+    ``.pos`` file ``landnav score`` reads); returns the CPU seconds rnx2rtkp took."""
+    import resource
+
+    exe = need_rnx2rtkp()
+    cmd = [exe, "-p", "2", "-f", "2", "-m", "15", "-h", "-r",
+           *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base), str(nav)]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    subprocess.run(cmd, check=True, capture_output=True, timeout=1800)
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)

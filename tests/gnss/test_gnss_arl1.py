@@ -54,6 +54,11 @@ ARL1 = StaticHour("ARL1", FOLDER, "arlm200a.15n", "arlm200a.15o", "P1", ARL1_XYZ
 GSI0759 = StaticHour("GSI 0759", REFDATA / "gsi0759_2005-04-02_rtklib", "07590920.05n",
                      "07590920.05o", "C1",
                      np.array([-3976219.1454, 3382371.6073, 3652511.1964]), 1316, 518400.0)
+# refdata 1d: GEONET station 3040 (Trimble 5700), the same hour 3.3 km away, at RTKLIB's static
+# solution of the 0759-3040 baseline (refdata README 1d); C1 code, no Doppler
+GSI3040 = StaticHour("GSI 3040", REFDATA / "gsi3040_2005-04-02_rtklib", "30400920.05n",
+                     "30400920.05o", "C1",
+                     np.array([-3978241.9164, 3382840.2376, 3649900.9086]), 1316, 518400.0)
 
 
 def residuals(obs: pd.DataFrame, nav: pd.DataFrame, rx: np.ndarray,
@@ -305,3 +310,25 @@ def test_residual_std_by_elevation_within_30_percent_of_arl1():
     print("\nresidual std by elevation band, real:", np.round(real, 2), "geodetic:",
           np.round(sims, 2))
     assert np.all(np.abs(sims.mean(axis=0) / real - 1.0) < 0.3)
+
+
+def test_residual_std_by_elevation_within_the_span_of_three_real_stations():
+    """The earlier ARL1 criterion, decided over three stations (one hour of one station samples
+    that hour's broadcast errors and its own multipath, so one station is no reference): the
+    geodetic preset's pseudorange residual std per elevation band, the mean over sixteen seeds
+    at each station's own position, hour and broadcast file, lies within the span of the three
+    real stations' (ARL1 2015, GEONET 0759 and 3040 2005, one and the same procedure) widened
+    by 30 % (from 0.7 x the lowest to 1.3 x the highest station)."""
+    stations = (ARL1, GSI0759, GSI3040)
+    real = np.array([std_by_elevation(residuals(real_observations(h), navigation(h), h.xyz,
+                                                week=h.week)) for h in stations])
+    low, high = 0.7 * real.min(axis=0), 1.3 * real.max(axis=0)
+    sim = np.array([np.mean([std_by_elevation(residuals(simulated(h, "geodetic", seed),
+                                                        navigation(h), h.xyz, week=h.week))
+                             for seed in SEEDS], axis=0) for h in stations])
+    for h, r, m in zip(stations, real, sim, strict=True):
+        print(f"\n{h.name}: real {np.round(r, 2)} m, geodetic (mean of {len(SEEDS)} seeds) "
+              f"{np.round(m, 2)} m")
+    print(f"span widened by 30 %: {np.round(low, 2)} - {np.round(high, 2)} m "
+          f"(bands {ELEVATION_BINS_DEG} deg)")
+    assert np.all((sim >= low) & (sim <= high)), (sim, low, high)

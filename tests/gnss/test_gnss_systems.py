@@ -36,6 +36,7 @@ from simulator.gnss.ephemeris import (
 from simulator.gnss.glonass import SLOT_CHANNELS
 from simulator.gnss.navfiles import read_rinex_nav
 from simulator.timebase import GPS_EPOCH
+from tests.gnss.rtklib import code_observations, need_rnx2rtkp, single_point
 
 FOLDER = REF / "gnss/multignss_2023-03-14_gnss_lib_py"
 NAV = "BRDM00DLR_S_20230730000_01D_MN.rnx"
@@ -268,30 +269,6 @@ def test_beidou_geo_and_qzss_orbits_behave_as_their_orbits_must():
         assert len(pairs) == 4 and jump.max() < 1.0
 
 
-def _rinex3_observations(path, rx: np.ndarray, t: np.ndarray, sats: list[tuple[str, int]],
-                         pseudorange: np.ndarray) -> None:
-    """A minimal RINEX 3.04 observation file: one code observable per system (C1C, BeiDou
-    C2I), epochs ``t`` (GPS seconds of week 2253, on 2023-03-14), rows of ``pseudorange``
-    per satellite of ``sats``."""
-    def label(text: str, name: str) -> str:
-        return f"{text:<60}{name}"
-
-    lines = [label("     3.04           OBSERVATION DATA    M", "RINEX VERSION / TYPE"),
-             label("landnav", "PGM / RUN BY / DATE"), label("TEST", "MARKER NAME"),
-             label("".join(f"{x:14.4f}" for x in rx), "APPROX POSITION XYZ")]
-    lines += [label(f"{s}    1 {'C2I' if s == 'C' else 'C1C'}", "SYS / # / OBS TYPES")
-              for s in "GERJC"]
-    slots = [(n, SLOT_CHANNELS[n]) for s, n in sats if s == "R"]
-    lines += [label(f"{len(slots):3d} " + "".join(f"R{n:02d} {k:2d} " for n, k in slots),
-                    "GLONASS SLOT / FRQ #"), label("", "END OF HEADER")]
-    for k, tow in enumerate(t):
-        sec = tow - 172800.0  # seconds into 2023-03-14
-        lines.append(f"> 2023 03 14 {int(sec // 3600):02d} {int(sec % 3600 // 60):02d}"
-                     f"{sec % 60:11.7f}  0{len(sats):3d}")
-        lines += [f"{s}{n:02d}{pseudorange[i, k]:14.3f}  " for i, (s, n) in enumerate(sats)]
-    path.write_text("\n".join(lines) + "\n")
-
-
 def test_rtklib_positions_from_landnav_orbits_and_clocks(tmp_path):
     """RTKLIB (Debian rtklib 2.4.3, its own orbit and clock code for every system) solves
     single-point positions from pseudoranges that are exactly landnav's geometry and broadcast
@@ -301,15 +278,11 @@ def test_rtklib_positions_from_landnav_orbits_and_clocks(tmp_path):
     0.05 ns, so its orbits, clocks and group delays agree with landnav's to millimetres (a
     GEO computed without the -5 deg rotation would be 3000 km off); its azimuths and elevations
     agree within its printed 0.1 deg."""
-    import shutil
-    import subprocess
-
     from simulator.earth import geodetic_to_ecef
     from simulator.gnss.ephemeris import STATE_KEYS
     from simulator.gnss.receiver import look_angles, signal_geometry
 
-    if shutil.which("rnx2rtkp") is None:
-        pytest.skip("RTKLIB's rnx2rtkp is not installed (Debian package rtklib)")
+    need_rnx2rtkp()
     nav_path = _need(FOLDER / NAV)
     eph = ephemeris_arrays(read_rinex_nav(nav_path), WEEK)
     sats = [("C", 1), ("C", 2), ("E", 2), ("G", 2), ("J", 2), ("J", 3), ("R", 1), ("R", 2)]
@@ -323,19 +296,11 @@ def test_rtklib_positions_from_landnav_orbits_and_clocks(tmp_path):
     geo = signal_geometry(gather(eph, idx, STATE_KEYS), t, np.tile(rx, (len(t), 1)),
                           np.zeros((len(t), 3)))
     look = look_angles(geo["los"], geo["los_rate"], np.full(len(t), lat), np.full(len(t), lon))
-    _rinex3_observations(tmp_path / "obs.rnx", rx, t, sats,
-                         geo["range"] - C_M_S * geo["clock_s"])
-    (tmp_path / "opt.conf").write_text(
-        "pos1-posmode=single\npos1-frequency=l1\npos1-elmask=5\npos1-ionoopt=off\n"
-        "pos1-tropopt=off\npos1-navsys=61\nout-solformat=xyz\n")
-    subprocess.run(["rnx2rtkp", "-k", "opt.conf", "-y", "2", "-o", "out.pos", "obs.rnx",
-                    str(nav_path)], cwd=tmp_path, check=True, capture_output=True)
-    status = (tmp_path / "out.pos.stat").read_text().splitlines()
-    positions = np.array([[float(x) for x in line.split(",")[4:7]] for line in status
-                          if line.startswith("$POS") and line.split(",")[3] != "0"])
-    clocks = np.array([[float(x) for x in line.split(",")[5:9]] for line in status
-                       if line.startswith("$CLK")])
-    sat_rows = [line.split(",") for line in status if line.startswith("$SAT")]
+    week_start = GPS_EPOCH + dt.timedelta(weeks=WEEK)
+    code_observations(tmp_path / "obs.rnx", rx, week_start, t, sats,
+                      geo["range"] - C_M_S * geo["clock_s"], SLOT_CHANNELS)
+    solved = single_point(tmp_path / "obs.rnx", nav_path)
+    positions, clocks, sat_rows = solved["pos"], solved["clock"], solved["sat"]
     assert len(positions) >= len(t) - 1  # RTKLIB leaves its first epoch unsolved
     error = np.linalg.norm(positions - rx, axis=1)
     print(f"\nRTKLIB from landnav's pseudoranges: position within {error.max() * 1e3:.1f} mm, "

@@ -1,5 +1,6 @@
 """What every hostile case asserts: exit 2, one message with the words expected, no traceback,
-and the watched folders unchanged (every path with its size and modification time)."""
+and the watched folders unchanged (every path with its size and modification time); and
+whether a process is still alive (``alive``)."""
 
 from __future__ import annotations
 
@@ -32,3 +33,12 @@ def refused(args: list[str], capsys, watch: list[Path], words: str,
     assert len(errors) == 1, text
     assert {str(w): tree(w) for w in watch} == before
     return text
+
+
+def alive(pid: int) -> bool:
+    """Whether process ``pid`` runs (a zombie, ended and waiting to be reaped, does not)."""
+    try:
+        state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import signal
 import sys
 import time
 
@@ -87,3 +88,18 @@ class NeverReturns(_Base):
     def on_imu(self, t, row):
         while True:
             time.sleep(0.01)
+
+
+class Holds(_Base):
+    """A well-behaved plug-in (it holds its initial state), light to import."""
+
+
+class KillsItsWorker(_Base):
+    """With ``config["kill"]``, kills the process it runs in at its first IMU message, as the
+    out-of-memory killer would kill a campaign's worker mid-run."""
+
+    defaults = {"kill": False}
+
+    def on_imu(self, t, row):
+        if self.config["kill"]:
+            os.kill(os.getpid(), signal.SIGKILL)

@@ -4,6 +4,7 @@ and in little memory, with nothing written."""
 
 from __future__ import annotations
 
+import os
 import tracemalloc
 from pathlib import Path
 
@@ -12,7 +13,14 @@ import yaml
 
 from simulator.cli import main
 from simulator.errors import InputError
-from simulator.scenario.yamlio import MAX_DEPTH, MAX_NODES, apply_overrides, read_yaml
+from simulator.scenario.yamlio import (
+    MAX_DEPTH,
+    MAX_FILE_BYTES,
+    MAX_NODES,
+    apply_overrides,
+    read_yaml,
+)
+from tests.reliability.checks import refused
 from tests.reliability.drives import straight_drive
 
 GOOD_HEAD = straight_drive(100)
@@ -145,3 +153,38 @@ def test_unbounded_job_refused_with_advice(tmp_path, capsys):
     text = GOOD_HEAD + "    - stop: {duration: '1e7 s'}\n"
     message = _validate(tmp_path, text, capsys)
     assert "trajectory:" in message and "split it into drives" in message
+
+
+def _fifo(path: Path) -> Path:
+    os.mkfifo(path)
+    return path
+
+
+def _zero_link(path: Path) -> Path:
+    path.symlink_to("/dev/zero")
+    return path
+
+
+def _sparse(path: Path) -> Path:
+    with path.open("wb") as f:
+        f.truncate(MAX_FILE_BYTES + 1)  # no blocks: a size, not data
+    return path
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo") or not Path("/dev/zero").exists(),
+                    reason="needs named pipes and /dev/zero")
+@pytest.mark.parametrize("make, words", [
+    (_fifo, "not a regular file"),  # read, it would wait for a writer without end
+    (_zero_link, "not a regular file"),  # read, it would fill the memory
+    (_sparse, "larger than a scenario may be"),
+    (lambda p: p.mkdir() or p, "not a regular file"),
+])
+@pytest.mark.parametrize("command", ["validate", "run", "campaign"])
+def test_a_scenario_that_is_no_regular_file_is_refused_unread(tmp_path, capsys, make, words,
+                                                              command):
+    path = make(tmp_path / "s.yaml")
+    args = {"validate": ["validate", str(path)],
+            "run": ["run", str(path), "-o", str(tmp_path / "out")],
+            "campaign": ["campaign", str(path), "--runs", "1", "-o", str(tmp_path / "out")]}
+    refused(args[command], capsys, [tmp_path], words,
+            prefix=str(path) if command == "validate" else "error:")

@@ -1,0 +1,65 @@
+"""rtk_ins_ekf (tightly coupled RTK/INS) against the truth and against RTKLIB's rnx2rtkp
+kinematic solution of the same measurements (the dataset exported as RINEX), on the shipped
+scenario rtk_open_road.yaml: 20 minutes of open road, two 30 s tunnels, a base 5 km east of the
+start, GPS L1 C/A + L2C at 10 Hz (GPS only: Galileo and BeiDou, which the export now writes
+for RTKLIB, triple the filter's states and have not been run through it yet).
+
+Claims (docs/rtk-ins.md): at least 95 % of the epochs fixed, a fixed-solution 3-D RMS of at most
+3 cm, under 1 % wrong fixes (3-D error over 10 cm), at least RTKLIB's fix rate; after each tunnel
+a re-fix faster than RTKLIB's (median over the tunnels) in at least 8 of 10 seeds; the position's
+mean (error / sigma)^2 per axis in 0.3-3 (seed mean) and none above 10 (SPEC section 8's
+consistency, after 60 s). CI runs a few minutes of the same road (one tunnel) at one seed; the
+ten 20-minute seeds run with --runslow."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.gnss.rtklib import need_rnx2rtkp
+from tests.rtk_drive import median_refix, process
+
+AXES = ("n", "e", "d")
+
+
+def _check_seed(fig: dict) -> None:
+    ours, theirs = fig["rtk_ins_ekf"], fig["rtklib"]
+    print(f"\nseed {fig['seed']}: rtk_ins_ekf {ours}\n  rtklib {theirs}\n  cpu {fig['cpu_s']}")
+    assert ours["fix_rate"] >= 0.95
+    assert ours["fixed_rms"] <= 0.03
+    assert ours["wrong_fix_rate"] < 0.01
+    nse = fig["consistency"]["position"]["nse"]
+    assert all(nse[a] <= 10.0 for a in AXES), nse
+
+
+@pytest.fixture(scope="module")
+def short_drive(tmp_path_factory):
+    need_rnx2rtkp()
+    return process(tmp_path_factory.mktemp("rtk_short"), seed=1, short=True)
+
+
+def test_short_drive_fixes_precisely_and_refixes_before_rtklib(short_drive):
+    _check_seed(short_drive)
+    assert median_refix(short_drive["rtk_ins_ekf"]) < median_refix(short_drive["rtklib"])
+    nse = short_drive["consistency"]["position"]["nse"]
+    assert all(0.3 <= nse[a] <= 3.0 for a in AXES), nse
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(reason="not shown on the 20-minute drive: seed 1 holds a fixed solution whose "
+                          "error grows to 5-7 cm (3-D RMS 4.2 cm, 1.03 % of fixes over 10 cm; "
+                          "RTKLIB 2.8 cm, 99.85 % fixed against 99.1 %; docs/rtk-ins.md)",
+                   strict=False)
+def test_ten_seeds_of_twenty_minutes(tmp_path):
+    need_rnx2rtkp()
+    figures = [process(tmp_path, seed, short=False) for seed in range(1, 11)]
+    for fig in figures:
+        _check_seed(fig)
+    ours = np.array([f["rtk_ins_ekf"]["fix_rate"] for f in figures])
+    theirs = np.array([f["rtklib"]["fix_rate"] for f in figures])
+    print(f"fix rate: rtk_ins_ekf {ours.round(4)}, rtklib {theirs.round(4)}")
+    assert ours.mean() >= theirs.mean()
+    faster = [median_refix(f["rtk_ins_ekf"]) < median_refix(f["rtklib"]) for f in figures]
+    assert sum(faster) >= 8
+    nse = {a: np.mean([f["consistency"]["position"]["nse"][a] for f in figures]) for a in AXES}
+    assert all(0.3 <= nse[a] <= 3.0 for a in AXES), nse

@@ -1,0 +1,78 @@
+"""A file system that fills up while a command writes: exit 2, one message, nothing of the output
+left (no ``.NAME.tmp``, no half-written file), the inputs unchanged, the temporary folder empty.
+
+The full disk is stood in for by the file-size limit (``RLIMIT_FSIZE``, set with
+``resource.setrlimit`` in the command's own process, ``SIGXFSZ`` ignored): a write that would
+pass it fails with ``OSError`` (``EFBIG``) at the write call, as one on a full disk fails with
+``ENOSPC``, through the same code. A small file system of its own (tmpfs, a loop device) would
+need root, which CI lacks; a writer patched to fail would not exercise the real writers (pyarrow,
+matplotlib, the isolated estimator's answer)."""
+
+from __future__ import annotations
+
+import os
+import resource
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from tests.reliability.checks import tree
+from tests.reliability.drives import shared_dataset, straight_drive  # noqa: F401 (fixture)
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def _landnav_on_a_full_disk(args: list[str], cwd: Path, max_file_bytes: int
+                            ) -> subprocess.CompletedProcess:
+    """``landnav ARGS`` in a process whose files cannot grow past ``max_file_bytes``; its
+    temporary folder is ``cwd/tmp``."""
+    def cap() -> None:
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (max_file_bytes, max_file_bytes))
+
+    (cwd / "tmp").mkdir()
+    env = {**os.environ, "PYTHONPATH": str(REPO), "TMPDIR": str(cwd / "tmp")}
+    return subprocess.run([sys.executable, "-m", "simulator.cli", *args], cwd=cwd, env=env,
+                          preexec_fn=cap, capture_output=True, text=True, timeout=600)
+
+
+SLOW = pytest.mark.slow  # each case about 4 s of CPU (a landnav process); two run by default
+CASES = {
+    "generate": (lambda ds: ["generate", "s.yaml", "-o", "out"], 20_000),
+    "run": (lambda ds: ["run", "s.yaml", "-o", "out"], 20_000),
+    "estimate": (lambda ds: ["estimate", str(ds), "-e", "dead_reckoning", "-o", "out.parquet"],
+                 2_000),
+    "estimate a plug-in": (lambda ds: ["estimate", str(ds), "-e",
+                                       "tests.reliability.hostile_plugins:Holds", "-o",
+                                       "out.parquet"], 2_000),
+    "report": (lambda ds: ["score", str(ds), "--solution", "sol.parquet", "--report", "out",
+                           "--json", "out.json"], 20_000),  # both or neither
+}
+
+
+@pytest.mark.skipif(not hasattr(resource, "RLIMIT_FSIZE"), reason="needs RLIMIT_FSIZE")
+@pytest.mark.parametrize("case", [pytest.param(c, marks=SLOW) if c in ("run", "estimate", "report")
+                                  else c for c in CASES])
+def test_a_full_disk_leaves_nothing_and_one_message(dataset, tmp_path, case):
+    args, limit = CASES[case]
+    if case == "report":
+        from simulator.cli import main
+
+        assert main(["estimate", str(dataset), "-e", "dead_reckoning", "-o",
+                     str(tmp_path / "sol.parquet")]) == 0
+    (tmp_path / "s.yaml").write_text(straight_drive(
+        100, sensors="  imu: {preset: ideal, rate: 50}\n",
+        tail="estimators: [{name: 'tests.reliability.hostile_plugins:Holds'}]\n"))
+    before = {"cwd": tree(tmp_path), "dataset": tree(dataset.parent)}
+    done = _landnav_on_a_full_disk(args(dataset), tmp_path, limit)
+    assert done.returncode == 2, done.stderr
+    assert "Traceback" not in done.stderr
+    assert [line for line in done.stderr.splitlines() if line.strip()] == [
+        done.stderr.strip()], done.stderr
+    assert done.stderr.startswith("error: ") and "File too large" in done.stderr
+    assert list((tmp_path / "tmp").iterdir()) == []
+    (tmp_path / "tmp").rmdir()
+    assert {"cwd": tree(tmp_path), "dataset": tree(dataset.parent)} == before

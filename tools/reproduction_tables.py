@@ -1,0 +1,131 @@
+"""Write the claims tables of the per-paper reproduction pages from a ``landnav reproduce`` run's
+results.json, so the pages' figures are those of the report run.
+
+Each page (docs/reproduction_PAPER.md) holds a block between the lines
+``<!-- claims: PAPER -->`` and ``<!-- end of claims -->``; this script replaces the block by
+the run's table of that paper's claims (the paper's claims, the claims under other values of a
+deciding condition, landnav's checks), headed by the run's software, commit and seeds. A block
+between ``<!-- summary -->`` and ``<!-- end of summary -->`` (docs/reproduction.md) gets the
+run's summary: per paper its claims and landnav's checks by word, counted apart.
+
+Usage::
+
+    python tools/reproduction_tables.py RUN/results.json docs/reproduction_cho2006.md ...
+
+A page without a block is left as it is and named; exit status 1 then, 0 otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+from pathlib import Path
+
+START = "<!-- claims: {paper} -->"
+END = "<!-- end of claims -->"
+
+
+def _cell(text: str) -> str:
+    return " ".join(str(text).split()).replace("|", "\\|")
+
+
+def _evidence(claim: dict) -> str:
+    e = claim["evidence"]
+    if e is None:
+        return "none"
+    unit = f" {e['unit']}" if e["unit"] else ""
+    kind = {"difference": "median paired difference", "ratio": "median paired ratio",
+            "value": "median value"}[e["kind"]]
+
+    def number(x: float | None) -> str:
+        return "none" if x is None else f"{x:.3g}"
+
+    extras = "".join([f", {e['ties']} ties" if e["ties"] else "",
+                      f", {e['missing']} without a value" if e["missing"] else ""])
+    return (f"{e['wins']} of {e['n']} seeds in the paper's direction{extras}; "
+            f"{kind} {number(e['effect'])}{unit} (95 % interval {number(e['ci_low'])} to "
+            f"{number(e['ci_high'])}{unit}); sign test p = {e['p_sign']:.3g}")
+
+
+def table(document: dict, paper: str) -> list[str]:
+    """The markdown lines of ``paper``'s claims in ``document`` (results.json)."""
+    claims = [c for c in document["claims"].values() if c["paper"] == paper]
+    seeds = document["seeds"]
+    lines = [f"Figures of `landnav reproduce` ({document['software']}; "
+             f"{'quick, ' if document['quick'] else ''}seeds {seeds[0]}-{seeds[-1]}, more "
+             "where an experiment asks for them), written from its results.json by "
+             "`tools/reproduction_tables.py`.", ""]
+    groups = (("The paper's claims", lambda c: c["kind"] == "paper" and not c["variant_of"]),
+              ("Under other values of a deciding condition", lambda c: bool(c["variant_of"])),
+              ("landnav's checks", lambda c: c["kind"] == "check" and not c["variant_of"]))
+    for title, keep in groups:
+        rows = [c for c in claims if keep(c)]
+        if not rows:
+            continue
+        lines += [f"**{title}**", "", "| claim | paper | landnav | evidence | word |",
+                  "|---|---|---|---|---|"]
+        for c in rows:
+            head = f"`{c['claim']}`" + (f" ({c['variant']})" if c["variant"] else "")
+            word = c["verdict"] + (f": {c['reason']}" if c["verdict"] == "not testable" else "")
+            lines.append("| " + " | ".join(_cell(x) for x in (
+                f"{head}: {c['statement']}", c["paper_figure"], c["measured"] or "none",
+                _evidence(c), f"**{word}**")) + " |")
+        lines.append("")
+    return lines
+
+
+def summary(document: dict) -> list[str]:
+    """The markdown lines of the run's summary: per paper its claims and landnav's checks by
+    word, counted apart."""
+    words = ("shown", "partly", "not shown", "not testable")
+    lines = [f"Summary of `landnav reproduce` ({document['software']}; "
+             f"{'quick, ' if document['quick'] else ''}seeds {document['seeds'][0]}-"
+             f"{document['seeds'][-1]}), written from its results.json by "
+             "`tools/reproduction_tables.py`.", "",
+             "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown |",
+             "|---|---|---|"]
+    for paper, counts in document["summary"]["per_paper"].items():
+        claims = " / ".join(str(counts["paper"].get(w, 0)) for w in words)
+        checks = " / ".join(str(counts["check"].get(w, 0)) for w in words[:3])
+        lines.append(f"| {paper} | {claims} | {checks} |")
+    return lines
+
+
+def rewrite(page: Path, document: dict) -> bool:
+    """Replace the claims blocks (and a summary block) of ``page``; False when it has
+    none."""
+    text = page.read_text(encoding="utf-8")
+    found = False
+    for match in reversed(list(re.finditer(r"<!-- claims: (\w+) -->\n.*?<!-- end of claims "
+                                           r"-->", text, re.S))):
+        paper = match.group(1)
+        block = "\n".join([START.format(paper=paper), *table(document, paper), END])
+        text = text[:match.start()] + block + text[match.end():]
+        found = True
+    match = re.search(r"<!-- summary -->\n.*?<!-- end of summary -->", text, re.S)
+    if match is not None:
+        block = "\n".join(["<!-- summary -->", *summary(document), "<!-- end of summary -->"])
+        text = text[:match.start()] + block + text[match.end():]
+        found = True
+    page.write_text(text, encoding="utf-8")
+    return found
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("results", type=Path)
+    parser.add_argument("pages", type=Path, nargs="+")
+    args = parser.parse_args(argv)
+    document = json.loads(args.results.read_text(encoding="utf-8"))
+    status = 0
+    for page in args.pages:
+        if not rewrite(page, document):
+            print(f"{page}: no '<!-- claims: PAPER -->' block", file=sys.stderr)
+            status = 1
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())
