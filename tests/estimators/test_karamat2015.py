@@ -1,10 +1,10 @@
-"""riss3d_tc_ekf (Karamat et al. 2015): the error model against numerical differentiation, the
-RISS mechanisation against the exact truth, and the paper's claims on its partial-outage
-protocol over ten seeds, computed by ``simulator/reproduce/karamat2015.py`` (what ``landnav
-reproduce karamat2015`` judges; figures in docs/reproduction_karamat2015.md). The protocol runs
-on the default automotive body (session 5: the filter mechanises the rear axle, where the
-odometer's velocity is along the body; on a rigid body the tight filter beat the loose one in
-24 of 30 windows). The mechanisation test compares with a rigid body's exact truth."""
+"""riss3d_tc_ekf (Karamat et al. 2015): the error model against numerical differentiation, the RISS
+mechanisation against the exact truth, and the paper's claims on its partial-outage protocol over
+seeds 1-3 (ten with ``--runslow``), computed by ``simulator/reproduce/karamat2015.py`` (what
+``landnav reproduce karamat2015`` judges; figures in docs/reproduction_karamat2015.md). The protocol
+runs on the default automotive body (session 5: the filter mechanises the rear axle, where the
+odometer's velocity is along the body; on a rigid body the tight filter beat the loose one in 24 of
+30 windows). The mechanisation test compares with a rigid body's exact truth."""
 
 from __future__ import annotations
 
@@ -24,6 +24,7 @@ from simulator.reproduce.measures import horizontal_error
 from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from simulator.scenario import load_scenario
+from tests.conftest import seed_sets
 
 RIGID = ["vehicle=rigid"]
 
@@ -101,11 +102,11 @@ THREE = replace(karamat.PROTOCOL, entries={k: karamat.PROTOCOL.entries[k]
                                            for k in ("tight", "loose", "simplified")})
 
 
-@pytest.fixture(scope="module")
-def protocol(tmp_path_factory):
-    """The shortened protocol (site 1, loops 1-4) for ten seeds, three variants each (the
-    reproduction's ablation variants left out: ``THREE``)."""
-    return run_experiment(THREE, SEEDS, tmp_path_factory.mktemp("karamat"), quick=True)
+@pytest.fixture(scope="module", params=seed_sets(SEEDS))
+def protocol(request, tmp_path_factory):
+    """The shortened protocol (site 1, loops 1-4), three variants each (the reproduction's
+    ablation variants left out: ``THREE``), for seeds 1-3 (the ten seeds with --runslow)."""
+    return run_experiment(THREE, request.param, tmp_path_factory.mktemp("karamat"), quick=True)
 
 
 def _maxima(protocol, label: str, count: int) -> np.ndarray:
@@ -121,21 +122,25 @@ def test_every_variant_is_a_working_filter(protocol):
             assert np.median(_maxima(protocol, label, count)) < 20.0, (label, count)
 
 
-@pytest.mark.parametrize("count", [
-    3, 2,
-    pytest.param(1, marks=pytest.mark.xfail(strict=True, reason=(
-        "not shown at one satellite: mean window maximum 13.1 m over the ten seeds (per seed "
-        "4.7-30.4 m, so the mean's sampling spread is about 2.6 m); 11.8 m before session 6's "
-        "signal-in-space change, which also changed every later random draw: the claim sat "
-        "within one sampling spread of its bound either way; docs/reproduction_karamat2015.md"))),
-    0,
-])
-def test_mean_window_maximum_under_12_m(protocol, count):
+ONE_SATELLITE_NOT_SHOWN = (
+    "not shown at one satellite: mean window maximum 13.1 m over the ten seeds (per seed "
+    "4.7-30.4 m, so the mean's sampling spread is about 2.6 m); 11.8 m before session 6's "
+    "signal-in-space change, which also changed every later random draw: the claim sat "
+    "within one sampling spread of its bound either way; docs/reproduction_karamat2015.md")
+
+
+@pytest.mark.parametrize("count", [3, 2, 1, 0])
+def test_mean_window_maximum_under_12_m(protocol, count, request):
     """Karamat et al. section 4.3.1: 'on average, the maximum position error is always less
     than 12 m, irrespective of the number of visible satellites' (measured means on the
     automotive body: 3.1, 5.9, 13.1, 10.2 m at 3, 2, 1, 0 satellites; session 5: 3.2, 5.6,
-    11.8, 9.8 m)."""
-    assert _maxima(protocol, "tight", count).mean() < 12.0
+    11.8, 9.8 m). At one satellite an expected failure over the ten seeds; seeds 1-3 draw a
+    mean under 12 m."""
+    if count == 1 and len(protocol) == len(SEEDS):
+        request.applymarker(pytest.mark.xfail(strict=True, reason=ONE_SATELLITE_NOT_SHOWN))
+    mean = _maxima(protocol, "tight", count).mean()
+    print(f"tight mean window maximum, {count} satellites, {len(protocol)} seeds: {mean:.1f} m")
+    assert mean < 12.0
 
 
 @pytest.mark.xfail(strict=True, reason="claim not reproduced: tight beats loose in 20 of the 30 "
@@ -145,7 +150,7 @@ def test_tight_beats_loose_with_one_to_three_satellites(protocol):
     """Issue 15: the tight filter beats ``coupling: loose`` (which has no GNSS below four
     satellites) in at least 80 % of the windows with 1-3 satellites, paired per seed."""
     wins, windows = karamat.window_wins(protocol, "tight", "loose", (1, 2, 3))
-    assert windows == 3 * len(SEEDS)
+    assert windows == 3 * len(protocol)
     assert wins >= 0.8 * windows
 
 
@@ -167,7 +172,7 @@ def test_gyro_bias_within_005_deg_s_by_300_s(protocol):
     """Karamat et al. section 4.3.3: the vertical-gyro bias converges in about 300 s (measured:
     the error at 300 s is at most 0.032 deg/s over the ten seeds)."""
     errors = protocol["tight.gyro_bias_error_300s_deg_s"].to_numpy()
-    assert len(errors) == len(SEEDS)
+    assert len(errors) == len(protocol)
     assert np.all(np.abs(errors) < 0.05)
 
 

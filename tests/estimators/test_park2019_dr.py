@@ -1,7 +1,8 @@
 """Park et al. 2019 dead-reckoning filters (``dr2d_odo_ekf``, ``dr3d_ekf``): the navigation
-processor against exact kinematics, the error model's Jacobians against finite differences, and
-the paper's garage claims over ten seeds (figures in docs/reproduction_park2019.md), computed
-by ``simulator.reproduce.park2019`` (what ``landnav reproduce park2019`` runs)."""
+processor against exact kinematics, the error model's Jacobians against finite differences, and the
+paper's garage claims over seeds 1-3 (ten with ``--runslow``; figures in
+docs/reproduction_park2019.md), computed by ``simulator.reproduce.park2019`` (what ``landnav
+reproduce park2019`` runs)."""
 
 from __future__ import annotations
 
@@ -17,8 +18,10 @@ from estimators.toolbox.nav_error import euler_error_jacobian
 from simulator.earth import dcm_to_euler, euler_to_dcm, euler_to_quat, radii_of_curvature, skew
 from simulator.pipeline import generate, load_scenario
 from simulator.reproduce import park2019
+from simulator.reproduce.measures import needed_count
 from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
+from tests.conftest import CI_SEEDS, seed_sets
 
 SEEDS = list(range(1, 11))
 
@@ -84,23 +87,39 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
 
 
 
-@pytest.fixture(scope="module", params=["short", pytest.param("full", marks=pytest.mark.slow)])
-def quick(request) -> bool:
-    """The drive length: the shortened CI drive (``park2019.SHORT``, the experiments' quick
-    overrides: 425 s -> about 300 s, the garage unchanged), or the scenario as shipped."""
-    return request.param == "short"
+@pytest.fixture(scope="module", params=[
+    pytest.param(("short", CI_SEEDS), id="short-3seeds"),
+    pytest.param(("short", SEEDS), id="short-10seeds", marks=pytest.mark.slow),
+    pytest.param(("full", SEEDS), id="full-10seeds", marks=pytest.mark.slow)])
+def drive(request) -> tuple[bool, range]:
+    """The drive length and the seeds: the shortened CI drive (``park2019.SHORT``, the
+    experiments' quick overrides: 425 s -> about 300 s, the garage unchanged) over seeds 1-3;
+    with --runslow also over ten seeds, and the scenario as shipped over ten seeds."""
+    length, seeds = request.param
+    return length == "short", seeds
 
 
 @pytest.fixture(scope="module")
-def garage(quick, tmp_path_factory) -> pd.DataFrame:
-    """The garage (true odometer scale factor 1.03) over ten seeds, the paper's three filters."""
-    return run_experiment(park2019.GARAGE, SEEDS, tmp_path_factory.mktemp("garage"), quick)
+def quick(drive) -> bool:
+    return drive[0]
+
+
+@pytest.fixture(scope="module")
+def seeds(drive) -> range:
+    return drive[1]
+
+
+@pytest.fixture(scope="module")
+def garage(quick, seeds, tmp_path_factory) -> pd.DataFrame:
+    """The garage (true odometer scale factor 1.03), the paper's three filters."""
+    return run_experiment(park2019.GARAGE, seeds, tmp_path_factory.mktemp("garage"), quick)
 
 
 @pytest.fixture(scope="module")
 def flat_garage(quick, tmp_path_factory) -> pd.DataFrame:
-    """The same garage made flat with a perfect odometer (``park2019.FLAT_PERFECT``), ten
-    seeds."""
+    """The same garage made flat with a perfect odometer (``park2019.FLAT_PERFECT``), ten seeds
+    in every run: its claim is a median of per-seed ratios that spread from 0.5 to 2.6, which
+    three seeds do not pin (seeds 1-3 give medians of 2.13 and 0.51 on the shortened drive)."""
     return run_experiment(park2019.FLAT, SEEDS, tmp_path_factory.mktemp("flat"), quick)
 
 
@@ -131,17 +150,19 @@ def _case(name: str, xfail: str | None = None, strict: bool = False) -> object:
     return pytest.param(name, marks=marks)
 
 
-@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf", DR2D_NOT_SHOWN, strict=True),
-                                   _case("ins_odo_ekf")])
+@pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf")])
 def test_dr3d_beats_the_baselines_in_the_garage(garage, quick, other, request):
     """Park Table 3: dr3d_ekf beats the baseline on exit and maximum horizontal error in at
-    least 8 of 10 seeds (paired per seed). Against ins_odo_ekf an expected failure on the
-    shortened drive only (its short open-road stretches leave the INS less to drift over)."""
+    least 8 of 10 seeds (paired per seed; 3 of 3 on three seeds). Against ins_odo_ekf an expected
+    failure on the shortened drive only (its short open-road stretches leave the INS less to
+    drift over); against dr2d_odo_ekf an expected failure over ten seeds (seeds 1-3: 3 of 3)."""
     if other == "ins_odo_ekf" and quick:
         request.applymarker(pytest.mark.xfail(strict=True, reason=INS_NOT_SHOWN))
+    if other == "dr2d_odo_ekf" and len(garage) == len(SEEDS):
+        request.applymarker(pytest.mark.xfail(strict=True, reason=DR2D_NOT_SHOWN))
     for key in ("exit_horizontal_m", "max_horizontal_m"):
         wins = _column(garage, "dr3d_ekf", key) < _column(garage, other, key)
-        assert wins.sum() >= 8, (key, wins.sum())
+        assert wins.sum() >= needed_count(0.8, len(wins)), (key, wins.sum())
 
 
 @pytest.mark.parametrize("other", [_case("dr2d_odo_ekf"), _case("ins_odo_ekf")])
@@ -163,13 +184,13 @@ def test_dr3d_height_change_through_the_garage(garage):
 
 
 @pytest.mark.parametrize("scale", [1.03, 0.97])
-def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, quick, scale):
+def test_odometer_scale_factor_at_garage_entry(tmp_path, garage, quick, seeds, scale):
     """Park section III-E, Fig. 9: the odometer scale factor (true 1.03 and 0.97) estimated
     within 0.5 % when GNSS is lost at the garage entry, every seed."""
     if scale == 1.03:
         rel = _column(garage, "dr3d_ekf", "scale_at_entry")
     else:
-        runs = run_experiment(park2019.SCALE_097, SEEDS, tmp_path, quick)
+        runs = run_experiment(park2019.SCALE_097, seeds, tmp_path, quick)
         rel = _column(runs, "dr3d_ekf", "scale_at_entry")
     assert np.all(np.abs(rel) < 0.005), rel
 
@@ -183,9 +204,10 @@ def test_filters_work_outside_the_outages(garage, name):
     assert np.median(rms) < 5.0 and np.all(rms < 7.0), rms
 
 
-def test_open_sky_blockage_stays_bounded(tmp_path):
+@pytest.mark.parametrize("seeds", seed_sets(SEEDS))
+def test_open_sky_blockage_stays_bounded(tmp_path, seeds):
     """Park Figs. 14-15: GNSS blocked for 40 s on an interchange ramp in open sky, the 3-D
-    DR/GPS's horizontal error stays under 7 m, every seed (measured: at most 4.0 m)."""
-    runs = run_experiment(park2019.OPEN_SKY, SEEDS, tmp_path)
+    DR/GPS's horizontal error stays under 7 m, every seed (measured on ten: at most 4.0 m)."""
+    runs = run_experiment(park2019.OPEN_SKY, seeds, tmp_path)
     worst = _column(runs, "dr3d_ekf", "max_horizontal_m")
     assert np.all(worst < 7.0), worst

@@ -34,21 +34,16 @@ def _nse(dataset, entry) -> dict[str, float]:
 
 
 @pytest.fixture(scope="module")
-def quickstart(tmp_path_factory):
-    """The README's quickstart drive (tunnel outage, a BMI-class IMU with a 1 deg/s turn-on
-    gyro bias and 70 mg accelerometer bias)."""
-    sc = load_scenario(REPO / "scenarios" / "quickstart.yaml", seed=1)
-    return open_dataset(generate_dataset(sc, tmp_path_factory.mktemp("q") / "d",
-                                         show_progress=False))
-
-
-@pytest.fixture(scope="module")
 def canyon(tmp_path_factory):
     """The SUMO city canyon (NLOS ranges of tens of metres), shortened as in CI."""
     sc = load_scenario(REPO / "scenarios" / "sumo_city_canyon.yaml",
                        ["trajectory.max_duration=150"], seed=1)
     return open_dataset(generate_dataset(sc, tmp_path_factory.mktemp("c") / "d",
                                          show_progress=False))
+
+
+# quickstart: the session's README quickstart drive (tests/conftest.py; tunnel outage, a BMI-class
+# IMU with a 1 deg/s turn-on gyro bias and 70 mg accelerometer bias), seed 1
 
 
 def _assert_consistent(nse: dict[str, float]) -> None:
