@@ -321,7 +321,10 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         spec = signal(letter, code)
         sel = np.flatnonzero(system_of == letter)
         if letter not in views:
-            views[letter] = {k: np.asarray(v)[sel] for k, v in per_satellite.items()}
+            # a system's satellites are consecutive rows of the sky: views, not copies
+            rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
+                    else sel)
+            views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
         v = views[letter]
         shape = (len(sel), n_ep)
         # per satellite (GLONASS: its FDMA channel)
