@@ -96,7 +96,15 @@ gyro's noise density plus its scale factor and misalignment times the turn rate 
 correlated-noise inflation of the receiver's carrier smoothing
 (``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
 ``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon. ``nis_gnss`` and ``nis_gnss_dof`` give the NIS of each GNSS update (SPEC section
+of a canyon. A gate that trusts the filter's covariance locks the filter out when its error
+outgrows that covariance (after an outage: the altitude runaway and heading jump of a turn with
+two satellites are not in Q): every returning range fails, only the Doppler rows pass, and these
+keep P small while the position stays tens of metres off. So after ``REACQUIRE_EPOCHS`` (3)
+epochs in a row in which most ranges fail (NLOS strikes satellites one by one, a wrong
+prediction all of them), the position and clock-bias variances grow by what makes the median
+range one sigma (covariance matching, ``gating.matching_variance``) and the ranges are gated
+again: the consistent ones pass, a range far beyond them stays out. ``nis_gnss`` and
+``nis_gnss_dof`` give the NIS of each GNSS update (SPEC section
 8). At a standstill the reported heading is the last direction of travel turned by the
 azimuth state since (the azimuth state itself was reported before, tens of degrees off). No
 velocity, roll or pitch sigma is written: the mechanisation recomputes the velocity from the
@@ -135,6 +143,7 @@ STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
 _I = {name: i for i, name in enumerate(STATES)}
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``chan``)
+REACQUIRE_EPOCHS = 3  # epochs with most pseudoranges gated out before the covariance is matched
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
 
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
@@ -341,6 +350,7 @@ class RissTcEkf(Estimator):
         self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n]
         self.nis_gnss = self.nis_gnss_dof = math.nan
+        self._rejecting = 0  # GNSS epochs in a row in which the gate rejected most ranges
         self._gm_index = np.array([g[0] for g in self._gm])
         self._noise_cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         # sums over the IMU samples of the current odometer interval
@@ -642,14 +652,31 @@ class RissTcEkf(Estimator):
         g = d_ned @ forward
         r[m:, m:] += self.config["odometer_speed_noise"] ** 2 * np.outer(g, g)
         keep = np.ones(2 * m, dtype=bool)
-        if self._gate_p is not None:  # each pseudorange against H P H^T + its reported R
-            p = self._filter.p
-            s_pr = np.einsum("ij,jk,ik->i", h[:m], p, h[:m]) + var_pr
-            keep[:m] = gating.rows_passing(dz[:m], s_pr, self._gate_p)
+        if self._gate_p is not None:
+            keep[:m] = self._gate_ranges(dz[:m], h[:m], var_pr)
         s = self._filter.update(dz[keep], h[keep], r[np.ix_(keep, keep)])
         self.nis_gnss = gating.normalised_innovation_squared(dz[keep], s)
         self.nis_gnss_dof = float(keep.sum())
         self._feedback()
+
+    def _gate_ranges(self, dz: np.ndarray, h: np.ndarray, var_pr: np.ndarray) -> np.ndarray:
+        """The pseudoranges passing the chi-square gate, each against H P H^T + its reported
+        variance; after ``REACQUIRE_EPOCHS`` epochs in a row in which most of them failed, the
+        position and clock-bias variances first grow by what makes the median range one sigma
+        (``gating.matching_variance``; each range's row has a unit line of sight and a 1 on the
+        clock, so half of it on each of the four states): without it a filter that left an
+        outage further off than its covariance says rejected every returning range for good."""
+        s_pr = np.einsum("ij,jk,ik->i", h, self._filter.p, h) + var_pr
+        passing = gating.rows_passing(dz, s_pr, self._gate_p)
+        self._rejecting = self._rejecting + 1 if 2 * passing.sum() < len(dz) else 0
+        if self._rejecting >= REACQUIRE_EPOCHS:
+            self._rejecting = 0
+            grow = 0.5 * gating.matching_variance(dz, s_pr)
+            states = [_I["N"], _I["E"], _I["h"], _I["cb"]]
+            self._filter.p[states, states] += grow
+            s_pr = np.einsum("ij,jk,ik->i", h, self._filter.p, h) + var_pr
+            passing = gating.rows_passing(dz, s_pr, self._gate_p)
+        return passing
 
     def _feedback(self) -> None:
         """Closed loop: remove the estimated errors (estimate minus truth) from the state."""
