@@ -80,7 +80,8 @@ update the estimated errors are removed from the navigation state and sensor-err
 The Gauss-Markov tilt and odometer-acceleration corrections decay as their models do.
 
 ``frozen_states`` (an ablation, empty by default) holds named states of the enhanced model at
-zero: no initial uncertainty, no process noise, so no update moves them; with ``bx, by`` the
+zero: no initial uncertainty, no process noise and no row of F (eq. 32 couples the speed error to
+a_od), so no update moves them; with ``bx, by`` the
 enhanced model runs without its accelerometer-bias states, which the reproduction uses to
 attribute the enhanced model's gain to the states that give it (docs/reproduction_karamat2015.md).
 
@@ -321,13 +322,16 @@ class RissTcEkf(Estimator):
         if problems:
             raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
         p0_sigma, q_white, gm = self._tuning(cfg["tuning"])
-        for name in frozen:  # a state without uncertainty or noise is never corrected
+        for name in frozen:  # without uncertainty, noise or coupling: never corrected
             p0_sigma[name], q_white[name] = 0.0, 0.0
             if name in gm:
                 gm[name] = (0.0, gm[name][1])
         self._enhanced = cfg["model"] == "enhanced"
         self._tight = cfg["coupling"] == "tight"
         self._n = len(STATES) if self._enhanced else SIMPLIFIED_STATES
+        # F's rows of the frozen states are zeroed: eq. 32 (dv_o' = da_od) would otherwise pass
+        # the a_od uncertainty into a frozen speed error, which the updates then correct
+        self._frozen = np.array([_I[name] for name in frozen if _I[name] < self._n], dtype=int)
         init = self.initial
         self._lat, self._lon, self._h = (float(v) for v in init.position)
         vn0, ve0, vd0 = (float(v) for v in init.velocity)
@@ -581,6 +585,7 @@ class RissTcEkf(Estimator):
         scale[0] = rm + self._h
         scale[1] = (rn + self._h) * math.cos(self._lat)
         f = f * scale[:, None] / scale[None, :]
+        f[self._frozen] = 0.0
         fdt = f * dt
         phi = np.eye(self._n) + fdt + 0.5 * fdt @ fdt
         phi_gm, q_d = self._noise(dt)
