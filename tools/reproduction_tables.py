@@ -13,6 +13,8 @@ Usage::
     python tools/reproduction_tables.py RUN/results.json docs/reproduction_cho2006.md ...
 
 Several runs (one per paper, say) are read as one: name each results.json before the pages.
+Each paper's table and summary row name the run (software, commit, seeds) its claims come
+from; a block of a paper that none of the runs holds is left as it is.
 
 A page without a block is left as it is and named; exit status 1 then, 0 otherwise.
 """
@@ -51,13 +53,19 @@ def _evidence(claim: dict) -> str:
             f"{number(e['ci_high'])}{unit}); sign test p = {e['p_sign']:.3g}")
 
 
+def _run(document: dict, paper: str) -> str:
+    """The software and seeds of the run that holds ``paper``'s claims."""
+    run = document.get("runs", {}).get(paper, document)
+    seeds = run["seeds"]
+    return (f"{run['software']}; {'quick, ' if run['quick'] else ''}"
+            f"seeds {seeds[0]}-{seeds[-1]}")
+
+
 def table(document: dict, paper: str) -> list[str]:
     """The markdown lines of ``paper``'s claims in ``document`` (results.json)."""
     claims = [c for c in document["claims"].values() if c["paper"] == paper]
-    seeds = document["seeds"]
-    lines = [f"Figures of `landnav reproduce` ({document['software']}; "
-             f"{'quick, ' if document['quick'] else ''}seeds {seeds[0]}-{seeds[-1]}, more "
-             "where an experiment asks for them), written from its results.json by "
+    lines = [f"Figures of `landnav reproduce` ({_run(document, paper)}, more where an "
+             "experiment asks for them), written from its results.json by "
              "`tools/reproduction_tables.py`.", ""]
     groups = (("The paper's claims", lambda c: c["kind"] == "paper" and not c["variant_of"]),
               ("Under other values of a deciding condition", lambda c: bool(c["variant_of"])),
@@ -82,16 +90,14 @@ def summary(document: dict) -> list[str]:
     """The markdown lines of the run's summary: per paper its claims and landnav's checks by
     word, counted apart."""
     words = ("shown", "partly", "not shown", "not testable")
-    lines = [f"Summary of `landnav reproduce` ({document['software']}; "
-             f"{'quick, ' if document['quick'] else ''}seeds {document['seeds'][0]}-"
-             f"{document['seeds'][-1]}), written from its results.json by "
+    lines = ["Summary of `landnav reproduce`, written from its results.json by "
              "`tools/reproduction_tables.py`.", "",
-             "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown |",
-             "|---|---|---|"]
+             "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown "
+             "| run |", "|---|---|---|---|"]
     for paper, counts in document["summary"]["per_paper"].items():
         claims = " / ".join(str(counts["paper"].get(w, 0)) for w in words)
         checks = " / ".join(str(counts["check"].get(w, 0)) for w in words[:3])
-        lines.append(f"| {paper} | {claims} | {checks} |")
+        lines.append(f"| {paper} | {claims} | {checks} | {_run(document, paper)} |")
     return lines
 
 
@@ -103,9 +109,11 @@ def rewrite(page: Path, document: dict) -> bool:
     for match in reversed(list(re.finditer(r"<!-- claims: (\w+) -->\n.*?<!-- end of claims "
                                            r"-->", text, re.S))):
         paper = match.group(1)
+        found = True
+        if not any(c["paper"] == paper for c in document["claims"].values()):
+            continue
         block = "\n".join([START.format(paper=paper), *table(document, paper), END])
         text = text[:match.start()] + block + text[match.end():]
-        found = True
     match = re.search(r"<!-- summary -->\n.*?<!-- end of summary -->", text, re.S)
     if match is not None:
         block = "\n".join(["<!-- summary -->", *summary(document), "<!-- end of summary -->"])
@@ -117,16 +125,13 @@ def rewrite(page: Path, document: dict) -> bool:
 
 def combined(documents: list[dict]) -> dict:
     """One results document of several runs: their claims and per-paper summaries together,
-    the software, seeds and mode of each run named when they differ."""
-    first = documents[0]
-    document = {**first, "claims": {}, "summary": {"per_paper": {}}}
+    and per paper the software, seeds and mode of the run its claims come from (``runs``)."""
+    document = {**documents[0], "claims": {}, "summary": {"per_paper": {}}, "runs": {}}
     for other in documents:
         document["claims"].update(other["claims"])
         document["summary"]["per_paper"].update(other["summary"]["per_paper"])
-    for key in ("software", "seeds", "quick"):
-        values = [d[key] for d in documents]
-        if any(v != values[0] for v in values):
-            raise SystemExit(f"the runs differ in {key!r}: {values}")
+        for paper in other["summary"]["per_paper"]:
+            document["runs"][paper] = {key: other[key] for key in ("software", "seeds", "quick")}
     return document
 
 

@@ -6,6 +6,7 @@ follow from its values."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import re
 import subprocess
@@ -170,3 +171,28 @@ def test_the_pages_tables_are_written_from_results_json(tmp_path):
     assert "6 of 6 seeds in the paper's direction" in text and "**partly**" in text
     assert "**landnav's checks**" in text and "commit abc" in text
     assert "| first | 1 / 1 / 0 / 1 | 1 / 0 / 0 |" in text
+
+
+def test_the_pages_tables_are_written_from_runs_of_several_commits(tmp_path):
+    # one run per paper, at two commits; a page's block of a paper no run holds is kept
+    first = write_results(tmp_path / "first.json", [_result("first", ["shown"])], SETTINGS)
+    second = write_results(tmp_path / "second.json", [_result("second", ["not shown"])],
+                           dataclasses.replace(SETTINGS, version="landnav 0.1.0, commit def"))
+    page = tmp_path / "page.md"
+    page.write_text("<!-- claims: first -->\nold\n<!-- end of claims -->\n"
+                    "<!-- claims: second -->\nold\n<!-- end of claims -->\n"
+                    "<!-- claims: third -->\nkept\n<!-- end of claims -->\n"
+                    "<!-- summary -->\nold\n<!-- end of summary -->\n")
+    run = subprocess.run([sys.executable, str(REPOSITORY / "tools" / "reproduction_tables.py"),
+                          str(first), str(second), str(page)], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    text = page.read_text()
+    assert "old" not in text and "<!-- claims: third -->\nkept\n" in text
+    first_block, second_block = text.split("<!-- claims: ")[1:3]
+    assert "commit abc" in first_block and "commit def" not in first_block
+    assert "commit def" in second_block and "commit abc" not in second_block
+    assert "| first | 1 / 0 / 0 / 1 | 0 / 0 / 0 | landnav 0.1.0, commit abc; quick, seeds 1-4 |" \
+        in text
+    assert "| second | 0 / 0 / 1 / 1 | 0 / 0 / 0 | landnav 0.1.0, commit def; quick, seeds 1-4 |" \
+        in text
