@@ -13,8 +13,7 @@ Usage::
     python tools/reproduction_tables.py RUN/results.json docs/reproduction_cho2006.md ...
 
 Several runs (one per paper, say) are read as one: name each results.json before the pages.
-Each paper's table and summary row name the run (software, commit, seeds) its claims come
-from; a block of a paper that none of the runs holds is left as it is.
+A block of a paper that none of the runs holds is left as it is.
 
 A page without a block is left as it is and named; exit status 1 then, 0 otherwise.
 """
@@ -53,19 +52,11 @@ def _evidence(claim: dict) -> str:
             f"{number(e['ci_high'])}{unit}); sign test p = {e['p_sign']:.3g}")
 
 
-def _run(document: dict, paper: str) -> str:
-    """The software and seeds of the run that holds ``paper``'s claims."""
-    run = document.get("runs", {}).get(paper, document)
-    seeds = run["seeds"]
-    return (f"{run['software']}; {'quick, ' if run['quick'] else ''}"
-            f"seeds {seeds[0]}-{seeds[-1]}")
-
-
 def table(document: dict, paper: str) -> list[str]:
     """The markdown lines of ``paper``'s claims in ``document`` (results.json)."""
     claims = [c for c in document["claims"].values() if c["paper"] == paper]
-    lines = [f"Figures of `landnav reproduce` ({_run(document, paper)}, more where an "
-             "experiment asks for them), written from its results.json by "
+    lines = [f"Figures of `landnav reproduce` ({_run(document, paper)}, more "
+             "where an experiment asks for them), written from its results.json by "
              "`tools/reproduction_tables.py`.", ""]
     groups = (("The paper's claims", lambda c: c["kind"] == "paper" and not c["variant_of"]),
               ("Under other values of a deciding condition", lambda c: bool(c["variant_of"])),
@@ -90,14 +81,14 @@ def summary(document: dict) -> list[str]:
     """The markdown lines of the run's summary: per paper its claims and landnav's checks by
     word, counted apart."""
     words = ("shown", "partly", "not shown", "not testable")
-    lines = ["Summary of `landnav reproduce`, written from its results.json by "
+    lines = [f"Summary of `landnav reproduce` ({_run(document)}), written from its results.json by "
              "`tools/reproduction_tables.py`.", "",
-             "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown "
-             "| run |", "|---|---|---|---|"]
+             "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown |",
+             "|---|---|---|"]
     for paper, counts in document["summary"]["per_paper"].items():
         claims = " / ".join(str(counts["paper"].get(w, 0)) for w in words)
         checks = " / ".join(str(counts["check"].get(w, 0)) for w in words[:3])
-        lines.append(f"| {paper} | {claims} | {checks} | {_run(document, paper)} |")
+        lines.append(f"| {paper} | {claims} | {checks} |")
     return lines
 
 
@@ -111,7 +102,7 @@ def rewrite(page: Path, document: dict) -> bool:
         paper = match.group(1)
         found = True
         if not any(c["paper"] == paper for c in document["claims"].values()):
-            continue
+            continue  # no run holds this paper: its block is kept
         block = "\n".join([START.format(paper=paper), *table(document, paper), END])
         text = text[:match.start()] + block + text[match.end():]
     match = re.search(r"<!-- summary -->\n.*?<!-- end of summary -->", text, re.S)
@@ -125,14 +116,32 @@ def rewrite(page: Path, document: dict) -> bool:
 
 def combined(documents: list[dict]) -> dict:
     """One results document of several runs: their claims and per-paper summaries together,
-    and per paper the software, seeds and mode of the run its claims come from (``runs``)."""
-    document = {**documents[0], "claims": {}, "summary": {"per_paper": {}}, "runs": {}}
+    each paper's software and seeds kept with it (``by_paper``)."""
+    first = documents[0]
+    document = {**first, "claims": {}, "summary": {"per_paper": {}}, "by_paper": {}}
     for other in documents:
+        if other["quick"] != first["quick"]:
+            raise SystemExit("the runs mix --quick and full runs")
         document["claims"].update(other["claims"])
         document["summary"]["per_paper"].update(other["summary"]["per_paper"])
         for paper in other["summary"]["per_paper"]:
-            document["runs"][paper] = {key: other[key] for key in ("software", "seeds", "quick")}
+            document["by_paper"][paper] = {"software": other["software"],
+                                           "seeds": other["seeds"]}
     return document
+
+
+def _run(document: dict, paper: str | None = None) -> str:
+    """The software and seeds of ``paper``'s run, or of the runs (the papers named where
+    they differ from the first)."""
+    def words(run: dict) -> str:
+        quick = "quick, " if document["quick"] else ""
+        return f"{run['software']}; {quick}seeds {run['seeds'][0]}-{run['seeds'][-1]}"
+
+    by_paper = document.get("by_paper", {})
+    if paper is not None:
+        return words(by_paper.get(paper, document))
+    others = [f"{p}: {words(r)}" for p, r in by_paper.items() if words(r) != words(document)]
+    return words(document) + "".join(f"; {o}" for o in others)
 
 
 def main(argv: list[str] | None = None) -> int:

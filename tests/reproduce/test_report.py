@@ -6,7 +6,6 @@ follow from its values."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import re
 import subprocess
@@ -173,26 +172,24 @@ def test_the_pages_tables_are_written_from_results_json(tmp_path):
     assert "| first | 1 / 1 / 0 / 1 | 1 / 0 / 0 |" in text
 
 
-def test_the_pages_tables_are_written_from_runs_of_several_commits(tmp_path):
-    # one run per paper, at two commits; a page's block of a paper no run holds is kept
+def test_the_pages_tables_read_several_runs_each_paper_with_its_own_seeds(tmp_path):
     first = write_results(tmp_path / "first.json", [_result("first", ["shown"])], SETTINGS)
+    other_settings = Settings((1, 2, 3, 4, 5), True, 2, None, 12.0, 20.0,
+                              "landnav 0.1.0, commit def")
     second = write_results(tmp_path / "second.json", [_result("second", ["not shown"])],
-                           dataclasses.replace(SETTINGS, version="landnav 0.1.0, commit def"))
+                           other_settings)
     page = tmp_path / "page.md"
-    page.write_text("<!-- claims: first -->\nold\n<!-- end of claims -->\n"
-                    "<!-- claims: second -->\nold\n<!-- end of claims -->\n"
+    page.write_text("<!-- claims: first -->\n<!-- end of claims -->\n"
+                    "<!-- claims: second -->\n<!-- end of claims -->\n"
                     "<!-- claims: third -->\nkept\n<!-- end of claims -->\n"
-                    "<!-- summary -->\nold\n<!-- end of summary -->\n")
+                    "<!-- summary -->\n<!-- end of summary -->\n")
     run = subprocess.run([sys.executable, str(REPOSITORY / "tools" / "reproduction_tables.py"),
                           str(first), str(second), str(page)], capture_output=True, text=True,
                          timeout=120)
     assert run.returncode == 0, run.stderr
     text = page.read_text()
-    assert "old" not in text and "<!-- claims: third -->\nkept\n" in text
-    first_block, second_block = text.split("<!-- claims: ")[1:3]
-    assert "commit abc" in first_block and "commit def" not in first_block
-    assert "commit def" in second_block and "commit abc" not in second_block
-    assert "| first | 1 / 0 / 0 / 1 | 0 / 0 / 0 | landnav 0.1.0, commit abc; quick, seeds 1-4 |" \
-        in text
-    assert "| second | 0 / 0 / 1 / 1 | 0 / 0 / 0 | landnav 0.1.0, commit def; quick, seeds 1-4 |" \
-        in text
+    assert "(landnav 0.1.0, commit abc; quick, seeds 1-4, more" in text
+    assert "(landnav 0.1.0, commit def; quick, seeds 1-5, more" in text
+    assert "seeds 1-4; second: landnav 0.1.0, commit def; quick, seeds 1-5)" in text
+    assert "| first | 1 / 0 / 0 / 1 |" in text and "| second | 0 / 0 / 1 / 1 |" in text
+    assert "<!-- claims: third -->\nkept\n" in text  # a paper no run holds keeps its block
