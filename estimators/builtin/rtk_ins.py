@@ -158,7 +158,8 @@ CONFIG_HELP = {
                      "obliquity factor)"),
     "iono_correlation_time": ("s", "correlation time of the ionosphere states"),
     "code_correlation_time": ("s", "correlation time of the code errors the weights count "
-                                   "(0: white; null: the rover datasheet's carrier_smoothing)"),
+                                   "(0: white; the rover's carrier-smoothing window, say 100, "
+                                   "weights a smoothed code as correlated)"),
     "phase_correlation_time": ("s", "correlation time of the carrier-phase errors the "
                                     "weights count (multipath along the road, 0: white)"),
     "gnss_interval": ("s", "the epoch interval the correlations are counted at (the "
@@ -286,12 +287,8 @@ class RtkInsEkf(Estimator):
                              extra_sigma=np.zeros(n_slots + n_iono),
                              extra_tau=np.r_[np.full(n_slots, np.inf),
                                              np.full(n_iono, cfg["iono_correlation_time"])])
-        gnss = self.datasheet.get("gnss") or {}
-        corr = cfg["code_correlation_time"]
-        if corr is None:
-            corr = float(gnss.get("carrier_smoothing") or 0.0)
         self._code_inflation = gnss_model.correlated_noise_inflation(
-            float(corr), float(cfg["gnss_interval"]))
+            float(cfg["code_correlation_time"]), float(cfg["gnss_interval"]))
         self._phase_inflation = gnss_model.correlated_noise_inflation(
             float(cfg["phase_correlation_time"]), float(cfg["gnss_interval"]))
         self._mask = math.radians(cfg["elevation_mask"])
