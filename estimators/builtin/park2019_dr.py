@@ -99,7 +99,7 @@ from numba import njit
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.constraints import NonholonomicNoise
-from estimators.toolbox.datasheet import fix_error_model, imu_error_model
+from estimators.toolbox.datasheet import fix_error_model, imu_error_model, odometer_speed_sigma
 from estimators.toolbox.gating import threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.installation import Installation
@@ -434,6 +434,13 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._rear_lever = float(-rear[0])
         self._odo_lever = float(odo[0] - rear[0])
         self._car = NonholonomicNoise(site.wheelbase or 2.7)
+        # the odometer's acceleration: two speeds ACCEL_WINDOW_S apart, each held for the
+        # odometer's period (the steps that share one reading share its error)
+        self._accel_sigma = (math.sqrt(2.0) * odometer_speed_sigma(self.datasheet, 1.0)
+                             / ACCEL_WINDOW_S)
+        odo_rate = float((self.datasheet.get("odometer") or {}).get("rate") or 10.0)
+        self._accel_hold_s = 1.0 / odo_rate
+        self._rate_prev = np.zeros(3)
         p[SQUAT, SQUAT] = self._car.pitch_compliance**2 if site.rear_axle is not None else 0.0
         return p
 
@@ -547,6 +554,10 @@ class Dr3dEkf(_OdometerDeadReckoning):
         q_d = np.diag(self._q_c * dt)
         if self._sheet:
             self._body_error_model(c_mid, rate, q_d, dt)
+            # the gyro scale-factor error moves the bias by s d(rate) (toolbox.datasheet)
+            q_d[7:10, 7:10] += np.diag((self._imu_model.gyro_scale_sigma
+                                        * (rate - self._rate_prev)) ** 2)
+            self._rate_prev = rate
         self._kf.predict(self._eye + self._f * dt, q_d)
         if self._imu.has_accel:
             self._step_one(f_b, rate)
@@ -627,6 +638,8 @@ class Dr3dEkf(_OdometerDeadReckoning):
                                      c["tilt_sigma_inflated"])
         else:
             var = c["tilt_sigma"] ** 2
+        if self._sheet:
+            var += self._tilt_model_variance(rate)
         rows, dzs, variances = [h], [dz], [var, var]
         if self._use_baro and self._baro_new and self._baro_offset is not None:
             dz_h, h_h = barometric_height(self._pos[2], self._baro_h,
@@ -644,6 +657,22 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._baro_new = False
         self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(variances))
         self._feedback()
+
+    def _tilt_model_variance(self, rate: np.ndarray) -> float:
+        """What the car's acceleration removed from the g-slave leaves (``tuning:
+        datasheet``), as the white-equivalent variance at the step's rate of errors that
+        last a time T (variance sigma^2 T / step when T exceeds the step, so that the T / step
+        updates that share one error weigh it as one sigma): the odometer's acceleration, two
+        speeds of the datasheet's noise ACCEL_WINDOW_S apart (T: the odometer's period), and
+        the tyres' slip velocity (``NonholonomicNoise``) turned by the yaw rate (T:
+        SLIP_TIME_S); over g, rad^2."""
+        if self._u == 0.0 and self._accel == 0.0:
+            return 0.0
+        step = self.config["step"]
+        v = self._v_body[0]
+        lateral = self._car.cornering_compliance * v * v * abs(rate[2])  # the tyres' slip
+        return ((self._accel_sigma**2 * max(self._accel_hold_s, step)
+                 + (rate[2] * lateral) ** 2 * SLIP_TIME_S) / (G0**2 * step))
 
     def _feedback(self) -> None:
         dx = self._kf.feedback()
