@@ -173,6 +173,20 @@ def _dr3d_navigate(q: np.ndarray, c_old: np.ndarray, pos: np.ndarray, v_prev: np
     return q_new, c_new, np.array([lat_new, lon_new, h_new]), v, c_mid
 
 
+def car_body_velocity(speed: float, yaw_rate: float, rear_lever: float, odometer_lever: float,
+                      squat: float, accel: float) -> np.ndarray:
+    """The IMU's body-frame (FRD) velocity on a car, m/s: the rear axle rolls along the body's
+    x axis (the kinematic bicycle model, Rajamani 2012, eq. 2.29), at the speed vr that gives
+    the odometer's point (``odometer_lever`` ahead of the rear axle: the centre of gravity,
+    ``toolbox.installation``) the ``speed``: vr^2 + (w_z d)^2 = speed^2; the IMU,
+    ``rear_lever`` L ahead of the rear axle, moves sideways at w_z L; the body pitches nose up
+    on its springs by ``squat`` k (rad per m/s^2) times the forward acceleration a, so the
+    path lies k a below its x axis: v = [vr, w_z L, vr k a]."""
+    vr = math.copysign(math.sqrt(max(speed * speed - (yaw_rate * odometer_lever) ** 2, 0.0)),
+                       speed)
+    return np.array([vr, yaw_rate * rear_lever, vr * squat * accel])
+
+
 # config key -> (SI unit, meaning), of both filters (`landnav estimators dr3d_ekf`)
 CONFIG_HELP = {
     "tuning": ("", "datasheet: noise and states from the manifest's datasheet (default); "
@@ -434,12 +448,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._rear_lever = float(-rear[0])
         self._odo_lever = float(odo[0] - rear[0])
         self._car = NonholonomicNoise(site.wheelbase or 2.7)
-        # the odometer's acceleration: two speeds ACCEL_WINDOW_S apart, each held for the
-        # odometer's period (the steps that share one reading share its error)
+        # the odometer's acceleration: two speeds ACCEL_WINDOW_S apart
         self._accel_sigma = (math.sqrt(2.0) * odometer_speed_sigma(self.datasheet, 1.0)
                              / ACCEL_WINDOW_S)
-        odo_rate = float((self.datasheet.get("odometer") or {}).get("rate") or 10.0)
-        self._accel_hold_s = 1.0 / odo_rate
         self._rate_prev = np.zeros(3)
         p[SQUAT, SQUAT] = self._car.pitch_compliance**2 if site.rear_axle is not None else 0.0
         return p
@@ -573,17 +584,11 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._yaw_accel = (yaw_rate - w0) / (t - t0) if t - t0 > 0 else 0.0
 
     def _body_velocity(self, rate: np.ndarray) -> np.ndarray:
-        """The IMU's body-frame velocity on a car (``tuning: datasheet``, class docstring): the
-        rear axle rolls along the body's x axis (the kinematic bicycle model, Rajamani 2012,
-        eq. 2.29), at the speed vr that gives the odometer's point (the centre of gravity, d
-        ahead of it, ``toolbox.installation``) the speed s u: vr^2 + (w_z d)^2 = (s u)^2; the
-        IMU, L ahead of the rear axle, moves sideways at w_z L; the body pitches on its springs
-        by k a under the forward acceleration a, so the path lies k a below its x axis."""
+        """The IMU's body-frame velocity on the car (``car_body_velocity``)."""
         if self._u == 0.0:
             return np.zeros(3)
-        su = self._s * self._u
-        vr = math.copysign(math.sqrt(max(su * su - (rate[2] * self._odo_lever) ** 2, 0.0)), su)
-        return np.array([vr, rate[2] * self._rear_lever, vr * self._squat * self._s * self._accel])
+        return car_body_velocity(self._s * self._u, float(rate[2]), self._rear_lever,
+                                 self._odo_lever, self._squat, self._s * self._accel)
 
     def _body_error_model(self, c_mid: np.ndarray, rate: np.ndarray, q_d: np.ndarray,
                           dt: float) -> None:
@@ -663,15 +668,17 @@ class Dr3dEkf(_OdometerDeadReckoning):
         datasheet``), as the white-equivalent variance at the step's rate of errors that
         last a time T (variance sigma^2 T / step when T exceeds the step, so that the T / step
         updates that share one error weigh it as one sigma): the odometer's acceleration, two
-        speeds of the datasheet's noise ACCEL_WINDOW_S apart (T: the odometer's period), and
-        the tyres' slip velocity (``NonholonomicNoise``) turned by the yaw rate (T:
-        SLIP_TIME_S); over g, rad^2."""
+        speeds of the datasheet's noise ACCEL_WINDOW_S apart (white: a tick count's speed
+        error is the difference of two quantisation errors, so the next reading's cancels it,
+        and a reading held over two steps adds nothing at low frequency), and the tyres' slip
+        velocity (``NonholonomicNoise``) turned by the yaw rate (T: SLIP_TIME_S); over g,
+        rad^2."""
         if self._u == 0.0 and self._accel == 0.0:
             return 0.0
         step = self.config["step"]
         v = self._v_body[0]
         lateral = self._car.cornering_compliance * v * v * abs(rate[2])  # the tyres' slip
-        return ((self._accel_sigma**2 * max(self._accel_hold_s, step)
+        return ((self._accel_sigma**2 * step
                  + (rate[2] * lateral) ** 2 * SLIP_TIME_S) / (G0**2 * step))
 
     def _feedback(self) -> None:
