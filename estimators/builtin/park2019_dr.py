@@ -100,7 +100,7 @@ from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import fix_error_model, imu_error_model, odometer_speed_sigma
-from estimators.toolbox.gating import threshold_variance
+from estimators.toolbox.gating import rows_passing, threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
@@ -124,6 +124,7 @@ G0 = 9.80665  # m/s^2
 # the body x axis per m/s^2, a random constant)
 TILT, BARO, FIX, SQUAT = slice(10, 12), 12, slice(13, 16), 16
 N_DR3D_SHEET = 17
+GATE_PROBABILITY = 0.999  # the fixes' chi-square gate with the datasheet tuning
 SLIP_TIME_S = 1.0  # correlation time of the tyres' unmodelled slip velocity (a turn's length)
 METRES_PER_PASCAL = 0.0833  # height per pascal near sea level (standard atmosphere), m/Pa
 ACCEL_WINDOW_S = 0.5  # odometer speeds differenced for the along-track acceleration, s
@@ -488,8 +489,15 @@ class Dr3dEkf(_OdometerDeadReckoning):
             dz += self._fix_error
             h_pos[:, FIX] = np.eye(3)
             var = list(self._fix_model.white_sigma(*dops)[:n] ** 2)
-        rows = [h_pos[:n]]
-        dzs = [dz[:n]]
+        keep = np.arange(n)
+        if self._sheet:  # a reflected fix's metres the receiver does not announce: each row
+            # behind a chi-square gate (one degree of freedom, GATE_PROBABILITY)
+            h_n = h_pos[:n]
+            s_diag = np.einsum("ij,jk,ik->i", h_n, self._kf.p, h_n) + np.array(var)
+            keep = keep[rows_passing(dz[:n], s_diag, GATE_PROBABILITY)]
+            var = [var[k] for k in keep]
+        rows = [h_pos[keep]]
+        dzs = [dz[keep]]
         speed = self._s * self._u
         slow = c["adaptive"] and speed < LOW_SPEED_THRESHOLD_M_S
         jac = euler_error_jacobian(self._cbn)
