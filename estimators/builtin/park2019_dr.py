@@ -79,14 +79,28 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   fix_error_model``, sized by the first fix's DOPs, its white remainder as the GPS noise);
   in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
   dominant error) and the barometer offset's error (set at the first good fix, a random walk
-  of the datasheet's weather drift; its white noise the sensor's), with the car's own
-  acceleration (the odometer speed's change over 0.5 s forwards, the turn's centripetal s u w
-  sideways) removed from the g-slave specific force; in 2-D the z gyro's
-  scale-factor error as bias process noise (s times the change of rate).
+  of the datasheet's weather drift; its white noise the sensor's); in 2-D the z gyro's
+  scale-factor error as bias process noise (s times the change of rate). In 3-D also the car
+  under the IMU (the datasheet's ``vehicle`` block, ``toolbox.installation``): the truth's
+  attitude is the body's, which yaws by the side slip and pitches on its springs relative to
+  the path the odometer counts, and Park's model (velocity along body x) turned both into
+  confident errors: the GPS course pulled the yaw to the path's heading (11 deg apart in an
+  8 m turn), the barometer's height rate the pitch to the path's grade (the squat, 0.3 deg
+  per m/s^2; open road pitch (error/sigma)^2 6.5, SUMO city 14, yaw 14). Here the IMU's
+  velocity is ``car_body_velocity`` (the rear axle along x, w_z L sideways, the squat k a
+  below x with k a random-constant state, prior ``NonholonomicNoise.pitch_compliance``), in
+  the position, the course (the tyres' slip and the fix's velocity noise its variance; the
+  fix's velocity noise the speed's) and the g-slave (the specific force loses d v/dt + w x v
+  of that velocity, the odometer's acceleration over 0.5 s); what it leaves out (the tyres'
+  slip, the suspension's travel: ``NonholonomicNoise``) is velocity noise correlated over
+  1 s; the g-slave's variance adds the odometer acceleration's noise (two speeds of the
+  datasheet's noise 0.5 s apart) and the tyres' slip turned by the yaw rate; the gyro scale
+  factor is bias process noise (a helix turns it into yaw); each fix row passes a chi-square
+  gate (0.999) against reflected canyon heights.
 
-Public classes
---------------
-Dr2dOdoEkf, Dr3dEkf.
+Public names
+------------
+Dr2dOdoEkf, Dr3dEkf, car_body_velocity.
 """
 
 from __future__ import annotations
