@@ -618,16 +618,18 @@ class Dr3dEkf(_OdometerDeadReckoning):
         velocity's z-gyro bias (the bias state is estimate minus truth, so w_z L is too low by
         L times it) and the squat state; the tyres' slip and the suspension's travel, which the
         model leaves out, as velocity noise (``NonholonomicNoise`` without its pitch term, now
-        a state) correlated over SLIP_TIME_S, white-equivalent on the position."""
+        a state) correlated over SLIP_TIME_S, white-equivalent on the position (a first-order
+        Gauss-Markov process's PSD at zero frequency, 2 sigma^2 T: Brown & Hwang, 4th ed.,
+        section 2.9)."""
         v_body = self._v_body
         f = self._f
         f[0:3, 9] = -self._rear_lever * c_mid[:, 1] if self._u != 0.0 else 0.0
         f[0:3, SQUAT] = c_mid[:, 2] * v_body[0] * self._s * self._accel
         if self._u != 0.0:
             lateral, vertical = self._car.sigma(v_body[0], float(rate[2]), 0.0)
-            q_d[0, 0] += lateral**2 * SLIP_TIME_S * dt
-            q_d[1, 1] += lateral**2 * SLIP_TIME_S * dt
-            q_d[2, 2] += vertical**2 * SLIP_TIME_S * dt
+            q_d[0, 0] += 2 * lateral**2 * SLIP_TIME_S * dt
+            q_d[1, 1] += 2 * lateral**2 * SLIP_TIME_S * dt
+            q_d[2, 2] += 2 * vertical**2 * SLIP_TIME_S * dt
 
     def _step_one(self, f_b: np.ndarray, rate: np.ndarray) -> None:
         """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer. With
@@ -687,10 +689,11 @@ class Dr3dEkf(_OdometerDeadReckoning):
 
     def _tilt_model_variance(self, rate: np.ndarray) -> float:
         """What the car's acceleration removed from the g-slave leaves (``tuning:
-        datasheet``), as the white-equivalent variance at the step's rate of errors that
-        last a time T (variance sigma^2 T / step when T exceeds the step, so that the T / step
-        updates that share one error weigh it as one sigma): the odometer's acceleration, two
-        speeds of the datasheet's noise ACCEL_WINDOW_S apart (white: a tick count's speed
+        datasheet``), as the white-equivalent variance at the step's rate of errors
+        correlated over a time T (2 sigma^2 T / step: a first-order Gauss-Markov process's
+        PSD at zero frequency, Brown & Hwang, 4th ed., section 2.9): the odometer's
+        acceleration, two speeds of the datasheet's noise ACCEL_WINDOW_S apart (white: a tick
+        count's speed
         error is the difference of two quantisation errors, so the next reading's cancels it,
         and a reading held over two steps adds nothing at low frequency), and the tyres' slip
         velocity (``NonholonomicNoise``) turned by the yaw rate (T: SLIP_TIME_S); over g,
@@ -701,7 +704,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         v = self._v_body[0]
         lateral = self._car.cornering_compliance * v * v * abs(rate[2])  # the tyres' slip
         return ((self._accel_sigma**2 * step
-                 + (rate[2] * lateral) ** 2 * SLIP_TIME_S) / (G0**2 * step))
+                 + 2 * (rate[2] * lateral) ** 2 * SLIP_TIME_S) / (G0**2 * step))
 
     def _feedback(self) -> None:
         dx = self._kf.feedback()

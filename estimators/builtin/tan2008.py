@@ -238,7 +238,8 @@ class TanLinearisedKF(Estimator):
         """The magnetometer heading's variance (rad^2): the paper's R_HEADING, or with
         ``tuning: datasheet`` the datasheet's magnetometer errors over the learnt horizontal
         field B_h: its disturbance (correlated over ``disturbance_time``, so white-equivalent
-        at the update interval, variance times T / interval), white noise and the soft iron
+        at the update interval: variance times 2 T / interval, the Gauss-Markov PSD 2 sigma^2
+        T, Brown & Hwang, 4th ed., section 2.9), white noise and the soft iron
         the calibration leaves out (``aiding.MagneticHeading``), each as an angle."""
         if self._fix_model is None:
             return self.R_HEADING
@@ -246,7 +247,7 @@ class TanLinearisedKF(Estimator):
         b_h = float(np.hypot(*self._mag.field_ned[:2]))
         interval = self.config["update_interval"]
         disturbance = float(sheet.get("disturbance") or 0.0) / b_h
-        held = max(1.0, float(sheet.get("disturbance_time") or 0.0) / interval)
+        held = max(1.0, 2 * float(sheet.get("disturbance_time") or 0.0) / interval)
         var = (disturbance**2 * held + (float(sheet.get("noise") or 0.0) / b_h) ** 2
                + float(sheet.get("soft_iron") or 0.0) ** 2)
         return np.array([[max(var, self.R_HEADING[0, 0])]])
