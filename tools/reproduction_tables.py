@@ -12,6 +12,8 @@ Usage::
 
     python tools/reproduction_tables.py RUN/results.json docs/reproduction_cho2006.md ...
 
+Several runs (one per paper, say) are read as one: name each results.json before the pages.
+
 A page without a block is left as it is and named; exit status 1 then, 0 otherwise.
 """
 
@@ -52,9 +54,7 @@ def _evidence(claim: dict) -> str:
 def table(document: dict, paper: str) -> list[str]:
     """The markdown lines of ``paper``'s claims in ``document`` (results.json)."""
     claims = [c for c in document["claims"].values() if c["paper"] == paper]
-    seeds = document["seeds"]
-    lines = [f"Figures of `landnav reproduce` ({document['software']}; "
-             f"{'quick, ' if document['quick'] else ''}seeds {seeds[0]}-{seeds[-1]}, more "
+    lines = [f"Figures of `landnav reproduce` ({_run(document, paper)}, more "
              "where an experiment asks for them), written from its results.json by "
              "`tools/reproduction_tables.py`.", ""]
     groups = (("The paper's claims", lambda c: c["kind"] == "paper" and not c["variant_of"]),
@@ -80,9 +80,7 @@ def summary(document: dict) -> list[str]:
     """The markdown lines of the run's summary: per paper its claims and landnav's checks by
     word, counted apart."""
     words = ("shown", "partly", "not shown", "not testable")
-    lines = [f"Summary of `landnav reproduce` ({document['software']}; "
-             f"{'quick, ' if document['quick'] else ''}seeds {document['seeds'][0]}-"
-             f"{document['seeds'][-1]}), written from its results.json by "
+    lines = [f"Summary of `landnav reproduce` ({_run(document)}), written from its results.json by "
              "`tools/reproduction_tables.py`.", "",
              "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown |",
              "|---|---|---|"]
@@ -113,14 +111,48 @@ def rewrite(page: Path, document: dict) -> bool:
     return found
 
 
+def combined(documents: list[dict]) -> dict:
+    """One results document of several runs: their claims and per-paper summaries together,
+    each paper's software and seeds kept with it (``by_paper``)."""
+    first = documents[0]
+    document = {**first, "claims": {}, "summary": {"per_paper": {}}, "by_paper": {}}
+    for other in documents:
+        if other["quick"] != first["quick"]:
+            raise SystemExit("the runs mix --quick and full runs")
+        document["claims"].update(other["claims"])
+        document["summary"]["per_paper"].update(other["summary"]["per_paper"])
+        for paper in other["summary"]["per_paper"]:
+            document["by_paper"][paper] = {"software": other["software"],
+                                           "seeds": other["seeds"]}
+    return document
+
+
+def _run(document: dict, paper: str | None = None) -> str:
+    """The software and seeds of ``paper``'s run, or of the runs (the papers named where
+    they differ from the first)."""
+    def words(run: dict) -> str:
+        quick = "quick, " if document["quick"] else ""
+        return f"{run['software']}; {quick}seeds {run['seeds'][0]}-{run['seeds'][-1]}"
+
+    by_paper = document.get("by_paper", {})
+    if paper is not None:
+        return words(by_paper.get(paper, document))
+    others = [f"{p}: {words(r)}" for p, r in by_paper.items() if words(r) != words(document)]
+    return words(document) + "".join(f"; {o}" for o in others)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("results", type=Path)
-    parser.add_argument("pages", type=Path, nargs="+")
+    parser.add_argument("files", type=Path, nargs="+",
+                        help="one or more results.json of landnav reproduce runs, then the pages")
     args = parser.parse_args(argv)
-    document = json.loads(args.results.read_text(encoding="utf-8"))
+    runs = [f for f in args.files if f.suffix == ".json"]
+    pages = [f for f in args.files if f.suffix != ".json"]
+    if not runs or not pages:
+        parser.error("name at least one results.json and one page")
+    document = combined([json.loads(f.read_text(encoding="utf-8")) for f in runs])
     status = 0
-    for page in args.pages:
+    for page in pages:
         if not rewrite(page, document):
             print(f"{page}: no '<!-- claims: PAPER -->' block", file=sys.stderr)
             status = 1
