@@ -27,8 +27,13 @@ with W = R^-1 (Aitken 1935; a common error scaled by each satellite's delay is m
 the clock and the height). With the reported variances as independent the horizontal sigma
 was 3-20 times the error on open sky (mean (error / sigma)^2 north 0.002-0.07 on four drives);
 with the field's common part (sqrt(0.75) of it) in a as well, the quickstart's east axis
-reached 22 (seeds 1-10: mean 5.7). The fault test is r^T W r, and the measurement excluded the
-one of largest normalised residual (W r)_i / sqrt(W_ii) (Baarda 1968's w-test).
+reached 22 (seeds 1-10: mean 5.7). The fault test is r^T W r against chi-square (false alarm
+1e-3); when it fails, the measurement excluded is the one whose Pope tau statistic (Baarda's
+normalised residual over the a-posteriori sigma_0, Pope 1976) is the largest and over its
+critical value at 1e-3: one outlier among good measurements stands out and goes; errors spread
+over every satellite (a variance the model understates) exclude none, and are left to the
+variance factor below (with the w-test, which takes sigma_0 as 1, they stripped good
+satellites one by one).
 
 Reflected signals (NLOS). In a street canyon a satellite behind a building is often tracked by
 its reflection off a facade: an extra path of tens of metres that the receiver's reported
@@ -37,16 +42,21 @@ are reflected at once. What announces it is the signal's C/N0: a reflection lose
 its C/N0 falls well below what a direct signal has at its elevation. The receiver's template
 (``simulator.datasheet.cn0_template``: the nominal C/N0 against elevation, and the scatter s
 of a direct signal's C/N0 about it from fading and estimation noise) gives each signal's
-deficit D; its variance becomes sigma^2 + p(D) sigma_NLOS^2, p a logistic step in D that is 1/2
-at 2.5 s (a direct signal's deficit goes that far 0.6 % of the time) and s/2 wide, and
-sigma_NLOS the ``nlos_sigma`` config key (20 m: the extra path of a reflection off the facade
-across a 20-35 m street). This is the elevation- and C/N0-dependent weighting of Groves 2013
+deficit D; its variance becomes sigma^2 + p(D) sigma_NLOS^2, p the probability that it is
+reflected by Bayes' rule: a direct signal's deficit N(0, s^2), a reflection's N(11 dB,
+(4.5 dB)^2) (the reflections of ``scenarios/urban_canyon.yaml``, seed 1: 4-18 dB, 5-95 %, the
+facade and depolarisation losses of ``simulator.environment.sky``), and as prior the share of
+the epoch's signals whose deficit is over 3 s (which no direct signal reaches but once in 700),
+at least 1 %: in a street whose reflections show, a signal of moderate deficit is likely one
+too; on open sky a faded direct signal keeps its weight. sigma_NLOS is the ``nlos_sigma``
+config key (20 m: the extra path of a reflection off the facade across a 20-35 m street).
+This is the elevation- and C/N0-dependent weighting of Groves 2013
 (chapter 9: a measurement's weight from its C/N0 and elevation; chapter 10: NLOS reception and
 its detection by C/N0), with the deficit against a template of the SIGMA-Delta
 model (Brunner, Hartinger & Troyer 1999); without a template (a recording's receiver without
 ``cn0_zenith``) no deficit is taken. Measured (docs/scores.md, 3 seeds): the street canyons'
-position axes went from mean (error / sigma)^2 of 14-106 to about 0.5-3, the open drives'
-stayed within a factor 2 (the faded direct signals weighted down a little).
+position axes went from mean (error / sigma)^2 of 14-106 to 0.2-2.6 per seed, the open drives'
+stayed as they were.
 Then the a-posteriori variance factor (the variance of unit weight, Koch 1999, *Parameter
 Estimation and Hypothesis Testing in Linear Models*, chapter 3; Groves 2013, chapter 17):
 sigma_0^2 = r^T W r / (m - n) after the exclusion; where it exceeds 1 the residuals show errors
@@ -66,7 +76,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.stats import chi2
+from scipy.stats import chi2, norm
 from scipy.stats import t as student_t
 
 from estimators.base import Estimator
@@ -81,10 +91,11 @@ ITERATIONS = 8
 BAND_HZ = 50e6  # carriers within 25 MHz share a band: L1/E1/G1 (FDMA) apart from B1I, L5/E5a
 CONVERGED_M = 1e-4
 FDE_FALSE_ALARM = 1e-3  # false-alarm probability of the residual test
-# the C/N0 deficit (dB below the template) at which a signal is taken as reflected with
-# probability 1/2, and the width of that step, in units of a direct signal's C/N0 scatter
-NLOS_DEFICIT_SIGMAS = 2.5
-NLOS_STEP_SIGMAS = 0.5
+# a reflected signal's C/N0 deficit below the direct-signal template, dB: mean and 1-sigma
+NLOS_DEFICIT_MEAN_DB = 11.0
+NLOS_DEFICIT_SIGMA_DB = 4.5
+CLEAR_NLOS_SIGMAS = 3.0  # a deficit over this many direct-signal scatters: clearly reflected
+OPEN_SKY_NLOS_SHARE = 0.01  # the prior share of reflections in an epoch with none clear
 
 OUTPUT_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                   "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd",
@@ -238,13 +249,21 @@ def _sigma(reported: np.ndarray, cn0: np.ndarray | None, floor: float) -> np.nda
 
 
 def nlos_probability(deficit_db: np.ndarray, scatter_db: float) -> np.ndarray:
-    """The weight given to a signal's being reflected (NLOS) for its C/N0 ``deficit_db`` below
-    the direct-signal template: a logistic step, 1/2 at ``NLOS_DEFICIT_SIGMAS`` times the
-    direct signal's scatter ``scatter_db`` (a direct signal that far down is a 0.6 % event),
-    ``NLOS_STEP_SIGMAS`` scatters wide; 0 where the deficit is not finite."""
-    z = (np.nan_to_num(deficit_db, nan=-np.inf) - NLOS_DEFICIT_SIGMAS * scatter_db) / (
-        NLOS_STEP_SIGMAS * max(scatter_db, 0.1))
-    return 0.5 * (1.0 + np.tanh(0.5 * z))  # 1 / (1 + exp(-z)), without overflow
+    """The probability that each signal of an epoch is reflected (NLOS) given its C/N0
+    ``deficit_db`` below the direct-signal template (module docstring): Bayes' rule with a
+    direct signal's deficit N(0, ``scatter_db``^2), a reflection's N(``NLOS_DEFICIT_MEAN_DB``,
+    ``NLOS_DEFICIT_SIGMA_DB``^2), and the epoch's prior share of reflections: the share of its
+    signals whose deficit no direct signal reaches (over ``CLEAR_NLOS_SIGMAS`` scatters), at
+    least ``OPEN_SKY_NLOS_SHARE``; 0 where the deficit is not finite."""
+    deficit = np.asarray(deficit_db, dtype=float)
+    finite = np.isfinite(deficit)
+    d = np.where(finite, deficit, 0.0)
+    scatter = max(scatter_db, 0.1)
+    clear = np.count_nonzero(d[finite] > CLEAR_NLOS_SIGMAS * scatter)
+    prior = max(clear / max(np.count_nonzero(finite), 1), OPEN_SKY_NLOS_SHARE)
+    direct = (1.0 - prior) * norm.pdf(d, 0.0, scatter)
+    reflected = prior * norm.pdf(d, NLOS_DEFICIT_MEAN_DB, NLOS_DEFICIT_SIGMA_DB)
+    return np.where(finite, reflected / np.maximum(direct + reflected, 1e-300), 0.0)
 
 
 def nlos_sigma(sigma: np.ndarray, cn0: np.ndarray, elevation: np.ndarray,
