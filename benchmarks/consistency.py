@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import signal
 import sys
 from pathlib import Path
 
@@ -203,6 +204,15 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
 
 def main(argv: list[str] | None = None) -> int:
     args = parse_args(argv)
+    # SIGTERM as Ctrl-C: the campaign stops its workers and keeps the finished runs
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        return _measure(args)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _measure(args: argparse.Namespace) -> int:
     drives = _names(args.drives, {"unseen": list(UNSEEN), "shipped": shipped_drives()})
     filters = _names(args.filters, {})
     options = {"workers": args.workers or os.cpu_count() or 1, "scheduler": args.scheduler}
