@@ -22,19 +22,12 @@ def pytest_addoption(parser: pytest.Parser) -> None:
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    """Without --runslow the slow cases are skipped. Under pytest-xdist (``-n 2 --dist
-    loadgroup``, the README's command) a module's tests run on one worker, so that its module- and
-    session-scoped fixtures are computed once; the cases of a module that sets
-    ``SPREAD_OVER_WORKERS = True`` (independent end-to-end runs sharing no fixture) are spread
-    one by one."""
+    if config.getoption("--runslow"):
+        return
     skip = pytest.mark.skip(reason="slow long-drive case: run with --runslow")
-    grouped = config.pluginmanager.hasplugin("xdist")
     for item in items:
-        if "slow" in item.keywords and not config.getoption("--runslow"):
+        if "slow" in item.keywords:
             item.add_marker(skip)
-        module = getattr(item, "module", None)
-        if grouped and module is not None and not getattr(module, "SPREAD_OVER_WORKERS", False):
-            item.add_marker(pytest.mark.xdist_group(module.__name__))
 
 
 @pytest.fixture

@@ -26,7 +26,6 @@ from simulator.reproduce.chan import short_partial_overrides as chan_short_parti
 from simulator.reproduce.karamat2015 import protocol_overrides as karamat_overrides
 
 REPO = Path(__file__).resolve().parents[1]
-SPREAD_OVER_WORKERS = True  # each scenario's run is independent (tests/conftest.py)
 SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
 
 # scenario -> the --set overrides that shorten it for CI (the whole drive in the comment)
