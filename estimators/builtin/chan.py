@@ -112,6 +112,7 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gating, gnss_model, nav_error
+from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.range_bias import RangeBiasChannels
@@ -194,14 +195,11 @@ DEFAULTS = {
     "gate_probability": None,  # pseudorange gate; None: 0.999 (datasheet), off (paper)
 }
 CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ekf`
-    "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
+    **shared_help("nhc", "nhc_point", "initial_position_std", "initial_velocity_std",
+                  "initial_attitude_std"),
     "nhc_std": ("m/s", "its 1-sigma on the body y and z velocity; null: from the car's physics"),
-    "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
     "nhc_rate": ("Hz", "constraint updates per second while GPS is missing"),
     "lever_arm": ("m", "IMU to GPS antenna, body FRD"),
-    "initial_position_std": ("m", "initial position uncertainty per axis, 1-sigma"),
-    "initial_velocity_std": ("m/s", "initial velocity uncertainty per axis, 1-sigma"),
-    "initial_attitude_std": ("deg", "initial roll, pitch, yaw uncertainty, 1-sigma"),
     "accel_bias_std": ("m/s^2", "prior of the accelerometer biases, 1-sigma"),
     "gyro_bias_std": ("rad/s", "prior of the gyro biases, 1-sigma"),
     "accel_noise": ("m/s^2/sqrt(Hz)", "accelerometer white noise (velocity random walk)"),

@@ -88,6 +88,7 @@ import numpy as np
 
 from estimators.base import Estimator
 from estimators.toolbox import aiding
+from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import (
     fix_error_model,
@@ -119,8 +120,7 @@ class ParkInsOdometer(Estimator):
     config_help = {
         "tuning": ("", "datasheet: noise from the manifest's datasheet (default); paper: the "
                        "values chosen for the reproduction of Park et al."),
-        "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
-        "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
+        **shared_help("nhc", "nhc_point"),
         "fix_error_states": ("", "three Gauss-Markov states of the GNSS fix's correlated error"),
         "odometer_scale_state": ("", "an odometer scale-factor state"),
         "odometer_period": ("s", "least time between two odometer updates (0: every sample; "

@@ -87,6 +87,7 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox import aiding, ambiguity, gating, gnss_model, nav_error
 from estimators.toolbox import double_difference as ddiff
+from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import imu_error_model, odometer_delay_s, odometer_speed_sigma
 from estimators.toolbox.ins_error import N_STATES
@@ -183,14 +184,12 @@ CONFIG_HELP = {
     "slip_sigmas": ("", "DD phase innovation, in its sigmas, taken as a slip"),
     "slip_cycles": ("cycles", "and at least this many cycles"),
     "max_gap": ("s", "a signal unseen for longer starts a new ambiguity"),
-    "initial_position_std": ("m", "initial position uncertainty per axis, 1-sigma"),
-    "initial_velocity_std": ("m/s", "initial velocity uncertainty per axis, 1-sigma"),
-    "initial_attitude_std": ("deg", "initial roll, pitch, yaw uncertainty, 1-sigma"),
+    **shared_help("initial_position_std", "initial_velocity_std", "initial_attitude_std",
+                  "nhc_point"),
     "odometer": ("", "odometer speed updates (when the dataset has an odometer)"),
     "odometer_rate": ("Hz", "odometer updates per second at most (the samples between are "
                             "not used)"),
     "nhc": ("", "non-holonomic constraint with the odometer updates"),
-    "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
     "lever_arm": ("m", "IMU to GNSS antenna, body FRD; null: the datasheet's"),
     "base_position": ("deg, deg, m", "base antenna latitude, longitude, ellipsoidal height; "
                                      "null: the datasheet's gnss_base.surveyed_position"),

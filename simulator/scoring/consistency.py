@@ -41,7 +41,6 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
-from scipy.stats import chi2
 
 from simulator import columns as col
 from simulator.scoring.align import ERR_ATT, ERR_POS, ERR_VEL, solution_errors
@@ -82,6 +81,8 @@ def chi2_band(dim: int, runs: int = 1) -> tuple[float, float]:
     """The two-sided 95 % band of the average over ``runs`` independent runs of a NEES with
     ``dim`` degrees of freedom: chi2_{runs*dim}(0.025, 0.975) / runs (Bar-Shalom et al. 2001,
     eq. 5.4.2-5); ``runs`` = 1 gives one epoch's band."""
+    from scipy.stats import chi2  # here: scipy.stats costs more than a second to import
+
     low, high = chi2.ppf(BAND_PROBABILITIES, runs * dim) / runs
     return float(low), float(high)
 
