@@ -57,7 +57,9 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
     ``range_rate_std``, 0.1 m/s, when the stream lacks them), white, as the paper treats
     them; no gate (``PAPER_TUNING``).
   - ``datasheet`` (the default): what a user knows from the dataset's datasheet
-    (``toolbox.sensor_datasheet``): the noise densities; the bias priors are the turn-on
+    (``toolbox.sensor_datasheet``): the noise densities (at least a tactical grade's, the
+    strapdown's own discretisation error: an ``ideal`` IMU's datasheet of zeros made the tilt
+    sigma fall 20 times below the error, roll NSE 522); the bias priors are the turn-on
     biases (the accelerometers' with their scale factor and misalignment under 1 g), the bias
     walks the rate random walk with the bias instability; the gyro and accelerometer scale
     factors and misalignments times the rate and the non-gravity specific force as extra
@@ -115,7 +117,11 @@ from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.range_bias import RangeBiasChannels
-from estimators.toolbox.sensor_datasheet import ImuDatasheet
+from estimators.toolbox.sensor_datasheet import (
+    ACCEL_NOISE_FLOOR,
+    GYRO_NOISE_FLOOR,
+    ImuDatasheet,
+)
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.datasheet import IONO_FIELD_OWN_SHARE, iono_residual_fractions
@@ -323,7 +329,9 @@ class _TightlyCoupled(Estimator):
             gravity = STANDARD_GRAVITY
             gnss = self.datasheet.get("gnss") or {}
             base.update(
-                accel_noise=a.noise_density, gyro_noise=g.noise_density,
+                # at least a tactical grade's: the mechanisation's own error (sensor_datasheet)
+                accel_noise=max(a.noise_density, ACCEL_NOISE_FLOOR),
+                gyro_noise=max(g.noise_density, GYRO_NOISE_FLOOR),
                 # the accelerometers' scale factor and misalignment under gravity act as a bias
                 accel_bias_std=float(np.sqrt(a.bias**2 + (gravity * a.scale_factor) ** 2
                                              + (gravity * a.misalignment) ** 2)),

@@ -115,7 +115,7 @@ class ParkInsOdometer(Estimator):
     paper = "Park et al. 2019 (IEEE Access), eqs. 1-14: INS/GPS/odometer EKF with NHC"
     defaults = {"tuning": "datasheet", "nhc": True, "nhc_point": "rear_axle",
                 "fix_error_states": False, "odometer_scale_state": False,
-                "odometer_period": 0.0}
+                "odometer_period": 0.0, "yaw_response_states": True}
     config_help = {
         "tuning": ("", "datasheet: noise from the manifest's datasheet (default); paper: the "
                        "values chosen for the reproduction of Park et al."),
@@ -125,6 +125,9 @@ class ParkInsOdometer(Estimator):
         "odometer_scale_state": ("", "an odometer scale-factor state"),
         "odometer_period": ("s", "least time between two odometer updates (0: every sample; "
                                  "1: once a second, at the GPS rate)"),
+        "yaw_response_states": ("", "with tuning datasheet: three states of the gyros' "
+                                    "response to the yaw rate (z scale factor, x and y "
+                                    "misalignment)"),
     }
     output_columns = SOLUTION_COLUMNS
 
@@ -166,14 +169,17 @@ class ParkInsOdometer(Estimator):
         sigma, taus = [], []
         if self._fix_states:
             sigma, taus = list(fix_sigma), [fix_tau] * 3
-        self._scale_col = None
+        scale_index = None
         if scale_state:  # a random constant (tau = inf)
-            self._scale_col = 15 + len(sigma)
+            scale_index = len(sigma)
             sigma.append(self.ODOMETER_SCALE_SIGMA)
             taus.append(np.inf)
         markov = dict(extra_sigma=np.array(sigma), extra_tau=np.array(taus)) if sigma else {}
+        if self._sheet and self.config["yaw_response_states"]:
+            markov["yaw_response_sigma"] = noise.yaw_response_sigma
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
                              p0, noise, mounting=site.mounting, **markov)
+        self._scale_index = scale_index  # the odometer scale's index among the extra states
         c = self.columns["gnss_fix"]
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]
@@ -225,7 +231,7 @@ class ParkInsOdometer(Estimator):
         dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna, n)
         if self._fix_states:  # the fix is the antenna plus its correlated error
             dz_p += ins.extra[:3]
-            h_p[:, 15:18] = np.eye(3)
+            h_p[:, ins.extra_start:ins.extra_start + 3] = np.eye(3)
         dz_v, h_v = aiding.gnss_velocity(ins.v, np.nan_to_num(values[3:6]), n, ins.q,
                                          ins.mean_rate, self._antenna)
         if not self._sheet:
@@ -259,10 +265,10 @@ class ParkInsOdometer(Estimator):
                                             ins.mean_rate, self._odo_point)
         r = self._r_odo
         scale_sigma = self.ODOMETER_SCALE_SIGMA
-        if self._scale_col is not None:  # the odometer reads (1 + k) v: dz = v_x - speed / (1 + k)
-            k = ins.extra[self._scale_col - 15]
+        if self._scale_index is not None:  # odometer reads (1 + k) v: dz = v_x - speed / (1 + k)
+            k = ins.extra[self._scale_index]
             dz[0] = dz[0] + speed - speed / (1.0 + k)
-            h[0, self._scale_col] = speed / (1.0 + k) ** 2
+            h[0, ins.extra_start + self._scale_index] = speed / (1.0 + k) ** 2
             scale_sigma = 0.0
         if self._sheet:  # its resolution (or cut-off), its age times the acceleration
             accel = ins.mean_force[0] + quat_to_dcm(ins.q)[2, 0] * G0
