@@ -188,7 +188,7 @@ class InsFilter:
         self._n = 0
         self._prev = np.zeros(12)
         self._sums = np.zeros(7)
-        self._rejected = 0  # measurements rejected in a row by ``gated_update``
+        self._rejected: dict[str, int] = {}  # per kind: rejected in a row by ``gated_update``
         self.mean_rate = np.zeros(3)  # compensated body angular rate over the last flush, rad/s
         self.mean_rate_dt = 0.0  # the length of that flush, s
         self.mean_force = np.zeros(3)  # compensated specific force over it, body, m/s^2
@@ -282,18 +282,21 @@ class InsFilter:
         return s
 
     def gated_update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray,
-                     probability: float = 0.999, max_rejected: int = 5) -> bool:
+                     probability: float = 0.999, max_rejected: int = 5,
+                     kind: str = "") -> bool:
         """``update`` only when the innovation passes the chi-square gate at ``probability``
-        (``gating.passes_gate``); whether it did. After ``max_rejected`` measurements rejected
-        in a row the next one is taken whatever its innovation: a filter whose own error has
-        grown past its covariance (after an outage) would otherwise reject every fix for
-        ever."""
+        (``gating.passes_gate``); whether it did. After ``max_rejected`` measurements of one
+        ``kind`` rejected in a row the next one is taken whatever its innovation: a filter
+        whose own error has grown past its covariance (after an outage) would otherwise reject
+        every fix for ever. The count is kept per ``kind``, so that an aid accepted at 10 Hz
+        does not reset that of the fixes."""
         nu = dz - h @ self.kf.x
-        if (self._rejected < max_rejected
+        rejected = self._rejected.get(kind, 0)
+        if (rejected < max_rejected
                 and not passes_gate(nu, innovation_covariance(self.kf.p, h, r), probability)):
-            self._rejected += 1
+            self._rejected[kind] = rejected + 1
             return False
-        self._rejected = 0
+        self._rejected[kind] = 0
         self.update(dz, h, r)
         return True
 
