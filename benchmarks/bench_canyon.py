@@ -14,13 +14,14 @@ the facades' diffuse scattering. Timed:
 from __future__ import annotations
 
 import sys
-import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
+from benchmarks.timing import timed_runs  # noqa: E402
 from simulator.drive import build_drive  # noqa: E402
 from simulator.scenario import validate_data  # noqa: E402
 from simulator.schema import Context  # noqa: E402
@@ -43,6 +44,10 @@ def _truth(zones: dict):
     return build_drive(data).truth
 
 
+def _generate(config, truth, seed: int) -> dict:
+    return Gnss(config).generate(truth, np.random.default_rng(seed))
+
+
 def main() -> None:
     for rate in (1, 10):
         config = GNSS_FIELD.check({"rate": rate}, ("gnss",), Context("bench"))
@@ -50,11 +55,7 @@ def main() -> None:
         for label, zones in (("open sky", {}), ("canyon, no scattering", no_scattering),
                              ("canyon", CANYON)):
             truth = _truth(zones)
-            cpu = []
-            for seed in range(2):
-                start = time.process_time()
-                out = Gnss(config).generate(truth, np.random.default_rng(seed))
-                cpu.append(time.process_time() - start)
+            cpu, _, out = timed_runs(partial(_generate, config, truth), 2)
             print(f"{rate:2d} Hz {label:21s}: CPU {min(cpu):.2f} s, "
                   f"{len(out['gnss_raw'])} raw rows, "
                   f"{len(out['gnss_raw']) / len(out['gnss_fix']):.1f} satellites per epoch")

@@ -24,12 +24,12 @@ from pathlib import Path
 import numpy as np
 
 from benchmarks.arguments import hours_and_repeat
+from benchmarks.timing import best_replay
 from estimators.builtin.cho2006 import DR_STEP_S, drm2_jacobian, drm2_transition
 from estimators.builtin.cho2006_tuning import PAPER_P0, PAPER_Q, PAPER_R
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
 from simulator.earth import normal_gravity, radii_of_curvature
-from simulator.replay import run_estimator
 from simulator.scenario import Scenario, load_scenario, validate_data
 
 SCENARIO = Path(__file__).resolve().parents[1] / "scenarios" / "cho2006_situation2.yaml"
@@ -108,12 +108,7 @@ def main() -> None:
         duration = float(t.iloc[-1] - t.iloc[0])
         print(f"drive {duration:.0f} s, {len(t)} IMU rows at 100 Hz, 1 Hz fixes")
         for name in NAMES:
-            times = []
-            for _ in range(args.repeat):
-                start = time.process_time()
-                run_estimator(ds, name, show_progress=False)
-                times.append(time.process_time() - start)
-            best = min(times)
+            best = best_replay(ds, name, args.repeat)[1]
             print(f"{name:16s} {best:6.2f} s (best of {args.repeat}), "
                   f"{duration / best:7.0f}x real time")
         u, z, extra = peer_inputs(ds)

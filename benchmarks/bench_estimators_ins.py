@@ -16,13 +16,13 @@ shared machine.
 from __future__ import annotations
 
 import tempfile
-import time
 from pathlib import Path
 
 import numpy as np
 from filterpy.kalman import ExtendedKalmanFilter
 
 from benchmarks.arguments import hours_and_repeat
+from benchmarks.timing import best_replay
 from estimators.builtin.park2019_ins import ParkInsOdometer
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
@@ -108,18 +108,6 @@ class FilterPyInsOdometer(ParkInsOdometer):
         self.ins.kf = FilterPyErrorState(self.ins.kf.p)
 
 
-def _best(dataset, entry: str, repeat: int) -> tuple[float, float, object]:
-    """Best wall time of the replay loop, best CPU time of the whole call, the solution."""
-    frame, _ = run_estimator(dataset, entry, show_progress=False)  # warm-up
-    wall = cpu = np.inf
-    for _ in range(repeat):
-        start = time.process_time()
-        _, info = run_estimator(dataset, entry, show_progress=False)
-        cpu = min(cpu, time.process_time() - start)
-        wall = min(wall, info["runtime_s"])
-    return wall, cpu, frame
-
-
 def main() -> None:
     args = hours_and_repeat(__doc__)
     with tempfile.TemporaryDirectory() as tmp:
@@ -132,7 +120,8 @@ def main() -> None:
         frames = {}
         for entry in ("ins_odo_ekf", "ins_lkf",
                       "benchmarks.bench_estimators_ins:FilterPyInsOdometer"):
-            wall, cpu, frames[entry] = _best(dataset, entry, args.repeat)
+            run_estimator(dataset, entry, show_progress=False)  # warm-up
+            wall, cpu, frames[entry] = best_replay(dataset, entry, args.repeat)
             print(f"{entry.split(':')[-1]:22s} wall {wall:6.2f} s ({duration / wall:5.0f} x real "
                   f"time)  CPU {cpu:6.2f} s ({duration / cpu:5.0f} x)")
         ours, peer = frames["ins_odo_ekf"], frames[

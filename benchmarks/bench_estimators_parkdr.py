@@ -24,6 +24,7 @@ import numpy as np
 import yaml
 
 from benchmarks.arguments import hours_and_repeat
+from benchmarks.timing import best_replay
 from estimators.builtin.park2019_dr import Dr3dEkf
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import open_dataset
@@ -91,12 +92,7 @@ def hour_scenario(hours: float, out: Path) -> Path:
 def _time(ds, entry, repeat: int) -> tuple[float, float, float, object]:
     """Best wall time of the message loop, best CPU time of the whole call, data span, solution
     (the CPU time is what counts on a shared machine)."""
-    best, best_cpu, sol = np.inf, np.inf, None
-    for _ in range(repeat):
-        cpu = time.process_time()
-        sol, info = run_estimator(ds, entry, show_progress=False)
-        best_cpu = min(best_cpu, time.process_time() - cpu)
-        best = min(best, info["runtime_s"])
+    best, best_cpu, sol = best_replay(ds, entry, repeat)
     return best, best_cpu, float(sol["t"].iloc[-1] - sol["t"].iloc[0]), sol
 
 

@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import datetime as dt
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -27,6 +26,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
 from benchmarks.bench_truth import LOOP  # noqa: E402
+from benchmarks.timing import timed_runs  # noqa: E402
 from simulator.schema import Context  # noqa: E402
 from simulator.sensors.gnss import GNSS_FIELD, Gnss  # noqa: E402
 from simulator.trajectory.kinematics import kinematics_from_profile  # noqa: E402
@@ -54,12 +54,8 @@ def main() -> None:
                                     dt.datetime(2010, 7, 1, 6, 0))
     config = GNSS_FIELD.check({"rate": args.rate, "constellation": str(NAV)}, ("gnss",), ctx)
     assert not ctx.problems, ctx.problems
-    times, cpu = [], []
-    for seed in range(3):
-        start, start_cpu = time.perf_counter(), time.process_time()
-        out = Gnss(config).generate(truth, np.random.default_rng(seed))
-        times.append(time.perf_counter() - start)
-        cpu.append(time.process_time() - start_cpu)
+    cpu, times, out = timed_runs(
+        lambda seed: Gnss(config).generate(truth, np.random.default_rng(seed)), 3)
     fix, raw = out["gnss_fix"], out["gnss_raw"]
     print(f"drive {truth.duration_s:.0f} s, {len(fix)} epochs, "
           f"{out['truth_gnss']['sv'].nunique()} satellites above the horizon of "

@@ -15,12 +15,12 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
 
+from benchmarks.timing import timed_runs  # noqa: E402
 from simulator.dataset.generate import sensor_rng  # noqa: E402
 from simulator.drive import build_drive  # noqa: E402
 from simulator.scenario import validate_data  # noqa: E402
@@ -47,13 +47,12 @@ def main() -> None:
     scenario = validate_data(data, "bench")
     truth = build_drive(scenario).truth
     blocks = scenario["sensors"]
-    cpu = []
+    rovers = []
     for _ in range(args.repeat):
-        rover = SENSOR_MODELS["gnss"](blocks["gnss"])
-        rover.attach(SENSOR_MODELS["gnss_base"](blocks["gnss_base"]))
-        start = time.process_time()
-        out = rover.generate(truth, sensor_rng(1, "gnss"))
-        cpu.append(time.process_time() - start)
+        rovers.append(SENSOR_MODELS["gnss"](blocks["gnss"]))
+        rovers[-1].attach(SENSOR_MODELS["gnss_base"](blocks["gnss_base"]))
+    cpu, _, out = timed_runs(lambda k: rovers[k].generate(truth, sensor_rng(1, "gnss")),
+                             args.repeat)
     print(f"{args.rate:g} Hz, {truth.duration_s:.0f} s: rover {len(out['gnss_raw'])} rows, base "
           f"{len(out['gnss_base_raw'])} rows; Gnss.generate CPU best {min(cpu):.2f} s of "
           f"{[round(c, 2) for c in cpu]}")

@@ -57,7 +57,9 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
     ``range_rate_std``, 0.1 m/s, when the stream lacks them), white, as the paper treats
     them; no gate (``PAPER_TUNING``).
   - ``datasheet`` (the default): what a user knows from the dataset's datasheet
-    (``toolbox.sensor_datasheet``): the noise densities; the bias priors are the turn-on
+    (``toolbox.sensor_datasheet``): the noise densities (at least a tactical grade's, the
+    strapdown's own discretisation error: an ``ideal`` IMU's datasheet of zeros made the tilt
+    sigma fall 20 times below the error, roll NSE 522); the bias priors are the turn-on
     biases (the accelerometers' with their scale factor and misalignment under 1 g), the bias
     walks the rate random walk with the bias instability; the gyro and accelerometer scale
     factors and misalignments times the rate and the non-gravity specific force as extra
@@ -112,10 +114,15 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gating, gnss_model, nav_error
+from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.range_bias import RangeBiasChannels
-from estimators.toolbox.sensor_datasheet import ImuDatasheet
+from estimators.toolbox.sensor_datasheet import (
+    ACCEL_NOISE_FLOOR,
+    GYRO_NOISE_FLOOR,
+    ImuDatasheet,
+)
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.datasheet import IONO_FIELD_OWN_SHARE, iono_residual_fractions
@@ -161,6 +168,7 @@ PAPER_TUNING = {
     "gyro_scale_factor": 0.0,  # 1-sigma, with the misalignment: rate-proportional gyro noise
     "accel_scale_factor": 0.0,  # the same for the accelerometers, on the non-gravity force
     "gyro_z_scale_factor_std": 0.0,  # prior of a z-gyro scale-factor state (0: no state)
+    "accel_z_misalignment_std": 0.0,  # prior of the z accelerometer's two misalignment states
     # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
     "pseudorange_correlation_time": 0.0,
     "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
@@ -194,14 +202,11 @@ DEFAULTS = {
     "gate_probability": None,  # pseudorange gate; None: 0.999 (datasheet), off (paper)
 }
 CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ekf`
-    "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
+    **shared_help("nhc", "nhc_point", "initial_position_std", "initial_velocity_std",
+                  "initial_attitude_std"),
     "nhc_std": ("m/s", "its 1-sigma on the body y and z velocity; null: from the car's physics"),
-    "nhc_point": ("", "where the constraint holds: rear_axle (the datasheet's) or imu"),
     "nhc_rate": ("Hz", "constraint updates per second while GPS is missing"),
     "lever_arm": ("m", "IMU to GPS antenna, body FRD"),
-    "initial_position_std": ("m", "initial position uncertainty per axis, 1-sigma"),
-    "initial_velocity_std": ("m/s", "initial velocity uncertainty per axis, 1-sigma"),
-    "initial_attitude_std": ("deg", "initial roll, pitch, yaw uncertainty, 1-sigma"),
     "accel_bias_std": ("m/s^2", "prior of the accelerometer biases, 1-sigma"),
     "gyro_bias_std": ("rad/s", "prior of the gyro biases, 1-sigma"),
     "accel_noise": ("m/s^2/sqrt(Hz)", "accelerometer white noise (velocity random walk)"),
@@ -219,6 +224,8 @@ CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ek
     "accel_scale_factor": ("", "accelerometer scale-factor error, 1-sigma: noise on the "
                                "non-gravity force"),
     "gyro_z_scale_factor_std": ("", "prior of a z-gyro scale-factor state (0: no state)"),
+    "accel_z_misalignment_std": ("rad", "prior of two states of the z accelerometer's "
+                                        "misalignment towards x and y (0: none)"),
     "iono_scale_std": ("", "1-sigma of the ionosphere-residual state (0: no such state)"),
     "tuning": ("", "datasheet: the null keys from the manifest's datasheet (default); paper: "
                    "the reproduction's values"),
@@ -266,6 +273,11 @@ class _TightlyCoupled(Estimator):
         self._channels = (RangeBiasChannels(self.n_states, n_channels, RANGE_BIAS_TIME_S)
                           if n_channels > 0 else None)
         self.n_states += n_channels
+        # the z accelerometer's misalignment towards x and y, two random constants: in a long
+        # turn it reads m f_y of the lateral force (1 mrad of 1.45 m/s^2 for the 50 s of a
+        # parking helix: 0.07 m/s of vertical velocity, which no white Q describes)
+        self._mz = self.n_states if tun["accel_z_misalignment_std"] > 0.0 else None
+        self.n_states += 2 * int(self._mz is not None)
         # the z gyro's scale-factor error: the last state (a car turns about z: a constant
         # error adds up over every turn one way, 11 deg over the garage's six helix turns at
         # 0.5 %, which no white Q describes)
@@ -277,6 +289,7 @@ class _TightlyCoupled(Estimator):
         # 1 / correlation time of the states after the 17 (Gauss-Markov), 1/s
         self._inv_tau = np.r_[np.full(int(self._iono), 1.0 / IONO_CORRELATION_TIME_S),
                               np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S),
+                              np.zeros(2 * int(self._mz is not None)),
                               np.zeros(int(self._sf is not None))]
         gate = cfg["gate_probability"]
         if gate is None and cfg["tuning"] == "datasheet":
@@ -310,6 +323,8 @@ class _TightlyCoupled(Estimator):
             p0[IONO] = tun["iono_scale_std"]
         if self._sf is not None:
             p0[self._sf] = tun["gyro_z_scale_factor_std"]
+        if self._mz is not None:
+            p0[self._mz:self._mz + 2] = tun["accel_z_misalignment_std"]
         self._p0 = np.diag(p0**2)
 
     def _tuning(self, cfg: dict) -> dict:
@@ -323,7 +338,9 @@ class _TightlyCoupled(Estimator):
             gravity = STANDARD_GRAVITY
             gnss = self.datasheet.get("gnss") or {}
             base.update(
-                accel_noise=a.noise_density, gyro_noise=g.noise_density,
+                # at least a tactical grade's: the mechanisation's own error (sensor_datasheet)
+                accel_noise=max(a.noise_density, ACCEL_NOISE_FLOOR),
+                gyro_noise=max(g.noise_density, GYRO_NOISE_FLOOR),
                 # the accelerometers' scale factor and misalignment under gravity act as a bias
                 accel_bias_std=float(np.sqrt(a.bias**2 + (gravity * a.scale_factor) ** 2
                                              + (gravity * a.misalignment) ** 2)),
@@ -331,6 +348,7 @@ class _TightlyCoupled(Estimator):
                 gyro_scale_factor=float(np.hypot(g.scale_factor, g.misalignment)),
                 accel_scale_factor=float(np.hypot(a.scale_factor, a.misalignment)),
                 gyro_z_scale_factor_std=g.scale_factor,
+                accel_z_misalignment_std=a.misalignment,
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
                 iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
                 iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
@@ -569,7 +587,7 @@ N_NOMINAL = 18
 
 @njit(cache=True)
 def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
-                      sf_col: int) -> None:
+                      sf_col: int, mz_col: int) -> None:
     """Integrate every point (rows of x, the ``TcUkf`` nominal layout) in place through the
     buffered IMU intervals: one RK4 step of Chan eqs. 1-3 per interval, bias-corrected rates at
     its start (row j of w, f), end (row j + 1) and their mean at its middle; cb' = d."""
@@ -591,6 +609,9 @@ def _propagate_points(x: np.ndarray, w: np.ndarray, f: np.ndarray, dt: np.ndarra
                 rates[1, a] = 0.5 * (rates[0, a] + rates[2, a])
                 rates[3, a] = f[j, a] - x[i, 10 + a]
                 rates[5, a] = f[j + 1, a] - x[i, 10 + a]
+                if a == 2 and mz_col >= 0:  # the z accelerometer reads m . (f_x, f_y) more
+                    rates[3, a] -= x[i, mz_col] * f[j, 0] + x[i, mz_col + 1] * f[j, 1]
+                    rates[5, a] -= x[i, mz_col] * f[j + 1, 0] + x[i, mz_col + 1] * f[j + 1, 1]
                 rates[4, a] = 0.5 * (rates[3, a] + rates[5, a])
             rk4_step(nav, rates[0], rates[1], rates[2], rates[3], rates[4], rates[5], dt[j], work)
         x[i, 0:10] = nav
@@ -649,12 +670,12 @@ def boxminus(xs: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 
 def _fx(points: np.ndarray, noise: None, w: np.ndarray, f: np.ndarray, dt: np.ndarray,
-        inv_tau: np.ndarray, sf_col: int) -> np.ndarray:
+        inv_tau: np.ndarray, sf_col: int, mz_col: int) -> np.ndarray:
     """The UKF's transition of the whole point set (``SigmaPointFilter.propagate`` hook); the
     Gauss-Markov states after the nominal 18 decay with their 1 / correlation times
     ``inv_tau``."""
     points = np.ascontiguousarray(points)
-    _propagate_points(points, w, f, dt, sf_col)
+    _propagate_points(points, w, f, dt, sf_col, mz_col)
     points[:, N_NOMINAL:] *= np.exp(-float(dt.sum()) * inv_tau)
     return points
 
@@ -691,7 +712,8 @@ class TcUkf(_TightlyCoupled):
         the driver sets the mean (paper steps 2-3)."""
         if self._buf_dt:
             sf_col = -1 if self._sf is None else self._sf + 1  # nominal: tangent index + 1
-            self.ukf.propagate(_fx, *self._take_buffer(), self._inv_tau, sf_col)
+            mz_col = -1 if self._mz is None else self._mz + 1
+            self.ukf.propagate(_fx, *self._take_buffer(), self._inv_tau, sf_col, mz_col)
             self._propagated = True
 
     def _predict(self, t: float) -> None:
@@ -880,6 +902,8 @@ class TcEkf(_TightlyCoupled):
             f_c = 0.5 * (f[1:] + f[:-1]) - self._ba
         if self._sf is not None:  # the z gyro reads (1 + s) times the rate
             w_c[:, 2] /= 1.0 + self._extra[-1]
+        if self._mz is not None:  # the z accelerometer reads m . (f_x, f_y) more
+            f_c[:, 2] -= f_c[:, :2] @ self._extra[self._mz - N_STATES:self._mz - N_STATES + 2]
         dth, dv = w_c * dt[:, None], f_c * dt[:, None]
         self._q, self._v, self._pos = _strapdown_block(self._q, self._v, self._pos, dth, dv,
                                                        self._dth_prev, self._dv_prev, dt)
@@ -894,6 +918,10 @@ class TcEkf(_TightlyCoupled):
         fm[extra, extra] = -self._inv_tau
         if self._sf is not None:  # psi' = -C_b^n [0, 0, w_z] ds
             fm[6:9, self._sf] = -c_bn[:, 2] * float(w_c[:, 2] @ dt) / total
+        if self._mz is not None:  # dv' = -C_b^n [0, 0, dm . (f_x, f_y)]
+            f_xy = dt @ f_c[:, :2] / total
+            fm[3:6, self._mz] = -c_bn[:, 2] * f_xy[0]
+            fm[3:6, self._mz + 1] = -c_bn[:, 2] * f_xy[1]
         self._extra *= np.exp(-total * self._inv_tau)
         fm *= total
         phi = np.eye(self.n_states) + fm + 0.5 * fm @ fm

@@ -53,6 +53,7 @@ from functools import partial
 import numpy as np
 
 from estimators.base import Estimator
+from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.gnss_model import clock_noise, predict, raw_epoch
 from estimators.toolbox.installation import Installation
@@ -126,7 +127,7 @@ class FgoLooselyCoupled(Estimator):
         "lag": ("s", "keyframes the fixed-lag smoother keeps"),
         "keyframe_interval": ("s", "time between keyframes (and their GNSS fixes)"),
         "odometer": ("", "odometer speed factors, when the dataset has an odometer"),
-        "nhc": ("", "non-holonomic constraint: zero lateral and vertical body velocity"),
+        **shared_help("nhc"),
     }
     output_columns = OUTPUT_COLUMNS
 

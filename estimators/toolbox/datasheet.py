@@ -12,7 +12,9 @@ that tunes itself "from the datasheet" means the same thing.
   s acts as a bias s x on a reading x, which moves by s dx when the reading changes, so
   ``InsFilter`` adds (s dx)^2 to the bias's process noise over each interval
   (``InsNoise.gyro_scale_sigma``, ``accel_scale_sigma``; the gyro's g-sensitivity times the
-  change of specific force likewise).
+  change of specific force likewise). A filter with the yaw-response states of ``InsFilter``
+  takes their 1-sigma from ``ImuErrorModel.yaw_response_sigma``: the gyro misalignment for x
+  and y, the scale factor for z.
 * ``fix_error_model``: the position error of a receiver's fix, per unit DOP, from the one
   receiver error budget (``simulator.datasheet.range_error_budget``), split by time behaviour:
 
@@ -66,6 +68,15 @@ class ImuErrorModel(InsNoise):
 
     accel_bias_initial: float = 0.0
     gyro_bias_initial: float = 0.0
+    gyro_scale_factor: float = 0.0
+    gyro_misalignment: float = 0.0
+
+    @property
+    def yaw_response_sigma(self) -> np.ndarray:
+        """1-sigma of the gyro triad's response to the z rate (``InsFilter``'s yaw-response
+        states): misalignment towards z on x and y, the scale factor on z."""
+        return np.array([self.gyro_misalignment, self.gyro_misalignment,
+                         self.gyro_scale_factor])
 
 
 def _value(group: Mapping[str, Any], key: str) -> float:
@@ -106,7 +117,9 @@ def imu_error_model(datasheet: Mapping[str, Any]) -> ImuErrorModel:
                          accel_bias_initial=max(a_bias, 1e-6),
                          gyro_bias_initial=max(g_bias, 1e-8),
                          accel_scale_sigma=a_scale, gyro_scale_sigma=g_scale,
-                         gyro_g_sensitivity=g_sens)
+                         gyro_g_sensitivity=g_sens,
+                         gyro_scale_factor=_value(imu.get("gyro") or {}, "scale_factor"),
+                         gyro_misalignment=_value(imu.get("gyro") or {}, "misalignment"))
 
 
 @dataclass(frozen=True)

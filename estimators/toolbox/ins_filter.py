@@ -16,6 +16,20 @@ steady-state sigma (Brown & Hwang, 4th ed., section 2.9), appended to F and G Q 
 current estimate ``extra`` is kept beside the nominal solution: fed back like the biases in
 closed loop, and decayed by exp(-dt / tau) between updates (the process's expected value).
 
+Optional yaw-response states (``yaw_response_sigma``), placed between the 15 and the extra states
+(``extra_start`` is the first extra state's index): the third column k of the gyro triad's
+scale-factor and misalignment error matrix S + M, what the three gyros read per rad/s of the
+body's z rate beyond it (the x and y gyros' misalignment towards z, the z gyro's scale factor).
+They are random constants (P0 from the datasheet) coupled to the attitude: the compensated rate
+is w - b_hat - k_hat w_z, so its error is -dbg - dk w_z and d(psi)/dt gains -C_b^n dk w_z
+(Groves 2013, eq. 14.63's scale-factor and misalignment terms, the column of the one large rate
+of a land vehicle kept). Without them a scale-factor error s enters only as bias process noise,
+(s dw)^2 for each flush's change dw of the reading (``InsNoise``): increments taken as
+independent although s is one constant, so a yaw rate that ramps up over N flushes adds 1/N of
+the variance (s w)^2 its bias really gains. With the states that noise keeps the x and y rates
+only. (The lever-arm terms of the aids take the rate error as -dbg alone: dk w_z times a lever
+arm of a metre is under a millimetre per second.)
+
 Public names
 ------------
 InsNoise, InsFilter.
@@ -134,13 +148,17 @@ class InsFilter:
         C_s^v, the IMU's sensor frame to the vehicle frame (``installation.Installation``): the
         samples are rotated into the vehicle frame before the strapdown, so that the filter
         navigates the vehicle (the frame of the constraints and lever arms).
+    yaw_response_sigma : (3,), optional
+        1-sigma of the yaw-response states (module docstring; x, y gyro misalignment towards
+        z, z gyro scale factor, dimensionless); None: no such states.
     """
 
     def __init__(self, initial: InitialState, imu_columns: Mapping[str, int], increments: bool,
                  p0_sigma: np.ndarray, noise: InsNoise, closed_loop: bool = True,
                  initial_biases: np.ndarray | None = None, buffer_size: int = 512,
                  mounting: np.ndarray | None = None, extra_sigma: np.ndarray | None = None,
-                 extra_tau: np.ndarray | None = None):
+                 extra_tau: np.ndarray | None = None,
+                 yaw_response_sigma: np.ndarray | None = None):
         self.t = float(initial.t)
         self.q = np.array(initial.quaternion, dtype=float)
         self.v = np.array(initial.velocity, dtype=float)
@@ -151,9 +169,13 @@ class InsFilter:
         self._extra_tau = np.broadcast_to(np.asarray(np.inf if extra_tau is None else extra_tau,
                                                      dtype=float), extra_sigma.shape).copy()
         self.extra = np.zeros(len(extra_sigma))  # estimate of the extra states
-        self.n_states = N_STATES + len(extra_sigma)
-        self.kf = ErrorState(np.diag(np.r_[np.asarray(p0_sigma, float), extra_sigma] ** 2),
-                             closed_loop)
+        yaw_sigma = (np.zeros(0) if yaw_response_sigma is None
+                     else np.asarray(yaw_response_sigma, float))
+        self.yaw_response = np.zeros(len(yaw_sigma))  # estimate of k (module docstring)
+        self.extra_start = N_STATES + len(yaw_sigma)  # index of the first extra state
+        self.n_states = self.extra_start + len(extra_sigma)
+        self.kf = ErrorState(np.diag(np.r_[np.asarray(p0_sigma, float), yaw_sigma,
+                                           extra_sigma] ** 2), closed_loop)
         self.noise = noise
         missing = [c for c in IMU_AXES if c not in imu_columns]
         if missing:
@@ -166,7 +188,7 @@ class InsFilter:
         self._n = 0
         self._prev = np.zeros(12)
         self._sums = np.zeros(7)
-        self._rejected = 0  # measurements rejected in a row by ``gated_update``
+        self._rejected: dict[str, int] = {}  # per kind: rejected in a row by ``gated_update``
         self.mean_rate = np.zeros(3)  # compensated body angular rate over the last flush, rad/s
         self.mean_rate_dt = 0.0  # the length of that flush, s
         self.mean_force = np.zeros(3)  # compensated specific force over it, body, m/s^2
@@ -177,14 +199,14 @@ class InsFilter:
             np.eye(3), noise.accel_noise**2, noise.gyro_noise**2,
             2 * noise.accel_bias_sigma**2 / noise.accel_bias_tau,
             2 * noise.gyro_bias_sigma**2 / noise.gyro_bias_tau)
-        extra = np.arange(N_STATES, self.n_states)
+        extra = np.arange(self.extra_start, self.n_states)
         self._gqg[extra, extra] = 2 * extra_sigma**2 / self._extra_tau
 
     def set_extra_sigma(self, index: int, sigma: float) -> None:
         """Reset the steady-state 1-sigma of extra state ``index`` (0 = the first after the
         15): its variance, its cross-covariances zeroed, and its driving noise (a state whose
         size is learnt at the first measurement, such as a fix error scaled by the DOP)."""
-        k = N_STATES + index
+        k = self.extra_start + index
         self.kf.p[k, :] = 0.0
         self.kf.p[:, k] = 0.0
         self.kf.p[k, k] = sigma * sigma
@@ -207,6 +229,9 @@ class InsFilter:
             raw = self._buf[:self._n]
             raw[:, 0:3] = raw[:, 0:3] @ self._mount.T
             raw[:, 3:6] = raw[:, 3:6] @ self._mount.T
+        if len(self.yaw_response):  # the yaw rate's share of every gyro, k_hat w_z
+            raw = self._buf[:self._n]
+            raw[:, 0:3] -= np.outer(raw[:, 2], self.yaw_response)
         self.t = _integrate(self._buf_t, self._buf, self._n, self._increments, self.t, self.q,
                             self.v, self.pos, self.ba, self.bg, self._prev, self._sums)
         self._n = 0
@@ -219,11 +244,17 @@ class InsFilter:
         n = self.noise
         f_nav = system_matrix(self.pos[0], self.pos[2], self.v, c_bn, f_body,
                               n.accel_bias_tau, n.gyro_bias_tau)
+        a = self.extra_start  # the coupled block: the 15 and the yaw-response states
+        if a > N_STATES:
+            f_nav = np.pad(f_nav, (0, a - N_STATES))
+            f_nav[6:9, N_STATES:a] = -c_bn * rate[2]
         # the extra states are uncoupled scalars: the transition is block diagonal
-        phi, q_d = discretise(f_nav, self._gqg[:N_STATES, :N_STATES], dt)
+        phi, q_d = discretise(f_nav, self._gqg[:a, :a], dt)
         if self.mean_rate_dt > 0 and (n.accel_scale_sigma or n.gyro_scale_sigma
                                       or n.gyro_g_sensitivity):
             d_rate, d_force = rate - self.mean_rate, f_body - self.mean_force
+            if a > N_STATES:  # the z rate's scale factor is a state
+                d_rate[2] = 0.0
             ia, ig = np.arange(N_STATES)[BA], np.arange(N_STATES)[BG]
             q_d[ia, ia] += (n.accel_scale_sigma * d_force) ** 2
             q_d[ig, ig] += ((n.gyro_scale_sigma * d_rate) ** 2
@@ -234,7 +265,7 @@ class InsFilter:
         if len(self.extra):
             f_extra = -dt / self._extra_tau
             phi_extra = 1.0 + f_extra + 0.5 * f_extra * f_extra
-            g_extra = np.diag(self._gqg)[N_STATES:]
+            g_extra = np.diag(self._gqg)[a:]
             q_extra = 0.5 * dt * (phi_extra * phi_extra * g_extra + g_extra)
             self.kf.predict_blocks(phi, q_d, phi_extra, q_extra)
         else:
@@ -251,18 +282,21 @@ class InsFilter:
         return s
 
     def gated_update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray,
-                     probability: float = 0.999, max_rejected: int = 5) -> bool:
+                     probability: float = 0.999, max_rejected: int = 5,
+                     kind: str = "") -> bool:
         """``update`` only when the innovation passes the chi-square gate at ``probability``
-        (``gating.passes_gate``); whether it did. After ``max_rejected`` measurements rejected
-        in a row the next one is taken whatever its innovation: a filter whose own error has
-        grown past its covariance (after an outage) would otherwise reject every fix for
-        ever."""
+        (``gating.passes_gate``); whether it did. After ``max_rejected`` measurements of one
+        ``kind`` rejected in a row the next one is taken whatever its innovation: a filter
+        whose own error has grown past its covariance (after an outage) would otherwise reject
+        every fix for ever. The count is kept per ``kind``, so that an aid accepted at 10 Hz
+        does not reset that of the fixes."""
         nu = dz - h @ self.kf.x
-        if (self._rejected < max_rejected
+        rejected = self._rejected.get(kind, 0)
+        if (rejected < max_rejected
                 and not passes_gate(nu, innovation_covariance(self.kf.p, h, r), probability)):
-            self._rejected += 1
+            self._rejected[kind] = rejected + 1
             return False
-        self._rejected = 0
+        self._rejected[kind] = 0
         self.update(dz, h, r)
         return True
 
@@ -274,7 +308,8 @@ class InsFilter:
         self.q, self.v, self.pos = nav_error.correct(self.q, self.v, self.pos, dx[:9])
         self.ba -= dx[BA]
         self.bg -= dx[BG]
-        self.extra -= dx[N_STATES:]
+        self.yaw_response -= dx[N_STATES:self.extra_start]
+        self.extra -= dx[self.extra_start:]
 
     def corrected(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The best estimate (nominal minus the open-loop error estimate): q, v, pos and the

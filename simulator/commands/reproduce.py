@@ -91,8 +91,10 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "edge runs more (its full_runs, e.g. 20)")
     p.add_argument("--quick", action="store_true",
                    help="shortened drives (each experiment's quick overrides) and 3 seeds "
-                        "unless --runs says otherwise: a check in minutes, not the paper's "
-                        "full protocol")
+                        "unless --runs says otherwise, and no variant (a claim judged again "
+                        "under another value of a deciding condition) nor the experiments "
+                        "only variants read: a check in minutes, not the paper's full "
+                        "protocol")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="report folder")
     p.add_argument("--workers", type=int, default=None, metavar="W",
                    help="local worker processes (default: the CPU count)")

@@ -368,6 +368,8 @@ GRADE_WHY = ("the paper says 'low grade IMU' and names no part; the automotive M
 START = "GNSS from"
 START_DEFAULT = "the first epoch"
 START_WHY = "the paper's Figure 2 gives both filters GNSS from the start"
+START_LATE = (f"{LATE_START_S:.0f} s after the start, 60 deg heading error (the heading's "
+              "settling time judged)")
 
 PARTIAL_OUTAGES = Experiment("partial_outages", "chan_partial_outages.yaml", NHC_PAIR,
                              measure_windows,
@@ -398,14 +400,17 @@ def _table1_claims() -> list[Claim]:
                   f"reduces the UKF's mean 3-D error by {pct} % on average",
                   f"{pct} % (Table 1)", [*CONDITIONS, "60 s windows on a lap of straights and "
                                          "40 m loops; the paper's outage places are unknown"],
-                  _cut(c, pct, why)) for c, pct, why in rows]
+                  _cut(c, pct, why), experiments=("partial_outages",))
+            for c, pct, why in rows]
 
 
 def _grade(key: str, text: str, figure: str, judge) -> list[Claim]:
     return judged.sweep(key, text, figure, CONDITIONS,
                         {"automotive": partial(judge, experiment="complete_outages"),
                          "consumer": partial(judge, experiment="complete_outages_consumer")},
-                        GRADE_DEFAULT, GRADE_WHY, GRADE)
+                        GRADE_DEFAULT, GRADE_WHY, GRADE,
+                        reads={"automotive": ("complete_outages",),
+                               "consumer": ("complete_outages_consumer",)})
 
 
 PAPER = Paper(
@@ -419,7 +424,7 @@ PAPER = Paper(
         Claim("fig1_ukf_slightly_better", "On a nominal drive the UKF's position error is "
               "slightly smaller than the EKF's; the difference is small in land navigation",
               "Figure 1 (no number); conclusion: 'a small difference between EKF and UKF'",
-              CONDITIONS, judge_nominal),
+              CONDITIONS, judge_nominal, experiments=("initial_error",)),
         *judged.sweep("fig2_ukf_superior_initial_error", "From large initial position errors "
                       "(100 m on each axis) the UKF performs better than the EKF",
                       "Figure 2 (no number); conclusion: 'the significant advantage ... for "
@@ -427,11 +432,11 @@ PAPER = Paper(
                       [*CONDITIONS, "the 100 m are on north, east, down (the paper's on ECEF "
                        "X, Y, Z: the same 173 m); both filters are told their 100 m"],
                       {START_DEFAULT: partial(judge_initial, experiment="initial_error"),
-                       f"{LATE_START_S:.0f} s after the start, 60 deg heading error (the "
-                       "heading's settling time judged)": partial(
-                           judge_initial, experiment="initial_error_late",
-                           figure="yaw_settle_s")},
-                      START_DEFAULT, START_WHY, START),
+                       START_LATE: partial(judge_initial, experiment="initial_error_late",
+                                           figure="yaw_settle_s")},
+                      START_DEFAULT, START_WHY, START,
+                      reads={START_DEFAULT: ("initial_error",),
+                             START_LATE: ("initial_error_late",)}),
         *_grade("fig3_no_nhc_diverges", "In complete GPS outages the UKF without the NHC "
                 "diverges quickly; with the NHC it keeps its path in clockwise and "
                 "counter-clockwise loops", "Figure 3 (trajectories, no number)",
@@ -441,14 +446,17 @@ PAPER = Paper(
                 judge_complete),
         Claim("fig5_nhc_better_partial", "In partial outages (1-4 satellites) the NHC "
               "significantly improves the navigation performance",
-              "Figure 5 (no number); Table 1", CONDITIONS, judge_all_partial),
+              "Figure 5 (no number); Table 1", CONDITIONS, judge_all_partial,
+              experiments=("partial_outages",)),
         *_table1_claims(),
         Claim("table1_4_smaller_than_0", "The NHC's reduction with 4 satellites is smaller than "
-              "with none", "22.6 % vs 54.4 % (Table 1)", CONDITIONS, judge_four_smaller),
+              "with none", "22.6 % vs 54.4 % (Table 1)", CONDITIONS, judge_four_smaller,
+              experiments=("partial_outages",)),
         Claim("nhc_does_not_degrade_with_gnss", "Using the NHC together with the GPS "
               "observables does not degrade the solution", "conclusion (no number)",
               [*CONDITIONS, "RMS 3-D error outside the partial-outage windows (every "
-               "satellite); non-inferiority margin 5 %"], judge_not_degrade),
+               "satellite); non-inferiority margin 5 %"], judge_not_degrade,
+              experiments=("partial_outages",)),
         judged.untestable("ukf_total_state_avoids_linearisation", "The total-state UKF avoids "
                           "the linearisation errors of the error-state EKF in high dynamics",
                           "introduction, conclusion (no figure)",

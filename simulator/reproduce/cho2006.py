@@ -271,17 +271,20 @@ VAN = ("a simulated curved drive with two 4 % slopes (the van's Daejeon route is
        "(the van had real receivers); DMU-300CC errors drawn per seed")
 
 
-def _variant(claim: Claim, key: str, variant: str, judge, extra: tuple[str, ...]) -> Claim:
+def _variant(claim: Claim, key: str, variant: str, experiment: str, judge,
+             extra: tuple[str, ...]) -> Claim:
     return Claim(key, claim.text, claim.paper_figure,
                  tuple(c for c in claim.conditions if c != PAPER_FIXES_WORDS) + extra, judge,
-                 kind=claim.kind, variant_of=claim.key, variant=variant)
+                 kind=claim.kind, variant_of=claim.key, variant=variant,
+                 experiments=(experiment,))
 
 
 def _spkf_vs_ekf(key: str, text: str, paper_figure: str, measure_words: str, experiment: str,
                  figure: str, unit: str, what: str) -> Claim:
     """A paper claim that the simplex SPKF's ``figure`` is smaller than the EKF's."""
     return Claim(key, text, paper_figure, (*CONDITIONS, measure_words),
-                 paired(experiment, "spkf", "ekf", figure, unit, what))
+                 paired(experiment, "spkf", "ekf", figure, unit, what),
+                 experiments=(experiment,))
 
 
 S1_Z = _spkf_vs_ekf("situation1_z_scale_faster",
@@ -306,16 +309,18 @@ S1_ACCEL = Claim("situation1_accel_scale_slower",
                  "Fig. 7(c): 'The estimation error of the accelerometer scale factor error in "
                  "the SPKF decreases slowly'", (*CONDITIONS, SCALE_WORDS),
                  paired("situation1", "ekf", "spkf", "accel_scale_converge_s", "s",
-                        "EKF converges sooner"))
+                        "EKF converges sooner"), experiments=("situation1",))
 S2_EKF = Claim("situation2_ekf_diverges_140",
                "Situation II: from -140 deg initial heading error the EKF's errors diverge",
                "Fig. 8: 'the EKF errors diverge with time'", (*CONDITIONS, CONVERGE_WORDS),
-               converged("situation2", ("ekf_m140",), "the EKF does not converge", "higher"))
+               converged("situation2", ("ekf_m140",), "the EKF does not converge", "higher"),
+               experiments=("situation2",))
 S2_SPKF = Claim("situation2_spkf_converges_140",
                 "Situation II: from -140 deg the SPKF's errors converge to near zero",
                 "Fig. 8: 'the errors of SPKF converge to the neighbor of 0 with time'",
                 (*CONDITIONS, CONVERGE_WORDS),
-                converged("situation2", ("spkf_m140",), "the SPKF converges"))
+                converged("situation2", ("spkf_m140",), "the SPKF converges"),
+                experiments=("situation2",))
 S3 = _spkf_vs_ekf("situation3_position",
                   "Situation III (GPS blocked 75-90 s): the EKF's position error grows more "
                   "than the SPKF's in the blockage",
@@ -354,23 +359,27 @@ PAPER = Paper(
               (*CONDITIONS, "heading RMS from 60 s after moving off, from -90 deg (the paper: "
                             "+45 and +90 deg on its own turning drives)"),
               paired("situation2", "ekf_m90", "drm1_m90", "heading_rms_deg", "deg",
-                     "DRM2 heading error smaller")),
+                     "DRM2 heading error smaller"), experiments=("situation2",)),
         Claim("fig3_ekf_below_100_deg",
               "The DRM2/GPS EKF performs well when the initial heading error is less than "
               "100 deg (it converges from -45 and -90 deg)",
               "Section IV.1.B text and Fig. 3", (*CONDITIONS, CONVERGE_WORDS),
-              converged("situation2", ("ekf_m45", "ekf_m90"), "the EKF converges")),
+              converged("situation2", ("ekf_m45", "ekf_m90"), "the EKF converges"),
+              experiments=("situation2",)),
         S1_Z,
         _variant(S1_Z, "situation1_z_scale_faster_landnav_fixes", FIXES_WORDS[LANDNAV_FIXES],
+                 "situation1_landnav_fixes",
                  paired("situation1_landnav_fixes", "spkf", "ekf", "z_scale_converge_s", "s",
                         "SPKF converges sooner"), (FIXES_WORDS[LANDNAV_FIXES],)),
         _variant(S1_Z, "situation1_z_scale_faster_symmetric", "symmetric SPKF point set",
+                 "situation1",
                  paired("situation1", "spkf_sym", "ekf", "z_scale_converge_s", "s",
                         "symmetric-set SPKF converges sooner"),
                  (PAPER_FIXES_WORDS, "the SPKF with the symmetric 2L + 1 point set instead of "
                                      "the paper's simplex set")),
         S1_HEADING,
         _variant(S1_HEADING, "situation1_heading_landnav_fixes", FIXES_WORDS[LANDNAV_FIXES],
+                 "situation1_landnav_fixes",
                  paired("situation1_landnav_fixes", "spkf", "ekf", "heading_rms_deg", "deg",
                         "SPKF heading error smaller"), (FIXES_WORDS[LANDNAV_FIXES],)),
         S1_POSITION,
@@ -384,6 +393,7 @@ PAPER = Paper(
         S2_EKF,
         _variant(S2_EKF, "situation2_ekf_diverges_140_landnav_fixes",
                  FIXES_WORDS[LANDNAV_FIXES],
+                 "situation2_landnav_fixes",
                  converged("situation2_landnav_fixes", ("ekf_m140",),
                            "the EKF does not converge", "higher"),
                  (FIXES_WORDS[LANDNAV_FIXES],)),
@@ -392,15 +402,19 @@ PAPER = Paper(
               "The DR/GPS system with the SPKF gives a stable solution even when the initial "
               "heading error is as large as 160 deg",
               "Abstract (no figure)", (*CONDITIONS, CONVERGE_WORDS, "from -160 deg"),
-              converged("situation2", ("spkf_m160",), "the SPKF converges")),
+              converged("situation2", ("spkf_m160",), "the SPKF converges"),
+              experiments=("situation2",)),
         S3,
         _variant(S3, "situation3_position_five_m_fixes", FIXES_WORDS[FIVE_M_FIXES],
+                 "situation3_five_m_fixes",
                  paired("situation3_five_m_fixes", "spkf", "ekf", "outage_growth_m", "m",
                         "SPKF error grows less"), (FIXES_WORDS[FIVE_M_FIXES],)),
         _variant(S3, "situation3_position_landnav_fixes", FIXES_WORDS[LANDNAV_FIXES],
+                 "situation3_landnav_fixes",
                  paired("situation3_landnav_fixes", "spkf", "ekf", "outage_growth_m", "m",
                         "SPKF error grows less"), (FIXES_WORDS[LANDNAV_FIXES],)),
         _variant(S3, "situation3_position_symmetric", "symmetric SPKF point set",
+                 "situation3",
                  paired("situation3", "spkf_sym", "ekf", "outage_growth_m", "m",
                         "symmetric-set SPKF error grows less"),
                  (PAPER_FIXES_WORDS, "the SPKF with the symmetric 2L + 1 point set")),
@@ -411,7 +425,7 @@ PAPER = Paper(
               "Fig. 12 (van data, trajectories only)",
               (VAN, "horizontal error 120 s after GNSS is lost"),
               paired("dr_outage", "drm2", "drm1", "dr_error_m", "m",
-                     "DRM2 error smaller")),
+                     "DRM2 error smaller"), experiments=("dr_outage",)),
         Claim("van_70_converges",
               "Van, initial heading 70 deg (true about 140): both filters converge to the "
               "right heading with GPS",
@@ -419,21 +433,21 @@ PAPER = Paper(
               "heading angle'",
               (VAN, "initial heading error -70 deg; converged: heading RMS over the second "
                     f"half of the 50 s before the loss below {CONVERGED_DEG:g} deg"),
-              lambda t: _before_outage(t, ("ekf_m70", "spkf_m70"))),
+              lambda t: _before_outage(t, ("ekf_m70", "spkf_m70")), experiments=("dr_outage",)),
         Claim("van_70_blockage",
               "Van from 70 deg: in the GPS blockage the EKF's position error becomes large, "
               "the SPKF's stays small (SPKF smaller)",
               "Figs. 13(a), 14(a) (trajectories, no number)",
               (VAN, "initial heading error -70 deg; error 120 s after the loss"),
               paired("dr_outage", "spkf_m70", "ekf_m70", "dr_error_m", "m",
-                     "SPKF error smaller")),
+                     "SPKF error smaller"), experiments=("dr_outage",)),
         Claim("van_0_blockage",
               "Van from 0 deg (true about 140): the SPKF gives a satisfactory solution, the "
               "EKF a somewhat large error in the blockage (SPKF smaller)",
               "Fig. 15 (trajectories, no number)",
               (VAN, "initial heading error -140 deg; error 120 s after the loss"),
               paired("dr_outage", "spkf_m140", "ekf_m140", "dr_error_m", "m",
-                     "SPKF error smaller")),
+                     "SPKF error smaller"), experiments=("dr_outage",)),
     ))
 
 

@@ -45,7 +45,6 @@ from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
-from scipy.stats import binomtest
 
 __all__ = ["ALPHA", "BOOTSTRAP_RESAMPLES", "BOOTSTRAP_SEED", "Better", "Evidence", "Magnitude",
            "evidence_text", "one_sample_evidence", "paired_evidence", "verdict_word"]
@@ -121,6 +120,8 @@ def _sign_p(wins: int, trials: int) -> float:
     """One-sided exact binomial sign test: P(X >= wins), X ~ Binomial(trials, 1/2)."""
     if trials == 0:
         return 1.0
+    from scipy.stats import binomtest  # here: scipy.stats costs more than a second to import
+
     return float(binomtest(wins, trials, 0.5, alternative="greater").pvalue)
 
 

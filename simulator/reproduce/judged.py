@@ -117,21 +117,25 @@ def untestable(key: str, text: str, paper_figure: str, reason: str,
 
 def sweep(key: str, text: str, paper_figure: str, conditions: Sequence[str],
           values: Mapping[str, Callable[[Mapping[str, pd.DataFrame]], Verdict]], default: str,
-          why_default: str, condition: str, kind: str = "paper") -> list[Claim]:
+          why_default: str, condition: str, kind: str = "paper",
+          reads: Mapping[str, Sequence[str]] | None = None) -> list[Claim]:
     """One claim per value of a deciding ``condition``: ``values`` maps the value in words
-    ("0.5 %") to its judge; ``default``, the value closest to the paper (``why_default``), is
-    the claim ``key``, the other values are its variants ``KEY@N``."""
+    ("0.5 %") to its judge, ``reads`` to the experiments that judge reads (default: every
+    experiment of the paper, ``Claim.experiments``); ``default``, the value closest to the
+    paper (``why_default``), is the claim ``key``, the other values are its variants
+    ``KEY@N``."""
     out = []
     for n, (value, judge) in enumerate(values.items()):
+        experiments = tuple((reads or {}).get(value, ()))
         if value == default:
             out.insert(0, Claim(key, text, paper_figure, (
                 *conditions, f"{condition}: {value} (the default: {why_default})"), judge,
-                kind=kind))
+                kind=kind, experiments=experiments))
         else:
             out.append(Claim(f"{key}@{n}", text, paper_figure, (
                 *conditions, f"{condition}: {value} (swept; the claim itself is judged at "
                              f"{default})"), judge, kind=kind, variant_of=key,
-                variant=f"{condition} {value}"))
+                variant=f"{condition} {value}", experiments=experiments))
     return out
 
 

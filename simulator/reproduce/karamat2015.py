@@ -461,17 +461,19 @@ def _bias_sweep(key: str, text: str, figure: str, values: dict) -> list[Claim]:
                                           values=values),
                          "5 mg": partial(judge_value, experiment="partial_outages_5mg",
                                          values=values)},
-                        BIAS_DEFAULT, BIAS_WHY, BIAS_LEVEL)
+                        BIAS_DEFAULT, BIAS_WHY, BIAS_LEVEL,
+                        reads={"30 mg": ("partial_outages",), "5 mg": ("partial_outages_5mg",)})
 
 
 def _gain(key: str, text: str, figure: str, experiment: str, worse: str,
           counts: tuple[int, ...], paper_pct: float | None, extra: str) -> Claim:
     return Claim(key, text, figure, [*CONDITIONS, EARLIER, extra],
                  partial(judge_gain, experiment=experiment, better="tight", worse=worse,
-                         counts=counts, paper_pct=paper_pct))
+                         counts=counts, paper_pct=paper_pct), experiments=(experiment,))
 
 
 KINGSTON = "the Kingston protocol: 60 s windows, each site with 3, 2, 1, 0 satellites"
+PROTOCOL_ONLY = ("partial_outages",)  # the experiments of the claims on the Kingston protocol
 TABLE2 = {
     "position": {"north (lat)": ("tight.sats0.rms_n_m", 5.48, "m"),
                  "east (long)": ("tight.sats0.rms_e_m", 4.65, "m"),
@@ -494,7 +496,8 @@ PAPER = Paper(
         *[Claim(f"under_12_m_{c}_satellites", f"On average the maximum horizontal error in a "
                 f"60 s window with {c} satellites is less than 12 m",
                 "< 12 m 'irrespective of the number of visible satellites' (section 4.3.1, "
-                "Figure 8)", [*CONDITIONS, KINGSTON], partial(judge_under_12, count=c))
+                "Figure 8)", [*CONDITIONS, KINGSTON], partial(judge_under_12, count=c),
+                experiments=PROTOCOL_ONLY)
           for c in COUNTS],
         *[_gain(f"fig8_tc_ekf_beats_tc_lkf_{c}_satellites", f"With {c} satellites TC-EKF's "
                 "average maximum horizontal error is smaller than TC-LKF's",
@@ -521,12 +524,14 @@ PAPER = Paper(
                       "roll": ("tight.rms_roll_deg", 0.52, "deg")}),
         Claim("more_satellites_can_hurt", "In some outages one satellite more increases the "
               "error, and zero or one satellite can do better than two or three",
-              "section 4.3.1, Figure 7 (bars)", [*CONDITIONS, KINGSTON], judge_more_can_hurt),
+              "section 4.3.1, Figure 7 (bars)", [*CONDITIONS, KINGSTON], judge_more_can_hurt,
+              experiments=PROTOCOL_ONLY),
         Claim("fig13_gyro_bias_converges", "The vertical-gyro bias estimate converges to its "
               "true value in about 300 s from the start of motion",
               "about -0.24 deg/s in about 300 s (section 4.3.3, Figure 13); landnav reads "
               "'converged' as within 0.05 deg/s", [*CONDITIONS, "the true bias drawn from "
-                                                  "Table 1's 2 deg/s"], judge_gyro_bias),
+                                                  "Table 1's 2 deg/s"], judge_gyro_bias,
+              experiments=PROTOCOL_ONLY),
         _gain("toronto_beats_tc_lkf", "In natural outages TC-EKF improves on TC-LKF by 63 % "
               "on average (maximum horizontal error)", "63 % (section 4.4, Figure 16)",
               "natural_outages", "simplified", (0,), 63.0, TORONTO),
@@ -536,20 +541,22 @@ PAPER = Paper(
         Claim("overall_beats_tc_lkf", "Overall TC-EKF improves on TC-LKF by 40 % in maximum "
               "2-D position error", "40 % (section 5): the mean of Kingston's 16 % with no "
               "satellite and Toronto's 63 %", [*CONDITIONS, EARLIER, KINGSTON, TORONTO],
-              partial(judge_overall, worse="simplified", paper_pct=40.0)),
+              partial(judge_overall, worse="simplified", paper_pct=40.0),
+              experiments=("partial_outages", "natural_outages")),
         Claim("overall_beats_lc_lkf", "Overall TC-EKF improves on LC-LKF by 53 %",
               "53 % (section 5): the mean of Kingston's 57 % and Toronto's 50 %",
               [*CONDITIONS, EARLIER, KINGSTON, TORONTO],
-              partial(judge_overall, worse="lc", paper_pct=53.0)),
+              partial(judge_overall, worse="lc", paper_pct=53.0),
+              experiments=("partial_outages", "natural_outages")),
         Claim("fig21_gyro_bias_steady", "Through the Toronto drive's outages the gyro-bias "
               "estimate converges close to its actual value and stays steady",
               "Figure 21 (no number); landnav: within 0.05 deg/s at the drive's end",
-              [*CONDITIONS, TORONTO], judge_gyro_bias_end),
+              [*CONDITIONS, TORONTO], judge_gyro_bias_end, experiments=("natural_outages",)),
         Claim("tight_below_four_satellites", "Tight coupling provides an integrated solution "
               "with fewer than four satellites (where loose coupling has none)",
               "introduction (no number)", [*CONDITIONS, KINGSTON, "the loose variant is the "
                                            "enhanced model on the receiver's fixes"],
-              judge_tight_below_four),
+              judge_tight_below_four, experiments=PROTOCOL_ONLY),
         judged.untestable("multipath_robustness", "The filter rejects or mitigates the "
                           "position errors of multipath and degraded GPS, keeping the "
                           "trajectory on the road while the GPS fixes jump",
@@ -568,15 +575,16 @@ PAPER = Paper(
         Claim("accel_bias_x_observable", "Check: the forward accelerometer-bias estimate "
               "follows the true bias (is nearer to it than zero is)", "not in the paper",
               [*CONDITIONS, KINGSTON], partial(judge_accel_bias_observed, axis="x"),
-              kind="check"),
+              kind="check", experiments=PROTOCOL_ONLY),
         Claim("accel_bias_y_observable", "Check: the lateral accelerometer-bias estimate "
               "follows the true bias", "not in the paper", [*CONDITIONS, KINGSTON],
-              partial(judge_accel_bias_observed, axis="y"), kind="check"),
+              partial(judge_accel_bias_observed, axis="y"), kind="check",
+              experiments=PROTOCOL_ONLY),
         *[Claim(f"ablation_{v}", f"Check: the enhanced model loses accuracy without "
                 f"{what} (mean window maximum over 3-0 satellites)",
                 "the paper attributes its gain to the tilt and accelerometer-error states",
                 [*CONDITIONS, KINGSTON], partial(judge_ablation, variant=v),
-                kind="check")
+                kind="check", experiments=PROTOCOL_ONLY)
           for v, what in (("no_accel_bias", "its accelerometer-bias states"),
                           ("no_tilt", "its tilt-error states"),
                           ("no_speed_error", "its odometer speed-error state"),

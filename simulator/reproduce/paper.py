@@ -20,7 +20,7 @@ Figures, Experiment, Verdict, Claim, ClaimKind, Paper, STATUSES, SCENARIO_DIR, s
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Literal
 
@@ -127,7 +127,12 @@ class Claim:
     if any, only gives landnav's figure for it (the word is "not testable", never one from
     evidence). A claim judged again under another value of a deciding condition names the
     default claim in ``variant_of`` and the value in ``variant`` ("fix noise 1.5 m"); the
-    summary tallies the default rows only."""
+    summary tallies the default rows only.
+
+    ``experiments`` names the experiments whose tables the judge reads (it is given those only,
+    so a judge reading another one fails); empty: every experiment of the paper. ``landnav
+    reproduce --quick`` runs the experiments of the claims that are no variant and leaves the
+    variants to the full run."""
 
     key: str
     text: str          # the claim as the paper makes it (a check: what landnav checks)
@@ -139,6 +144,7 @@ class Claim:
     untestable: str = field(default="", kw_only=True)  # why the paper claim cannot be tested
     variant_of: str = field(default="", kw_only=True)  # key of the default claim of a sweep
     variant: str = field(default="", kw_only=True)     # the swept condition's value, in words
+    experiments: tuple[str, ...] = field(default=(), kw_only=True)  # keys the judge reads
 
     def __post_init__(self) -> None:
         if isinstance(self.conditions, str) or not all(isinstance(c, str)
@@ -152,6 +158,7 @@ class Claim:
             raise ValueError(f"claim {self.key}: a testable claim needs a judge")
         if bool(self.variant_of) != bool(self.variant):
             raise ValueError(f"claim {self.key}: variant_of and variant go together")
+        object.__setattr__(self, "experiments", tuple(self.experiments))
 
 
 @dataclass(frozen=True)
@@ -167,3 +174,25 @@ class Paper:
     # experiment key -> per-seed figures) -> [(caption, matplotlib Figure)]
     figures: Callable[[Mapping[str, pd.DataFrame], Mapping[str, pd.DataFrame]],
                       list[tuple[str, Figure]]] | None = None
+
+    def __post_init__(self) -> None:
+        keys = {e.key for e in self.experiments}
+        for claim in self.claims:
+            unknown = sorted(set(claim.experiments) - keys)
+            if unknown:
+                raise ValueError(f"paper {self.key}, claim {claim.key}: no experiment "
+                                 f"{', '.join(unknown)}")
+
+    def read_by(self, claim: Claim) -> tuple[Experiment, ...]:
+        """The experiments whose tables ``claim``'s judge reads (``Claim.experiments``)."""
+        return tuple(e for e in self.experiments
+                     if not claim.experiments or e.key in claim.experiments)
+
+    def quick(self) -> Paper:
+        """The paper as ``landnav reproduce --quick`` runs it: its claims that are no variant
+        of another (a swept condition's other values are left to the full run) and the
+        experiments those claims read."""
+        claims = tuple(c for c in self.claims if not c.variant_of)
+        read = {e.key for c in claims if c.judge is not None for e in self.read_by(c)}
+        return replace(self, claims=claims,
+                       experiments=tuple(e for e in self.experiments if e.key in read))

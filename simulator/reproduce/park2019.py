@@ -281,6 +281,9 @@ def _judge_rms(tables: Mapping[str, pd.DataFrame]) -> Verdict:
                         RMS_OUTSIDE_M, "horizontal RMS outside the outages")
 
 
+INS_GARAGES = ("ins_park_garage", "ins_parking_garage")
+
+
 def _judge_ins_working(tables: Mapping[str, pd.DataFrame]) -> Verdict:
     return _every_below(tables, {k: (k, "nhc.rms_outside_m")
                                  for k in ("ins_park_garage", "ins_parking_garage")},
@@ -313,6 +316,7 @@ GYRO_SF_WHY = ("Park prints no scale factor for the SMI130; 0.5 % is the automot
 HELIX = "garage helices"
 HELIX_DEFAULT = "opposite-handed, 4.3 %"
 HELIX_WHY = "the paper's Fig. 16 shows the garage's two helices; the shipped garage's reading"
+HELIX_READS = {HELIX_DEFAULT: ("garage",), "same-handed, 8.7 %": ("garage_same_handed_steep",)}
 ODO = "INS odometer updates"
 ODO_DEFAULT = "every sample (10 Hz)"
 ODO_WHY = ("'sequentially after the GPS measurement update' orders the updates within a "
@@ -328,7 +332,8 @@ def _garage_sweep(key: str, text: str, figure: str, judge, experiments: Mapping[
     return judged.sweep(key, text, figure, CONDITIONS,
                         {value: partial(judge, experiment=experiment)
                          for value, experiment in experiments.items()},
-                        default, why, condition)
+                        default, why, condition,
+                        reads={value: (experiment,) for value, experiment in experiments.items()})
 
 
 def _vs(other: str, analysis: str = "", key: str = "exit_horizontal_m") -> partial:
@@ -360,7 +365,7 @@ PAPER = Paper(
                        "same-handed, 8.7 %": partial(
                            judge_beats, experiment="garage_same_handed_steep", mine="dr3d_ekf",
                            other="dr2d_odo_ekf", key="exit_yaw_deg")},
-                      HELIX_DEFAULT, HELIX_WHY, HELIX),
+                      HELIX_DEFAULT, HELIX_WHY, HELIX, reads=HELIX_READS),
         *judged.sweep("garage_beats_ins", GARAGE_CLAIM.format("INS/GPS/odometer's"),
                       f"{AREA1}: INS/GPS/odometer 23.69 m", CONDITIONS,
                       {HELIX_DEFAULT: partial(judge_beats, experiment="garage",
@@ -368,7 +373,7 @@ PAPER = Paper(
                        "same-handed, 8.7 %": partial(
                            judge_beats, experiment="garage_same_handed_steep", mine="dr3d_ekf",
                            other="ins_odo_ekf")},
-                      HELIX_DEFAULT, HELIX_WHY, HELIX),
+                      HELIX_DEFAULT, HELIX_WHY, HELIX, reads=HELIX_READS),
         *judged.sweep("garage_ins_worse_than_2d", "Underground garage: INS/GPS/odometer shows "
                       "larger errors than the 2-D DR/GPS (the accelerometer bias's velocity "
                       "error exceeds the odometer's)", f"{AREA1}: 23.69 m vs 13.72 m",
@@ -380,45 +385,50 @@ PAPER = Paper(
                            judge_beats, experiment="garage_ins_odometer_1hz",
                            mine="dr2d_odo_ekf", other="ins_odo_ekf", mine_from="garage",
                            paper_ratio=13.72 / 23.69)},
-                      ODO_DEFAULT, ODO_WHY, ODO),
+                      ODO_DEFAULT, ODO_WHY, ODO,
+                      reads={ODO_DEFAULT: ("garage",),
+                             "once a second (GPS rate)": ("garage_ins_odometer_1hz", "garage")}),
         Claim("fig19_height_contrast", "The 3-D DR/GPS's height changed only 1.22 m between the "
               "garage's entrance and exit (the same point), the INS/GPS/odometer's 22.34 m",
               "Fig. 19", [*CONDITIONS, "entry and exit are different points here: the "
                           "figure is the error of the estimated height change"],
-              judge_height_contrast),
+              judge_height_contrast, experiments=("garage",)),
         Claim("adaptation_improves_attitude", "The adaptation rule is important to estimate the "
               "attitude accurately: the 3-D DR/GPS without it estimates roll and pitch worse",
               "section IV-B, Fig. 16 (no number)", [*CONDITIONS, "roll and pitch RMS inside "
                                                     "the garage, against the truth"],
               partial(judge_beats, experiment="garage_ablation", mine="dr3d_ekf",
-                      other="dr3d_no_adaptation", key="rms_tilt_deg", mine_from="garage")),
+                      other="dr3d_no_adaptation", key="rms_tilt_deg", mine_from="garage"),
+              experiments=("garage_ablation", "garage")),
         Claim("scale_not_estimated_hurts", "Without estimating the odometer scale factor a "
               "wrong one induces yaw error at curves and a larger position error even with GPS",
               "section III-E, Figs. 5-8 (MATLAB simulation, no number)",
               [*CONDITIONS, "the garage drive's open road, true scale factor 1.03, held at 1.0 "
                "without the state; horizontal RMS outside the outage"],
               partial(judge_beats, experiment="garage_ablation", mine="dr3d_ekf",
-                      other="dr3d_fixed_scale", key="rms_outside_m", mine_from="garage")),
+                      other="dr3d_fixed_scale", key="rms_outside_m", mine_from="garage"),
+              experiments=("garage_ablation", "garage")),
         Claim("fig9_scale_factor_converges", "The odometer scale-factor estimate converges to "
               "the true value (1.03 and 0.97 here)", "Fig. 9 (MATLAB simulation); landnav "
               "reads 'converges' as within 0.5 % at the garage's entry", CONDITIONS,
-              judge_scale),
+              judge_scale, experiments=("garage", "garage_scale_097")),
         Claim("fig15_open_sky_bounded", "In open sky with GPS blocked for 40 s the 3-D DR/GPS's "
               "horizontal error does not diverge and stays under 7 m",
               "Figs. 14-15: bounded under 7 m (against GPS)",
               ["simulated interchange loop ramp (8 % grade, 270 deg) in open sky, GNSS blocked "
                "for 40 s by a fault; errors against the truth (the paper: against GPS)"],
-              judge_open_sky_bounded),
+              judge_open_sky_bounded, experiments=("open_sky",)),
         Claim("open_sky_conventional_grows", "A conventional algorithm's error would grow in "
               "the blockage: the 2-D DR/GPS and the INS/GPS/odometer do worse",
               "section IV-B: 'the error will increase monotonically with time' (no figure)",
               ["the open-sky blockage above; the 2-D DR and the INS replay the same data"],
-              judge_open_sky_conventional),
+              judge_open_sky_conventional, experiments=("open_sky_conventional", "open_sky")),
         *[Claim(f"area2_beats_{tag}", f"Multilevel garage: the 3-D DR/GPS's position error is "
                 f"smaller than the {name}'s", f"Table 3, area 2 (182 s): {figure}",
                 ["simulated multilevel garage (four-floor helix up, rooftop lap, helix down; "
                  "the real geometry is not published), 203 s without GNSS",
-                 *CONDITIONS[1:]], partial(_vs(other), experiment="multilevel_garage"))
+                 *CONDITIONS[1:]], partial(_vs(other), experiment="multilevel_garage"),
+                experiments=("multilevel_garage",))
           for tag, name, other, figure in (
               ("2d", "2-D DR/GPS", "dr2d_odo_ekf", "2-D DR/GPS 9.60 m"),
               ("ins", "INS/GPS/odometer", "ins_odo_ekf", "INS/GPS/odometer 24.20 m"))],
@@ -426,25 +436,29 @@ PAPER = Paper(
               "larger than the 2-D DR/GPS's", "Table 3, area 2: 24.20 m vs 9.60 m",
               ["the multilevel garage above", *CONDITIONS[1:]],
               partial(judge_beats, experiment="multilevel_garage", mine="dr2d_odo_ekf",
-                      other="ins_odo_ekf", paper_ratio=9.60 / 24.20)),
+                      other="ins_odo_ekf", paper_ratio=9.60 / 24.20),
+              experiments=("multilevel_garage",)),
         Claim("fig18_tunnel_beats_2d", "Curved tunnel (159 s): the 3-D DR/GPS's error after the "
               "exit is 1.91 m against the 2-D DR/GPS's 5.74 m", "Fig. 18",
               ["simulated 2.6 km tunnel with a gentle S-curve and a 3 % climb (the real "
                "geometry is not published); error at the last epoch before GNSS returns",
                *CONDITIONS[1:]],
               partial(judge_beats, experiment="curved_tunnel", mine="dr3d_ekf",
-                      other="dr2d_odo_ekf", paper_ratio=1.91 / 5.74, analysis=TUNNEL_ANALYSIS)),
+                      other="dr2d_odo_ekf", paper_ratio=1.91 / 5.74, analysis=TUNNEL_ANALYSIS),
+              experiments=("curved_tunnel",)),
         Claim("fig18_tunnel_ins_bad", "Curved tunnel: the INS/GPS/odometer performs badly (its "
               "attitude is not compensated correctly)", "section IV-B (no number)",
               ["the curved tunnel above", *CONDITIONS[1:]],
-              partial(_vs("ins_odo_ekf"), experiment="curved_tunnel")),
+              partial(_vs("ins_odo_ekf"), experiment="curved_tunnel"),
+              experiments=("curved_tunnel",)),
         Claim("fig21_beats_riss", "In a tunnel the 3-D DR/GPS is more accurate than the 3-D "
               "RISS/GPS", "Fig. 21 (132 s tunnel of dataset 2): 20.86 m vs 24.56 m",
               ["the 159 s curved tunnel above (the 132 s tunnel is not described)",
                "the 3-D RISS/GPS is Karamat's riss3d_tc_ekf on the receiver's fixes, its noise "
                "from the SMI130 datasheet", *CONDITIONS[1:]],
               partial(judge_beats, experiment="curved_tunnel", mine="dr3d_ekf", other="riss3d",
-                      paper_ratio=20.86 / 24.56)),
+                      paper_ratio=20.86 / 24.56),
+              experiments=("curved_tunnel",)),
         judged.untestable("dataset2", "Dataset 2: area 1 (314 s) INS/GPS/odometer 92.83 m, 2-D "
                           "DR/GPS 20.37 m; area 2 (201 s) 26.44 m and 21.93 m; the proposed "
                           "filter smaller", "Table 3, dataset 2",
@@ -461,21 +475,22 @@ PAPER = Paper(
               "dr2d_odo_ekf disappears (exit and max error ratios within 0.3 of 1)",
               "sections III-E and IV-B: the gain comes from the 3-D geometry and the odometer "
               "scale factor (no number)", [*CONDITIONS, "helices and ramps levelled"],
-              lambda t: _flat(t, "dr2d_odo_ekf"), kind="check"),
+              lambda t: _flat(t, "dr2d_odo_ekf"), kind="check", experiments=("flat_garage",)),
         Claim("flat_no_advantage_ins", "Check: the same against ins_odo_ekf (ratios within 0.3 "
               "of 1)", "sections III-E and IV-B (no number)",
               [*CONDITIONS, "helices and ramps levelled"],
-              lambda t: _flat(t, "ins_odo_ekf"), kind="check"),
+              lambda t: _flat(t, "ins_odo_ekf"), kind="check", experiments=("flat_garage",)),
         Claim("working_filters", "Check: all three filters have horizontal RMS under 5 m "
-              "outside the outages", "not printed", CONDITIONS, _judge_rms, kind="check"),
+              "outside the outages", "not printed", CONDITIONS, _judge_rms, kind="check",
+              experiments=("garage",)),
         Claim("ins_working", "Check: ins_odo_ekf on the automotive body is under 5 m RMS "
               "outside the outages of Park's garage and parking_garage.yaml", "not printed",
               ["NHC at the rear axle (the datasheet's installation geometry), its noise from "
                "the bicycle model's tyre slip; parking_garage.yaml has a 100 Hz IMU"],
-              _judge_ins_working, kind="check"),
+              _judge_ins_working, kind="check", experiments=INS_GARAGES),
         Claim("ins_uses_nhc", "Check: ins_odo_ekf's NHC lowers its garage error (both garages)",
               "section II-A, eqs. 12-14: the NHC bounds the INS error (no number)",
-              ["NHC at the rear axle"], _judge_ins_nhc, kind="check"),
+              ["NHC at the rear axle"], _judge_ins_nhc, kind="check", experiments=INS_GARAGES),
     ))
 
 
@@ -506,19 +521,21 @@ def figures(histories: Mapping[str, pd.DataFrame], tables: Mapping[str, pd.DataF
                     "outage", fig))
     if "garage" in tables:
         table = tables["garage"]
-        fig, axes = seed_plots.new_figure(2)
+        fig, axes = seed_plots.new_figure(2, width_in=5.0, height_in=3.6)
         seed_plots.seed_bars(axes[0], {f: m.column(table, f"{f}.height_change_error_m")
                                        for f in ("dr3d_ekf", "ins_odo_ekf")})
-        axes[0].set(title="Fig. 19: height change error (paper 1.22 vs 22.34 m)",
-                    ylabel="|estimated - true height change| (m)", yscale="log")
-        sweeps = {f"{f} {value}": m.column(tables[key], f"{f}.exit_horizontal_m")
+        axes[0].set(ylabel="|estimated - true height change| (m)", yscale="log")
+        axes[0].set_title("Fig. 19: height change error\n(paper: 3-D DR 1.22 m, INS 22.34 m)",
+                          fontsize=9)
+        sweeps = {f"{name} {value}": m.column(tables[key], f"{f}.exit_horizontal_m")
                   for value, key in (("0.5 %", "garage"), ("0.25 %", "garage_gyro_sf_025"),
                                      ("0.1 %", "garage_gyro_sf_010"),
-                                     ("same-handed 8.7 %", "garage_same_handed_steep"))
-                  if key in tables for f in ("dr3d_ekf", "dr2d_odo_ekf")}
+                                     ("same-handed", "garage_same_handed_steep"))
+                  if key in tables for f, name in (("dr3d_ekf", "3-D"), ("dr2d_odo_ekf", "2-D"))}
         seed_plots.seed_bars(axes[1], sweeps)
-        axes[1].set(title="Table 3 area 1: exit error by gyro scale factor and helices",
-                    ylabel="horizontal error at the exit (m)")
+        axes[1].set(ylabel="horizontal error at the exit (m)")
+        axes[1].set_title("Table 3 area 1: exit error by z-gyro scale factor\n(same-handed: "
+                          "8.7 % helices turning one way, 0.5 %)", fontsize=9)
         out.append(("Fig. 19 and Table 3 layout: the height change through the garage, and the "
                     "garage exit error under the swept conditions", fig))
     return (out + seed_plots.nees_figure(tables)

@@ -69,7 +69,7 @@ def _settings_rows(settings: Settings) -> list[tuple[str, str]]:
     seeds = settings.seeds
     where = (f"Dask scheduler {settings.scheduler}" if settings.scheduler
              else f"{settings.workers} local worker process(es)")
-    return [("mode", "quick (shortened drives)" if settings.quick else "full"),
+    return [("mode", "quick (shortened drives, no variant claims)" if settings.quick else "full"),
             ("seeds", f"{len(seeds)} ({seeds[0]}..{seeds[-1]})" if seeds else "none"),
             ("wall time", f"{settings.wall_time_s:.0f} s"),
             ("CPU time of the runs", f"{settings.cpu_time_s:.0f} s"),

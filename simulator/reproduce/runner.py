@@ -168,7 +168,8 @@ class Settings:
 
 
 def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict]:
-    """Every testable claim of a paper judged on its experiments' tables; a judge that raises
+    """Every testable claim of a paper judged on the tables of the experiments it reads
+    (``Claim.experiments``); a judge that raises
     (figures missing because seeds failed) gives ``not shown`` with the error as its reason,
     and a word that does not follow from its evidence by the rule is replaced by the rule's
     (``ruled``)."""
@@ -177,7 +178,8 @@ def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict
         if claim.judge is None:
             continue
         try:
-            verdict = claim.judge(tables)
+            verdict = claim.judge({e.key: tables[e.key] for e in paper.read_by(claim)
+                                   if e.key in tables})
             # an untestable claim's judge gives landnav's figure only: no evidence, no word
             out[claim.key] = (replace(verdict, status="not shown", evidence=None,
                                       magnitude=None, compared=())
@@ -223,8 +225,9 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
               force: bool = False) -> list[PaperResult]:
     """Reproduce ``papers`` (keys of ``simulator.reproduce.papers.PAPERS``; all when empty) over
     seeds 1..``runs`` (default 10, or 3 with ``quick``, which also shortens each experiment's
-    drive by its ``quick_overrides``), on ``workers`` local processes or the Dask
-    ``scheduler``; write the figures and the report into ``out`` (module docstring).
+    drive by its ``quick_overrides`` and runs no variant claim, ``Paper.quick``), on
+    ``workers`` local processes or the Dask ``scheduler``; write the figures and the report
+    into ``out`` (module docstring).
 
     Raises
     ------
@@ -233,6 +236,8 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
         an installation without the shipped scenarios.
     """
     loaded = [load_paper(key) for key in (papers or paper_keys())]
+    if quick:
+        loaded = [paper.quick() for paper in loaded]
     for paper in loaded:  # a missing scenario stops the run before any worker starts
         for experiment in paper.experiments:
             scenario_path(experiment.scenario)

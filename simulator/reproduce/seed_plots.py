@@ -61,7 +61,8 @@ def seed_bars(ax: object, groups: Mapping[str, Sequence[float] | np.ndarray],
         color = colors[k % len(colors)]
         ax.bar(k, np.nanmean(v), color=color, alpha=0.4, width=0.7)
         ax.plot(k + rng.uniform(-0.2, 0.2, len(v)), v, "o", color=color, ms=3)
-    ax.set_xticks(range(len(groups)), list(groups), rotation=20, fontsize=8)
+    ax.set_xticks(range(len(groups)), list(groups), rotation=30, ha="right",
+                  rotation_mode="anchor", fontsize=8)
 
 
 def nees_figure(tables: Mapping[str, pd.DataFrame]) -> list[tuple[str, Figure]]:

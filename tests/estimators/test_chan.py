@@ -102,3 +102,38 @@ def test_registered_with_the_spec_config_keys():
     assert get_estimator("tc_ukf").defaults["beta"] == 2.0
     with pytest.raises(InputError, match="unknown config key"):
         get_estimator("tc_ekf")(config={"gamma": 1}, initial=None, columns={}, units={})
+
+
+def test_z_accelerometer_misalignment_states_grow_the_vertical_velocity_variance():
+    """A car standing rolled by 30 deg (the specific force f_y = g sin 30 deg on its y axis),
+    no GNSS: the two states of the z accelerometer's misalignment towards x and y (prior
+    sigma_m) add (C_b^n[2, 2] sigma_m |f_xy| T)^2 to the vertical velocity's variance after T
+    seconds, the closed form of a random constant times a known force (the filter otherwise
+    identical, its states' prior set to 0). tc_ekf: the UKF forms its covariance only at an
+    update, and its points take the same states in ``_propagate_points``."""
+    from estimators.base import InitialState
+    from simulator.earth import OMEGA_E_RAD_S, euler_to_dcm, normal_gravity
+
+    lat, roll, seconds, sigma_m = np.radians(45.0), np.radians(30.0), 20.0, 1e-3
+    c_bn = euler_to_dcm(roll, 0.0, 0.0)
+    g = float(normal_gravity(lat, 0.0))
+    f_body = c_bn.T @ np.array([0.0, 0.0, -g])
+    w_body = c_bn.T @ (OMEGA_E_RAD_S * np.array([np.cos(lat), 0.0, -np.sin(lat)]))
+    columns = {"imu": {c: i + 1 for i, c in enumerate(
+        ("gyro_x", "gyro_y", "gyro_z", "accel_x", "accel_y", "accel_z"))}}
+    quiet = {"nhc": False, "accel_noise": 1e-9, "gyro_noise": 1e-12, "accel_bias_walk": 0.0,
+             "gyro_bias_walk": 0.0, "accel_bias_std": 1e-6, "gyro_bias_std": 1e-9,
+             "initial_attitude_std": [1e-6] * 3, "initial_velocity_std": 1e-3,
+             "accel_scale_factor": 0.0, "gyro_scale_factor": 0.0}
+
+    def vd_variance(m_std: float) -> float:
+        initial = InitialState(0.0, np.array([lat, 0.0, 0.0]), np.zeros(3),
+                               np.array([roll, 0.0, 0.0]))
+        est = get_estimator("tc_ekf")({**quiet, "accel_z_misalignment_std": m_std}, initial,
+                                  columns, {}, imu_output="rate")
+        for t in np.arange(0.0, seconds + 1e-9, 0.01):
+            est.on_imu(float(t), np.r_[t, w_body, f_body])
+        return float(est.solution(seconds)[14]) ** 2  # std_vd
+
+    expected = (c_bn[2, 2] * sigma_m * np.hypot(*f_body[:2]) * seconds) ** 2
+    assert vd_variance(sigma_m) - vd_variance(0.0) == pytest.approx(expected, rel=0.02)

@@ -1,8 +1,9 @@
-"""The short straight drive the hostile-input tests start from, as scenario text, and its
-dataset generated through the command line; the small dataset several cases share (IMU,
-odometer, GNSS fix and raw; 100 m) as the fixtures ``dataset`` and ``copy_dataset``
-(``shared_dataset``, ``shared_dataset_copy``), imported by the modules that use them: a
-second conftest.py would shadow the tests' own ``conftest`` module."""
+"""The short straight drive the hostile-input tests start from, as scenario text, as a
+scenario file with estimators, and its dataset generated through the command line; the small
+dataset several cases share (IMU, odometer, GNSS fix and raw; 100 m) as the fixtures
+``dataset`` and ``copy_dataset`` (``shared_dataset``, ``shared_dataset_copy``), imported by
+the modules that use them: a second conftest.py would shadow the tests' own ``conftest``
+module."""
 
 from __future__ import annotations
 
@@ -29,6 +30,17 @@ def straight_drive(length_m: float = 100, sensors: str = "", tail: str = "") -> 
     if sensors:
         text += "sensors:\n" + sensors
     return text + tail
+
+
+def estimator_scenario(folder: Path, length_m: float, imu_rate_hz: float,
+                       estimators: str) -> Path:
+    """``folder/s.yaml``: the straight drive of ``length_m`` with an ideal IMU at
+    ``imu_rate_hz`` and the YAML list ``estimators``; its path."""
+    path = folder / "s.yaml"
+    path.write_text(straight_drive(length_m,
+                                   sensors=f"  imu: {{preset: ideal, rate: {imu_rate_hz:g}}}\n",
+                                   tail=f"estimators: {estimators}\n"))
+    return path
 
 
 def generated_dataset(root: Path, scenario_text: str) -> Path:

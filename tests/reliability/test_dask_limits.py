@@ -5,13 +5,11 @@ the other runs complete; a worker process killed mid-run fails that run (named b
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pandas as pd
 import pytest
 
 from simulator.cli import main
-from tests.reliability.drives import straight_drive
+from tests.reliability.drives import estimator_scenario
 
 PLUGINS = "tests.reliability.hostile_plugins"
 
@@ -29,16 +27,10 @@ def cluster():
         yield c
 
 
-def _scenario(tmp_path: Path, estimators: str) -> Path:
-    path = tmp_path / "s.yaml"
-    path.write_text(straight_drive(20, sensors="  imu: {preset: ideal, rate: 25}\n",
-                                   tail=f"estimators: {estimators}\n"))
-    return path
-
-
 def test_the_time_limit_holds_on_dask_workers(cluster, tmp_path, capsys):
-    scenario = _scenario(tmp_path, f"[{{name: '{PLUGINS}:Holds', label: holds}}, "
-                                   f"{{name: '{PLUGINS}:NeverReturns', label: never}}]")
+    scenario = estimator_scenario(tmp_path, 20, 25,
+                                  f"[{{name: '{PLUGINS}:Holds', label: holds}}, "
+                                  f"{{name: '{PLUGINS}:NeverReturns', label: never}}]")
     out = tmp_path / "mc"
     assert main(["campaign", str(scenario), "--runs", "2", "--scheduler",
                  cluster.scheduler_address, "--time-limit", "5", "-o", str(out)]) == 0
@@ -54,7 +46,8 @@ def test_the_time_limit_holds_on_dask_workers(cluster, tmp_path, capsys):
 
 @pytest.mark.slow  # about 10 s of CPU: two worker restarts
 def test_a_worker_killed_mid_run_fails_that_run_only(cluster, tmp_path, capsys):
-    scenario = _scenario(tmp_path, f"[{{name: '{PLUGINS}:KillsItsWorker', label: kills}}]")
+    scenario = estimator_scenario(tmp_path, 20, 25,
+                                  f"[{{name: '{PLUGINS}:KillsItsWorker', label: kills}}]")
     out = tmp_path / "mc"
     assert main(["campaign", str(scenario), "--runs", "2", "--scheduler",
                  cluster.scheduler_address, "--sweep", "estimators.0.config.kill=false,true",

@@ -15,7 +15,10 @@ import pytest
 from simulator import isolated
 from simulator.cli import main
 from tests.reliability.checks import alive, refused
-from tests.reliability.drives import shared_dataset, straight_drive  # noqa: F401 (fixture)
+from tests.reliability.drives import (  # noqa: F401 (fixture)
+    estimator_scenario,
+    shared_dataset,
+)
 
 PLUGIN_CLASS = ("from tests.reliability.hostile_plugins import _Base\n\n\n"
                 "class Hostile(_Base):\n    pass\n")
@@ -45,10 +48,7 @@ def _plugin(tmp_path: Path, monkeypatch, module: str, text: str) -> Path:
 
 
 def _scenario(work: Path, module: str) -> Path:
-    path = work / "s.yaml"
-    path.write_text(straight_drive(30, sensors="  imu: {preset: ideal, rate: 50}\n",
-                                   tail=f"estimators: [{{name: '{module}:Hostile'}}]\n"))
-    return path
+    return estimator_scenario(work, 30, 50, f"[{{name: '{module}:Hostile'}}]")
 
 
 @pytest.mark.parametrize("module", list(AT_IMPORT))

@@ -82,9 +82,9 @@ def test_a_failing_run_is_reported_with_its_error():
 @pytest.mark.parametrize("runs", [1, pytest.param(3, marks=pytest.mark.slow)])
 def test_quick_run_of_every_paper(tmp_path, capsys, runs):
     """Every registered paper on its shortened drives end to end, one seed (``--quick``'s 3
-    with --runslow; the claims themselves are asserted on seeds 1-3 by tests/estimators/; three
-    seeds: 130 s of CPU in the runs for Cho and Tan, whose situations run at two or three
-    fix-noise levels). The report names each paper and every claim with a figure and a word,
+    with --runslow; the claims themselves are asserted on seeds 1-3 by tests/estimators/). The
+    report names each paper and every claim that is no variant with a figure and a word (each
+    judge given only the experiments it declares), runs no experiment that only variants read,
     and the independent script recomputes every word from results.json."""
     out = tmp_path / "repro"
     assert main(["reproduce", "--quick", "--runs", str(runs), "--workers", "2", "-o",
@@ -93,11 +93,17 @@ def test_quick_run_of_every_paper(tmp_path, capsys, runs):
     page = (out / "report.html").read_text()
     for key in paper_keys():
         paper = load_paper(key)
+        quick = paper.quick()
         assert paper.title in md and html.escape(paper.title, quote=False) in page
-        for experiment in paper.experiments:
+        for experiment in quick.experiments:
             table = pd.read_parquet(out / "figures" / key / f"{experiment.key}.parquet")
             assert list(table.index) == list(range(1, runs + 1)), (key, experiment.key)
+        left = {e.key for e in paper.experiments} - {e.key for e in quick.experiments}
+        assert not [p for p in (out / "figures" / key).iterdir() if p.stem in left]
         for claim in paper.claims:
+            if claim.variant_of:  # --quick leaves the variants to the full run
+                assert f"**{claim.key}**" not in md, claim.key
+                continue
             if claim.untestable:
                 continue
             (row,) = [line for line in md.splitlines() if f"**{claim.key}**" in line]
@@ -124,15 +130,16 @@ def test_help_lists_the_papers(capsys):
 
 
 def test_on_a_dask_cluster_the_figures_are_those_of_an_in_process_run(tmp_path):
-    """Tan's outage, 2 seeds, shortened drive, on a loopback Dask cluster: the figures stored
-    equal those of ``run_experiment`` in this process (same scenario and seed, same numbers)."""
+    """Tan's outage (the smallest experiment), one seed, shortened drive, on a loopback Dask
+    cluster of one worker process: the figures stored equal those of ``run_experiment`` in this
+    process (same scenario and seed, same numbers)."""
     distributed = pytest.importorskip("distributed")
     out = tmp_path / "dask"
-    with distributed.LocalCluster(host="127.0.0.1", n_workers=2, threads_per_worker=1,
+    with distributed.LocalCluster(host="127.0.0.1", n_workers=1, threads_per_worker=1,
                                   processes=True, dashboard_address=None) as cluster:
-        assert main(["reproduce", "tan2008", "--quick", "--runs", "2", "--scheduler",
+        assert main(["reproduce", "tan2008", "--quick", "--runs", "1", "--scheduler",
                      cluster.scheduler_address, "-o", str(out)]) == 0
     stored = pd.read_parquet(out / "figures" / "tan2008" / "outage.parquet")
-    expected = run_experiment(tan2008.OUTAGE, [1, 2], tmp_path, quick=True)
+    expected = run_experiment(tan2008.OUTAGE, [1], tmp_path, quick=True)
     pd.testing.assert_frame_equal(stored, expected, check_exact=False, rtol=1e-12)
     assert "Dask scheduler" in (out / "report.md").read_text()

@@ -160,3 +160,39 @@ def test_every_registered_paper_loads_with_unique_keys_and_module_level_measures
             # picklable by reference: a module-level function
             assert e.measure.__qualname__ == e.measure.__name__
             assert (SCENARIO_DIR / e.scenario).is_file(), e.scenario
+
+
+@pytest.mark.parametrize("key", paper_keys())
+def test_quick_runs_the_claims_that_are_no_variant_and_only_the_experiments_they_read(key):
+    """``--quick`` (``Paper.quick``): every claim but the variants, every experiment a kept
+    claim's judge reads, and no other; every experiment of the full paper is read by a claim."""
+    paper = load_paper(key)
+    quick = paper.quick()
+    assert [c.key for c in quick.claims] == [c.key for c in paper.claims if not c.variant_of]
+    read = {e.key for c in quick.claims if c.judge is not None for e in paper.read_by(c)}
+    assert [e.key for e in quick.experiments] == [e.key for e in paper.experiments
+                                                 if e.key in read]
+    assert {e.key for c in paper.claims if c.judge is not None for e in paper.read_by(c)} == \
+        {e.key for e in paper.experiments}
+
+
+def test_a_judge_is_given_only_the_experiments_it_declares():
+    """A claim reading an experiment it does not name cannot be judged (the mapping --quick
+    relies on is checked on every run); one without ``experiments`` reads them all."""
+    from simulator.reproduce.paper import Claim, Experiment, Paper
+
+    def read_b(tables):
+        return m.count_verdict(int(tables["b"]["x"].sum()), 3, 0.9, "measured", "x")
+
+    experiments = tuple(Experiment(k, "quickstart.yaml", {}, measure=len) for k in ("a", "b"))
+    paper = Paper("p", "t", "c", experiments, (
+        Claim("names_a", "t", "f", (), read_b, experiments=("a",)),
+        Claim("names_b", "t", "f", (), read_b, experiments=("b",)),
+        Claim("names_none", "t", "f", (), read_b)))
+    table = pd.DataFrame({"x": [1, 1, 1]}, index=pd.Index([1, 2, 3], name="seed"))
+    verdicts = judge(paper, {"a": table, "b": table})
+    assert "could not be judged: KeyError" in verdicts["names_a"].reason
+    assert verdicts["names_b"].evidence.wins == verdicts["names_none"].evidence.wins == 3
+    with pytest.raises(ValueError, match="no experiment c"):
+        Paper("p", "t", "c", experiments, (Claim("names_c", "t", "f", (), read_b,
+                                                 experiments=("c",)),))

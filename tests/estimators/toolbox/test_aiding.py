@@ -118,6 +118,7 @@ def test_gnss_velocity_and_odometer_with_lever_arms_against_finite_differences()
     fns = {
         "velocity": lambda q, v, w: aiding.gnss_velocity(v, V_TRUE, 15, q, w, arm),
         "odometer": lambda q, v, w: aiding.odometer(q, v, 10.0, True, 15, w, rear),
+        "path_speed": lambda q, v, w: aiding.path_speed(q, v, 10.0, 15, w, rear),
     }
     for fn in fns.values():
         def measure(dx, fn=fn):
@@ -131,3 +132,23 @@ def test_gnss_velocity_and_odometer_with_lever_arms_against_finite_differences()
     c_bn = quat_to_dcm(Q_TRUE)
     dz, _ = aiding.gnss_velocity(V_TRUE, V_TRUE, 15, Q_TRUE, rate, arm)
     np.testing.assert_allclose(dz, c_bn @ np.cross(rate, arm), atol=1e-12)
+
+
+@pytest.mark.parametrize("direction", [1.0, -1.0])
+def test_path_speed_is_the_speed_on_the_circle_a_point_turns_on(direction):
+    """A car turning steadily about a centre R = 11 m beside its rear axle (which rolls without
+    sliding), the IMU on the rear axle: its centre of gravity, l_r = 1.35 m ahead, runs on a
+    circle of radius sqrt(R^2 + l_r^2) at w sqrt(R^2 + l_r^2), forward or reversing, while
+    its body-x velocity is only w R (the factor cos(beta), beta = atan(l_r / R))."""
+    radius, l_r, speed = 11.0, 1.35, 4.0 * direction
+    yaw = 0.7
+    q = euler_to_quat(0.0, 0.0, yaw)
+    v_ned = speed * np.array([np.cos(yaw), np.sin(yaw), 0.0])  # the rear axle's, along x
+    rate = np.array([0.0, 0.0, speed / radius])
+    cog = np.array([l_r, 0.0, 0.0])
+    along_path = speed / radius * np.hypot(radius, l_r)
+    dz, _ = aiding.path_speed(q, v_ned, along_path, 15, rate, cog)
+    assert dz[0] == pytest.approx(0.0, abs=1e-12)
+    dz_x, _ = aiding.odometer(q, v_ned, along_path, False, 15, rate, cog)
+    assert dz_x[0] == pytest.approx(speed - along_path, rel=1e-12)
+    assert abs(dz_x[0]) == pytest.approx(abs(speed) * (np.hypot(1.0, l_r / radius) - 1.0))
