@@ -82,6 +82,7 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     if profile is not None:
         ctx.built["profile"] = profile
         _check_job_size(value, profile.duration_s, path, ctx)
+        _check_rates(value, profile.duration_s, path, ctx)
         check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
                      float(profile.distance_of_time(profile.duration_s)))
     labels: set[str] = set()
@@ -171,6 +172,22 @@ def _check_job_size(value: dict, duration_s: float, path: Path, ctx: Context) ->
                   f"{', '.join(gnss.get('systems') or ('gps',))}), more than one job may hold "
                   f"({MAX_JOB_BYTES / 1e9:.3g} GB); lower sensors.gnss.rate, track fewer "
                   "systems or signals, or split the drive")
+
+
+def _check_rates(value: dict, duration_s: float, path: Path, ctx: Context) -> None:
+    """No rate of the truth or of a sensor has a period longer than the drive: one such as
+    ``rate: 1e-300`` gives a table of one row at most, and a stream timed by it (the IMU's
+    integration interval) ages without bound."""
+    rated = [(("sensors", name, "rate"), sensor.get("rate"))
+             for name, sensor in value["sensors"].items() if isinstance(sensor, dict)]
+    imu = value["sensors"].get("imu")
+    if not (isinstance(imu, dict) and imu.get("rate") == value["trajectory"].get("rate")):
+        rated.append((("trajectory", "rate"), value["trajectory"].get("rate")))  # its own
+    for key, rate_hz in rated:
+        if isinstance(rate_hz, float | int) and rate_hz * duration_s < 1:
+            ctx.error(path + key, f"at {rate_hz:g} Hz one sample period is longer than the "
+                                  f"{duration_s:.4g} s drive; give at least "
+                                  f"{1 / duration_s:.3g} Hz")
 
 
 def _zones_used(value: dict) -> set[str] | None:
