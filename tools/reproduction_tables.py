@@ -12,6 +12,8 @@ Usage::
 
     python tools/reproduction_tables.py RUN/results.json docs/reproduction_cho2006.md ...
 
+Several runs (one per paper, say) are read as one: name each results.json before the pages.
+
 A page without a block is left as it is and named; exit status 1 then, 0 otherwise.
 """
 
@@ -113,14 +115,33 @@ def rewrite(page: Path, document: dict) -> bool:
     return found
 
 
+def combined(documents: list[dict]) -> dict:
+    """One results document of several runs: their claims and per-paper summaries together,
+    the software, seeds and mode of each run named when they differ."""
+    first = documents[0]
+    document = {**first, "claims": {}, "summary": {"per_paper": {}}}
+    for other in documents:
+        document["claims"].update(other["claims"])
+        document["summary"]["per_paper"].update(other["summary"]["per_paper"])
+    for key in ("software", "seeds", "quick"):
+        values = [d[key] for d in documents]
+        if any(v != values[0] for v in values):
+            raise SystemExit(f"the runs differ in {key!r}: {values}")
+    return document
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("results", type=Path)
-    parser.add_argument("pages", type=Path, nargs="+")
+    parser.add_argument("files", type=Path, nargs="+",
+                        help="one or more results.json of landnav reproduce runs, then the pages")
     args = parser.parse_args(argv)
-    document = json.loads(args.results.read_text(encoding="utf-8"))
+    runs = [f for f in args.files if f.suffix == ".json"]
+    pages = [f for f in args.files if f.suffix != ".json"]
+    if not runs or not pages:
+        parser.error("name at least one results.json and one page")
+    document = combined([json.loads(f.read_text(encoding="utf-8")) for f in runs])
     status = 0
-    for page in args.pages:
+    for page in pages:
         if not rewrite(page, document):
             print(f"{page}: no '<!-- claims: PAPER -->' block", file=sys.stderr)
             status = 1

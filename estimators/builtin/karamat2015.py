@@ -80,7 +80,8 @@ update the estimated errors are removed from the navigation state and sensor-err
 The Gauss-Markov tilt and odometer-acceleration corrections decay as their models do.
 
 ``frozen_states`` (an ablation, empty by default) holds named states of the enhanced model at
-zero: no initial uncertainty, no process noise, so no update moves them; with ``bx, by`` the
+zero: no initial uncertainty, no process noise and no row of F (eq. 32 couples the speed error to
+a_od), so no update moves them; with ``bx, by`` the
 enhanced model runs without its accelerometer-bias states, which the reproduction uses to
 attribute the enhanced model's gain to the states that give it (docs/reproduction_karamat2015.md).
 
@@ -96,7 +97,15 @@ gyro's noise density plus its scale factor and misalignment times the turn rate 
 correlated-noise inflation of the receiver's carrier smoothing
 (``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
 ``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon. ``nis_gnss`` and ``nis_gnss_dof`` give the NIS of each GNSS update (SPEC section
+of a canyon. A gate that trusts the filter's covariance locks the filter out when its error
+outgrows that covariance (after an outage: the altitude runaway and heading jump of a turn with
+two satellites are not in Q): every returning range fails, only the Doppler rows pass, and these
+keep P small while the position stays tens of metres off. So after ``REACQUIRE_EPOCHS`` (3)
+epochs in a row in which most ranges fail (NLOS strikes satellites one by one, a wrong
+prediction all of them), the position and clock-bias variances grow by what makes the median
+range one sigma (covariance matching, ``gating.matching_variance``) and the ranges are gated
+again: the consistent ones pass, a range far beyond them stays out. ``nis_gnss`` and
+``nis_gnss_dof`` give the NIS of each GNSS update (SPEC section
 8). At a standstill the reported heading is the last direction of travel turned by the
 azimuth state since (the azimuth state itself was reported before, tens of degrees off). No
 velocity, roll or pitch sigma is written: the mechanisation recomputes the velocity from the
@@ -135,6 +144,7 @@ STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
 _I = {name: i for i, name in enumerate(STATES)}
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``chan``)
+REACQUIRE_EPOCHS = 3  # epochs with most pseudoranges gated out before the covariance is matched
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
 
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
@@ -312,13 +322,16 @@ class RissTcEkf(Estimator):
         if problems:
             raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
         p0_sigma, q_white, gm = self._tuning(cfg["tuning"])
-        for name in frozen:  # a state without uncertainty or noise is never corrected
+        for name in frozen:  # without uncertainty, noise or coupling: never corrected
             p0_sigma[name], q_white[name] = 0.0, 0.0
             if name in gm:
                 gm[name] = (0.0, gm[name][1])
         self._enhanced = cfg["model"] == "enhanced"
         self._tight = cfg["coupling"] == "tight"
         self._n = len(STATES) if self._enhanced else SIMPLIFIED_STATES
+        # F's rows of the frozen states are zeroed: eq. 32 (dv_o' = da_od) would otherwise pass
+        # the a_od uncertainty into a frozen speed error, which the updates then correct
+        self._frozen = np.array([_I[name] for name in frozen if _I[name] < self._n], dtype=int)
         init = self.initial
         self._lat, self._lon, self._h = (float(v) for v in init.position)
         vn0, ve0, vd0 = (float(v) for v in init.velocity)
@@ -341,6 +354,7 @@ class RissTcEkf(Estimator):
         self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n]
         self.nis_gnss = self.nis_gnss_dof = math.nan
+        self._rejecting = 0  # GNSS epochs in a row in which the gate rejected most ranges
         self._gm_index = np.array([g[0] for g in self._gm])
         self._noise_cache: dict[float, tuple[np.ndarray, np.ndarray]] = {}
         # sums over the IMU samples of the current odometer interval
@@ -571,6 +585,7 @@ class RissTcEkf(Estimator):
         scale[0] = rm + self._h
         scale[1] = (rn + self._h) * math.cos(self._lat)
         f = f * scale[:, None] / scale[None, :]
+        f[self._frozen] = 0.0
         fdt = f * dt
         phi = np.eye(self._n) + fdt + 0.5 * fdt @ fdt
         phi_gm, q_d = self._noise(dt)
@@ -642,14 +657,31 @@ class RissTcEkf(Estimator):
         g = d_ned @ forward
         r[m:, m:] += self.config["odometer_speed_noise"] ** 2 * np.outer(g, g)
         keep = np.ones(2 * m, dtype=bool)
-        if self._gate_p is not None:  # each pseudorange against H P H^T + its reported R
-            p = self._filter.p
-            s_pr = np.einsum("ij,jk,ik->i", h[:m], p, h[:m]) + var_pr
-            keep[:m] = gating.rows_passing(dz[:m], s_pr, self._gate_p)
+        if self._gate_p is not None:
+            keep[:m] = self._gate_ranges(dz[:m], h[:m], var_pr)
         s = self._filter.update(dz[keep], h[keep], r[np.ix_(keep, keep)])
         self.nis_gnss = gating.normalised_innovation_squared(dz[keep], s)
         self.nis_gnss_dof = float(keep.sum())
         self._feedback()
+
+    def _gate_ranges(self, dz: np.ndarray, h: np.ndarray, var_pr: np.ndarray) -> np.ndarray:
+        """The pseudoranges passing the chi-square gate, each against H P H^T + its reported
+        variance; after ``REACQUIRE_EPOCHS`` epochs in a row in which most of them failed, the
+        position and clock-bias variances first grow by what makes the median range one sigma
+        (``gating.matching_variance``; each range's row has a unit line of sight and a 1 on the
+        clock, so half of it on each of the four states): without it a filter that left an
+        outage further off than its covariance says rejected every returning range for good."""
+        s_pr = np.einsum("ij,jk,ik->i", h, self._filter.p, h) + var_pr
+        passing = gating.rows_passing(dz, s_pr, self._gate_p)
+        self._rejecting = self._rejecting + 1 if 2 * passing.sum() < len(dz) else 0
+        if self._rejecting >= REACQUIRE_EPOCHS:
+            self._rejecting = 0
+            grow = 0.5 * gating.matching_variance(dz, s_pr)
+            states = [_I["N"], _I["E"], _I["h"], _I["cb"]]
+            self._filter.p[states, states] += grow
+            s_pr = np.einsum("ij,jk,ik->i", h, self._filter.p, h) + var_pr
+            passing = gating.rows_passing(dz, s_pr, self._gate_p)
+        return passing
 
     def _feedback(self) -> None:
         """Closed loop: remove the estimated errors (estimate minus truth) from the state."""

@@ -12,6 +12,15 @@ toolbox (off unless a paper's filter uses them).
   specific-force norm minus gravity, the vehicle speed, the innovation) is beyond a threshold.
   ``threshold_variance`` gives the variance for one such rule; the rules themselves, with the
   paper's thresholds, live with the filter that uses them.
+* Re-acquisition after a lock-out: a gate tests each measurement against the filter's own
+  covariance, so a filter whose error has outgrown its covariance (an outage its process noise
+  under-describes) rejects every returning measurement and never recovers. Outliers (multipath,
+  NLOS) strike satellites one by one; when most rows of an epoch fail, the prediction is the
+  more likely culprit. ``matching_variance`` gives the variance that, added to every row's S,
+  makes the median row's innovation one sigma (covariance matching, Mehra, "Approaches to
+  adaptive filtering", IEEE Trans. Autom. Control 17, 1972, section III-B): the filter adds it
+  to the states the rows observe and gates again, so the consistent majority passes and a row
+  still far beyond it stays rejected.
 
 ``update`` of ``estimators.toolbox.kalman`` returns S, so a filter gates by computing the
 prediction, calling ``passes_gate(nu, s)`` with S = H P H^T + R (``innovation_covariance``), and
@@ -19,8 +28,8 @@ updating only when it passes.
 
 Public functions
 ----------------
-chi2_threshold, innovation_covariance, normalised_innovation_squared, passes_gate,
-rows_passing, threshold_variance.
+chi2_threshold, innovation_covariance, matching_variance, normalised_innovation_squared,
+passes_gate, rows_passing, threshold_variance.
 """
 
 from __future__ import annotations
@@ -75,6 +84,14 @@ def rows_passing(nu: np.ndarray, s_diag: np.ndarray, probability: float = 0.999)
     nu_i^2 <= chi2_1(probability) S_ii, for ``nu`` (m,) and the variances ``s_diag`` (m,)
     (the per-measurement outlier test of Groves 2013, section 17.3.1)."""
     return np.asarray(nu, float) ** 2 <= chi2_threshold(1, probability) * np.asarray(s_diag)
+
+
+def matching_variance(nu: np.ndarray, s_diag: np.ndarray) -> float:
+    """The variance q >= 0 to add to every row's S_ii so that the median row's innovation is
+    one sigma: median(nu_i^2 - S_ii) (covariance matching, Mehra 1972; module docstring), for
+    ``nu`` (m,) and the variances ``s_diag`` (m,)."""
+    excess = np.asarray(nu, float) ** 2 - np.asarray(s_diag, float)
+    return max(0.0, float(np.median(excess)))
 
 
 def threshold_variance(statistic: float, threshold: float, sigma_nominal: float,

@@ -209,7 +209,8 @@ def test_full_drive_gyro_bias_converged(full_drive):
 def test_frozen_states_are_never_corrected(tmp_path):
     """``frozen_states`` (the ablation of the enhanced model's states): with the accelerometer
     biases frozen their estimates stay exactly zero through a loop with GNSS, while the full
-    model moves them; an unknown state name is refused."""
+    model moves them; with all of its additions frozen and the accelerometer update off the
+    enhanced model is the earlier one; an unknown state name is refused."""
     ds = one_loop(tmp_path / "d")
     frozen, _ = run_estimator(ds, {"name": "riss3d_tc_ekf", "config": {
         "tuning": "paper", "frozen_states": ["bx", "by"]}}, show_progress=False)
@@ -217,6 +218,41 @@ def test_frozen_states_are_never_corrected(tmp_path):
                             show_progress=False)
     assert (frozen[["accel_bias_x", "accel_bias_y"]].to_numpy() == 0.0).all()
     assert np.abs(full["accel_bias_x"].to_numpy()).max() > 1e-4
+    # every addition of the enhanced model frozen and its accelerometer update off: the earlier
+    # model's solution (a leak through eq. 32's dv_o' = da_od moved the frozen speed error)
+    inert, _ = run_estimator(ds, {"name": "riss3d_tc_ekf", "config": {
+        "tuning": "paper", "frozen_states": ["r", "p", "bx", "by", "vo"],
+        "accel_update_interval": 1e9}}, show_progress=False)
+    earlier, _ = run_estimator(ds, {"name": "riss3d_tc_ekf", "config": {
+        "tuning": "paper", "model": "simplified"}}, show_progress=False)
+    columns = ["lat", "lon", "alt", "vn", "ve", "vd", "yaw", "std_n", "gyro_bias_z", "clock_bias"]
+    np.testing.assert_allclose(inert[columns].to_numpy(), earlier[columns].to_numpy(),
+                               rtol=1e-12, atol=1e-9)
     with pytest.raises(InputError, match="frozen_states must be among r, p, bx, by, vo"):
         run_estimator(ds, {"name": "riss3d_tc_ekf", "label": None, "init": None,
                            "config": {"frozen_states": ["bz"]}}, show_progress=False)
+
+
+def test_gate_takes_the_ranges_back_from_a_filter_off_by_a_known_error(tmp_path):
+    """The datasheet tuning's chi-square gate after a lock-out: the filter starts 50 m off while
+    its covariance says 3 m (as after an outage its process noise under-describes), so every
+    pseudorange fails the gate at first. After ``REACQUIRE_EPOCHS`` such epochs the position and
+    clock covariance is matched to the innovations: from 30 s on every range is accepted and
+    the horizontal error is inside three of the filter's own sigmas (without the rule: 45 m at
+    30 s, three or four of the seven ranges accepted)."""
+    drive = ("[{accelerate: {to_speed: 12.0, accel: 1.2}}, {straight: {length: 600}}, "
+             "{turn: {angle: 90, radius: 40}}, {straight: {length: 600}}]")
+    scenario = load_scenario(scenario_path(karamat.SCENARIO), [
+        f"trajectory.segments={drive}", "faults=[]", "estimators=[]"], seed=1)
+    ds = open_dataset(generate_dataset(scenario, tmp_path / "d", show_progress=False))
+    solution, _ = run_estimator(ds, {"name": "riss3d_tc_ekf", "label": "ds", "config": {},
+                                     "init": {"position_error": [40.0, -30.0, 0.0]}},
+                                show_progress=False)
+    t, err = horizontal_error(ds, solution)
+    assert err[0] > 40.0
+    late = solution["t"].to_numpy() >= 30.0
+    sigma = np.hypot(solution["std_n"], solution["std_e"]).to_numpy()[late]
+    assert np.all(np.interp(solution["t"].to_numpy()[late], t, err) < 3.0 * sigma)
+    satellites = ds.read("gnss_raw").groupby("t").size().to_numpy()
+    accepted = solution.loc[late, "nis_gnss_dof"].dropna().to_numpy()
+    assert np.all(accepted == 2 * satellites.max())  # every range and every rate

@@ -107,3 +107,39 @@ def test_nees_history_figure_draws_one_panel_per_history():
     ((caption, fig),) = seed_plots.nees_history_figure({"a": history, "b": history})
     assert caption.startswith("Position NEES against time") and len(fig.axes) == 2
     assert seed_plots.nees_history_figure({}) == []
+
+
+def _karamat_check(key: str):
+    return next(c for c in karamat2015.PAPER.claims if c.key == key)
+
+
+def test_karamat_bias_observability_check_tells_a_tracking_estimate_from_a_stuck_one():
+    """The check's evidence is per seed: an estimate within 2 mg of truths of 10-60 mg is
+    observed (6/6 seeds, sign test p = 1/64), one stuck near zero whatever the truth is not."""
+    assert _karamat_check("accel_bias_x_observable").kind == "check"
+    true = np.array([10.0, -25.0, 40.0, 60.0, -15.0, 30.0])
+    for estimate, status in ((true + 2.0, "shown"), (np.full(6, 0.4), "not shown")):
+        table = pd.DataFrame({"tight.accel_bias_x_est_mg": estimate,
+                              "true.accel_bias_x_mg": true}, index=SEEDS)
+        verdict = _karamat_check("accel_bias_x_observable").judge({"partial_outages": table})
+        assert verdict.status == status
+        assert verdict.per_seed["|estimate - truth|"] == pytest.approx(
+            list(np.abs(estimate - true)))
+
+
+@pytest.mark.parametrize("variant", ["no_accel_bias", "no_tilt", "no_speed_error",
+                                     "no_accel_update", "simplified"])
+def test_karamat_ablation_check_pairs_the_variant_with_the_full_model_per_seed(variant):
+    """A variant 40 % worse on every seed is a loss (ratio 1 / 1.4); one equal to the full model
+    is not (every seed a tie)."""
+    full = np.array([10.0, 3.0, 8.0, 12.0, 6.0, 9.0])
+    for factor, status in ((1.4, "shown"), (1.0, "not shown")):
+        columns = {}
+        for label, values in (("tight", full), (variant, factor * full)):
+            for c in karamat2015.COUNTS:
+                columns[f"{label}.sats{c}.mean_max_h_m"] = values
+        table = pd.DataFrame(columns, index=SEEDS)
+        verdict = _karamat_check(f"ablation_{variant}").judge({"partial_outages": table})
+        assert verdict.status == status
+        assert verdict.evidence.effect == pytest.approx(1.0 / factor)
+        assert verdict.per_seed[variant] == pytest.approx(list(factor * full))

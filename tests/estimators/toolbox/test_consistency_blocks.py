@@ -2,14 +2,17 @@
 independent of itself: the Euler-angle covariance against a Monte Carlo of the attitude
 perturbation, the range-error channels against their bookkeeping contract and the closed-form
 Gauss-Markov variance, the datasheet reader against a preset's own figures, the row gate
-against scipy's chi-square quantile, the sigma-point measurement prediction against H P H^T."""
+against scipy's chi-square quantile, the re-acquisition's covariance matching against a
+position error of known size, the sigma-point measurement prediction against H P H^T."""
 
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.stats import chi2
 
-from estimators.toolbox.gating import rows_passing
+from estimators.toolbox.gating import matching_variance, rows_passing
+from estimators.toolbox.kalman import update
 from estimators.toolbox.nav_error import euler_covariance, perturb
 from estimators.toolbox.range_bias import RangeBiasChannels
 from estimators.toolbox.sensor_datasheet import BIAS_INSTABILITY_TIME_S, ImuDatasheet
@@ -79,6 +82,35 @@ def test_rows_passing_is_the_chi_square_quantile_of_one_dof():
     s = np.array([4.0, 4.0, 1.0])
     nu = np.sqrt(limit * s) * np.array([0.99, 1.01, 1.0 - 1e-9])
     assert list(rows_passing(nu, s, 0.999)) == [True, False, True]
+
+
+def test_matching_variance_lets_a_filter_off_by_a_known_error_take_its_ranges_back():
+    """A filter whose position is 40 m off while its covariance says 1 m (what a lock-out after
+    an outage looks like): every range fails the gate; with the matched variance added to the
+    position and clock states the consistent ranges pass, a 300 m NLOS range still fails, and
+    one update with the passing ranges removes most of the 40 m."""
+    rng = np.random.default_rng(3)
+    los = rng.normal(size=(7, 3))
+    los[:, 2] = np.abs(los[:, 2]) + 0.3  # satellites above the horizon (north, east, up)
+    los /= np.linalg.norm(los, axis=1)[:, None]
+    h = np.hstack([los, np.ones((7, 1))])  # d range / d (north, east, up, clock)
+    error = np.array([40.0, -10.0, 15.0, 0.0])  # estimate minus truth, m
+    r_var = np.full(7, 1.5**2)
+    nu = h @ error + rng.normal(0.0, 1.5, 7)  # predicted minus measured range
+    nu[6] += 300.0  # one NLOS range
+    p = np.eye(4)
+    s_diag = np.einsum("ij,jk,ik->i", h, p, h) + r_var
+    assert not rows_passing(nu, s_diag).any()
+    q = matching_variance(nu, s_diag)
+    assert q == pytest.approx(np.median(nu**2 - s_diag))
+    p_grown = p + 0.5 * q * np.eye(4)  # each row: unit line of sight and a 1 on the clock
+    s_grown = np.einsum("ij,jk,ik->i", h, p_grown, h) + r_var
+    np.testing.assert_allclose(s_grown, s_diag + q)
+    passing = rows_passing(nu, s_grown)
+    assert passing[:6].sum() >= 4 and not passing[6]
+    x, _, _ = update(np.zeros(4), p_grown, nu[passing], h[passing], np.diag(r_var[passing]))
+    assert np.linalg.norm((error - x)[:3]) < 0.25 * np.linalg.norm(error[:3])
+    assert matching_variance(np.zeros(3), np.ones(3)) == 0.0  # a consistent filter: nothing
 
 
 def test_predicted_measurement_of_a_linear_model_is_h_x_and_h_p_h():
