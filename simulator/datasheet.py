@@ -31,11 +31,22 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
     over the carrier-smoothing time (``RangeErrorBudget.smoothed_m``).
 
 * ``fix_uere_m``: the root sum square of the two, the one number of a ROS fix covariance.
+* ``cn0_template``: the C/N0 a direct signal has at each elevation (the receiver and antenna's
+  nominal ``cn0_zenith`` and ``cn0_horizon``, ``nominal_cn0_dbhz``) and the scatter of a
+  direct signal's reported C/N0 about it (``cn0_fading`` and ``cn0_noise`` in quadrature): the
+  template a user calibrates on open sky, against which a reflected or diffracted signal
+  shows its loss (Brunner, Hartinger & Troyer 1999, the SIGMA-Delta model).
 
 Public names
 ------------
-iono_residual_fractions, RangeErrorBudget, range_error_budget, fix_uere_m,
-KLOBUCHAR_NIGHT_SLANT_M, TROPO_MAPPING_30_DEG, IONO_FIELD_OWN_SHARE.
+iono_residual_fractions, RangeErrorBudget, range_error_budget, fix_uere_m, Cn0Template,
+cn0_template, nominal_cn0_dbhz, KLOBUCHAR_NIGHT_SLANT_M, TROPO_MAPPING_30_DEG,
+IONO_FIELD_OWN_SHARE, CN0_ELEVATION_SCALE_DEG.
+
+References
+----------
+Brunner, Hartinger & Troyer, "GPS signal diffraction modelling: the stochastic SIGMA-Delta
+model", Journal of Geodesy 73, 259-267, 1999.
 """
 
 from __future__ import annotations
@@ -45,10 +56,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 C_M_S = 299_792_458.0  # speed of light, m/s
 KLOBUCHAR_NIGHT_SLANT_M = 5e-9 * C_M_S * 1.77  # the broadcast model's night floor at 30 deg, m
 TROPO_MAPPING_30_DEG = 2.0  # slant / zenith troposphere at 30 deg elevation (1 / sin 30 deg)
 IONO_FIELD_OWN_SHARE = 0.5  # the share of the field's 1-sigma that differs between satellites
+CN0_ELEVATION_SCALE_DEG = 17.0  # e-folding elevation of the C/N0 loss towards the horizon
 
 
 def _value(gnss: Mapping[str, Any], key: str, default: float = 0.0) -> float:
@@ -103,3 +117,34 @@ def fix_uere_m(gnss: Mapping[str, Any], ionosphere: bool = True) -> float:
     ``ionosphere=False`` leaves the ionosphere out."""
     budget = range_error_budget(gnss)
     return math.hypot(budget.correlated_m(ionosphere), budget.smoothed)
+
+
+def nominal_cn0_dbhz(elevation_rad: np.ndarray, zenith_dbhz: float, horizon_dbhz: float
+                     ) -> np.ndarray:
+    """A direct signal's carrier-to-noise density, dB-Hz, from the antenna gain pattern and the
+    path through the atmosphere: zenith - (zenith - horizon) exp(-el / 17 deg) (the shape
+    fitted to the ARL1 station's L1 C/N0, ``simulator.gnss.receiver.cn0_model``)."""
+    el_deg = np.degrees(np.clip(elevation_rad, 0, None))
+    return zenith_dbhz - (zenith_dbhz - horizon_dbhz) * np.exp(-el_deg / CN0_ELEVATION_SCALE_DEG)
+
+
+@dataclass(frozen=True)
+class Cn0Template:
+    """A receiver's C/N0 of direct signals against elevation and their scatter about it, dB."""
+
+    zenith_dbhz: float
+    horizon_dbhz: float
+    scatter_db: float
+
+    def expected_dbhz(self, elevation_rad: np.ndarray) -> np.ndarray:
+        """The C/N0 of a direct signal at ``elevation_rad``, dB-Hz."""
+        return nominal_cn0_dbhz(elevation_rad, self.zenith_dbhz, self.horizon_dbhz)
+
+
+def cn0_template(gnss: Mapping[str, Any]) -> Cn0Template | None:
+    """The C/N0 template of a receiver block (module docstring); None when it has no
+    ``cn0_zenith`` and ``cn0_horizon`` (a real recording's receiver)."""
+    if gnss.get("cn0_zenith") is None or gnss.get("cn0_horizon") is None:
+        return None
+    return Cn0Template(float(gnss["cn0_zenith"]), float(gnss["cn0_horizon"]),
+                       math.hypot(_value(gnss, "cn0_fading"), _value(gnss, "cn0_noise")))

@@ -32,18 +32,28 @@ SHORT_SEGMENTS = [
 ]
 
 
-def scenario(seed: int, short: bool) -> dict:
-    """The shipped scenario at ``seed``, shortened to ``SHORT_SEGMENTS`` if ``short``."""
+# the dual-band rover's signals of each system (the base tracks the same)
+SIGNALS = {"gps": ["1C", "2L"], "galileo": ["1C", "7Q"], "beidou": ["2I", "7I"]}
+RINEX_LETTERS = {"gps": "G", "galileo": "E", "beidou": "C"}
+
+
+def scenario(seed: int, short: bool, systems: tuple[str, ...] = ("gps",)) -> dict:
+    """The shipped scenario at ``seed``, shortened to ``SHORT_SEGMENTS`` if ``short``, rover
+    and base tracking ``systems`` (the dual-band signals of ``SIGNALS``)."""
     data = yaml.safe_load(SCENARIO.read_text())
     data = copy.deepcopy(data)
     data["seed"] = seed
     if short:
         data["trajectory"]["segments"] = SHORT_SEGMENTS
+    if tuple(systems) != ("gps",):
+        data["sensors"]["gnss"]["systems"] = list(systems)
+        data["sensors"]["gnss_base"]["systems"] = list(systems)
+        data["sensors"]["gnss_base"]["signals"] = {s: SIGNALS[s] for s in systems}
     data["estimators"] = ["rtk_ins_ekf"]
     return data
 
 
-def process(work: Path, seed: int, short: bool) -> dict:
+def process(work: Path, seed: int, short: bool, systems: tuple[str, ...] = ("gps",)) -> dict:
     """Generate, replay rtk_ins_ekf, export RINEX, run rnx2rtkp; the two solutions' scores
     (``rtk_ins_ekf`` and ``rtklib``: the ``rtk`` block, and ``consistency`` for ours) and the
     CPU seconds of each (``cpu_s``) with the drive's duration (``duration_s``)."""
@@ -56,7 +66,7 @@ def process(work: Path, seed: int, short: bool) -> dict:
 
     work.mkdir(parents=True, exist_ok=True)
     path = work / f"rtk_seed{seed}.yaml"
-    path.write_text(yaml.safe_dump(scenario(seed, short)))
+    path.write_text(yaml.safe_dump(scenario(seed, short, systems)))
     data = work / f"seed{seed}"
     generate(load_scenario(path), data, show_progress=False)
     dataset = open_dataset(data)
@@ -68,7 +78,9 @@ def process(work: Path, seed: int, short: bool) -> dict:
     base = manifest["gnss_base"]
     pos = work / f"seed{seed}.pos"
     rtklib_cpu = kinematic_solution(obs, obs.with_name(obs.stem + "_base.obs"), nav,
-                                    np.array([base["x"], base["y"], base["z"]]), pos)
+                                    np.array([base["x"], base["y"], base["z"]]), pos,
+                                    None if tuple(systems) == ("gps",)
+                                    else "".join(RINEX_LETTERS[s] for s in systems))
     start_gps = manifest["gps_time_start"]
     rtklib, _, _ = read_solution_file(pos, (start_gps["week"], start_gps["tow"]))
     scored = score_solutions(dataset, {"rtk_ins_ekf": (frame, info), "rtklib": (rtklib, None)})

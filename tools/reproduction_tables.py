@@ -54,9 +54,7 @@ def _evidence(claim: dict) -> str:
 def table(document: dict, paper: str) -> list[str]:
     """The markdown lines of ``paper``'s claims in ``document`` (results.json)."""
     claims = [c for c in document["claims"].values() if c["paper"] == paper]
-    seeds = document["seeds"]
-    lines = [f"Figures of `landnav reproduce` ({document['software']}; "
-             f"{'quick, ' if document['quick'] else ''}seeds {seeds[0]}-{seeds[-1]}, more "
+    lines = [f"Figures of `landnav reproduce` ({_run(document, paper)}, more "
              "where an experiment asks for them), written from its results.json by "
              "`tools/reproduction_tables.py`.", ""]
     groups = (("The paper's claims", lambda c: c["kind"] == "paper" and not c["variant_of"]),
@@ -82,9 +80,7 @@ def summary(document: dict) -> list[str]:
     """The markdown lines of the run's summary: per paper its claims and landnav's checks by
     word, counted apart."""
     words = ("shown", "partly", "not shown", "not testable")
-    lines = [f"Summary of `landnav reproduce` ({document['software']}; "
-             f"{'quick, ' if document['quick'] else ''}seeds {document['seeds'][0]}-"
-             f"{document['seeds'][-1]}), written from its results.json by "
+    lines = [f"Summary of `landnav reproduce` ({_run(document)}), written from its results.json by "
              "`tools/reproduction_tables.py`.", "",
              "| paper | claims: " + " / ".join(words) + " | checks: shown / partly / not shown |",
              "|---|---|---|"]
@@ -117,17 +113,32 @@ def rewrite(page: Path, document: dict) -> bool:
 
 def combined(documents: list[dict]) -> dict:
     """One results document of several runs: their claims and per-paper summaries together,
-    the software, seeds and mode of each run named when they differ."""
+    each paper's software and seeds kept with it (``by_paper``)."""
     first = documents[0]
-    document = {**first, "claims": {}, "summary": {"per_paper": {}}}
+    document = {**first, "claims": {}, "summary": {"per_paper": {}}, "by_paper": {}}
     for other in documents:
+        if other["quick"] != first["quick"]:
+            raise SystemExit("the runs mix --quick and full runs")
         document["claims"].update(other["claims"])
         document["summary"]["per_paper"].update(other["summary"]["per_paper"])
-    for key in ("software", "seeds", "quick"):
-        values = [d[key] for d in documents]
-        if any(v != values[0] for v in values):
-            raise SystemExit(f"the runs differ in {key!r}: {values}")
+        for paper in other["summary"]["per_paper"]:
+            document["by_paper"][paper] = {"software": other["software"],
+                                           "seeds": other["seeds"]}
     return document
+
+
+def _run(document: dict, paper: str | None = None) -> str:
+    """The software and seeds of ``paper``'s run, or of the runs (the papers named where
+    they differ from the first)."""
+    def words(run: dict) -> str:
+        quick = "quick, " if document["quick"] else ""
+        return f"{run['software']}; {quick}seeds {run['seeds'][0]}-{run['seeds'][-1]}"
+
+    by_paper = document.get("by_paper", {})
+    if paper is not None:
+        return words(by_paper.get(paper, document))
+    others = [f"{p}: {words(r)}" for p, r in by_paper.items() if words(r) != words(document)]
+    return words(document) + "".join(f"; {o}" for o in others)
 
 
 def main(argv: list[str] | None = None) -> int:

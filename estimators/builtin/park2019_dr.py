@@ -79,14 +79,28 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   fix_error_model``, sized by the first fix's DOPs, its white remainder as the GPS noise);
   in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
   dominant error) and the barometer offset's error (set at the first good fix, a random walk
-  of the datasheet's weather drift; its white noise the sensor's), with the car's own
-  acceleration (the odometer speed's change over 0.5 s forwards, the turn's centripetal s u w
-  sideways) removed from the g-slave specific force; in 2-D the z gyro's
-  scale-factor error as bias process noise (s times the change of rate).
+  of the datasheet's weather drift; its white noise the sensor's); in 2-D the z gyro's
+  scale-factor error as bias process noise (s times the change of rate). In 3-D also the car
+  under the IMU (the datasheet's ``vehicle`` block, ``toolbox.installation``): the truth's
+  attitude is the body's, which yaws by the side slip and pitches on its springs relative to
+  the path the odometer counts, and Park's model (velocity along body x) turned both into
+  confident errors: the GPS course pulled the yaw to the path's heading (11 deg apart in an
+  8 m turn), the barometer's height rate the pitch to the path's grade (the squat, 0.3 deg
+  per m/s^2; open road pitch (error/sigma)^2 6.5, SUMO city 14, yaw 14). Here the IMU's
+  velocity is ``car_body_velocity`` (the rear axle along x, w_z L sideways, the squat k a
+  below x with k a random-constant state, prior ``NonholonomicNoise.pitch_compliance``), in
+  the position, the course (the tyres' slip and the fix's velocity noise its variance; the
+  fix's velocity noise the speed's) and the g-slave (the specific force loses d v/dt + w x v
+  of that velocity, the odometer's acceleration over 0.5 s); what it leaves out (the tyres'
+  slip, the suspension's travel: ``NonholonomicNoise``) is velocity noise correlated over
+  1 s; the g-slave's variance adds the odometer acceleration's noise (two speeds of the
+  datasheet's noise 0.5 s apart) and the tyres' slip turned by the yaw rate; the gyro scale
+  factor is bias process noise (a helix turns it into yaw); each fix row passes a chi-square
+  gate (0.999) against reflected canyon heights.
 
-Public classes
---------------
-Dr2dOdoEkf, Dr3dEkf.
+Public names
+------------
+Dr2dOdoEkf, Dr3dEkf, car_body_velocity.
 """
 
 from __future__ import annotations
@@ -98,9 +112,11 @@ from numba import njit
 
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
-from estimators.toolbox.datasheet import fix_error_model, imu_error_model
-from estimators.toolbox.gating import threshold_variance
+from estimators.toolbox.constraints import NonholonomicNoise
+from estimators.toolbox.datasheet import fix_error_model, imu_error_model, odometer_speed_sigma
+from estimators.toolbox.gating import rows_passing, threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
+from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.nav_error import euler_error_jacobian
 from estimators.toolbox.strapdown import attitude_step, frame_rates, radii
@@ -118,8 +134,12 @@ TUNINGS = ("datasheet", "paper")
 G0 = 9.80665  # m/s^2
 # dr3d_ekf's states added by the datasheet tuning after Park's ten: the accelerometers' roll and
 # pitch error, the barometer's offset error, the fix's correlated north, east, down error
-TILT, BARO, FIX = slice(10, 12), 12, slice(13, 16)
-N_DR3D_SHEET = 16
+# pitch and the body's pitch on its springs per forward acceleration (the velocity's angle below
+# the body x axis per m/s^2, a random constant)
+TILT, BARO, FIX, SQUAT = slice(10, 12), 12, slice(13, 16), 16
+N_DR3D_SHEET = 17
+GATE_PROBABILITY = 0.999  # the fixes' chi-square gate with the datasheet tuning
+SLIP_TIME_S = 1.0  # correlation time of the tyres' unmodelled slip velocity (a turn's length)
 METRES_PER_PASCAL = 0.0833  # height per pascal near sea level (standard atmosphere), m/Pa
 ACCEL_WINDOW_S = 0.5  # odometer speeds differenced for the along-track acceleration, s
 BARO_RATE_TIME_S = 600.0  # the weather's constant pressure rate as a random walk over 10 min
@@ -127,21 +147,24 @@ BARO_RATE_TIME_S = 600.0  # the weather's constant pressure rate as a random wal
 
 @njit(cache=True)
 def _dr3d_navigate(q: np.ndarray, c_old: np.ndarray, pos: np.ndarray, v_prev: np.ndarray,
-                   dtheta: np.ndarray, v_body: float, u: float, dt: float,
-                   f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+                   dtheta: np.ndarray, v_body: np.ndarray, u: float, dt: float,
+                   f: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+                                           np.ndarray]:
     """The 3-D DR navigation processor over one step (eqs. 3, 20-21) and the error model's
     time-varying blocks (eqs. 28-32, toolbox psi sign) written into ``f`` (10, 10).
 
     q, c_old: attitude at the step start; pos: latitude, longitude (rad), height (m); v_prev:
     NED velocity of the previous step (for the transport rate); dtheta: bias-corrected gyro
-    increment (rad); v_body: s u (m/s); u: odometer reading (m/s). Returns q, C_b^n, position,
-    NED velocity at the step end."""
+    increment (rad); v_body: the IMU's body-frame velocity (m/s), [s u, 0, 0] in Park's model;
+    u: odometer reading (m/s). Returns q, C_b^n, position, NED velocity at the step end and the
+    step's mean C_b^n (the body axes the velocity was resolved on)."""
     lat, lon, h = pos[0], pos[1], pos[2]
     w_ie, w_en = frame_rates(lat, h, v_prev)
     w_in = w_ie + w_en
     q_new, c_new = attitude_step(q, w_in * dt, dtheta)
-    x_axis = 0.5 * (c_old[:, 0] + c_new[:, 0])
-    v = v_body * x_axis
+    c_mid = 0.5 * (c_old + c_new)
+    x_axis = c_mid[:, 0]
+    v = v_body[0] * x_axis + v_body[1] * c_mid[:, 1] + v_body[2] * c_mid[:, 2]
     rn, re = radii(lat)
     lat_new = lat + v[0] * dt / (rn + h)
     lon_new = lon + v[1] * dt / ((re + h) * np.cos(lat_new))
@@ -162,7 +185,21 @@ def _dr3d_navigate(q: np.ndarray, c_old: np.ndarray, pos: np.ndarray, v_prev: np
     f[6, 0] = d_lat * (OMEGA_E_RAD_S * np.cos(lat) + v[1] / ((re + h) * np.cos(lat) ** 2))
     f[4:7, 2] = -w_en * d_lat
     f[4:7, 7:10] = -c_new
-    return q_new, c_new, np.array([lat_new, lon_new, h_new]), v
+    return q_new, c_new, np.array([lat_new, lon_new, h_new]), v, c_mid
+
+
+def car_body_velocity(speed: float, yaw_rate: float, rear_lever: float, odometer_lever: float,
+                      squat: float, accel: float) -> np.ndarray:
+    """The IMU's body-frame (FRD) velocity on a car, m/s: the rear axle rolls along the body's
+    x axis (the kinematic bicycle model, Rajamani 2012, eq. 2.29), at the speed vr that gives
+    the odometer's point (``odometer_lever`` ahead of the rear axle: the centre of gravity,
+    ``toolbox.installation``) the ``speed``: vr^2 + (w_z d)^2 = speed^2; the IMU,
+    ``rear_lever`` L ahead of the rear axle, moves sideways at w_z L; the body pitches nose up
+    on its springs by ``squat`` k (rad per m/s^2) times the forward acceleration a, so the
+    path lies k a below its x axis: v = [vr, w_z L, vr k a]."""
+    vr = math.copysign(math.sqrt(max(speed * speed - (yaw_rate * odometer_lever) ** 2, 0.0)),
+                       speed)
+    return np.array([vr, yaw_rate * rear_lever, vr * squat * accel])
 
 
 # config key -> (SI unit, meaning), of both filters (`landnav estimators dr3d_ekf`)
@@ -264,6 +301,7 @@ class _OdometerDeadReckoning(Estimator):
     def _take_inputs(self) -> None:
         self._u = 0.0  # latest odometer reading, m/s
         self._u_history: list[tuple[float, float]] = []
+        self._w_history: list[tuple[float, float]] = []  # (t, yaw rate) of the last steps
         self._accel = 0.0  # along-track acceleration from the odometer, m/s^2
         self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment",
                                      self.initial.t)
@@ -390,6 +428,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._q_c[3] = q_gm[0]
         self._q_c[4:7] = c["gyro_noise_density"] ** 2
         self._q_c[7:10] = q_gm[1:]
+        self._v_body = np.zeros(3)  # the IMU's body-frame velocity over the last step, m/s
+        self._squat = 0.0  # the body's pitch per forward acceleration estimate, rad per m/s^2
+        self._yaw_accel = 0.0  # the yaw rate's change over the last ACCEL_WINDOW_S, rad/s^2
         if self._sheet:
             self._q_c[4:7] = self._imu_model.gyro_noise**2
             self._q_c[TILT] = 2 * self._imu_model.accel_bias_sigma**2 / (
@@ -414,6 +455,19 @@ class Dr3dEkf(_OdometerDeadReckoning):
         p[TILT, TILT] = np.eye(2) * (imu.accel_bias_initial / G0) ** 2
         p[FIX, FIX] = np.diag(self._fix_model.correlated_sigma(1.0, 2.0) ** 2)  # again at the
         # first fix, with its DOPs
+        # the car's body (class docstring): the rear axle behind the IMU, the odometer's point
+        # (the centre of gravity) ahead of the rear axle, the tyres' slip and the body's pitch
+        site = Installation.from_datasheet(self.datasheet)
+        rear = site.rear_axle if site.rear_axle is not None else np.zeros(3)
+        odo = site.odometer if site.odometer is not None else rear
+        self._rear_lever = float(-rear[0])
+        self._odo_lever = float(odo[0] - rear[0])
+        self._car = NonholonomicNoise(site.wheelbase or 2.7)
+        # the odometer's acceleration: two speeds ACCEL_WINDOW_S apart
+        self._accel_sigma = (math.sqrt(2.0) * odometer_speed_sigma(self.datasheet, 1.0)
+                             / ACCEL_WINDOW_S)
+        self._rate_prev = np.zeros(3)
+        p[SQUAT, SQUAT] = self._car.pitch_compliance**2 if site.rear_axle is not None else 0.0
         return p
 
     # -- messages ---------------------------------------------------------------------------
@@ -449,8 +503,15 @@ class Dr3dEkf(_OdometerDeadReckoning):
             dz += self._fix_error
             h_pos[:, FIX] = np.eye(3)
             var = list(self._fix_model.white_sigma(*dops)[:n] ** 2)
-        rows = [h_pos[:n]]
-        dzs = [dz[:n]]
+        keep = np.arange(n)
+        if self._sheet:  # a reflected fix's metres the receiver does not announce: each row
+            # behind a chi-square gate (one degree of freedom, GATE_PROBABILITY)
+            h_n = h_pos[:n]
+            s_diag = np.einsum("ij,jk,ik->i", h_n, self._kf.p, h_n) + np.array(var)
+            keep = keep[rows_passing(dz[:n], s_diag, GATE_PROBABILITY)]
+            var = [var[k] for k in keep]
+        rows = [h_pos[keep]]
+        dzs = [dz[keep]]
         speed = self._s * self._u
         slow = c["adaptive"] and speed < LOW_SPEED_THRESHOLD_M_S
         jac = euler_error_jacobian(self._cbn)
@@ -461,15 +522,29 @@ class Dr3dEkf(_OdometerDeadReckoning):
             h[4:7] = -abs(speed) * math.sin(pitch) * jac[1]
             rows.append(h[None])
             dzs.append([abs(speed) * math.cos(pitch) - row[fx.speed]])
-            var.append(c["gps_speed_sigma_inflated" if slow else "gps_speed_sigma"] ** 2)
+            if self._sheet:
+                var.append(self._fix_model.velocity_sigma(*dops)[0] ** 2)
+            else:
+                var.append(c["gps_speed_sigma_inflated" if slow else "gps_speed_sigma"] ** 2)
         if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
-            # the course is the heading of the body x axis (no side slip; eq. 41's last row)
-            dz_c, h_c = heading(self._q, float(row[fx.course]), n_states=9)
+            # Park: the course is the heading of the body x axis (no side slip; eq. 41's last
+            # row); datasheet: of the IMU's velocity on the car, w_z L to the side
+            course = float(row[fx.course])
             h = np.zeros((1, n_x))
+            if self._sheet:
+                v_b = self._v_body
+                course -= math.atan2(v_b[1], v_b[0])
+                h[0, 9] = -self._rear_lever * v_b[0] / (v_b[0] ** 2 + v_b[1] ** 2)
+                lateral = self._car.sigma(v_b[0], v_b[1] / self._rear_lever
+                                          if self._rear_lever else 0.0, 0.0)[0]
+                var.append((self._fix_model.velocity_sigma(*dops)[0] ** 2 + lateral**2)
+                           / (v_b[0] ** 2 + v_b[1] ** 2))
+            else:
+                var.append(c["gps_course_sigma_inflated" if slow else "gps_course_sigma"] ** 2)
+            dz_c, h_c = heading(self._q, course, n_states=9)
             h[0, 4:7] = h_c[0, 6:9]  # the INS layout's psi columns to this filter's
             rows.append(h)
             dzs.append(dz_c)
-            var.append(c["gps_course_sigma_inflated" if slow else "gps_course_sigma"] ** 2)
         self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(var))
         self._feedback()
 
@@ -500,12 +575,61 @@ class Dr3dEkf(_OdometerDeadReckoning):
         dtheta = np.array(acc.dtheta) - self._bias * dt
         f_b = np.array(acc.dvel) / dt
         acc.reset()
-        self._q, self._cbn, self._pos, self._v_ned = _dr3d_navigate(
-            self._q, self._cbn, self._pos, self._v_ned, dtheta, self._s * self._u, self._u,
-            dt, self._f)
-        self._kf.predict(self._eye + self._f * dt, np.diag(self._q_c * dt))
+        rate = dtheta / dt
+        if self._sheet:
+            self._track_yaw_accel(acc.t, float(rate[2]))
+            v_body = self._body_velocity(rate)
+        else:
+            v_body = np.array([self._s * self._u, 0.0, 0.0])
+        self._v_body = v_body
+        self._q, self._cbn, self._pos, self._v_ned, c_mid = _dr3d_navigate(
+            self._q, self._cbn, self._pos, self._v_ned, dtheta, v_body, self._u, dt, self._f)
+        q_d = np.diag(self._q_c * dt)
+        if self._sheet:
+            self._body_error_model(c_mid, rate, q_d, dt)
+            # the gyro scale-factor error moves the bias by s d(rate) (toolbox.datasheet)
+            q_d[7:10, 7:10] += np.diag((self._imu_model.gyro_scale_sigma
+                                        * (rate - self._rate_prev)) ** 2)
+            self._rate_prev = rate
+        self._kf.predict(self._eye + self._f * dt, q_d)
         if self._imu.has_accel:
-            self._step_one(f_b, dtheta / dt)
+            self._step_one(f_b, rate)
+
+    def _track_yaw_accel(self, t: float, yaw_rate: float) -> None:
+        """The yaw rate's change per second over the last ACCEL_WINDOW_S (the window of the
+        odometer's acceleration), for the IMU's sideways acceleration ahead of the rear axle."""
+        hist = self._w_history
+        hist.append((t, yaw_rate))
+        while len(hist) > 2 and t - hist[1][0] >= ACCEL_WINDOW_S:
+            hist.pop(0)
+        t0, w0 = hist[0]
+        self._yaw_accel = (yaw_rate - w0) / (t - t0) if t - t0 > 0 else 0.0
+
+    def _body_velocity(self, rate: np.ndarray) -> np.ndarray:
+        """The IMU's body-frame velocity on the car (``car_body_velocity``)."""
+        if self._u == 0.0:
+            return np.zeros(3)
+        return car_body_velocity(self._s * self._u, float(rate[2]), self._rear_lever,
+                                 self._odo_lever, self._squat, self._s * self._accel)
+
+    def _body_error_model(self, c_mid: np.ndarray, rate: np.ndarray, q_d: np.ndarray,
+                          dt: float) -> None:
+        """The error model's columns of the car's body (``_body_velocity``): the sideways
+        velocity's z-gyro bias (the bias state is estimate minus truth, so w_z L is too low by
+        L times it) and the squat state; the tyres' slip and the suspension's travel, which the
+        model leaves out, as velocity noise (``NonholonomicNoise`` without its pitch term, now
+        a state) correlated over SLIP_TIME_S, white-equivalent on the position (a first-order
+        Gauss-Markov process's PSD at zero frequency, 2 sigma^2 T: Brown & Hwang, 4th ed.,
+        section 2.9)."""
+        v_body = self._v_body
+        f = self._f
+        f[0:3, 9] = -self._rear_lever * c_mid[:, 1] if self._u != 0.0 else 0.0
+        f[0:3, SQUAT] = c_mid[:, 2] * v_body[0] * self._s * self._accel
+        if self._u != 0.0:
+            lateral, vertical = self._car.sigma(v_body[0], float(rate[2]), 0.0)
+            q_d[0, 0] += 2 * lateral**2 * SLIP_TIME_S * dt
+            q_d[1, 1] += 2 * lateral**2 * SLIP_TIME_S * dt
+            q_d[2, 2] += 2 * vertical**2 * SLIP_TIME_S * dt
 
     def _step_one(self, f_b: np.ndarray, rate: np.ndarray) -> None:
         """Step 1 of section III-C: g-slave roll and pitch (eqs. 34-37) and barometer. With
@@ -520,9 +644,13 @@ class Dr3dEkf(_OdometerDeadReckoning):
         jac = euler_error_jacobian(cbn)
         h = np.zeros((2, n_x))
         h[:, 4:7] = jac[:2]
-        if self._sheet:
-            v = self._s * self._u
-            f_b = f_b - np.array([self._s * self._accel, v * rate[2], -v * rate[1]])
+        if self._sheet:  # a = d v_b/dt + w x v_b of the IMU's velocity on the car
+            v = self._v_body
+            moving = 1.0 if self._u != 0.0 else 0.0
+            f_b = f_b - np.array([self._s * self._accel + rate[1] * v[2] - rate[2] * v[1],
+                                  moving * self._rear_lever * self._yaw_accel + rate[2] * v[0]
+                                  - rate[0] * v[2],
+                                  rate[0] * v[1] - rate[1] * v[0]])
             roll, pitch = roll + self._tilt_bias[0], pitch + self._tilt_bias[1]
             h[:, TILT] = np.eye(2)
         roll_acc = math.atan2(-f_b[1], -f_b[2])
@@ -539,6 +667,8 @@ class Dr3dEkf(_OdometerDeadReckoning):
                                      c["tilt_sigma_inflated"])
         else:
             var = c["tilt_sigma"] ** 2
+        if self._sheet:
+            var += self._tilt_model_variance(rate)
         rows, dzs, variances = [h], [dz], [var, var]
         if self._use_baro and self._baro_new and self._baro_offset is not None:
             dz_h, h_h = barometric_height(self._pos[2], self._baro_h,
@@ -557,6 +687,25 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(variances))
         self._feedback()
 
+    def _tilt_model_variance(self, rate: np.ndarray) -> float:
+        """What the car's acceleration removed from the g-slave leaves (``tuning:
+        datasheet``), as the white-equivalent variance at the step's rate of errors
+        correlated over a time T (2 sigma^2 T / step: a first-order Gauss-Markov process's
+        PSD at zero frequency, Brown & Hwang, 4th ed., section 2.9): the odometer's
+        acceleration, two speeds of the datasheet's noise ACCEL_WINDOW_S apart (white: a tick
+        count's speed
+        error is the difference of two quantisation errors, so the next reading's cancels it,
+        and a reading held over two steps adds nothing at low frequency), and the tyres' slip
+        velocity (``NonholonomicNoise``) turned by the yaw rate (T: SLIP_TIME_S); over g,
+        rad^2."""
+        if self._u == 0.0 and self._accel == 0.0:
+            return 0.0
+        step = self.config["step"]
+        v = self._v_body[0]
+        lateral = self._car.cornering_compliance * v * v * abs(rate[2])  # the tyres' slip
+        return ((self._accel_sigma**2 * step
+                 + 2 * (rate[2] * lateral) ** 2 * SLIP_TIME_S) / (G0**2 * step))
+
     def _feedback(self) -> None:
         dx = self._kf.feedback()
         pos = self._pos
@@ -571,6 +720,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._tilt_bias -= dx[TILT]
             self._baro_bias -= dx[BARO]
             self._fix_error -= dx[FIX]
+            self._squat -= dx[SQUAT]
 
     def solution(self, t: float) -> list[float]:
         p = self._kf.p

@@ -26,13 +26,20 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   H has -(u_s - u_ref) on the position error, (u_s - u_ref) [(C_b^n l) x] on the attitude
   error (u the NED lines of sight; Groves eq. 14.127 differenced) and +-lambda on the two
   ambiguities. Each receiver's undifferenced 1-sigma is ``*_std`` / sin(elevation) (the
-  elevation model of RTKLIB's ``err`` option), plus ``baseline_ppm`` of the baseline over
-  sin(elevation) for the residual ionosphere and troposphere (scaled by (f_L1 / f)^2); the
-  single differences are independent, the double differences share their reference's
-  variance (``double_difference_covariance``). The rover's code is carrier smoothed
-  (``carrier_smoothing`` of its datasheet): its sigma is scaled by the correlated-noise
-  inflation of that time at ``code_inflation_interval`` (``gnss_model.correlated_noise_
-  inflation``). Each DD code row passes a chi-square gate (``gate_probability``).
+  elevation model of RTKLIB's ``err`` option); the single differences are independent, the
+  double differences share their reference's variance (``double_difference_covariance``).
+  The code's sigma is scaled by the correlated-noise inflation of ``code_correlation_time``
+  at ``gnss_interval`` (``gnss_model.correlated_noise_inflation``), the phase's by that of
+  ``phase_correlation_time``. Each DD code row passes a chi-square gate
+  (``gate_probability``).
+* **Ionosphere**: one state per satellite, g_s, the horizontal gradient of the L1 vertical
+  delay along the baseline at the satellite's pierce point, in parts per million (a
+  Gauss-Markov process, 1-sigma ``iono_ppm``, ``iono_correlation_time``); the satellite's
+  single-difference L1 delay is I_s = g_s b M(el_s), b the current baseline length and M the
+  thin-shell (350 km) obliquity, gamma I_s on a band of gamma = (f_L1 / f)^2, delaying the
+  code and advancing the phase. A delay that grows with the baseline (the residual of the
+  broadcast model and the travelling disturbances of a gradient: 1-2 ppm, Wanninger 1995)
+  is then a constant state, not a state that has to move.
 * **Cycle slips**: a signal's ambiguity state is reset (new value, ``ambiguity_std``, no
   correlation, not held) when either receiver's LLI has bit 0 (loss of lock), its lock time
   fell, it was not seen for ``max_gap`` s, its half-cycle flag (LLI bit 1) cleared (the phase
@@ -51,7 +58,11 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   Q_a^-1 P_ax (Teunissen 1995). **Fix and hold** (``hold``): when every double difference is
   fixed, the integers are applied to the filter as measurements of 1-sigma ``hold_std``
   cycles and their states marked held; an epoch whose phases all belong to held states is
-  fixed without a search (a slip or a failed innovation releases a state).
+  fixed without a search (a slip or a failed innovation releases a state). Such an epoch
+  uses no code (``held_code``): the rover's carrier-smoothed code errors stay correlated over
+  the smoothing (100 s), and its thousand rows per 100 s weighted as independent pull the
+  held ambiguities and the position by centimetres over minutes, where the phases alone
+  know them to millimetres.
 * **Odometer and NHC** (``odometer``, ``nhc``) when the dataset has an odometer: the body
   velocity of the rear axle [v_odo, 0, 0] (``aiding.odometer``), its noise the odometer's
   datasheet resolution and age and a 3 % scale, the lateral and vertical the car's physics
@@ -121,6 +132,7 @@ DEFAULTS = {
     "fixed_position_std": 0.05,
     "hold": True,
     "hold_std": 0.01,
+    "held_code": False,
     "slip_geometry_free": 0.05,
     "slip_sigmas": 6.0,
     "slip_cycles": 0.5,
@@ -141,12 +153,13 @@ CONFIG_HELP = {
     "base_code_std": ("m", "base pseudorange 1-sigma at zenith"),
     "phase_std": ("m", "rover carrier-phase 1-sigma at zenith"),
     "base_phase_std": ("m", "base carrier-phase 1-sigma at zenith"),
-    "iono_ppm": ("", "single-difference ionosphere on L1, parts per million of the baseline, "
-                     "1-sigma in the vertical (times the obliquity factor)"),
-    "iono_correlation_time": ("s", "correlation time of the single-difference ionosphere "
-                                   "states"),
+    "iono_ppm": ("", "1-sigma of each satellite's ionosphere state: the single-difference L1 "
+                     "delay in parts per million of the baseline, vertical (times the "
+                     "obliquity factor)"),
+    "iono_correlation_time": ("s", "correlation time of the ionosphere states"),
     "code_correlation_time": ("s", "correlation time of the code errors the weights count "
-                                   "(0: white; null: the rover datasheet's carrier_smoothing)"),
+                                   "(0: white; the rover's carrier-smoothing window, say 100, "
+                                   "weights a smoothed code as correlated)"),
     "phase_correlation_time": ("s", "correlation time of the carrier-phase errors the "
                                     "weights count (multipath along the road, 0: white)"),
     "gnss_interval": ("s", "the epoch interval the correlations are counted at (the "
@@ -163,6 +176,9 @@ CONFIG_HELP = {
                                 "is at most this on every axis"),
     "hold": ("", "fix and hold: a full fix constrains the float ambiguities"),
     "hold_std": ("cycles", "1-sigma of the hold's ambiguity measurements"),
+    "held_code": ("", "use the double-differenced code in an epoch whose ambiguities are all "
+                      "held (its errors, correlated over the carrier smoothing, pull a held "
+                      "solution by centimetres)"),
     "slip_geometry_free": ("m", "geometry-free phase jump between epochs taken as a slip"),
     "slip_sigmas": ("", "DD phase innovation, in its sigmas, taken as a slip"),
     "slip_cycles": ("cycles", "and at least this many cycles"),
@@ -271,12 +287,8 @@ class RtkInsEkf(Estimator):
                              extra_sigma=np.zeros(n_slots + n_iono),
                              extra_tau=np.r_[np.full(n_slots, np.inf),
                                              np.full(n_iono, cfg["iono_correlation_time"])])
-        gnss = self.datasheet.get("gnss") or {}
-        corr = cfg["code_correlation_time"]
-        if corr is None:
-            corr = float(gnss.get("carrier_smoothing") or 0.0)
         self._code_inflation = gnss_model.correlated_noise_inflation(
-            float(corr), float(cfg["gnss_interval"]))
+            float(cfg["code_correlation_time"]), float(cfg["gnss_interval"]))
         self._phase_inflation = gnss_model.correlated_noise_inflation(
             float(cfg["phase_correlation_time"]), float(cfg["gnss_interval"]))
         self._mask = math.radians(cfg["elevation_mask"])
@@ -394,7 +406,7 @@ class RtkInsEkf(Estimator):
         slots = self._assign_slots(rover, base, phase_ok)
         for key in rover.keys:
             self._last_seen[int(key)] = t
-        self._iono = self._assign_iono(t, rover)
+        self._iono, self._iono_scale = self._assign_iono(t, rover)
         self._update(rover, base, slots)
         self._resolve(rover, slots)
         self._status_t = t
@@ -440,12 +452,16 @@ class RtkInsEkf(Estimator):
             self._iono_free.append(index)
             del self._iono_seen[sat]
 
-    def _assign_iono(self, t: float, rover: _Epoch) -> np.ndarray:
-        """The extra-state index (after the 15) of each signal's satellite's single-difference
-        ionosphere (-1: none free); a new satellite's starts at zero with 1-sigma ``iono_ppm``
-        of the baseline times the thin-shell obliquity (350 km) at its elevation."""
+    def _assign_iono(self, t: float, rover: _Epoch) -> tuple[np.ndarray, np.ndarray]:
+        """The extra-state index (after the 15) of each signal's satellite's ionosphere
+        gradient (-1: none free), and the factor (m per ppm) that turns it into the
+        single-difference L1 delay: the current baseline times the thin-shell obliquity (350
+        km) at the satellite's elevation (module docstring). A new satellite's state starts
+        at zero with 1-sigma ``iono_ppm``."""
         ins = self.ins
         baseline = float(np.linalg.norm(geodetic_to_ecef(*ins.pos) - self._base_xyz))
+        ratio = EARTH_RADIUS_M * np.cos(rover.elevation) / (EARTH_RADIUS_M + IONO_SHELL_M)
+        scale = 1e-6 * baseline / np.sqrt(1.0 - ratio**2)
         sats = rover.keys // 10_000
         out = np.full(len(sats), -1, dtype=np.int64)
         for i, sat in enumerate(sats.tolist()):
@@ -455,14 +471,11 @@ class RtkInsEkf(Estimator):
                     continue
                 index = self._iono_free.pop()
                 self._iono_slot[sat] = index
-                ratio = EARTH_RADIUS_M * math.cos(rover.elevation[i]) / (
-                    EARTH_RADIUS_M + IONO_SHELL_M)
-                sigma = self.config["iono_ppm"] * 1e-6 * baseline / math.sqrt(1.0 - ratio**2)
-                ins.set_extra_sigma(index, max(sigma, 1e-4))
+                ins.set_extra_sigma(index, self.config["iono_ppm"])
                 ins.extra[index] = 0.0
             self._iono_seen[sat] = t
             out[i] = index
-        return out
+        return out, scale
 
     def _release(self, key: int) -> None:
         """Forget a signal's ambiguity (its slot is given back, its state zeroed)."""
@@ -548,7 +561,8 @@ class RtkInsEkf(Estimator):
             sign = 1.0 if code else -1.0
             for rows_of, iono in ((sig, self._iono[sig]), (refs, self._iono[refs])):
                 have = iono >= 0
-                g = sign * rover.gamma[rows_of[have]] * (1.0 if rows_of is sig else -1.0)
+                g = (sign * rover.gamma[rows_of[have]] * self._iono_scale[rows_of[have]]
+                     * (1.0 if rows_of is sig else -1.0))
                 h[np.flatnonzero(have), N_STATES + iono[have]] += g
                 dz[have] += g * ins.extra[iono[have]]
             if not code:
@@ -594,6 +608,8 @@ class RtkInsEkf(Estimator):
             slots = self._reassign(rover, base, slots)
         s_c = np.einsum("ij,jk,ik->i", h_c, ins.kf.p, h_c) + np.diag(r_c)
         keep = gating.rows_passing(dz_c, s_c, float(self.config["gate_probability"]))
+        if not self.config["held_code"] and self._all_held(rover, sig, refs):
+            keep[:] = False
         dz = np.concatenate([dz_c[keep], dz_p])
         h = np.vstack([h_c[keep], h_p])
         r = np.zeros((len(dz), len(dz)))
@@ -606,6 +622,12 @@ class RtkInsEkf(Estimator):
         self.nis_gnss = gating.normalised_innovation_squared(dz, s)
         self.nis_gnss_dof = float(len(dz))
         self._phase_rows = (sig, refs, slots)
+
+    def _all_held(self, rover: _Epoch, sig: np.ndarray, refs: np.ndarray) -> bool:
+        """Whether the epoch's double differences (signals ``sig`` against ``refs``) are at
+        least ``min_fixed`` and all of held ambiguities."""
+        return len(sig) >= self.config["min_fixed"] and all(
+            int(rover.keys[i]) in self._held for i in np.unique(np.r_[sig, refs]))
 
     def _reassign(self, rover: _Epoch, base: _Epoch, slots: np.ndarray) -> np.ndarray:
         """Slots again after resets: the reset signals start new ambiguities."""
@@ -629,7 +651,7 @@ class RtkInsEkf(Estimator):
         sig, refs, slots = rows
         keys = [int(rover.keys[i]) for i in np.unique(np.r_[sig, refs])]
         cfg = self.config
-        if all(k in self._held for k in keys) and len(sig) >= cfg["min_fixed"]:
+        if self._all_held(rover, sig, refs):
             self._status = 2.0
             self._n_fixed = len(sig)
             return

@@ -20,11 +20,11 @@ import numpy as np
 import pandas as pd
 
 from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, STATUS_OK
-from simulator.scoring.consistency import BLOCKS, PLANAR_BLOCKS, anees
+from simulator.scoring.consistency import AXIS_BLOCKS, BLOCKS, PLANAR_BLOCKS, anees
 
 SUMMARY_FORMAT = "landnav-campaign-summary/1"
 # every consistency block a solution can have, and the dimension of its NEES
-_BLOCK_DIMS = {b.name: b.dim for b in (*BLOCKS, *PLANAR_BLOCKS.values())}
+_BLOCK_DIMS = {b.name: b.dim for b in (*BLOCKS, *PLANAR_BLOCKS.values(), *AXIS_BLOCKS.values())}
 
 
 def score_columns(runs: pd.DataFrame, sweep_keys: list[str]) -> list[str]:

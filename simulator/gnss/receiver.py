@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simulator.datasheet import nominal_cn0_dbhz
 from simulator.earth import ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S, CHIP_L1CA_M, OMEGA_E_DOT_RAD_S
 from simulator.gnss.ephemeris import satellite_state
@@ -162,7 +163,6 @@ def clock_process(n: int, dt_s: float, h0: float, h_minus2: float, bias0_s: floa
     return bias, drift
 
 
-CN0_ELEVATION_SCALE_DEG = 17.0  # e-folding elevation of the C/N0 loss towards the horizon
 
 
 def cn0_model(elevation_rad: np.ndarray, zenith_dbhz: float, horizon_dbhz: float) -> np.ndarray:
@@ -174,8 +174,7 @@ def cn0_model(elevation_rad: np.ndarray, zenith_dbhz: float, horizon_dbhz: float
     20-30, 30-45, 45-60 and 60-90 deg bands), which it follows within 1 dB with the defaults
     zenith 46.5 and horizon 18 dB-Hz.
     """
-    el_deg = np.degrees(np.clip(elevation_rad, 0, None))
-    return zenith_dbhz - (zenith_dbhz - horizon_dbhz) * np.exp(-el_deg / CN0_ELEVATION_SCALE_DEG)
+    return nominal_cn0_dbhz(elevation_rad, zenith_dbhz, horizon_dbhz)
 
 
 def dll_sigma_m(cn0_dbhz: np.ndarray, bandwidth_hz: float, spacing_chip: float,

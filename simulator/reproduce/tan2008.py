@@ -33,7 +33,7 @@ from simulator.reproduce.tan2008_figures import figures, history
 # the last straight (segment 16) shortened: the drive ends about 20 s after the outage
 SHORT = ("trajectory.segments.16.straight.length=200",)
 STANDSTILL_S = 60.0  # the scenario's and the filter's initial standstill
-FULL = {}  # the paper's design: ins_lkf's defaults
+FULL = {"tuning": "paper"}  # the paper's design: ins_lkf's defaults with the paper's noise
 
 
 def _measure(dataset: Dataset, solutions: Mapping[str, pd.DataFrame]) -> Figures:
@@ -52,12 +52,12 @@ def _measure(dataset: Dataset, solutions: Mapping[str, pd.DataFrame]) -> Figures
 OUTAGE = Experiment(
     key="outage", scenario="tan2008_outage.yaml",
     entries={"full": {"name": "ins_lkf", "config": FULL},
-             "constraints": {"name": "ins_lkf", "config": {"mag_heading": False}},
+             "constraints": {"name": "ins_lkf", "config": {**FULL, "mag_heading": False}},
              "free": {"name": "ins_lkf",
-                      "config": {"nhc": False, "height_constraint": False,
+                      "config": {**FULL, "nhc": False, "height_constraint": False,
                                  "mag_heading": False}},
-             "closed": {"name": "ins_lkf", "config": {"open_loop_outages": False}},
-             "no_standstill": {"name": "ins_lkf", "config": {"standstill": 0.0}}},
+             "closed": {"name": "ins_lkf", "config": {**FULL, "open_loop_outages": False}},
+             "no_standstill": {"name": "ins_lkf", "config": {**FULL, "standstill": 0.0}}},
     measure=_measure, quick_overrides=SHORT, history=history, full_runs=20)
 
 

@@ -18,12 +18,14 @@ wrapped angle errors; for a 2-D solution the horizontal n/e and the yaw alone):
 Everything is taken over the epochs from ``CONSISTENCY_SKIP_S`` after the solution's first row
 (an estimator's start-up transient is not what consistency judges), on the rows where the
 block's errors and sigmas are all finite and the sigmas positive. A block is 2-D when the
-solution never has a finite down error with its sigma (``horizontal`` replaces ``position``) or
-never a finite roll and pitch with their sigmas (``yaw`` replaces ``attitude``).
+solution never has a finite down error with its sigma (``horizontal`` replaces ``position``),
+never a finite vertical velocity (``horizontal_velocity`` replaces ``velocity``) or never a finite
+roll and pitch with their sigmas (``yaw`` replaces ``attitude``); an axis with a sigma that no
+block holds then is a one-axis block of its own, named by the axis (a 2-D filter's ``pitch``).
 
 Public names
 ------------
-CONSISTENCY_SKIP_S, BAND_PROBABILITIES, Block, BLOCKS, PLANAR_BLOCKS, AXES, chi2_band,
+CONSISTENCY_SKIP_S, BAND_PROBABILITIES, Block, BLOCKS, PLANAR_BLOCKS, AXIS_BLOCKS, AXES, chi2_band,
 normalised_errors, axis_nse, block_nees, consistency_blocks, consistency_scores, nis_scores,
 anees.
 
@@ -68,8 +70,12 @@ class Block:
 
 BLOCKS = (Block("position", ("n", "e", "d")), Block("velocity", ("vn", "ve", "vd")),
           Block("attitude", ("roll", "pitch", "yaw")))
-# a 2-D solution's block in place of the 3-D one with the same index in BLOCKS
-PLANAR_BLOCKS = {"position": Block("horizontal", ("n", "e")), "attitude": Block("yaw", ("yaw",))}
+# a 2-D solution's block in place of the 3-D one of the same name in BLOCKS
+PLANAR_BLOCKS = {"position": Block("horizontal", ("n", "e")),
+                 "velocity": Block("horizontal_velocity", ("vn", "ve")),
+                 "attitude": Block("yaw", ("yaw",))}
+# the one-axis block of an axis that no block of a solution holds (``consistency_blocks``)
+AXIS_BLOCKS = {axis: Block(axis, (axis,)) for axis in AXES}
 
 
 def chi2_band(dim: int, runs: int = 1) -> tuple[float, float]:
@@ -141,14 +147,19 @@ def _has_any(errors: pd.DataFrame, block: Block) -> bool:
 
 
 def consistency_blocks(errors: pd.DataFrame) -> list[Block]:
-    """The blocks a solution is judged on: every one of ``BLOCKS``, and the 2-D block of
+    """The blocks a solution is judged on: every one of ``BLOCKS``, the 2-D block of
     ``PLANAR_BLOCKS`` beside a 3-D block that has no epoch with every axis finite where the
-    2-D one has (a 2-D solution: NaN height or roll and pitch, or no sigma for them)."""
+    2-D one has (a 2-D solution: NaN height or roll and pitch, or no sigma for them), and the
+    one-axis block of ``AXIS_BLOCKS`` of each axis with a finite epoch that none of those
+    blocks with a finite epoch holds (the pitch of a filter that has no roll)."""
     out = list(BLOCKS)
     for block in BLOCKS:
-        planar = PLANAR_BLOCKS.get(block.name)
-        if planar is not None and not _has_any(errors, block) and _has_any(errors, planar):
+        planar = PLANAR_BLOCKS[block.name]
+        if not _has_any(errors, block) and _has_any(errors, planar):
             out.append(planar)
+    held = {axis for block in out if _has_any(errors, block) for axis in block.axes}
+    out += [AXIS_BLOCKS[axis] for axis in AXES
+            if axis not in held and _has_any(errors, AXIS_BLOCKS[axis])]
     return out
 
 

@@ -51,6 +51,7 @@ from matplotlib.ticker import FuncFormatter
 
 from simulator.scoring.align import ERR_ATT, ERR_H, ERR_POS, local_ned
 from simulator.scoring.consistency import (
+    AXES,
     CONSISTENCY_SKIP_S,
     Block,
     block_nees,
@@ -271,7 +272,8 @@ def _nees_blocks(ev: Evaluation) -> dict[str, tuple[Block, list[str]]]:
         for block in consistency_blocks(e):
             if np.isfinite(block_nees(e, block)).any():
                 out.setdefault(block.name, (block, []))[1].append(label)
-    order = ("position", "horizontal", "velocity", "attitude", "yaw")
+    order = ("position", "horizontal", "velocity", "horizontal_velocity", "attitude", "yaw",
+             *(axis for axis in AXES if axis != "yaw"))
     return {name: out[name] for name in order if name in out}
 
 

@@ -6,7 +6,8 @@ seeds lies between 0.3 and 3 (1 for a consistent filter); ten seeds under ``--ru
 snapshot ``gnss_wls`` (its position and velocity sigmas) too. Two seeds, since the fix's error
 is constant over a drive: one seed's horizontal axis is a chi-square draw of one degree of freedom
 (0.01 happens). Measured (mean over the axes, seeds 1 / 2): ins_odo_ekf 0.37 / 0.37, dr3d_ekf
-0.95 / 1.06, dr2d_odo_ekf 0.25 / 1.25. With ``tuning: paper`` on seed 1: ins_odo_ekf down 11.2,
+0.27 / 0.48 (the car-body model of its datasheet tuning),
+dr2d_odo_ekf 0.25 / 1.25. With ``tuning: paper`` on seed 1: ins_odo_ekf down 11.2,
 dr3d_ekf roll 1700 and down 3200 (the white-noise tilt, barometer and fix of the paper's
 model)."""
 

@@ -71,8 +71,9 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     for k in range(1, len(t)):
         dt = t[k] - t[k - 1]
         dtheta = 0.5 * (rates[k] + rates[k - 1]) * dt
-        quat, c, pos, v = _dr3d_navigate(quat, c, pos, v, dtheta, 0.5 * (speed[k] + speed[k - 1]),
-                                         0.0, dt, f)
+        quat, c, pos, v, _ = _dr3d_navigate(quat, c, pos, v, dtheta,
+                                            np.array([0.5 * (speed[k] + speed[k - 1]), 0, 0]),
+                                            0.0, dt, f)
         out[k] = pos
     rn, re = radii_of_curvature(out[:, 0])
     d_n = (out[:, 0] - np.radians(truth["lat"])) * rn

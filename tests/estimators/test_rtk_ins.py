@@ -1,15 +1,14 @@
 """rtk_ins_ekf (tightly coupled RTK/INS) against the truth and against RTKLIB's rnx2rtkp
 kinematic solution of the same measurements (the dataset exported as RINEX), on the shipped
 scenario rtk_open_road.yaml: 20 minutes of open road, two 30 s tunnels, a base 5 km east of the
-start, GPS L1 C/A + L2C at 10 Hz (GPS only: Galileo and BeiDou, which the export now writes
-for RTKLIB, triple the filter's states and have not been run through it yet).
+start, GPS L1 C/A + L2C at 10 Hz (and, in one slow case, GPS, Galileo and BeiDou on two bands).
 
 Claims (docs/rtk-ins.md): at least 95 % of the epochs fixed, a fixed-solution 3-D RMS of at most
 3 cm, under 1 % wrong fixes (3-D error over 10 cm), at least RTKLIB's fix rate; after each tunnel
 a re-fix faster than RTKLIB's (median over the tunnels) in at least 8 of 10 seeds; the position's
 mean (error / sigma)^2 per axis in 0.3-3 (seed mean) and none above 10 (SPEC section 8's
-consistency, after 60 s). CI runs a few minutes of the same road (one tunnel) at one seed; the
-ten 20-minute seeds run with --runslow."""
+consistency, after 60 s). CI runs a few minutes of the same road (one tunnel) at one seed; three
+20-minute seeds and the three-system short drive run with --runslow."""
 
 from __future__ import annotations
 
@@ -45,21 +44,44 @@ def test_short_drive_fixes_precisely_and_refixes_before_rtklib(short_drive):
     assert all(0.3 <= nse[a] <= 3.0 for a in AXES), nse
 
 
+SLOW_SEEDS = (1, 2, 3)
+
+
 @pytest.mark.slow
-@pytest.mark.xfail(reason="not shown on the 20-minute drive: seed 1 holds a fixed solution whose "
-                          "error grows to 5-7 cm (3-D RMS 4.2 cm, 1.03 % of fixes over 10 cm; "
-                          "RTKLIB 2.8 cm, 99.85 % fixed against 99.1 %; docs/rtk-ins.md)",
+@pytest.mark.xfail(reason="not shown: the fix rate of at least RTKLIB's and the re-fix before it "
+                          "(seed 1: 99.1 % against 99.85 %, re-fix 4.4 s and 0.9 s against 1.0 s "
+                          "and 0.6 s; seed 2: 99.29 % against 99.62 %, 0.5 s and 1.7 s against "
+                          "0.0 s and 1.2 s; seed 3: 99.37 % against 99.90 %, 4.4 s and 0.7 s "
+                          "against 0.7 s and 0.0 s); each seed's own claims hold "
+                          "(docs/rtk-ins.md)",
                    strict=False)
-def test_ten_seeds_of_twenty_minutes(tmp_path):
+def test_three_seeds_of_twenty_minutes(tmp_path):
     need_rnx2rtkp()
-    figures = [process(tmp_path, seed, short=False) for seed in range(1, 11)]
+    figures = [process(tmp_path, seed, short=False) for seed in SLOW_SEEDS]
+    failed = []
     for fig in figures:
-        _check_seed(fig)
+        try:
+            _check_seed(fig)
+        except AssertionError as error:
+            failed.append(f"seed {fig['seed']}: {error}")
     ours = np.array([f["rtk_ins_ekf"]["fix_rate"] for f in figures])
     theirs = np.array([f["rtklib"]["fix_rate"] for f in figures])
     print(f"fix rate: rtk_ins_ekf {ours.round(4)}, rtklib {theirs.round(4)}")
+    nse = {a: np.mean([f["consistency"]["position"]["nse"][a] for f in figures]) for a in AXES}
+    print(f"position (error/sigma)^2, seed mean: {nse}")
+    assert not failed, failed
     assert ours.mean() >= theirs.mean()
     faster = [median_refix(f["rtk_ins_ekf"]) < median_refix(f["rtklib"]) for f in figures]
-    assert sum(faster) >= 8
-    nse = {a: np.mean([f["consistency"]["position"]["nse"][a] for f in figures]) for a in AXES}
+    assert sum(faster) >= 0.8 * len(figures), faster
     assert all(0.3 <= nse[a] <= 3.0 for a in AXES), nse
+
+
+@pytest.mark.slow
+def test_three_systems_short_drive_against_rtklib(tmp_path):
+    """GPS, Galileo and BeiDou on two bands each: double differences within each system and
+    band against its own reference satellite (no inter-system term). The same claims as the
+    GPS drive, and the fix rate at least RTKLIB's on the same files (GPS + Galileo + BeiDou)."""
+    need_rnx2rtkp()
+    fig = process(tmp_path, 1, short=True, systems=("gps", "galileo", "beidou"))
+    _check_seed(fig)
+    assert fig["rtk_ins_ekf"]["fix_rate"] >= fig["rtklib"]["fix_rate"]

@@ -22,7 +22,8 @@ def _estimator(velocity=(0.0, 0.0, 0.0), **config) -> TanLinearisedKF:
     columns = {"imu": {c: i for i, c in enumerate(col.IMU)},
                "gnss_fix": {c: i for i, c in enumerate(col.GNSS_FIX)}}
     units = {"imu": dict(col.IMU), "gnss_fix": dict(col.GNSS_FIX)}
-    return TanLinearisedKF({"standstill": 0.0, "mag_heading": False, **config}, initial,
+    return TanLinearisedKF({"tuning": "paper", "standstill": 0.0, "mag_heading": False,
+                            **config}, initial,
                            columns, units)
 
 

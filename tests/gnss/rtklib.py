@@ -75,6 +75,17 @@ def single_point(obs: Path, nav: Path, systems_mask: int = 61) -> dict[str, np.n
 SYSTEM_MASKS = {"G": 1, "R": 4, "E": 8, "J": 16, "C": 32}  # RTKLIB's pos1-navsys bits
 
 
+def _systems_options(out: Path, systems: str | None, more: str = "") -> list[str]:
+    """rnx2rtkp's ``-k`` options file beside ``out`` that sets ``pos1-navsys`` to ``systems``
+    (RINEX letters; rnx2rtkp 2.4.3's ``-sys`` falls through its switch and enables every
+    later system) and the ``more`` lines; none without ``systems``."""
+    if systems is None:
+        return []
+    conf = Path(str(out) + ".conf")
+    conf.write_text(f"pos1-navsys={sum(SYSTEM_MASKS[s] for s in systems)}\n{more}")
+    return ["-k", str(conf)]
+
+
 def kinematic(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path,
               systems: str | None = None) -> dict[str, np.ndarray]:
     """Run rnx2rtkp kinematic (``-p 2 -f 2 -m 15 -h -v 3 -e -y 2 -r X Y Z``) and read the
@@ -85,13 +96,9 @@ def kinematic(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Pat
     and enables every later system); without it, rnx2rtkp's default GPS + GLONASS. The other
     options are RTKLIB's defaults: frequency index 2 is GPS L2, Galileo E5b, BeiDou B2I."""
     exe = need_rnx2rtkp()
-    options = []
-    if systems is not None:
-        conf = Path(str(out) + ".conf")
-        conf.write_text(f"pos1-navsys={sum(SYSTEM_MASKS[s] for s in systems)}\n"
-                        "out-timeform=tow\n")  # an options file resets rnx2rtkp's own
-        options = ["-k", str(conf)]
-    cmd = [exe, *options, "-p", "2", "-f", "2", "-m", "15", "-h", "-v", "3", "-e", "-y", "2",
+    # an options file resets rnx2rtkp's own time format
+    cmd = [exe, *_systems_options(out, systems, "out-timeform=tow\n"), "-p", "2", "-f", "2",
+           "-m", "15", "-h", "-v", "3", "-e", "-y", "2",
            "-r", *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base),
            str(nav)]
     subprocess.run(cmd, check=True, capture_output=True, timeout=600)
@@ -121,15 +128,16 @@ def residual_std_by_band(sat: dict[str, np.ndarray], frequency: int, kind: str) 
     return np.array(out)
 
 
-def kinematic_solution(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path
-                       ) -> float:
+def kinematic_solution(rover: Path, base: Path, nav: Path, base_xyz: np.ndarray, out: Path,
+                       systems: str | None = None) -> float:
     """Run rnx2rtkp kinematic with the options of ``kinematic`` (``-p 2 -f 2 -m 15 -h``,
-    the base at ``base_xyz``), writing its latitude-longitude-height solution to ``out`` (a
-    ``.pos`` file ``landnav score`` reads); returns the CPU seconds rnx2rtkp took."""
+    the base at ``base_xyz``, ``systems`` as there), writing its latitude-longitude-height
+    solution to ``out`` (a ``.pos`` file ``landnav score`` reads); returns the CPU seconds
+    rnx2rtkp took."""
     import resource
 
     exe = need_rnx2rtkp()
-    cmd = [exe, "-p", "2", "-f", "2", "-m", "15", "-h", "-r",
+    cmd = [exe, *_systems_options(out, systems), "-p", "2", "-f", "2", "-m", "15", "-h", "-r",
            *(f"{v:.4f}" for v in base_xyz), "-o", str(out), str(rover), str(base), str(nav)]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     subprocess.run(cmd, check=True, capture_output=True, timeout=1800)

@@ -170,3 +170,24 @@ def test_the_pages_tables_are_written_from_results_json(tmp_path):
     assert "6 of 6 seeds in the paper's direction" in text and "**partly**" in text
     assert "**landnav's checks**" in text and "commit abc" in text
     assert "| first | 1 / 1 / 0 / 1 | 1 / 0 / 0 |" in text
+
+
+def test_the_pages_tables_read_several_runs_each_paper_with_its_own_seeds(tmp_path):
+    first = write_results(tmp_path / "first.json", [_result("first", ["shown"])], SETTINGS)
+    other_settings = Settings((1, 2, 3, 4, 5), True, 2, None, 12.0, 20.0,
+                              "landnav 0.1.0, commit def")
+    second = write_results(tmp_path / "second.json", [_result("second", ["not shown"])],
+                           other_settings)
+    page = tmp_path / "page.md"
+    page.write_text("<!-- claims: first -->\n<!-- end of claims -->\n"
+                    "<!-- claims: second -->\n<!-- end of claims -->\n"
+                    "<!-- summary -->\n<!-- end of summary -->\n")
+    run = subprocess.run([sys.executable, str(REPOSITORY / "tools" / "reproduction_tables.py"),
+                          str(first), str(second), str(page)], capture_output=True, text=True,
+                         timeout=120)
+    assert run.returncode == 0, run.stderr
+    text = page.read_text()
+    assert "(landnav 0.1.0, commit abc; quick, seeds 1-4, more" in text
+    assert "(landnav 0.1.0, commit def; quick, seeds 1-5, more" in text
+    assert "seeds 1-4; second: landnav 0.1.0, commit def; quick, seeds 1-5)" in text
+    assert "| first | 1 / 0 / 0 / 1 |" in text and "| second | 0 / 0 / 1 / 1 |" in text

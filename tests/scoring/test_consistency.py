@@ -94,6 +94,23 @@ def test_a_2d_solution_is_judged_on_horizontal_position_and_yaw(truth):
     json.dumps(c, allow_nan=False)
 
 
+def test_a_planar_filter_keeps_its_horizontal_velocity_and_pitch(truth):
+    # Cho's DRM2 filters: n, e, vn, ve, pitch and yaw with sigmas, no height, vd or roll
+    sol = offset_solution(truth.iloc[::10], dpos=(1.0, 2.0, 0.0), dvel=(0.3, -0.1, 0.0),
+                          datt_deg=(0.0, 2.0, -3.0))
+    sol["alt"] = sol["vd"] = sol["roll"] = np.nan
+    sol["std_n"], sol["std_e"] = 1.0, 1.0
+    sol["std_vn"], sol["std_ve"] = 0.1, 0.1
+    sol["std_pitch"], sol["std_yaw"] = np.radians(1.0), np.radians(1.0)
+    c = score_solution(truth, events(), sol)["consistency"]
+    assert c["velocity"] is None and c["attitude"] is None
+    assert c["horizontal_velocity"]["nees_expected"] == 2.0
+    assert c["horizontal_velocity"]["nse"] == pytest.approx({"vn": 9.0, "ve": 1.0}, abs=1e-3)
+    assert c["pitch"]["nse"] == pytest.approx({"pitch": 4.0}, abs=1e-6)
+    assert c["yaw"]["nse"] == pytest.approx({"yaw": 9.0}, abs=1e-6)
+    assert "roll" not in c and "d" not in c  # no sigma, no block
+
+
 def test_no_sigma_columns_no_consistency(truth):
     s = score_solution(truth, events(), truth.iloc[::10])
     assert "consistency" not in s and "nis" not in s
