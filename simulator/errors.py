@@ -2,12 +2,20 @@
 
 Public classes
 --------------
-Problem, InputError, Terminated, refuse_undecodable.
+Problem, InputError, StorageError, Terminated, refuse_undecodable, storage_error,
+STORAGE_ERRNOS.
 """
 
 from __future__ import annotations
 
+import errno
+import os
 from dataclasses import dataclass
+
+# a write refused by the machine's storage, whatever is written: no space left, a file larger
+# than the volume (or the process's limit) allows, a disk quota, a read-only volume
+STORAGE_ERRNOS = frozenset(getattr(errno, name) for name in ("ENOSPC", "EFBIG", "EDQUOT", "EROFS")
+                           if hasattr(errno, name))
 
 
 @dataclass(frozen=True)
@@ -37,6 +45,29 @@ class InputError(Exception):
             problems = [Problem("landnav", None, "", problems)]
         self.problems = list(problems)
         super().__init__("\n".join(str(p) for p in self.problems))
+
+
+class StorageError(InputError):
+    """A write into ``folder`` refused by the storage (``STORAGE_ERRNOS``): the machine's
+    problem, not the input's. A command stops at it with one message; a campaign stops rather
+    than record its runs as failed. Pickled whole (a campaign's worker process raises it)."""
+
+    def __init__(self, folder: str, reason: str):
+        self.folder, self.reason = str(folder), reason
+        super().__init__([Problem(self.folder, None, "", f"cannot write here: {reason}")])
+
+    def __reduce__(self) -> tuple:
+        return type(self), (self.folder, self.reason)
+
+
+def storage_error(path: object, exc: BaseException) -> StorageError | None:
+    """``exc`` as a ``StorageError`` naming ``path`` when it is an ``OSError`` the storage
+    raised (``STORAGE_ERRNOS``), else None."""
+    if not isinstance(exc, OSError) or exc.errno not in STORAGE_ERRNOS:
+        return None
+    reason = ("no space left on the device" if exc.errno == errno.ENOSPC
+              else os.strerror(exc.errno))
+    return StorageError(str(path), reason)
 
 
 class Terminated(BaseException):

@@ -43,7 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from estimators.registry import BUILTINS, entry_problems, plugin_file
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, storage_error
 
 PARENT_POLL_S = 0.5  # how often a child checks that the process it works for still runs
 # how long importing the plug-ins and checking their configs may take without --time-limit
@@ -137,8 +137,7 @@ def _serve() -> None:
     try:
         _write_answer(Path(folder), _ANSWER, answer)
     except OSError as exc:  # a full disk: said on the control channel, read by the parent
-        os.write(control, f"cannot hand its answer back through {folder}: "
-                          f"{exc.strerror or exc}".encode())
+        os.write(control, f"{exc.errno or 0} {exc.strerror or exc}".encode())
         sys.exit(1)
 
 
@@ -205,14 +204,28 @@ def _child(request: tuple) -> Iterator[tuple[subprocess.Popen, Path, bool]]:
         shutil.rmtree(folder, ignore_errors=True)
 
 
-def _said(child: subprocess.Popen) -> str:
-    """What an ended child said on its control channel after its first byte (why it wrote no
-    answer), "" when nothing."""
+def _said(child: subprocess.Popen, folder: Path) -> str:
+    """Why an ended child wrote no answer into ``folder``, as it said on its control channel
+    after its first byte (``ERRNO REASON``), "" when nothing.
+
+    Raises
+    ------
+    StorageError
+        The storage refused the answer (no space, a file size limit): named by the folder
+        the private one was made in.
+    """
     os.set_blocking(child.stdout.fileno(), False)  # a plug-in's fork may hold it open
     try:
-        return os.read(child.stdout.fileno(), 2000).decode("utf-8", "replace")
+        said = os.read(child.stdout.fileno(), 2000).decode("utf-8", "replace")
     except BlockingIOError:
         return ""
+    code, _, reason = said.partition(" ")
+    if not code.isdigit():
+        return said
+    refused = storage_error(folder.parent, OSError(int(code), reason))
+    if refused is not None:
+        raise refused
+    return f"cannot hand its answer back through {folder}: {reason}"
 
 
 def _answer(folder: Path, name: str) -> Any:
@@ -265,7 +278,7 @@ def check_entries(entries: Sequence[Entry], time_limit_s: float | None = None
             what = (f"importing it and checking its config did not finish within {limit:g} s; "
                     "it was stopped (a plug-in's module must not wait or loop when imported; "
                     "--time-limit sets this bound)" if not finished else
-                    _said(child) or f"{_ended(child, start)} while being imported and "
+                    _said(child, folder) or f"{_ended(child, start)} while being imported and "
                     "checked, without an answer; a plug-in's module must not exit or crash when "
                     "imported")
             answer = ("ok", [[] for _ in unique])
@@ -297,7 +310,7 @@ def run_isolated(dataset_path: str | Path, entry: Entry,
                                       "the limit with --time-limit if it is only slow)")])
         answer = _answer(folder, _ANSWER)
         if answer is None:
-            raise InputError([Problem(_where(entry), None, "", _said(child) or (
+            raise InputError([Problem(_where(entry), None, "", _said(child, folder) or (
                 f"{_ended(child, start)} without a solution; an estimator must return, not "
                 "exit"))])
     status, value = answer

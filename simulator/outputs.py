@@ -43,7 +43,13 @@ import tempfile
 from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 
-from simulator.errors import InputError, Problem, refuse_undecodable
+from simulator.errors import (
+    InputError,
+    Problem,
+    StorageError,
+    refuse_undecodable,
+    storage_error,
+)
 
 OWNER_FILE = ".landnav-owner"  # inside a claimed temporary folder: the writer's process id
 MARKER_FILE = ".landnav-output"  # inside every folder written here: what --force may replace
@@ -57,11 +63,10 @@ def _problem(path: Path | str, message: str) -> InputError:
 
 
 def os_problem(path: Path | str, exc: OSError) -> InputError:
-    """A file-system error writing ``path`` as one message with the reason."""
-    reason = exc.strerror or str(exc)
-    if exc.errno == errno.ENOSPC:
-        reason = "no space left on the device"
-    return _problem(path, f"cannot write here: {reason}")
+    """A file-system error writing ``path`` as one message with the reason (a
+    ``StorageError`` when the storage refused it: full, over a size limit, read-only)."""
+    return storage_error(path, exc) or _problem(path, f"cannot write here: "
+                                                      f"{exc.strerror or exc}")
 
 
 def resolved(path: Path | str) -> Path:
@@ -381,14 +386,15 @@ def atomic_output_dir(out_dir: Path | str, force: bool, inputs: Iterable[Path | 
 
 
 def _named_by(exc: InputError, draft: Path, out_dir: Path) -> InputError:
-    """``exc`` with the files under ``draft`` named by where they were to be, in ``out_dir``."""
-    problems = []
-    for p in exc.problems:
-        file = Path(p.file)
-        if file == draft or draft in file.parents:
-            p = dataclasses.replace(p, file=str(out_dir / file.relative_to(draft)))
-        problems.append(p)
-    return InputError(problems)
+    """``exc`` with the files under ``draft`` named by where they were to be, in ``out_dir``
+    (a ``StorageError`` stays one)."""
+    def named(file: Path) -> str:
+        in_draft = file == draft or draft in file.parents
+        return str(out_dir / file.relative_to(draft) if in_draft else file)
+
+    if isinstance(exc, StorageError):
+        return StorageError(named(Path(exc.folder)), exc.reason)
+    return InputError([dataclasses.replace(p, file=named(Path(p.file))) for p in exc.problems])
 
 
 @contextlib.contextmanager

@@ -21,6 +21,7 @@ from simulator.campaign.execute import completed, open_executor
 from simulator.campaign.plan import CampaignPlan
 from simulator.campaign.report import write_campaign_report
 from simulator.campaign.store import (
+    PARTS,
     RUNS_FILE,
     campaign_lock,
     check_campaign_dir,
@@ -32,7 +33,7 @@ from simulator.campaign.store import (
 )
 from simulator.campaign.summary import summarise
 from simulator.campaign.worker import STATUS_OK, execute_run, failed_rows
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, StorageError
 from simulator.outputs import os_problem, refuse_inside, replace_file
 from simulator.progress import progress
 
@@ -100,8 +101,21 @@ def run_campaign(plan: CampaignPlan, out: Path, options: CampaignOptions) -> Cam
         check_campaign_dir(out, record, fingerprint, options.force)
         try:
             return _run_locked(plan, out, options, fingerprint, record)
-        except OSError as exc:  # no space, a read-only volume: the finished runs stay
-            raise os_problem(out, exc) from None
+        except (StorageError, OSError) as exc:  # no space, a read-only volume: runs kept
+            problem = exc if isinstance(exc, InputError) else os_problem(out, exc)
+            if isinstance(problem, StorageError):
+                raise _stopped(problem, out) from None
+            raise problem from None
+
+
+def _stopped(refused: StorageError, out: Path) -> InputError:
+    """The one message of a campaign that the storage stopped: where, why, the finished runs
+    kept and how to go on."""
+    kept = len(done_parts(out)) if (out / PARTS).is_dir() else 0
+    return InputError([Problem(refused.folder, None, "", (
+        f"cannot write here: {refused.reason}; the campaign stopped, its {kept} finished "
+        f"run(s) kept in {out}: free space there (or raise the limit), then run the same "
+        "command again: the campaign resumes from them"))])
 
 
 def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerprint: str,
@@ -118,6 +132,8 @@ def _run_locked(plan: CampaignPlan, out: Path, options: CampaignOptions, fingerp
         for task, future in progress(finished, "runs", options.show_progress, len(todo)):
             try:
                 rows = future.result()
+            except StorageError:  # the machine's problem: the campaign stops (run_campaign)
+                raise
             except Exception as exc:  # the run never returned: its worker died or was lost
                 rows = failed_rows(task, "".join(traceback.format_exception(exc)))
             write_part(out, task.part, rows)

@@ -4,10 +4,13 @@ flight so that an interrupted campaign has little work under way.
 
 Local processes come from a ``forkserver`` whose preloaded worker module is forked for each
 process (fast start, and no fork of a parent that runs threads; ``spawn`` where there is no
-forkserver). On Ctrl-C they receive the
-interrupt too and abandon their run; nothing of an unfinished run is recorded. A worker process
-that dies (a crash inside an estimator's compiled code, the out-of-memory killer) fails the runs
-that were under way in the pool, and a new pool takes the next runs.
+forkserver). Each leads a process group of its own, which holds what a plug-in estimator
+forks there; when the pool ends, every worker's group is killed, so nothing a plug-in started
+outlives the campaign (nor the campaign's process: a worker ends its group when that process
+is gone). On Ctrl-C or SIGTERM the campaign stops its workers with SIGTERM, on which a worker
+abandons its run and removes the run's temporaries; nothing of an unfinished run is recorded.
+A worker process that dies (a crash inside an estimator's compiled code, the out-of-memory
+killer) fails the runs that were under way in the pool, and a new pool takes the next runs.
 
 Public functions
 ----------------
@@ -21,12 +24,13 @@ import contextlib
 import multiprocessing
 import os
 import re
+import signal
 import socket
 import threading
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
 
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, Terminated
 from simulator.isolated import watch_parent
 
 T = TypeVar("T")
@@ -34,7 +38,8 @@ _WORKER_MODULE = "simulator.campaign.worker"  # preloaded by the forkserver
 
 
 class _RenewingPool(cf.Executor):
-    """A local process pool that is replaced by a new one when a worker process has died."""
+    """A local process pool that is replaced by a new one when a worker process has died; on
+    its way out every worker is ended with its process group."""
 
     def __init__(self, workers: int):
         self.workers = workers
@@ -44,43 +49,103 @@ class _RenewingPool(cf.Executor):
         else:  # Windows
             self.context = multiprocessing.get_context("spawn")
         self.pool = self._new()
+        self.started: set[int] = set()  # the ids of the worker processes, dead ones included
 
     def _new(self) -> cf.ProcessPoolExecutor:
         return cf.ProcessPoolExecutor(self.workers, mp_context=self.context,
-                                      initializer=watch_parent, initargs=(os.getpid(),))
+                                      initializer=_start_worker, initargs=(os.getpid(),))
 
     def __exit__(self, kind: type | None, *rest: object) -> bool:
-        if kind is None:
-            self.shutdown(wait=True)
-        else:  # interrupted or failed: a stuck run must not hold the campaign
-            self.shutdown(wait=False, cancel_futures=True)
-            self.terminate_workers()
-            self.shutdown(wait=True)  # the pool, its workers gone, winds down at once
+        # every run is in, or the campaign stops: a stuck run must not hold it
+        self.shutdown(wait=False, cancel_futures=True)
+        self.terminate_workers()
+        self.shutdown(wait=True)  # the pool, its workers gone, winds down at once
+        self.end_orphaned_groups()
         return False
 
     @staticmethod
     def terminate_workers() -> None:
-        """SIGTERM to every worker process still running (or still starting): the campaign's
-        only child processes are its pools' workers."""
+        """SIGTERM to every worker process still running (or still starting), which ends it
+        with its process group (``_stop_worker``); SIGKILL to the group of one that does not
+        end within 2 s. The campaign's only child processes are its pools' workers."""
         children = multiprocessing.active_children()
         for process in children:
             process.terminate()
         for process in children:  # gone before this process ends and frees their queues
             process.join(2.0)
             if process.is_alive():
-                process.kill()
+                _kill_group(process.pid)
                 process.join(1.0)
+
+    def end_orphaned_groups(self) -> None:
+        """SIGKILL to the process group of every worker that has died (killed from outside,
+        it could not end its group): what a plug-in forked there. Only for an id that no
+        process holds now: the group is then one of its own processes, or none."""
+        for pid in self.started:
+            try:
+                os.kill(pid, 0)
+            except ProcessLookupError:
+                _kill_group(pid)
+            except PermissionError:  # the id taken by another user's process
+                pass
+        self.started = {p.pid for p in multiprocessing.active_children()}
 
     def submit(self, fn: Callable, /, *args: Any, **kwargs: Any) -> cf.Future:
         try:
-            return self.pool.submit(fn, *args, **kwargs)
+            future = self.pool.submit(_in_worker, fn, *args, **kwargs)
         except (cf.BrokenExecutor, EOFError, OSError):  # a worker died, or could not start
             self.pool.shutdown(wait=False)
+            self.end_orphaned_groups()
             self.pool = self._new()
-            return self.pool.submit(fn, *args, **kwargs)
+            future = self.pool.submit(_in_worker, fn, *args, **kwargs)
+        self.started.update(p.pid for p in multiprocessing.active_children())
+        return future
 
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         self.pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
+def _kill_group(pid: int) -> None:
+    """SIGKILL to the process group led by ``pid`` (where there are process groups)."""
+    if hasattr(os, "killpg"):
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            os.killpg(pid, signal.SIGKILL)
+
+
+_in_run = False  # in a worker process: whether it is running a task
+
+
+def _in_worker(fn: Callable, /, *args: Any, **kwargs: Any) -> Any:
+    """``fn(*args, **kwargs)`` in a worker process; stopped (SIGTERM), the task unwinds (its
+    temporaries removed), then the worker ends with its process group."""
+    global _in_run
+    _in_run = True
+    try:
+        return fn(*args, **kwargs)
+    except Terminated:
+        _kill_group(os.getpid())
+        raise
+    finally:
+        _in_run = False
+
+
+def _stop_worker(signum: int, frame: object) -> None:
+    """SIGTERM in a worker: unwind the task under way (``_in_worker``), or, idle, end the
+    worker with its process group at once."""
+    if _in_run:
+        raise Terminated(signum)
+    _kill_group(os.getpid())
+
+
+def _start_worker(parent_pid: int) -> None:
+    """A local worker process starts: the leader of a process group of its own, which holds
+    what a plug-in forks there and is ended with the worker (``_stop_worker``), and when
+    ``parent_pid`` (the campaign's process) is gone (``watch_parent``)."""
+    own_group = hasattr(os, "setpgid")
+    if own_group:
+        os.setpgid(0, 0)
+        signal.signal(signal.SIGTERM, _stop_worker)
+    watch_parent(parent_pid, whole_group=own_group)
 
 
 @contextlib.contextmanager

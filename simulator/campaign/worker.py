@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import contextlib
 import signal
+import socket
 import tempfile
 import threading
 import traceback
@@ -28,6 +29,7 @@ import numpy as np
 
 from simulator import pipeline
 from simulator.campaign.plan import RunTask, entry_labels
+from simulator.errors import StorageError, storage_error
 
 STATUS_OK = "ok"
 STATUS_FAILED = "failed"
@@ -130,12 +132,24 @@ def failed_rows(task: RunTask, error: str) -> list[dict[str, Any]]:
             for label in entry_labels(task.scenario.data["estimators"])]
 
 
+def _raise_storage(exc: Exception, folder: Path) -> None:
+    """Raise ``exc`` again when the storage refused a write (``StorageError``, or the
+    ``OSError`` of a full disk written into ``folder``): the machine's problem, which stops the
+    campaign, not the run's failure."""
+    if isinstance(exc, StorageError):
+        raise exc
+    refused = storage_error(folder, exc)
+    if refused is not None:
+        raise refused from None
+
+
 def _score_all(task: RunTask, dataset_dir: Path, time_limit_s: float | None
                ) -> list[dict[str, Any]]:
     labels = entry_labels(task.scenario.data["estimators"])
     try:
         dataset = pipeline.generate(task.scenario, dataset_dir, force=True, honour_lock=False)
-    except Exception:
+    except Exception as exc:
+        _raise_storage(exc, dataset_dir.parent)
         return failed_rows(task, traceback.format_exc())
     rows = []
     for label, entry in zip(labels, task.scenario.data["estimators"], strict=True):
@@ -143,7 +157,8 @@ def _score_all(task: RunTask, dataset_dir: Path, time_limit_s: float | None
             frame, info = _estimate(dataset, entry, label, time_limit_s)
             scores = pipeline.score(dataset, {label: (frame, info)}).scores()[label]
             rows.append(_row(task, label, STATUS_OK, flatten_scores(scores)))
-        except Exception:
+        except Exception as exc:
+            _raise_storage(exc, dataset_dir.parent)
             rows.append(_row(task, label, STATUS_FAILED, error=traceback.format_exc()))
     return rows
 
@@ -173,19 +188,26 @@ def time_limit(seconds: float | None, label: str) -> Iterator[None]:
         signal.signal(signal.SIGALRM, previous)
 
 
+def _in_main_thread() -> bool:
+    """Whether this runs in a local worker process's main thread (not a Dask worker's)."""
+    return threading.current_thread() is threading.main_thread()
+
+
 def _estimate(dataset: Any, entry: Any, label: str, time_limit_s: float | None
               ) -> tuple[Any, dict]:
     """One estimator of a run within ``time_limit_s``: here under a timer in a local worker
     (its main thread runs the tasks); in a child process that is killed at the limit in a
     thread of a Dask worker, where no timer signal can reach the estimator."""
-    if time_limit_s is not None and threading.current_thread() is not threading.main_thread():
+    if time_limit_s is not None and not _in_main_thread():
         return pipeline.estimate(dataset, entry, time_limit_s=time_limit_s)
     with time_limit(time_limit_s, label):
         return pipeline.estimate(dataset, entry, isolate=False)
 
 
 def execute_run(task: RunTask, time_limit_s: float | None = None) -> list[dict[str, Any]]:
-    """Run one campaign run; never raises for a failure inside the run.
+    """Run one campaign run; never raises for a failure inside the run, only when the storage
+    refuses its writes (``StorageError``: no space, a file size limit, a read-only volume),
+    which is the machine's problem (the campaign stops; the run's temporaries are removed).
 
     Parameters
     ----------
@@ -199,5 +221,13 @@ def execute_run(task: RunTask, time_limit_s: float | None = None) -> list[dict[s
     """
     if task.keep is not None:
         return _score_all(task, Path(task.keep), time_limit_s)
-    with tempfile.TemporaryDirectory(prefix="landnav-run-") as tmp:
-        return _score_all(task, Path(tmp) / "dataset", time_limit_s)
+    try:
+        with tempfile.TemporaryDirectory(prefix="landnav-run-") as tmp:
+            return _score_all(task, Path(tmp) / "dataset", time_limit_s)
+    except (StorageError, OSError) as exc:  # named by the temporary folder, not the run's own
+        refused = exc if isinstance(exc, StorageError) else storage_error("", exc)
+        if refused is None:
+            raise
+        on = "" if _in_main_thread() else f" on the Dask worker's host {socket.gethostname()}"
+        raise StorageError(tempfile.gettempdir(), f"{refused.reason} (the temporary folder of "
+                           f"the campaign's runs{on}; TMPDIR chooses it)") from None

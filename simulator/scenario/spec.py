@@ -82,6 +82,7 @@ def _check_whole(value: dict, path: Path, ctx: Context) -> dict:
     if profile is not None:
         ctx.built["profile"] = profile
         _check_job_size(value, profile.duration_s, path, ctx)
+        _check_rates(value, profile.duration_s, path, ctx)
         check_faults(value, path, ctx, profile.duration_s, {z[2] for z in profile.zones},
                      float(profile.distance_of_time(profile.duration_s)))
     labels: set[str] = set()
@@ -126,20 +127,35 @@ def _check_base(sensors: dict, path: Path, ctx: Context) -> None:
 # What one generation holds, measured with /usr/bin/time -v on `landnav generate` of a straight
 # drive with every sensor (IMU 100 Hz, odometer, barometer, magnetometer, GNSS fix and raw at
 # 1 Hz, 31 satellites): peak RSS 233 MB at 10 min, 347 MB at 30 min, 527 MB at 60 min, so
-# 0.35 GB per drive hour (1 kB per truth sample at 100 Hz) over 0.17 GB; the same 10 min with
-# GNSS at 10 Hz peaked at 323 MB: 17 kB per GNSS epoch of the constellation.
+# 0.35 GB per drive hour (1 kB per truth sample at 100 Hz) over 0.17 GB. A GNSS epoch costs by
+# what it tracks: 10 Hz GNSS (fix and raw) with a 100 Hz IMU, drives of 2 and 10 min, peaked at
+# 230 and 473 MB with GPS alone (40.6 kB per epoch beyond the truth samples), 365 and 1026 MB
+# with GPS, Galileo, BeiDou and GLONASS (128 kB), 611 MB over 10 min with three GPS signals
+# instead of one (24 kB more): 40 kB per system and 12 kB per further signal of a system.
 BYTES_PER_TRUTH_SAMPLE = 1000
-BYTES_PER_GNSS_EPOCH = 17_000
+BYTES_PER_SYSTEM_EPOCH = 40_000
+BYTES_PER_EXTRA_SIGNAL_EPOCH = 12_000
 MAX_TRUTH_SAMPLES = 10_000_000  # about 28 h at 100 Hz: 10 GB
 MAX_JOB_BYTES = 10e9
+
+
+def _gnss_epoch_bytes(gnss: dict) -> int:
+    """What one epoch of a GNSS receiver costs a generation, by the systems and signals it
+    tracks (measured: see above); each system tracks one signal where none are named."""
+    signals = gnss.get("signals") or {}
+    return sum(BYTES_PER_SYSTEM_EPOCH
+               + BYTES_PER_EXTRA_SIGNAL_EPOCH * max(len(signals.get(system) or ()) - 1, 0)
+               for system in gnss.get("systems") or ("gps",))
 
 
 def _check_job_size(value: dict, duration_s: float, path: Path, ctx: Context) -> None:
     rate_hz = value["trajectory"]["rate"]
     samples = rate_hz * duration_s
-    gnss = value["sensors"].get("gnss")
-    epochs = gnss["rate"] * duration_s if isinstance(gnss, dict) else 0.0
-    job_bytes = samples * BYTES_PER_TRUTH_SAMPLE + epochs * BYTES_PER_GNSS_EPOCH
+    receivers = [r for r in (value["sensors"].get("gnss"), value["sensors"].get("gnss_base"))
+                 if isinstance(r, dict)]
+    epochs = sum(r["rate"] * duration_s for r in receivers)
+    gnss_bytes = sum(r["rate"] * duration_s * _gnss_epoch_bytes(r) for r in receivers)
+    job_bytes = samples * BYTES_PER_TRUTH_SAMPLE + gnss_bytes
     if samples > MAX_TRUTH_SAMPLES:
         hours = MAX_TRUTH_SAMPLES / rate_hz / 3600
         ctx.error(path + ("trajectory",),
@@ -148,11 +164,30 @@ def _check_job_size(value: dict, duration_s: float, path: Path, ctx: Context) ->
                   f"one job may hold ({MAX_TRUTH_SAMPLES:.0e}); split it into drives of at most "
                   f"{hours:.3g} h, or lower trajectory.rate")
     elif job_bytes > MAX_JOB_BYTES:
+        gnss = receivers[0]
         ctx.error(path + ("sensors", "gnss", "rate"),
                   f"the drive lasts {duration_s / 3600:.4g} h: its {samples:.3g} truth samples "
                   f"and {epochs:.3g} GNSS epochs at {gnss['rate']:g} Hz need about "
-                  f"{job_bytes / 1e9:.3g} GB, more than one job may hold "
-                  f"({MAX_JOB_BYTES / 1e9:.3g} GB); lower sensors.gnss.rate or split the drive")
+                  f"{job_bytes / 1e9:.3g} GB (tracking "
+                  f"{', '.join(gnss.get('systems') or ('gps',))}), more than one job may hold "
+                  f"({MAX_JOB_BYTES / 1e9:.3g} GB); lower sensors.gnss.rate, track fewer "
+                  "systems or signals, or split the drive")
+
+
+def _check_rates(value: dict, duration_s: float, path: Path, ctx: Context) -> None:
+    """No rate of the truth or of a sensor has a period longer than the drive: one such as
+    ``rate: 1e-300`` gives a table of one row at most, and a stream timed by it (the IMU's
+    integration interval) ages without bound."""
+    rated = [(("sensors", name, "rate"), sensor.get("rate"))
+             for name, sensor in value["sensors"].items() if isinstance(sensor, dict)]
+    imu = value["sensors"].get("imu")
+    if not (isinstance(imu, dict) and imu.get("rate") == value["trajectory"].get("rate")):
+        rated.append((("trajectory", "rate"), value["trajectory"].get("rate")))  # its own
+    for key, rate_hz in rated:
+        if isinstance(rate_hz, float | int) and rate_hz * duration_s < 1:
+            ctx.error(path + key, f"at {rate_hz:g} Hz one sample period is longer than the "
+                                  f"{duration_s:.4g} s drive; give at least "
+                                  f"{1 / duration_s:.3g} Hz")
 
 
 def _zones_used(value: dict) -> set[str] | None:

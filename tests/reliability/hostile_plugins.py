@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 import signal
+import subprocess
 import sys
 import time
 
@@ -103,3 +104,19 @@ class KillsItsWorker(_Base):
     def on_imu(self, t, row):
         if self.config["kill"]:
             os.kill(os.getpid(), signal.SIGKILL)
+
+
+class LeavesSleepers(_Base):
+    """At setup, starts a sleeping process and forks a sleeping copy of itself, both meant to
+    outlive it; appends their ids to the file ``config["pids"]``."""
+
+    defaults = {"pids": ""}
+
+    def setup(self):
+        sleeper = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(600)"])
+        forked = os.fork()
+        if forked == 0:
+            time.sleep(600)
+            os._exit(0)  # the copy never returns into the estimator's caller
+        with open(self.config["pids"], "a", encoding="utf-8") as pids:
+            pids.write(f"{sleeper.pid} {forked}\n")

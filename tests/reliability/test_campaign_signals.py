@@ -19,9 +19,12 @@ import pandas as pd
 import pytest
 import yaml
 
+from simulator.cli import main
 from tests.reliability.checks import alive
+from tests.reliability.drives import straight_drive
 
 REPO = Path(__file__).resolve().parents[2]
+PLUGINS = "tests.reliability.hostile_plugins"
 
 
 def _scenario(tmp_path: Path, stuck_while: Path) -> Path:
@@ -114,6 +117,27 @@ def test_workers_end_with_a_killed_campaign(tmp_path):
     while any(alive(p) for p in workers) and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not any(alive(p) for p in workers)
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs Linux's /proc")
+def test_what_a_plugin_forks_in_a_worker_ends_with_the_campaign(tmp_path, capsys):
+    """A plug-in that starts a process and forks itself in every run, each meant to sleep 600
+    s: when the campaign has ended, none of them is left (each worker ends with its process
+    group)."""
+    pids = tmp_path / "pids.txt"
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(straight_drive(
+        20, sensors="  imu: {preset: ideal, rate: 25}\n",
+        tail=f"estimators: [{{name: '{PLUGINS}:LeavesSleepers', config: {{pids: '{pids}'}}}}]\n"))
+    assert main(["campaign", str(scenario), "--runs", "2", "--workers", "2", "-o",
+                 str(tmp_path / "mc")]) == 0, capsys.readouterr().err
+    assert "2 result(s) ok, 0 failed" in capsys.readouterr().out
+    started = [int(p) for p in pids.read_text().split()]
+    assert len(started) == 4  # two in each run
+    deadline = time.monotonic() + 60  # a hang guard: they are killed as the campaign ends
+    while any(alive(p) for p in started) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(alive(p) for p in started)
 
 
 def test_campaign_time_limit_fails_the_stuck_run_and_goes_on(tmp_path):

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import pytest
 
+from simulator.cli import main
 from tests.reliability.checks import tree
 from tests.reliability.drives import shared_dataset, straight_drive  # noqa: F401 (fixture)
 
@@ -59,8 +60,6 @@ CASES = {
 def test_a_full_disk_leaves_nothing_and_one_message(dataset, tmp_path, case):
     args, limit = CASES[case]
     if case == "report":
-        from simulator.cli import main
-
         assert main(["estimate", str(dataset), "-e", "dead_reckoning", "-o",
                      str(tmp_path / "sol.parquet")]) == 0
     (tmp_path / "s.yaml").write_text(straight_drive(
@@ -76,3 +75,77 @@ def test_a_full_disk_leaves_nothing_and_one_message(dataset, tmp_path, case):
     assert list((tmp_path / "tmp").iterdir()) == []
     (tmp_path / "tmp").rmdir()
     assert {"cwd": tree(tmp_path), "dataset": tree(dataset.parent)} == before
+
+
+CAMPAIGN = straight_drive(100, sensors="  imu: {preset: ideal, rate: 50}\n  odometer: {rate: 10}\n",
+                          tail="estimators: [dead_reckoning]\n")
+
+
+def _message(stderr: str) -> str:
+    """The one line a stopped command printed (progress lines apart)."""
+    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("runs: ")]
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith("error: ") and "Traceback" not in stderr
+    return lines[0]
+
+
+@pytest.mark.skipif(not hasattr(resource, "RLIMIT_FSIZE"), reason="needs RLIMIT_FSIZE")
+def test_a_campaign_stops_on_a_full_disk_and_resumes(tmp_path, monkeypatch, capsys):
+    """The runs' datasets cannot be written (the limit is below a dataset's size): the
+    campaign stops with exit 2 and one message naming the folder and what to do (before, every
+    run was recorded as failed and it exited 0); the run finished before is kept, no temporary
+    is left (the other worker's run unwinds); run again with room, it resumes."""
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.yaml").write_text(CAMPAIGN)
+    args = ["campaign", "s.yaml", "--workers", "2", "-o", "mc"]
+    assert main([*args, "--runs", "1"]) == 0
+    before = tree(tmp_path)
+    done = _landnav_on_a_full_disk([*args, "--runs", "3"], tmp_path, 20_000)
+    assert done.returncode == 2, done.stderr
+    message = _message(done.stderr)
+    assert f"error: {tmp_path / 'tmp'}: cannot write here: File too large" in message
+    assert "1 finished run(s) kept in mc" in message and "run the same command again" in message
+    assert list((tmp_path / "tmp").iterdir()) == []
+    (tmp_path / "tmp").rmdir()
+    assert tree(tmp_path) == before
+    capsys.readouterr()
+    assert main([*args, "--runs", "3"]) == 0
+    assert "(2 run(s) computed now, 1 already done)" in capsys.readouterr().out
+
+
+CLUSTER = """import resource, signal, sys
+from distributed import LocalCluster
+signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+resource.setrlimit(resource.RLIMIT_FSIZE, ({limit}, {limit}))
+with LocalCluster(host="127.0.0.1", n_workers=1, threads_per_worker=2, processes=False,
+                  protocol="tcp", dashboard_address=None) as cluster:
+    print(cluster.scheduler_address, flush=True)
+    sys.stdin.read()
+"""
+
+
+@SLOW  # about 8 s of CPU: a Dask cluster in a process of its own
+@pytest.mark.skipif(not hasattr(resource, "RLIMIT_FSIZE"), reason="needs RLIMIT_FSIZE")
+def test_a_campaign_on_dask_workers_stops_on_their_full_disk(tmp_path, monkeypatch, capsys):
+    """The Dask workers' disk is full (their process's file-size limit): the campaign stops
+    with exit 2 and one message naming the workers' folder and host; nothing is recorded."""
+    pytest.importorskip("distributed")
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "s.yaml").write_text(CAMPAIGN)
+    (tmp_path / "tmp").mkdir()
+    env = {**os.environ, "PYTHONPATH": str(REPO), "TMPDIR": str(tmp_path / "tmp")}
+    with subprocess.Popen([sys.executable, "-c", CLUSTER.format(limit=20_000)], env=env,
+                          stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True) as cluster:
+        try:
+            address = cluster.stdout.readline().strip()
+            assert address.startswith("tcp://")
+            code = main(["campaign", "s.yaml", "--runs", "3", "--scheduler", address, "-o", "mc"])
+        finally:
+            cluster.stdin.close()  # the cluster ends
+    printed = capsys.readouterr()
+    assert code == 2, printed.err
+    message = _message(printed.err)
+    assert f"error: {tmp_path / 'tmp'}: cannot write here: File too large" in message
+    assert "on the Dask worker's host" in message and "0 finished run(s) kept in mc" in message
+    assert [p.name for p in (tmp_path / "tmp").iterdir()] == ["dask-scratch-space"]
+    assert sorted(p.name for p in (tmp_path / "mc").rglob("*")) == ["campaign.json", "parts"]
