@@ -88,7 +88,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--runs", type=int, default=None, metavar="N",
                    help=f"seeds 1..N per experiment (default {FULL_SEEDS}; {QUICK_SEEDS} with "
                         "--quick); without --quick an experiment whose verdicts sit at an "
-                        "edge runs more (its full_runs, e.g. 20)")
+                        "edge runs more (its full_runs, e.g. 20), and a claim whose sign-test "
+                        "p after N seeds lies in [0.05, 0.2) has the experiments it reads run "
+                        "again up to 2N seeds")
     p.add_argument("--quick", action="store_true",
                    help="shortened drives (each experiment's quick overrides) and 3 seeds "
                         "unless --runs says otherwise, and no variant (a claim judged again "

@@ -8,6 +8,13 @@ every entry of the experiment replays it (``simulator.pipeline.estimate``), the 
 raises is recorded with its seed and error and the others go on; a claim whose figures are
 missing is judged on the seeds that have them (and says so).
 
+A full run (not ``--quick``) is made in two stages, by a rule fixed before any figure is seen:
+after the run's seeds every claim is judged, and a claim whose sign-test p lies in
+[``ALPHA``, ``EDGE_P``) sits at an edge (at ten seeds: 7 or 8 in the paper's direction); the
+experiments it reads are run again on further seeds, up to ``EDGE_SEEDS_FACTOR`` times the run's
+(twenty at ten), and every claim is judged on all of them. A verdict is never read at a stage
+and then kept from it: the words are those of the final tables.
+
 The output folder (written under a temporary name and renamed when complete,
 ``simulator.outputs.atomic_output_dir``)::
 
@@ -21,7 +28,7 @@ The output folder (written under a temporary name and renamed when complete,
 Public names
 ------------
 Settings, ExperimentResult, PaperResult, run_experiment, reproduce, judge, ruled, seeds_of,
-QUICK_SEEDS, FULL_SEEDS.
+edge_experiments, QUICK_SEEDS, FULL_SEEDS, EDGE_P, EDGE_SEEDS_FACTOR.
 """
 
 from __future__ import annotations
@@ -45,16 +52,19 @@ from simulator.outputs import atomic_output_dir
 from simulator.pipeline import estimate, generate, load_scenario
 from simulator.progress import progress
 from simulator.reproduce import FULL_SEEDS, QUICK_SEEDS
-from simulator.reproduce.evidence import verdict_word
+from simulator.reproduce.evidence import ALPHA, verdict_word
 from simulator.reproduce.paper import SCENARIO_DIR, Experiment, Paper, Verdict, scenario_path
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.report import write_report
 from simulator.reproduce.results import RESULTS_FILE, write_results
 
-__all__ = ["FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult", "PaperResult", "Settings", "judge",
-           "reproduce", "ruled", "run_experiment", "seeds_of"]
+__all__ = ["EDGE_P", "EDGE_SEEDS_FACTOR", "FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult",
+           "PaperResult", "Settings", "edge_experiments", "judge", "reproduce", "ruled",
+           "run_experiment", "seeds_of"]
 
 SCHEDULER_TIMEOUT_S = 10.0
+EDGE_P = 0.2  # a verdict with ALPHA <= sign-test p < EDGE_P after the run's seeds is at an edge
+EDGE_SEEDS_FACTOR = 2  # an edge claim's experiments run again up to this times the run's seeds
 
 
 def seeds_of(runs: int) -> list[int]:
@@ -190,6 +200,18 @@ def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict
     return out
 
 
+def edge_experiments(paper: Paper, verdicts: Mapping[str, Verdict]) -> set[str]:
+    """The keys of ``paper``'s experiments read by a claim whose verdict sits at an edge: its
+    one-sided sign test's p in [``ALPHA``, ``EDGE_P``), where more seeds can decide the word."""
+    keys: set[str] = set()
+    for claim in paper.claims:
+        verdict = verdicts.get(claim.key)
+        evidence = verdict.evidence if verdict is not None else None
+        if evidence is not None and ALPHA <= evidence.p_sign < EDGE_P:
+            keys.update(e.key for e in paper.read_by(claim))
+    return keys
+
+
 def ruled(verdict: Verdict) -> Verdict:
     """``verdict`` if its word is the one the documented rule gives on its evidence
     (``evidence.verdict_word``; without evidence only "not shown" follows), else the rule's
@@ -252,20 +274,35 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
     software = version()  # the code the tasks run: read before they start
     with atomic_output_dir(Path(out), force) as tmp:
         with open_executor(workers, scheduler, SCHEDULER_TIMEOUT_S) as (executor, in_flight):
-            for task, future in progress(completed(executor, in_flight, _execute, tasks),
-                                         "reproduce", show_progress, total=len(tasks)):
-                key = (task.paper, task.experiment)
-                try:
-                    result, error, task_cpu = future.result()
-                except Exception as exc:  # a worker that died: this seed failed
-                    result, error, task_cpu = None, f"{type(exc).__name__}: {exc}", 0.0
-                cpu += task_cpu
-                if result is None:
-                    failures.setdefault(key, {})[task.seed] = error or "unknown error"
-                else:
-                    figures.setdefault(key, {})[task.seed] = result[0]
-                    if result[1] is not None:
-                        histories[key] = result[1]
+            def run(batch: list[_Task], label: str) -> None:
+                nonlocal cpu
+                for task, future in progress(completed(executor, in_flight, _execute, batch),
+                                             label, show_progress, total=len(batch)):
+                    key = (task.paper, task.experiment)
+                    try:
+                        result, error, task_cpu = future.result()
+                    except Exception as exc:  # a worker that died: this seed failed
+                        result, error, task_cpu = None, f"{type(exc).__name__}: {exc}", 0.0
+                    cpu += task_cpu
+                    if result is None:
+                        failures.setdefault(key, {})[task.seed] = error or "unknown error"
+                    else:
+                        figures.setdefault(key, {})[task.seed] = result[0]
+                        if result[1] is not None:
+                            histories[key] = result[1]
+
+            run(tasks, "reproduce")
+            further = []
+            for paper in loaded if not quick else ():
+                verdicts = judge(paper, {e.key: _table(figures.get((paper.key, e.key), {}))
+                                         for e in paper.experiments})
+                at_edge = edge_experiments(paper, verdicts)
+                further += [_Task(paper.key, e.key, seed, tuple(experiment_overrides(e, quick)))
+                            for e in paper.experiments if e.key in at_edge
+                            for seed in seeds_of(EDGE_SEEDS_FACTOR * len(seeds))
+                            if seed not in experiment_seeds(e, seeds, quick)]
+            if further:
+                run(further, "reproduce, further seeds where a verdict is at an edge")
         results = []
         for paper in loaded:
             experiments = {}

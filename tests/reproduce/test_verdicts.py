@@ -196,3 +196,79 @@ def test_a_judge_is_given_only_the_experiments_it_declares():
     with pytest.raises(ValueError, match="no experiment c"):
         Paper("p", "t", "c", experiments, (Claim("names_c", "t", "f", (), read_b,
                                                  experiments=("c",)),))
+
+
+def test_the_experiments_of_a_claim_at_its_edge_are_run_on_further_seeds():
+    from simulator.reproduce.evidence import one_sample_evidence
+    from simulator.reproduce.paper import Claim, Experiment, Paper, Verdict
+    from simulator.reproduce.runner import edge_experiments
+
+    def experiment(key):
+        return Experiment(key, "quickstart.yaml", {"a": {"name": "dead_reckoning"}},
+                          measure=print)
+
+    def verdict(wins):  # ten seeds, ``wins`` of them below the threshold
+        values = [0.0] * wins + [2.0] * (10 - wins)
+        evidence = one_sample_evidence(values, threshold=1.0, better="lower")
+        word = "shown" if evidence.significant else "not shown"
+        return Verdict(word, "", "", evidence, {"values": values})
+
+    claims = tuple(Claim(f"c{i}", "", "", (), judge=len, experiments=(f"e{i}",))
+                   for i in range(4))
+    paper = Paper("p", "", "", tuple(experiment(f"e{i}") for i in range(4)), claims)
+    # 9/10 (p 0.011) is shown, 8/10 (p 0.055) and 7/10 (p 0.17) sit at the edge, 6/10 (p 0.38)
+    # is not shown whatever a few more seeds say
+    verdicts = {"c0": verdict(9), "c1": verdict(8), "c2": verdict(7), "c3": verdict(6)}
+    assert edge_experiments(paper, verdicts) == {"e1", "e2"}
+    assert edge_experiments(paper, {"c0": verdicts["c0"]}) == set()
+
+
+def _measured(experiment, seed, overrides, work, with_history=False):
+    """Stands in for a seed's run: experiment "e0" below its threshold on every seed, "e1" on
+    the even seeds only."""
+    below = experiment.key == "e0" or seed % 2 == 0
+    return {"value": 0.0 if below else 2.0}, None
+
+
+def _judge_values(tables):
+    from simulator.reproduce.evidence import one_sample_evidence
+    from simulator.reproduce.paper import Verdict
+    from simulator.reproduce.runner import ruled
+
+    (table,) = tables.values()
+    values = table["value"].tolist()
+    evidence = one_sample_evidence(values, threshold=1.0, better="lower")
+    return ruled(Verdict("not shown", "", "", evidence, {"values": values}))
+
+
+def test_a_full_run_runs_the_edge_claims_experiments_again_on_further_seeds(tmp_path,
+                                                                            monkeypatch):
+    from concurrent.futures import ThreadPoolExecutor
+    from contextlib import contextmanager
+
+    from simulator.reproduce import runner
+    from simulator.reproduce.paper import Claim, Experiment, Paper
+
+    paper = Paper("fake", "A fake paper", "", tuple(
+        Experiment(k, "quickstart.yaml", {"a": {"name": "dead_reckoning"}}, measure=print)
+        for k in ("e0", "e1")), tuple(
+        Claim(f"c{k}", "below 1", "Table 1", (), judge=_judge_values, experiments=(k,))
+        for k in ("e0", "e1")))
+
+    @contextmanager
+    def in_threads(workers, scheduler, timeout_s):
+        with ThreadPoolExecutor(1) as executor:
+            yield executor, 1
+
+    monkeypatch.setattr(runner, "load_paper", lambda key: paper)
+    monkeypatch.setattr(runner, "measure_seed", _measured)
+    monkeypatch.setattr(runner, "open_executor", in_threads)
+    # three seeds: e0 below on 3 of 3 (p 0.125, at the edge: three more seeds), e1 on 1 of 3
+    (result,) = runner.reproduce(["fake"], 3, False, tmp_path / "out", 1)
+    assert list(result.experiments["e0"].table.index) == [1, 2, 3, 4, 5, 6]
+    assert list(result.experiments["e1"].table.index) == [1, 2, 3]
+    assert result.verdicts["ce0"].status == "shown"  # 6 of 6: p = 1/64
+    assert result.verdicts["ce0"].evidence.n == 6
+    # --quick has no second stage
+    (quick,) = runner.reproduce(["fake"], 3, True, tmp_path / "quick", 1)
+    assert list(quick.experiments["e0"].table.index) == [1, 2, 3]
