@@ -102,14 +102,16 @@ def gnss_gap_events(fix_t: np.ndarray, end_t: float, nominal_interval_s: float
                          "detail": ["no fix in the recording"] * len(long)})
 
 
-def _resolved_sensors(sensors: dict[str, Any]) -> dict[str, Any]:
+def _resolved_sensors(sensors: dict[str, Any], duration_s: float) -> dict[str, Any]:
     """The recording's sensor blocks with every default filled, through the scenario schema
-    (the same resolution as a scenario's)."""
+    (the same resolution as a scenario's) on a standstill as long as the recording (a slow
+    stream, a station's 30 s RINEX, is checked against the recording's span)."""
     from simulator.scenario import validate_data
 
     data = {"name": "recording", "start": {"utc": "2020-01-01T00:00:00Z", "lat": 0.0,
                                            "lon": 0.0, "alt": 0.0},
-            "trajectory": {"kind": "segments", "segments": [{"stop": {"duration": 10}}]},
+            "trajectory": {"kind": "segments",
+                           "segments": [{"stop": {"duration": max(10.0, duration_s)}}]},
             "sensors": sensors}
     return validate_data(data, "<recording sensors>")["sensors"]
 
@@ -122,7 +124,8 @@ def write_recording(recording: Recording, out_dir: str | Path, force: bool = Fal
     streams = {k: v for k, v in recording.streams.items() if v is not None}
     truth = streams["truth"]
     first = truth.iloc[0]
-    sensors = _resolved_sensors(recording.sensors)
+    sensors = _resolved_sensors(recording.sensors,
+                                float(truth["t"].iloc[-1]) - float(truth["t"].iloc[0]))
     datasheet = {k: v for k, v in sensors.items() if v is not None}
     datasheet["vehicle"] = vehicle_datasheet(recording.vehicle)
     end_t = float(max(float(f["t"].iloc[-1]) for f in streams.values() if "t" in f))
