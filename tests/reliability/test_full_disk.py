@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import os
 import resource
+import shutil
 import signal
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -89,25 +91,34 @@ def _message(stderr: str) -> str:
     return lines[0]
 
 
+@pytest.fixture
+def short_tmp_path():
+    """A folder with a short path: a campaign's workers listen on a Unix socket in TMPDIR,
+    whose path may not exceed 107 bytes (pytest's own tmp_path under xdist comes near)."""
+    folder = Path(tempfile.mkdtemp(prefix="fd-"))
+    yield folder
+    shutil.rmtree(folder, ignore_errors=True)
+
+
 @pytest.mark.skipif(not hasattr(resource, "RLIMIT_FSIZE"), reason="needs RLIMIT_FSIZE")
-def test_a_campaign_stops_on_a_full_disk_and_resumes(tmp_path, monkeypatch, capsys):
+def test_a_campaign_stops_on_a_full_disk_and_resumes(short_tmp_path, monkeypatch, capsys):
     """The runs' datasets cannot be written (the limit is below a dataset's size): the
     campaign stops with exit 2 and one message naming the folder and what to do (before, every
     run was recorded as failed and it exited 0); the run finished before is kept, no temporary
     is left (the other worker's run unwinds); run again with room, it resumes."""
-    monkeypatch.chdir(tmp_path)
-    (tmp_path / "s.yaml").write_text(CAMPAIGN)
+    monkeypatch.chdir(short_tmp_path)
+    (short_tmp_path / "s.yaml").write_text(CAMPAIGN)
     args = ["campaign", "s.yaml", "--workers", "2", "-o", "mc"]
     assert main([*args, "--runs", "1"]) == 0
-    before = tree(tmp_path)
-    done = _landnav_on_a_full_disk([*args, "--runs", "3"], tmp_path, 20_000)
+    before = tree(short_tmp_path)
+    done = _landnav_on_a_full_disk([*args, "--runs", "3"], short_tmp_path, 20_000)
     assert done.returncode == 2, done.stderr
     message = _message(done.stderr)
-    assert f"error: {tmp_path / 'tmp'}: cannot write here: File too large" in message
+    assert f"error: {short_tmp_path / 'tmp'}: cannot write here: File too large" in message
     assert "1 finished run(s) kept in mc" in message and "run the same command again" in message
-    assert list((tmp_path / "tmp").iterdir()) == []
-    (tmp_path / "tmp").rmdir()
-    assert tree(tmp_path) == before
+    assert list((short_tmp_path / "tmp").iterdir()) == []
+    (short_tmp_path / "tmp").rmdir()
+    assert tree(short_tmp_path) == before
     capsys.readouterr()
     assert main([*args, "--runs", "3"]) == 0
     assert "(2 run(s) computed now, 1 already done)" in capsys.readouterr().out
