@@ -145,12 +145,11 @@ def _chunks(path: Path, what: str, where: _Rows, keep: tuple[str, ...] = (), **o
             ) -> Iterator[pd.DataFrame]:
     """``pandas.read_csv(path, **options)`` (a file of the format ``what``) chunk by chunk,
     each with its cells (but the columns ``keep``) checked as numbers (``_refuse_text``,
-    naming the file's line) and indexed by its rows' numbers in the file; refused past
+    naming the file's line; pandas numbers a chunk's rows from the file's first); refused past
     ``MAX_SOLUTION_ROWS``."""
     rows = 0
     try:
         for chunk in pd.read_csv(path, chunksize=_CHUNK_ROWS, **options):
-            chunk.index += rows
             _refuse_text(path, chunk, where, keep)
             rows += len(chunk)
             if rows > MAX_SOLUTION_ROWS:
