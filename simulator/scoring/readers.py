@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import datetime as dt
 import math
+import warnings
 from array import array
 from collections.abc import Iterable, Iterator
 from pathlib import Path
@@ -149,12 +150,19 @@ def _chunks(path: Path, what: str, where: _Rows, keep: tuple[str, ...] = (), **o
     ``MAX_SOLUTION_ROWS``."""
     rows = 0
     try:
-        for chunk in pd.read_csv(path, chunksize=_CHUNK_ROWS, **options):
-            _refuse_text(path, chunk, where, keep)
-            rows += len(chunk)
-            if rows > MAX_SOLUTION_ROWS:
-                raise _too_many_rows(path, rows)
-            yield chunk
+        with warnings.catch_warnings():
+            # a row of more fields than the header: refused, not its fields dropped (nor the
+            # first columns taken as the index, as pandas would without index_col=False)
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            for chunk in pd.read_csv(path, chunksize=_CHUNK_ROWS, index_col=False, **options):
+                _refuse_text(path, chunk, where, keep)
+                rows += len(chunk)
+                if rows > MAX_SOLUTION_ROWS:
+                    raise _too_many_rows(path, rows)
+                yield chunk
+    except pd.errors.ParserWarning:
+        raise _problem(path, f"not a readable {what} file: a row has more fields than the "
+                             "header names") from None
     except (ValueError, OSError) as exc:
         raise _problem(path, f"not a readable {what} file: {exc}") from None
 
@@ -236,7 +244,7 @@ def _pos_rows(path: Path, table: pd.DataFrame, names: list[str], where: _Rows,
                    + clock["_time2"].to_numpy(float))
     out = pd.DataFrame({"t": seconds - (gps_start[0] * SECONDS_PER_WEEK + gps_start[1])},
                        index=table.index)
-    if "latitude(deg)" in table:
+    if "longitude(deg)" in table:
         out["lat"], out["lon"] = table["latitude(deg)"], table["longitude(deg)"]
         out["alt"] = table["height(m)"]
     else:
@@ -268,15 +276,21 @@ def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[s
     if geodetic:
         raise _problem(path, "heights are geodetic (above the geoid); write ellipsoidal heights"
                              " (RTKLIB option out-height=ellipsoidal)")
-    if "latitude(deg)" not in names and "x-ecef(m)" not in names:
+    if not ({"latitude(deg)", "longitude(deg)", "height(m)"} <= set(names)
+            or {"x-ecef(m)", "y-ecef(m)", "z-ecef(m)"} <= set(names)):
         raise _problem(path, "neither latitude(deg)/longitude(deg)/height(m) nor x/y/z-ecef(m) "
                              "columns (east/north/up relative positions cannot be scored)")
+    for group in (("vn(m/s)", "ve(m/s)", "vu(m/s)"), ("sdn(m)", "sde(m)", "sdu(m)")):
+        if 0 < len(set(group) & set(names)) < len(group):
+            raise _problem(path, f"the header names some of {', '.join(group)} but not all")
     where = _Rows(first_line=header_lines + 1)
     fields = ["_time1", "_time2", *names[1:]]
     chunks = []
     for table in _chunks(path, "RTKLIB .pos", where, ("_time1", "_time2"), sep=r"\s+",
                          header=None, names=fields, comment="%", skiprows=header_lines,
                          dtype=str, keep_default_na=False):
+        if table.empty:
+            continue
         short = table.index[table[fields[-1]].isna().to_numpy()]
         if len(short):
             raise _problem(path, f"{where(int(short[0]))}: rows "

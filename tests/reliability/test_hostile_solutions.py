@@ -186,3 +186,23 @@ def test_solutions_longer_than_a_replay_are_refused_as_read(dataset, tmp_path, c
             path = tmp_path / "s.parquet"
     refused(["score", str(dataset), "--solution", str(path)], capsys, [dataset.parent],
             "more than 10 rows")
+
+
+HEADER = "%  GPST          latitude(deg) longitude(deg)  height(m)   Q  ns\n"
+
+
+@pytest.mark.parametrize("name, text, words", [
+    ("empty.pos", HEADER, "the solution has no rows"),  # was an IndexError
+    ("half.pos", HEADER.replace("longitude", "easting"), "neither latitude(deg)"),  # KeyError
+    ("speeds.pos", HEADER.replace("ns", "ns vn(m/s) ve(m/s)") + "2300 1.0 37.5 127 10 1 5 0 0\n",
+     "some of vn(m/s), ve(m/s), vu(m/s) but not all"),  # was a KeyError
+    ("semicolons.csv", "t;lat;lon;alt;vn;ve;vd;roll;pitch;yaw\n0;37;127;0;0;0;0;0;0;0\n",
+     "missing column(s) t, lat"),  # was "no rows"
+    ("far.csv", "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw\n1e308,37,127,0,0,0,0,0,0,0\n"
+     "1e308,37,127,0,0,0,0,0,0,0\n", "row 1 has t = 1e+308 s after t = 1e+308 s"),  # 309 digits
+])
+def test_malformed_solution_files(dataset, tmp_path, capsys, name, text, words):
+    path = tmp_path / name
+    path.write_text(text)
+    refused(["score", str(dataset), "--solution", str(path)], capsys, [dataset.parent, tmp_path],
+            words)
