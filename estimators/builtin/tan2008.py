@@ -83,6 +83,7 @@ TanLinearisedKF.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
@@ -93,6 +94,7 @@ from estimators.toolbox.datasheet import fix_error_model, imu_error_model
 from estimators.toolbox.ins_error import BG, N_STATES
 from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
 from estimators.toolbox.installation import Installation
+from estimators.toolbox.sensor_datasheet import ACCEL_NOISE_FLOOR, GYRO_NOISE_FLOOR
 from simulator.errors import InputError
 
 G0 = 9.80665  # standard gravity, m/s^2 (datasheet mg)
@@ -111,10 +113,11 @@ class TanLinearisedKF(Estimator):
              "loop with NHC, height and magnetometer aiding in outages")
     defaults = {"nhc": True, "height_constraint": None, "mag_heading": True,
                 "update_interval": 0.5, "standstill": None, "course_speed": 5.0,
-                "open_loop_outages": True, "tuning": "datasheet"}
+                "open_loop_outages": None, "tuning": "datasheet"}
     # the defaults left None: the paper's design with ``tuning: paper``, else the datasheet's
-    PAPER_DESIGN = {"height_constraint": True, "standstill": 60.0}
-    DATASHEET_DESIGN = {"height_constraint": False, "standstill": 0.0}
+    PAPER_DESIGN = {"height_constraint": True, "standstill": 60.0, "open_loop_outages": True}
+    DATASHEET_DESIGN = {"height_constraint": False, "standstill": 0.0,
+                        "open_loop_outages": False}
     config_help = {
         "nhc": ("", "zero lateral and vertical body velocity during outages (eqs. 6-7)"),
         "height_constraint": ("", "hold the last GPS-aided height during outages (section "
@@ -124,7 +127,8 @@ class TanLinearisedKF(Estimator):
         "standstill": ("s", "zero-velocity and zero-rate updates over the first seconds; "
                             "default: 60 with tuning paper, 0 with datasheet"),
         "course_speed": ("m/s", "speed above which the GPS course aids the heading"),
-        "open_loop_outages": ("", "open the loop during outages (the paper's design)"),
+        "open_loop_outages": ("", "open the loop during outages (the paper's design); "
+                                  "default: on with tuning paper, off with datasheet"),
         "tuning": ("", "datasheet (noise from the dataset's datasheet) or paper (the values "
                        "chosen for the reproduction)"),
     }
@@ -157,7 +161,10 @@ class TanLinearisedKF(Estimator):
         self._fix_model = None
         noise, p0, markov = self.NOISE, self.P0_SIGMA, {}
         if self.config["tuning"] == "datasheet":
-            noise = imu_error_model(self.datasheet)
+            sheet = imu_error_model(self.datasheet)
+            # white noise at least a tactical grade's: the strapdown's own error (sensor_datasheet)
+            noise = replace(sheet, accel_noise=max(sheet.accel_noise, ACCEL_NOISE_FLOOR),
+                            gyro_noise=max(sheet.gyro_noise, GYRO_NOISE_FLOOR))
             p0 = self.P0_SIGMA.copy()
             p0[9:12], p0[12:15] = noise.accel_bias_initial, noise.gyro_bias_initial
             self._fix_model = fix_error_model(self.datasheet)
