@@ -304,6 +304,7 @@ class _ChoDr(Estimator):
         self._lateral_var = 0.0  # its error variance, (m/s)^2
         self._datasheet = self.config["tuning"] == "datasheet"
         self._matching = FixNoiseMatching()
+        self._speed_matching = FixNoiseMatching()
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
         self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
         x0 = self._initial_state()
@@ -461,8 +462,13 @@ class _ChoDr(Estimator):
         gate = chi2_threshold(2, GATE_PROBABILITY)
         if d2 > gate and p[4, 4] < ALIGNED_HEADING_VAR:
             r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
+        zhat, h = self._measure(x[None, :])
+        speed_var = float(r[2, 2])
+        r[2, 2] *= self._speed_matching.scale
         self._update(z, r)
         self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
+        if h[2].any():  # the speed's noise matched likewise (a reflected Doppler)
+            self._speed_matching.add(z[2:] - zhat[0, 2:], h[2:] @ p @ h[2:].T, speed_var)
 
     def _fix_speed(self, vn: float, ve: float, x: np.ndarray) -> float:
         """The speed row of a fix with the datasheet tuning: eq. 18's norm of the fix's
