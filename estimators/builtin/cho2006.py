@@ -20,9 +20,14 @@ Tuning (``config: {tuning: datasheet | paper}``, ``estimators.builtin.cho2006_tu
 datasheet, R from each fix's HDOP, and adds what a consistent filter on a real car needs:
 accelerometer-bias states (DRM2's pitch and forward bias are one unobservable combination,
 eq. 11, so without the bias state its pitch claims the bias's accuracy), DRM2's pitch rate
-corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle, fixes
-weighted down beyond a 99.9 % chi-square gate, and, with an odometer, a zero-velocity update
-at each stop. The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
+corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle (in
+the position and, as w_z times it, in the speed's dynamics: ``drm2_transition``), DRM2's
+speed row as the fix's velocity along the heading (``_Drm2._fix_speed``: eq. 18's norm is
+rectified at a stop), the fix speed's noise matched to its innovations as the position's
+is (``cho2006_tuning.FixNoiseMatching``: a reflected Doppler), fixes weighted down beyond a
+99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop (the DR
+running on until the stop is confirmed, since a wheel below its cut-off may still roll).
+The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
 ``auto`` (the default) is the paper's simplex set with the paper's tuning and the symmetric
 set with the datasheet's: the simplex set's non-zero third moments move unobservable states
 under eq. 33's 180 deg heading prior (docs/reproduction_cho2006.md), and with the datasheet's
