@@ -24,7 +24,7 @@ corrected for the body's roll in turns, the IMU's lateral velocity about the rea
 the position and, as w_z times it, in the speed's dynamics: ``drm2_transition``), DRM2's
 speed row as the fix's velocity along the heading (``_Drm2._fix_speed``: eq. 18's norm is
 rectified at a stop), the fix speed's noise matched to its innovations as the position's
-is (``cho2006_tuning.FixNoiseMatching``: a reflected Doppler), fixes weighted down beyond a
+is (``toolbox.gating.FixNoiseMatching``: a reflected Doppler), fixes weighted down beyond a
 99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop (the DR
 running on until the stop is confirmed, since a wheel below its cut-off may still roll).
 The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
@@ -110,13 +110,16 @@ from estimators.builtin.cho2006_tuning import (
     PAPER_R,
     TUNINGS,
     TURN_HOLD_S,
-    FixNoiseMatching,
     Tuning,
     datasheet_tuning,
     paper_tuning,
     stopped_speed_sigma,
 )
-from estimators.toolbox.gating import chi2_threshold, normalised_innovation_squared
+from estimators.toolbox.gating import (
+    FixNoiseMatching,
+    chi2_threshold,
+    normalised_innovation_squared,
+)
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks, psd_sqrt
