@@ -23,10 +23,9 @@ eq. 11, so without the bias state its pitch claims the bias's accuracy), DRM2's 
 corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle (in
 the position and, as w_z times it, in the speed's dynamics: ``drm2_transition``), DRM2's
 speed row as the fix's velocity along the heading (``_Drm2._fix_speed``: eq. 18's norm is
-rectified at a stop), the fix speed's noise matched to its innovations as the position's
-is (``toolbox.gating.FixNoiseMatching``: a reflected Doppler), fixes weighted down beyond a
-99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop (the DR
-running on until the stop is confirmed, since a wheel below its cut-off may still roll).
+rectified at a stop), fixes weighted down beyond a 99.9 % chi-square gate, and, with an
+odometer, a zero-velocity update at each stop (the DR running on until the stop is
+confirmed, since a wheel below its cut-off may still roll).
 The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
 ``auto`` (the default) is the paper's simplex set with the paper's tuning and the symmetric
 set with the datasheet's: the simplex set's non-zero third moments move unobservable states
@@ -312,7 +311,6 @@ class _ChoDr(Estimator):
         self._lateral_var = 0.0  # its error variance, (m/s)^2
         self._datasheet = self.config["tuning"] == "datasheet"
         self._matching = FixNoiseMatching()
-        self._speed_matching = FixNoiseMatching()
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
         self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
         x0 = self._initial_state()
@@ -470,13 +468,8 @@ class _ChoDr(Estimator):
         gate = chi2_threshold(2, GATE_PROBABILITY)
         if d2 > gate and p[4, 4] < ALIGNED_HEADING_VAR:
             r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
-        zhat, h = self._measure(x[None, :])
-        speed_var = float(r[2, 2])
-        r[2, 2] *= self._speed_matching.scale
         self._update(z, r)
         self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
-        if h[2].any():  # the speed's noise matched likewise (a reflected Doppler)
-            self._speed_matching.add(z[2:] - zhat[0, 2:], h[2:] @ p @ h[2:].T, speed_var)
 
     def _fix_speed(self, vn: float, ve: float, x: np.ndarray) -> float:
         """The speed row of a fix with the datasheet tuning: eq. 18's norm of the fix's

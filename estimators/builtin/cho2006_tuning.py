@@ -29,9 +29,7 @@ the paper's printed values, or values derived from what a user knows.
     canyon errors hold for minutes, and a filter treating them as white believes the mean
     of its fixes to a fraction of their sigma); the speed's 1-sigma HDOP sigma_rate / sqrt(2)
     with the pseudorange-rate noise of an FLL at 40 dB-Hz (``RATE_SIGMA_M_S``, scaled by the
-    datasheet's ``tracking_noise``), raised by covariance matching on the speed's own
-    innovations (a second ``FixNoiseMatching``: a canyon's reflected Doppler, 0.2-0.6 m/s at
-    the same HDOP, ``canyon`` seed 1);
+    datasheet's ``tracking_noise``);
   - the car's model errors (``vehicle`` in the datasheet, absent on a rigid body): the
     forward-acceleration error of the planar model on a real body (surge and side slip,
     ``CAR_ACCEL_SIGMA_M_S2``); for DRM2 the body's roll and the IMU's lateral velocity. Its

@@ -112,8 +112,8 @@ class FixNoiseMatching:
     is estimated as the running mean of nu^2 - (H P H^T) over the position rows (innovation
     nu, predicted covariance H P H^T), and the HDOP-based variance is scaled up to it
     (never down). A street canyon's reflected signals leave HDOP unchanged while the fixes
-    move by metres: without this the filter believes them to a metre. The same on a fix's
-    speed or one velocity axis (Cho's DRM filters, ``ins_lkf``): a reflected Doppler."""
+    move by metres: without this the filter believes them to a metre. The same on one axis of
+    a fix's velocity (``ins_lkf``): a reflected Doppler."""
 
     def __init__(self) -> None:
         self.scale = 1.0
