@@ -1,9 +1,11 @@
-"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, and the one drive
+"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, the one drive
 builder (``build_drive``: segments to truth kinematics, through the scenario and the drive as
-``landnav generate`` builds them)."""
+``landnav generate`` builds them), and the papers' experiments computed once per session
+(``shared_experiments``)."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -127,3 +129,19 @@ def quickstart(tmp_path_factory):
     out = tmp_path_factory.mktemp("quickstart") / "dataset"
     return open_dataset(generate_dataset(load_scenario(REPO / "scenarios" / "quickstart.yaml"),
                                          out, show_progress=False))
+
+
+@pytest.fixture(scope="session")
+def shared_experiments(tmp_path_factory):
+    """The reproduction's ``measure_seed`` computing each (experiment, seed) once in the session
+    (tests/experiment_cache.py), for the claim tests and the quick reproduction alike. Its
+    folder is shared by pytest-xdist's workers (the parent of each worker's base folder)."""
+    from simulator.reproduce import runner
+    from tests.experiment_cache import cached_measure_seed
+
+    base = tmp_path_factory.getbasetemp()
+    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "experiments"
+    folder.mkdir(exist_ok=True)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(runner, "measure_seed", cached_measure_seed(folder, runner.measure_seed))
+        yield folder

@@ -21,6 +21,7 @@ import pytest
 from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.pipeline import load_scenario
+from simulator.reproduce import park2019, tan2008
 from simulator.reproduce.chan import short_complete_overrides as chan_short_complete
 from simulator.reproduce.chan import short_partial_overrides as chan_short_partial
 from simulator.reproduce.karamat2015 import protocol_overrides as karamat_overrides
@@ -54,6 +55,14 @@ SHORTENED: dict[str, list[str]] = {
                           for i in (2, 4, 5, 7, 8, 9, 11, 13)],
 }
 
+# shorter still in the default run, where the papers' claim tests run these drives (with
+# --runslow as in SHORTENED): reproduce --quick's cuts, and Karamat's first loop
+SHORTER_IN_CI: dict[str, list[str]] = {
+    "tan2008_outage": list(tan2008.OUTAGE.quick_overrides),
+    "park2019_underground_garage": list(park2019.SHORT),
+    "karamat2015_partial_outages": karamat_overrides(1),
+}
+
 # zones a (shortened) run must pass through: the library scenarios are what their comments say
 EXPECTED_ZONES: dict[str, set[str]] = {
     "highway_long": {"underpass", "tunnel"},
@@ -64,15 +73,27 @@ EXPECTED_ZONES: dict[str, set[str]] = {
 
 
 def test_shortened_scenarios_exist():
-    assert set(SHORTENED) <= {p.stem for p in SCENARIOS}
+    assert set(SHORTENED) | set(SHORTER_IN_CI) <= {p.stem for p in SCENARIOS}
     assert len(SCENARIOS) >= 15  # issue 16: at least 15 scenarios ship
 
 
-@pytest.mark.parametrize("path", SCENARIOS, ids=[p.stem for p in SCENARIOS])
-def test_shipped_scenario_runs(path, tmp_path):
+def _runs() -> list:
+    cases = []
+    for path in SCENARIOS:
+        if path.stem in SHORTER_IN_CI:
+            cases += [pytest.param(path, SHORTER_IN_CI[path.stem], id=path.stem),
+                      pytest.param(path, SHORTENED.get(path.stem, []), id=f"{path.stem}-longer",
+                                   marks=pytest.mark.slow)]
+        else:
+            cases.append(pytest.param(path, SHORTENED.get(path.stem, []), id=path.stem))
+    return cases
+
+
+@pytest.mark.parametrize(("path", "overrides"), _runs())
+def test_shipped_scenario_runs(path, overrides, tmp_path):
     assert main(["validate", str(path)]) == 0
     out = tmp_path / "run"
-    sets = [arg for override in SHORTENED.get(path.stem, []) for arg in ("--set", override)]
+    sets = [arg for override in overrides for arg in ("--set", override)]
     assert main(["run", str(path), "-o", str(out), *sets]) == 0
     ds = open_dataset(out / "dataset")
     truth = ds.read("truth")

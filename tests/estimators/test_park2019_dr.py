@@ -23,6 +23,8 @@ from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from tests.conftest import CI_SEEDS, seed_sets
 
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
+
 SEEDS = list(range(1, 11))
 
 
