@@ -87,8 +87,14 @@ def seed_sets(full: range) -> list:
     """A multi-seed claim's seed sets as test parameters: seeds 1-3 in the default run (the
     same property on fewer seeds; a criterion "in 8 of 10 seeds" asks for
     ``needed_count(0.8, 3)`` = 3 of 3), and ``full`` under ``--runslow``."""
-    return [pytest.param(CI_SEEDS, id=f"{len(CI_SEEDS)}seeds"),
-            pytest.param(full, id=f"{len(full)}seeds", marks=pytest.mark.slow)]
+    return ci_and_slow(f"{len(CI_SEEDS)}seeds", (CI_SEEDS,), (full,), f"{len(full)}seeds")
+
+
+def ci_and_slow(name: str, ci: tuple, slow: tuple, slow_name: str) -> list:
+    """A long case as two test parameters: its short CI variant ``ci`` in the default run (id
+    ``name``) and the long one, ``slow``, with --runslow (id ``slow_name``)."""
+    return [pytest.param(*ci, id=name),
+            pytest.param(*slow, id=slow_name, marks=pytest.mark.slow)]
 
 
 DEFAULT_START = {"lat": 37.5, "lon": 127.0, "alt": 40.0, "heading": 30.0}

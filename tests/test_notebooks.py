@@ -7,6 +7,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.conftest import ci_and_slow
+
 REPO = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((REPO / "notebooks").glob("*.ipynb"))
 
@@ -22,18 +24,12 @@ SHORTER = {"monte_carlo_sweep": ("seeds = 5  # runs per IMU grade\n",
                                  "seeds = 2  # runs per IMU grade (shortened for the tests)\n")}
 
 
-def _cases() -> list:
-    cases = []
-    for path in NOTEBOOKS:
-        if path.stem in SHORTER:
-            cases += [pytest.param(path, True, id=f"{path.stem}-short"),
-                      pytest.param(path, False, id=path.stem, marks=pytest.mark.slow)]
-        else:
-            cases.append(pytest.param(path, False, id=path.stem))
-    return cases
+CASES = [case for path in NOTEBOOKS for case in (
+    ci_and_slow(f"{path.stem}-short", (path, True), (path, False), path.stem)
+    if path.stem in SHORTER else [pytest.param(path, False, id=path.stem)])]
 
 
-@pytest.mark.parametrize(("path", "shortened"), _cases())
+@pytest.mark.parametrize(("path", "shortened"), CASES)
 def test_notebook_runs(path, shortened, monkeypatch):
     monkeypatch.setenv("MPLBACKEND", "Agg")
     nbformat = pytest.importorskip("nbformat")

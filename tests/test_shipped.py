@@ -25,6 +25,7 @@ from simulator.reproduce import park2019, tan2008
 from simulator.reproduce.chan import short_complete_overrides as chan_short_complete
 from simulator.reproduce.chan import short_partial_overrides as chan_short_partial
 from simulator.reproduce.karamat2015 import protocol_overrides as karamat_overrides
+from tests.conftest import ci_and_slow
 
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
@@ -77,19 +78,14 @@ def test_shortened_scenarios_exist():
     assert len(SCENARIOS) >= 15  # issue 16: at least 15 scenarios ship
 
 
-def _runs() -> list:
-    cases = []
-    for path in SCENARIOS:
-        if path.stem in SHORTER_IN_CI:
-            cases += [pytest.param(path, SHORTER_IN_CI[path.stem], id=path.stem),
-                      pytest.param(path, SHORTENED.get(path.stem, []), id=f"{path.stem}-longer",
-                                   marks=pytest.mark.slow)]
-        else:
-            cases.append(pytest.param(path, SHORTENED.get(path.stem, []), id=path.stem))
-    return cases
+RUNS = [case for path in SCENARIOS for case in (
+    ci_and_slow(path.stem, (path, SHORTER_IN_CI[path.stem]),
+                (path, SHORTENED.get(path.stem, [])), f"{path.stem}-longer")
+    if path.stem in SHORTER_IN_CI
+    else [pytest.param(path, SHORTENED.get(path.stem, []), id=path.stem)])]
 
 
-@pytest.mark.parametrize(("path", "overrides"), _runs())
+@pytest.mark.parametrize(("path", "overrides"), RUNS)
 def test_shipped_scenario_runs(path, overrides, tmp_path):
     assert main(["validate", str(path)]) == 0
     out = tmp_path / "run"

@@ -16,7 +16,7 @@ from simulator.dataset.io import open_dataset
 from simulator.replay import run_estimator
 from simulator.scenario import load_scenario
 from simulator.scoring.align import solution_errors
-from tests.conftest import REPO
+from tests.conftest import REPO, ci_and_slow
 
 AXES = (("err_n", "std_n"), ("err_e", "std_e"), ("err_d", "std_d"),
         ("err_vn", "std_vn"), ("err_ve", "std_ve"), ("err_vd", "std_vd"),
@@ -59,10 +59,7 @@ def test_tc_ekf_is_consistent(drive, request):
 
 # urban_canyon's first 600 m, into the canyon and an underpass (slow), and the CI drive: its
 # first 300 m, 200 m of canyon, the underpass
-IDEAL_IMU_DRIVES = [
-    pytest.param((300, 200), id="300m"),
-    pytest.param((600, 400), id="600m", marks=pytest.mark.slow),
-]
+IDEAL_IMU_DRIVES = ci_and_slow("300m", ((300, 200),), ((600, 400),), "600m")
 
 
 @pytest.mark.parametrize("lengths_m", IDEAL_IMU_DRIVES)
