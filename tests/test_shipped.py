@@ -3,7 +3,9 @@ scenario's estimators, scores, report); the code base stays ruff-clean.
 
 Long drives run shortened here with ``--set`` (table below; each scenario's comment says so too)
 and whole in ``benchmarks/bench_shipped.py``. The two Chan drives run shortened as
-``landnav reproduce --quick`` runs them (whole: 65 s and 23 s of CPU in this test).
+``landnav reproduce --quick`` runs them (whole: 65 s and 23 s of CPU in this test). The drives
+whose papers' claims are tested in tests/estimators/ run shorter still in the default run
+(``SHORTER_IN_CI``) and as in ``SHORTENED`` with --runslow.
 """
 
 from __future__ import annotations
@@ -57,11 +59,13 @@ SHORTENED: dict[str, list[str]] = {
 }
 
 # shorter still in the default run, where the papers' claim tests run these drives (with
-# --runslow as in SHORTENED): reproduce --quick's cuts, and Karamat's first loop
+# --runslow as in SHORTENED): reproduce --quick's cuts, Karamat's first loop, Chan's first
+# straight and first double loop with their windows
 SHORTER_IN_CI: dict[str, list[str]] = {
     "tan2008_outage": list(tan2008.OUTAGE.quick_overrides),
     "park2019_underground_garage": list(park2019.SHORT),
     "karamat2015_partial_outages": karamat_overrides(1),
+    "chan_partial_outages": chan_short_partial(1, windows=2),
 }
 
 # zones a (shortened) run must pass through: the library scenarios are what their comments say
