@@ -26,6 +26,8 @@ from simulator.reproduce.runner import run_experiment
 from simulator.scenario import load_scenario
 from tests.conftest import seed_sets
 
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
+
 RIGID = ["vehicle=rigid"]
 
 

@@ -24,6 +24,8 @@ from simulator.reproduce.runner import run_experiment
 from simulator.scenario import Scenario, validate_data
 from tests.conftest import seed_sets
 
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
+
 EXPERIMENTS = [park2019.INS_PARK_GARAGE, park2019.INS_PARKING_GARAGE]
 SEEDS = range(1, 11)
 
