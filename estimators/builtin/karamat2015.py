@@ -352,6 +352,9 @@ class RissTcEkf(Estimator):
         # F's rows of the frozen states are zeroed: eq. 32 (dv_o' = da_od) would otherwise pass
         # the a_od uncertainty into a frozen speed error, which the updates then correct
         self._frozen = np.array([_I[name] for name in frozen if _I[name] < self._n], dtype=int)
+        # dv_u in the pitch and speed errors (eq. 6 linearised) needs one of them; without
+        # either (the earlier model, or both frozen) it is eq. 31's integrating state
+        self._vu_eq6 = self._enhanced and not {"p", "vo"} <= set(frozen)
         init = self.initial
         self._lat, self._lon, self._h = (float(v) for v in init.position)
         vn0, ve0, vd0 = (float(v) for v in init.velocity)
@@ -629,7 +632,7 @@ class RissTcEkf(Estimator):
         if self._sf_psd:
             q_d = q_d.copy()
             q_d[_I["A"], _I["A"]] += self._sf_psd * wz_c**2 * dt
-        if self._enhanced:
+        if self._vu_eq6:
             phi, q_d = self._vertical_velocity_is_eq6(phi, q_d, dt)
         self._filter.predict(phi, q_d)
 
