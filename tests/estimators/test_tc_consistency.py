@@ -113,9 +113,9 @@ def test_karamat_heading_is_consistent_on_the_quickstart(quickstart):
     assert nse["yaw"] < 10.0 and nse["n"] < 10.0 and nse["e"] < 10.0, nse
 
 
-@pytest.mark.xfail(strict=True, reason="riss3d_tc_ekf's height is the integral of v_o sin p "
-                   "with p from the forward accelerometer (eqs. 2, 6, 9): the quickstart IMU's "
-                   "70 mg bias, which the model cannot tell from tilt, drifts it beyond its "
-                   "covariance (docs/reproduction_karamat2015.md, Consistency)")
 def test_karamat_height_is_consistent_on_the_quickstart(quickstart):
+    """The height is the integral of v_o sin p (eqs. 6, 9) with p from the forward accelerometer
+    (eq. 2) and the quickstart IMU's 70 mg bias: consistent since the vertical-velocity error
+    is eq. 6 linearised in the pitch and speed errors (0.24 on seed 1; it was 33 on average
+    over seeds 1-5 while v_u was an independent state whose corrections eq. 6 threw away)."""
     assert _nse(quickstart, "riss3d_tc_ekf")["d"] < 10.0
