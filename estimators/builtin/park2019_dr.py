@@ -524,11 +524,11 @@ class Dr3dEkf(_OdometerDeadReckoning):
                 self._dop_known = True
             dz += self._fix_error
             h_pos[:, FIX] = np.eye(3)
-            var = list(self._fix_model.white_sigma(*dops)[:n] ** 2)
             std_pos, speed_sigma, cross_sigma = fx.reported(row)
-            excess = self._fix_model.excess_sigma(std_pos, *dops)
-            dz += excess * self._nlos
-            h_pos[:, NLOS] = np.diag(excess)
+            gain, white = self._fix_model.nlos_split(std_pos, *dops)
+            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:n])
+            dz += gain * self._nlos
+            h_pos[:, NLOS] = np.diag(gain)
         keep = np.arange(n)
         if self._sheet:  # a reflected fix's metres the receiver does not announce: each row
             # behind a chi-square gate (one degree of freedom, GATE_PROBABILITY)
@@ -896,11 +896,11 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
                 self._dop_known = True
             dz = dz + self._fix_error
             h[:, 5:7] = np.eye(2)
-            var = list(self._fix_model.white_sigma(*dops)[:2] ** 2)
             std_pos, speed_sigma, _ = fx.reported(row)
-            excess = self._fix_model.excess_sigma(std_pos, *dops)[:2]
-            dz = dz + excess * self._nlos
-            h[:, 7:9] = np.diag(excess)
+            gain, white = self._fix_model.nlos_split(std_pos, *dops)
+            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:2])
+            dz = dz + gain[:2] * self._nlos
+            h[:, 7:9] = np.diag(gain[:2])
             speed_var = (speed_sigma if math.isfinite(speed_sigma)
                          else self._fix_model.velocity_sigma(*dops)[0]) ** 2
         if self._u != 0.0 and math.isfinite(row[fx.speed]):

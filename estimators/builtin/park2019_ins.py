@@ -270,12 +270,13 @@ class ParkInsOdometer(Estimator):
             self._dop_known = True
         # the error the fix reports beyond the budget (reflections): its unit states' gain
         std_pos, std_vel = self._accuracy.read(row)
-        excess = model.excess_sigma(std_pos, *dops)
+        gain, white = model.nlos_split(std_pos, *dops)
         nlos = ins.extra_start + 3
-        dz_p += excess * ins.extra[3:6]
-        h_p[:, nlos:nlos + 3] = np.diag(excess)
+        dz_p += gain * ins.extra[3:6]
+        h_p[:, nlos:nlos + 3] = np.diag(gain)
         # a fix that does not fit (a reflected signal's metres) is left out, not averaged in
-        ins.gated_update(dz_p, h_p, np.diag(model.white_sigma(*dops) ** 2), GATE_PROBABILITY)
+        ins.gated_update(dz_p, h_p, np.diag(model.white_sigma(*dops) ** 2 + white),
+                         GATE_PROBABILITY)
         rows = keep[3:]
         if rows.any():  # the fix's own velocity accuracy, else the datasheet's at its DOPs
             sigma_v = np.where(np.isfinite(std_vel), std_vel, model.velocity_sigma(*dops))
