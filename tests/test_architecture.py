@@ -14,13 +14,11 @@ layer, so that a scenario's estimator names are checked where the scenario is.
 from __future__ import annotations
 
 import ast
+import json
 import os
 import subprocess
 import sys
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
-
-import pytest
 
 REPO = Path(__file__).resolve().parents[1]
 PACKAGES = ("simulator", "estimators")
@@ -126,24 +124,39 @@ def test_the_layer_check_sees_an_upward_import(tmp_path):
     assert layer_of("simulator.sensors") < layer_of("simulator.faults") < layer_of("simulator.cli")
 
 
-def _import_alone(module: str) -> tuple[str, int, str]:
-    """Import ``module`` in a fresh interpreter (nothing imported before it but the standard
-    library's start-up). Byte-code caches are written and read as on an ordinary installation
-    (a sandbox's PYTHONDONTWRITEBYTECODE would make every interpreter recompile every module)."""
+def imports_failing_alone(modules: list[str], path: Path = REPO) -> dict[str, str]:
+    """module -> error of each of ``modules`` that fails to import on its own, each in a process
+    of its own forked from a fresh interpreter (``tests.fresh_imports``) that finds modules on
+    ``path``. Byte-code caches are written and read as on an ordinary installation (a sandbox's
+    PYTHONDONTWRITEBYTECODE would make every interpreter recompile every module)."""
     env = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"},
-           "PYTHONPATH": str(REPO)}
-    done = subprocess.run([sys.executable, "-c", f"import {module}"], capture_output=True,
+           "PYTHONPATH": os.pathsep.join([str(path), str(REPO)])}
+    code = ("import json, sys; from tests.fresh_imports import failures; "
+            "print(json.dumps(failures(sys.argv[1:])))")
+    done = subprocess.run([sys.executable, "-c", code, *modules], capture_output=True,
                           text=True, cwd=REPO, env=env)
-    return module, done.returncode, done.stderr.strip().splitlines()[-1:]
+    assert done.returncode == 0, done.stderr
+    return json.loads(done.stdout.splitlines()[-1])  # after anything a module printed
 
 
-@pytest.mark.parametrize("package", PACKAGES)
-def test_every_module_imports_on_its_own(package):
-    """One fresh interpreter per module, four per core at a time (much of an import waits on
-    the disk and on the other processes of a busy machine): an import cycle, or a module that
-    works only after another has been imported, fails here."""
-    modules = [m for m in MODULES if _matches(m, package)]
-    with ThreadPoolExecutor(max_workers=4 * (os.cpu_count() or 1)) as pool:
-        failed = [f"{module}: {error}" for module, code, error in pool.map(_import_alone, modules)
-                  if code != 0]
-    assert not failed, "\n".join(failed)
+def test_every_module_imports_on_its_own():
+    """Every module of landnav imported first in its own process, one per core at a time: an
+    import cycle, or a module that works only after another has been imported, fails here."""
+    failed = imports_failing_alone(list(MODULES))
+    assert not failed, "\n".join(f"{module}: {error}" for module, error in failed.items())
+
+
+def test_the_import_check_sees_a_module_that_needs_another_first(tmp_path):
+    """The checker itself: a module that reads a sibling its package has not imported fails
+    alone (it works once the sibling is imported), a cycle fails, a plain module passes."""
+    package = tmp_path / "needy"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "sibling.py").write_text("VALUE = 1\n")
+    (package / "reader.py").write_text("import needy\n\nVALUE = needy.sibling.VALUE\n")
+    (package / "first.py").write_text("from needy.second import B\n\nA = 1\n")
+    (package / "second.py").write_text("from needy.first import A\n\nB = 2\n")
+    failed = imports_failing_alone(["needy.sibling", "needy.reader", "needy.first"], tmp_path)
+    assert sorted(failed) == ["needy.first", "needy.reader"]
+    assert "has no attribute 'sibling'" in failed["needy.reader"]
+    assert "partially initialized" in failed["needy.first"]
