@@ -11,11 +11,11 @@ that finds one of landnav's modules already imported says so instead of importin
 
 from __future__ import annotations
 
-import concurrent.futures as cf
 import multiprocessing
 import os
 import sys
 import traceback
+from multiprocessing.connection import Connection
 
 PRELOADED = ("numpy", "pandas", "scipy", "numba", "yaml", "pyarrow", "matplotlib")
 OURS = ("simulator", "estimators")
@@ -33,14 +33,33 @@ def import_error(module: str) -> str:
     return ""
 
 
+def _report(module: str, sender: Connection) -> None:
+    sender.send(import_error(module))
+    sender.close()
+
+
 def failures(modules: list[str]) -> dict[str, str]:
-    """module -> error of every module of ``modules`` that does not import on its own."""
+    """module -> error of every module of ``modules`` that does not import on its own, one
+    process per core at a time."""
     if "forkserver" in multiprocessing.get_all_start_methods():
         context = multiprocessing.get_context("forkserver")
         context.set_forkserver_preload(list(PRELOADED))
     else:  # Windows: a spawned interpreter per module
         context = multiprocessing.get_context("spawn")
-    with cf.ProcessPoolExecutor(os.cpu_count() or 1, mp_context=context,
-                                max_tasks_per_child=1) as pool:
-        errors = pool.map(import_error, modules)
-        return {module: error for module, error in zip(modules, errors, strict=True) if error}
+    pending, running, found = list(modules), [], {}
+    while pending or running:
+        while pending and len(running) < (os.cpu_count() or 1):
+            receiver, sender = context.Pipe(duplex=False)
+            process = context.Process(target=_report, args=(pending[0], sender))
+            process.start()
+            sender.close()
+            running.append((pending.pop(0), process, receiver))
+        module, process, receiver = running.pop(0)
+        try:
+            error = receiver.recv()
+        except EOFError:  # the process died without a word
+            error = "the importing process ended without a report"
+        process.join()
+        if error or process.exitcode:
+            found[module] = error or f"exit code {process.exitcode}"
+    return found
