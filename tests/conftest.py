@@ -139,15 +139,17 @@ def quickstart(tmp_path_factory):
 
 @pytest.fixture(scope="session")
 def shared_experiments(tmp_path_factory):
-    """The reproduction's ``measure_seed`` computing each (experiment, seed) once in the session
-    (tests/experiment_cache.py), for the claim tests and the quick reproduction alike. Its
-    folder is shared by pytest-xdist's workers (the parent of each worker's base folder)."""
+    """The reproduction's ``measure_seed`` computing each (experiment, seed) once in the session,
+    and its ``estimate`` each (dataset, estimator entry) once (tests/experiment_cache.py), for
+    the claim tests and the quick reproduction alike. Its folder is shared by pytest-xdist's
+    workers (the parent of each worker's base folder)."""
     from simulator.reproduce import runner
-    from tests.experiment_cache import cached_measure_seed
+    from tests.experiment_cache import cached_estimate, cached_measure_seed
 
     base = tmp_path_factory.getbasetemp()
     folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "experiments"
     folder.mkdir(exist_ok=True)
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(runner, "measure_seed", cached_measure_seed(folder, runner.measure_seed))
+        patch.setattr(runner, "estimate", cached_estimate(folder, runner.estimate))
         yield folder
