@@ -1,6 +1,7 @@
 """Park et al. 2019's INS/GPS/odometer EKF (``ins_odo_ekf``) is a working filter: horizontal RMS
-under 5 m outside the GNSS outages of an underground-garage drive, on each seed (seeds 1-3; the ten
-with ``--runslow``), and it really uses its aids (the odometer/NHC update bounds the garage error).
+under 5 m outside the GNSS outages of an underground-garage drive, on each seed (seeds 1-3 on the
+reproduction's shortened drives; the ten on the drives as shipped with ``--runslow``), and it
+really uses its aids (the odometer/NHC update bounds the garage error).
 Two garages: Park's (``park2019_underground_garage.yaml``, 20 Hz IMU, odometer scale factor 1.03,
 shipped with the Park DR estimators) and ``parking_garage.yaml`` (100 Hz IMU)."""
 
@@ -22,7 +23,7 @@ from simulator.reproduce import park2019
 from simulator.reproduce.measures import spread_text as spread
 from simulator.reproduce.runner import run_experiment
 from simulator.scenario import Scenario, validate_data
-from tests.conftest import seed_sets
+from tests.conftest import CI_SEEDS, ci_and_slow
 
 pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
 
@@ -30,22 +31,29 @@ EXPERIMENTS = [park2019.INS_PARK_GARAGE, park2019.INS_PARKING_GARAGE]
 SEEDS = range(1, 11)
 
 
-@pytest.fixture(scope="module", params=seed_sets(SEEDS))
-def seeds(request) -> range:
+@pytest.fixture(scope="module", params=ci_and_slow("short-3seeds", ((True, CI_SEEDS),),
+                                                  ((False, SEEDS),), "full-10seeds"))
+def drive(request) -> tuple[bool, range]:
+    """The drives' length and the seeds: the reproduction's shortened drives
+    (``park2019.SHORT`` on Park's garage: the approach roads cut, the garage unchanged;
+    parking_garage.yaml as shipped) over seeds 1-3, the drives as shipped over ten seeds with
+    --runslow."""
     return request.param
 
 
 @pytest.fixture(scope="module", params=EXPERIMENTS, ids=lambda e: e.scenario)
-def runs(request, seeds, tmp_path_factory) -> dict[str, np.ndarray]:
+def runs(request, drive, tmp_path_factory) -> dict[str, np.ndarray]:
     """label -> per seed (horizontal RMS outside the outages, largest error in the garage's
-    outage), figures of ``simulator.reproduce.park2019``, full-length drives."""
+    outage), figures of ``simulator.reproduce.park2019``."""
+    quick, seeds = drive
     # on the default automotive body: the constraint at the rear axle (from the datasheet's
-    # installation geometry), its noise from the bicycle model's tyre slip. Measured, ten seeds:
-    # RMS outside the outages median 2.77 m (1.64-3.02) on Park's garage, 3.29 m (2.48-3.85) on
-    # parking_garage.yaml; garage maximum with the NHC 20.8 / 21.1 m against 43.9 / 44.6 m
-    # without. At the IMU instead (nhc_point: imu), where the car slips sideways by up to 11 deg
-    # in the 8 m turns, it is 3.38 / 7.88 m and 72.0 / 48.7 m: the violated constraint hurts
-    table = run_experiment(request.param, seeds, tmp_path_factory.mktemp("park"))
+    # installation geometry), its noise from the bicycle model's tyre slip. Measured, ten
+    # seeds, drives as shipped: RMS outside the outages median 2.77 m (1.64-3.02) on Park's
+    # garage, 3.29 m (2.48-3.85) on parking_garage.yaml; garage maximum with the NHC 20.8 /
+    # 21.1 m against 43.9 / 44.6 m without. At the IMU instead (nhc_point: imu), where the car
+    # slips sideways by up to 11 deg in the 8 m turns, it is 3.38 / 7.88 m and 72.0 / 48.7 m:
+    # the violated constraint hurts
+    table = run_experiment(request.param, seeds, tmp_path_factory.mktemp("park"), quick)
     return {label: table[[f"{label}.rms_outside_m", f"{label}.max_horizontal_m"]].to_numpy()
             for label in request.param.entries}
 
