@@ -3,11 +3,11 @@ tests/test_architecture.py (run in a fresh interpreter: ``failures(modules)``).
 
 The processes are forked, one per module, from a ``forkserver`` (the standard library's
 ``multiprocessing``) that has imported the third-party packages every module builds on
-(``PRELOADED``, top-level packages only) and none of landnav's: each import starts where an
-interpreter that has just imported numpy and pandas would, so an import cycle among landnav's
-modules, or a module that works only once another of landnav's has been imported, fails as in a
-fresh interpreter, without paying numpy's, pandas' and numba's start-up once per module. A child
-that finds one of landnav's modules already imported says so instead of importing."""
+(``PRELOADED``) and none of landnav's: each import starts where an interpreter that has just
+imported numpy, pandas and scipy would, so an import cycle among landnav's modules, or a module
+that works only once another of landnav's has been imported, fails as in a fresh interpreter,
+without paying the third-party packages' start-up once per module. A child that finds one of
+landnav's modules already imported says so instead of importing."""
 
 from __future__ import annotations
 
@@ -17,7 +17,12 @@ import sys
 import traceback
 from multiprocessing.connection import Connection
 
-PRELOADED = ("numpy", "pandas", "scipy", "numba", "yaml", "pyarrow", "matplotlib")
+# scipy's submodules that landnav's modules import (scipy.stats alone is most of an import of
+# simulator.datasheet): scipy loads a submodule when first named, so preloading them hides no
+# missing import
+PRELOADED = ("numpy", "pandas", "numba", "yaml", "pyarrow", "matplotlib", "scipy", "scipy.stats",
+             "scipy.interpolate", "scipy.spatial.transform", "scipy.special", "scipy.linalg",
+             "scipy.signal", "scipy.sparse.linalg")
 OURS = ("simulator", "estimators")
 
 
