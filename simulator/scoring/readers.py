@@ -169,8 +169,15 @@ def _chunks(path: Path, what: str, where: _Rows, keep: tuple[str, ...] = (), **o
 
 
 def _joined(chunks: list[pd.DataFrame], columns: Iterable[str]) -> pd.DataFrame:
-    return (pd.concat(chunks, ignore_index=True) if chunks
-            else pd.DataFrame(columns=list(columns), dtype=float))
+    """The chunks as one table, joined a column at a time, each chunk's column released as
+    it is copied: the rows are held about once, not twice as ``pandas.concat`` holds them."""
+    if not chunks:
+        return pd.DataFrame(columns=list(columns), dtype=float)
+    names = list(chunks[0].columns)
+    joined = {}
+    for name in names:
+        joined[name] = np.concatenate([chunk.pop(name).to_numpy() for chunk in chunks])
+    return pd.DataFrame(joined, copy=False)
 
 
 def _csv(path: Path) -> pd.DataFrame:
