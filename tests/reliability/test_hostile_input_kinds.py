@@ -9,10 +9,14 @@ from __future__ import annotations
 import os
 import shutil
 import socket
+from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
+from simulator.cli import main
+from simulator.commands import score
+from simulator.errors import InputError, Problem, Terminated
 from tests.reliability.checks import refused
 from tests.reliability.drives import shared_dataset  # noqa: F401 (fixtures)
 
@@ -78,3 +82,20 @@ def test_recording_and_reference_that_are_not_files(tmp_path, capsys):
              "--reference", str(zero), "-o", str(tmp_path / "out")], capsys, [tmp_path],
             f"{words}, not a reference file")
     assert not (tmp_path / "out").exists()
+
+
+def test_a_stop_while_the_message_prints_is_no_traceback(capsys, monkeypatch):
+    """SIGTERM arriving while a refusal is printed (its handler raises ``Terminated`` there):
+    exit 143 with its own message, not a traceback from inside the error report."""
+    @dataclass(frozen=True)
+    class StoppedWhilePrinted(Problem):
+        def __str__(self) -> str:
+            raise Terminated(15)
+
+    def refuse(args):
+        raise InputError([StoppedWhilePrinted("f", None, "", "bad")])
+
+    monkeypatch.setattr(score, "run", refuse)
+    assert main(["score", "ds", "-e", "gnss_only"]) == 143
+    err = capsys.readouterr().err
+    assert "terminated: unfinished outputs were removed" in err and "Traceback" not in err
