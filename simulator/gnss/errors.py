@@ -64,7 +64,7 @@ Public names
 ------------
 OSCILLATORS, SIS_RECORD_SHARE, IONO_CORRELATION_TIME_S, IONO_CORRELATION_LENGTH_KM,
 IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S,
-REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, GRID_STEP, IONO_GRID_STEP,
+REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, IONO_GRID_STEP,
 loop_time_constant_s,
 decorrelation_coordinate, gauss_markov_along, pierce_points_km, iono_field_correlation,
 iono_field, iono_field_at_epochs, draw_receiver_clock, draw_fading, draw_sis,
@@ -95,7 +95,7 @@ import numpy as np
 from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
-from simulator.stochastic import ar1_filter, gauss_markov
+from simulator.stochastic import ar1_filter, gauss_markov, gauss_markov_at
 
 # receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
 # crystal) and the 1-sigma spread of the clock state at switch-on
@@ -117,9 +117,6 @@ IONO_SHELL_RADIUS_KM = 6371.0 + 350.0  # Klobuchar's shell: mean Earth radius + 
 IONO_FIELD_STEP_S = 10.0
 REPORTED_PR_STD_FLOOR_M = 0.1  # the smallest pseudorange 1-sigma the receiver reports
 REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it reports
-# step of the grid (in correlation lengths of u) on which the motion-driven processes are drawn
-# before linear interpolation to the epochs: the interpolation keeps over 99 % of the variance
-GRID_STEP = 0.05
 # the amplitudes of the ionosphere field's waves are drawn once per correlation time (30 min)
 # and interpolated: their rate is then sigma x 1.1 / 30 min, about 1.5 mm/s on an 8 m delay
 # with the default 1.5 x 0.2,
@@ -144,13 +141,16 @@ def decorrelation_coordinate(t_s: np.ndarray, distance_m: np.ndarray, distance_s
 
 
 def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator,
-                       step: float = GRID_STEP) -> np.ndarray:
+                       step: float | None = None) -> np.ndarray:
     """Unit-variance processes with correlation exp(-|u_i - u_j|) at the points u (ascending,
-    shape (n,)), one per row: shape (rows, n). Each is the exact Gauss-Markov process
-    (``simulator.stochastic.gauss_markov``, unit correlation length) on a grid of ``step`` in
-    u, interpolated linearly at u (between grid points the variance falls to (1 + e^-step) / 2
-    at the middle: 0.99 for the default step, 0.68 for a step of 1)."""
+    shape (n,)), one per row: shape (rows, n). Without ``step``, the exact Gauss-Markov process
+    at the points themselves (``simulator.stochastic.gauss_markov_at``). With ``step``, the
+    exact process on a grid of ``step`` in u, interpolated linearly at u: smoother between grid
+    points, where the variance falls to (1 + e^-step) / 2 at the middle (0.68 for a step of 1:
+    the ionosphere field's amplitudes, whose rate this keeps at that of a quiet ionosphere)."""
     u = np.asarray(u, dtype=float)
+    if step is None:
+        return gauss_markov_at(u, rows, rng).T
     grid = u[0] + np.arange(int(np.ceil((u[-1] - u[0]) / step)) + 2) * step
     values = gauss_markov(len(grid), step, np.ones(rows), 1.0, rng)
     pos = (u - grid[0]) / step

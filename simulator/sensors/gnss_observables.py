@@ -55,8 +55,10 @@ from simulator.gnss.carrier import (
     draw_slips,
     dynamic_stress_cycles,
     phase_arcs,
+    pll_response,
     pll_sigma_cycles,
     reflection_multipath,
+    reflection_path_rate_m_s,
     slip_probability,
 )
 from simulator.gnss.constants import C_M_S, F_L1_HZ
@@ -128,13 +130,21 @@ class Observed:
 def _rows(t: np.ndarray, svs: np.ndarray, rows: np.ndarray, mask: np.ndarray,
           columns: dict[str, np.ndarray], order: int, n_signals: int) -> dict[str, np.ndarray]:
     """(satellite, epoch) arrays of the satellites ``rows`` (of ``svs``) as stream columns
-    where ``mask`` (a text value fills its column), with a sort key ``_key`` putting epochs
-    first, then satellites in PRN order, then signals in the receiver's order."""
+    where ``mask`` (a text value stays one text, for the whole column), with a sort key
+    ``_key`` putting epochs first, then satellites in PRN order, then signals in the
+    receiver's order."""
     ep, sat = np.nonzero(mask.T)
+    flat = sat * mask.shape[1] + ep  # the samples' places in a (satellite, epoch) array
     out = {"t": t[ep], "sv": svs[rows[sat]]}
     for key, value in columns.items():
-        if isinstance(value, str):
-            out[key] = np.full(len(ep), value, dtype=object)
+        if isinstance(value, str):  # kept as it is: ``_sorted`` spreads it over the rows
+            out[key] = value
+        elif value.shape == mask.shape:
+            out[key] = np.take(value, flat)
+        elif value.shape == (mask.shape[0], 1):  # one value per satellite
+            out[key] = value[sat, 0]
+        elif value.shape == (1, mask.shape[1]):  # one value per epoch
+            out[key] = value[0, ep]
         else:
             out[key] = np.broadcast_to(value, mask.shape)[sat, ep]
     out["_key"] = (ep.astype(np.int64) * len(svs) + rows[sat]) * n_signals + order
@@ -147,8 +157,16 @@ def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFra
     import pandas as pd
 
     order = np.argsort(np.concatenate([p["_key"] for p in pieces]), kind="stable")
-    return pd.DataFrame({name: np.concatenate([p[name] for p in pieces])[order]
-                         for name in names}, copy=False)
+    sizes = [len(p["_key"]) for p in pieces]
+    columns = {}
+    for name in names:
+        if isinstance(pieces[0][name], str):  # a text per piece: taken from the distinct ones
+            texts = sorted({p[name] for p in pieces})
+            codes = np.repeat([texts.index(p[name]) for p in pieces], sizes)
+            columns[name] = pd.Series(texts).array.take(np.take(codes, order))
+        else:
+            columns[name] = np.take(np.concatenate([p[name] for p in pieces]), order)
+    return pd.DataFrame(columns, copy=False)
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
@@ -259,14 +277,21 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
     quadrature = gauss_markov_along(u, n_sat, rng)
+    # the reflecting plane's normal (uniform in direction, changing as the reflectors do): with
+    # the antenna's velocity it sets how fast the reflection's carrier phase turns
+    from scipy.special import ndtr  # imported on first use, as in simulator.gnss.carrier
+
+    wall_normal = np.pi * ndtr(gauss_markov_along(u, n_sat, rng))
+    moving = bool(np.any(ant["v_ned"] != 0.0))
+    path_rate = (reflection_path_rate_m_s(ant["v_ned"], az, el, wall_normal) if moving
+                 else None)  # standing still, the loop's gain is 1
     los_jerk = (np.gradient(np.gradient(geo["range_rate"], dt_s, axis=1), dt_s, axis=1)
                 if n_ep > 2 else np.zeros((n_sat, n_ep)))
     reflected = _switches(nlos & ~los)  # a switch between direct and reflected: lock lost
     scale = cfg["tracking_noise"]
 
     # per-satellite arrays each signal uses, taken on its system's rows only (the other rows
-    # of a signal are never measured); the random draws are made for every row, in the same
-    # order, so that the streams do not depend on this
+    # of a signal are never measured, so nothing is drawn for them)
     per_satellite = {
         "el": el, "az": az, "signal_cn0": signal_cn0, "cn0": cn0, "tracked": tracked,
         "visible": visible, "have": have, "los": los, "nlos_only": nlos & ~los,
@@ -283,10 +308,12 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         "los_jerk": los_jerk, "health": sky["health"].astype(np.int64),
         "primary_delay_s": sky["primary_delay_s"], "tgd_s": sky["tgd_s"],
         "tgd2_s": sky["tgd2_s"], "channel": sky["channel"]}
+    if path_rate is not None:
+        per_satellite["path_rate"] = path_rate
     views: dict[str, dict[str, np.ndarray]] = {}
 
     def unit_gm(tau_s: float, rows: np.ndarray) -> np.ndarray:
-        return gauss_markov(n_ep, dt_s, np.ones(n_sat), tau_s, rng, columns=rows).T
+        return gauss_markov(n_ep, dt_s, np.ones(len(rows)), tau_s, rng).T
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     raw_pieces, truth_pieces = [], []
@@ -294,7 +321,10 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         spec = signal(letter, code)
         sel = np.flatnonzero(system_of == letter)
         if letter not in views:
-            views[letter] = {k: np.asarray(v)[sel] for k, v in per_satellite.items()}
+            # a system's satellites are consecutive rows of the sky: views, not copies
+            rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
+                    else sel)
+            views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
         v = views[letter]
         shape = (len(sel), n_ep)
         # per satellite (GLONASS: its FDMA channel)
@@ -307,7 +337,7 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
             rate_sigma, rate_noise = v["rate_sigma"], v["rate_noise"]
         else:
             cn0_true = v["signal_cn0"] + spec.cn0_offset_db
-            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(el.shape)[sel]
+            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(shape)
             tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
             if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
                 tracked_s &= v["tracked"]
@@ -321,6 +351,9 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         code_mp, carrier_mp = reflection_multipath(
             v["multipath_unit"], v["quadrature"], v["multipath_sigma"], cfg["multipath_delay"],
             freq - F_L1_HZ, lam)
+        if path_rate is not None:  # the loop follows the carrier multipath: its gain at the
+            # fringe frequency
+            carrier_mp *= pll_response(v["path_rate"] / lam, cfg["pll_bandwidth"])
         iono_s = k_iono * v["iono_true"]
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
@@ -360,11 +393,13 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         if cfg["carrier_phase"]:
             sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
                                                     cfg["integration_time"])
-            phase_noise = lam * sigma_cycles * rng.standard_normal(el.shape)[sel]
+            phase_noise = lam * sigma_cycles * rng.standard_normal(shape)
             stress = dynamic_stress_cycles(v["los_jerk"], lam, cfg["pll_bandwidth"])
-            chance = (slip_probability(sigma_cycles, stress, cfg["pll_bandwidth"], dt_s,
-                                       spec.pilot) if scale > 0 else np.zeros(shape))
-            slips = draw_slips(rng.random(el.shape)[sel], chance, tracked_s)
+            chance = np.zeros(shape)  # a slip only matters where the signal is tracked
+            if scale > 0:
+                chance[tracked_s] = slip_probability(sigma_cycles[tracked_s], stress[tracked_s],
+                                                     cfg["pll_bandwidth"], dt_s, spec.pilot)
+            slips = draw_slips(rng.random(shape), chance, tracked_s)
             arcs = phase_arcs(rng, tracked_s, slips, v["reflected"], dt_s, spec.pilot,
                               spec.frame_s)
             phase_m = (v["range"] + rx_clock - v["reference_clock"] - iono_s

@@ -25,6 +25,7 @@ from simulator.gnss.errors import (
     pierce_points_km,
     smoothed_variance_factor,
 )
+from simulator.stochastic import gauss_markov_at, gauss_markov_avar
 
 
 def _hatch_loop(x: np.ndarray, tracked: np.ndarray, n_window: float) -> np.ndarray:
@@ -148,6 +149,43 @@ def test_multipath_process_decorrelates_with_distance_and_time():
         corr = np.sum(x[:, lag:] * x[:, :-lag]) / np.sum(x * x)
         assert corr == pytest.approx(np.exp(-du), abs=0.03)
         assert x.var() == pytest.approx(1.0, rel=0.1)
+
+
+def test_gauss_markov_at_irregular_points_is_the_exact_recursion():
+    """The blocked closed form against the recursion x_k = e^-dp x_(k-1) + sqrt(1 - e^-2dp) w_k
+    run sample by sample on the same draws, over steps from 1e-6 to 100 correlation lengths
+    (gaps beyond 30 restart the state: their correlation is below 1e-13)."""
+    steps = np.random.default_rng(3).uniform(0.0, 3.0, 4000)
+    steps[100:110], steps[500:700] = 100.0, 1e-6
+    points = np.cumsum(steps)
+    got = gauss_markov_at(points, 3, np.random.default_rng(4))
+    w = np.random.default_rng(4).standard_normal((len(points), 3))
+    want = np.empty_like(w)
+    want[0] = w[0]
+    for k in range(1, len(points)):
+        phi = np.exp(-(points[k] - points[k - 1]))
+        want[k] = phi * want[k - 1] + np.sqrt(1.0 - phi * phi) * w[k]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-11)
+
+
+def test_gauss_markov_at_has_the_analytic_allan_deviation_and_correlation():
+    """Sampled every 0.1 correlation length (60 series of 5000 points): the Allan variance
+    at 1, 1.89 (the peak) and 5 correlation lengths (allantools) is the Markov formula's
+    (IEEE Std 952, Annex C), and the correlation at one correlation length e^-1, each within
+    four standard errors of its mean over the series."""
+    import allantools
+
+    rows, step = 60, 0.1
+    x = gauss_markov_at(np.arange(5000) * step, rows, np.random.default_rng(5))
+    for tau in (1.0, 1.89, 5.0):
+        per_row = np.array([allantools.oadev(x[:, j], rate=1.0 / step, data_type="freq",
+                                             taus=[tau])[1][0] ** 2 for j in range(rows)])
+        want = gauss_markov_avar(tau, 1.0, 1.0)
+        assert abs(per_row.mean() - want) < 4 * per_row.std() / np.sqrt(rows), (tau, want)
+    lag = int(round(1.0 / step))
+    corr = np.mean(x[lag:] * x[:-lag], axis=0) / np.mean(x * x, axis=0)
+    assert abs(corr.mean() - np.exp(-1.0)) < 4 * corr.std() / np.sqrt(rows)
+    assert abs(np.mean(x * x) - 1.0) < 4 * np.mean(x * x, axis=0).std() / np.sqrt(rows)
 
 
 def test_multipath_of_a_moving_receiver_decorrelates_faster():
