@@ -205,6 +205,60 @@ def test_multipath_of_a_moving_receiver_decorrelates_faster():
     assert got["moving"] == pytest.approx(np.exp(-1.5 - 1 / 120), abs=0.08)
 
 
+@pytest.mark.parametrize("rate_hz", [1.0, 10.0])
+def test_drawn_code_multipath_has_the_models_variance_and_correlation_time(rate_hz):
+    """The code multipath the receiver draws (raw code, no carrier smoothing) on a straight at
+    15 m/s, each sample over the DO-229D J.2.4 sigma at its elevation (the preset's zenith value
+    times (0.13 + 0.53 exp(-el / 10 deg)) / 0.13, written out here): unit variance, and the
+    autocorrelation at lag L s exp(-L (v / D + 1 / T)) (D = 10 m, T = 120 s: a correlation time
+    of 0.66 s), at 0.1 s (10 Hz only), 1 s and 2 s; and the overlapping Allan variance
+    (allantools) at 1 s and 3 s that of that process sampled at the rate (from its
+    autocorrelation: the variance of an m-sample mean minus its covariance with the next one).
+    Each figure is the mean over the satellites' series, within four of its standard errors."""
+    import allantools
+
+    speed, distance_m, static_s = 15.0, 10.0, 120.0
+    truth = drive([{"accelerate": {"to_speed": speed, "accel": 5.0}},
+                   {"straight": {"length": speed * 400.0}}], rate_hz=10.0)
+    gnss = receiver(rate=rate_hz, carrier_smoothing=0.0, outputs=["raw"],
+                    multipath_distance=distance_m, multipath_correlation_time=static_s)
+    table = gnss.generate(truth, np.random.default_rng(12))["truth_gnss"]
+    table = table.query("tracked == 1 and t >= 5").copy()
+    el_deg = np.degrees(table["elevation"])
+    sigma = gnss.config["multipath"] * (0.13 + 0.53 * np.exp(-el_deg / 10.0)) / 0.13
+    table["unit"] = table["multipath"] / sigma
+    wide = table.pivot(index="t", columns="sv", values="unit")
+    series = [wide[sv].dropna().to_numpy() for sv in wide if wide[sv].count() > 300 * rate_hz]
+    assert len(series) >= 6  # satellites tracked over at least 450 correlation times
+    tau_c = 1.0 / (speed / distance_m + 1.0 / static_s)
+
+    def close(per_series: np.ndarray, want: float) -> bool:
+        return abs(per_series.mean() - want) < 4.0 * per_series.std() / np.sqrt(len(series))
+
+    variances = np.array([np.mean(x * x) for x in series])
+    print(f"\n{rate_hz:g} Hz: multipath / model sigma variance {variances.mean():.3f} "
+          f"(+-{variances.std() / np.sqrt(len(series)):.3f}, {len(series)} satellites)")
+    assert close(variances, 1.0)
+    for lag_s in (0.1, 1.0, 2.0):
+        lag = int(round(lag_s * rate_hz))
+        if lag == 0:
+            continue
+        corr = np.array([np.sum(x[lag:] * x[:-lag]) / np.sum(x * x) for x in series])
+        assert close(corr, np.exp(-lag_s / tau_c)), (lag_s, corr.mean())
+    for tau in (1.0, 3.0):
+        m = int(round(tau * rate_hz))
+        lags = np.arange(1 - m, m)
+        weights = (m - np.abs(lags)) / m**2
+
+        def correlation(j: np.ndarray) -> np.ndarray:
+            return np.exp(-np.abs(j) / (rate_hz * tau_c))
+
+        want = np.sum(weights * (correlation(lags) - correlation(lags + m)))
+        avar = np.array([allantools.oadev(x, rate=rate_hz, data_type="freq", taus=[tau])[1][0]
+                         ** 2 for x in series])
+        assert close(avar, want), (tau, avar.mean(), want)
+
+
 def test_cn0_fading_is_correlated_not_white():
     """The reported C/N0 about the elevation model: fading (2 dB, correlated like the multipath)
     plus the white estimate noise (1 dB): lag-1 correlation 4 exp(-1/120) / 5 = 0.79 standing."""
