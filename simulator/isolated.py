@@ -1,5 +1,6 @@
 """A plug-in's code run in a child process, under a time limit: importing it and checking its
-config (``check_entries``), and replaying a dataset into it (``run_isolated``). What a plug-in
+config (``check_entries``), describing it (``call_isolated``), and replaying a dataset into it
+(``run_isolated``). What a plug-in
 does there (exit the process, hang or loop at import or in a handler, crash in compiled code,
 print without end, fork processes that outlive it) ends the child, not landnav, and is
 reported as the estimator's failure, naming the plug-in's file.
@@ -23,7 +24,8 @@ the child ends itself and its group when landnav's process is gone (``watch_pare
 
 Public names
 ------------
-check_entries, run_isolated, needs_isolation, watch_parent, PARENT_POLL_S, CHECK_LIMIT_S.
+check_entries, call_isolated, run_isolated, needs_isolation, watch_parent, PARENT_POLL_S,
+CHECK_LIMIT_S.
 """
 
 from __future__ import annotations
@@ -38,7 +40,7 @@ import sys
 import tempfile
 import threading
 import time
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -124,6 +126,10 @@ def _serve() -> None:
         if kind == "check":
             started()
             answer: tuple = ("ok", _checked(args[0], Path(folder)))
+        elif kind == "call":
+            function, arguments = args
+            started()
+            answer = ("ok", function(*arguments))
         else:
             from simulator.dataset.io import open_dataset
             from simulator.replay import run_estimator
@@ -292,6 +298,48 @@ def check_entries(entries: Sequence[Entry], time_limit_s: float | None = None
     return out
 
 
+def _answered(request: tuple, entry: Entry, time_limit_s: float | None, overrun: str,
+              no_answer: str) -> Any:
+    """The answer of a child serving ``request`` for the plug-in ``entry`` within
+    ``time_limit_s`` (s of its own time; None: no limit); an InputError naming the estimator
+    and its file with ``overrun`` when it runs past the limit, with ``no_answer`` when it ends
+    without an answer (after how it ended), and the problems it answered with."""
+    with _child(request) as (child, folder, started):
+        start = time.monotonic()
+        if not _waited(child.pid, time_limit_s if started else None):
+            raise InputError([Problem(_where(entry), None, "", overrun)])
+        answer = _answer(folder, _ANSWER)
+        if answer is None:
+            raise InputError([Problem(_where(entry), None, "", _said(child, folder) or (
+                f"{_ended(child, start)} {no_answer}"))])
+    status, value = answer
+    if status == "error":
+        raise InputError(value)
+    return value
+
+
+def call_isolated(function: Callable[..., Any], arguments: tuple, entry: Entry,
+                  time_limit_s: float | None = None) -> Any:
+    """``function(*arguments)`` in a child process, bounded by ``time_limit_s`` (s; None:
+    ``CHECK_LIMIT_S``): a
+    function of landnav's own (found by its module and name) that imports the plug-in
+    ``entry`` names and returns plain data (text, numbers), so that nothing of the plug-in is
+    unpickled here.
+
+    Raises
+    ------
+    InputError
+        As ``function``; and when the child ends without an answer or runs past the limit,
+        naming the estimator and its file.
+    """
+    limit = CHECK_LIMIT_S if time_limit_s is None else time_limit_s
+    return _answered(("call", function, arguments), entry, limit,
+                     f"importing it did not finish within {limit:g} s; it was stopped "
+                     "(a plug-in's module must not wait or loop when imported)",
+                     "while being imported, without an answer; a plug-in's module must not "
+                     "exit or crash when imported")
+
+
 def run_isolated(dataset_path: str | Path, entry: Entry,
                  time_limit_s: float | None = None) -> tuple[Any, dict]:
     """``run_estimator`` of ``entry`` over the dataset at ``dataset_path``, in a child process.
@@ -302,21 +350,10 @@ def run_isolated(dataset_path: str | Path, entry: Entry,
         As ``run_estimator``; and when the estimator ends the child without a solution, or
         runs past ``time_limit_s`` (s; None: no limit).
     """
-    with _child(("replay", str(dataset_path), entry)) as (child, folder, started):
-        start = time.monotonic()
-        if not _waited(child.pid, time_limit_s if started else None):
-            raise InputError([Problem(_where(entry), None, "", "did not finish within the time "
-                                      f"limit of {time_limit_s:g} s; it was stopped (raise "
-                                      "the limit with --time-limit if it is only slow)")])
-        answer = _answer(folder, _ANSWER)
-        if answer is None:
-            raise InputError([Problem(_where(entry), None, "", _said(child, folder) or (
-                f"{_ended(child, start)} without a solution; an estimator must return, not "
-                "exit"))])
-    status, value = answer
-    if status == "error":
-        raise InputError(value)
-    return value
+    return _answered(("replay", str(dataset_path), entry), entry, time_limit_s,
+                     f"did not finish within the time limit of {time_limit_s or 0:g} s; it "
+                     "was stopped (raise the limit with --time-limit if it is only slow)",
+                     "without a solution; an estimator must return, not exit")
 
 
 if __name__ == "__main__":

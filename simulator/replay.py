@@ -400,6 +400,11 @@ def _solution_row(row: Any, cls: type, t: float) -> np.ndarray:
     return values
 
 
+def _seconds(t: float) -> str:
+    """A time for a message: to the microsecond, or in 6 digits beyond 1e12 s."""
+    return f"{t:.6f}" if abs(t) < 1e12 else f"{t:.6g}"
+
+
 def solution_problems(frame: pd.DataFrame) -> list[str]:
     """What makes a table not a solution (docs/solution-format.md): missing columns, t not
     finite or not increasing; empty when it is one."""
@@ -413,8 +418,8 @@ def solution_problems(frame: pd.DataFrame) -> list[str]:
     bad = np.flatnonzero(np.diff(t) <= 0)
     if len(bad):
         i = int(bad[0])
-        return [f"t is not increasing: row {i + 1} has t = {t[i + 1]:.6f} s after "
-                f"t = {t[i]:.6f} s"]
+        return [f"t is not increasing: row {i + 1} has t = {_seconds(t[i + 1])} s after "
+                f"t = {_seconds(t[i])} s"]
     return []
 
 

@@ -284,7 +284,7 @@ class RissTcEkf(Estimator):
     defaults = {"model": "enhanced", "coupling": "tight", "tilt_window": 2.0,
                 "accel_update_interval": 1.0, "odometer_speed_noise": 0.2,
                 "nhc_point": "rear_axle", "tuning": "datasheet", "gate_probability": None,
-                "frozen_states": ()}
+                "zero_rate_update": None, "frozen_states": ()}
     config_help = {
         "model": ("", "enhanced (eqs. 1-58) or simplified, the earlier model"),
         "coupling": ("", "tight (pseudoranges and rates) or loose (position and velocity fixes)"),
@@ -296,6 +296,8 @@ class RissTcEkf(Estimator):
                        "reproduction's values"),
         "gate_probability": ("", "chi-square gate on each pseudorange (e.g. 0.999); none: "
                                  "the tuning's default"),
+        "zero_rate_update": ("", "observe the gyro bias while the wheels stand still (none: on "
+                                 "with the datasheet tuning, off with the paper's)"),
         "frozen_states": ("", "states of the enhanced model (r, p, bx, by, vo) held at zero: "
                               "no initial uncertainty and no process noise (an ablation)"),
     }
@@ -322,6 +324,11 @@ class RissTcEkf(Estimator):
         if problems:
             raise InputError("config of riss3d_tc_ekf: " + "; ".join(problems))
         p0_sigma, q_white, gm = self._tuning(cfg["tuning"])
+        # the zero-rate update's noise: the gyro's white noise (the azimuth's, either tuning)
+        zero_rate = cfg["zero_rate_update"]
+        if zero_rate is None:
+            zero_rate = cfg["tuning"] == "datasheet"
+        self._zero_rate_psd = q_white["A"] if zero_rate else 0.0
         for name in frozen:  # without uncertainty, noise or coupling: never corrected
             p0_sigma[name], q_white[name] = 0.0, 0.0
             if name in gm:
@@ -353,6 +360,7 @@ class RissTcEkf(Estimator):
         self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n]]))
         self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n]
+        self._tau = {s: tau for s, (_, tau) in gm.items()}  # s; infinite: a random walk
         self.nis_gnss = self.nis_gnss_dof = math.nan
         self._rejecting = 0  # GNSS epochs in a row in which the gate rejected most ranges
         self._gm_index = np.array([g[0] for g in self._gm])
@@ -395,10 +403,13 @@ class RissTcEkf(Estimator):
         p0.update(bz=g.bias, bx=accel_bias, by=accel_bias)
         q_white["A"] = g.noise_density**2
         self._sf_psd = (g.scale_factor**2 + g.misalignment**2) * SCALE_FACTOR_TIME_S
-        # a Gauss-Markov bias whose driving noise 2 sigma^2 / tau is the datasheet's walk
+        # a random constant (the turn-on bias, P0) plus the datasheet's walk: an infinite
+        # correlation time, whose "sigma" is the walk's density (``_noise``). A Gauss-Markov
+        # bias of 1 h pulled the estimate of a 2.5 deg/s turn-on bias towards zero by 0.0007
+        # deg/s each second while its variance shrank as the model's steady state says
+        # (0.18 deg/s off at 0.002 deg/s sigma after 480 s on the Crossbow unit)
         for name, walk in (("bz", g.bias_walk), ("bx", a.bias_walk), ("by", a.bias_walk)):
-            tau = gm[name][1]
-            gm[name] = (walk * math.sqrt(tau / 2.0), tau)
+            gm[name] = (walk, math.inf)
         receiver = self.datasheet.get("gnss") or {}
         self._pr_inflation = gnss_model.correlated_noise_inflation(
             float(receiver.get("carrier_smoothing") or 0.0), 1.0)
@@ -499,7 +510,7 @@ class RissTcEkf(Estimator):
             ffwd_avg = sum(self._ffwd) / (2 * k)
         else:
             ao_raw, ffwd_avg = 0.0, ffwd
-        decay = [math.exp(-dt / GM_PARAMETERS[s][1]) for s in ("ao", "r", "p", "bz", "bx", "by")]
+        decay = [math.exp(-dt / self._tau[s]) for s in ("ao", "r", "p", "bz", "bx", "by")]
         self._c_ao *= decay[0]
         self._c_r *= decay[1]
         self._c_p *= decay[2]
@@ -511,6 +522,7 @@ class RissTcEkf(Estimator):
         # a wheel that does not turn reads zero whatever its scale error: at a standstill the
         # speed is exactly zero (the estimated speed error applies to a moving wheel only)
         vo = speed - self._c_vo if speed != 0.0 else 0.0
+        backwards = self._vo < 0.0  # the last velocity points against the body's forward axis
         self._vo = vo
         wz_c = wz - self._bz
         pitch = _asin((ffwd_avg - ao - self._by) / g) - self._c_p  # eq. 2
@@ -528,9 +540,15 @@ class RissTcEkf(Estimator):
         turn = a_dot * dt
         c_t, s_t = math.cos(turn), math.sin(turn)
         ue, un = ve0 * c_t + vn0 * s_t, vn0 * c_t - ve0 * s_t
+        if backwards:  # the forward axis, which the signed speed then scales (reversing)
+            ue, un = -ue, -un
         norm = math.hypot(ue, un)
-        if norm < 0.1:  # too slow for a direction of its own: along the azimuth
-            ue, un, norm = math.sin(az_mid), math.cos(az_mid), 1.0
+        if norm < 0.1:  # too slow for a direction of its own: the last direction of travel
+            # turned by the azimuth state since (``_heading``); the azimuth state alone drifts
+            # from it by tens of degrees, which a restart after a stop turned into a jump of
+            # the heading (57 deg in a garage)
+            travel = az_mid + self._heading_offset
+            ue, un, norm = math.sin(travel), math.cos(travel), 1.0
         self._ve = vo * cos_p * ue / norm
         self._vn = vo * cos_p * un / norm
         self._vu = vo * math.sin(pitch)  # eq. 6
@@ -541,6 +559,8 @@ class RissTcEkf(Estimator):
         self._pitch, self._roll = pitch, roll
         self._t = t
         self._predict(dt, rm, rn, wz_c)
+        if self._zero_rate_psd and count_speed and speed == 0.0 and n > 0.0:
+            self._update_zero_rate(wz, lat, n)
         if (self._enhanced and t - self._t_accel_update >= self.config["accel_update_interval"]
                 - 1e-9):
             self._t_accel_update = t
@@ -567,7 +587,9 @@ class RissTcEkf(Estimator):
             q = self._q_white * dt
             sigma = np.array([g[1] for g in self._gm])
             tau = np.array([g[2] for g in self._gm])
-            phi_gm, q_gm = gauss_markov_discrete(tau, sigma, dt)
+            walk = np.isinf(tau)  # random walks: sigma is the density, unit/sqrt(s)
+            phi_gm, q_gm = np.ones(len(tau)), sigma**2 * dt
+            phi_gm[~walk], q_gm[~walk] = gauss_markov_discrete(tau[~walk], sigma[~walk], dt)
             q[self._gm_index] = q_gm
             q_d = np.diag(q)
             clock = slice(_I["cb"], _I["cd"] + 1)
@@ -594,9 +616,41 @@ class RissTcEkf(Estimator):
         if self._sf_psd:
             q_d = q_d.copy()
             q_d[_I["A"], _I["A"]] += self._sf_psd * wz_c**2 * dt
+        if self._enhanced:
+            phi, q_d = self._vertical_velocity_is_eq6(phi, q_d, dt)
         self._filter.predict(phi, q_d)
 
+    def _vertical_velocity_is_eq6(self, phi: np.ndarray, q_d: np.ndarray, dt: float
+                                  ) -> tuple[np.ndarray, np.ndarray]:
+        """The vertical-velocity error after a step is that of eq. 6, which recomputes v_u =
+        v_o sin p from the corrected speed and pitch: dv_u = sin p dv_o + v_o cos p dp, with
+        the white noise of the accelerometer pitch on top. Eq. 31 is this relation's time
+        derivative without its pitch term; propagating dv_u as an independent state instead
+        kept each Doppler correction of v_u in the covariance while eq. 6 threw it away, and
+        the same innovation then pulled the height through the v_u-h correlation at every
+        epoch (about 4 m/s of height drift with three satellites). Returns T phi, T Q T^T +
+        the white noise, with T the identity whose v_u row is that relation."""
+        i = _I
+        t = np.eye(self._n)
+        t[i["vu"], i["vu"]] = 0.0
+        t[i["vu"], i["vo"]] = math.sin(self._pitch)
+        t[i["vu"], i["p"]] = self._vo * math.cos(self._pitch)
+        q_d = t @ q_d @ t.T
+        q_d[i["vu"], i["vu"]] += self._q_white[i["vu"]] * dt
+        return t @ phi, q_d
+
     # --- measurement updates ------------------------------------------------------------------
+    def _update_zero_rate(self, wz: float, lat: float, interval_s: float) -> None:
+        """A car whose wheels stand still does not turn: the mean up-axis rate of the interval
+        is the gyro bias plus the Earth rate's up component (eq. 1 at rest, dA/dt = 0), with
+        the gyro's white noise averaged over the interval (a zero-rate update; not in the
+        paper, ``zero_rate_update``)."""
+        h = np.zeros((1, self._n))
+        h[0, _I["bz"]] = 1.0
+        dz = np.array([self._bz + OMEGA_E_RAD_S * math.sin(lat) - wz])
+        self._filter.update(dz, h, np.array([[self._zero_rate_psd / interval_s]]))
+        self._feedback()
+
     def _update_accelerometers(self, g: float, ffwd: float, flat: float, wz: float) -> None:
         """Eqs. 50-57: f_x = -g sin r cos p - v_o (w_z - b_z) + b_x (eq. 51) and f_y = g sin p +
         a_od + b_y (eq. 54), linearised in r, p, b_z, v_o, b_x, a_od, b_y (eqs. 53, 56)."""

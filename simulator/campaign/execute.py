@@ -4,11 +4,12 @@ flight so that an interrupted campaign has little work under way.
 
 Local processes come from a ``forkserver`` whose preloaded worker module is forked for each
 process (fast start, and no fork of a parent that runs threads; ``spawn`` where there is no
-forkserver). Each leads a process group of its own, which holds what a plug-in estimator
-forks there; when the pool ends, every worker's group is killed, so nothing a plug-in started
-outlives the campaign (nor the campaign's process: a worker ends its group when that process
-is gone). On Ctrl-C or SIGTERM the campaign stops its workers with SIGTERM, on which a worker
-abandons its run and removes the run's temporaries; nothing of an unfinished run is recorded.
+forkserver, or where the temporary folder's path is too long for its socket). Each leads a
+process group of its own, which holds what a plug-in estimator forks there; when the pool
+ends, every worker's group is killed, so nothing a plug-in started outlives the campaign (nor
+the campaign's process: a worker ends its group when that process is gone). On Ctrl-C or
+SIGTERM the campaign stops its workers with SIGTERM, on which a worker abandons its run and
+removes the run's temporaries; nothing of an unfinished run is recorded.
 A worker process that dies (a crash inside an estimator's compiled code, the out-of-memory
 killer) fails the runs that were under way in the pool, and a new pool takes the next runs.
 
@@ -26,6 +27,7 @@ import os
 import re
 import signal
 import socket
+import tempfile
 import threading
 from collections.abc import Callable, Iterable, Iterator
 from typing import Any, TypeVar
@@ -43,10 +45,10 @@ class _RenewingPool(cf.Executor):
 
     def __init__(self, workers: int):
         self.workers = workers
-        if "forkserver" in multiprocessing.get_all_start_methods():
+        if "forkserver" in multiprocessing.get_all_start_methods() and _socket_fits():
             self.context = multiprocessing.get_context("forkserver")
             self.context.set_forkserver_preload([_WORKER_MODULE])
-        else:  # Windows
+        else:  # Windows, or a temporary folder too deep for the forkserver's socket
             self.context = multiprocessing.get_context("spawn")
         self.pool = self._new()
         self.started: set[int] = set()  # the ids of the worker processes, dead ones included
@@ -103,6 +105,14 @@ class _RenewingPool(cf.Executor):
 
     def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
         self.pool.shutdown(wait=wait, cancel_futures=cancel_futures)
+
+
+def _socket_fits() -> bool:
+    """Whether the forkserver's Unix socket, ``TMPDIR/pymp-XXXXXXXX/listener-XXXXXXXX``, fits
+    the length a socket's path may have (107 bytes on Linux, 103 on macOS): in a deeper
+    temporary folder the workers are spawned instead (each imports the worker module itself,
+    a second or two more at its start)."""
+    return len(os.fsencode(tempfile.gettempdir())) + len("/pymp-12345678/listener-12345678") <= 103
 
 
 def _kill_group(pid: int) -> None:

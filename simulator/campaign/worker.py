@@ -170,19 +170,30 @@ class TimeLimitExceeded(Exception):
 @contextlib.contextmanager
 def time_limit(seconds: float | None, label: str) -> Iterator[None]:
     """Raise ``TimeLimitExceeded`` in the block after ``seconds`` (a SIGALRM timer: call it
-    in the main thread only)."""
+    in the main thread only). Whatever the block raises once the timer has fired is reported
+    as the time limit: the timer's exception can surface as another (an extension module
+    interrupted while it initialises raises ImportError)."""
     if seconds is None:
         yield
         return
+    message = f"estimator {label!r} did not finish within the time limit of {seconds:g} s"
+    fired = False
 
     def expire(signum: int, frame: object) -> None:
-        raise TimeLimitExceeded(f"estimator {label!r} did not finish within the time limit "
-                                f"of {seconds:g} s")
+        nonlocal fired
+        fired = True
+        raise TimeLimitExceeded(message)
 
     previous = signal.signal(signal.SIGALRM, expire)
     signal.setitimer(signal.ITIMER_REAL, seconds)
     try:
         yield
+    except TimeLimitExceeded:
+        raise
+    except Exception as exc:
+        if fired:
+            raise TimeLimitExceeded(message) from exc
+        raise
     finally:
         signal.setitimer(signal.ITIMER_REAL, 0)
         signal.signal(signal.SIGALRM, previous)

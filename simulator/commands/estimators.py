@@ -7,6 +7,7 @@ import argparse
 from typing import Any
 
 from simulator.commands import SUMMARIES
+from simulator.errors import InputError
 
 
 def add_parser(sub: argparse._SubParsersAction) -> None:
@@ -25,22 +26,50 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from estimators.registry import get_estimator, list_estimators
-    from simulator.errors import InputError
+    from estimators.registry import BUILTINS, list_estimators
+    from simulator.isolated import call_isolated, needs_isolation
 
     if args.name:
-        print(describe(get_estimator(args.name), args.name))
+        print(call_isolated(described, (args.name,), args.name)
+              if needs_isolation(args.name, None) else described(args.name))
         return 0
     names = list_estimators()
-    width = max(len(n) for n in names)
+    plugins = [name for name in names if name not in BUILTINS]
+    lines = listed(names[:len(names) - len(plugins)])
+    for name in plugins:  # installed plug-ins: each imported in a child, under a time limit
+        try:
+            lines += call_isolated(listed, ([name],), name)
+        except InputError as exc:
+            lines.append(f"{name}  (cannot be loaded: {exc.problems[0].file}: "
+                         f"{exc.problems[0].message})")
+    width = max(len(line.partition("  ")[0]) for line in lines)
+    for line in lines:
+        name, _, rest = line.partition("  ")
+        print(f"{name:<{width}}  {rest}")
+    return 0
+
+
+def described(name: str) -> str:
+    """What ``landnav estimators NAME`` prints (``describe``), the class imported here."""
+    from estimators.registry import get_estimator
+
+    return describe(get_estimator(name), name)
+
+
+def listed(names: list[str]) -> list[str]:
+    """One line per estimator, ``NAME  needs STREAMS  PAPER`` (or why it cannot be loaded),
+    each class imported here."""
+    from estimators.registry import get_estimator
+
+    lines = []
     for name in names:
         try:
             cls = get_estimator(name)
         except InputError as exc:
-            print(f"{name:<{width}}  (cannot be loaded: {exc.problems[0].message})")
+            lines.append(f"{name}  (cannot be loaded: {exc.problems[0].message})")
             continue
-        print(f"{name:<{width}}  needs {_streams(cls)}  {cls.paper}")
-    return 0
+        lines.append(f"{name}  needs {_streams(cls)}  {cls.paper}")
+    return lines
 
 
 def _streams(cls: type) -> str:

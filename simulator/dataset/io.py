@@ -262,6 +262,8 @@ def _first(mask: np.ndarray) -> int:
 
 
 _MANIFEST_FIELDS = {  # key path -> the JSON types it may have
+    ("gps_time_start",): (dict,),
+    ("origin",): (dict,),
     ("gps_time_start", "week"): (int,),
     ("gps_time_start", "tow"): (int, float),
     ("origin", "lat"): (int, float),

@@ -59,8 +59,8 @@ from simulator.reproduce.report import write_report
 from simulator.reproduce.results import RESULTS_FILE, write_results
 
 __all__ = ["EDGE_P", "EDGE_SEEDS_FACTOR", "FULL_SEEDS", "QUICK_SEEDS", "ExperimentResult",
-           "PaperResult", "Settings", "edge_experiments", "judge", "reproduce", "ruled",
-           "run_experiment", "seeds_of"]
+           "PaperResult", "Settings", "edge_experiments", "judge", "on_common_seeds", "reproduce",
+           "ruled", "run_experiment", "seeds_of"]
 
 SCHEDULER_TIMEOUT_S = 10.0
 EDGE_P = 0.2  # a verdict with ALPHA <= sign-test p < EDGE_P after the run's seeds is at an edge
@@ -188,8 +188,9 @@ def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict
         if claim.judge is None:
             continue
         try:
-            verdict = claim.judge({e.key: tables[e.key] for e in paper.read_by(claim)
-                                   if e.key in tables})
+            verdict = claim.judge(on_common_seeds({e.key: tables[e.key]
+                                                   for e in paper.read_by(claim)
+                                                   if e.key in tables}))
             # an untestable claim's judge gives landnav's figure only: no evidence, no word
             out[claim.key] = (replace(verdict, status="not shown", evidence=None,
                                       magnitude=None, compared=())
@@ -198,6 +199,19 @@ def judge(paper: Paper, tables: Mapping[str, pd.DataFrame]) -> dict[str, Verdict
             out[claim.key] = Verdict("not shown", "no figure",
                                      f"could not be judged: {type(exc).__name__}: {exc}")
     return out
+
+
+def on_common_seeds(tables: Mapping[str, pd.DataFrame]) -> dict[str, pd.DataFrame]:
+    """``tables`` (index: seed) restricted to the seeds they all have: a claim that pairs the
+    figures of two experiments pairs them seed by seed, and the second stage may have run one of
+    them on further seeds (``edge_experiments``)."""
+    if len(tables) < 2:
+        return dict(tables)
+    indexes = [table.index for table in tables.values()]
+    common = indexes[0]
+    for index in indexes[1:]:
+        common = common.intersection(index)
+    return {key: table[table.index.isin(common)] for key, table in tables.items()}
 
 
 def edge_experiments(paper: Paper, verdicts: Mapping[str, Verdict]) -> set[str]:

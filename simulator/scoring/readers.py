@@ -39,6 +39,9 @@ from __future__ import annotations
 
 import datetime as dt
 import math
+import warnings
+from array import array
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 import numpy as np
@@ -47,16 +50,24 @@ import pandas as pd
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic
 from simulator.errors import InputError, Problem, refuse_undecodable
-from simulator.replay import USES_GNSS_KEY, solution_problems
+from simulator.replay import MAX_SOLUTION_ROWS, USES_GNSS_KEY, solution_problems
 from simulator.scoring.align import solution_errors
 from simulator.timebase import GPS_EPOCH, SECONDS_PER_WEEK, leap_seconds
 
 MAX_MEDIAN_HORIZONTAL_M = 100e3  # a solution whose median horizontal error exceeds it is refused
 # a solution file larger than this is refused before it is read (10 million rows of a text
-# solution are about 1.5 GB; a replay asks for at most 10 million rows)
+# solution are about 1.5-2.4 GB), and one of more rows than a replay may ask for is refused as
+# soon as its reader gets there: text is read in chunks of _CHUNK_ROWS, so reading holds the
+# numbers of the rows read and one chunk
 MAX_SOLUTION_BYTES = 2 * 1024**3
+_CHUNK_ROWS = 200_000
+_MAX_HEADER_CHARS = 65_536  # an RTKLIB header line longer than this is no header
 MIN_EARTH_RADIUS_M = 6.3e6  # an ECEF position nearer the Earth's centre is no position
+# a height outside this span (m, ellipsoidal) is no land vehicle's: a unit or a format mistake
+HEIGHT_SPAN_M = (-1e5, 1e5)
 _UNITS = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
+# the columns a solution file is read for (any other column is left unread)
+_READ = {**_UNITS, **col.SOLUTION_NIS, **col.SOLUTION_FIX}
 _ANGLE_UNITS = {"deg": math.pi / 180.0, "degree": math.pi / 180.0, "degrees": math.pi / 180.0,
                 "rad": 1.0, "radian": 1.0, "radians": 1.0}
 _NMEA_SUFFIXES = {".nmea", ".nma", ".gps", ".log", ".txt"}
@@ -94,87 +105,154 @@ def _honour_units(frame: pd.DataFrame, units: dict[str, str], path: Path) -> lis
     return notes
 
 
+def _too_many_rows(path: Path, rows: int) -> InputError:
+    return _problem(path, f"more than {MAX_SOLUTION_ROWS:,} rows ({rows:,} read), more than a "
+                          "solution may hold (a replay asks for at most as many); score it in "
+                          "parts")
+
+
+class _Rows:
+    """Where a solution file's row ``i`` (0 for the first row of data) is, for messages: the
+    file's line when its rows are lines after ``first_line - 1`` others, else the row."""
+
+    def __init__(self, first_line: int | None = None) -> None:
+        self.first_line = first_line
+
+    def __call__(self, i: int) -> str:
+        return f"row {i}" if self.first_line is None else f"line {i + self.first_line}"
+
+
 def _parquet(path: Path) -> tuple[pd.DataFrame, list[str], bool]:
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
     from simulator.dataset.parquet import read_metadata, read_table, read_units
 
-    frame = read_table(path)
+    try:
+        schema = pq.ParquetFile(path)
+        rows, names = schema.metadata.num_rows, schema.schema_arrow.names
+    except (pa.ArrowException, OSError) as exc:
+        raise _problem(path, f"not a readable Parquet file: {exc}") from None
+    if rows > MAX_SOLUTION_ROWS:
+        raise _too_many_rows(path, rows)
+    frame = read_table(path, [n for n in names if n in _READ])
     uses_gnss = read_metadata(path).get(USES_GNSS_KEY, "true") != "false"
-    return frame, _honour_units(frame, read_units(path), path), uses_gnss
+    units = {k: v for k, v in read_units(path).items() if k in frame.columns}
+    _refuse_text(path, frame, _Rows())
+    return frame, _honour_units(frame, units, path), uses_gnss
+
+
+def _chunks(path: Path, what: str, where: _Rows, keep: tuple[str, ...] = (), **options
+            ) -> Iterator[pd.DataFrame]:
+    """``pandas.read_csv(path, **options)`` (a file of the format ``what``) chunk by chunk,
+    each with its cells (but the columns ``keep``) checked as numbers (``_refuse_text``,
+    naming the file's line; pandas numbers a chunk's rows from the file's first); refused past
+    ``MAX_SOLUTION_ROWS``."""
+    rows = 0
+    try:
+        with warnings.catch_warnings():
+            # a row of more fields than the header: refused, not its fields dropped (nor the
+            # first columns taken as the index, as pandas would without index_col=False)
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            for chunk in pd.read_csv(path, chunksize=_CHUNK_ROWS, index_col=False, **options):
+                _refuse_text(path, chunk, where, keep)
+                rows += len(chunk)
+                if rows > MAX_SOLUTION_ROWS:
+                    raise _too_many_rows(path, rows)
+                yield chunk
+    except pd.errors.ParserWarning:
+        raise _problem(path, f"not a readable {what} file: a row has more fields than the "
+                             "header names") from None
+    except (ValueError, OSError) as exc:
+        raise _problem(path, f"not a readable {what} file: {exc}") from None
+
+
+def _joined(chunks: list[pd.DataFrame], columns: Iterable[str]) -> pd.DataFrame:
+    return (pd.concat(chunks, ignore_index=True) if chunks
+            else pd.DataFrame(columns=list(columns), dtype=float))
 
 
 def _csv(path: Path) -> pd.DataFrame:
-    try:
-        return pd.read_csv(path, comment=None, skipinitialspace=True)
-    except (ValueError, OSError) as exc:
-        raise _problem(path, f"not a readable CSV file: {exc}") from None
+    """A CSV solution, its known columns only (header names stripped of spaces)."""
+    chunks = [chunk.rename(columns=str.strip) for chunk in _chunks(
+        path, "CSV", _Rows(first_line=2), comment=None, skipinitialspace=True,
+        usecols=lambda name: name.strip() in _READ)]
+    return _joined(chunks, col.SOLUTION)
+
+
+def _leap_seconds(utc_s: np.ndarray) -> np.ndarray:
+    """GPS - UTC (s) at UTC times given as seconds since the GPS epoch's midnight (leap seconds
+    start at midnight, so one value a day)."""
+    days = np.floor(utc_s / 86400.0)
+    unique, at = np.unique(days, return_inverse=True)
+    return np.array([leap_seconds(GPS_EPOCH + dt.timedelta(days=float(d))) for d in unique],
+                    dtype=float)[at] if len(days) else np.zeros(0)
 
 
 def _gps_seconds(stamps: pd.Series, utc: bool) -> np.ndarray:
     """Seconds since the GPS epoch of naive datetimes in GPS time, or in UTC when ``utc``."""
     seconds = (stamps - pd.Timestamp(GPS_EPOCH)).dt.total_seconds().to_numpy()
-    if utc:
-        seconds = seconds + np.array([leap_seconds(s.to_pydatetime()) for s in stamps])
-    return seconds
+    return seconds + _leap_seconds(seconds) if utc else seconds
 
 
-def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[str]]:
-    lines = path.read_text(encoding="utf-8", errors="replace").splitlines()
-    header = [ln for ln in lines if ln.startswith("%")]
-    names_line = next((ln for ln in reversed(header) if "Q" in ln.split()), None)
-    if names_line is None:
+def _pos_header(path: Path) -> tuple[list[str], bool, int]:
+    """The column names an RTKLIB header's last line naming them gives (``%`` removed), whether
+    a header line says the heights are geodetic, and how many lines precede the rows."""
+    names: list[str] | None = None
+    geodetic = False
+    lines = 0
+    with path.open(encoding="utf-8", errors="replace") as stream:
+        while True:
+            line = stream.readline(_MAX_HEADER_CHARS)
+            if len(line) >= _MAX_HEADER_CHARS and not line.endswith("\n"):
+                raise _problem(path, f"line {lines + 1} is longer than "
+                                     f"{_MAX_HEADER_CHARS} characters: not an RTKLIB .pos file")
+            if line.strip() and not line.startswith("%"):
+                break
+            if not line:
+                break
+            lines += 1
+            geodetic = geodetic or "geodetic" in line
+            if "Q" in line.split():
+                names = line[1:].split()
+    if names is None:
         raise _problem(path, "not an RTKLIB .pos file (no '%' header line naming the columns)")
-    names = names_line[1:].split()
+    return names, geodetic, lines
+
+
+def _pos_rows(path: Path, table: pd.DataFrame, names: list[str], where: _Rows,
+              gps_start: tuple[int, float]) -> pd.DataFrame:
+    """One chunk of an RTKLIB solution's rows (``table``: the two time fields as text
+    ``_time1, _time2``, then the header's columns as numbers) as solution rows."""
     system = names[0]
-    if system not in ("GPST", "UTC"):
-        raise _problem(path, f"time system {system!r}: only GPST and UTC are read")
-    if any("geodetic" in ln for ln in header):
-        raise _problem(path, "heights are geodetic (above the geoid); write ellipsoidal heights"
-                             " (RTKLIB option out-height=ellipsoidal)")
-    rows = [ln.split() for ln in lines if ln.strip() and not ln.startswith("%")]
-    if not rows:
-        return pd.DataFrame(columns=list(col.SOLUTION)), []
-    width = len(names) + 1  # the time takes two fields (week and seconds, or date and time)
-    if any(len(r) != width for r in rows):
-        raise _problem(path, f"rows do not have the {width} fields the header names "
-                             "(latitude/longitude in degrees-minutes-seconds cannot be read; "
-                             "write degrees)")
-    table = pd.DataFrame([r[2:] for r in rows], columns=names[1:])
-    _refuse_text(path, table, offset=len(lines) - len(rows))
-    table = table.apply(pd.to_numeric)
-    first = [r[0] for r in rows]
-    if "/" in first[0]:
+    first = table["_time1"]
+    if first.str.contains("/", regex=False).iloc[0]:
         try:
-            stamps = pd.to_datetime([f"{r[0]} {r[1]}" for r in rows],
+            stamps = pd.to_datetime(first + " " + table["_time2"],
                                     format="%Y/%m/%d %H:%M:%S.%f")
         except (ValueError, OverflowError) as exc:
             raise _problem(path, f"a time is not a date and time YYYY/MM/DD hh:mm:ss.sss "
                                  f"({exc})") from None
         seconds = _gps_seconds(pd.Series(stamps), system == "UTC")
     else:
-        clock = pd.DataFrame({"week": first, "seconds": [r[1] for r in rows]})
-        _refuse_text(path, clock, offset=len(lines) - len(rows))
-        seconds = (clock["week"].astype(float).to_numpy() * SECONDS_PER_WEEK
-                   + clock["seconds"].astype(float).to_numpy())
         if system == "UTC":
             raise _problem(path, "UTC given as week and seconds is not an RTKLIB output; use "
                                  "GPST or a date")
-    out = pd.DataFrame({"t": seconds - (gps_start[0] * SECONDS_PER_WEEK + gps_start[1])})
-    notes = [f"{path}: RTKLIB {system} solution, {len(out)} rows"]
-    if "latitude(deg)" in table:
+        clock = table[["_time1", "_time2"]].copy()
+        _refuse_text(path, clock, where)
+        seconds = (clock["_time1"].to_numpy(float) * SECONDS_PER_WEEK
+                   + clock["_time2"].to_numpy(float))
+    out = pd.DataFrame({"t": seconds - (gps_start[0] * SECONDS_PER_WEEK + gps_start[1])},
+                       index=table.index)
+    if "longitude(deg)" in table:
         out["lat"], out["lon"] = table["latitude(deg)"], table["longitude(deg)"]
         out["alt"] = table["height(m)"]
-    elif "x-ecef(m)" in table:
+    else:
         xyz = table[["x-ecef(m)", "y-ecef(m)", "z-ecef(m)"]].to_numpy(float)
         lat, lon, alt = ecef_to_geodetic(xyz)
         out["lat"], out["lon"], out["alt"] = np.degrees(lat), np.degrees(lon), alt
-        centre = np.linalg.norm(xyz, axis=1) < MIN_EARTH_RADIUS_M
-        if centre.any():  # RTKLIB's "no solution" rows: no position, not one 6370 km off
-            out.loc[centre, ["lat", "lon", "alt"]] = np.nan
-            notes.append(f"{path}: {int(centre.sum())} row(s) at the Earth's centre "
-                         "(x, y, z = 0: no solution) have no position")
-    else:
-        raise _problem(path, "neither latitude(deg)/longitude(deg)/height(m) nor x/y/z-ecef(m) "
-                             "columns (east/north/up relative positions cannot be scored)")
+        # RTKLIB's "no solution" rows: no position, not one 6370 km off
+        out.loc[np.linalg.norm(xyz, axis=1) < MIN_EARTH_RADIUS_M, ["lat", "lon", "alt"]] = np.nan
     if "vn(m/s)" in table:
         out["vn"], out["ve"], out["vd"] = table["vn(m/s)"], table["ve(m/s)"], -table["vu(m/s)"]
     else:
@@ -182,11 +260,52 @@ def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[s
     for name in _ATTITUDE:
         out[name] = np.nan
     if "sdn(m)" in table:
-        out["std_n"], out["std_e"], out["std_d"] = table["sdn(m)"], table["sde(m)"], table["sdu(m)"]
+        out["std_n"], out["std_e"] = table["sdn(m)"], table["sde(m)"]
+        out["std_d"] = table["sdu(m)"]
     # the quality flag as SPEC section 8's fix status: Q = 1 fixed (2), Q = 2 float (1), else
     # none (0: single point, DGPS, dead reckoning)
     out["fix_status"] = np.select([table["Q"] == 1, table["Q"] == 2], [2, 1], 0)
-    return out, notes
+    return out
+
+
+def _pos(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[str], _Rows]:
+    names, geodetic, header_lines = _pos_header(path)
+    system = names[0]
+    if system not in ("GPST", "UTC"):
+        raise _problem(path, f"time system {system!r}: only GPST and UTC are read")
+    if geodetic:
+        raise _problem(path, "heights are geodetic (above the geoid); write ellipsoidal heights"
+                             " (RTKLIB option out-height=ellipsoidal)")
+    if not ({"latitude(deg)", "longitude(deg)", "height(m)"} <= set(names)
+            or {"x-ecef(m)", "y-ecef(m)", "z-ecef(m)"} <= set(names)):
+        raise _problem(path, "neither latitude(deg)/longitude(deg)/height(m) nor x/y/z-ecef(m) "
+                             "columns (east/north/up relative positions cannot be scored)")
+    for group in (("vn(m/s)", "ve(m/s)", "vu(m/s)"), ("sdn(m)", "sde(m)", "sdu(m)")):
+        if 0 < len(set(group) & set(names)) < len(group):
+            raise _problem(path, f"the header names some of {', '.join(group)} but not all")
+    where = _Rows(first_line=header_lines + 1)
+    fields = ["_time1", "_time2", *names[1:]]
+    chunks = []
+    for table in _chunks(path, "RTKLIB .pos", where, ("_time1", "_time2"), sep=r"\s+",
+                         header=None, names=fields, comment="%", skiprows=header_lines,
+                         dtype=str, keep_default_na=False):
+        if table.empty:
+            continue
+        short = table.index[table[fields[-1]].isna().to_numpy()]
+        if len(short):
+            raise _problem(path, f"{where(int(short[0]))}: rows "
+                                 f"do not have the {len(fields)} fields the header names "
+                                 "(latitude/longitude in degrees-minutes-seconds cannot be "
+                                 "read; write degrees)")
+        chunks.append(_pos_rows(path, table, names, where, gps_start))
+    out = _joined(chunks, col.SOLUTION)
+    notes = [f"{path}: RTKLIB {system} solution, {len(out)} rows"]
+    if "x-ecef(m)" in names and len(out):
+        centre = int(out["lat"].isna().sum())
+        if centre:
+            notes.append(f"{path}: {centre} row(s) at the Earth's centre (x, y, z = 0: no "
+                         "solution) have no position")
+    return out, notes, where
 
 
 def _float(value: object) -> float:
@@ -199,9 +318,16 @@ def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[
 
     start_date = (GPS_EPOCH + dt.timedelta(seconds=gps_start[0] * SECONDS_PER_WEEK
                                            + gps_start[1])).date()
-    gga, rmc = [], {}
+    # GGA: UTC seconds since the GPS epoch, lat, lon, ellipsoidal height; RMC: the same time,
+    # speed over ground (knots), course (deg); plain arrays (8 bytes a number)
+    gga = {name: array("d") for name in ("utc", "lat", "lon", "alt")}
+    rmc = {name: array("d") for name in ("utc", "speed", "course")}
     untimed = 0
     date = start_date
+
+    def utc_seconds(time: dt.time) -> float:
+        return (dt.datetime.combine(date, time) - GPS_EPOCH).total_seconds()
+
     with path.open("rb") as stream:
         for _, msg in NMEAReader(stream, quitonerror=0):
             if msg is None:
@@ -209,31 +335,43 @@ def _nmea(path: Path, gps_start: tuple[int, float]) -> tuple[pd.DataFrame, list[
             if msg.msgID == "RMC" and msg.date:
                 date = msg.date
                 if msg.status == "A":
-                    rmc[(date, msg.time)] = (_float(msg.spd), _float(msg.cog))
+                    for name, value in zip(rmc, (utc_seconds(msg.time), _float(msg.spd),
+                                                 _float(msg.cog)), strict=True):
+                        rmc[name].append(value)
             elif msg.msgID == "GGA" and msg.quality and msg.lat != "" and not msg.time:
                 untimed += 1
             elif msg.msgID == "GGA" and msg.quality and msg.lat != "":
-                gga.append((date, msg.time, msg.lat, msg.lon,
-                             _float(msg.alt) + (_float(msg.sep) if msg.sep != "" else 0.0)))
-    if not gga:
-        return pd.DataFrame(columns=list(col.SOLUTION)), (
-            [f"{path}: {untimed} GGA sentence(s) without a time left out"] if untimed else [])
-    stamps = pd.Series([dt.datetime.combine(d, tm) for d, tm, *_ in gga])
-    seconds = _gps_seconds(stamps, utc=True)
-    speed_course = np.array([rmc.get((d, tm), (np.nan, np.nan)) for d, tm, *_ in gga],
-                            dtype=float)
-    speed = speed_course[:, 0] * 1852.0 / 3600.0  # knots
-    course = np.radians(speed_course[:, 1])
+                height = _float(msg.alt) + (_float(msg.sep) if msg.sep != "" else 0.0)
+                for name, value in zip(gga, (utc_seconds(msg.time), msg.lat, msg.lon, height),
+                                       strict=True):
+                    gga[name].append(value)
+            if max(len(gga["utc"]), len(rmc["utc"])) > MAX_SOLUTION_ROWS:
+                raise _too_many_rows(path, max(len(gga["utc"]), len(rmc["utc"])))
+    notes = [f"{path}: {untimed} GGA sentence(s) without a time left out"] if untimed else []
+    if not gga["utc"]:
+        return pd.DataFrame(columns=list(col.SOLUTION), dtype=float), notes
+    utc = np.frombuffer(gga["utc"], dtype=float)
+    seconds = utc + _leap_seconds(utc)
+    # each GGA with the speed and course of the RMC of its time (the last of equal times)
+    speed_knots, course_deg = np.full(len(utc), np.nan), np.full(len(utc), np.nan)
+    rmc_utc = np.frombuffer(rmc["utc"], dtype=float)
+    if len(rmc_utc):
+        last = len(rmc_utc) - 1 - np.unique(rmc_utc[::-1], return_index=True)[1]
+        at = np.minimum(np.searchsorted(rmc_utc[last], utc), len(last) - 1)
+        found = rmc_utc[last][at] == utc
+        speed_knots[found] = np.frombuffer(rmc["speed"], dtype=float)[last][at[found]]
+        course_deg[found] = np.frombuffer(rmc["course"], dtype=float)[last][at[found]]
+    speed = speed_knots * 1852.0 / 3600.0
+    course = np.radians(course_deg)
     out = pd.DataFrame({"t": seconds - (gps_start[0] * SECONDS_PER_WEEK + gps_start[1]),
-                        "lat": [g[2] for g in gga], "lon": [g[3] for g in gga],
-                        "alt": [g[4] for g in gga], "vn": speed * np.cos(course),
-                        "ve": speed * np.sin(course), "vd": np.nan})
+                        "lat": np.frombuffer(gga["lat"], dtype=float),
+                        "lon": np.frombuffer(gga["lon"], dtype=float),
+                        "alt": np.frombuffer(gga["alt"], dtype=float),
+                        "vn": speed * np.cos(course), "ve": speed * np.sin(course),
+                        "vd": np.nan})
     for name in _ATTITUDE:
         out[name] = np.nan
-    notes = [f"{path}: NMEA GGA/RMC solution, {len(out)} rows (UTC times)"]
-    if untimed:
-        notes.append(f"{path}: {untimed} GGA sentence(s) without a time left out")
-    return out, notes
+    return out, [f"{path}: NMEA GGA/RMC solution, {len(out)} rows (UTC times)", *notes]
 
 
 def _kind(path: Path) -> str:
@@ -285,44 +423,62 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
     kind = _kind(path)
     notes: list[str] = []
     uses_gnss = True
+    where = _Rows()
     if kind == "parquet":
         frame, notes, uses_gnss = _parquet(path)
     elif kind == "csv":
-        frame = _csv(path)
-        _refuse_text(path, frame, [c for c in frame.columns if c in _UNITS], offset=1)
+        frame, where = _csv(path), _Rows(first_line=2)
     elif kind == "pos":
-        frame, notes = _pos(path, gps_start)
+        frame, notes, where = _pos(path, gps_start)
     else:
         frame, notes = _nmea(path, gps_start)
-    _refuse_text(path, frame, [c for c in frame.columns if c in _UNITS])
+    _refuse_out_of_range(path, frame, where)
     problems = solution_problems(frame)
     if problems:
         raise InputError([Problem(str(path), None, "", p) for p in problems])
     return frame, notes, uses_gnss
 
 
-def _refuse_text(path: Path, frame: pd.DataFrame, columns: list[str] | None = None,
-                 offset: int = 0) -> None:
-    """Refuse a cell of ``frame``'s ``columns`` (all by default) that is not a number (empty
-    cells are missing values), naming its column and the file's line (``offset``: the lines
-    before the first row; 0 when there are no lines, as in Parquet: then the row); numbers
-    written as text become numbers, in place."""
-    for name in frame.columns if columns is None else columns:
+def _refuse_text(path: Path, frame: pd.DataFrame, where: _Rows,
+                 keep: tuple[str, ...] = ()) -> None:
+    """Refuse a cell of ``frame`` (but its columns ``keep``) that is not a number (empty cells
+    are missing values), naming its column and ``where`` its row is (the frame's index counts
+    the file's rows); numbers written as text become numbers, in place."""
+    for name in frame.columns:
         values = frame[name]
-        if pd.api.types.is_numeric_dtype(values.dtype) or pd.api.types.is_bool_dtype(
-                values.dtype):
+        if name in keep or pd.api.types.is_numeric_dtype(values.dtype) or (
+                pd.api.types.is_bool_dtype(values.dtype)):
             continue
         if not (pd.api.types.is_object_dtype(values.dtype)
                 or pd.api.types.is_string_dtype(values.dtype)):
             raise _problem(path, f"column {name} holds {values.dtype} values, not numbers "
                                  "(times are seconds since the dataset's start)", name)
         numbers = pd.to_numeric(values, errors="coerce")
-        bad = numbers.isna() & values.notna() & (values.astype(str).str.strip() != "")
+        bad = (numbers.isna() & values.notna() & (values.astype(str).str.strip() != "")
+               ).to_numpy()
         if bad.any():
-            i = int(np.flatnonzero(bad.to_numpy())[0])
-            where = f"line {i + offset + 1}" if offset else f"row {i}"
-            raise _problem(path, f"{where}: {values.iloc[i]!r} is not a number", name)
+            i = int(np.flatnonzero(bad)[0])
+            raise _problem(path, f"{where(int(frame.index[i]))}: {values.iloc[i]!r} is not a "
+                                 "number", name)
         frame[name] = numbers
+
+
+def _refuse_out_of_range(path: Path, frame: pd.DataFrame, where: _Rows) -> None:
+    """Refuse an infinite value in any column, and a latitude, longitude (deg) or height (m)
+    that no position has, naming the first such row and its column (NaN is a missing value)."""
+    spans = {"lat": (-90.0, 90.0, "a latitude in degrees"),
+             "lon": (-180.0, 360.0, "a longitude in degrees"),
+             "alt": (*HEIGHT_SPAN_M, "a land vehicle's ellipsoidal height in metres")}
+    for name in frame.columns:
+        values = frame[name].to_numpy(float)
+        low, high, what = spans.get(name, (-np.inf, np.inf, ""))
+        bad = np.isinf(values) | (values < low) | (values > high)
+        if not bad.any():
+            continue
+        i = int(np.flatnonzero(bad)[0])
+        reason = ("is not finite (a missing value is an empty cell or NaN)"
+                  if np.isinf(values[i]) else f"lies outside [{low:g}, {high:g}]: not {what}")
+        raise _problem(path, f"{where(i)}: {name} = {values[i]:g} {reason}", name)
 
 
 def _cause(frame: pd.DataFrame, truth: pd.DataFrame) -> str:

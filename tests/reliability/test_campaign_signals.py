@@ -140,6 +140,21 @@ def test_what_a_plugin_forks_in_a_worker_ends_with_the_campaign(tmp_path, capsys
     assert not any(alive(p) for p in started)
 
 
+def test_the_time_limit_names_itself_when_the_timer_surfaces_as_another_exception():
+    """A plug-in interrupted while an extension module initialises raises ImportError, not the
+    timer's exception: it is still the time limit (a loaded machine hits it while importing)."""
+    from simulator.campaign.worker import TimeLimitExceeded, time_limit
+
+    with pytest.raises(TimeLimitExceeded, match="did not finish within the time limit of 0.05 s"):
+        with time_limit(0.05, "slow"):
+            try:
+                time.sleep(5.0)
+            except TimeLimitExceeded:
+                raise ImportError("initialization failed") from None
+    with pytest.raises(ValueError, match="its own"), time_limit(5.0, "quick"):
+        raise ValueError("its own failure, before the limit")
+
+
 def test_campaign_time_limit_fails_the_stuck_run_and_goes_on(tmp_path):
     """The limit also bounds importing and checking the estimator before the runs: 10 s, as
     importing this test module takes about 3 s of CPU (pytest, matplotlib)."""

@@ -88,6 +88,8 @@ CORRUPTIONS: dict[str, tuple[Callable[[Path], None], str]] = {
     "gps week as text": (lambda ds: _manifest(
         ds, lambda m: m["gps_time_start"].update(week="2300")),
         "gps_time_start.week: not an integer"),
+    "gps start as list": (lambda ds: _manifest(ds, lambda m: m.update(gps_time_start=[1, 2])),
+                          "gps_time_start: not a mapping (got [1, 2])"),  # was a TypeError
     "origin lat as list": (lambda ds: _manifest(ds, lambda m: m["origin"].update(lat=[1])),
                            "origin.lat: not an integer or a number"),
     "not a parquet file": (lambda ds: (ds / "imu.parquet").write_bytes(b"PAR1 garbage"),
@@ -135,6 +137,7 @@ READS = {
     "imu samples without value": ("estimate",), "truth time backwards": ("score",),
     "events without t_end": ("score",), "gnss_fix course missing": ("score",),
     "gps week as text": ("export",), "origin lat as list": ("export",),
+    "gps start as list": ("score", "export"),
     "not a parquet file": ("estimate",), "imu empty": ("estimate",),
     "imu sample of 1e300": ("estimate",), "imu unit deg/s": ("estimate",),
     "broadcast ionosphere as text": ("export",), "gps week -5": ("export",),

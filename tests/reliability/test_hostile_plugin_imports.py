@@ -1,12 +1,13 @@
 """Plug-in modules that misbehave when imported (hang, loop, wait, crash the interpreter, exit,
 abort): every command that imports them (``estimate``, ``run``, ``campaign``, ``validate
---import-plugins``) imports them in a child process and ends within the time limit with exit 2
-and one message naming the module's file, nothing written. A module that prints megabytes or
-forks processes that would outlive it: the command's own output stays clean and no process of
-the plug-in is left running."""
+--import-plugins``, ``estimators``) imports them in a child process and ends within the time
+limit with exit 2 and one message naming the module's file, nothing written. A module that
+prints megabytes or forks processes that would outlive it: the command's own output stays
+clean and no process of the plug-in is left running."""
 
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
 
@@ -86,6 +87,27 @@ def test_every_command_bounds_a_plugin_import(tmp_path, monkeypatch, capsys, com
                       prefix=str(scenario) if command == "validate" else "error:")
     assert str(path) in printed
     assert sorted(p.name for p in work.iterdir()) == ["s.yaml"]
+
+
+@pytest.mark.parametrize("module", ["hangs", "segfaults", "exits"])
+def test_describing_a_plugin_bounds_its_import(tmp_path, monkeypatch, capsys, module):
+    """``landnav estimators module:Class`` imports the module in a child process, within the
+    bound, and names its file."""
+    text, words = AT_IMPORT[module]
+    path = _plugin(tmp_path, monkeypatch, module, text)
+    monkeypatch.setattr(isolated, "CHECK_LIMIT_S", 2.0)
+    printed = refused(["estimators", f"{module}:Hostile"], capsys, [path.parent], words)
+    assert str(path) in printed
+
+
+def test_describing_a_plugin_runs_none_of_it_here(tmp_path, monkeypatch, capsys):
+    """A plug-in that works is described as a built-in is, from a child process: its module
+    is never imported into landnav's own."""
+    _plugin(tmp_path, monkeypatch, "described", "")
+    assert main(["estimators", "described:Hostile"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("described:Hostile (described:Hostile)\npaper:")
+    assert "described" not in sys.modules
 
 
 NOISY = ("import sys\nprint('x' * 3_000_000)\nsys.stdout.write('y' * 1_000_000)\n"

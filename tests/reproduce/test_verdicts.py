@@ -198,6 +198,27 @@ def test_a_judge_is_given_only_the_experiments_it_declares():
                                                  experiments=("c",)),))
 
 
+def test_a_claim_pairing_two_experiments_is_judged_on_the_seeds_both_have():
+    """The second stage may run one experiment on further seeds: a claim pairing its figures
+    with another experiment's is judged on their common seeds (it failed on 20 against 10)."""
+    from simulator.reproduce.paper import Claim, Experiment, Paper
+
+    def a_below_b(tables):
+        return m.paired_judgement({"a": tables["long"]["x"].to_numpy(),
+                                   "b": tables["short"]["x"].to_numpy()}, "a", "b",
+                                  better="lower", kind="difference", unit="m", what="a lower")
+
+    experiments = tuple(Experiment(k, "quickstart.yaml", {}, measure=len)
+                        for k in ("long", "short"))
+    paper = Paper("p", "t", "c", experiments, (
+        Claim("pairs", "t", "f", (), a_below_b, experiments=("long", "short")),))
+    long = pd.DataFrame({"x": [0.0] * 6}, index=pd.Index(range(1, 7), name="seed"))
+    short = pd.DataFrame({"x": [1.0] * 3}, index=pd.Index([1, 2, 3], name="seed"))
+    verdict = judge(paper, {"long": long, "short": short})["pairs"]
+    assert verdict.evidence is not None, verdict.reason
+    assert (verdict.evidence.n, verdict.evidence.wins) == (3, 3)
+
+
 def test_the_experiments_of_a_claim_at_its_edge_are_run_on_further_seeds():
     from simulator.reproduce.evidence import one_sample_evidence
     from simulator.reproduce.paper import Claim, Experiment, Paper, Verdict
