@@ -35,6 +35,9 @@ GNSS_FIX = {
     "num_sats": "1", "hdop": "1", "vdop": "1", "fix": "1",
     # the receiver's clock solution: c dt_r and c d(dt_r)/dt
     "clock_bias": "m", "clock_drift": "m/s",
+    # the receiver's own accuracy of the fix, 1-sigma per NED axis (as NMEA GST, UBX-NAV-COV):
+    # what it knows of its error, not the error (simulator.gnss.fix)
+    "std_n": "m", "std_e": "m", "std_d": "m", "std_vn": "m/s", "std_ve": "m/s", "std_vd": "m/s",
 }
 
 GNSS_RAW = {

@@ -1,9 +1,11 @@
-"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, and the one drive
+"""Shared test fixtures: the ``../shared`` reference folder, ``--runslow``, the one drive
 builder (``build_drive``: segments to truth kinematics, through the scenario and the drive as
-``landnav generate`` builds them)."""
+``landnav generate`` builds them), and the papers' experiments computed once per session
+(``shared_experiments``)."""
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -85,8 +87,14 @@ def seed_sets(full: range) -> list:
     """A multi-seed claim's seed sets as test parameters: seeds 1-3 in the default run (the
     same property on fewer seeds; a criterion "in 8 of 10 seeds" asks for
     ``needed_count(0.8, 3)`` = 3 of 3), and ``full`` under ``--runslow``."""
-    return [pytest.param(CI_SEEDS, id=f"{len(CI_SEEDS)}seeds"),
-            pytest.param(full, id=f"{len(full)}seeds", marks=pytest.mark.slow)]
+    return ci_and_slow(f"{len(CI_SEEDS)}seeds", (CI_SEEDS,), (full,), f"{len(full)}seeds")
+
+
+def ci_and_slow(name: str, ci: tuple, slow: tuple, slow_name: str) -> list:
+    """A long case as two test parameters: its short CI variant ``ci`` in the default run (id
+    ``name``) and the long one, ``slow``, with --runslow (id ``slow_name``)."""
+    return [pytest.param(*ci, id=name),
+            pytest.param(*slow, id=slow_name, marks=pytest.mark.slow)]
 
 
 DEFAULT_START = {"lat": 37.5, "lon": 127.0, "alt": 40.0, "heading": 30.0}
@@ -127,3 +135,19 @@ def quickstart(tmp_path_factory):
     out = tmp_path_factory.mktemp("quickstart") / "dataset"
     return open_dataset(generate_dataset(load_scenario(REPO / "scenarios" / "quickstart.yaml"),
                                          out, show_progress=False))
+
+
+@pytest.fixture(scope="session")
+def shared_experiments(tmp_path_factory):
+    """The reproduction's ``measure_seed`` computing each (experiment, seed) once in the session
+    (tests/experiment_cache.py), for the claim tests and the quick reproduction alike. Its
+    folder is shared by pytest-xdist's workers (the parent of each worker's base folder)."""
+    from simulator.reproduce import runner
+    from tests.experiment_cache import cached_measure_seed
+
+    base = tmp_path_factory.getbasetemp()
+    folder = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "experiments"
+    folder.mkdir(exist_ok=True)
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(runner, "measure_seed", cached_measure_seed(folder, runner.measure_seed))
+        yield folder

@@ -3,7 +3,9 @@ scenario's estimators, scores, report); the code base stays ruff-clean.
 
 Long drives run shortened here with ``--set`` (table below; each scenario's comment says so too)
 and whole in ``benchmarks/bench_shipped.py``. The two Chan drives run shortened as
-``landnav reproduce --quick`` runs them (whole: 65 s and 23 s of CPU in this test).
+``landnav reproduce --quick`` runs them (whole: 65 s and 23 s of CPU in this test). The drives
+whose papers' claims are tested in tests/estimators/ run shorter still in the default run
+(``SHORTER_IN_CI``) and as in ``SHORTENED`` with --runslow.
 """
 
 from __future__ import annotations
@@ -21,9 +23,11 @@ import pytest
 from simulator.cli import main
 from simulator.dataset.io import open_dataset
 from simulator.pipeline import load_scenario
+from simulator.reproduce import park2019, tan2008
 from simulator.reproduce.chan import short_complete_overrides as chan_short_complete
 from simulator.reproduce.chan import short_partial_overrides as chan_short_partial
 from simulator.reproduce.karamat2015 import protocol_overrides as karamat_overrides
+from tests.conftest import ci_and_slow
 
 REPO = Path(__file__).resolve().parents[1]
 SCENARIOS = sorted((REPO / "scenarios").glob("*.yaml"))
@@ -54,6 +58,16 @@ SHORTENED: dict[str, list[str]] = {
                           for i in (2, 4, 5, 7, 8, 9, 11, 13)],
 }
 
+# shorter still in the default run, where the papers' claim tests run these drives (with
+# --runslow as in SHORTENED): reproduce --quick's cuts, Karamat's first loop, Chan's first
+# straight and first double loop with their windows
+SHORTER_IN_CI: dict[str, list[str]] = {
+    "tan2008_outage": list(tan2008.OUTAGE.quick_overrides),
+    "park2019_underground_garage": list(park2019.SHORT),
+    "karamat2015_partial_outages": karamat_overrides(1),
+    "chan_partial_outages": chan_short_partial(1, windows=2),
+}
+
 # zones a (shortened) run must pass through: the library scenarios are what their comments say
 EXPECTED_ZONES: dict[str, set[str]] = {
     "highway_long": {"underpass", "tunnel"},
@@ -64,15 +78,22 @@ EXPECTED_ZONES: dict[str, set[str]] = {
 
 
 def test_shortened_scenarios_exist():
-    assert set(SHORTENED) <= {p.stem for p in SCENARIOS}
+    assert set(SHORTENED) | set(SHORTER_IN_CI) <= {p.stem for p in SCENARIOS}
     assert len(SCENARIOS) >= 15  # issue 16: at least 15 scenarios ship
 
 
-@pytest.mark.parametrize("path", SCENARIOS, ids=[p.stem for p in SCENARIOS])
-def test_shipped_scenario_runs(path, tmp_path):
+RUNS = [case for path in SCENARIOS for case in (
+    ci_and_slow(path.stem, (path, SHORTER_IN_CI[path.stem]),
+                (path, SHORTENED.get(path.stem, [])), f"{path.stem}-longer")
+    if path.stem in SHORTER_IN_CI
+    else [pytest.param(path, SHORTENED.get(path.stem, []), id=path.stem)])]
+
+
+@pytest.mark.parametrize(("path", "overrides"), RUNS)
+def test_shipped_scenario_runs(path, overrides, tmp_path):
     assert main(["validate", str(path)]) == 0
     out = tmp_path / "run"
-    sets = [arg for override in SHORTENED.get(path.stem, []) for arg in ("--set", override)]
+    sets = [arg for override in overrides for arg in ("--set", override)]
     assert main(["run", str(path), "-o", str(out), *sets]) == 0
     ds = open_dataset(out / "dataset")
     truth = ds.read("truth")

@@ -20,9 +20,13 @@ Tuning (``config: {tuning: datasheet | paper}``, ``estimators.builtin.cho2006_tu
 datasheet, R from each fix's HDOP, and adds what a consistent filter on a real car needs:
 accelerometer-bias states (DRM2's pitch and forward bias are one unobservable combination,
 eq. 11, so without the bias state its pitch claims the bias's accuracy), DRM2's pitch rate
-corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle, fixes
-weighted down beyond a 99.9 % chi-square gate, and, with an odometer, a zero-velocity update
-at each stop. The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
+corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle (in
+the position and, as w_z times it, in the speed's dynamics: ``drm2_transition``), DRM2's
+speed row as the fix's velocity along the heading (``_Drm2._fix_speed``: eq. 18's norm is
+rectified at a stop), fixes weighted down beyond a 99.9 % chi-square gate, and, with an
+odometer, a zero-velocity update at each stop (the DR running on until the stop is
+confirmed, since a wheel below its cut-off may still roll).
+The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
 ``auto`` (the default) is the paper's simplex set with the paper's tuning and the symmetric
 set with the datasheet's: the simplex set's non-zero third moments move unobservable states
 under eq. 33's 180 deg heading prior (docs/reproduction_cho2006.md), and with the datasheet's
@@ -108,13 +112,16 @@ from estimators.builtin.cho2006_tuning import (
     PAPER_R,
     TUNINGS,
     TURN_HOLD_S,
-    FixNoiseMatching,
     Tuning,
     datasheet_tuning,
     paper_tuning,
     stopped_speed_sigma,
 )
-from estimators.toolbox.gating import chi2_threshold, normalised_innovation_squared
+from estimators.toolbox.gating import (
+    FixNoiseMatching,
+    chi2_threshold,
+    normalised_innovation_squared,
+)
 from estimators.toolbox.kalman import predict as kf_predict
 from estimators.toolbox.kalman import update as kf_update
 from estimators.toolbox.ukf import SigmaPointFilter, angle_hooks, psd_sqrt
@@ -144,7 +151,10 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     ``u`` = [f_x (m/s^2), w_y, w_z (rad/s)], bias-compensated means over the step; ``w``
     (k, 8) is the noise of each point over one second, added in proportion dt / 1 s. The
     position moves with the mean of the step's old (eq. 24a-b) and new (eq. 5) velocity
-    vectors (the trapezoidal rule).
+    vectors (the trapezoidal rule). An IMU with the lateral velocity ``lat`` (u[3]) in a turn
+    senses f_x = dV/dt - w_z lat along its x axis (the body-frame acceleration dv/dt + w x v),
+    so its speed gains (1 - d_gz) w_z lat per second (at 60 deg/s with the IMU 1.7 m ahead
+    of the rear axle, 2 m/s^2 that eq. 24c, written for a point without side slip, leaves out).
     """
     pn, pe, v, th, psi, d_ax, d_gy, d_gz = x.T[:8]
     f_x, w_y, w_z = u[:3]
@@ -152,6 +162,8 @@ def drm2_transition(x: np.ndarray, w: np.ndarray | None, u: np.ndarray, dt: floa
     out = np.empty_like(x)
     f_h = (1.0 - d_ax) * f_x - (x[:, 8] if x.shape[1] > 8 else 0.0)  # eq. 14b (+ bias, eq. 9)
     v_new = v + (f_h - g * np.sin(th)) * np.cos(th) * dt  # eqs. 24c, 6
+    if lat:
+        v_new = v_new + (1.0 - d_gz) * w_z * lat * dt
     psi_new = psi + (1.0 - d_gz) * w_z * dt  # eq. 24e
     c0, s0, c1, s1 = np.cos(psi), np.sin(psi), np.cos(psi_new), np.sin(psi_new)
     out[:, 0] = pn + 0.5 * (v * c0 - lat * s0 + v_new * c1 - lat * s1) * dt  # eqs. 24a, 5
@@ -175,8 +187,12 @@ def drm2_jacobian(x: np.ndarray, u: np.ndarray, dt: float, g: float) -> np.ndarr
     st, ct = math.sin(th), math.cos(th)
     f_h = (1.0 - d_ax) * f_x - (x[8] if x.size > 8 else 0.0)
     v_new = v + (f_h - g * st) * ct * dt
+    if lat:
+        v_new += (1.0 - d_gz) * w_z * lat * dt
     psi_new = psi + (1.0 - d_gz) * w_z * dt
     phi = np.eye(x.size)
+    if lat:
+        phi[2, 7] = -w_z * lat * dt  # the IMU's lateral velocity in the turn (drm2_transition)
     # A_3 (eq. 17c) with SF_ax = 1 - d_ax (and the bias), and the scale-factor column
     phi[2, 3] = (g * st * st - f_h * st - g * ct * ct) * dt
     phi[2, 5] = -f_x * ct * dt
@@ -397,10 +413,16 @@ class _ChoDr(Estimator):
             else:
                 self._still_sum += u * dt
                 self._still_t += dt
-                if self._odo_stop and self._still_t >= MIN_STOP_S:
+                if not self._odo_stop:
+                    return
+                if self._still_t >= MIN_STOP_S:
                     self._zero_velocity(STOPPED_SIGMA_M_S)  # the wheel has stayed still
                     self._odo_stop = False
-                return
+                    return
+                # a wheel below its cut-off, the stop not yet confirmed: the car may still
+                # roll, so the DR goes on (held, its speed stayed where the wheel stopped
+                # reading: 0.28 +- 0.02 m/s two seconds into a SUMO stop the car had come
+                # down to 0.05 m/s)
         self._propagate(self._inputs(u - self._bias), dt)
 
     def _end_standstill(self) -> None:
@@ -452,13 +474,11 @@ class _ChoDr(Estimator):
                       (math.radians(lon) - self._lon0) * self._re * math.cos(self._lat0),
                       math.hypot(vn, ve)])  # eq. 18
         r = self._tuning.r(hdop, self._matching.scale)
-        if self._lateral:  # the speed's share of the lateral velocity (``Drm2._measure``)
-            r[2, 2] += (0.5 * self._lateral**2 / max(abs(float(self._estimate()[0][2])),
-                                                     MOVE_SPEED_M_S)) ** 2
         if not self._datasheet:
             self._update(z, r)
             return
         x, p = self._predicted()
+        z[2] = self._fix_speed(vn, ve, x)
         if p[4, 4] >= ALIGNED_HEADING_VAR:
             # the heading not yet found: the fixes weighted as eq. 35 weighs them, which lets the
             # 180 deg prior of eq. 33 converge (the sigma points span half a turn until then)
@@ -470,6 +490,11 @@ class _ChoDr(Estimator):
             r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
         self._update(z, r)
         self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
+
+    def _fix_speed(self, vn: float, ve: float, x: np.ndarray) -> float:
+        """The speed row of a fix with the datasheet tuning: eq. 18's norm of the fix's
+        velocity (DRM2 overrides it)."""
+        return math.hypot(vn, ve)
 
     # -- output ----------------------------------------------------------------------------
     @property
@@ -548,11 +573,21 @@ class _Drm2(_ChoDr):
         return drm2_jacobian(x, u, dt, self._g)
 
     def _measure(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """h(x) = [P_N, P_E, V] for states (k, n) and its (constant) Jacobian (eq. 16). With a
-        lateral velocity (datasheet tuning on a car) the GPS speed is sqrt(V^2 + lat^2), more
-        than V by lat^2 / (2 V): 0.08 m/s at 5 m/s in a 10 m turn, counted in R; the norm
-        itself would be blind to the sign of V and let the EKF settle on -V."""
+        """h(x) = [P_N, P_E, V] for states (k, n) and its (constant) Jacobian (eq. 16); with
+        the datasheet tuning the speed row is the fix's velocity along the heading
+        (``_fix_speed``), which keeps V's sign (the norm would let the EKF settle on -V)."""
         return x[:, :3], np.eye(3, x.shape[1])
+
+    def _fix_speed(self, vn: float, ve: float, x: np.ndarray) -> float:
+        """The speed row of a fix with the datasheet tuning: the fix's velocity along the
+        estimated heading, V + lat sin(dpsi) with the heading's error dpsi, unbiased with the
+        noise of one horizontal axis of the fix's velocity. Eq. 18's norm of it is rectified:
+        at a stop, with 1-sigma s per axis, its mean is s sqrt(pi / 2) (Rayleigh), 0.04 m/s at
+        s = 0.03, which held the SUMO city's stopped cars at 0.05 m/s under a sigma of
+        0.006 (east velocity (error / sigma)^2 50 over a 23 s stop); in a turn it exceeds V by
+        lat^2 / (2 V) of the IMU's lateral velocity lat."""
+        psi = float(x[4])
+        return vn * math.cos(psi) + ve * math.sin(psi)
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()

@@ -23,8 +23,8 @@ the paper's printed values, or values derived from what a user knows.
     (HDOP sigma_UERE)^2 / 2, sigma_UERE = sqrt(sis_error^2 + (MULTIPATH_ELEVATION_FACTOR
     multipath)^2) from the receiver's datasheet (signal in space and code multipath; the Hatch
     filter leaves the tracking noise a few centimetres), at least ``MIN_FIX_SIGMA_M``, raised
-    to the fixes' measured scatter by covariance matching (``FixNoiseMatching``: a street
-    canyon's reflected signals leave HDOP unchanged) and counted as correlated over
+    to the fixes' measured scatter by covariance matching (``gating.FixNoiseMatching``: a
+    street canyon's reflected signals leave HDOP unchanged) and counted as correlated over
     ``FIX_CORRELATION_S`` (``gnss_model.correlated_noise_inflation``; the signal-in-space and
     canyon errors hold for minutes, and a filter treating them as white believes the mean
     of its fixes to a fraction of their sigma); the speed's 1-sigma HDOP sigma_rate / sqrt(2)
@@ -52,7 +52,7 @@ the paper's printed values, or values derived from what a user knows.
 
 Public names
 ------------
-PAPER_P0, PAPER_Q, PAPER_R, TUNINGS, TURN_HOLD_S, Tuning, FixNoiseMatching, paper_tuning,
+PAPER_P0, PAPER_Q, PAPER_R, TUNINGS, TURN_HOLD_S, Tuning, paper_tuning,
 datasheet_tuning, stopped_speed_sigma.
 """
 
@@ -89,7 +89,6 @@ DRIVING_ACCEL_M_S2 = 0.1 * 9.80665  # a drive's rms acceleration, on the g-sensi
 MULTIPATH_ELEVATION_FACTOR = 2.0  # code multipath at 20-30 deg elevation / zenith (DO-229D J.2.4)
 FIX_CORRELATION_S = 30.0  # s: a fix's error counted as correlated over this (module docstring)
 FIX_INFLATION = correlated_noise_inflation(FIX_CORRELATION_S, 1.0)  # on a 1 Hz fix's sigma
-MATCHING_FIXES = 20.0  # fixes in the covariance-matching average (its e-folding length)
 MIN_FIX_SIGMA_M = 0.1  # the smallest fix 1-sigma per axis believed
 RATE_SIGMA_M_S = 0.04  # pseudorange-rate noise at 40 dB-Hz, 2 Hz FLL (Kaplan & Hegarty eq. 8.37)
 MIN_SPEED_SIGMA_M_S = 0.01
@@ -145,29 +144,6 @@ class Tuning:
         pos = self.white_position_var(hdop) * scale * FIX_INFLATION**2
         speed = max(hdop * self.speed_sigma_m_s / math.sqrt(2.0), MIN_SPEED_SIGMA_M_S)
         return np.diag([pos, pos, speed**2])
-
-
-class FixNoiseMatching:
-    """Covariance matching of the fixes' position noise (Mehra 1972; Mohamed & Schwarz 1999,
-    "Adaptive Kalman filtering for INS/GPS", J. Geodesy 73): the fix's real variance per axis
-    is estimated as the running mean of nu^2 - (H P H^T) over the position rows (innovation
-    nu, predicted covariance H P H^T), and the HDOP-based variance is scaled up to it
-    (never down). A street canyon's reflected signals leave HDOP unchanged while the fixes
-    move by metres: without this the filter believes them to a metre."""
-
-    def __init__(self) -> None:
-        self.scale = 1.0
-        self._excess = 0.0  # running mean of the ratio (nu^2 - HPH^T) / R, per axis
-        self._weight = 0.0
-
-    def add(self, nu: np.ndarray, hph: np.ndarray, white_var: float) -> None:
-        """Learn from one fix's position rows: innovations ``nu`` (2,), the predicted
-        covariance ``hph`` (2, 2) and the fix's HDOP variance per axis ``white_var``
-        (``Tuning.white_position_var``)."""
-        ratio = float(np.mean(nu**2 - np.diag(hph))) / white_var
-        self._weight = min(self._weight + 1.0, MATCHING_FIXES)
-        self._excess += (ratio - self._excess) / self._weight
-        self.scale = max(1.0, self._excess)
 
 
 def paper_tuning(model: str) -> Tuning:

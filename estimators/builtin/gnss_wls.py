@@ -43,12 +43,10 @@ its C/N0 falls well below what a direct signal has at its elevation. The receive
 (``simulator.datasheet.cn0_template``: the nominal C/N0 against elevation, and the scatter s
 of a direct signal's C/N0 about it from fading and estimation noise) gives each signal's
 deficit D; its variance becomes sigma^2 + p(D) sigma_NLOS^2, p the probability that it is
-reflected by Bayes' rule: a direct signal's deficit N(0, s^2), a reflection's N(11 dB,
-(4.5 dB)^2) (the reflections of ``scenarios/urban_canyon.yaml``, seed 1: 4-18 dB, 5-95 %, the
-facade and depolarisation losses of ``simulator.environment.sky``), and as prior the share of
-the epoch's signals whose deficit is over 3 s (which no direct signal reaches but once in 700),
-at least 1 %: in a street whose reflections show, a signal of moderate deficit is likely one
-too; on open sky a faded direct signal keeps its weight. sigma_NLOS is the ``nlos_sigma``
+reflected by Bayes' rule (``simulator.datasheet.nlos_probability``, the receiver's own fix
+accuracy reads it too: a direct signal's deficit N(0, s^2), a reflection's N(11 dB,
+(4.5 dB)^2), and as prior the share of the epoch's signals whose deficit is over 3 s, at
+least 1 %). sigma_NLOS is the ``nlos_sigma``
 config key (20 m: the extra path of a reflection off the facade across a 20-35 m street).
 This is the elevation- and C/N0-dependent weighting of Groves 2013
 (chapter 9: a measurement's weight from its C/N0 and elevation; chapter 10: NLOS reception and
@@ -68,7 +66,7 @@ tracked), ``clock_drift`` the drift (m/s).
 
 Public names
 ------------
-GnssWls, nlos_probability, nlos_sigma.
+GnssWls, nlos_sigma (and ``nlos_probability`` from ``simulator.datasheet``).
 """
 
 from __future__ import annotations
@@ -76,12 +74,17 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.stats import chi2, norm
+from scipy.stats import chi2
 from scipy.stats import t as student_t
 
 from estimators.base import Estimator
 from estimators.toolbox.gnss_model import predict, raw_epoch
-from simulator.datasheet import Cn0Template, cn0_template, iono_residual_fractions
+from simulator.datasheet import (
+    Cn0Template,
+    cn0_template,
+    iono_residual_fractions,
+    nlos_probability,
+)
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 
 C_N0_FLOOR_M = 0.5      # a: the sigma of a strong signal, m
@@ -91,11 +94,6 @@ ITERATIONS = 8
 BAND_HZ = 50e6  # carriers within 25 MHz share a band: L1/E1/G1 (FDMA) apart from B1I, L5/E5a
 CONVERGED_M = 1e-4
 FDE_FALSE_ALARM = 1e-3  # false-alarm probability of the residual test
-# a reflected signal's C/N0 deficit below the direct-signal template, dB: mean and 1-sigma
-NLOS_DEFICIT_MEAN_DB = 11.0
-NLOS_DEFICIT_SIGMA_DB = 4.5
-CLEAR_NLOS_SIGMAS = 3.0  # a deficit over this many direct-signal scatters: clearly reflected
-OPEN_SKY_NLOS_SHARE = 0.01  # the prior share of reflections in an epoch with none clear
 
 OUTPUT_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                   "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd",
@@ -246,24 +244,6 @@ def _sigma(reported: np.ndarray, cn0: np.ndarray | None, floor: float) -> np.nda
         cn0 = np.where(np.isfinite(cn0), cn0, DEFAULT_CN0_DBHZ)
         model = np.sqrt(C_N0_FLOOR_M**2 + C_N0_SCALE_M**2 * 10.0 ** (-cn0 / 10.0))
     return np.where(np.isfinite(reported) & (reported > 0), reported, model)
-
-
-def nlos_probability(deficit_db: np.ndarray, scatter_db: float) -> np.ndarray:
-    """The probability that each signal of an epoch is reflected (NLOS) given its C/N0
-    ``deficit_db`` below the direct-signal template (module docstring): Bayes' rule with a
-    direct signal's deficit N(0, ``scatter_db``^2), a reflection's N(``NLOS_DEFICIT_MEAN_DB``,
-    ``NLOS_DEFICIT_SIGMA_DB``^2), and the epoch's prior share of reflections: the share of its
-    signals whose deficit no direct signal reaches (over ``CLEAR_NLOS_SIGMAS`` scatters), at
-    least ``OPEN_SKY_NLOS_SHARE``; 0 where the deficit is not finite."""
-    deficit = np.asarray(deficit_db, dtype=float)
-    finite = np.isfinite(deficit)
-    d = np.where(finite, deficit, 0.0)
-    scatter = max(scatter_db, 0.1)
-    clear = np.count_nonzero(d[finite] > CLEAR_NLOS_SIGMAS * scatter)
-    prior = max(clear / max(np.count_nonzero(finite), 1), OPEN_SKY_NLOS_SHARE)
-    direct = (1.0 - prior) * norm.pdf(d, 0.0, scatter)
-    reflected = prior * norm.pdf(d, NLOS_DEFICIT_MEAN_DB, NLOS_DEFICIT_SIGMA_DB)
-    return np.where(finite, reflected / np.maximum(direct + reflected, 1e-300), 0.0)
 
 
 def nlos_sigma(sigma: np.ndarray, cn0: np.ndarray, elevation: np.ndarray,

@@ -52,13 +52,23 @@ Velocity: the paper's error model treats the velocities as states driven by eqs.
 heading then diverged in the first sharp turn of every drive we tried (the filter explains the
 persistent innovation with a huge azimuth correction). So the direction of the horizontal
 velocity is propagated as eqs. 22 and 26 do (turned by dA/dt each step, corrected by the
-filter) and its magnitude is the odometer's, v_o cos p (eqs. 4-5); v_u is eq. 6. Integrating
+filter) and its magnitude is the odometer's, v_o cos p (eqs. 4-5); v_u is eq. 6, so its error
+after each step is eq. 6's, dv_u = sin p dv_o + v_o cos p dp, in the speed-error and
+pitch-error states (enhanced model; eq. 31 is this relation's derivative without the pitch
+term): carried as an independent state, each Doppler correction of v_u was thrown away by
+eq. 6 at the next step but kept in the covariance, and the same innovation then pulled the
+height through the v_u-h correlation at every epoch (4 m/s of height drift with three
+satellites while the mechanised v_u was within 0.2 m/s of the truth). Integrating
 eqs. 22/26 fully instead lets the a_od corrections accumulate into a speed error no measurement
 anchors (1 m/s in a 60 s one-satellite window). The azimuth state is observed only through the
 acceleration terms of eqs. 24/28 and the gyro bias and drifted up to 17 deg from the direction
 of travel, so the direction of travel (the horizontal velocity's, against it while reversing)
 gives F's sin A, cos A and the reported yaw above 1 m/s. A wheel at a standstill reads zero
-whatever its scale error, so the speed is exactly zero while the odometer reads zero. The
+whatever its scale error, so the speed is exactly zero while the odometer reads zero. After a
+stop the velocity starts along the last direction of travel turned by the azimuth state since
+(along the azimuth state alone, which drifts from it, a restart turned the heading by tens of
+degrees), and a signed speed below zero (reversing) scales the body's forward axis, not the
+last velocity, which already points backwards. The
 odometer's own speed noise (``odometer_speed_noise``) is in the mechanised velocity the rates
 are predicted from, so it enters the Doppler rows' R through the forward axis.
 
@@ -89,9 +99,12 @@ The Gauss-Markov parameters are images lost from our copy of the paper; chosen h
 IMU300CC values of its Table 1 (``GM_PARAMETERS``; docs/reproduction_karamat2015.md). That is
 ``tuning: paper``, which the reproduction (``simulator/reproduce/karamat2015.py``) names so that
 its figures do not move. ``tuning: datasheet`` (the default) takes what a user knows of the
-dataset's sensors (``toolbox.sensor_datasheet``): the gyro and accelerometer bias priors are
-their turn-on biases (the accelerometers' with scale factor and misalignment under 1 g), the
-biases' Gauss-Markov driving noise the datasheet's bias walk, the azimuth's white noise the
+dataset's sensors (``toolbox.sensor_datasheet``): the gyro and accelerometer biases are random
+constants with their turn-on biases as prior (the accelerometers' with scale factor and
+misalignment under 1 g) plus the datasheet's bias walk (a Gauss-Markov bias of 1 h pulled
+the estimate towards zero while its variance shrank), a zero-rate update while the wheels
+stand still (``zero_rate_update``: the gyro's mean rate is its bias plus the Earth rate's up
+component, with the gyro's white noise; not in the paper), the azimuth's white noise the
 gyro's noise density plus its scale factor and misalignment times the turn rate over
 ``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
 correlated-noise inflation of the receiver's carrier smoothing
@@ -339,6 +352,9 @@ class RissTcEkf(Estimator):
         # F's rows of the frozen states are zeroed: eq. 32 (dv_o' = da_od) would otherwise pass
         # the a_od uncertainty into a frozen speed error, which the updates then correct
         self._frozen = np.array([_I[name] for name in frozen if _I[name] < self._n], dtype=int)
+        # dv_u in the pitch and speed errors (eq. 6 linearised) needs one of them; without
+        # either (the earlier model, or both frozen) it is eq. 31's integrating state
+        self._vu_eq6 = self._enhanced and not {"p", "vo"} <= set(frozen)
         init = self.initial
         self._lat, self._lon, self._h = (float(v) for v in init.position)
         vn0, ve0, vd0 = (float(v) for v in init.velocity)
@@ -616,7 +632,7 @@ class RissTcEkf(Estimator):
         if self._sf_psd:
             q_d = q_d.copy()
             q_d[_I["A"], _I["A"]] += self._sf_psd * wz_c**2 * dt
-        if self._enhanced:
+        if self._vu_eq6:
             phi, q_d = self._vertical_velocity_is_eq6(phi, q_d, dt)
         self._filter.predict(phi, q_d)
 

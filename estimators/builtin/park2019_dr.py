@@ -96,7 +96,12 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   1 s; the g-slave's variance adds the odometer acceleration's noise (two speeds of the
   datasheet's noise 0.5 s apart) and the tyres' slip turned by the yaw rate; the gyro scale
   factor is bias process noise (a helix turns it into yaw); each fix row passes a chi-square
-  gate (0.999) against reflected canyon heights.
+  gate (0.999) against reflected canyon heights. Both filters read the fix's own accuracy
+  (``std_*`` of ``gnss_fix``, ``toolbox.datasheet.FixAccuracy``): its velocity 1-sigma sets the
+  speed's and the course's noise, and its position 1-sigma beyond the budget (the reflected
+  signals of a street canyon) is carried by unit NLOS states (north, east and, in 3-D, down;
+  ``FixErrorModel.nlos_split``): on the SUMO canyon's seeds 1-2 dr3d_ekf's height went from
+  11 / 27 to 1.0 / 2.3 and dr2d_odo_ekf's north from 10 / 2.5 to 0.7 / 1.1.
 
 Public names
 ------------
@@ -113,7 +118,14 @@ from numba import njit
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.toolbox.aiding import barometric_height, gnss_position, heading
 from estimators.toolbox.constraints import NonholonomicNoise
-from estimators.toolbox.datasheet import fix_error_model, imu_error_model, odometer_speed_sigma
+from estimators.toolbox.datasheet import (
+    NLOS_TIME_CONSTANT_S,
+    FixAccuracy,
+    fix_error_model,
+    ground_track_sigma,
+    imu_error_model,
+    odometer_speed_sigma,
+)
 from estimators.toolbox.gating import rows_passing, threshold_variance
 from estimators.toolbox.gauss_markov import gauss_markov_continuous
 from estimators.toolbox.installation import Installation
@@ -133,11 +145,12 @@ _LEVEL = np.array([1.0, 0.0, 0.0, 0.0])  # identity quaternion
 TUNINGS = ("datasheet", "paper")
 G0 = 9.80665  # m/s^2
 # dr3d_ekf's states added by the datasheet tuning after Park's ten: the accelerometers' roll and
-# pitch error, the barometer's offset error, the fix's correlated north, east, down error
-# pitch and the body's pitch on its springs per forward acceleration (the velocity's angle below
-# the body x axis per m/s^2, a random constant)
-TILT, BARO, FIX, SQUAT = slice(10, 12), 12, slice(13, 16), 16
-N_DR3D_SHEET = 17
+# pitch error, the barometer's offset error, the fix's correlated north, east, down error,
+# the body's pitch on its springs per forward acceleration (the velocity's angle below the body
+# x axis per m/s^2, a random constant), and the reflected fixes' north, east, down error in
+# units of the fix's reported excess (``toolbox.datasheet``)
+TILT, BARO, FIX, SQUAT, NLOS = slice(10, 12), 12, slice(13, 16), 16, slice(17, 20)
+N_DR3D_SHEET = 20
 GATE_PROBABILITY = 0.999  # the fixes' chi-square gate with the datasheet tuning
 SLIP_TIME_S = 1.0  # correlation time of the tyres' unmodelled slip velocity (a turn's length)
 METRES_PER_PASCAL = 0.0833  # height per pascal near sea level (standard atmosphere), m/Pa
@@ -244,6 +257,16 @@ class _FixColumns:
         self.lat, self.lon, self.alt = columns["lat"], columns["lon"], columns["alt"]
         self.speed, self.course = columns["speed"], columns["course"]
         self.fix, self.hdop, self.vdop = columns["fix"], columns["hdop"], columns["vdop"]
+        self.vn, self.ve = columns["vn"], columns["ve"]
+        self.accuracy = FixAccuracy(columns)
+
+    def reported(self, row: np.ndarray) -> tuple[np.ndarray, float, float]:
+        """A fix row's own position 1-sigma (NED, m), ground-speed 1-sigma (m/s) and course
+        1-sigma times its speed (m/s, across the track); NaN where it reports none."""
+        std_pos, std_vel = self.accuracy.read(row)
+        vn, ve = float(row[self.vn]), float(row[self.ve])
+        speed_sigma, course_sigma = ground_track_sigma(vn, ve, std_vel[0], std_vel[1])
+        return std_pos, speed_sigma, course_sigma * math.hypot(vn, ve)
 
 
 class _StepAccumulator:
@@ -412,6 +435,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._tilt_bias = np.zeros(2)  # accelerometer tilt error estimate (roll, pitch), rad
         self._baro_bias = 0.0  # barometer offset error estimate, m
         self._fix_error = np.zeros(3)  # the fix's correlated error estimate, NED m
+        self._nlos = np.zeros(3)  # the reflected fixes' error estimate, units of the excess
         self._dop_known = False
         if self._sheet:
             p0 = self._datasheet_states(p0)
@@ -438,6 +462,8 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._f[TILT, TILT] = -1.0 / self._imu_model.accel_bias_tau
             self._q_c[BARO] = self._baro_rate_sigma**2 * BARO_RATE_TIME_S
             self._f[FIX, FIX] = -1.0 / self._fix_model.correlated_tau
+            self._f[NLOS, NLOS] = -np.eye(3) / NLOS_TIME_CONSTANT_S
+            self._q_c[NLOS] = 2.0 / NLOS_TIME_CONSTANT_S
 
     def _datasheet_states(self, p0: np.ndarray) -> np.ndarray:
         """``tuning: datasheet`` (class docstring): the gyro noise, in-run and turn-on bias of
@@ -468,6 +494,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
                              / ACCEL_WINDOW_S)
         self._rate_prev = np.zeros(3)
         p[SQUAT, SQUAT] = self._car.pitch_compliance**2 if site.rear_axle is not None else 0.0
+        p[NLOS, NLOS] = np.eye(3)  # unit states (their gain is the fix's excess)
         return p
 
     # -- messages ---------------------------------------------------------------------------
@@ -502,7 +529,11 @@ class Dr3dEkf(_OdometerDeadReckoning):
                 self._dop_known = True
             dz += self._fix_error
             h_pos[:, FIX] = np.eye(3)
-            var = list(self._fix_model.white_sigma(*dops)[:n] ** 2)
+            std_pos, speed_sigma, cross_sigma = fx.reported(row)
+            gain, white = self._fix_model.nlos_split(std_pos, *dops)
+            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:n])
+            dz += gain * self._nlos
+            h_pos[:, NLOS] = np.diag(gain)
         keep = np.arange(n)
         if self._sheet:  # a reflected fix's metres the receiver does not announce: each row
             # behind a chi-square gate (one degree of freedom, GATE_PROBABILITY)
@@ -522,8 +553,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
             h[4:7] = -abs(speed) * math.sin(pitch) * jac[1]
             rows.append(h[None])
             dzs.append([abs(speed) * math.cos(pitch) - row[fx.speed]])
-            if self._sheet:
-                var.append(self._fix_model.velocity_sigma(*dops)[0] ** 2)
+            if self._sheet:  # the fix's own speed accuracy, else the datasheet's at its DOPs
+                var.append((speed_sigma if math.isfinite(speed_sigma)
+                            else self._fix_model.velocity_sigma(*dops)[0]) ** 2)
             else:
                 var.append(c["gps_speed_sigma_inflated" if slow else "gps_speed_sigma"] ** 2)
         if speed > c["course_min_speed"] and math.isfinite(row[fx.course]):
@@ -537,8 +569,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
                 h[0, 9] = -self._rear_lever * v_b[0] / (v_b[0] ** 2 + v_b[1] ** 2)
                 lateral = self._car.sigma(v_b[0], v_b[1] / self._rear_lever
                                           if self._rear_lever else 0.0, 0.0)[0]
-                var.append((self._fix_model.velocity_sigma(*dops)[0] ** 2 + lateral**2)
-                           / (v_b[0] ** 2 + v_b[1] ** 2))
+                across = (cross_sigma if math.isfinite(cross_sigma)
+                          else self._fix_model.velocity_sigma(*dops)[0])
+                var.append((across**2 + lateral**2) / (v_b[0] ** 2 + v_b[1] ** 2))
             else:
                 var.append(c["gps_course_sigma_inflated" if slow else "gps_course_sigma"] ** 2)
             dz_c, h_c = heading(self._q, course, n_states=9)
@@ -586,6 +619,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._q, self._cbn, self._pos, self._v_ned, dtheta, v_body, self._u, dt, self._f)
         q_d = np.diag(self._q_c * dt)
         if self._sheet:
+            self._nlos *= math.exp(-dt / NLOS_TIME_CONSTANT_S)  # its Gauss-Markov mean
             self._body_error_model(c_mid, rate, q_d, dt)
             # the gyro scale-factor error moves the bias by s d(rate) (toolbox.datasheet)
             q_d[7:10, 7:10] += np.diag((self._imu_model.gyro_scale_sigma
@@ -721,6 +755,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._baro_bias -= dx[BARO]
             self._fix_error -= dx[FIX]
             self._squat -= dx[SQUAT]
+            self._nlos -= dx[NLOS]
 
     def solution(self, t: float) -> list[float]:
         p = self._kf.p
@@ -769,9 +804,10 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
         self._fix_error = np.zeros(2)  # the fix's correlated north, east error (datasheet), m
+        self._nlos = np.zeros(2)  # the reflected fixes' error, units of the fix's excess
         self._dop_known = False
         self._take_inputs()
-        n = 7 if self._sheet else 5
+        n = 9 if self._sheet else 5
         gyro_noise, bias_sigma, bias_tau, bias_initial = (
             c["gyro_noise_density"], c["gyro_bias_sigma"], c["gyro_bias_time_constant"],
             c["gyro_bias_initial"])
@@ -793,6 +829,10 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
             p0[5:7, 5:7] = np.diag(sigma**2)
             self._f[5:7, 5:7] = np.eye(2) * (-1.0 / self._fix_model.correlated_tau)
             self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
+            # the reflected fixes' north, east error: unit states, their gain the fix's excess
+            p0[7:9, 7:9] = np.eye(2)
+            self._f[7:9, 7:9] = -np.eye(2) / NLOS_TIME_CONSTANT_S
+            self._q_c[7:9] = 2.0 / NLOS_TIME_CONSTANT_S
         self._kf = ErrorState(p0)
         # Gauss-Markov speed error and z-gyro bias
         f_gm, q_gm = gauss_markov_continuous([c["speed_error_time_constant"], bias_tau],
@@ -831,6 +871,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         if self._sheet:  # the scale-factor error moves the bias by s d(rate) (toolbox.datasheet)
             q_d[4, 4] += (self._gyro_scale * (rate - self._rate)) ** 2
             self._rate = rate
+            self._nlos *= math.exp(-dt / NLOS_TIME_CONSTANT_S)  # its Gauss-Markov mean
         self._kf.predict(self._eye + f * dt, q_d)
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
@@ -860,8 +901,13 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
                 self._dop_known = True
             dz = dz + self._fix_error
             h[:, 5:7] = np.eye(2)
-            var = list(self._fix_model.white_sigma(*dops)[:2] ** 2)
-            speed_var = self._fix_model.velocity_sigma(*dops)[0] ** 2
+            std_pos, speed_sigma, _ = fx.reported(row)
+            gain, white = self._fix_model.nlos_split(std_pos, *dops)
+            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:2])
+            dz = dz + gain[:2] * self._nlos
+            h[:, 7:9] = np.diag(gain[:2])
+            speed_var = (speed_sigma if math.isfinite(speed_sigma)
+                         else self._fix_model.velocity_sigma(*dops)[0]) ** 2
         if self._u != 0.0 and math.isfinite(row[fx.speed]):
             dz = np.r_[dz, abs(self._speed()) - row[fx.speed]]
             h = np.vstack([h, np.eye(n)[2]])
@@ -876,6 +922,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._bias -= dx[4]
         if self._sheet:
             self._fix_error -= dx[5:7]
+            self._nlos -= dx[7:9]
 
     def solution(self, t: float) -> list[float]:
         v = self._speed()

@@ -588,7 +588,7 @@ class RtkInsEkf(Estimator):
         self._phase_rows = None
         for _ in range(2):
             dz_c, h_c, r_c, dz_p, h_p, r_p, sig, refs = self._rows(rover, base, slots)
-            s_p = np.einsum("ij,jk,ik->i", h_p, ins.kf.p, h_p) + np.diag(r_p)
+            s_p = np.einsum("ij,ij->i", h_p @ ins.kf.p, h_p) + np.diag(r_p)
             lam = rover.wavelength[sig]
             bad = ((np.abs(dz_p) > self.config["slip_sigmas"] * np.sqrt(s_p))
                    & (np.abs(dz_p) > self.config["slip_cycles"] * lam))
@@ -605,7 +605,7 @@ class RtkInsEkf(Estimator):
                     self._release(key)
                     slots[i] = -1
             slots = self._reassign(rover, base, slots)
-        s_c = np.einsum("ij,jk,ik->i", h_c, ins.kf.p, h_c) + np.diag(r_c)
+        s_c = np.einsum("ij,ij->i", h_c @ ins.kf.p, h_c) + np.diag(r_c)
         keep = gating.rows_passing(dz_c, s_c, float(self.config["gate_probability"]))
         if not self.config["held_code"] and self._all_held(rover, sig, refs):
             keep[:] = False

@@ -35,24 +35,78 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 from scipy.special import erf
 
 
-def _ltdl(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``Q = L^T diag(d) L`` with L unit lower triangular, factorised from the last row up
-    (Chang et al. 2005, eq. 3; de Jonge & Tiberius 1996, section 3.3)."""
-    a = np.array(q, dtype=float, copy=True)
+@njit(cache=True)
+def _ltdl_kernel(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """``Q = L^T diag(d) L`` (``_ltdl``); the flag is False when Q is not positive definite."""
+    a = q.copy()
     n = a.shape[0]
     low = np.zeros((n, n))
     d = np.zeros(n)
     for i in range(n - 1, -1, -1):
         d[i] = a[i, i]
         if not d[i] > 0.0:
-            raise np.linalg.LinAlgError("ambiguity covariance is not positive definite")
-        row = a[i, : i + 1] / np.sqrt(d[i])
-        a[:i, :i] -= np.outer(row[:i], row[:i])
-        low[i, : i + 1] = row / row[i]
+            return low, d, False
+        root = np.sqrt(d[i])
+        row = a[i, : i + 1] / root
+        for r in range(i):
+            for c in range(i):
+                a[r, c] -= row[r] * row[c]
+        for c in range(i + 1):
+            low[i, c] = row[c] / row[i]
+    return low, d, True
+
+
+def _ltdl(q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``Q = L^T diag(d) L`` with L unit lower triangular, factorised from the last row up
+    (Chang et al. 2005, eq. 3; de Jonge & Tiberius 1996, section 3.3)."""
+    low, d, positive = _ltdl_kernel(np.ascontiguousarray(q, dtype=float))
+    if not positive:
+        raise np.linalg.LinAlgError("ambiguity covariance is not positive definite")
     return low, d
+
+
+@njit(cache=True)
+def _reduce(low: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """The integer Gauss transformations and permutations of ``decorrelate`` on its factors
+    (updated in place); returns Z."""
+    n = d.size
+    z = np.eye(n)
+    j = n - 2
+    k = n - 2
+    while j >= 0:
+        if j <= k:
+            for i in range(j + 1, n):
+                mu = np.rint(low[i, j])
+                if mu != 0.0:  # integer Gauss transformation, Chang et al. eq. 9
+                    for r in range(i, n):
+                        low[r, j] -= mu * low[r, i]
+                    for r in range(n):
+                        z[r, j] -= mu * z[r, i]
+        delta = d[j] + low[j + 1, j] ** 2 * d[j + 1]
+        if delta + 1e-6 < d[j + 1]:  # permutation of j and j+1, Chang et al. eqs. 11-14
+            eta = d[j] / delta
+            lam = d[j + 1] * low[j + 1, j] / delta
+            d[j] = eta * d[j + 1]
+            d[j + 1] = delta
+            for c in range(j):
+                upper = low[j, c]
+                lower = low[j + 1, c]
+                low[j, c] = -low[j + 1, j] * upper + lower
+                low[j + 1, c] = eta * upper + lam * lower
+            low[j + 1, j] = lam
+            for r in range(j + 2, n):
+                low[r, j], low[r, j + 1] = low[r, j + 1], low[r, j]
+            for r in range(n):
+                z[r, j], z[r, j + 1] = z[r, j + 1], z[r, j]
+            k = j
+            j = n - 2
+        else:
+            j -= 1
+    return z
 
 
 def decorrelate(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -69,48 +123,14 @@ def decorrelate(q: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         decorrelated covariance, ``z.T @ q @ z = low.T @ diag(d) @ low``.
     """
     low, d = _ltdl(q)
-    n = d.size
-    z = np.eye(n)
-    j = n - 2
-    k = n - 2
-    while j >= 0:
-        if j <= k:
-            for i in range(j + 1, n):
-                mu = np.round(low[i, j])
-                if mu != 0.0:  # integer Gauss transformation, Chang et al. eq. 9
-                    low[i:, j] -= mu * low[i:, i]
-                    z[:, j] -= mu * z[:, i]
-        delta = d[j] + low[j + 1, j] ** 2 * d[j + 1]
-        if delta + 1e-6 < d[j + 1]:  # permutation of j and j+1, Chang et al. eqs. 11-14
-            eta = d[j] / delta
-            lam = d[j + 1] * low[j + 1, j] / delta
-            d[j] = eta * d[j + 1]
-            d[j + 1] = delta
-            upper = low[j, :j].copy()
-            lower = low[j + 1, :j].copy()
-            low[j, :j] = -low[j + 1, j] * upper + lower
-            low[j + 1, :j] = eta * upper + lam * lower
-            low[j + 1, j] = lam
-            low[j + 2 :, [j, j + 1]] = low[j + 2 :, [j + 1, j]]
-            z[:, [j, j + 1]] = z[:, [j + 1, j]]
-            k = j
-            j = n - 2
-        else:
-            j -= 1
+    z = _reduce(low, d)
     return z, low, d
 
 
-def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
-           candidates: int = 2) -> tuple[np.ndarray, np.ndarray]:
-    """The ``candidates`` integer vectors nearest to ``z_float`` in the metric
-    ``(z_float - z)^T (low^T diag(d) low)^-1 (z_float - z)`` (Chang et al. 2005, Algorithm SEARCH).
-
-    Returns
-    -------
-    z_int : (candidates, n) integer vectors, best first; norms : (candidates,) their squared
-        distances, increasing. With fewer lattice points than asked (impossible in practice),
-        the missing rows are NaN.
-    """
+@njit(cache=True)
+def _search_kernel(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
+                   candidates: int) -> tuple[np.ndarray, np.ndarray]:
+    """``search`` (Chang et al. 2005, Algorithm SEARCH), unsorted."""
     n = d.size
     best = np.full((candidates, n), np.nan)
     norms = np.full(candidates, np.inf)
@@ -124,7 +144,7 @@ def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
     s = np.zeros((n, n))    # s[k, :k+1]: accumulated corrections of levels above k
     k = n - 1
     cond[k] = z_float[k]
-    z[k] = np.round(cond[k])
+    z[k] = np.rint(cond[k])
     y = cond[k] - z[k]
     step[k] = 1.0 if y > 0.0 else -1.0
     while True:
@@ -133,9 +153,10 @@ def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
             if k != 0:
                 k -= 1
                 dist[k] = new_dist
-                s[k, : k + 1] = s[k + 1, : k + 1] + (z[k + 1] - cond[k + 1]) * low[k + 1, : k + 1]
+                for c in range(k + 1):
+                    s[k, c] = s[k + 1, c] + (z[k + 1] - cond[k + 1]) * low[k + 1, c]
                 cond[k] = z_float[k] + s[k, k]
-                z[k] = np.round(cond[k])
+                z[k] = np.rint(cond[k])
                 y = cond[k] - z[k]
                 step[k] = 1.0 if y > 0.0 else -1.0
             else:
@@ -150,7 +171,7 @@ def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
                 else:
                     best[worst] = z
                     norms[worst] = new_dist
-                    worst = int(np.argmax(norms))
+                    worst = np.argmax(norms)
                     max_dist = norms[worst]
                 z[0] += step[0]
                 y = cond[0] - z[0]
@@ -162,6 +183,23 @@ def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
             z[k] += step[k]
             y = cond[k] - z[k]
             step[k] = -step[k] - np.sign(step[k])
+    return best, norms
+
+
+def search(z_float: np.ndarray, low: np.ndarray, d: np.ndarray,
+           candidates: int = 2) -> tuple[np.ndarray, np.ndarray]:
+    """The ``candidates`` integer vectors nearest to ``z_float`` in the metric
+    ``(z_float - z)^T (low^T diag(d) low)^-1 (z_float - z)`` (Chang et al. 2005, Algorithm SEARCH).
+
+    Returns
+    -------
+    z_int : (candidates, n) integer vectors, best first; norms : (candidates,) their squared
+        distances, increasing. With fewer lattice points than asked (impossible in practice),
+        the missing rows are NaN.
+    """
+    best, norms = _search_kernel(np.ascontiguousarray(z_float, dtype=float),
+                                 np.ascontiguousarray(low, dtype=float),
+                                 np.ascontiguousarray(d, dtype=float), int(candidates))
     order = np.argsort(norms)
     return best[order], norms[order]
 
@@ -199,8 +237,12 @@ def ratio(norms: np.ndarray) -> float:
 def bootstrap_success_rate(d: np.ndarray) -> float:
     """Integer bootstrapping success rate from the conditional variances of a decorrelated
     problem (Teunissen 1998, eq. 14); a lower bound of the ILS success rate."""
-    d = np.asarray(d, dtype=float)
-    return float(np.prod(erf(1.0 / (2.0 * np.sqrt(2.0 * d)))))
+    return float(np.prod(_bootstrap_factors(d)))
+
+
+def _bootstrap_factors(d: np.ndarray) -> np.ndarray:
+    """Each conditional variance's factor of ``bootstrap_success_rate``."""
+    return erf(1.0 / (2.0 * np.sqrt(2.0 * np.asarray(d, dtype=float))))
 
 
 @dataclass(frozen=True)
@@ -243,9 +285,10 @@ def resolve(a_float: np.ndarray, q: np.ndarray, ratio_threshold: float = 3.0,
     z_float_all = z.T @ (a_float - shift)
     q_z = z.T @ q @ z
     last_ratio = 0.0
+    factors = _bootstrap_factors(d)
     for start in range(n - min_fixed + 1 if n >= min_fixed else 0):
         sub = slice(start, n)
-        rate = bootstrap_success_rate(d[sub])
+        rate = float(np.prod(factors[sub]))
         if rate < min_success_rate:
             continue
         low_s, d_s = _ltdl(q_z[sub, sub])
@@ -263,5 +306,4 @@ def resolve(a_float: np.ndarray, q: np.ndarray, ratio_threshold: float = 3.0,
             q_fixed = np.zeros_like(q)
         return Resolution(True, a_fixed, 0.5 * (q_fixed + q_fixed.T), n - start, last_ratio,
                           rate)
-    return Resolution(False, a_float.copy(), q.copy(), 0, last_ratio,
-                      bootstrap_success_rate(d))
+    return Resolution(False, a_float.copy(), q.copy(), 0, last_ratio, float(np.prod(factors)))

@@ -28,6 +28,24 @@ that tunes itself "from the datasheet" means the same thing.
     2 sigma^2 T).
   - velocity: 0.05 m/s per range rate (u-blox NEO-M8 data sheet; the ``automotive`` FLL's
     0.024-0.08 m/s at 45-35 dB-Hz, docs/gnss-errors.md) times the DOP.
+  - what the fix itself reports (``FixAccuracy``: its ``std_*`` columns, a receiver's own
+    accuracy, ``simulator.gnss.fix``): its velocity 1-sigma replaces the datasheet's; its
+    position 1-sigma beyond the budget's (``FixErrorModel.excess_sigma``: the variance over
+    the correlated and smoothed parts at the DOPs) is error the budget does not hold, the
+    reflected (NLOS) signals of a street canyon. That excess is not white: a reflection's extra
+    path lasts while the street's geometry does (the fixes of the simulated canyons, their
+    error over the excess: the height's stays near -1.2 for minutes, the horizontal's
+    correlation is 0.2-0.6 after 20 s and 0.0-0.4 after 40 s, seeds 1-5 of canyon,
+    urban_canyon and sumo_city_canyon), so a filter carries it as states: a unit-variance
+    first-order Gauss-Markov u per axis of correlation time ``NLOS_TIME_CONSTANT_S`` whose
+    fix row is the excess, e = excess_k u (a known time-varying gain on a stationary process:
+    zero on open sky, where u is unobserved and inert). Not all of it is slow: from one epoch
+    to the next the horizontal error over the excess keeps a correlation of only 0.4-0.8 (the
+    set of reflected satellites changes), the height's 0.8-0.9. ``FixErrorModel.nlos_split``
+    gives the share ``NLOS_WHITE_SHARE`` of the excess variance (north, east, down: 0.5, 0.5,
+    0.1, the drives' lag-one correlation rounded down) to the fix's white noise and the rest
+    to the states' gain; with all of it slow the filter read the epoch-to-epoch jumps as
+    motion (the unseen canyon's 2-D yaw error 2-3 deg against a sigma of 0.7-1 deg).
 
 * ``odometer_speed_sigma``: the white 1-sigma of an odometer's speed: the tick count's
   quantisation, 1 / (``ticks_per_meter`` dt) over an interval dt = 1 / ``rate``, uniform, so
@@ -39,8 +57,8 @@ that tunes itself "from the datasheet" means the same thing.
 
 Public names
 ------------
-ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, odometer_speed_sigma,
-odometer_delay_s, CORRELATED_TAU_S.
+ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, ground_track_sigma,
+odometer_speed_sigma, odometer_delay_s, CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S.
 """
 
 from __future__ import annotations
@@ -58,6 +76,9 @@ from simulator.datasheet import range_error_budget
 CORRELATED_TAU_S = 1800.0  # ionosphere and ephemeris residuals change over tens of minutes
 RANGE_RATE_SIGMA_M_S = 0.05  # a car receiver's range-rate noise (u-blox NEO-M8: 0.05 m/s)
 DEFAULT_BIAS_TAU_S = 600.0  # correlation time of the in-run bias when the sheet gives none
+NLOS_TIME_CONSTANT_S = 60.0  # a reflected fix error's correlation time (module docstring)
+NLOS_WHITE_SHARE = np.array([0.5, 0.5, 0.1])  # its variance's white share, NED (docstring)
+FIX_STD_COLUMNS = ("std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd")
 
 
 @dataclass(frozen=True)
@@ -126,12 +147,14 @@ def imu_error_model(datasheet: Mapping[str, Any]) -> ImuErrorModel:
 class FixErrorModel:
     """A receiver's fix error per unit DOP (module docstring): the user range errors in m
     (``correlated_range``, ``white_range``: the latter already the white equivalent at the fix
-    interval), their correlation time, and the range-rate 1-sigma (m/s)."""
+    interval; ``smoothed_range`` the smoothed error's own 1-sigma), their correlation time,
+    and the range-rate 1-sigma (m/s)."""
 
     correlated_range: float
     white_range: float
     correlated_tau: float
     range_rate: float
+    smoothed_range: float = 0.0
 
     def correlated_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m) of the drive-long correlated error at these DOPs."""
@@ -144,6 +167,21 @@ class FixErrorModel:
     def velocity_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m/s) of the fix's velocity at these DOPs."""
         return self.range_rate * _axes(hdop, vdop)
+
+    def excess_sigma(self, reported: np.ndarray, hdop: float, vdop: float) -> np.ndarray:
+        """NED 1-sigma (m) of a fix's reported position error beyond this budget at its DOPs
+        (the correlated and smoothed parts in quadrature): 0 where the report is within it or
+        not finite."""
+        budget = (self.correlated_range**2 + self.smoothed_range**2) * _axes(hdop, vdop) ** 2
+        extra = np.nan_to_num(np.asarray(reported, dtype=float) ** 2 - budget, nan=0.0)
+        return np.sqrt(np.maximum(extra, 0.0))
+
+    def nlos_split(self, reported: np.ndarray, hdop: float, vdop: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+        """The ``excess_sigma`` split into the gain of the unit NLOS states and the variance
+        added to the fix's white noise (NED; module docstring)."""
+        excess2 = self.excess_sigma(reported, hdop, vdop) ** 2
+        return np.sqrt((1.0 - NLOS_WHITE_SHARE) * excess2), NLOS_WHITE_SHARE * excess2
 
 
 def _axes(hdop: float, vdop: float) -> np.ndarray:
@@ -162,7 +200,35 @@ def fix_error_model(datasheet: Mapping[str, Any]) -> FixErrorModel:
         white *= math.sqrt(2.0 * budget.smoothing_s * float(gnss.get("rate") or 1.0))
     return FixErrorModel(correlated_range=max(budget.correlated_m(), 0.1),
                          white_range=max(white, 0.1), correlated_tau=CORRELATED_TAU_S,
-                         range_rate=RANGE_RATE_SIGMA_M_S)
+                         range_rate=RANGE_RATE_SIGMA_M_S, smoothed_range=budget.smoothed)
+
+
+class FixAccuracy:
+    """A fix stream's own accuracy columns (``FIX_STD_COLUMNS``, module docstring), read from
+    a row: ``position`` and ``velocity`` NED 1-sigma, NaN where the stream or the row has
+    none."""
+
+    def __init__(self, columns: Mapping[str, int]):
+        self._cols = [columns.get(c) for c in FIX_STD_COLUMNS]
+
+    def read(self, row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(position 1-sigma (3,), m; velocity 1-sigma (3,), m/s) of a fix row."""
+        std = np.array([float(row[i]) if i is not None else math.nan for i in self._cols])
+        return std[:3], std[3:]
+
+
+def ground_track_sigma(vn: float, ve: float, std_vn: float, std_ve: float
+                       ) -> tuple[float, float]:
+    """1-sigma of the ground speed (m/s) and course (rad) of a horizontal velocity with
+    independent north and east errors (first order: the speed's gradient is the unit velocity,
+    the course's the perpendicular over the speed); NaN where a sigma is not finite or the
+    car stands."""
+    speed2 = vn * vn + ve * ve
+    if not (math.isfinite(std_vn) and math.isfinite(std_ve)) or speed2 <= 0.0:
+        return math.nan, math.nan
+    var_speed = (vn * vn * std_vn**2 + ve * ve * std_ve**2) / speed2
+    var_course = (ve * ve * std_vn**2 + vn * vn * std_ve**2) / (speed2 * speed2)
+    return math.sqrt(var_speed), math.sqrt(var_course)
 
 
 ODOMETER_FLOOR_M_S = 0.05  # wheel motion the body does not share, m/s (chosen)

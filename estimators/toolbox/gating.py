@@ -29,7 +29,7 @@ updating only when it passes.
 Public functions
 ----------------
 chi2_threshold, innovation_covariance, matching_variance, normalised_innovation_squared,
-passes_gate, rows_passing, threshold_variance.
+passes_gate, rows_passing, threshold_variance, FixNoiseMatching.
 """
 
 from __future__ import annotations
@@ -101,3 +101,30 @@ def threshold_variance(statistic: float, threshold: float, sigma_nominal: float,
     it with ``above=False``), else ``sigma_nominal``^2."""
     beyond = statistic > threshold if above else statistic < threshold
     return (sigma_inflated if beyond else sigma_nominal) ** 2
+
+
+MATCHING_FIXES = 20.0  # fixes in the covariance-matching average (its e-folding length)
+
+
+class FixNoiseMatching:
+    """Covariance matching of the fixes' position noise (Mehra 1972; Mohamed & Schwarz 1999,
+    "Adaptive Kalman filtering for INS/GPS", J. Geodesy 73): the fix's real variance per axis
+    is estimated as the running mean of nu^2 - (H P H^T) over the position rows (innovation
+    nu, predicted covariance H P H^T), and the HDOP-based variance is scaled up to it
+    (never down). A street canyon's reflected signals leave HDOP unchanged while the fixes
+    move by metres: without this the filter believes them to a metre. The same on one axis of
+    a fix's velocity (``ins_lkf``): a reflected Doppler."""
+
+    def __init__(self) -> None:
+        self.scale = 1.0
+        self._excess = 0.0  # running mean of the ratio (nu^2 - HPH^T) / R, per axis
+        self._weight = 0.0
+
+    def add(self, nu: np.ndarray, hph: np.ndarray, white_var: float) -> None:
+        """Learn from one fix's position rows: innovations ``nu`` (2,), the predicted
+        covariance ``hph`` (2, 2) and the fix's HDOP variance per axis ``white_var``
+        (``Tuning.white_position_var``)."""
+        ratio = float(np.mean(nu**2 - np.diag(hph))) / white_var
+        self._weight = min(self._weight + 1.0, MATCHING_FIXES)
+        self._excess += (ratio - self._excess) / self._weight
+        self.scale = max(1.0, self._excess)

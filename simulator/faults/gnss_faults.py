@@ -105,7 +105,7 @@ def _refix(streams, intervals, context) -> None:
     upto = t <= t[mask].max()
     gnss = context.sensors.get("gnss") or {}
     new = receiver_fixes(t[upto], raw.loc[raw["t"].to_numpy() <= t[mask].max()],
-                         gnss.get("smoothing", 0.0), gnss.get("dop_mask", np.inf))
+                         gnss.get("smoothing", 0.0), gnss.get("dop_mask", np.inf), gnss)
     fix.loc[mask, list(new.columns)] = new.to_numpy()[mask[upto]]
 
 

@@ -115,19 +115,21 @@ def run_filter(dataset: Dataset, name: str, **config) -> tuple[pd.DataFrame, np.
     return solution, m.position_error_3d(dataset, solution)[1]
 
 
-def short_partial_overrides(seed: int) -> list[str]:
-    """``--set`` overrides cutting the partial-outage drive after its warm-up and first two and a
-    half laps (straight, two loops, straight, two loops, straight) with its first five 60 s
-    windows; the satellite counts are 0, 1, 2, 3, 4 in window order for even seeds, shifted by
-    one window for odd seeds, so that over several seeds each count but 4 falls on straight and
-    on curved road. (Halving the windows to 30 s instead does not keep the claim's meaning: the
-    errors then stay at the 1-3 m of the pseudorange solution.)"""
+def short_partial_overrides(seed: int, windows: int = 5) -> list[str]:
+    """``--set`` overrides cutting the partial-outage drive after its warm-up and the road of its
+    first ``windows`` 60 s windows (one per straight or double loop; five: two and a half laps,
+    straight, two loops, straight, two loops, straight); the satellite counts are 0, 1, 2, 3, 4
+    in window order for even seeds, shifted by one window for odd seeds, so that over several
+    seeds each count but 4 falls on straight and on curved road. (Halving the windows to 30 s
+    instead does not keep the claim's meaning: the errors then stay at the 1-3 m of the
+    pseudorange solution.)"""
     data = yaml.safe_load(scenario_path("chan_partial_outages.yaml").read_text())
     segments = data["trajectory"]["segments"]
-    faults = data["faults"][:5]
+    faults = data["faults"][:windows]
     for k, fault in enumerate(faults):
         fault["count"] = (k + seed % 2) % 5
-    return [f"trajectory.segments={json.dumps(segments[:12] + segments[-2:])}",
+    warm_up = 7  # the segments before the first window's straight
+    return [f"trajectory.segments={json.dumps(segments[:warm_up + windows] + segments[-2:])}",
             f"faults={json.dumps(faults)}"]
 
 

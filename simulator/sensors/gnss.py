@@ -516,7 +516,7 @@ class Gnss(PresetSensor):
         # are recomputed from them; the generator drops it if the scenario did not ask for it
         out["gnss_raw"] = rover.raw
         if "fix" in cfg["outputs"]:
-            out["gnss_fix"] = receiver_fixes(t, rover.raw, cfg["smoothing"], cfg["dop_mask"])
+            out["gnss_fix"] = receiver_fixes(t, rover.raw, cfg["smoothing"], cfg["dop_mask"], cfg)
         base = getattr(self, "base", None)
         if base is not None:
             out.update(base.observe_with(self, truth, t, dt_s, sky, rover.shared))

@@ -27,6 +27,8 @@ from simulator.reproduce import chan
 from simulator.reproduce.runner import run_experiment
 from tests.conftest import seed_sets
 
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
+
 SEEDS = range(1, 11)
 SEED_SETS = seed_sets(SEEDS)  # seeds 1-3 (both window orders of the shortened drive); 1-10
 

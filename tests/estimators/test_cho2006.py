@@ -32,6 +32,7 @@ from tests.synthetic import FLAT_LOOP
 G = 9.8
 U2 = np.array([0.7, 0.05, -0.2])  # f_x, w_y, w_z
 U1 = np.array([0.7, 2.1, -0.2])  # f_x, f_y, w_z
+U2_LATERAL = np.array([0.7, 0.05, -0.2, -0.35])  # and the IMU's lateral velocity (m/s)
 X = np.array([3.0, -4.0, 12.0, 0.05, 2.5, 0.02, -0.03, 0.05])
 
 
@@ -57,13 +58,32 @@ def _numeric_jacobian(f, x: np.ndarray, step: float = 1e-6) -> np.ndarray:
 
 
 @pytest.mark.parametrize("transition, jacobian, u", [
-    (drm2_transition, drm2_jacobian, U2), (drm1_transition, drm1_jacobian, U1)],
-    ids=["DRM2", "DRM1"])
+    (drm2_transition, drm2_jacobian, U2), (drm2_transition, drm2_jacobian, U2_LATERAL),
+    (drm1_transition, drm1_jacobian, U1)], ids=["DRM2", "DRM2-lateral", "DRM1"])
 def test_transition_matrix_is_the_jacobian_of_the_propagation(transition, jacobian, u):
     def f(x):
         return transition(x[None, :], None, u, 0.1, G)[0]
 
     np.testing.assert_allclose(jacobian(X, u, 0.1, G), _numeric_jacobian(f, X), atol=1e-8)
+
+
+def test_an_imu_ahead_of_the_rear_axle_keeps_its_speed_on_a_circle():
+    """A car on a level circle at constant speed V: the rear axle moves along the path, an
+    IMU a metres ahead of it has the same forward speed V and the lateral velocity a w; its
+    forward accelerometer reads the centripetal share -a w^2 (f = dv/dt + w x v in the body
+    frame). DRM2 with the lateral velocity as input keeps V; eq. 24c alone loses a w^2 t."""
+    arm, w, v0, dt = 1.7, 0.8, 4.0, 0.1
+    u = np.array([-arm * w * w, 0.0, w, arm * w])
+    x = np.zeros((1, 9))
+    x[0, 2] = v0
+    for _ in range(100):  # 10 s
+        x = drm2_transition(x, None, u, dt, G)
+    assert abs(x[0, 2] - v0) < 1e-12
+    x_rigid = np.zeros((1, 9))
+    x_rigid[0, 2] = v0
+    for _ in range(100):
+        x_rigid = drm2_transition(x_rigid, None, u[:3], dt, G)
+    assert x_rigid[0, 2] == pytest.approx(v0 - arm * w * w * 10.0)
 
 
 def test_drm2_transition_matrix_has_the_terms_of_eq_17():

@@ -24,7 +24,10 @@ from simulator.reproduce.measures import horizontal_error
 from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from simulator.scenario import load_scenario
+from simulator.scoring.align import solution_errors
 from tests.conftest import seed_sets
+
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
 
 RIGID = ["vehicle=rigid"]
 
@@ -160,11 +163,11 @@ def test_enhanced_model_gains_16_percent_with_no_satellite(protocol):
     assert karamat.gain(protocol, (0,)) >= 0.16
 
 
-@pytest.mark.xfail(strict=True, reason="claim not reproduced: the enhanced model gains 26 % over "
-                   "all windows (24 % rigid; docs/reproduction_karamat2015.md)")
 def test_enhanced_model_gains_40_percent_overall(protocol):
     """Karamat et al. section 5: 40 % better than the earlier tightly coupled filter in overall
-    maximum 2-D error (measured: 26 %; 40, 43, 16, 20 % at 3, 2, 1, 0 satellites)."""
+    maximum 2-D error (26 % over ten seeds, an expected failure, while v_u was an independent
+    state whose corrections eq. 6 threw away; at least 40 % on seeds 1-3 since; the ten seeds
+    of ``--runslow`` not re-measured)."""
     assert karamat.gain(protocol, (3, 2, 1, 0)) >= 0.40
 
 
@@ -256,3 +259,25 @@ def test_gate_takes_the_ranges_back_from_a_filter_off_by_a_known_error(tmp_path)
     satellites = ds.read("gnss_raw").groupby("t").size().to_numpy()
     accepted = solution.loc[late, "nis_gnss_dof"].dropna().to_numpy()
     assert np.all(accepted == 2 * satellites.max())  # every range and every rate
+
+
+@pytest.mark.parametrize("seed", [1, 2])
+def test_height_holds_through_a_climb_with_three_satellites(tmp_path, seed):
+    """A 90 deg turn into a 4.5 % climb inside a 60 s window of the three highest satellites
+    (the turn-and-slope windows of docs/reproduction_karamat2015.md, shortened): the height
+    error stays inside two of the filter's own sigmas (measured 0.58 and 0.37 sigma, 1.8 and
+    1.1 m on seeds 1 and 2). While v_u was an independent error state, eq. 6 threw each
+    Doppler correction of it away and the covariance kept it: 2.3 sigma (7.4 m) on seed 1,
+    210 m in the fifth window of the long drive."""
+    drive = ("[{accelerate: {to_speed: 12.0, accel: 1.2}}, {straight: {length: 700}}, "
+             "{turn: {angle: 90, radius: 30}}, {slope: {grade: 0.045, length: 280}}, "
+             "{straight: {length: 300}}]")
+    scenario = load_scenario(scenario_path(karamat.SCENARIO), [
+        f"trajectory.segments={drive}", "estimators=[]",
+        "faults=[{kind: gnss_satellite_limit, start: 63.0, duration: 60, count: 3}]"], seed=seed)
+    ds = open_dataset(generate_dataset(scenario, tmp_path / "d", show_progress=False))
+    solution, _ = run_estimator(ds, "riss3d_tc_ekf", show_progress=False)
+    e = solution_errors(ds.read("truth"), solution).errors
+    window = e[(e["t"] >= 63.0) & (e["t"] <= 123.0)]
+    assert len(window) > 500
+    assert (window["err_d"].abs() / window["std_d"]).max() < 2.0

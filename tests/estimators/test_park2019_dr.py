@@ -15,13 +15,16 @@ import pytest
 from estimators.builtin.park2019_dr import _dr3d_navigate
 from estimators.registry import BUILTINS
 from estimators.toolbox.nav_error import euler_error_jacobian
+from simulator.dataset.generate import build_truth
 from simulator.earth import dcm_to_euler, euler_to_dcm, euler_to_quat, radii_of_curvature, skew
-from simulator.pipeline import generate, load_scenario
+from simulator.pipeline import load_scenario
 from simulator.reproduce import park2019
 from simulator.reproduce.measures import needed_count
 from simulator.reproduce.paper import scenario_path
 from simulator.reproduce.runner import run_experiment
 from tests.conftest import CI_SEEDS, seed_sets
+
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
 
 SEEDS = list(range(1, 11))
 
@@ -45,7 +48,7 @@ def test_euler_error_jacobian_matches_finite_differences(attitude_deg):
     np.testing.assert_allclose(jac, numeric, atol=1e-7)
 
 
-def test_navigation_processor_follows_exact_kinematics(tmp_path):
+def test_navigation_processor_follows_exact_kinematics():
     """Eqs. 3 and 20-21 fed with the true body rates and the true speed (trapezoidal, 200 Hz)
     follow the exact truth of the garage (helices, 15 % ramps, speed bumps) to centimetres.
     At the paper's 20 Hz the speed bumps' pitch-rate pulses are undersampled and the same
@@ -55,8 +58,7 @@ def test_navigation_processor_follows_exact_kinematics(tmp_path):
     scenario = load_scenario(scenario_path(park2019.GARAGE.scenario),
                              ["sensors.imu.preset=ideal", "trajectory.rate=200", "vehicle=rigid"],
                              1)
-    ds = generate(scenario, tmp_path / "g")
-    truth = ds.read("truth")
+    truth = build_truth(scenario.data).table()  # the truth table a dataset holds
     t = truth["t"].to_numpy()
     rates = truth[["wx", "wy", "wz"]].to_numpy()
     speed = truth["speed"].to_numpy()

@@ -24,6 +24,8 @@ from simulator.reproduce.runner import run_experiment
 from simulator.scenario import Scenario, validate_data
 from tests.conftest import seed_sets
 
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
+
 EXPERIMENTS = [park2019.INS_PARK_GARAGE, park2019.INS_PARKING_GARAGE]
 SEEDS = range(1, 11)
 
@@ -90,12 +92,13 @@ def test_fix_error_states_take_the_receivers_carrier_smoothing_time():
     assert states(100.0) == 19 and states(0.0) == 16
     paper = {"tuning": "paper"}
     assert ParkInsOdometer(paper, initial, columns, {}, imu_output="rate").ins.n_states == 15
-    # the datasheet tuning always carries the fix's correlated error
-    assert ParkInsOdometer(None, initial, columns, {}, imu_output="rate").ins.n_states == 18
+    # the datasheet tuning always carries the fix's correlated error, the reflected fixes'
+    # unit states and the odometer scale factor
+    assert ParkInsOdometer(None, initial, columns, {}, imu_output="rate").ins.n_states == 22
     # and, with a gyro scale factor in the sheet, the three yaw-response states before them
     sheet = {"imu": {"gyro": {"scale_factor": 0.005, "misalignment": 1e-3}}}
     est = ParkInsOdometer(None, initial, columns, {}, imu_output="rate", datasheet=sheet)
-    assert est.ins.n_states == 21 and est.ins.extra_start == 18
+    assert est.ins.n_states == 25 and est.ins.extra_start == 18
 
 
 def test_the_antenna_lever_arm_is_taken_from_the_datasheet(tmp_path):

@@ -14,6 +14,8 @@ import pytest
 from simulator.reproduce import tan2008
 from simulator.reproduce.runner import judge, run_experiment
 
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
+
 
 @pytest.fixture(scope="module")
 def short_runs(tmp_path_factory):

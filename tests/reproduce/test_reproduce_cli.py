@@ -15,9 +15,12 @@ import pandas as pd
 import pytest
 
 from simulator.cli import main
-from simulator.reproduce import tan2008
+from simulator.reproduce import runner, tan2008
 from simulator.reproduce.papers import load_paper, paper_keys
 from simulator.reproduce.runner import _execute, _Task, run_experiment
+from tests.experiment_cache import in_this_process
+
+pytestmark = pytest.mark.usefixtures("shared_experiments")  # each (experiment, seed) once
 
 REPOSITORY = Path(__file__).resolve().parents[2]
 
@@ -80,12 +83,16 @@ def test_a_failing_run_is_reported_with_its_error():
 
 
 @pytest.mark.parametrize("runs", [1, pytest.param(3, marks=pytest.mark.slow)])
-def test_quick_run_of_every_paper(tmp_path, capsys, runs):
+def test_quick_run_of_every_paper(tmp_path, capsys, monkeypatch, runs):
     """Every registered paper on its shortened drives end to end, one seed (``--quick``'s 3
     with --runslow; the claims themselves are asserted on seeds 1-3 by tests/estimators/). The
     report names each paper and every claim that is no variant with a figure and a word (each
     judge given only the experiments it declares), runs no experiment that only variants read,
-    and the independent script recomputes every word from results.json."""
+    and the independent script recomputes every word from results.json. The tasks run in this
+    process, where a seed the claim tests have computed is read, not computed again
+    (tests/experiment_cache.py); the worker processes run in
+    ``test_on_local_or_dask_workers_the_figures_are_those_of_an_in_process_run``."""
+    monkeypatch.setattr(runner, "open_executor", in_this_process)
     out = tmp_path / "repro"
     assert main(["reproduce", "--quick", "--runs", str(runs), "--workers", "2", "-o",
                  str(out)]) == 0
@@ -129,17 +136,23 @@ def test_help_lists_the_papers(capsys):
     assert "landnav reproduce --list" in text  # each paper's claims: tests/commands/test_help.py
 
 
-def test_on_a_dask_cluster_the_figures_are_those_of_an_in_process_run(tmp_path):
-    """Tan's outage (the smallest experiment), one seed, shortened drive, on a loopback Dask
-    cluster of one worker process: the figures stored equal those of ``run_experiment`` in this
-    process (same scenario and seed, same numbers)."""
-    distributed = pytest.importorskip("distributed")
-    out = tmp_path / "dask"
-    with distributed.LocalCluster(host="127.0.0.1", n_workers=1, threads_per_worker=1,
-                                  processes=True, dashboard_address=None) as cluster:
-        assert main(["reproduce", "tan2008", "--quick", "--runs", "1", "--scheduler",
-                     cluster.scheduler_address, "-o", str(out)]) == 0
+@pytest.mark.parametrize("where", ["local", "dask"])
+def test_on_local_or_dask_workers_the_figures_are_those_of_an_in_process_run(tmp_path, where):
+    """Tan's outage (the smallest experiment), one seed, shortened drive, on a local worker
+    process and on a loopback Dask cluster of one worker process: the figures stored equal
+    those of ``run_experiment`` in this process (same scenario and seed, same numbers)."""
+    out = tmp_path / where
+    if where == "local":
+        assert main(["reproduce", "tan2008", "--quick", "--runs", "1", "--workers", "1", "-o",
+                     str(out)]) == 0
+        assert "1 local worker process(es)" in (out / "report.md").read_text()
+    else:
+        distributed = pytest.importorskip("distributed")
+        with distributed.LocalCluster(host="127.0.0.1", n_workers=1, threads_per_worker=1,
+                                      processes=True, dashboard_address=None) as cluster:
+            assert main(["reproduce", "tan2008", "--quick", "--runs", "1", "--scheduler",
+                         cluster.scheduler_address, "-o", str(out)]) == 0
+        assert "Dask scheduler" in (out / "report.md").read_text()
     stored = pd.read_parquet(out / "figures" / "tan2008" / "outage.parquet")
     expected = run_experiment(tan2008.OUTAGE, [1], tmp_path, quick=True)
     pd.testing.assert_frame_equal(stored, expected, check_exact=False, rtol=1e-12)
-    assert "Dask scheduler" in (out / "report.md").read_text()

@@ -264,11 +264,9 @@ def _judge_values(tables):
 
 def test_a_full_run_runs_the_edge_claims_experiments_again_on_further_seeds(tmp_path,
                                                                             monkeypatch):
-    from concurrent.futures import ThreadPoolExecutor
-    from contextlib import contextmanager
-
     from simulator.reproduce import runner
     from simulator.reproduce.paper import Claim, Experiment, Paper
+    from tests.experiment_cache import in_this_process
 
     paper = Paper("fake", "A fake paper", "", tuple(
         Experiment(k, "quickstart.yaml", {"a": {"name": "dead_reckoning"}}, measure=print)
@@ -276,14 +274,9 @@ def test_a_full_run_runs_the_edge_claims_experiments_again_on_further_seeds(tmp_
         Claim(f"c{k}", "below 1", "Table 1", (), judge=_judge_values, experiments=(k,))
         for k in ("e0", "e1")))
 
-    @contextmanager
-    def in_threads(workers, scheduler, timeout_s):
-        with ThreadPoolExecutor(1) as executor:
-            yield executor, 1
-
     monkeypatch.setattr(runner, "load_paper", lambda key: paper)
     monkeypatch.setattr(runner, "measure_seed", _measured)
-    monkeypatch.setattr(runner, "open_executor", in_threads)
+    monkeypatch.setattr(runner, "open_executor", in_this_process)
     # three seeds: e0 below on 3 of 3 (p 0.125, at the edge: three more seeds), e1 on 1 of 3
     (result,) = runner.reproduce(["fake"], 3, False, tmp_path / "out", 1)
     assert list(result.experiments["e0"].table.index) == [1, 2, 3, 4, 5, 6]
