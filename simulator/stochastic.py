@@ -21,7 +21,7 @@ Public names
 FLICKER_ADEV_FACTOR, GM_ADEV_PEAK, GM_ADEV_PEAK_TAU, FLICKER_TAUS_S, gm_adev_peak,
 gauss_markov_continuous, gauss_markov_discrete,
 ar1_filter, white, random_walk, gauss_markov, gauss_markov_at, flicker, gauss_markov_avar,
-flicker_avar, adev_model, stream_rng.
+flicker_avar, adev_model, stream_rng, child_rng.
 
 References
 ----------
@@ -387,3 +387,15 @@ def stream_rng(seed: int, name: str) -> np.random.Generator:
     normals, 8 % quicker than with the default PCG64."""
     return np.random.Generator(np.random.SFC64(np.random.SeedSequence(seed, spawn_key=(
         zlib.crc32(name.encode()),))))
+
+
+def child_rng(rng: np.random.Generator, name: str) -> np.random.Generator:
+    """The random stream named ``name`` inside the stream ``rng`` (one error process of a
+    sensor): the SeedSequence child of ``rng``'s seed keyed by the name (its spawn key extended
+    by the name's CRC-32), with ``rng``'s bit generator. It depends only on ``rng``'s seed and
+    the name, never on how many draws ``rng`` or any other child has made, so a process that
+    changes how many numbers it draws redraws no other process."""
+    seq = rng.bit_generator.seed_seq
+    return np.random.Generator(type(rng.bit_generator)(np.random.SeedSequence(
+        seq.entropy, spawn_key=(*seq.spawn_key, zlib.crc32(name.encode())),
+        pool_size=seq.pool_size)))

@@ -95,7 +95,7 @@ import numpy as np
 from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
-from simulator.stochastic import ar1_filter, gauss_markov, gauss_markov_at
+from simulator.stochastic import ar1_filter, child_rng, gauss_markov, gauss_markov_at
 
 # receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
 # crystal) and the 1-sigma spread of the clock state at switch-on
@@ -298,6 +298,10 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
 
     Parameters
     ----------
+    rng : Generator
+        The receiver's random stream: each term draws from its own named child of it
+        (``simulator.stochastic.child_rng``: ``sis``, ``iono_field``, ``tropo_zenith``,
+        ``multipath``, ``code_noise``, ``rate_noise``), so no term's draws move another's.
     cfg : dict
         The resolved ``sensors.gnss`` block (error levels and tracking-loop parameters).
     elevation_rad, cn0_dbhz : ndarray, shape (n_sat, n_epoch)
@@ -328,33 +332,34 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
     n_sat, n_ep = shape
     scale = cfg["tracking_noise"]
 
-    def unit_gm(rows: int, tau_s: float) -> np.ndarray:  # (rows, n_ep), unit variance
-        return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
+    def unit_gm(rows: int, tau_s: float, name: str) -> np.ndarray:  # (rows, n_ep), unit variance
+        return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, child_rng(rng, name)).T
 
     # the ionosphere's error: a field smooth over the pierce points and in time (module
     # docstring), so that nearby signals share it and its rate (which the carrier smoothing's
     # code-carrier divergence sees) stays at the mm/s of a quiet ionosphere
     if shared is None:
-        out = {"sis": draw_sis(rng, cfg["sis_error"], record)}
-        out["iono_field"] = IonoField(rng, n_ep, dt_s) if cfg["iono_residual"] > 0 else None
+        out = {"sis": draw_sis(child_rng(rng, "sis"), cfg["sis_error"], record)}
+        out["iono_field"] = (IonoField(child_rng(rng, "iono_field"), n_ep, dt_s)
+                             if cfg["iono_residual"] > 0 else None)
     else:
         out = {"sis": shared.sis, "iono_field": shared.iono_field}
     field = (out["iono_field"](pierce_km) if out["iono_field"] is not None
              else np.zeros(shape))
     out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"] * field)
-    out["tropo_zenith"] = (cfg["tropo_residual"] * rng.standard_normal() if shared is None
-                           else shared.tropo_zenith_m)
+    out["tropo_zenith"] = (cfg["tropo_residual"] * child_rng(rng, "tropo_zenith").standard_normal()
+                           if shared is None else shared.tropo_zenith_m)
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
-    out["multipath_unit"] = gauss_markov_along(u, n_sat, rng)
+    out["multipath_unit"] = gauss_markov_along(u, n_sat, child_rng(rng, "multipath"))
     out["multipath"] = out["multipath_sigma"] * out["multipath_unit"]
     out["code_sigma"] = scale * dll_sigma_m(cn0_dbhz, cfg["dll_bandwidth"],
                                             cfg["correlator_spacing"], cfg["integration_time"])
     out["code_noise"] = out["code_sigma"] * unit_gm(
-        n_sat, loop_time_constant_s(cfg["dll_bandwidth"]))
+        n_sat, loop_time_constant_s(cfg["dll_bandwidth"]), "code_noise")
     out["rate_sigma"] = scale * LAMBDA_L1_M * fll_sigma_hz(cn0_dbhz, cfg["fll_bandwidth"],
                                                           cfg["integration_time"])
     out["rate_noise"] = out["rate_sigma"] * unit_gm(
-        n_sat, loop_time_constant_s(cfg["fll_bandwidth"]))
+        n_sat, loop_time_constant_s(cfg["fll_bandwidth"]), "rate_noise")
     return out
 
 

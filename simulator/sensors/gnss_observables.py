@@ -27,6 +27,25 @@ from T_GD, BGD or TGD1/TGD2: ``simulator.gnss.signals.signal_group_delay_s``; th
 carries no hardware delay). The carrier phase has RINEX's sign: it grows with the range, as
 the pseudorange does.
 
+Random streams: every error process draws from its own stream, the child of the receiver's
+stream (the rover's: the sensor stream ``gnss``) named after the process
+(``simulator.stochastic.child_rng``), so a process that draws more or fewer numbers (a new
+model, a speed-up) redraws no other one, and the same scenario and seed give the same files:
+
+- drawn once per drive or per satellite: ``receiver_clock`` (initial bias and drift, then the
+  oscillator's noise), ``sis`` (per satellite and broadcast record), ``iono_field`` (the
+  regional field's waves), ``tropo_zenith``; shared with a second receiver, and drawn by the
+  first only: ``iono_tid``, ``tropo_gradient``, ``orbit_error``; the canyon zones' buildings
+  and facade losses, one stream per zone named after it, in the child ``environment``;
+- along the drive, for every satellite: ``cn0_fading``, ``cn0_noise``, ``multipath`` (its
+  in-phase unit process), ``multipath_quadrature``, ``reflector_normal``, ``code_noise`` and
+  ``rate_noise`` (the primary signals' tracking noise);
+- per signal, named ``<system letter><RINEX code>/<process>`` (e.g. ``E5Q/phase_noise``):
+  ``cn0_noise``, ``code_noise`` and ``rate_noise`` (signals other than the primary one),
+  ``phase_noise``, ``cycle_slips``, ``phase_arcs`` (ambiguities, slip sizes, half cycles);
+- ``second_receiver``: the base station's own stream, from which it names its processes as
+  above (it draws none of the shared ones).
+
 Public names
 ------------
 TID_LENGTH_KM, TID_TIME_S, ORBIT_ERROR_M, Shared, Observed, observe, signal_geometry_chunks.
@@ -90,7 +109,7 @@ from simulator.gnss.signals import (
     signal_group_delay_s,
 )
 from simulator.gnss.timesystems import SYSTEMS
-from simulator.stochastic import gauss_markov
+from simulator.stochastic import child_rng, gauss_markov
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -114,7 +133,7 @@ class Shared:
     orbit_m: np.ndarray  # per broadcast record, (n_records, 3)
     origin_lla: tuple[float, float, float]
     los: np.ndarray  # the first receiver's lines of sight (n_sat, n_epoch, 3)
-    seed: int  # of the second receiver's own random stream
+    second_rng: np.random.Generator  # the second receiver's own random stream
 
 
 @dataclass
@@ -178,18 +197,17 @@ def _switches(state: np.ndarray) -> np.ndarray:
 
 def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int, n_ep: int,
                   dt_s: float, ant: dict, los: np.ndarray) -> Shared:
-    """The first receiver's draws a second one shares, made after all its other error draws
-    (so that they do not change them)."""
-    tid = IonoField(rng, n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
-    gradient = cfg["tropo_gradient"] * rng.standard_normal(2)
-    orbit = ORBIT_ERROR_M * rng.standard_normal((n_records, 3))
-    seed = int(rng.integers(2**62))
+    """The first receiver's draws a second one shares, each from its own named stream (module
+    docstring), and the second receiver's own stream."""
+    tid = IonoField(child_rng(rng, "iono_tid"), n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
+    gradient = cfg["tropo_gradient"] * child_rng(rng, "tropo_gradient").standard_normal(2)
+    orbit = ORBIT_ERROR_M * child_rng(rng, "orbit_error").standard_normal((n_records, 3))
     return Shared(sis=err["sis"], iono_field=err["iono_field"], tid=tid,
                   tid_sigma_m=cfg["iono_gradient"] * TID_LENGTH_KM * 1e3,
                   tropo_zenith_m=float(err["tropo_zenith"]), tropo_gradient=gradient,
                   orbit_m=orbit,
                   origin_lla=(float(ant["lat"][0]), float(ant["lon"][0]), float(ant["alt"][0])),
-                  los=los, seed=seed)
+                  los=los, second_rng=child_rng(rng, "second_receiver"))
 
 
 def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
@@ -225,13 +243,14 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     los, nlos, extra, loss = reception(
         az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
     signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
-                  + draw_fading(rng, cfg, u, n_sat))
-    cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+                  + draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_sat))
+    cn0 = signal_cn0 + cfg["cn0_noise"] * child_rng(rng, "cn0_noise").standard_normal(el.shape)
     have = idx >= 0
     visible = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos)
     tracked = visible & (cn0 >= cfg["cn0_threshold"])
 
-    bias_s, drift_s_s, drawn_clock = draw_receiver_clock(rng, cfg["clock"], n_ep, dt_s)
+    bias_s, drift_s_s, drawn_clock = draw_receiver_clock(child_rng(rng, "receiver_clock"),
+                                                         cfg["clock"], n_ep, dt_s)
     # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
     # (below the horizon, where nothing is tracked, the pierce point of the horizon)
     pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
@@ -276,12 +295,12 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     nlos_delay = np.where(nlos & ~los, extra, 0.0)
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
-    quadrature = gauss_markov_along(u, n_sat, rng)
+    quadrature = gauss_markov_along(u, n_sat, child_rng(rng, "multipath_quadrature"))
     # the reflecting plane's normal (uniform in direction, changing as the reflectors do): with
     # the antenna's velocity it sets how fast the reflection's carrier phase turns
     from scipy.special import ndtr  # imported on first use, as in simulator.gnss.carrier
 
-    wall_normal = np.pi * ndtr(gauss_markov_along(u, n_sat, rng))
+    wall_normal = np.pi * ndtr(gauss_markov_along(u, n_sat, child_rng(rng, "reflector_normal")))
     moving = bool(np.any(ant["v_ned"] != 0.0))
     path_rate = (reflection_path_rate_m_s(ant["v_ned"], az, el, wall_normal) if moving
                  else None)  # standing still, the loop's gain is 1
@@ -312,14 +331,19 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         per_satellite["path_rate"] = path_rate
     views: dict[str, dict[str, np.ndarray]] = {}
 
-    def unit_gm(tau_s: float, rows: np.ndarray) -> np.ndarray:
-        return gauss_markov(n_ep, dt_s, np.ones(len(rows)), tau_s, rng).T
+    def unit_gm(tau_s: float, rows: np.ndarray, stream: np.random.Generator) -> np.ndarray:
+        return gauss_markov(n_ep, dt_s, np.ones(len(rows)), tau_s, stream).T
+
+    def stream(signal_name: str, process: str) -> np.random.Generator:
+        """One signal's process's own stream (module docstring)."""
+        return child_rng(rng, f"{signal_name}/{process}")
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     raw_pieces, truth_pieces = [], []
     for order, (letter, code) in enumerate(codes):  # one pass per signal, vectorised
         spec = signal(letter, code)
         sel = np.flatnonzero(system_of == letter)
+        signal_name = f"{letter}{code}"  # its processes' streams are named after it
         if letter not in views:
             # a system's satellites are consecutive rows of the sky: views, not copies
             rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
@@ -337,17 +361,20 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
             rate_sigma, rate_noise = v["rate_sigma"], v["rate_noise"]
         else:
             cn0_true = v["signal_cn0"] + spec.cn0_offset_db
-            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(shape)
+            cn0_out = cn0_true + cfg["cn0_noise"] * stream(signal_name, "cn0_noise"
+                                                            ).standard_normal(shape)
             tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
             if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
                 tracked_s &= v["tracked"]
             code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
                                              cfg["correlator_spacing"], cfg["integration_time"]
                                              ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
-            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel)
+            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel,
+                                              stream(signal_name, "code_noise"))
             rate_sigma = scale * lam * fll_sigma_hz(cn0_true, cfg["fll_bandwidth"],
                                                     cfg["integration_time"])
-            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel)
+            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel,
+                                              stream(signal_name, "rate_noise"))
         code_mp, carrier_mp = reflection_multipath(
             v["multipath_unit"], v["quadrature"], v["multipath_sigma"], cfg["multipath_delay"],
             freq - F_L1_HZ, lam)
@@ -393,15 +420,17 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         if cfg["carrier_phase"]:
             sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
                                                     cfg["integration_time"])
-            phase_noise = lam * sigma_cycles * rng.standard_normal(shape)
+            phase_noise = lam * sigma_cycles * stream(signal_name, "phase_noise"
+                                                      ).standard_normal(shape)
             stress = dynamic_stress_cycles(v["los_jerk"], lam, cfg["pll_bandwidth"])
             chance = np.zeros(shape)  # a slip only matters where the signal is tracked
             if scale > 0:
                 chance[tracked_s] = slip_probability(sigma_cycles[tracked_s], stress[tracked_s],
                                                      cfg["pll_bandwidth"], dt_s, spec.pilot)
-            slips = draw_slips(rng.random(shape), chance, tracked_s)
-            arcs = phase_arcs(rng, tracked_s, slips, v["reflected"], dt_s, spec.pilot,
-                              spec.frame_s)
+            slips = draw_slips(stream(signal_name, "cycle_slips").random(shape), chance,
+                               tracked_s)
+            arcs = phase_arcs(stream(signal_name, "phase_arcs"), tracked_s, slips,
+                              v["reflected"], dt_s, spec.pilot, spec.frame_s)
             phase_m = (v["range"] + rx_clock - v["reference_clock"] - iono_s
                        + v["tropo_true"] + v["sis"] + carrier_mp + v["nlos_delay"]
                        + phase_noise)
