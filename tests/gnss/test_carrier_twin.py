@@ -74,13 +74,12 @@ def test_twin_fixes_at_least_95_percent_of_epochs(processed):
     assert processed["fixed"] >= 0.95
 
 
-@pytest.mark.parametrize("key", [
-    "carrier L1", "carrier L2", "code L1",
-    pytest.param("code L2", marks=pytest.mark.xfail(
-        strict=True, reason="not shown at seed 1: the P2 code residual std of the 30-45 deg "
-        "band is 0.48 x the real one (0.21 against 0.43 m; 15-30 and 45-90 deg: 0.63, 0.72 x); "
-        "seeds 2 and 3: 0.62 and 0.57 x in that band. docs/gnss-carrier.md"))])
+@pytest.mark.parametrize("key", ["carrier L1", "carrier L2", "code L1", "code L2"])
 def test_twin_double_difference_residuals_lie_within_0_6_to_1_6_of_the_real_ones(processed, key):
+    """The P2 code's ratio sits at the lower bound: with the GNSS draws before each error
+    process had its own stream, seeds 1-3 gave 0.48, 0.62 and 0.57 x the real std in the
+    30-45 deg band (docs/gnss-carrier.md), and seed 1 of the present streams lies within the
+    bound; which side a seed falls on is its draw, so the claim for P2 is at its edge."""
     ratio = processed[key][2]
     assert np.all((ratio >= 0.6) & (ratio <= 1.6)), ratio
 
