@@ -16,12 +16,18 @@ rate enters as GTSAM's Coriolis rate, constant in that frame):
   local vertical turns by d / R from the frame's origin) is added to each specific-force sample
   with the current attitude, so the constant gravity of the preintegration stays exact.
 * GNSS: the fix's position at the antenna (the datasheet's lever arm) is the antenna's
-  position plus the fix's own error, a first-order Gauss-Markov state with the receiver's error
-  budget times the DOP as its steady-state sigma (the UERE of SPEC section 9's covariances)
-  and the receiver's carrier-smoothing time as its correlation time (a fix error correlated
-  over 100 s, taken as white, would make the smoother average it away and claim decimetres),
-  plus a white 0.5/0.5/1 m; and its
-  NED velocity as a prior on V_k (the lever arm's rotation term left out: 0.3 m/s at most in a
+  position plus the fix's own error, as the filters model it (``toolbox.datasheet.
+  fix_error_model``): its drive-long part (the signal-in-space error and the ionosphere's
+  residual, the budget's correlated range error times the DOP) a first-order Gauss-Markov
+  state of correlation time ``CORRELATED_TAU_S`` (30 min), plus white noise, the smoothed
+  error's white equivalent in quadrature with the fix's reported accuracy beyond the budget
+  (``excess_sigma``: the reflected signals of a canyon; ``std_*`` of ``gnss_fix``). The
+  horizontal sigma was once the budget without the ionosphere (0.6 m of range error for the
+  ``automotive`` receiver, 2.2 m with it) correlated over the carrier smoothing's 100 s: the
+  smoother averaged a drive-long error away (the quickstart's north (error / sigma)^2 36, 29
+  and 11 on three of eight seeds). Its NED
+  velocity, a prior on V_k with the fix's own velocity accuracy (``std_vn, std_ve, std_vd``;
+  0.1/0.1/0.2 m/s without them; the lever arm's rotation term left out: 0.3 m/s at most in a
   tight turn, inside the velocity sigma).
 * Odometer and non-holonomic constraint at each keyframe: the body velocity at the rear axle,
   R^T v + w x r = (s, 0, 0), with the odometer's speed s, forward sigma 0.1 m/s + 3 % of s and
