@@ -110,8 +110,10 @@ gyro's noise density plus its scale factor and misalignment times the turn rate 
 correlated-noise inflation of the receiver's carrier smoothing
 (``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
 ``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon, each pseudorange's variance with the reflected-signal (NLOS) share its C/N0
-deficit announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``), the range rates'
+of a canyon, each pseudorange's R with the reflected-signal (NLOS) share its C/N0 deficit
+announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``; the gate keeps the
+reported variance alone: with the NLOS share in it too it passed more reflected ranges, the
+unseen canyon's height 2.5 -> 4.7 over seeds 1-3), the range rates'
 with the rear axle's sideways motion that eqs. 4-5 leave out (the tyres' slip in a turn,
 ``toolbox.constraints.NonholonomicNoise``, along the body's right axis: in the sharp junction
 turns of a SUMO city, 60 deg/s at 5 m/s, the rear axle moves up to 6 deg off the heading, and
@@ -760,7 +762,6 @@ class RissTcEkf(Estimator):
         var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
         var_nlos = self._nlos_variance(epoch)
         r = np.diag(np.concatenate([var_pr * self._pr_inflation**2 + var_nlos, var_rate]))
-        var_pr = var_pr + var_nlos
         # the mechanised velocity carries the white noise of the last odometer speed: it enters
         # every predicted rate through the forward axis, so R gains sigma^2 g g^T
         forward = np.array([math.cos(self._az), math.sin(self._az), 0.0]) * math.cos(self._pitch)
@@ -781,7 +782,8 @@ class RissTcEkf(Estimator):
         """Each pseudorange's variance from a reflected (NLOS) signal's extra path, which the
         receiver's reported sigma does not hold: p (20 m)^2, p the probability that it is
         reflected given its C/N0 deficit below the receiver's template (``tuning: datasheet``
-        with a template, C/N0 and elevations; ``gnss_model.nlos_sigma``, as ``gnss_wls``)."""
+        with a template, C/N0 and elevations; ``gnss_model.nlos_sigma``, as ``gnss_wls``). In
+        R only: the gate tests against the reported variance."""
         if (self._cn0_template is None or epoch.cn0 is None or epoch.elevation is None):
             return 0.0
         cn0 = np.where(np.isfinite(epoch.cn0), epoch.cn0, np.inf)  # none: not reflected
