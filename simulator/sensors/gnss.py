@@ -91,7 +91,7 @@ from simulator.earth import (
 )
 from simulator.environment import ZONE_FIELD
 from simulator.environment.sky import canyon_reception, street_buildings
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, not_regular
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.constellation import (
     EXPANDABLE_SLOTS,
@@ -242,6 +242,11 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
         if ctx.file and not FilePath(source).is_absolute():
             candidates.insert(0, FilePath(ctx.file).resolve().parent / source)
         found = [c for c in candidates if c.is_file()]
+        other = next((kind for c in candidates
+                      if (kind := not_regular(c)) not in (None, "missing")), None)
+        if not found and other is not None:
+            return ctx.error(path + ("constellation",), f"{source!r} is {other}, not a RINEX "
+                                                        "navigation or YUMA almanac file")
         if not found:
             return ctx.error(path + ("constellation",),
                              f"{source!r} is neither 'gps-almanac', 'nominal-gps' nor an "
