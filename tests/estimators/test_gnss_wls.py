@@ -258,7 +258,7 @@ def test_the_nlos_probability_is_calibrated():
     prior is taken from the epoch, so this is not exact). On open sky (no reflection) the mean
     probability is under 1 % and under 0.5 % of the signals get over 0.5 (a direct signal
     faded by over 3 scatters, 0.13 % of them, looks reflected)."""
-    from estimators.builtin.gnss_wls import nlos_probability
+    from simulator.datasheet import nlos_probability
 
     rng = np.random.default_rng(3)
     scatter = 2.24
