@@ -281,6 +281,20 @@ class InsFilter:
             self._remove(self.kf.feedback())
         return s
 
+    def passes(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray, probability: float = 0.999,
+               max_rejected: int = 5, kind: str = "") -> bool:
+        """``gated_update``'s decision without the update, its count of rejections in a row
+        kept: whether the measurement passes (so that rows of several gates can be taken in
+        one update)."""
+        nu = dz - h @ self.kf.x
+        rejected = self._rejected.get(kind, 0)
+        if (rejected < max_rejected
+                and not passes_gate(nu, innovation_covariance(self.kf.p, h, r), probability)):
+            self._rejected[kind] = rejected + 1
+            return False
+        self._rejected[kind] = 0
+        return True
+
     def gated_update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray,
                      probability: float = 0.999, max_rejected: int = 5,
                      kind: str = "") -> bool:
@@ -290,13 +304,8 @@ class InsFilter:
         whose own error has grown past its covariance (after an outage) would otherwise reject
         every fix for ever. The count is kept per ``kind``, so that an aid accepted at 10 Hz
         does not reset that of the fixes."""
-        nu = dz - h @ self.kf.x
-        rejected = self._rejected.get(kind, 0)
-        if (rejected < max_rejected
-                and not passes_gate(nu, innovation_covariance(self.kf.p, h, r), probability)):
-            self._rejected[kind] = rejected + 1
+        if not self.passes(dz, h, r, probability, max_rejected, kind):
             return False
-        self._rejected[kind] = 0
         self.update(dz, h, r)
         return True
 
