@@ -146,11 +146,12 @@ def _run(args: argparse.Namespace) -> int:
     if threading.current_thread() is threading.main_thread():
         previous = _install_stop_handlers()
     try:
-        return int(args.run(args) or 0)
-    except InputError as exc:
-        for problem in exc.problems:
-            print(f"error: {problem}", file=sys.stderr)
-        return 2
+        try:
+            return int(args.run(args) or 0)
+        except InputError as exc:  # a signal while this prints ends it as below
+            for problem in exc.problems:
+                print(f"error: {problem}", file=sys.stderr)
+            return 2
     except KeyboardInterrupt:
         print("interrupted: unfinished outputs were removed", file=sys.stderr)
         return 130

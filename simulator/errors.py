@@ -3,13 +3,14 @@
 Public classes
 --------------
 Problem, InputError, StorageError, Terminated, refuse_undecodable, storage_error,
-STORAGE_ERRNOS.
+STORAGE_ERRNOS, not_regular, refuse_unless_regular.
 """
 
 from __future__ import annotations
 
 import errno
 import os
+import stat
 from dataclasses import dataclass
 
 # a write refused by the machine's storage, whatever is written: no space left, a file larger
@@ -86,3 +87,38 @@ def refuse_undecodable(path: object, what: str = "name") -> None:
         shown = text.encode("utf-8", "backslashreplace").decode("ascii", "backslashreplace")
         raise InputError([Problem(shown, None, "", f"the {what} is not valid UTF-8 text; "
                                   "rename it")]) from None
+
+
+_KINDS = ((stat.S_ISDIR, "a folder"), (stat.S_ISFIFO, "a named pipe"),
+          (stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+          (stat.S_ISSOCK, "a socket"))
+
+
+def not_regular(path: object, folder: bool = False) -> str | None:
+    """What ``path`` is (links followed) when it is not a regular file (or, with ``folder``,
+    not a folder), for a message: ``"missing"``, ``"a dangling symbolic link"``, ``"a named
+    pipe"``, ``"a character device"`` (``/dev/zero``), ...; None when it is what is wanted.
+    Only ``stat`` is asked: nothing is opened, so a pipe or a device is never waited on or
+    read."""
+    try:
+        mode = os.stat(str(path)).st_mode
+    except FileNotFoundError:
+        return "a dangling symbolic link" if os.path.islink(str(path)) else "missing"
+    except OSError as exc:
+        return f"not accessible ({exc.strerror})"
+    if (stat.S_ISDIR if folder else stat.S_ISREG)(mode):
+        return None
+    if stat.S_ISREG(mode):
+        return "a file"
+    return next((kind for test, kind in _KINDS if test(mode)), "not a regular file")
+
+
+def refuse_unless_regular(path: object, what: str, folder: bool = False) -> None:
+    """Raise InputError naming ``path`` unless it is a regular file (with ``folder``, a
+    folder): ``what`` names what it should be (``"solution file"``); a device, a pipe or a
+    socket is refused unread, as what it is."""
+    kind = not_regular(path, folder)
+    if kind == "missing":
+        raise InputError([Problem(str(path), None, "", f"no such {what}")])
+    if kind is not None:
+        raise InputError([Problem(str(path), None, "", f"{kind}, not a {what}")])

@@ -20,8 +20,8 @@ Public names
 ------------
 FLICKER_ADEV_FACTOR, GM_ADEV_PEAK, GM_ADEV_PEAK_TAU, FLICKER_TAUS_S, gm_adev_peak,
 gauss_markov_continuous, gauss_markov_discrete,
-ar1_filter, white, random_walk, gauss_markov, flicker, gauss_markov_avar, flicker_avar,
-adev_model, stream_rng.
+ar1_filter, white, random_walk, gauss_markov, gauss_markov_at, flicker, gauss_markov_avar,
+flicker_avar, adev_model, stream_rng, child_rng.
 
 References
 ----------
@@ -215,7 +215,7 @@ def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generat
 
 
 def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarray,
-                 rng: np.random.Generator, columns: np.ndarray | None = None) -> np.ndarray:
+                 rng: np.random.Generator) -> np.ndarray:
     """Stationary first-order Gauss-Markov process, exact discretisation (Gelb 1974, Table 3.8-1).
 
     x[k+1] = exp(-dt/tau) x[k] + sigma sqrt(1 - exp(-2 dt/tau)) w[k], x[0] ~ N(0, sigma^2).
@@ -226,8 +226,6 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     dt_s : sample interval, s.
     sigma : stationary standard deviation per axis, shape (m,).
     tau_s : correlation time, s: one for all axes or one per axis, shape (m,).
-    columns : the axes wanted (indices), optional: the draws are made for all m axes (the
-        random stream is the same) and only these are filtered and returned, shape (n, k).
 
     Returns
     -------
@@ -237,12 +235,52 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
     drive = rng.standard_normal((n, sigma.size))
     drive[0] = rng.standard_normal(sigma.size)  # the stationary state x[0] / sigma
-    if columns is not None:
-        drive, sigma = drive[:, columns], sigma[columns]
-        if np.ndim(phi):  # one correlation time per axis
-            phi, q_unit = np.asarray(phi)[columns], np.asarray(q_unit)[columns]
     drive[0] /= np.sqrt(q_unit)  # which the filter's gain_in turns back into N(0, 1)
     return ar1_filter(drive, phi, overwrite=True, gain_in=np.sqrt(q_unit), gain_out=sigma)
+
+
+# the largest step (in correlation lengths) ``gauss_markov_at`` carries a state across: beyond it
+# the correlation exp(-step) is below 1e-13 and the state restarts (the exponents of one block
+# then stay within _AR1_BLOCK_LOG_RANGE however sparse the points)
+_GM_MAX_STEP = 30.0
+
+
+def gauss_markov_at(points: np.ndarray, rows: int, rng: np.random.Generator) -> np.ndarray:
+    """Unit-variance Gauss-Markov processes sampled exactly at ascending points (shape (n,), in
+    correlation lengths: any coordinate along which the process decorrelates, such as time /
+    tau or distance / D), one per column: shape (n, rows), correlation exp(-|p_i - p_j|).
+
+    The exact discretisation of a first-order Markov process between unequally spaced points
+    (Gelb 1974, Table 3.8-1, with a step of its own per interval): x_0 ~ N(0, 1),
+    x_k = e^{-dp_k} x_{k-1} + sqrt(1 - e^{-2 dp_k}) w_k. Solved without a loop over the samples,
+    as ``ar1_filter`` does: over a block of points within ``_AR1_BLOCK_LOG_RANGE`` of its first
+    point p_b, x_k = e^{-(p_k - p_b)} (e^{-(p_b - p_{b-1})} x_{b-1}
+    + cumsum_j e^{p_j - p_b} g_j w_j), one pass per block (about (p_n - p_0) / 300 of them).
+    """
+    p = np.asarray(points, dtype=float)
+    n = len(p)
+    x = rng.standard_normal((n, rows))
+    if n < 2:
+        return x
+    step = np.diff(p)
+    gain = np.sqrt(-np.expm1(-2.0 * step))  # the innovations' std, the first sample's is 1
+    x[1:] *= gain[:, None]
+    # the decorrelation accumulated along the points, each step capped (module constant)
+    s = np.concatenate([[0.0], np.cumsum(np.minimum(step, _GM_MAX_STEP))])
+    start, carry = 0, None
+    while start < n:  # one pass per block of points within the log range of its first
+        end = max(int(np.searchsorted(s, s[start] + _AR1_BLOCK_LOG_RANGE, side="right")),
+                  start + 1)
+        rel = s[start:end] - s[start]
+        block = x[start:end]
+        block *= np.exp(rel)[:, None]
+        if carry is not None:
+            block[0] += np.exp(-(s[start] - s[start - 1])) * carry
+        np.cumsum(block, axis=0, out=block)
+        block *= np.exp(-rel)[:, None]
+        carry = block[-1]
+        start = end
+    return x
 
 
 def flicker(n: int, dt_s: float, instability: np.ndarray, rng: np.random.Generator) -> np.ndarray:
@@ -349,3 +387,15 @@ def stream_rng(seed: int, name: str) -> np.random.Generator:
     normals, 8 % quicker than with the default PCG64."""
     return np.random.Generator(np.random.SFC64(np.random.SeedSequence(seed, spawn_key=(
         zlib.crc32(name.encode()),))))
+
+
+def child_rng(rng: np.random.Generator, name: str) -> np.random.Generator:
+    """The random stream named ``name`` inside the stream ``rng`` (one error process of a
+    sensor): the SeedSequence child of ``rng``'s seed keyed by the name (its spawn key extended
+    by the name's CRC-32), with ``rng``'s bit generator. It depends only on ``rng``'s seed and
+    the name, never on how many draws ``rng`` or any other child has made, so a process that
+    changes how many numbers it draws redraws no other process."""
+    seq = rng.bit_generator.seed_seq
+    return np.random.Generator(type(rng.bit_generator)(np.random.SeedSequence(
+        seq.entropy, spawn_key=(*seq.spawn_key, zlib.crc32(name.encode())),
+        pool_size=seq.pool_size)))

@@ -17,21 +17,21 @@ at 10 Hz) and update with each 1 Hz GPS fix: north and east position and horizon
 Tuning (``config: {tuning: datasheet | paper}``, ``estimators.builtin.cho2006_tuning``):
 ``paper`` is P0, Q and R of eqs. 33-35 and the paper's eight states; the reproduction names it.
 ``datasheet`` (the default) takes the noise and the sensor-error priors from the dataset's
-datasheet, R from each fix's HDOP, and adds what a consistent filter on a real car needs:
-accelerometer-bias states (DRM2's pitch and forward bias are one unobservable combination,
-eq. 11, so without the bias state its pitch claims the bias's accuracy), DRM2's pitch rate
-corrected for the body's roll in turns, the IMU's lateral velocity about the rear axle (in
-the position and, as w_z times it, in the speed's dynamics: ``drm2_transition``), DRM2's
-speed row as the fix's velocity along the heading (``_Drm2._fix_speed``: eq. 18's norm is
-rectified at a stop), fixes weighted down beyond a 99.9 % chi-square gate, and, with an
-odometer, a zero-velocity update at each stop (the DR running on until the stop is
-confirmed, since a wheel below its cut-off may still roll).
-The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set;
-``auto`` (the default) is the paper's simplex set with the paper's tuning and the symmetric
-set with the datasheet's: the simplex set's non-zero third moments move unobservable states
-under eq. 33's 180 deg heading prior (docs/reproduction_cho2006.md), and with the datasheet's
-R it lost the heading at the start on 3 of 10 seeds of two drives (urban canyon, garage),
-where the symmetric set converged on every seed.
+datasheet, R from each fix's HDOP and its own reported accuracy, and adds what a consistent
+filter on a real car needs: accelerometer-bias states (DRM2's pitch and forward bias are one
+unobservable combination, eq. 11, so without the bias state its pitch claims the bias's
+accuracy), DRM2's pitch rate corrected for the body's roll in turns, the IMU's lateral velocity
+about the rear axle (in the position and, as w_z times it, in the speed's dynamics:
+``drm2_transition``), DRM2's speed row as the fix's velocity along the heading
+(``_Drm2._fix_speed``: eq. 18's norm is rectified at a stop), fixes weighted down beyond a
+99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop (the DR running
+on until the stop is confirmed, since a wheel below its cut-off may still roll). The SPKF's
+``sigma_set: auto | simplex | symmetric`` picks the point set; ``auto`` (the default) is the
+paper's simplex set with the paper's tuning and the symmetric set with the datasheet's: the
+simplex set's non-zero third moments move unobservable states under eq. 33's 180 deg heading
+prior (docs/reproduction_cho2006.md), and with the datasheet's R it lost the heading at the
+start on 3 of 10 seeds of two drives (urban canyon, garage), where the symmetric set converged
+on every seed.
 
 Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction_cho2006.md)
 ----------------------------------------------------------------------------------------
@@ -117,6 +117,7 @@ from estimators.builtin.cho2006_tuning import (
     paper_tuning,
     stopped_speed_sigma,
 )
+from estimators.toolbox.datasheet import FixAccuracy, fix_error_model, ground_track_sigma
 from estimators.toolbox.gating import (
     FixNoiseMatching,
     chi2_threshold,
@@ -301,6 +302,8 @@ class _ChoDr(Estimator):
         self._increment = self.imu_output == "increment"
         fix = self.columns["gnss_fix"]
         self._fix_cols = (fix["fix"], fix["lat"], fix["lon"], fix["vn"], fix["ve"], fix["hdop"])
+        self._accuracy = FixAccuracy(fix)  # the receiver's own 1-sigma, NaN without it
+        self._fix_model = fix_error_model(self.datasheet)  # its budget (``excess_sigma``)
         self._s0 = self._s1 = self._s2 = 0.0  # the three inputs integrated over the DR step
         self._acc_t = 0.0  # time accumulated in the current DR step
         self._t_imu = init.t
@@ -478,7 +481,11 @@ class _ChoDr(Estimator):
             self._update(z, r)
             return
         x, p = self._predicted()
-        z[2] = self._fix_speed(vn, ve, x)
+        std_pos, std_vel = self._accuracy.read(row)
+        z[2], speed_sigma = self._fix_speed(vn, ve, x, std_vel)
+        reported = bool(np.isfinite(std_pos[:2]).all())
+        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan) if reported else None
+        r = self._tuning.reported_r(r, excess, speed_sigma)
         if p[4, 4] >= ALIGNED_HEADING_VAR:
             # the heading not yet found: the fixes weighted as eq. 35 weighs them, which lets the
             # 180 deg prior of eq. 33 converge (the sigma points span half a turn until then)
@@ -489,12 +496,15 @@ class _ChoDr(Estimator):
         if d2 > gate and p[4, 4] < ALIGNED_HEADING_VAR:
             r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
         self._update(z, r)
-        self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
+        if not reported:  # the fix's scatter learnt from its innovations instead
+            self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
 
-    def _fix_speed(self, vn: float, ve: float, x: np.ndarray) -> float:
-        """The speed row of a fix with the datasheet tuning: eq. 18's norm of the fix's
-        velocity (DRM2 overrides it)."""
-        return math.hypot(vn, ve)
+    def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
+                   ) -> tuple[float, float]:
+        """The speed row of a fix with the datasheet tuning and its 1-sigma from the fix's
+        reported velocity 1-sigma ``std_vel`` (NED; NaN when not reported): eq. 18's norm of
+        the fix's velocity, the 1-sigma along it (``ground_track_sigma``; DRM2 overrides it)."""
+        return math.hypot(vn, ve), ground_track_sigma(vn, ve, std_vel[0], std_vel[1])[0]
 
     # -- output ----------------------------------------------------------------------------
     @property
@@ -578,16 +588,18 @@ class _Drm2(_ChoDr):
         (``_fix_speed``), which keeps V's sign (the norm would let the EKF settle on -V)."""
         return x[:, :3], np.eye(3, x.shape[1])
 
-    def _fix_speed(self, vn: float, ve: float, x: np.ndarray) -> float:
+    def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
+                   ) -> tuple[float, float]:
         """The speed row of a fix with the datasheet tuning: the fix's velocity along the
         estimated heading, V + lat sin(dpsi) with the heading's error dpsi, unbiased with the
-        noise of one horizontal axis of the fix's velocity. Eq. 18's norm of it is rectified:
+        noise of one horizontal axis of the fix's velocity (its reported 1-sigma ``std_vel``
+        projected on the heading; NaN when not reported). Eq. 18's norm of it is rectified:
         at a stop, with 1-sigma s per axis, its mean is s sqrt(pi / 2) (Rayleigh), 0.04 m/s at
         s = 0.03, which held the SUMO city's stopped cars at 0.05 m/s under a sigma of
         0.006 (east velocity (error / sigma)^2 50 over a 23 s stop); in a turn it exceeds V by
         lat^2 / (2 V) of the IMU's lateral velocity lat."""
-        psi = float(x[4])
-        return vn * math.cos(psi) + ve * math.sin(psi)
+        c, s = math.cos(float(x[4])), math.sin(float(x[4]))
+        return vn * c + ve * s, math.hypot(c * std_vel[0], s * std_vel[1])
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()

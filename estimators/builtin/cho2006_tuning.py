@@ -29,7 +29,17 @@ the paper's printed values, or values derived from what a user knows.
     canyon errors hold for minutes, and a filter treating them as white believes the mean
     of its fixes to a fraction of their sigma); the speed's 1-sigma HDOP sigma_rate / sqrt(2)
     with the pseudorange-rate noise of an FLL at 40 dB-Hz (``RATE_SIGMA_M_S``, scaled by the
-    datasheet's ``tracking_noise``);
+    datasheet's ``tracking_noise``). A fix that reports its own accuracy (``std_*`` of
+    ``gnss_fix``, the receiver's least squares with its reflected signals;
+    ``Tuning.reported_r``) replaces the matching: the position's reported 1-sigma beyond the
+    receiver's budget (``toolbox.datasheet.FixErrorModel.excess_sigma``: the reflections,
+    which leave HDOP unchanged) is added to the HDOP's variance and counted as correlated
+    like it, and the speed row's 1-sigma is the fix's reported velocity 1-sigma along it. With
+    the HDOP's 0.04 m/s a canyon's reflected Doppler (0.2-0.6 m/s, reported so) left DRM2's
+    velocity (error / sigma)^2 at 2-4 on the unseen canyon, and the matching, which follows
+    the fixes' scatter only after it, left ``urban_canyon``'s north position at 6-27 (seeds
+    1-2); with the report every axis is at most 1 there (the position now too cautious, 0.07-0.7,
+    where the DR coasts through the canyon);
   - the car's model errors (``vehicle`` in the datasheet, absent on a rigid body): the
     forward-acceleration error of the planar model on a real body (surge and side slip,
     ``CAR_ACCEL_SIGMA_M_S2``); for DRM2 the body's roll and the IMU's lateral velocity. Its
@@ -144,6 +154,21 @@ class Tuning:
         pos = self.white_position_var(hdop) * scale * FIX_INFLATION**2
         speed = max(hdop * self.speed_sigma_m_s / math.sqrt(2.0), MIN_SPEED_SIGMA_M_S)
         return np.diag([pos, pos, speed**2])
+
+    def reported_r(self, r: np.ndarray, excess_ne: np.ndarray | None, speed_sigma: float
+                   ) -> np.ndarray:
+        """The noise ``r`` of a fix with what the fix reports of its own accuracy (module
+        docstring): the north and east 1-sigma ``excess_ne`` (m; None when not reported) of
+        its reported error beyond the receiver's budget (reflected signals,
+        ``FixErrorModel.excess_sigma``) added to the HDOP's variance, counted as correlated
+        like it, and the speed row's ``speed_sigma`` (m/s, NaN when not reported)."""
+        r = r.copy()
+        if excess_ne is not None:
+            r[0, 0] += excess_ne[0] ** 2 * FIX_INFLATION**2
+            r[1, 1] += excess_ne[1] ** 2 * FIX_INFLATION**2
+        if math.isfinite(speed_sigma):
+            r[2, 2] = max(speed_sigma, MIN_SPEED_SIGMA_M_S) ** 2
+        return r
 
 
 def paper_tuning(model: str) -> Tuning:

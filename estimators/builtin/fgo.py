@@ -16,12 +16,18 @@ rate enters as GTSAM's Coriolis rate, constant in that frame):
   local vertical turns by d / R from the frame's origin) is added to each specific-force sample
   with the current attitude, so the constant gravity of the preintegration stays exact.
 * GNSS: the fix's position at the antenna (the datasheet's lever arm) is the antenna's
-  position plus the fix's own error, a first-order Gauss-Markov state with the receiver's error
-  budget times the DOP as its steady-state sigma (the UERE of SPEC section 9's covariances)
-  and the receiver's carrier-smoothing time as its correlation time (a fix error correlated
-  over 100 s, taken as white, would make the smoother average it away and claim decimetres),
-  plus a white 0.5/0.5/1 m; and its
-  NED velocity as a prior on V_k (the lever arm's rotation term left out: 0.3 m/s at most in a
+  position plus the fix's own error, as the filters model it (``toolbox.datasheet.
+  fix_error_model``): its drive-long part (the signal-in-space error and the ionosphere's
+  residual, the budget's correlated range error times the DOP) a first-order Gauss-Markov
+  state of correlation time ``CORRELATED_TAU_S`` (30 min), plus white noise, the smoothed
+  error's white equivalent in quadrature with the fix's reported accuracy beyond the budget
+  (``excess_sigma``: the reflected signals of a canyon; ``std_*`` of ``gnss_fix``). The
+  horizontal sigma was once the budget without the ionosphere (0.6 m of range error for the
+  ``automotive`` receiver, 2.2 m with it) correlated over the carrier smoothing's 100 s: the
+  smoother averaged a drive-long error away (the quickstart's north (error / sigma)^2 36, 29
+  and 11 on three of eight seeds). Its NED
+  velocity, a prior on V_k with the fix's own velocity accuracy (``std_vn, std_ve, std_vd``;
+  0.1/0.1/0.2 m/s without them; the lever arm's rotation term left out: 0.3 m/s at most in a
   tight turn, inside the velocity sigma).
 * Odometer and non-holonomic constraint at each keyframe: the body velocity at the rear axle,
   R^T v + w x r = (s, 0, 0), with the odometer's speed s, forward sigma 0.1 m/s + 3 % of s and
@@ -55,6 +61,7 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
+from estimators.toolbox.datasheet import FixAccuracy, fix_error_model
 from estimators.toolbox.gnss_model import clock_noise, predict, raw_epoch
 from estimators.toolbox.installation import Installation
 from simulator.datasheet import fix_uere_m
@@ -75,10 +82,8 @@ BIAS_WALK_FLOOR = 1e-16  # an ideal IMU's bias still walks a little (the informa
 ODOMETER_FLOOR_M_S = 0.1
 ODOMETER_SCALE = 0.03     # unmodelled odometer scale error, 1-sigma
 DEFAULT_UERE_M = 3.0  # a datasheet without a receiver error budget
-FIX_VELOCITY_SIGMA_M_S = np.array([0.1, 0.1, 0.2])  # NED, the Doppler velocity's
+FIX_VELOCITY_SIGMA_M_S = np.array([0.1, 0.1, 0.2])  # NED, without the fix's own std_v*
 DEFAULT_DOP = 1.5
-FIX_ERROR_TAU_S = 60.0          # the fix error's correlation time without a datasheet value
-FIX_WHITE_SIGMA_M = np.array([0.5, 0.5, 1.0])  # the fix error's white part, NED
 
 OUTPUT_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                   "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd",
@@ -163,12 +168,9 @@ class FgoLooselyCoupled(Estimator):
         self._antenna = site.antenna if site.antenna is not None else np.zeros(3)
         self._rear = site.rear_axle if site.rear_axle is not None else np.zeros(3)
         self._slip = NonholonomicNoise(site.wheelbase or 2.7)
-        gnss = sheet.get("gnss") or {}
-        self._uere = fix_uere_m(gnss) or DEFAULT_UERE_M
-        self._uere_h = fix_uere_m(gnss, ionosphere=False) or DEFAULT_UERE_M
-        # the fix's error is correlated over the receiver's smoothing: a first-order
-        # Gauss-Markov state per keyframe (steady-state sigma UERE x DOP), plus a white part
-        self._fix_tau = float(gnss.get("carrier_smoothing") or 0.0) or FIX_ERROR_TAU_S
+        # the fix's error (``toolbox.datasheet.fix_error_model``, as the filters read it): the
+        # drive-long part a first-order Gauss-Markov state per keyframe, the rest white
+        self._fix_model = fix_error_model(sheet)
         self._e_key: int | None = None   # the last fix-error state, its time, value, covariance
         self._t_e = 0.0
         self._e_last = np.zeros(3)
@@ -180,6 +182,7 @@ class FgoLooselyCoupled(Estimator):
         fix_cols = c.get("gnss_fix", {})
         self._fix_cols = [fix_cols.get(k) for k in ("lat", "lon", "alt", "vn", "ve", "vd",
                                                     "fix")]
+        self._accuracy = FixAccuracy(fix_cols)
         self._hdop = fix_cols.get("hdop")
         self._vdop = fix_cols.get("vdop")
         self._speed_col = c.get("odometer", {}).get("speed")
@@ -332,8 +335,10 @@ class FgoLooselyCoupled(Estimator):
         vdop = float(row[self._vdop]) if self._vdop is not None else math.nan
         hdop = hdop if math.isfinite(hdop) else DEFAULT_DOP
         vdop = vdop if math.isfinite(vdop) else 2 * DEFAULT_DOP
-        sigma = np.array([self._uere_h * hdop / math.sqrt(2),
-                          self._uere_h * hdop / math.sqrt(2), self._uere * vdop])
+        model = self._fix_model
+        sigma = model.correlated_sigma(hdop, vdop)
+        std_pos, std_vel = self._accuracy.read(row)
+        white = np.hypot(model.white_sigma(hdop, vdop), model.excess_sigma(std_pos, hdop, vdop))
         e_key = self._e(k)
         current = self._smoother.calculateEstimate()
         if self._e_key is None:
@@ -341,19 +346,19 @@ class FgoLooselyCoupled(Estimator):
                                               gtsam.noiseModel.Diagonal.Sigmas(sigma)))
             values.insert(e_key, np.zeros(3))
         elif current.exists(self._e_key):
-            phi = math.exp(-(t - self._t_e) / self._fix_tau)
+            phi = math.exp(-(t - self._t_e) / model.correlated_tau)
             graph.add(gtsam.CustomFactor(
                 gtsam.noiseModel.Diagonal.Sigmas(sigma * math.sqrt(1.0 - phi * phi)),
                 [self._e_key, e_key], partial(_markov_error, phi, self._e_key, e_key)))
             values.insert(e_key, phi * current.atVector(self._e_key))
         else:  # the last error state left the window in an outage: its forecast as prior
-            phi = math.exp(-(t - self._t_e) / self._fix_tau)
+            phi = math.exp(-(t - self._t_e) / model.correlated_tau)
             cov = phi * phi * self._e_cov + np.diag(sigma**2) * (1.0 - phi * phi)
             graph.add(gtsam.PriorFactorVector(e_key, phi * self._e_last,
                                               gtsam.noiseModel.Gaussian.Covariance(cov)))
             values.insert(e_key, phi * self._e_last)
         graph.add(gtsam.CustomFactor(
-            gtsam.noiseModel.Diagonal.Sigmas(FIX_WHITE_SIGMA_M),
+            gtsam.noiseModel.Diagonal.Sigmas(white),
             [self._x(k), e_key], partial(_fix_error, ned, self._antenna, self._x(k),
                                          e_key)))
         self._e_key, self._t_e = e_key, t
@@ -361,7 +366,8 @@ class FgoLooselyCoupled(Estimator):
         if np.isfinite(v_fix).all():
             graph.add(gtsam.PriorFactorVector(
                 self._v(k), v_fix,
-                gtsam.noiseModel.Diagonal.Sigmas(FIX_VELOCITY_SIGMA_M_S)))
+                gtsam.noiseModel.Diagonal.Sigmas(np.where(np.isfinite(std_vel), std_vel,
+                                                          FIX_VELOCITY_SIGMA_M_S))))
         stamps[e_key] = t
 
     def _after_gnss(self, estimate, k: int) -> None:

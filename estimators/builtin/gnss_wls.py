@@ -66,7 +66,8 @@ tracked), ``clock_drift`` the drift (m/s).
 
 Public names
 ------------
-GnssWls, nlos_sigma (and ``nlos_probability`` from ``simulator.datasheet``).
+GnssWls (``nlos_sigma`` is ``toolbox.gnss_model``'s, ``nlos_probability``
+``simulator.datasheet``'s).
 """
 
 from __future__ import annotations
@@ -78,13 +79,8 @@ from scipy.stats import chi2
 from scipy.stats import t as student_t
 
 from estimators.base import Estimator
-from estimators.toolbox.gnss_model import predict, raw_epoch
-from simulator.datasheet import (
-    Cn0Template,
-    cn0_template,
-    iono_residual_fractions,
-    nlos_probability,
-)
+from estimators.toolbox.gnss_model import NLOS_SIGMA_M, nlos_sigma, predict, raw_epoch
+from simulator.datasheet import cn0_template, iono_residual_fractions
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 
 C_N0_FLOOR_M = 0.5      # a: the sigma of a strong signal, m
@@ -108,7 +104,7 @@ class GnssWls(Estimator):
     paper = "baseline: epoch-by-epoch weighted least squares (Misra & Enge 2011, 6.1-6.2)"
     initialises_itself = True
     output_rate_hz = 1.0
-    defaults = {"elevation_mask": 10.0, "nlos_sigma": 20.0}
+    defaults = {"elevation_mask": 10.0, "nlos_sigma": NLOS_SIGMA_M}
     config_help = {"elevation_mask": ("deg", "satellites below this elevation are left out"),
                    "nlos_sigma": ("m", "1-sigma of a reflected signal's extra path, added to "
                                        "a pseudorange whose C/N0 is far below the template")}
@@ -244,15 +240,6 @@ def _sigma(reported: np.ndarray, cn0: np.ndarray | None, floor: float) -> np.nda
         cn0 = np.where(np.isfinite(cn0), cn0, DEFAULT_CN0_DBHZ)
         model = np.sqrt(C_N0_FLOOR_M**2 + C_N0_SCALE_M**2 * 10.0 ** (-cn0 / 10.0))
     return np.where(np.isfinite(reported) & (reported > 0), reported, model)
-
-
-def nlos_sigma(sigma: np.ndarray, cn0: np.ndarray, elevation: np.ndarray,
-               template: Cn0Template, nlos_sigma_m: float) -> np.ndarray:
-    """Each pseudorange's 1-sigma with the reflected-signal (NLOS) error its C/N0 announces:
-    sigma^2 + p nlos_sigma_m^2, p = ``nlos_probability`` of its deficit below the template at
-    its elevation (module docstring)."""
-    p = nlos_probability(template.expected_dbhz(elevation) - cn0, template.scatter_db)
-    return np.sqrt(sigma**2 + p * nlos_sigma_m**2)
 
 
 def _tau_statistics(h: np.ndarray, weight: np.ndarray, residual: np.ndarray,

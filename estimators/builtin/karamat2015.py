@@ -110,7 +110,19 @@ gyro's noise density plus its scale factor and misalignment times the turn rate 
 correlated-noise inflation of the receiver's carrier smoothing
 (``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
 ``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon. A gate that trusts the filter's covariance locks the filter out when its error
+of a canyon, each pseudorange's R with the reflected-signal (NLOS) share its C/N0 deficit
+announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``; the gate keeps the
+reported variance alone: with the NLOS share in it too it passed more reflected ranges, the
+unseen canyon's height 2.5 -> 4.7 over seeds 1-3), the range rates'
+with the rear axle's sideways motion that eqs. 4-5 leave out (the tyres' slip in a turn,
+``toolbox.constraints.NonholonomicNoise``, along the body's right axis: in the sharp junction
+turns of a SUMO city, 60 deg/s at 5 m/s, the rear axle moves up to 6 deg off the heading, and
+the Doppler rows, taken as exact about it, turned the velocity's direction by 2-4 deg after
+each turn), the gyro's white noise and scale factor on the velocity's direction as on the
+azimuth (both turn by the same rate, eqs. 1, 22, 26), and the reported yaw's sigma that of
+the velocity's direction it is (``_yaw_sigma``; the azimuth state's, reported before, is not
+the heading's: at a stop the heading's error was 0.5-1.5 deg against an azimuth sigma of
+0.12 deg). A gate that trusts the filter's covariance locks the filter out when its error
 outgrows that covariance (after an outage: the altitude runaway and heading jump of a turn with
 two satellites are not in Q): every returning range fails, only the Doppler rows pass, and these
 keep P small while the position stays tens of metres off. So after ``REACQUIRE_EPOCHS`` (3)
@@ -138,10 +150,12 @@ import numpy as np
 
 from estimators.base import Estimator
 from estimators.toolbox import gating, gnss_model
+from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
+from simulator.datasheet import Cn0Template, cn0_template
 from simulator.earth import (
     OMEGA_E_RAD_S,
     geodetic_to_ecef,
@@ -158,6 +172,7 @@ STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
 _I = {name: i for i, name in enumerate(STATES)}
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``chan``)
 REACQUIRE_EPOCHS = 3  # epochs with most pseudoranges gated out before the covariance is matched
+DEFAULT_WHEELBASE_M = 2.7  # a saloon's, where the datasheet gives none
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
 
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
@@ -369,11 +384,15 @@ class RissTcEkf(Estimator):
         # the IMU from the mechanised point (body FRD, m): the rear axle's lever arm reversed
         rear = Installation.from_datasheet(self.datasheet).rear_axle
         self._arm = -rear if rear is not None and cfg["nhc_point"] == "rear_axle" else None
+        self._slip = NonholonomicNoise(Installation.from_datasheet(self.datasheet).wheelbase
+                                       or DEFAULT_WHEELBASE_M)
         self._wz = 0.0  # mean up-axis rate of the last interval, rad/s
         self._heading_offset = 0.0  # direction of travel minus azimuth state, while moving
         d_e, d_n, _, _ = self._arm_offset()
         self._lat, self._lon = self._moved(-d_n, -d_e)  # the rear axle at the start (at rest)
         self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n]]))
+        # the reported yaw's variance at the last moving row and the azimuth state's then
+        self._stop_heading_var = self._stop_az_var = float(self._filter.p[_I["A"], _I["A"]])
         self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
         self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n]
         self._tau = {s: tau for s, (_, tau) in gm.items()}  # s; infinite: a random walk
@@ -410,7 +429,9 @@ class RissTcEkf(Estimator):
         self._pr_inflation, self._gate_p = 1.0, self.config["gate_probability"]
         self._sf_psd = 0.0  # (rad/s)^2 s per (rad/s)^2 of turn rate: the gyro scale factor's
         sheet = ImuDatasheet.from_datasheet(self.datasheet)
-        if tuning != "datasheet" or sheet is None:
+        self._sheet_tuning = tuning == "datasheet" and sheet is not None
+        self._cn0_template: Cn0Template | None = None
+        if not self._sheet_tuning:
             return p0, q_white, gm
         g, a = sheet.gyro, sheet.accel
         gravity = 9.80665
@@ -427,6 +448,7 @@ class RissTcEkf(Estimator):
         for name, walk in (("bz", g.bias_walk), ("bx", a.bias_walk), ("by", a.bias_walk)):
             gm[name] = (walk, math.inf)
         receiver = self.datasheet.get("gnss") or {}
+        self._cn0_template = cn0_template(receiver)
         self._pr_inflation = gnss_model.correlated_noise_inflation(
             float(receiver.get("carrier_smoothing") or 0.0), 1.0)
         if self._gate_p is None:
@@ -587,12 +609,16 @@ class RissTcEkf(Estimator):
         reversing) when moving; at a standstill the last one, turned since by the azimuth
         state (the azimuth state itself drifts from the heading by up to tens of degrees,
         module docstring)."""
-        if abs(self._vo) > 1.0 and math.hypot(self._ve, self._vn) > 0.5:
+        if self._moving():
             sign = 1.0 if self._vo > 0.0 else -1.0
             heading = math.atan2(sign * self._ve, sign * self._vn)
             self._heading_offset = float(wrap_angle(heading - self._az))
             return heading
         return float(wrap_angle(self._az + self._heading_offset))
+
+    def _moving(self) -> bool:
+        """Fast enough for the velocity's direction to be the heading."""
+        return abs(self._vo) > 1.0 and math.hypot(self._ve, self._vn) > 0.5
 
     def _noise(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         """Gauss-Markov transition factors and the discrete process noise Q_d over ``dt``
@@ -632,9 +658,24 @@ class RissTcEkf(Estimator):
         if self._sf_psd:
             q_d = q_d.copy()
             q_d[_I["A"], _I["A"]] += self._sf_psd * wz_c**2 * dt
+        if self._sheet_tuning:
+            q_d = self._direction_noise(q_d, dt, wz_c)
         if self._vu_eq6:
             phi, q_d = self._vertical_velocity_is_eq6(phi, q_d, dt)
         self._filter.predict(phi, q_d)
+
+    def _direction_noise(self, q_d: np.ndarray, dt: float, wz_c: float) -> np.ndarray:
+        """The horizontal velocity's direction turns by the same gyro rate as the azimuth
+        (eqs. 22, 26), so the gyro's white noise and scale-factor error that the azimuth's
+        white noise holds turn it too: Q gains q g g^T, g = (1 on A, v_n on v_e, -v_e on v_n)
+        (F's b_z column for eqs. 24, 28), less the azimuth's own share already on the
+        diagonal."""
+        q = (self._q_white[_I["A"]] + self._sf_psd * wz_c**2) * dt
+        g = np.zeros(self._n)
+        g[_I["A"]], g[_I["ve"]], g[_I["vn"]] = 1.0, self._vn, -self._ve
+        q_d = q_d + q * np.outer(g, g)
+        q_d[_I["A"], _I["A"]] -= q
+        return q_d
 
     def _vertical_velocity_is_eq6(self, phi: np.ndarray, q_d: np.ndarray, dt: float
                                   ) -> tuple[np.ndarray, np.ndarray]:
@@ -719,13 +760,16 @@ class RissTcEkf(Estimator):
         dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
         var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
         var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
-        r = np.diag(np.concatenate([var_pr * self._pr_inflation**2, var_rate]))
+        var_nlos = self._nlos_variance(epoch)
+        r = np.diag(np.concatenate([var_pr * self._pr_inflation**2 + var_nlos, var_rate]))
         # the mechanised velocity carries the white noise of the last odometer speed: it enters
         # every predicted rate through the forward axis, so R gains sigma^2 g g^T
         forward = np.array([math.cos(self._az), math.sin(self._az), 0.0]) * math.cos(self._pitch)
         forward[2] = -math.sin(self._pitch)
         g = d_ned @ forward
         r[m:, m:] += self.config["odometer_speed_noise"] ** 2 * np.outer(g, g)
+        if self._sheet_tuning and self._vo != 0.0:
+            r[m:, m:] += self._side_slip_variance(d_ned)
         keep = np.ones(2 * m, dtype=bool)
         if self._gate_p is not None:
             keep[:m] = self._gate_ranges(dz[:m], h[:m], var_pr)
@@ -733,6 +777,29 @@ class RissTcEkf(Estimator):
         self.nis_gnss = gating.normalised_innovation_squared(dz[keep], s)
         self.nis_gnss_dof = float(keep.sum())
         self._feedback()
+
+    def _nlos_variance(self, epoch: gnss_model.RawEpoch) -> np.ndarray | float:
+        """Each pseudorange's variance from a reflected (NLOS) signal's extra path, which the
+        receiver's reported sigma does not hold: p (20 m)^2, p the probability that it is
+        reflected given its C/N0 deficit below the receiver's template (``tuning: datasheet``
+        with a template, C/N0 and elevations; ``gnss_model.nlos_sigma``, as ``gnss_wls``). In
+        R only: the gate tests against the reported variance."""
+        if (self._cn0_template is None or epoch.cn0 is None or epoch.elevation is None):
+            return 0.0
+        cn0 = np.where(np.isfinite(epoch.cn0), epoch.cn0, np.inf)  # none: not reflected
+        return gnss_model.nlos_sigma(np.zeros(len(cn0)), cn0, epoch.elevation,
+                                     self._cn0_template, gnss_model.NLOS_SIGMA_M) ** 2
+
+    def _side_slip_variance(self, d_ned: np.ndarray) -> np.ndarray:
+        """The range rates' covariance from the rear axle's sideways motion, which eqs. 4-5
+        (the velocity along the heading) leave out: the tyres' slip in a turn and the body's
+        other motion (``toolbox.constraints.NonholonomicNoise``: 3.5 deg of slip at 5 m/s^2 of
+        lateral acceleration), sigma^2 g g^T with g the rates' gradient along the body's right
+        axis."""
+        lateral, _ = self._slip.sigma(self._vo, self._wz - self._bz, self._ao)
+        heading = self._heading()
+        g = d_ned @ np.array([-math.sin(heading), math.cos(heading), 0.0])
+        return lateral**2 * np.outer(g, g)
 
     def _gate_ranges(self, dz: np.ndarray, h: np.ndarray, var_pr: np.ndarray) -> np.ndarray:
         """The pseudoranges passing the chi-square gate, each against H P H^T + its reported
@@ -821,8 +888,25 @@ class RissTcEkf(Estimator):
         return [math.degrees(lat), math.degrees(lon), self._h + self._vu * lead,
                 vn_i, ve_i, -self._vu, self._roll, self._pitch, self._heading(),
                 math.sqrt(p[i["N"], i["N"]]), math.sqrt(p[i["E"], i["E"]]),
-                math.sqrt(p[i["h"], i["h"]]), math.sqrt(p[i["A"], i["A"]]),
+                math.sqrt(p[i["h"], i["h"]]), self._yaw_sigma(),
                 -self._bz, accel[0], accel[1], *clock, *self._take_nis()]
+
+    def _yaw_sigma(self) -> float:
+        """1-sigma of the reported yaw (``_heading``). ``tuning: paper``: the azimuth state's.
+        ``tuning: datasheet``: while moving, the horizontal velocity's direction's, from the
+        velocity states (d heading = (v_n dv_e - v_e dv_n) / v^2); at a standstill, that of the
+        last moving row plus what the azimuth state's variance grew since."""
+        p = self._filter.p
+        p_az = p[_I["A"], _I["A"]]
+        if not self._sheet_tuning:
+            return math.sqrt(p_az)
+        if self._moving():
+            v2 = self._ve**2 + self._vn**2
+            j = np.array([self._vn, -self._ve]) / v2
+            block = p[_I["ve"]:_I["vn"] + 1, _I["ve"]:_I["vn"] + 1]
+            self._stop_heading_var = float(j @ block @ j)
+            self._stop_az_var = p_az
+        return math.sqrt(self._stop_heading_var + max(0.0, p_az - self._stop_az_var))
 
     def _take_nis(self) -> tuple[float, float]:
         """The NIS of the last GNSS update and its dof, once (NaN in the rows after it)."""

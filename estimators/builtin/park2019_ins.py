@@ -133,7 +133,9 @@ from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
     fix_error_model,
+    fix_velocity_sigma,
     imu_error_model,
+    nlos_position_rows,
     odometer_delay_s,
     odometer_speed_sigma,
     odometer_window_s,
@@ -304,16 +306,13 @@ class ParkInsOdometer(Estimator):
             self._dop_known = True
         # the error the fix reports beyond the budget (reflections): its unit states' gain
         std_pos, std_vel = self._accuracy.read(row)
-        gain, white = model.nlos_split(std_pos, *dops)
-        nlos = ins.extra_start + 3
-        dz_p += gain * ins.extra[3:6]
-        h_p[:, nlos:nlos + 3] = np.diag(gain)
+        r_p = nlos_position_rows(model, std_pos, *dops, dz_p, h_p, ins.extra[3:6],
+                                 ins.extra_start + 3)
         # a fix that does not fit (a reflected signal's metres) is left out, not averaged in
-        ins.gated_update(dz_p, h_p, np.diag(model.white_sigma(*dops) ** 2 + white),
-                         GATE_PROBABILITY)
+        ins.gated_update(dz_p, h_p, r_p, GATE_PROBABILITY)
         rows = keep[3:]
         if rows.any():  # the fix's own velocity accuracy, else the datasheet's at its DOPs
-            sigma_v = np.where(np.isfinite(std_vel), std_vel, model.velocity_sigma(*dops))
+            sigma_v = fix_velocity_sigma(model, std_vel, *dops)
             ins.gated_update(dz_v[rows], h_v[rows], np.diag(sigma_v[rows] ** 2),
                              GATE_PROBABILITY)
 

@@ -238,6 +238,40 @@ class _Epoch:
             setattr(self, name, getattr(self, name)[index])
 
 
+class _Track:
+    """The last time and values seen of each integer key of one receiver (the per-signal
+    state of the slip detectors), as sorted arrays: looked up and replaced an epoch at a
+    time."""
+
+    def __init__(self, n_values: int):
+        self.keys = np.zeros(0, dtype=np.int64)
+        self.t = np.zeros(0)
+        self.values = np.zeros((0, n_values))
+
+    def swap(self, keys: np.ndarray, t: float, values: np.ndarray
+             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Store ``values`` (len(keys), n_values) seen at ``t`` for the unique ``keys``;
+        returns whether each key was known, and its previous time and values (NaN where
+        not)."""
+        at = np.searchsorted(self.keys, keys)
+        known = at < len(self.keys)
+        known[known] = self.keys[at[known]] == keys[known]
+        at = at[known]
+        prev_t = np.full(len(keys), np.nan)
+        prev = np.full(values.shape, np.nan)
+        prev_t[known] = self.t[at]
+        prev[known] = self.values[at]
+        self.t[at] = t
+        self.values[at] = values[known]
+        if not known.all():
+            new = ~known
+            order = np.argsort(np.r_[self.keys, keys[new]], kind="stable")
+            self.keys = np.r_[self.keys, keys[new]][order]
+            self.t = np.r_[self.t, np.full(int(new.sum()), t)][order]
+            self.values = np.concatenate([self.values, values[new]])[order]
+        return known, prev_t, prev
+
+
 def _geometry_free(keys: np.ndarray, phase_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Per satellite with two bands or more: lambda_1 phi_1 - lambda_2 phi_2 of its first two
     (by band key), and the satellite's part of the key; signals sorted by key."""
@@ -285,7 +319,8 @@ class RtkInsEkf(Estimator):
                              p0, imu, mounting=site.mounting,
                              extra_sigma=np.zeros(n_slots + n_iono),
                              extra_tau=np.r_[np.full(n_slots, np.inf),
-                                             np.full(n_iono, cfg["iono_correlation_time"])])
+                                             np.full(n_iono, cfg["iono_correlation_time"])],
+                             sparse=True)
         self._code_inflation = gnss_model.correlated_noise_inflation(
             float(cfg["code_correlation_time"]), float(cfg["gnss_interval"]))
         self._phase_inflation = gnss_model.correlated_noise_inflation(
@@ -298,9 +333,10 @@ class RtkInsEkf(Estimator):
         self._iono_seen: dict[int, float] = {}
         self._held: set[int] = set()
         self._last_seen: dict[int, float] = {}
-        self._half: set[int] = set()
-        self._lock: dict[int, tuple[float, float]] = {}
-        self._gf: dict[tuple[int, int], tuple[float, float]] = {}
+        # per receiver (rover, base): each signal's lock time and half-cycle flag, each
+        # satellite's geometry-free phase, when last seen
+        self._signal_track = (_Track(2), _Track(2))
+        self._gf_track = (_Track(1), _Track(1))
         self._base: tuple[float, np.ndarray] | None = None
         self._status = np.nan
         self._status_t = -np.inf
@@ -309,6 +345,8 @@ class RtkInsEkf(Estimator):
         self._fixed_dx: np.ndarray | None = None  # the fix's correction of the nav errors
         self._fixed_p: np.ndarray | None = None
         self._phase_rows: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+        self._held_epoch = False  # the epoch's double differences all held
+        self._groups = np.zeros(0, dtype=np.int64)  # the epoch's signals' groups
         self._pending = np.zeros(0, dtype=bool)  # half cycle unresolved, per signal
         self.nis_gnss = np.nan
         self.nis_gnss_dof = np.nan
@@ -415,29 +453,21 @@ class RtkInsEkf(Estimator):
         """Reset the ambiguity of every signal with a slip or a loss of lock at either
         receiver (module docstring): LLI bit 0, a lock time that fell, a half cycle that
         cleared, a geometry-free jump, a gap."""
-        slipped: set[int] = set()
         max_gap = float(self.config["max_gap"])
-        for rx, ep in enumerate((rover, base)):
-            for key, lli, lock in zip(ep.keys.tolist(), ep.lli.tolist(), ep.lock.tolist(),
-                                      strict=True):
-                prev = self._lock.get((rx, key))
-                if lli & LOSS_OF_LOCK or (prev is not None and (lock < prev[1] - 1e-6
-                                                                 or t - prev[0] > max_gap)):
-                    slipped.add(key)
-                self._lock[(rx, key)] = (t, lock)
-                half_key = rx * 10**12 + key
-                if lli & HALF_CYCLE:
-                    self._half.add(half_key)
-                elif half_key in self._half:
-                    self._half.discard(half_key)
-                    slipped.add(key)
+        slipped = []
+        for ep, signals, satellites in zip((rover, base), self._signal_track,
+                                           self._gf_track, strict=True):
+            half = (ep.lli & HALF_CYCLE) != 0
+            known, prev_t, prev = signals.swap(ep.keys, t, np.stack([ep.lock, half], axis=1))
+            lost = ((ep.lli & LOSS_OF_LOCK) != 0) | (known & (
+                (ep.lock < prev[:, 0] - 1e-6) | (t - prev_t > max_gap) | ((prev[:, 1] == 1.0)
+                                                                          & ~half)))
             sats, gf = _geometry_free(ep.keys, ep.raw_phase_m)
-            for sat, value in zip(sats.tolist(), gf.tolist(), strict=True):
-                prev = self._gf.get((rx, sat))
-                self._gf[(rx, sat)] = (t, value)
-                if (prev is not None and t - prev[0] <= max_gap
-                        and abs(value - prev[1]) > self.config["slip_geometry_free"]):
-                    slipped.update(int(k) for k in ep.keys[ep.keys // 10_000 == sat])
+            known, prev_t, prev = satellites.swap(sats, t, gf[:, None])
+            jumped = sats[known & (t - prev_t <= max_gap)
+                          & (np.abs(gf - prev[:, 0]) > self.config["slip_geometry_free"])]
+            slipped.append(ep.keys[lost | np.isin(ep.keys // 10_000, jumped)])
+        slipped = np.unique(np.concatenate(slipped)).tolist()
         for key in slipped:
             self._release(key)
         stale = [k for k, seen in self._last_seen.items() if t - seen > max_gap]
@@ -507,17 +537,21 @@ class RtkInsEkf(Estimator):
 
     # -- measurement update --------------------------------------------------------------------
     def _geometry(self, rover: _Epoch, base: _Epoch) -> tuple[np.ndarray, np.ndarray,
-                                                                np.ndarray]:
-        """Single-differenced predicted ranges (m), NED lines of sight of the rover (m, 3) and
-        the baseline length (m)."""
+                                                                np.ndarray, float]:
+        """Single-differenced predicted ranges (m), NED lines of sight of the rover (m, 3),
+        the skew matrix of the lever arm in NED (the attitude error's columns) and the
+        baseline length (m)."""
         ins = self.ins
         c_bn = quat_to_dcm(ins.q)
         c_ne = ned_to_ecef_matrix(ins.pos[0], ins.pos[1])
-        antenna = geodetic_to_ecef(*ins.pos) + c_ne @ (c_bn @ self._lever)
-        rng_r, _, los = gnss_model.predict(rover.sat_pos, rover.sat_vel, antenna, np.zeros(3))
-        rng_b, _, _ = gnss_model.predict(base.sat_pos, base.sat_vel, self._base_xyz,
-                                         np.zeros(3))
-        return rng_r - rng_b, los @ c_ne, float(np.linalg.norm(antenna - self._base_xyz))
+        arm = c_bn @ self._lever
+        antenna = geodetic_to_ecef(*ins.pos) + c_ne @ arm
+        # the two receivers in one call: (2, m, 3) satellites against (2, 3) antennas
+        rng, _, los = gnss_model.predict(np.stack([rover.sat_pos, base.sat_pos]),
+                                         np.stack([rover.sat_vel, base.sat_vel]),
+                                         np.stack([antenna, self._base_xyz]), np.zeros(3))
+        return (rng[0] - rng[1], los[0] @ c_ne, skew(arm),
+                float(np.linalg.norm(antenna - self._base_xyz)))
 
     def _sd_variance(self, rover: _Epoch, base: _Epoch, baseline: float, code: bool
                      ) -> np.ndarray:
@@ -532,63 +566,59 @@ class RtkInsEkf(Estimator):
             base_std = cfg["base_phase_std"] * self._phase_inflation
         return (rover_std**2 + base_std**2) / sin_el**2
 
-    def _rows(self, rover: _Epoch, base: _Epoch, slots: np.ndarray
-              ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                         np.ndarray, np.ndarray, np.ndarray]:
-        """dz, H, R of the DD code rows, then of the DD phase rows, with each phase row's
-        signal and reference indices."""
+    def _rows(self, rover: _Epoch, base: _Epoch, geometry: tuple[np.ndarray, np.ndarray,
+                                                                   np.ndarray, float],
+              sel: np.ndarray, priority: np.ndarray | None, observed: np.ndarray,
+              slots: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray,
+                                                 np.ndarray, np.ndarray]:
+        """dz, H, R of the double differences of the signals ``sel`` (their single
+        differences ``observed``, m): code rows, or phase rows with the signals' ambiguity
+        ``slots``; and each row's signal and reference indices. ``geometry``: the
+        single-differenced ranges, the NED lines of sight, the lever arm's attitude columns
+        and the baseline (``_geometry``)."""
         ins = self.ins
-        n = ins.n_states
-        sd_range, u, baseline = self._geometry(rover, base)
-        arm = skew(quat_to_dcm(ins.q) @ self._lever)
-        groups = ddiff.group_of(rover.keys)
-
-        def rows(sel: np.ndarray, priority: np.ndarray | None, observed: np.ndarray,
-                 code: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray,
-                                      np.ndarray]:
-            idx = np.flatnonzero(sel)
-            ref = ddiff.references(groups[idx], rover.elevation[idx],
-                                   None if priority is None else priority[idx])
-            d, nonref = ddiff.difference_matrix(ref)
-            sig, refs = idx[nonref], idx[ref[nonref]]
-            du = u[sig] - u[refs]
-            h = np.zeros((len(sig), n))
-            h[:, 0:3] = -du
-            h[:, 6:9] = du @ arm
-            dz = d @ (sd_range[idx] - observed[idx])
-            # the single-difference ionosphere: the code delayed, the phase advanced
-            sign = 1.0 if code else -1.0
-            for rows_of, iono in ((sig, self._iono[sig]), (refs, self._iono[refs])):
-                have = iono >= 0
-                g = (sign * rover.gamma[rows_of[have]] * self._iono_scale[rows_of[have]]
-                     * (1.0 if rows_of is sig else -1.0))
-                h[np.flatnonzero(have), N_STATES + iono[have]] += g
-                dz[have] += g * ins.extra[iono[have]]
-            if not code:
-                lam = rover.wavelength[sig]
-                a = ins.extra[slots[sig]] - ins.extra[slots[refs]]
-                dz = dz + lam * a
-                h[np.arange(len(sig)), N_STATES + slots[sig]] = lam
-                h[np.arange(len(sig)), N_STATES + slots[refs]] = -lam
-            var = self._sd_variance(rover, base, baseline, code)[idx]
-            return dz, h, ddiff.double_difference_covariance(d, var), sig, refs
-
-        sd_code = rover.code - base.code
-        sd_phase = rover.phase - base.phase
-        code = rows(np.ones(len(rover.keys), dtype=bool), None, sd_code, True)
-        has_slot = slots >= 0
-        priority = np.array([2 if int(k) in self._held else 1 for k in rover.keys])
-        phase = rows(has_slot, priority, sd_phase, False)
-        return (code[0], code[1], code[2], phase[0], phase[1], phase[2], phase[3], phase[4])
+        sd_range, u, arm, baseline = geometry
+        code = slots is None
+        idx = np.flatnonzero(sel)
+        ref = ddiff.references(self._groups[idx], rover.elevation[idx],
+                               None if priority is None else priority[idx])
+        d, nonref = ddiff.difference_matrix(ref)
+        sig, refs = idx[nonref], idx[ref[nonref]]
+        du = u[sig] - u[refs]
+        h = np.zeros((len(sig), ins.n_states))
+        h[:, 0:3] = -du
+        h[:, 6:9] = du @ arm
+        dz = d @ (sd_range[idx] - observed[idx])
+        # the single-difference ionosphere: the code delayed, the phase advanced
+        sign = 1.0 if code else -1.0
+        for rows_of, side in ((sig, 1.0), (refs, -1.0)):
+            iono = self._iono[rows_of]
+            have = iono >= 0
+            g = (sign * side) * rover.gamma[rows_of[have]] * self._iono_scale[rows_of[have]]
+            h[np.flatnonzero(have), N_STATES + iono[have]] += g
+            dz[have] += g * ins.extra[iono[have]]
+        if not code:
+            lam = rover.wavelength[sig]
+            a = ins.extra[slots[sig]] - ins.extra[slots[refs]]
+            dz = dz + lam * a
+            h[np.arange(len(sig)), N_STATES + slots[sig]] = lam
+            h[np.arange(len(sig)), N_STATES + slots[refs]] = -lam
+        var = self._sd_variance(rover, base, baseline, code)[idx]
+        return dz, h, ddiff.double_difference_covariance(d, var), sig, refs
 
     def _update(self, rover: _Epoch, base: _Epoch, slots: np.ndarray) -> None:
         """One update with the epoch's DD code (gated) and phase rows; phase innovations the
         INS did not predict are slips (their states reset, the rows formed again)."""
         ins = self.ins
         self._phase_rows = None
+        self._groups = ddiff.group_of(rover.keys)
+        geometry = self._geometry(rover, base)
+        sd_phase = rover.phase - base.phase
         for _ in range(2):
-            dz_c, h_c, r_c, dz_p, h_p, r_p, sig, refs = self._rows(rover, base, slots)
-            s_p = np.einsum("ij,ij->i", h_p @ ins.kf.p, h_p) + np.diag(r_p)
+            priority = np.where(np.isin(rover.keys, self._held_keys()), 2, 1)
+            dz_p, h_p, r_p, sig, refs = self._rows(rover, base, geometry, slots >= 0, priority,
+                                                   sd_phase, slots)
+            s_p = gating.innovation_variances(ins.kf.p, h_p, r_p)
             lam = rover.wavelength[sig]
             bad = ((np.abs(dz_p) > self.config["slip_sigmas"] * np.sqrt(s_p))
                    & (np.abs(dz_p) > self.config["slip_cycles"] * lam))
@@ -605,28 +635,39 @@ class RtkInsEkf(Estimator):
                     self._release(key)
                     slots[i] = -1
             slots = self._reassign(rover, base, slots)
-        s_c = np.einsum("ij,ij->i", h_c @ ins.kf.p, h_c) + np.diag(r_c)
-        keep = gating.rows_passing(dz_c, s_c, float(self.config["gate_probability"]))
-        if not self.config["held_code"] and self._all_held(rover, sig, refs):
-            keep[:] = False
-        dz = np.concatenate([dz_c[keep], dz_p])
-        h = np.vstack([h_c[keep], h_p])
-        r = np.zeros((len(dz), len(dz)))
-        k = int(keep.sum())
-        r[:k, :k] = r_c[np.ix_(keep, keep)]
-        r[k:, k:] = r_p
+        self._held_epoch = self._all_held(rover, sig, refs)
+        keep_code = self.config["held_code"] or not self._held_epoch
+        if keep_code:
+            dz_c, h_c, r_c, _, _ = self._rows(rover, base, geometry,
+                                              np.ones(len(rover.keys), dtype=bool), None,
+                                              rover.code - base.code, None)
+            s_c = gating.innovation_variances(ins.kf.p, h_c, r_c)
+            keep = gating.rows_passing(dz_c, s_c, float(self.config["gate_probability"]))
+            dz_c, h_c, r_c = dz_c[keep], h_c[keep], r_c[np.ix_(keep, keep)]
+        else:
+            dz_c, h_c, r_c = np.zeros(0), np.zeros((0, ins.n_states)), np.zeros((0, 0))
+        dz = np.concatenate([dz_c, dz_p])
         if len(dz) == 0:
             return
+        h = np.vstack([h_c, h_p])
+        k = len(dz_c)
+        r = np.zeros((len(dz), len(dz)))
+        r[:k, :k] = r_c
+        r[k:, k:] = r_p
         s = ins.update(dz, h, r)
         self.nis_gnss = gating.normalised_innovation_squared(dz, s)
         self.nis_gnss_dof = float(len(dz))
         self._phase_rows = (sig, refs, slots)
 
+    def _held_keys(self) -> np.ndarray:
+        """The keys of the held ambiguities."""
+        return np.fromiter(self._held, dtype=np.int64, count=len(self._held))
+
     def _all_held(self, rover: _Epoch, sig: np.ndarray, refs: np.ndarray) -> bool:
         """Whether the epoch's double differences (signals ``sig`` against ``refs``) are at
         least ``min_fixed`` and all of held ambiguities."""
-        return len(sig) >= self.config["min_fixed"] and all(
-            int(rover.keys[i]) in self._held for i in np.unique(np.r_[sig, refs]))
+        return len(sig) >= self.config["min_fixed"] and bool(
+            np.isin(rover.keys[np.r_[sig, refs]], self._held_keys()).all())
 
     def _reassign(self, rover: _Epoch, base: _Epoch, slots: np.ndarray) -> np.ndarray:
         """Slots again after resets: the reset signals start new ambiguities."""
@@ -650,7 +691,7 @@ class RtkInsEkf(Estimator):
         sig, refs, slots = rows
         keys = [int(rover.keys[i]) for i in np.unique(np.r_[sig, refs])]
         cfg = self.config
-        if self._all_held(rover, sig, refs):
+        if self._held_epoch:
             self._status = 2.0
             self._n_fixed = len(sig)
             return

@@ -56,11 +56,20 @@ What the paper gives and what is chosen here:
   (P0), its scale factors as bias process noise; the fix's error as three Gauss-Markov states
   of the receiver's correlated error budget (30 min, sized by the first fix's DOPs) plus the
   white equivalent of its smoothed noise, behind a chi-square gate (0.999), and the fix's
-  velocity (its datasheet noise; Tan uses positions only, and with the white equivalent of
-  the smoothed position noise alone the velocity's sigma was ten times its error; per axis
-  its noise is raised to the innovations' scatter by covariance matching,
-  ``gating.FixNoiseMatching``: in a street canyon the reflected Doppler is 0.2-0.6 m/s at
-  the same DOPs, and the unseen canyon's seed 1 had velocity north and east 6.4 and 7.7,
+  velocity (Tan uses positions only, and with the white equivalent of the smoothed position
+  noise alone the velocity's sigma was ten times its error). What the fix reports of its
+  own accuracy (``std_*`` of ``gnss_fix``, the receiver's least squares with its reflected
+  signals; ``toolbox.datasheet.FixAccuracy``) is taken as ``ins_odo_ekf`` takes it: the
+  position's 1-sigma beyond the budget (reflected signals) as three unit NLOS states after
+  the fix's (``datasheet.nlos_position_rows``), the velocity's 1-sigma as its noise. In a
+  street canyon the reflected fixes sink by 20-50 m at a VDOP of 1.5-2.9, reporting 20-37 m
+  for it; with the DOPs' 3 m the filter followed them down under a 3.5 m sigma and held the
+  offset in its 30-minute fix-error states (the unseen canyon's height (error / sigma)^2
+  9.6 and 13.5 on seeds 1 and 2, 0.59 and 1.1 with the report; ``urban_canyon``'s height
+  8.6 and 14, vertical velocity 18 and 18, then 0.19 and 0.60, 1.4 and 0.41). A fix
+  without the columns has its velocity noise raised per axis to the innovations' scatter by
+  covariance matching instead (``gating.FixNoiseMatching``: the reflected Doppler is 0.2-0.6
+  m/s at the same DOPs; the unseen canyon's seed 1 had velocity north and east 6.4 and 7.7,
   roll and pitch 3.5 and 3.4 without it, 1.3, 0.72, 0.66 and 1.2 with it); the
   magnetometer heading's variance from the datasheet's field disturbance (correlated over its
   ``disturbance_time``), noise and soft iron over the learnt horizontal field (with the
@@ -101,7 +110,14 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox import aiding
 from estimators.toolbox.constraints import NonholonomicNoise, height, nonholonomic
-from estimators.toolbox.datasheet import fix_error_model, imu_error_model
+from estimators.toolbox.datasheet import (
+    NLOS_TIME_CONSTANT_S,
+    FixAccuracy,
+    fix_error_model,
+    fix_velocity_sigma,
+    imu_error_model,
+    nlos_position_rows,
+)
 from estimators.toolbox.gating import FixNoiseMatching
 from estimators.toolbox.ins_error import BG, N_STATES
 from estimators.toolbox.ins_filter import SOLUTION_COLUMNS, InsFilter, InsNoise
@@ -180,12 +196,16 @@ class TanLinearisedKF(Estimator):
             p0 = self.P0_SIGMA.copy()
             p0[9:12], p0[12:15] = noise.accel_bias_initial, noise.gyro_bias_initial
             self._fix_model = fix_error_model(self.datasheet)
-            markov = dict(extra_sigma=self._fix_model.correlated_sigma(1.0, 2.0),
-                          extra_tau=np.full(3, self._fix_model.correlated_tau))
+            # the fix's correlated error, then its reflected (NLOS) error as unit states
+            markov = dict(extra_sigma=np.r_[self._fix_model.correlated_sigma(1.0, 2.0),
+                                            np.ones(3)],
+                          extra_tau=np.r_[np.full(3, self._fix_model.correlated_tau),
+                                          np.full(3, NLOS_TIME_CONSTANT_S)])
         self._noise = noise
         self._dop_known = False
         c = self.columns["gnss_fix"]
         self._dop = [c.get("hdop"), c.get("vdop")]
+        self._accuracy = FixAccuracy(c)
         self.ins = InsFilter(self.initial, self.columns["imu"], self.imu_output == "increment",
                              p0, noise, mounting=site.mounting, **markov)
         self._antenna = site.antenna
@@ -208,7 +228,8 @@ class TanLinearisedKF(Estimator):
                          if "mag" in self.columns else None)
         self._moving_fix = False
         self._next_solve = self._t0
-        # per NED axis, the fix velocity's noise matched to its innovations (datasheet tuning)
+        # per NED axis, the fix velocity's noise matched to its innovations (datasheet tuning,
+        # a fix that does not report its accuracy)
         self._velocity_matching = [FixNoiseMatching() for _ in range(3)]
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
@@ -323,19 +344,21 @@ class TanLinearisedKF(Estimator):
         dz, h = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna, ins.n_states)
         dz += ins.extra[:3]
         h[:, N_STATES:N_STATES + 3] = np.eye(3)
+        std_pos, std_vel = self._accuracy.read(row)
+        r = nlos_position_rows(model, std_pos, *dops, dz, h, ins.extra[3:6], N_STATES + 3)
         rows = slice(0, 3) if math.isfinite(pos[2]) else slice(0, 2)
-        ins.gated_update(dz[rows], h[rows], np.diag(model.white_sigma(*dops)[rows] ** 2),
-                         GATE_PROBABILITY)
+        ins.gated_update(dz[rows], h[rows], r[rows, rows], GATE_PROBABILITY)
         v_fix = row[self._vel_idx]
         if np.isfinite(v_fix).all():
             dz_v, h_v = aiding.gnss_velocity(ins.v, v_fix, ins.n_states, ins.q, ins.mean_rate,
                                              self._antenna)
-            sigma = model.velocity_sigma(*dops)
-            nu = dz_v - h_v @ ins.kf.x
-            hph = np.einsum("ij,jk,ik->i", h_v, ins.kf.p, h_v)
-            for k, matching in enumerate(self._velocity_matching):
-                matching.add(nu[k:k + 1], hph[k:k + 1, None], float(sigma[k]) ** 2)
-            sigma = sigma * np.sqrt([m.scale for m in self._velocity_matching])
+            sigma = fix_velocity_sigma(model, std_vel, *dops)
+            if not np.isfinite(std_vel).all():  # no accuracy reported: matched to innovations
+                nu = dz_v - h_v @ ins.kf.x
+                hph = np.einsum("ij,jk,ik->i", h_v, ins.kf.p, h_v)
+                for k, matching in enumerate(self._velocity_matching):
+                    matching.add(nu[k:k + 1], hph[k:k + 1, None], float(sigma[k]) ** 2)
+                sigma = sigma * np.sqrt([m.scale for m in self._velocity_matching])
             ins.gated_update(dz_v, h_v, np.diag(sigma**2), GATE_PROBABILITY)
 
     def solution(self, t: float) -> list[float]:

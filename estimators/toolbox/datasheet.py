@@ -61,8 +61,9 @@ that tunes itself "from the datasheet" means the same thing.
 
 Public names
 ------------
-ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, ground_track_sigma,
-odometer_speed_sigma, odometer_delay_s, odometer_window_s, CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S.
+ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, nlos_position_rows,
+fix_velocity_sigma, ground_track_sigma, odometer_speed_sigma, odometer_delay_s, odometer_window_s,
+CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S.
 """
 
 from __future__ import annotations
@@ -219,6 +220,27 @@ class FixAccuracy:
         """(position 1-sigma (3,), m; velocity 1-sigma (3,), m/s) of a fix row."""
         std = np.array([float(row[i]) if i is not None else math.nan for i in self._cols])
         return std[:3], std[3:]
+
+
+def nlos_position_rows(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float,
+                       dz: np.ndarray, h: np.ndarray, nlos: np.ndarray, first: int
+                       ) -> np.ndarray:
+    """A fix's position rows with the reflected-fix states (module docstring): adds their part
+    e = gain u to the innovation rows ``dz`` (3,) and to ``h`` (3, n) in place, for the states'
+    estimate ``nlos`` (3,) at column ``first``, and returns the rows' noise covariance (3, 3):
+    the white remainder at the DOPs and the excess's white share (``FixErrorModel.nlos_split``
+    of the fix's ``reported`` position 1-sigma)."""
+    gain, white = model.nlos_split(reported, hdop, vdop)
+    dz += gain * nlos
+    h[:, first:first + 3] = np.diag(gain)
+    return np.diag(model.white_sigma(hdop, vdop) ** 2 + white)
+
+
+def fix_velocity_sigma(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float
+                       ) -> np.ndarray:
+    """NED 1-sigma (m/s) of a fix's velocity: its ``reported`` own where finite, else the
+    datasheet's at its DOPs (``FixErrorModel.velocity_sigma``)."""
+    return np.where(np.isfinite(reported), reported, model.velocity_sigma(hdop, vdop))
 
 
 def ground_track_sigma(vn: float, ve: float, std_vn: float, std_ve: float

@@ -53,10 +53,11 @@ def references(groups: np.ndarray, elevation: np.ndarray, priority: np.ndarray |
     score = np.asarray(elevation, dtype=float)
     if priority is not None:
         score = score + 10.0 * np.asarray(priority, dtype=float)
+    # by group, then by falling score (a stable sort: of equal scores the first signal)
+    order = np.lexsort((-score, groups))
+    first = np.r_[True, groups[order][1:] != groups[order][:-1]]
     ref = np.empty(len(groups), dtype=np.int64)
-    for g in np.unique(groups):
-        members = np.flatnonzero(groups == g)
-        ref[members] = members[np.argmax(score[members])]
+    ref[order] = order[first][np.cumsum(first) - 1]
     return ref
 
 

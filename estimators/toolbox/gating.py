@@ -28,8 +28,8 @@ updating only when it passes.
 
 Public functions
 ----------------
-chi2_threshold, innovation_covariance, matching_variance, normalised_innovation_squared,
-passes_gate, rows_passing, threshold_variance, FixNoiseMatching.
+chi2_threshold, innovation_covariance, innovation_variances, matching_variance,
+normalised_innovation_squared, passes_gate, rows_passing, threshold_variance, FixNoiseMatching.
 """
 
 from __future__ import annotations
@@ -64,6 +64,15 @@ def innovation_covariance(p: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.nda
     h = np.atleast_2d(h)
     s = h @ p @ h.T + np.atleast_2d(r)
     return 0.5 * (s + s.T)
+
+
+def innovation_variances(p: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """The diagonal of S = H P H^T + R, shape (m,), from H's non-zero columns only (a
+    carrier-phase filter's rows touch a few of its states)."""
+    h = np.atleast_2d(h)
+    cols = np.flatnonzero(np.any(h != 0.0, axis=0))
+    h_c = h[:, cols]
+    return np.einsum("ij,ij->i", h_c @ p[np.ix_(cols, cols)], h_c) + np.diag(np.atleast_2d(r))
 
 
 def normalised_innovation_squared(nu: np.ndarray, s: np.ndarray) -> float:

@@ -39,7 +39,8 @@ The constants (speed of light, the GPS Earth rotation rate) are imported from th
 Public names
 ------------
 RawEpoch, single_frequency, raw_epoch, select, predict, los_jacobians, antenna_offset,
-clock_transition, clock_noise, correlated_noise_inflation, TCXO_H0, TCXO_H_MINUS2.
+clock_transition, clock_noise, correlated_noise_inflation, nlos_sigma, NLOS_SIGMA_M, TCXO_H0,
+TCXO_H_MINUS2.
 """
 
 from __future__ import annotations
@@ -49,6 +50,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from simulator.datasheet import Cn0Template, nlos_probability
 from simulator.gnss.constants import C_M_S, OMEGA_E_DOT_RAD_S
 
 SAGNAC_ITERATIONS = 2  # flight-time iterations: the second changes the range by < 1e-6 m
@@ -239,3 +241,16 @@ def correlated_noise_inflation(correlation_time_s: float, interval_s: float) -> 
         return 1.0
     phi = np.exp(-interval_s / correlation_time_s)
     return float(np.sqrt((1.0 + phi) / (1.0 - phi)))
+
+
+NLOS_SIGMA_M = 20.0  # a reflected signal's extra path, 1-sigma (gnss_wls's module docstring)
+
+
+def nlos_sigma(sigma: np.ndarray, cn0: np.ndarray, elevation: np.ndarray,
+               template: Cn0Template, nlos_sigma_m: float) -> np.ndarray:
+    """Each pseudorange's 1-sigma with the reflected-signal (NLOS) error its C/N0 announces:
+    sigma^2 + p nlos_sigma_m^2, p = ``nlos_probability`` of its deficit below the template at
+    its elevation (``estimators/builtin/gnss_wls.py``'s module docstring: the extra
+    path's spread, 20 m there)."""
+    p = nlos_probability(template.expected_dbhz(elevation) - cn0, template.scatter_db)
+    return np.sqrt(sigma**2 + p * nlos_sigma_m**2)

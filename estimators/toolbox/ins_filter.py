@@ -158,7 +158,7 @@ class InsFilter:
                  initial_biases: np.ndarray | None = None, buffer_size: int = 512,
                  mounting: np.ndarray | None = None, extra_sigma: np.ndarray | None = None,
                  extra_tau: np.ndarray | None = None,
-                 yaw_response_sigma: np.ndarray | None = None):
+                 yaw_response_sigma: np.ndarray | None = None, sparse: bool = False):
         self.t = float(initial.t)
         self.q = np.array(initial.quaternion, dtype=float)
         self.v = np.array(initial.velocity, dtype=float)
@@ -175,7 +175,7 @@ class InsFilter:
         self.extra_start = N_STATES + len(yaw_sigma)  # index of the first extra state
         self.n_states = self.extra_start + len(extra_sigma)
         self.kf = ErrorState(np.diag(np.r_[np.asarray(p0_sigma, float), yaw_sigma,
-                                           extra_sigma] ** 2), closed_loop)
+                                           extra_sigma] ** 2), closed_loop, sparse)
         self.noise = noise
         missing = [c for c in IMU_AXES if c not in imu_columns]
         if missing:

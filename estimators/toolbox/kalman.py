@@ -11,6 +11,15 @@ Joseph-form measurement update, and the closed- or open-loop handling of an erro
   extra states of an INS filter, the ambiguities of a carrier-phase filter): P_AA <- Phi_A
   P_AA Phi_A^T + Q_A, P_AB <- Phi_A P_AB diag(phi_B), P_BB <- phi_B phi_B^T * P_BB + diag(q_B),
   the products of ``predict`` without the zero blocks (O(a^2 n) instead of O(n^3)).
+* ``predict_static``: ``predict_blocks`` for a state vector whose B states are mostly static
+  (phi = 1, no noise: the ambiguities of a carrier-phase filter): only the rows and columns
+  of the B states that move are touched, O(a n + b_moving n) instead of O(n^2).
+* ``update_sparse``: ``update`` for a measurement matrix with few non-zero columns c (the
+  rows of a carrier-phase filter's double differences, an odometer's rows on the INS block):
+  P H^T = P[:, c] H_c^T, and only the states correlated with those columns (rows r of P with
+  a non-zero in P[:, c]) change; on that block the Joseph form's products in the order
+  (I - K H) P = P - K (P H^T)^T, then ((I - K H) P) (I - K H)^T = B - (B H^T) K^T, plus
+  K R K^T: the same form, its zero terms skipped (O(r^2 m) instead of O(n^3)).
 * ``ErrorState``: the estimate of errors of a nominal (total-state) solution. Errors are defined
   as estimate minus truth, and a measurement enters as dz = h(nominal) - z ~ H dx + noise. In
   closed loop (Groves section 14.1.1) the estimated errors are fed back into the nominal solution
@@ -25,7 +34,7 @@ numba would save little of that and cost every process 20 s of compilation.
 
 Public names
 ------------
-predict, predict_blocks, update, ErrorState.
+predict, predict_blocks, predict_static, update, update_sparse, ErrorState.
 """
 
 from __future__ import annotations
@@ -73,6 +82,54 @@ def predict_blocks(x: np.ndarray, p: np.ndarray, phi_a: np.ndarray, q_a: np.ndar
     return x_new, 0.5 * (p_new + p_new.T)
 
 
+def predict_static(x: np.ndarray, p: np.ndarray, phi_a: np.ndarray, q_a: np.ndarray,
+                   phi_b: np.ndarray, q_b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``predict_blocks`` (same arguments) touching only the B states that move (phi_b not 1
+    or q_b not 0): P_BB[i, j] = phi_i phi_j P_BB[i, j] + q_i delta_ij is P_BB[i, j] itself
+    where both are static. The result is symmetric; P must be."""
+    a = phi_a.shape[0]
+    p_new = p.copy()
+    p_aa = phi_a @ p[:a, :a] @ phi_a.T + q_a
+    p_new[:a, :a] = 0.5 * (p_aa + p_aa.T)
+    p_new[:a, a:] = (phi_a @ p[:a, a:]) * phi_b
+    p_new[a:, :a] = p_new[:a, a:].T
+    moving = np.flatnonzero((phi_b != 1.0) | (q_b != 0.0))
+    if len(moving):
+        rows = a + moving
+        block = p[rows, a:] * (phi_b[moving, None] * phi_b)  # phi_i phi_j: symmetric
+        block[np.arange(len(moving)), moving] += q_b[moving]
+        p_new[rows, a:] = block
+        p_new[a:, rows] = block.T
+    return np.concatenate([phi_a @ x[:a], phi_b * x[a:]]), p_new
+
+
+def update_sparse(x: np.ndarray, p: np.ndarray, innovation: np.ndarray, h: np.ndarray,
+                  r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``update`` (same arguments and results, the Joseph form) computed on H's non-zero
+    columns and the states correlated with them (module docstring); the other states' rows
+    and columns of P are returned unchanged, as the dense form leaves them."""
+    h = np.atleast_2d(h)
+    r = np.atleast_2d(r)
+    cols = np.flatnonzero(np.any(h != 0.0, axis=0))
+    touched = np.any(p[:, cols] != 0.0, axis=1)
+    touched[cols] = True
+    rows = np.flatnonzero(touched)
+    h_c = h[:, cols]
+    at = np.searchsorted(rows, cols)  # the columns' places among the rows
+    p_rr = p[np.ix_(rows, rows)]
+    pht = p_rr[:, at] @ h_c.T  # P H^T on the rows
+    s = h_c @ pht[at] + r
+    s = 0.5 * (s + s.T)
+    k = np.linalg.solve(s, pht.T).T
+    b = p_rr - k @ pht.T  # (I - K H) P
+    p_rr = b + (k @ r - b[:, at] @ h_c.T) @ k.T  # B (I - K H)^T + K R K^T
+    p_new = p.copy()
+    p_new[np.ix_(rows, rows)] = 0.5 * (p_rr + p_rr.T)
+    x_new = x.copy()
+    x_new[rows] += k @ innovation
+    return x_new, p_new, s
+
+
 def update(x: np.ndarray, p: np.ndarray, innovation: np.ndarray, h: np.ndarray,
            r: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Measurement update in Joseph form.
@@ -109,12 +166,18 @@ class ErrorState:
         True: call ``feedback()`` after each update and remove the returned errors from the
         nominal solution. False: never correct the nominal solution; output nominal minus
         ``estimate``.
+    sparse : bool
+        Update with ``update_sparse`` and predict blockwise with ``predict_static`` (the same
+        filter to rounding, faster when H has few columns and the extra states are mostly
+        static); False: ``update`` and ``predict_blocks``.
     """
 
-    def __init__(self, p0: np.ndarray, closed_loop: bool = True):
+    def __init__(self, p0: np.ndarray, closed_loop: bool = True, sparse: bool = False):
         self.p = np.array(p0, dtype=float)
         self.x = np.zeros(self.p.shape[0])
         self.closed_loop = closed_loop
+        self._update = update_sparse if sparse else update
+        self._predict_blocks = predict_static if sparse else predict_blocks
 
     @property
     def estimate(self) -> np.ndarray:
@@ -127,13 +190,15 @@ class ErrorState:
 
     def predict_blocks(self, phi_a: np.ndarray, q_a: np.ndarray, phi_b: np.ndarray,
                        q_b: np.ndarray) -> None:
-        """``predict`` with a block-diagonal transition (module function ``predict_blocks``)."""
-        self.x, self.p = predict_blocks(self.x, self.p, phi_a, q_a, phi_b, q_b)
+        """``predict`` with a block-diagonal transition (module function ``predict_blocks``,
+        or ``predict_static`` for a sparse filter)."""
+        self.x, self.p = self._predict_blocks(self.x, self.p, phi_a, q_a, phi_b, q_b)
 
     def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Update with dz = h(nominal) - z (shape (m,)); returns the innovation covariance."""
         h = np.atleast_2d(np.asarray(h, dtype=float))
-        self.x, self.p, s = update(self.x, self.p, np.asarray(dz, float) - h @ self.x, h, r)
+        self.x, self.p, s = self._update(self.x, self.p, np.asarray(dz, float) - h @ self.x, h,
+                                         r)
         return s
 
     def feedback(self) -> np.ndarray:

@@ -22,8 +22,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from simulator import columns as col
-from simulator.errors import InputError, Problem, refuse_undecodable
+from simulator.errors import (
+    InputError,
+    Problem,
+    not_regular,
+    refuse_undecodable,
+    refuse_unless_regular,
+)
 from simulator.tables import Table, column, n_rows
+
+MAX_MANIFEST_BYTES = 64 * 2**20  # a manifest is read whole: a larger one is no manifest
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -316,9 +324,10 @@ def _manifest_problems(path: Path, manifest: dict) -> list[Problem]:
         if Path(file).name != file or target.parent != root:
             problems.append(Problem(where, None, f"streams.{name}.file",
                                     f"{file!r} is not a file inside the dataset folder"))
-        elif not target.is_file():
+        elif (kind := not_regular(target)) is not None:
             problems.append(Problem(where, None, f"streams.{name}",
-                                    f"its file {file!r} is missing"))
+                                    f"its file {file!r} is missing" if kind == "missing"
+                                    else f"its file {file!r} is {kind}, not a regular file"))
     return problems
 
 
@@ -327,13 +336,18 @@ def open_dataset(path: str | Path) -> Dataset:
     path = Path(path)
     refuse_undecodable(path, "dataset's name")
     manifest_path = path / "manifest.json"
-    if not path.is_dir():
-        raise InputError([Problem(str(path), None, "", "no such dataset directory")])
-    if not manifest_path.is_file():
+    refuse_unless_regular(path, "dataset directory", folder=True)
+    if not_regular(manifest_path) == "missing":
         raise InputError([Problem(str(path), None, "", "not a landnav dataset (no manifest.json;"
                                   " make one with `landnav generate SCENARIO -o DIR`)")])
+    refuse_unless_regular(manifest_path, "manifest file")  # a pipe or a device: unread
     try:
-        manifest = json.loads(manifest_path.read_text(encoding="utf-8"))
+        with manifest_path.open("rb") as stream:
+            text = stream.read(MAX_MANIFEST_BYTES + 1)
+        if len(text) > MAX_MANIFEST_BYTES:
+            raise ValueError(f"larger than a manifest may be ({MAX_MANIFEST_BYTES // 2**20} "
+                             "MiB)")
+        manifest = json.loads(text.decode("utf-8"))
     except (OSError, ValueError) as exc:
         raise InputError([Problem(str(manifest_path), None, "", f"corrupt manifest: {exc}")]
                          ) from None

@@ -108,7 +108,9 @@ def write_table(frame: Table, path: Path, units: dict[str, str],
 def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
     """Read one Parquet table; raise InputError naming the file if it is missing or corrupt."""
     try:
-        return pq.read_table(path, columns=columns).to_pandas()
+        # each Arrow column is released as it is converted: the table is not held twice
+        return pq.read_table(path, columns=columns).to_pandas(split_blocks=True,
+                                                              self_destruct=True)
     except FileNotFoundError:
         raise InputError([Problem(str(path), None, "", "file not found")]) from None
     except (pa.ArrowException, OSError) as exc:

@@ -8,8 +8,9 @@ sums over the tracking and slip masks, never from a loop over epochs.
 
 Public names
 ------------
-LLI_LOST_LOCK, LLI_HALF_CYCLE, pll_sigma_cycles, dynamic_stress_cycles, slip_probability,
-draw_slips, PhaseArcs, phase_arcs, reflection_multipath.
+LLI_LOST_LOCK, LLI_HALF_CYCLE, pll_sigma_cycles, dynamic_stress_cycles, pll_response,
+reflection_path_rate_m_s, slip_probability, draw_slips, PhaseArcs, phase_arcs,
+reflection_multipath.
 
 References
 ----------
@@ -28,6 +29,15 @@ Multipath of one reflection of relative amplitude alpha and phase psi: code erro
 d alpha cos psi and carrier error atan(alpha sin psi / (1 + alpha cos psi)) for a reflection
 delayed d (m) (Braasch 1996, "Multipath effects", in Parkinson & Spilker, vol. I ch. 14,
 eqs. 6 and 11, narrow-correlator small-delay form; Georgiadou & Kleusberg 1988).
+The third-order loop's closed-loop response H(s) = (b w0 s^2 + a w0^2 s + w0^3) / (s^3 +
+b w0 s^2 + a w0^2 s + w0^3), a = 1.1, b = 2.4, B_n = 0.7845 w0 (Kaplan & Hegarty 2017, Table 8.23:
+the loop filter of a third-order PLL). The carrier multipath of one reflection oscillates at
+the fading (fringe) frequency, the rate of change of the reflection's extra path over the
+wavelength (Braasch 1996, the fading frequency of a moving antenna's multipath); the loop's
+phase follows that input with the gain |H| at that frequency, so a reflection whose phase turns
+well beyond the loop's bandwidth leaves little carrier error (the choice made here: the loop's
+gain scales the phase error; its harmonics, at multiples of the fringe, are attenuated at least
+as much).
 """
 
 from __future__ import annotations
@@ -40,6 +50,7 @@ LLI_LOST_LOCK = 1  # RINEX 3.04: lost lock between the previous and this observa
 LLI_HALF_CYCLE = 2  # RINEX 3.04: half-cycle ambiguity / slip possible
 _THIRD_ORDER_BN_PER_OMEGA0 = 0.7845  # Kaplan & Hegarty Table 8.23: B_n = 0.7845 omega_0
 _MAX_SLIP_CYCLES = 8  # the largest integer jump drawn for one slip
+_THIRD_ORDER_A, _THIRD_ORDER_B = 1.1, 2.4  # Kaplan & Hegarty Table 8.23: the loop filter's a3, b3
 
 
 def pll_sigma_cycles(cn0_dbhz: np.ndarray, bandwidth_hz: float, integration_s: float
@@ -57,6 +68,35 @@ def dynamic_stress_cycles(los_jerk_m_s3: np.ndarray, wavelength_m: float, bandwi
     Table 8.23)."""
     omega0 = bandwidth_hz / _THIRD_ORDER_BN_PER_OMEGA0
     return np.abs(np.asarray(los_jerk_m_s3, dtype=float)) / omega0**3 / wavelength_m
+
+
+def pll_response(frequency_hz: np.ndarray, bandwidth_hz: float) -> np.ndarray:
+    """|H(j 2 pi f)| of a third-order PLL of noise bandwidth B_n (module docstring): the gain
+    with which the loop's phase follows a phase input at frequency f (1 well inside the
+    bandwidth, a peak of 1.28 near B_n / 5, then falling as b w0 / (2 pi f))."""
+    omega0 = bandwidth_hz / _THIRD_ORDER_BN_PER_OMEGA0
+    s = 2j * np.pi * np.asarray(frequency_hz, dtype=float) / omega0  # in units of omega0
+    numerator = _THIRD_ORDER_B * s**2 + _THIRD_ORDER_A * s + 1.0
+    return np.abs(numerator / (s**3 + numerator))
+
+
+def reflection_path_rate_m_s(v_ned: np.ndarray, azimuth_rad: np.ndarray,
+                             elevation_rad: np.ndarray, wall_normal_rad: np.ndarray
+                             ) -> np.ndarray:
+    """Rate (m/s) at which the extra path of a reflection off a vertical plane changes while
+    the antenna moves; over the wavelength, the frequency at which its carrier multipath turns.
+    The extra path 2 h cos(el) cos(az - phi) of a plane at distance h with horizontal normal
+    phi (Georgiadou & Kleusberg 1988, a vertical reflector) changes as dh/dt = -v . n
+    (n = (cos phi, sin phi) north, east): |2 cos(el) cos(az - phi) (v . n)|, up to 2 v towards
+    a wall ahead, zero along a wall parallel to the track.
+
+    Parameters
+    ----------
+    v_ned : ndarray, shape (n_epoch, 3)
+    azimuth_rad, elevation_rad, wall_normal_rad : ndarray, shape (n_sat, n_epoch)
+    """
+    along = v_ned[:, 0] * np.cos(wall_normal_rad) + v_ned[:, 1] * np.sin(wall_normal_rad)
+    return np.abs(2.0 * np.cos(elevation_rad) * np.cos(azimuth_rad - wall_normal_rad) * along)
 
 
 def slip_probability(sigma_cycles: np.ndarray, stress_cycles: np.ndarray, bandwidth_hz: float,

@@ -229,7 +229,8 @@ def gather(eph: dict[str, np.ndarray], idx: np.ndarray,
     only ``keys`` (e.g. ``STATE_KEYS``); the GLONASS state table is passed on as it is."""
     safe = np.where(idx < 0, 0, idx)
     chosen = eph if keys is None else {k: eph[k] for k in keys if k in eph}
-    return {k: (v[safe] if isinstance(v, np.ndarray) else v) for k, v in chosen.items()}
+    return {k: (np.take(v, safe, axis=0) if isinstance(v, np.ndarray) else v)
+            for k, v in chosen.items()}
 
 
 def satellite_state(eph: dict[str, np.ndarray], t_s: np.ndarray) -> dict[str, np.ndarray]:

@@ -64,7 +64,7 @@ Public names
 ------------
 OSCILLATORS, SIS_RECORD_SHARE, IONO_CORRELATION_TIME_S, IONO_CORRELATION_LENGTH_KM,
 IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S,
-REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, GRID_STEP, IONO_GRID_STEP,
+REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, IONO_GRID_STEP,
 loop_time_constant_s,
 decorrelation_coordinate, gauss_markov_along, pierce_points_km, iono_field_correlation,
 iono_field, iono_field_at_epochs, draw_receiver_clock, draw_fading, draw_sis,
@@ -95,7 +95,7 @@ import numpy as np
 from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
-from simulator.stochastic import ar1_filter, gauss_markov
+from simulator.stochastic import ar1_filter, child_rng, gauss_markov, gauss_markov_at
 
 # receiver oscillators: Allan h-parameters (Brown & Hwang Table 9.1: compensated and ovenized
 # crystal) and the 1-sigma spread of the clock state at switch-on
@@ -117,9 +117,6 @@ IONO_SHELL_RADIUS_KM = 6371.0 + 350.0  # Klobuchar's shell: mean Earth radius + 
 IONO_FIELD_STEP_S = 10.0
 REPORTED_PR_STD_FLOOR_M = 0.1  # the smallest pseudorange 1-sigma the receiver reports
 REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it reports
-# step of the grid (in correlation lengths of u) on which the motion-driven processes are drawn
-# before linear interpolation to the epochs: the interpolation keeps over 99 % of the variance
-GRID_STEP = 0.05
 # the amplitudes of the ionosphere field's waves are drawn once per correlation time (30 min)
 # and interpolated: their rate is then sigma x 1.1 / 30 min, about 1.5 mm/s on an 8 m delay
 # with the default 1.5 x 0.2,
@@ -144,13 +141,16 @@ def decorrelation_coordinate(t_s: np.ndarray, distance_m: np.ndarray, distance_s
 
 
 def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator,
-                       step: float = GRID_STEP) -> np.ndarray:
+                       step: float | None = None) -> np.ndarray:
     """Unit-variance processes with correlation exp(-|u_i - u_j|) at the points u (ascending,
-    shape (n,)), one per row: shape (rows, n). Each is the exact Gauss-Markov process
-    (``simulator.stochastic.gauss_markov``, unit correlation length) on a grid of ``step`` in
-    u, interpolated linearly at u (between grid points the variance falls to (1 + e^-step) / 2
-    at the middle: 0.99 for the default step, 0.68 for a step of 1)."""
+    shape (n,)), one per row: shape (rows, n). Without ``step``, the exact Gauss-Markov process
+    at the points themselves (``simulator.stochastic.gauss_markov_at``). With ``step``, the
+    exact process on a grid of ``step`` in u, interpolated linearly at u: smoother between grid
+    points, where the variance falls to (1 + e^-step) / 2 at the middle (0.68 for a step of 1:
+    the ionosphere field's amplitudes, whose rate this keeps at that of a quiet ionosphere)."""
     u = np.asarray(u, dtype=float)
+    if step is None:
+        return gauss_markov_at(u, rows, rng).T
     grid = u[0] + np.arange(int(np.ceil((u[-1] - u[0]) / step)) + 2) * step
     values = gauss_markov(len(grid), step, np.ones(rows), 1.0, rng)
     pos = (u - grid[0]) / step
@@ -298,6 +298,10 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
 
     Parameters
     ----------
+    rng : Generator
+        The receiver's random stream: each term draws from its own named child of it
+        (``simulator.stochastic.child_rng``: ``sis``, ``iono_field``, ``tropo_zenith``,
+        ``multipath``, ``code_noise``, ``rate_noise``), so no term's draws move another's.
     cfg : dict
         The resolved ``sensors.gnss`` block (error levels and tracking-loop parameters).
     elevation_rad, cn0_dbhz : ndarray, shape (n_sat, n_epoch)
@@ -328,33 +332,34 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
     n_sat, n_ep = shape
     scale = cfg["tracking_noise"]
 
-    def unit_gm(rows: int, tau_s: float) -> np.ndarray:  # (rows, n_ep), unit variance
-        return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, rng).T
+    def unit_gm(rows: int, tau_s: float, name: str) -> np.ndarray:  # (rows, n_ep), unit variance
+        return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, child_rng(rng, name)).T
 
     # the ionosphere's error: a field smooth over the pierce points and in time (module
     # docstring), so that nearby signals share it and its rate (which the carrier smoothing's
     # code-carrier divergence sees) stays at the mm/s of a quiet ionosphere
     if shared is None:
-        out = {"sis": draw_sis(rng, cfg["sis_error"], record)}
-        out["iono_field"] = IonoField(rng, n_ep, dt_s) if cfg["iono_residual"] > 0 else None
+        out = {"sis": draw_sis(child_rng(rng, "sis"), cfg["sis_error"], record)}
+        out["iono_field"] = (IonoField(child_rng(rng, "iono_field"), n_ep, dt_s)
+                             if cfg["iono_residual"] > 0 else None)
     else:
         out = {"sis": shared.sis, "iono_field": shared.iono_field}
     field = (out["iono_field"](pierce_km) if out["iono_field"] is not None
              else np.zeros(shape))
     out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"] * field)
-    out["tropo_zenith"] = (cfg["tropo_residual"] * rng.standard_normal() if shared is None
-                           else shared.tropo_zenith_m)
+    out["tropo_zenith"] = (cfg["tropo_residual"] * child_rng(rng, "tropo_zenith").standard_normal()
+                           if shared is None else shared.tropo_zenith_m)
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
-    out["multipath_unit"] = gauss_markov_along(u, n_sat, rng)
+    out["multipath_unit"] = gauss_markov_along(u, n_sat, child_rng(rng, "multipath"))
     out["multipath"] = out["multipath_sigma"] * out["multipath_unit"]
     out["code_sigma"] = scale * dll_sigma_m(cn0_dbhz, cfg["dll_bandwidth"],
                                             cfg["correlator_spacing"], cfg["integration_time"])
     out["code_noise"] = out["code_sigma"] * unit_gm(
-        n_sat, loop_time_constant_s(cfg["dll_bandwidth"]))
+        n_sat, loop_time_constant_s(cfg["dll_bandwidth"]), "code_noise")
     out["rate_sigma"] = scale * LAMBDA_L1_M * fll_sigma_hz(cn0_dbhz, cfg["fll_bandwidth"],
                                                           cfg["integration_time"])
     out["rate_noise"] = out["rate_sigma"] * unit_gm(
-        n_sat, loop_time_constant_s(cfg["fll_bandwidth"]))
+        n_sat, loop_time_constant_s(cfg["fll_bandwidth"]), "rate_noise")
     return out
 
 

@@ -18,9 +18,12 @@ KINDS, import_recording.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+from simulator.errors import not_regular, refuse_unless_regular
 
 if TYPE_CHECKING:  # imported where a recording is read: `landnav import --help` lists KINDS
     from simulator.recordings.common import Recording
@@ -67,6 +70,11 @@ def import_recording(kind: str, sources: list[str], out_dir: str | Path,
     from simulator.recordings.common import write_recording
 
     reader, _ = KINDS[kind]
+    for source in sources:  # a device or a pipe is refused unread (a reader would wait on it)
+        if not_regular(source, folder=True) not in (None, "missing"):
+            refuse_unless_regular(source, "recording file")
+    if reference is not None and os.path.lexists(reference):  # a file, not LAT,LON,HEIGHT
+        refuse_unless_regular(reference, "reference file")
     if kind == "rinex":
         recording = _rinex([str(s) for s in sources], reference)
     else:

@@ -27,6 +27,7 @@ read_rinex_recording.
 from __future__ import annotations
 
 import datetime as dt
+import os
 import warnings
 from pathlib import Path
 
@@ -77,7 +78,7 @@ def _observations(path: Path) -> tuple[pd.DataFrame, np.ndarray]:
 def _reference(text: str | None, week: int, tow0: float) -> pd.DataFrame | None:
     if text is None:
         return None
-    if "," in text and not Path(text).exists():
+    if "," in text and not os.path.lexists(text):
         try:
             lat, lon, alt = (float(x) for x in text.split(","))
         except ValueError:

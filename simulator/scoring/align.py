@@ -46,6 +46,9 @@ ERR_ATT = ("err_roll", "err_pitch", "err_yaw")  # attitude error, rad, wrapped t
 
 # the solution's (and truth's) lat, lon, alt / vn, ve, vd / roll, pitch, yaw columns
 _POS, _VEL, _ATT = (tuple(col.SOLUTION)[i:i + 3] for i in (1, 4, 7))
+# solution rows whose errors are computed at a time: the temporaries (the rotation matrices,
+# positions in ECEF) are those of one chunk, not of the whole solution
+CHUNK_ROWS = 100_000
 
 
 @dataclass
@@ -119,41 +122,57 @@ def solution_errors(truth: pd.DataFrame, solution: pd.DataFrame,
     t_truth = truth["t"].to_numpy(float)
     t_all = solution["t"].to_numpy(float)
     inside = (t_all >= t_truth[0]) & (t_all <= t_truth[-1])
-    sol = solution.loc[inside]
-    t = t_all[inside]
+    rows = None if inside.all() else np.flatnonzero(inside)
 
-    def interp(values: np.ndarray) -> np.ndarray:
-        return np.interp(t, t_truth, values)
+    def column(name: str) -> np.ndarray:  # the solution's rows inside (no copy when all are)
+        values = solution[name].to_numpy(float)
+        return values if rows is None else values[rows]
 
-    truth_ecef = np.stack([interp(x) for x in _ecef(truth).T], axis=-1)
-    # the NED frame of the interpolated true position (lat/lon interpolated only for the rotation)
-    c_ne = ned_to_ecef_matrix(np.radians(interp(truth["lat"].to_numpy(float))),
-                              np.radians(interp(truth["lon"].to_numpy(float))))
-    # a solution without a height (NaN alt) still has a horizontal error: its point is taken at
-    # the true height for that, and its down error stays NaN
-    alt = sol["alt"].to_numpy(float)
-    no_alt = ~np.isfinite(alt)
-    sol_ecef = geodetic_to_ecef(np.radians(sol["lat"].to_numpy(float)),
-                                np.radians(sol["lon"].to_numpy(float)),
-                                np.where(no_alt, interp(truth["alt"].to_numpy(float)), alt))
-    err_pos = np.einsum("kji,kj->ki", c_ne, sol_ecef - truth_ecef)
-    err_pos[no_alt, 2] = np.nan
-    out = {"t": t}
-    out.update(zip(ERR_POS, err_pos.T, strict=True))
-    out[ERR_H] = np.hypot(err_pos[:, 0], err_pos[:, 1])
-    for name, key in zip(ERR_VEL, _VEL, strict=True):
-        out[name] = sol[key].to_numpy(float) - interp(truth[key].to_numpy(float))
-    for name, key in zip(ERR_ATT, _ATT, strict=True):
-        true_angle = interp(np.unwrap(truth[key].to_numpy(float)))
-        out[name] = wrap_angle(sol[key].to_numpy(float) - true_angle)
+    t = column("t")
+    out = {"t": t, **{name: np.empty(len(t)) for name in (*ERR_POS, ERR_H, *ERR_VEL, *ERR_ATT)}}
+    truth_ecef = _ecef(truth)
+    truth_lat, truth_lon = (truth[k].to_numpy(float) for k in ("lat", "lon"))  # deg
+    truth_alt = truth["alt"].to_numpy(float)
+    truth_vel = [truth[key].to_numpy(float) for key in _VEL]
+    truth_att = [np.unwrap(truth[key].to_numpy(float)) for key in _ATT]
+    for a in range(0, len(t), CHUNK_ROWS):  # the temporaries of one chunk at a time
+        at = slice(a, a + CHUNK_ROWS)
+        rows_at = at if rows is None else rows[at]
+
+        def interp(values: np.ndarray, at: slice = at) -> np.ndarray:
+            return np.interp(t[at], t_truth, values)
+
+        def sol(name: str, rows_at: slice | np.ndarray = rows_at) -> np.ndarray:
+            return solution[name].to_numpy(float)[rows_at]
+
+        true_ecef = np.stack([interp(x) for x in truth_ecef.T], axis=-1)
+        # the NED frame of the interpolated true position (lat/lon interpolated only for the
+        # rotation)
+        c_ne = ned_to_ecef_matrix(np.radians(interp(truth_lat)), np.radians(interp(truth_lon)))
+        # a solution without a height (NaN alt) still has a horizontal error: its point is
+        # taken at the true height for that, and its down error stays NaN
+        alt = sol("alt")
+        no_alt = ~np.isfinite(alt)
+        sol_ecef = geodetic_to_ecef(np.radians(sol("lat")), np.radians(sol("lon")),
+                                    np.where(no_alt, interp(truth_alt), alt))
+        err_pos = np.einsum("kji,kj->ki", c_ne, sol_ecef - true_ecef)
+        err_pos[no_alt, 2] = np.nan
+        for i, name in enumerate(ERR_POS):
+            out[name][at] = err_pos[:, i]
+        out[ERR_H][at] = np.hypot(err_pos[:, 0], err_pos[:, 1])
+        for name, key, true in zip(ERR_VEL, _VEL, truth_vel, strict=True):
+            out[name][at] = sol(key) - interp(true)
+        for name, key, true in zip(ERR_ATT, _ATT, truth_att, strict=True):
+            out[name][at] = wrap_angle(sol(key) - interp(true))
     for name in (*col.SOLUTION_STD, *col.SOLUTION_NIS, *col.SOLUTION_FIX):
-        if name in sol:
-            out[name] = sol[name].to_numpy(float)
+        if name in solution:
+            out[name] = column(name)
     if truth_sensors is not None and len(truth_sensors):
         t_sensors = truth_sensors["t"].to_numpy(float)
         for name in col.SENSOR_ERRORS:
-            if name in sol and name in truth_sensors:
+            if name in solution and name in truth_sensors:
                 true_value = np.interp(t, t_sensors, truth_sensors[name].to_numpy(float),
                                        left=np.nan, right=np.nan)
-                out[sensor_error_name(name)] = sol[name].to_numpy(float) - true_value
-    return SolutionErrors(pd.DataFrame(out), len(solution), int((~inside).sum()))
+                out[sensor_error_name(name)] = column(name) - true_value
+    return SolutionErrors(pd.DataFrame(out, copy=False), len(solution),
+                          int((~inside).sum()))

@@ -88,8 +88,9 @@ def chi2_band(dim: int, runs: int = 1) -> tuple[float, float]:
 
 
 def _after_skip(errors: pd.DataFrame, skip_s: float) -> pd.DataFrame:
+    """The rows from ``skip_s`` after the first: a slice (t increases), not a copy."""
     t = errors["t"].to_numpy(float)
-    return errors.loc[t >= t[0] + skip_s] if t.size else errors
+    return errors.iloc[int(np.searchsorted(t, t[0] + skip_s)):] if t.size else errors
 
 
 def _squares(errors: pd.DataFrame, axes: tuple[str, ...]) -> np.ndarray:

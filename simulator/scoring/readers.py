@@ -49,9 +49,10 @@ import pandas as pd
 
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic
-from simulator.errors import InputError, Problem, refuse_undecodable
+from simulator.errors import InputError, Problem, refuse_undecodable, refuse_unless_regular
 from simulator.replay import MAX_SOLUTION_ROWS, USES_GNSS_KEY, solution_problems
 from simulator.scoring.align import solution_errors
+from simulator.scoring.csv_rows import first_short_row
 from simulator.timebase import GPS_EPOCH, SECONDS_PER_WEEK, leap_seconds
 
 MAX_MEDIAN_HORIZONTAL_M = 100e3  # a solution whose median horizontal error exceeds it is refused
@@ -168,12 +169,27 @@ def _chunks(path: Path, what: str, where: _Rows, keep: tuple[str, ...] = (), **o
 
 
 def _joined(chunks: list[pd.DataFrame], columns: Iterable[str]) -> pd.DataFrame:
-    return (pd.concat(chunks, ignore_index=True) if chunks
-            else pd.DataFrame(columns=list(columns), dtype=float))
+    """The chunks as one table, joined a column at a time, each chunk's column released as
+    it is copied: the rows are held about once, not twice as ``pandas.concat`` holds them."""
+    if not chunks:
+        return pd.DataFrame(columns=list(columns), dtype=float)
+    names = list(chunks[0].columns)
+    joined = {}
+    for name in names:
+        joined[name] = np.concatenate([chunk.pop(name).to_numpy() for chunk in chunks])
+    return pd.DataFrame(joined, copy=False)
 
 
 def _csv(path: Path) -> pd.DataFrame:
-    """A CSV solution, its known columns only (header names stripped of spaces)."""
+    """A CSV solution, its known columns only (header names stripped of spaces); a row of
+    fewer fields than the header is refused (pandas would fill them with NaN)."""
+    short = first_short_row(path)
+    if short is not None:
+        missing = short.missing()
+        raise _problem(path, f"line {short.line}: {short.fields} field(s) where the header names "
+                             f"{len(short.header)}: no {', '.join(missing[:5])}"
+                             f"{', ...' if len(missing) > 5 else ''} (a truncated or cut line?)",
+                       missing[0])
     chunks = [chunk.rename(columns=str.strip) for chunk in _chunks(
         path, "CSV", _Rows(first_line=2), comment=None, skipinitialspace=True,
         usecols=lambda name: name.strip() in _READ)]
@@ -413,8 +429,7 @@ def read_solution_file(path: str | Path, gps_start: tuple[int, float]
     """
     path = Path(path)
     refuse_undecodable(path, "solution file's name")
-    if not path.is_file():
-        raise _problem(path, "no such solution file")
+    refuse_unless_regular(path, "solution file")
     size = path.stat().st_size
     if size > MAX_SOLUTION_BYTES:
         raise _problem(path, f"{size / 1e9:.3g} GB, more than a solution file may be "

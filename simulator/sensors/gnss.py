@@ -91,7 +91,7 @@ from simulator.earth import (
 )
 from simulator.environment import ZONE_FIELD
 from simulator.environment.sky import canyon_reception, street_buildings
-from simulator.errors import InputError, Problem
+from simulator.errors import InputError, Problem, not_regular
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.constellation import (
     EXPANDABLE_SLOTS,
@@ -127,6 +127,7 @@ from simulator.schema import (
 from simulator.sensors.base import sample_times
 from simulator.sensors.gnss_observables import observe
 from simulator.sensors.presets import PresetSensor, fill_from_preset, known_preset
+from simulator.stochastic import child_rng
 from simulator.timebase import utc_to_gps
 from simulator.trajectory.kinematics import Kinematics
 
@@ -242,6 +243,11 @@ def _resolve(value: dict, path: Path, ctx: Context) -> dict:
         if ctx.file and not FilePath(source).is_absolute():
             candidates.insert(0, FilePath(ctx.file).resolve().parent / source)
         found = [c for c in candidates if c.is_file()]
+        other = next((kind for c in candidates
+                      if (kind := not_regular(c)) not in (None, "missing")), None)
+        if not found and other is not None:
+            return ctx.error(path + ("constellation",), f"{source!r} is {other}, not a RINEX "
+                                                        "navigation or YUMA almanac file")
         if not found:
             return ctx.error(path + ("constellation",),
                              f"{source!r} is neither 'gps-almanac', 'nominal-gps' nor an "
@@ -400,8 +406,7 @@ class Gnss(PresetSensor):
         is the reflection point. Diffuse scattering off the facade across the street
         (``scattering_coefficient``) arrives from that facade, where the antenna's gain
         (``antenna_gain_db`` against elevation) differs from its gain toward the satellite.
-        Draws are made only when the drive has a canyon, so open drives' random streams are
-        unchanged."""
+        Each canyon zone draws from its own stream (``rng``'s child named after the zone)."""
         los = np.ones(el.shape, dtype=bool)
         nlos = np.zeros(el.shape, dtype=bool)
         extra = np.zeros(el.shape)
@@ -415,12 +420,14 @@ class Gnss(PresetSensor):
                 los[:, here] = False
             elif zone["sky"] == "canyon":
                 ahead, behind, streets = _street_ends(truth, name, t[here], distance[here])
+                zone_rng = child_rng(rng, name)  # each canyon zone's own stream
                 buildings = street_buildings(
-                    rng, streets, zone["block_length"], zone["cross_street_width"],
+                    zone_rng, streets, zone["block_length"], zone["cross_street_width"],
                     zone["facade_length"], zone["building_gap"], zone["building_height"],
                     zone["building_height_spread"])
                 facade_loss = np.maximum(zone["nlos_attenuation"] + zone["nlos_attenuation_spread"]
-                                         * rng.standard_normal((el.shape[0], buildings.count)),
+                                         * zone_rng.standard_normal((el.shape[0],
+                                                                     buildings.count)),
                                          0.0)
                 # traced only for the satellites above the horizon (about 40 % of them)
                 shape = el[:, here].shape
@@ -504,7 +511,8 @@ class Gnss(PresetSensor):
 
         def reception(az: np.ndarray, el: np.ndarray, antenna_gain_db: Callable
                       ) -> tuple[np.ndarray, ...]:
-            return self.sky(truth, t, az, el, ant["yaw"], ant["distance"], rng, antenna_gain_db)
+            return self.sky(truth, t, az, el, ant["yaw"], ant["distance"],
+                            child_rng(rng, "environment"), antenna_gain_db)
 
         rover = observe(cfg, t, dt_s, sky, ant, rng, reception)
         self.drawn.update(rover.drawn)

@@ -3,7 +3,7 @@ positioning (RTK), made by the rover's receiver model so that it sees the same s
 same broadcast records and their errors, and the same ionosphere and troposphere, each at its
 own place (``simulator.sensors.gnss_observables``: the fields at its own pierce points, the
 troposphere's gradient, the orbit error along its own lines of sight); its clock, multipath,
-C/N0 fading and tracking noise are its own (a random stream seeded from the rover's).
+C/N0 fading and tracking noise are its own (the rover's child stream ``second_receiver``).
 
 Scenario block: ``position`` ({lat, lon, alt}) or ``offset`` ({east, north, up} in m from the
 drive's start), ``preset`` (default ``geodetic``), ``rate`` (the rover's rate divided by a whole
@@ -116,7 +116,7 @@ class GnssBase(PresetSensor):
             return (np.ones(el.shape, bool), np.zeros(el.shape, bool), np.zeros(el.shape),
                     np.zeros(el.shape))
 
-        base = observe(self.config, t, dt_s, sky, ant, np.random.default_rng(shared.seed),
+        base = observe(self.config, t, dt_s, sky, ant, shared.second_rng,
                        open_sky, shared)
         self.drawn.update(base.drawn)
         self.drawn["position"] = {"lat": np.degrees(lat), "lon": np.degrees(lon), "alt": alt,

@@ -27,6 +27,25 @@ from T_GD, BGD or TGD1/TGD2: ``simulator.gnss.signals.signal_group_delay_s``; th
 carries no hardware delay). The carrier phase has RINEX's sign: it grows with the range, as
 the pseudorange does.
 
+Random streams: every error process draws from its own stream, the child of the receiver's
+stream (the rover's: the sensor stream ``gnss``) named after the process
+(``simulator.stochastic.child_rng``), so a process that draws more or fewer numbers (a new
+model, a speed-up) redraws no other one, and the same scenario and seed give the same files:
+
+- drawn once per drive or per satellite: ``receiver_clock`` (initial bias and drift, then the
+  oscillator's noise), ``sis`` (per satellite and broadcast record), ``iono_field`` (the
+  regional field's waves), ``tropo_zenith``; shared with a second receiver, and drawn by the
+  first only: ``iono_tid``, ``tropo_gradient``, ``orbit_error``; the canyon zones' buildings
+  and facade losses, one stream per zone named after it, in the child ``environment``;
+- along the drive, for every satellite: ``cn0_fading``, ``cn0_noise``, ``multipath`` (its
+  in-phase unit process), ``multipath_quadrature``, ``reflector_normal``, ``code_noise`` and
+  ``rate_noise`` (the primary signals' tracking noise);
+- per signal, named ``<system letter><RINEX code>/<process>`` (e.g. ``E5Q/phase_noise``):
+  ``cn0_noise``, ``code_noise`` and ``rate_noise`` (signals other than the primary one),
+  ``phase_noise``, ``cycle_slips``, ``phase_arcs`` (ambiguities, slip sizes, half cycles);
+- ``second_receiver``: the base station's own stream, from which it names its processes as
+  above (it draws none of the shared ones).
+
 Public names
 ------------
 TID_LENGTH_KM, TID_TIME_S, ORBIT_ERROR_M, Shared, Observed, observe, signal_geometry_chunks.
@@ -55,8 +74,10 @@ from simulator.gnss.carrier import (
     draw_slips,
     dynamic_stress_cycles,
     phase_arcs,
+    pll_response,
     pll_sigma_cycles,
     reflection_multipath,
+    reflection_path_rate_m_s,
     slip_probability,
 )
 from simulator.gnss.constants import C_M_S, F_L1_HZ
@@ -88,7 +109,7 @@ from simulator.gnss.signals import (
     signal_group_delay_s,
 )
 from simulator.gnss.timesystems import SYSTEMS
-from simulator.stochastic import gauss_markov
+from simulator.stochastic import child_rng, gauss_markov
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -112,7 +133,7 @@ class Shared:
     orbit_m: np.ndarray  # per broadcast record, (n_records, 3)
     origin_lla: tuple[float, float, float]
     los: np.ndarray  # the first receiver's lines of sight (n_sat, n_epoch, 3)
-    seed: int  # of the second receiver's own random stream
+    second_rng: np.random.Generator  # the second receiver's own random stream
 
 
 @dataclass
@@ -128,13 +149,21 @@ class Observed:
 def _rows(t: np.ndarray, svs: np.ndarray, rows: np.ndarray, mask: np.ndarray,
           columns: dict[str, np.ndarray], order: int, n_signals: int) -> dict[str, np.ndarray]:
     """(satellite, epoch) arrays of the satellites ``rows`` (of ``svs``) as stream columns
-    where ``mask`` (a text value fills its column), with a sort key ``_key`` putting epochs
-    first, then satellites in PRN order, then signals in the receiver's order."""
+    where ``mask`` (a text value stays one text, for the whole column), with a sort key
+    ``_key`` putting epochs first, then satellites in PRN order, then signals in the
+    receiver's order."""
     ep, sat = np.nonzero(mask.T)
+    flat = sat * mask.shape[1] + ep  # the samples' places in a (satellite, epoch) array
     out = {"t": t[ep], "sv": svs[rows[sat]]}
     for key, value in columns.items():
-        if isinstance(value, str):
-            out[key] = np.full(len(ep), value, dtype=object)
+        if isinstance(value, str):  # kept as it is: ``_sorted`` spreads it over the rows
+            out[key] = value
+        elif value.shape == mask.shape:
+            out[key] = np.take(value, flat)
+        elif value.shape == (mask.shape[0], 1):  # one value per satellite
+            out[key] = value[sat, 0]
+        elif value.shape == (1, mask.shape[1]):  # one value per epoch
+            out[key] = value[0, ep]
         else:
             out[key] = np.broadcast_to(value, mask.shape)[sat, ep]
     out["_key"] = (ep.astype(np.int64) * len(svs) + rows[sat]) * n_signals + order
@@ -147,8 +176,16 @@ def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFra
     import pandas as pd
 
     order = np.argsort(np.concatenate([p["_key"] for p in pieces]), kind="stable")
-    return pd.DataFrame({name: np.concatenate([p[name] for p in pieces])[order]
-                         for name in names}, copy=False)
+    sizes = [len(p["_key"]) for p in pieces]
+    columns = {}
+    for name in names:
+        if isinstance(pieces[0][name], str):  # a text per piece: taken from the distinct ones
+            texts = sorted({p[name] for p in pieces})
+            codes = np.repeat([texts.index(p[name]) for p in pieces], sizes)
+            columns[name] = pd.Series(texts).array.take(np.take(codes, order))
+        else:
+            columns[name] = np.take(np.concatenate([p[name] for p in pieces]), order)
+    return pd.DataFrame(columns, copy=False)
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
@@ -160,18 +197,17 @@ def _switches(state: np.ndarray) -> np.ndarray:
 
 def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int, n_ep: int,
                   dt_s: float, ant: dict, los: np.ndarray) -> Shared:
-    """The first receiver's draws a second one shares, made after all its other error draws
-    (so that they do not change them)."""
-    tid = IonoField(rng, n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
-    gradient = cfg["tropo_gradient"] * rng.standard_normal(2)
-    orbit = ORBIT_ERROR_M * rng.standard_normal((n_records, 3))
-    seed = int(rng.integers(2**62))
+    """The first receiver's draws a second one shares, each from its own named stream (module
+    docstring), and the second receiver's own stream."""
+    tid = IonoField(child_rng(rng, "iono_tid"), n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
+    gradient = cfg["tropo_gradient"] * child_rng(rng, "tropo_gradient").standard_normal(2)
+    orbit = ORBIT_ERROR_M * child_rng(rng, "orbit_error").standard_normal((n_records, 3))
     return Shared(sis=err["sis"], iono_field=err["iono_field"], tid=tid,
                   tid_sigma_m=cfg["iono_gradient"] * TID_LENGTH_KM * 1e3,
                   tropo_zenith_m=float(err["tropo_zenith"]), tropo_gradient=gradient,
                   orbit_m=orbit,
                   origin_lla=(float(ant["lat"][0]), float(ant["lon"][0]), float(ant["alt"][0])),
-                  los=los, seed=seed)
+                  los=los, second_rng=child_rng(rng, "second_receiver"))
 
 
 def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
@@ -207,13 +243,14 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     los, nlos, extra, loss = reception(
         az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
     signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
-                  + draw_fading(rng, cfg, u, n_sat))
-    cn0 = signal_cn0 + cfg["cn0_noise"] * rng.standard_normal(el.shape)
+                  + draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_sat))
+    cn0 = signal_cn0 + cfg["cn0_noise"] * child_rng(rng, "cn0_noise").standard_normal(el.shape)
     have = idx >= 0
     visible = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos)
     tracked = visible & (cn0 >= cfg["cn0_threshold"])
 
-    bias_s, drift_s_s, drawn_clock = draw_receiver_clock(rng, cfg["clock"], n_ep, dt_s)
+    bias_s, drift_s_s, drawn_clock = draw_receiver_clock(child_rng(rng, "receiver_clock"),
+                                                         cfg["clock"], n_ep, dt_s)
     # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
     # (below the horizon, where nothing is tracked, the pierce point of the horizon)
     pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
@@ -258,15 +295,22 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     nlos_delay = np.where(nlos & ~los, extra, 0.0)
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
-    quadrature = gauss_markov_along(u, n_sat, rng)
+    quadrature = gauss_markov_along(u, n_sat, child_rng(rng, "multipath_quadrature"))
+    # the reflecting plane's normal (uniform in direction, changing as the reflectors do): with
+    # the antenna's velocity it sets how fast the reflection's carrier phase turns
+    from scipy.special import ndtr  # imported on first use, as in simulator.gnss.carrier
+
+    wall_normal = np.pi * ndtr(gauss_markov_along(u, n_sat, child_rng(rng, "reflector_normal")))
+    moving = bool(np.any(ant["v_ned"] != 0.0))
+    path_rate = (reflection_path_rate_m_s(ant["v_ned"], az, el, wall_normal) if moving
+                 else None)  # standing still, the loop's gain is 1
     los_jerk = (np.gradient(np.gradient(geo["range_rate"], dt_s, axis=1), dt_s, axis=1)
                 if n_ep > 2 else np.zeros((n_sat, n_ep)))
     reflected = _switches(nlos & ~los)  # a switch between direct and reflected: lock lost
     scale = cfg["tracking_noise"]
 
     # per-satellite arrays each signal uses, taken on its system's rows only (the other rows
-    # of a signal are never measured); the random draws are made for every row, in the same
-    # order, so that the streams do not depend on this
+    # of a signal are never measured, so nothing is drawn for them)
     per_satellite = {
         "el": el, "az": az, "signal_cn0": signal_cn0, "cn0": cn0, "tracked": tracked,
         "visible": visible, "have": have, "los": los, "nlos_only": nlos & ~los,
@@ -283,18 +327,28 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         "los_jerk": los_jerk, "health": sky["health"].astype(np.int64),
         "primary_delay_s": sky["primary_delay_s"], "tgd_s": sky["tgd_s"],
         "tgd2_s": sky["tgd2_s"], "channel": sky["channel"]}
+    if path_rate is not None:
+        per_satellite["path_rate"] = path_rate
     views: dict[str, dict[str, np.ndarray]] = {}
 
-    def unit_gm(tau_s: float, rows: np.ndarray) -> np.ndarray:
-        return gauss_markov(n_ep, dt_s, np.ones(n_sat), tau_s, rng, columns=rows).T
+    def unit_gm(tau_s: float, rows: np.ndarray, stream: np.random.Generator) -> np.ndarray:
+        return gauss_markov(n_ep, dt_s, np.ones(len(rows)), tau_s, stream).T
+
+    def stream(signal_name: str, process: str) -> np.random.Generator:
+        """One signal's process's own stream (module docstring)."""
+        return child_rng(rng, f"{signal_name}/{process}")
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     raw_pieces, truth_pieces = [], []
     for order, (letter, code) in enumerate(codes):  # one pass per signal, vectorised
         spec = signal(letter, code)
         sel = np.flatnonzero(system_of == letter)
+        signal_name = f"{letter}{code}"  # its processes' streams are named after it
         if letter not in views:
-            views[letter] = {k: np.asarray(v)[sel] for k, v in per_satellite.items()}
+            # a system's satellites are consecutive rows of the sky: views, not copies
+            rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
+                    else sel)
+            views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
         v = views[letter]
         shape = (len(sel), n_ep)
         # per satellite (GLONASS: its FDMA channel)
@@ -307,20 +361,26 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
             rate_sigma, rate_noise = v["rate_sigma"], v["rate_noise"]
         else:
             cn0_true = v["signal_cn0"] + spec.cn0_offset_db
-            cn0_out = cn0_true + cfg["cn0_noise"] * rng.standard_normal(el.shape)[sel]
+            cn0_out = cn0_true + cfg["cn0_noise"] * stream(signal_name, "cn0_noise"
+                                                            ).standard_normal(shape)
             tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
             if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
                 tracked_s &= v["tracked"]
             code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
                                              cfg["correlator_spacing"], cfg["integration_time"]
                                              ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
-            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel)
+            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel,
+                                              stream(signal_name, "code_noise"))
             rate_sigma = scale * lam * fll_sigma_hz(cn0_true, cfg["fll_bandwidth"],
                                                     cfg["integration_time"])
-            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel)
+            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel,
+                                              stream(signal_name, "rate_noise"))
         code_mp, carrier_mp = reflection_multipath(
             v["multipath_unit"], v["quadrature"], v["multipath_sigma"], cfg["multipath_delay"],
             freq - F_L1_HZ, lam)
+        if path_rate is not None:  # the loop follows the carrier multipath: its gain at the
+            # fringe frequency
+            carrier_mp *= pll_response(v["path_rate"] / lam, cfg["pll_bandwidth"])
         iono_s = k_iono * v["iono_true"]
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
@@ -360,13 +420,17 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         if cfg["carrier_phase"]:
             sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
                                                     cfg["integration_time"])
-            phase_noise = lam * sigma_cycles * rng.standard_normal(el.shape)[sel]
+            phase_noise = lam * sigma_cycles * stream(signal_name, "phase_noise"
+                                                      ).standard_normal(shape)
             stress = dynamic_stress_cycles(v["los_jerk"], lam, cfg["pll_bandwidth"])
-            chance = (slip_probability(sigma_cycles, stress, cfg["pll_bandwidth"], dt_s,
-                                       spec.pilot) if scale > 0 else np.zeros(shape))
-            slips = draw_slips(rng.random(el.shape)[sel], chance, tracked_s)
-            arcs = phase_arcs(rng, tracked_s, slips, v["reflected"], dt_s, spec.pilot,
-                              spec.frame_s)
+            chance = np.zeros(shape)  # a slip only matters where the signal is tracked
+            if scale > 0:
+                chance[tracked_s] = slip_probability(sigma_cycles[tracked_s], stress[tracked_s],
+                                                     cfg["pll_bandwidth"], dt_s, spec.pilot)
+            slips = draw_slips(stream(signal_name, "cycle_slips").random(shape), chance,
+                               tracked_s)
+            arcs = phase_arcs(stream(signal_name, "phase_arcs"), tracked_s, slips,
+                              v["reflected"], dt_s, spec.pilot, spec.frame_s)
             phase_m = (v["range"] + rx_clock - v["reference_clock"] - iono_s
                        + v["tropo_true"] + v["sis"] + carrier_mp + v["nlos_delay"]
                        + phase_noise)

@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from simulator.errors import not_regular
 from simulator.schema import Context, Number, Record, Text
 from simulator.trajectory.fit import (
     fit_along,
@@ -88,8 +89,10 @@ def read_log(path: Path) -> pd.DataFrame:
     """
     import pandas as pd
 
-    if not path.is_file():
-        raise LogError(("file",), f"log file not found: {path}")
+    kind = not_regular(path)
+    if kind is not None:
+        raise LogError(("file",), f"log file not found: {path}" if kind == "missing"
+                       else f"log file {path} is {kind}, not a regular file")
     try:
         if path.suffix.lower() in (".parquet", ".pq"):
             table = pd.read_parquet(path)

@@ -51,6 +51,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from simulator.errors import not_regular
 from simulator.schema import Boolean, Either, Integer, Number, Record, Text
 
 if TYPE_CHECKING:
@@ -204,8 +205,10 @@ def prepare_network(spec: str | dict, base: Path, yellow_decel: float = 3.0) -> 
 
 def _existing(base: Path, name: str, key: tuple) -> Path:
     path = (base / name).resolve()
-    if not path.is_file():
-        raise NetworkError(key, f"network file not found: {path}")
+    kind = not_regular(path)
+    if kind is not None:
+        raise NetworkError(key, f"network file not found: {path}" if kind == "missing"
+                           else f"network file {path} is {kind}, not a regular file")
     return path
 
 

@@ -15,7 +15,7 @@ pytest.importorskip("gtsam")
 def solved(quickstart):
     from simulator import pipeline
 
-    solutions = pipeline.run_estimators(quickstart, ["fgo_lc", "fgo_tc", "gnss_only"])
+    solutions = pipeline.run_estimators(quickstart, ["fgo_lc", "fgo_tc", "gnss_only", "gnss_wls"])
     return quickstart, solutions, pipeline.score(quickstart, solutions).scores()
 
 
@@ -52,9 +52,18 @@ def test_follows_the_truth_with_honest_position_sigmas(solved):
 
 
 def test_tightly_coupled_follows_the_truth_and_the_clock(solved):
+    """Horizontally the smoother is, like the snapshot least squares of the same pseudoranges
+    (``gnss_wls``, the image of the simulated errors to the millimetre: test_gnss_wls), bound
+    to the drive-long range errors no filter of these measurements removes, whose size over
+    one drive is one draw (gnss_wls 0.5-2.8 m horizontal RMS over seeds 1-8). So its
+    horizontal RMS is compared with gnss_wls's, within twice its own reported horizontal
+    1-sigma (the RMS of sqrt(std_n^2 + std_e^2) after 60 s), not with a fixed figure."""
     dataset, solutions, scores = solved
-    assert scores["fgo_tc"]["horizontal"]["rms"] < 1.0
     frame = solutions["fgo_tc"][0]
+    spread = float(np.sqrt(np.mean((frame["std_n"] ** 2 + frame["std_e"] ** 2)[
+        frame["t"].to_numpy() > 60.0])))
+    assert abs(scores["fgo_tc"]["horizontal"]["rms"]
+               - scores["gnss_wls"]["horizontal"]["rms"]) < 2.0 * spread
     truth = dataset.read("truth_sensors")
     late = frame["t"].to_numpy() > 60.0
     drift = frame["clock_drift"] - np.interp(frame["t"], truth["t"], truth["clock_drift"])

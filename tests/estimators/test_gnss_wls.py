@@ -2,13 +2,13 @@
 their own clocks give the position to the millimetre and each clock; one faulty pseudorange is
 excluded by the residual test; pseudorange errors with an ionosphere part common to the
 satellites give position errors whose spread its sigmas match (a Monte Carlo); on the
-quickstart dataset it lies within a metre of the truth."""
+quickstart dataset its error is the least-squares image of the simulated errors."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from estimators.builtin.gnss_wls import GnssWls
+from estimators.builtin.gnss_wls import GnssWls, nlos_sigma
 from estimators.toolbox.gnss_model import predict
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
 
@@ -105,12 +105,49 @@ def test_sigmas_match_errors_with_a_common_ionosphere_part():
 
 
 def test_on_the_quickstart_drive(quickstart):
+    """On the quickstart drive (seed 1) gnss_wls's position error is, epoch by epoch, the
+    generalised least-squares image K e of the simulated pseudorange errors e (truth_gnss: the
+    signal-in-space error, the ionosphere and troposphere the broadcast models miss, multipath,
+    reflected path and code noise), K = (H^T W H)^-1 H^T W with H at the true antenna and W the
+    inverse of its covariance model (module docstring: the reported sigmas with the C/N0's
+    NLOS share, the common ionosphere part). The difference is bounded by 1 mm: the
+    Gauss-Newton iteration stops below a 0.1 mm step (CONVERGED_M), and H at the truth and at
+    the solution differ by |dx| / range (a few m over 2e7 m), micrometres on errors of metres.
+    This holds whatever the seed's draw (the error's size over one drive is one draw of its
+    drive-long terms: 0.3-2.9 m horizontal RMS over seeds 1-8). Epochs where the exclusion
+    dropped a satellite are left out (none on this drive; at least 90 % must be compared)."""
     from simulator import pipeline
+    from simulator.datasheet import cn0_template, iono_residual_fractions
 
     solved = pipeline.run_estimators(quickstart, {"gnss_wls": None})
-    scores = pipeline.score(quickstart, solved).scores()["gnss_wls"]
-    assert scores["horizontal"]["rms"] < 1.0
-    assert scores["velocity"]["rms"] < 0.2
+    solution = solved["gnss_wls"][0].set_index("t")
+    gnss = quickstart.manifest["datasheet"]["gnss"]
+    common = iono_residual_fractions(gnss)[0]
+    template = cn0_template(gnss)
+    m = quickstart.read("gnss_raw").merge(quickstart.read("truth_gnss"),
+                                          on=["t", "sv", "signal"], suffixes=("", "_true"))
+    m = m[(m["health"] == 0) & (m["elevation"] >= np.radians(GnssWls.defaults["elevation_mask"]))]
+    error = (m["sis_error"] + m["iono_true"] - m["iono"] + m["tropo_true"] - m["tropo"]
+             + m["multipath"] + m["nlos_delay"] + m["code_noise"])
+    differences = []
+    for t, g in m.assign(error=error).groupby("t"):
+        if t not in solution.index or len(g) != solution.loc[t, "num_sats"]:
+            continue
+        rx = g[["antenna_x", "antenna_y", "antenna_z"]].to_numpy()[0]
+        rel = g[["sat_x", "sat_y", "sat_z"]].to_numpy() - rx
+        h = np.column_stack([-rel / np.linalg.norm(rel, axis=1, keepdims=True), np.ones(len(g))])
+        sigma = nlos_sigma(g["pseudorange_std"].to_numpy(), g["cn0"].to_numpy(),
+                           g["elevation"].to_numpy(), template, GnssWls.defaults["nlos_sigma"])
+        part = common * g["iono"].to_numpy()
+        weight = np.linalg.inv(np.diag(np.maximum(sigma**2 - part**2, (0.1 * sigma) ** 2))
+                               + np.outer(part, part))
+        image = np.linalg.solve(h.T @ weight @ h, h.T @ weight @ g["error"].to_numpy())[:3]
+        row = solution.loc[t]
+        got = geodetic_to_ecef(np.radians(row["lat"]), np.radians(row["lon"]), row["alt"]).ravel()
+        differences.append(got - rx - image)
+    assert len(differences) >= 0.9 * len(solution)
+    assert np.max(np.linalg.norm(differences, axis=1)) < 1e-3
+    assert pipeline.score(quickstart, solved).scores()["gnss_wls"]["velocity"]["rms"] < 0.2
 
 
 def _with_elevation(block: np.ndarray) -> np.ndarray:
@@ -221,7 +258,7 @@ def test_the_nlos_probability_is_calibrated():
     prior is taken from the epoch, so this is not exact). On open sky (no reflection) the mean
     probability is under 1 % and under 0.5 % of the signals get over 0.5 (a direct signal
     faded by over 3 scatters, 0.13 % of them, looks reflected)."""
-    from estimators.builtin.gnss_wls import nlos_probability
+    from simulator.datasheet import nlos_probability
 
     rng = np.random.default_rng(3)
     scatter = 2.24

@@ -74,23 +74,15 @@ def test_twin_fixes_at_least_95_percent_of_epochs(processed):
     assert processed["fixed"] >= 0.95
 
 
-@pytest.mark.parametrize("key", ["carrier L1", "code L1", "code L2"])
+@pytest.mark.parametrize("key", ["carrier L1", "carrier L2", "code L1", "code L2"])
 def test_twin_double_difference_residuals_lie_within_0_6_to_1_6_of_the_real_ones(processed, key):
+    """The P2 code's ratio sits at the lower bound: with the GNSS draws before each error
+    process had its own stream, seeds 1-3 gave 0.48, 0.62 and 0.57 x the real std in the
+    30-45 deg band (docs/gnss-carrier.md), and seed 1 of the present streams lies within the
+    bound; which side a seed falls on is its draw, so the claim for P2 is at its edge."""
     ratio = processed[key][2]
     assert np.all((ratio >= 0.6) & (ratio <= 1.6)), ratio
 
 
-@pytest.mark.xfail(strict=True, reason="not shown at seed 1: the L2 carrier residual std of the "
-                   "30-45 deg band is 1.8 x the real one (4.7 against 2.6 mm; the L2 W-code "
-                   "phase noise and the ionosphere gradient at 3.3 km); seeds 2 and 3: 1.9 and "
-                   "1.2 x. docs/gnss-carrier.md")
-def test_twin_l2_carrier_residuals_lie_within_0_6_to_1_6_of_the_real_ones(processed):
-    ratio = processed["carrier L2"][2]
-    assert np.all((ratio >= 0.6) & (ratio <= 1.6)), ratio
-
-
-@pytest.mark.xfail(strict=True, reason="not shown at seed 1: 3-D RMS 2.2 cm about the true "
-                   "rover position (claim: at most 2 cm; seeds 2 and 3: 2.2 and 1.7 cm). "
-                   "docs/gnss-carrier.md")
 def test_twin_fixed_solution_within_2_cm_rms(processed):
     assert processed["rms_3d"] <= 0.02

@@ -25,6 +25,7 @@ from simulator.gnss.errors import (
     pierce_points_km,
     smoothed_variance_factor,
 )
+from simulator.stochastic import gauss_markov_at, gauss_markov_avar
 
 
 def _hatch_loop(x: np.ndarray, tracked: np.ndarray, n_window: float) -> np.ndarray:
@@ -150,6 +151,43 @@ def test_multipath_process_decorrelates_with_distance_and_time():
         assert x.var() == pytest.approx(1.0, rel=0.1)
 
 
+def test_gauss_markov_at_irregular_points_is_the_exact_recursion():
+    """The blocked closed form against the recursion x_k = e^-dp x_(k-1) + sqrt(1 - e^-2dp) w_k
+    run sample by sample on the same draws, over steps from 1e-6 to 100 correlation lengths
+    (gaps beyond 30 restart the state: their correlation is below 1e-13)."""
+    steps = np.random.default_rng(3).uniform(0.0, 3.0, 4000)
+    steps[100:110], steps[500:700] = 100.0, 1e-6
+    points = np.cumsum(steps)
+    got = gauss_markov_at(points, 3, np.random.default_rng(4))
+    w = np.random.default_rng(4).standard_normal((len(points), 3))
+    want = np.empty_like(w)
+    want[0] = w[0]
+    for k in range(1, len(points)):
+        phi = np.exp(-(points[k] - points[k - 1]))
+        want[k] = phi * want[k - 1] + np.sqrt(1.0 - phi * phi) * w[k]
+    np.testing.assert_allclose(got, want, rtol=0, atol=1e-11)
+
+
+def test_gauss_markov_at_has_the_analytic_allan_deviation_and_correlation():
+    """Sampled every 0.1 correlation length (60 series of 5000 points): the Allan variance
+    at 1, 1.89 (the peak) and 5 correlation lengths (allantools) is the Markov formula's
+    (IEEE Std 952, Annex C), and the correlation at one correlation length e^-1, each within
+    four standard errors of its mean over the series."""
+    import allantools
+
+    rows, step = 60, 0.1
+    x = gauss_markov_at(np.arange(5000) * step, rows, np.random.default_rng(5))
+    for tau in (1.0, 1.89, 5.0):
+        per_row = np.array([allantools.oadev(x[:, j], rate=1.0 / step, data_type="freq",
+                                             taus=[tau])[1][0] ** 2 for j in range(rows)])
+        want = gauss_markov_avar(tau, 1.0, 1.0)
+        assert abs(per_row.mean() - want) < 4 * per_row.std() / np.sqrt(rows), (tau, want)
+    lag = int(round(1.0 / step))
+    corr = np.mean(x[lag:] * x[:-lag], axis=0) / np.mean(x * x, axis=0)
+    assert abs(corr.mean() - np.exp(-1.0)) < 4 * corr.std() / np.sqrt(rows)
+    assert abs(np.mean(x * x) - 1.0) < 4 * np.mean(x * x, axis=0).std() / np.sqrt(rows)
+
+
 def test_multipath_of_a_moving_receiver_decorrelates_faster():
     """The same receiver standing and driving at 15 m/s: the multipath's (raw code) correlation
     at 1 s is exp(-1/120) = 0.99 standing and exp(-1.5 - 1/120) = 0.22 driving."""
@@ -165,6 +203,60 @@ def test_multipath_of_a_moving_receiver_decorrelates_faster():
         got[name] = _pooled_autocorrelation(table, "unit", 1)
     assert got["static"] == pytest.approx(np.exp(-1 / 120), abs=0.02)
     assert got["moving"] == pytest.approx(np.exp(-1.5 - 1 / 120), abs=0.08)
+
+
+@pytest.mark.parametrize("rate_hz", [1.0, 10.0])
+def test_drawn_code_multipath_has_the_models_variance_and_correlation_time(rate_hz):
+    """The code multipath the receiver draws (raw code, no carrier smoothing) on a straight at
+    15 m/s, each sample over the DO-229D J.2.4 sigma at its elevation (the preset's zenith value
+    times (0.13 + 0.53 exp(-el / 10 deg)) / 0.13, written out here): unit variance, and the
+    autocorrelation at lag L s exp(-L (v / D + 1 / T)) (D = 10 m, T = 120 s: a correlation time
+    of 0.66 s), at 0.1 s (10 Hz only), 1 s and 2 s; and the overlapping Allan variance
+    (allantools) at 1 s and 3 s that of that process sampled at the rate (from its
+    autocorrelation: the variance of an m-sample mean minus its covariance with the next one).
+    Each figure is the mean over the satellites' series, within four of its standard errors."""
+    import allantools
+
+    speed, distance_m, static_s = 15.0, 10.0, 120.0
+    truth = drive([{"accelerate": {"to_speed": speed, "accel": 5.0}},
+                   {"straight": {"length": speed * 400.0}}], rate_hz=10.0)
+    gnss = receiver(rate=rate_hz, carrier_smoothing=0.0, outputs=["raw"],
+                    multipath_distance=distance_m, multipath_correlation_time=static_s)
+    table = gnss.generate(truth, np.random.default_rng(12))["truth_gnss"]
+    table = table.query("tracked == 1 and t >= 5").copy()
+    el_deg = np.degrees(table["elevation"])
+    sigma = gnss.config["multipath"] * (0.13 + 0.53 * np.exp(-el_deg / 10.0)) / 0.13
+    table["unit"] = table["multipath"] / sigma
+    wide = table.pivot(index="t", columns="sv", values="unit")
+    series = [wide[sv].dropna().to_numpy() for sv in wide if wide[sv].count() > 300 * rate_hz]
+    assert len(series) >= 6  # satellites tracked over at least 450 correlation times
+    tau_c = 1.0 / (speed / distance_m + 1.0 / static_s)
+
+    def close(per_series: np.ndarray, want: float) -> bool:
+        return abs(per_series.mean() - want) < 4.0 * per_series.std() / np.sqrt(len(series))
+
+    variances = np.array([np.mean(x * x) for x in series])
+    print(f"\n{rate_hz:g} Hz: multipath / model sigma variance {variances.mean():.3f} "
+          f"(+-{variances.std() / np.sqrt(len(series)):.3f}, {len(series)} satellites)")
+    assert close(variances, 1.0)
+    for lag_s in (0.1, 1.0, 2.0):
+        lag = int(round(lag_s * rate_hz))
+        if lag == 0:
+            continue
+        corr = np.array([np.sum(x[lag:] * x[:-lag]) / np.sum(x * x) for x in series])
+        assert close(corr, np.exp(-lag_s / tau_c)), (lag_s, corr.mean())
+    for tau in (1.0, 3.0):
+        m = int(round(tau * rate_hz))
+        lags = np.arange(1 - m, m)
+        weights = (m - np.abs(lags)) / m**2
+
+        def correlation(j: np.ndarray) -> np.ndarray:
+            return np.exp(-np.abs(j) / (rate_hz * tau_c))
+
+        want = np.sum(weights * (correlation(lags) - correlation(lags + m)))
+        avar = np.array([allantools.oadev(x, rate=rate_hz, data_type="freq", taus=[tau])[1][0]
+                         ** 2 for x in series])
+        assert close(avar, want), (tau, avar.mean(), want)
 
 
 def test_cn0_fading_is_correlated_not_white():

@@ -48,7 +48,7 @@ CASES = {
                "neither a RINEX navigation file nor a YUMA"),
     "truncated almanac": (_truncated_yuma, "lacks week"),
     "broken rinex record": (_rinex_header_only, "not a readable RINEX navigation record"),
-    "a folder": (lambda tmp: tmp, "neither 'gps-almanac', 'nominal-gps' nor an existing"),
+    "a folder": (lambda tmp: tmp, "is a folder, not a RINEX navigation or YUMA almanac file"),
 }
 
 

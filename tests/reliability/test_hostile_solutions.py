@@ -200,6 +200,11 @@ HEADER = "%  GPST          latitude(deg) longitude(deg)  height(m)   Q  ns\n"
      "missing column(s) t, lat"),  # was "no rows"
     ("far.csv", "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw\n1e308,37,127,0,0,0,0,0,0,0\n"
      "1e308,37,127,0,0,0,0,0,0,0\n", "row 1 has t = 1e+308 s after t = 1e+308 s"),  # 309 digits
+    ("cut.csv", "t,lat,lon,alt,vn,ve,vd,roll,pitch,yaw\n0,37,127,0,0,0,0,0,0,0\n\n"
+     "1,37,127,0,0,0,0,0\n2,37,127,0,0,0,0,0,0,0\n",  # was NaN pitch and yaw, silently
+     "line 4: 8 field(s) where the header names 10: no pitch, yaw"),
+    ("quoted.csv", 't,lat,lon,alt,vn,ve,vd,roll,pitch,"yaw"\n0,37,127,0,0,0,0,0,0,0\n'
+     '1,37,127,0,0,0,0,0,"0,0"\n', "line 3: 9 field(s) where the header names 10: no yaw"),
 ])
 def test_malformed_solution_files(dataset, tmp_path, capsys, name, text, words):
     path = tmp_path / name

@@ -25,6 +25,23 @@ def test_reference_is_the_highest_of_the_highest_priority():
     assert ddiff.references(groups, elevation, priority).tolist() == [2, 2, 2, 4, 4]
 
 
+def test_references_match_a_search_of_each_group():
+    """Random epochs (ties of elevation and priority included): each signal's reference is
+    the first signal of its group with the highest priority and, of those, elevation."""
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        m = int(rng.integers(1, 30))
+        groups = rng.integers(0, 5, m) * 10_000 + 1575
+        elevation = rng.choice([0.3, 0.5, 0.9, 1.2], m)
+        priority = rng.integers(1, 3, m)
+        expected = np.empty(m, dtype=int)
+        for i in range(m):
+            members = [j for j in range(m) if groups[j] == groups[i]]
+            best = max(members, key=lambda j: (priority[j], elevation[j], -j))
+            expected[i] = best
+        assert ddiff.references(groups, elevation, priority).tolist() == expected.tolist()
+
+
 def test_double_differences_and_their_covariance_match_the_hand_written_ones():
     ref = np.array([1, 1, 1, 3, 3])  # two groups: references 1 and 3
     d, rows = ddiff.difference_matrix(ref)

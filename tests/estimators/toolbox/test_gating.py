@@ -49,6 +49,19 @@ def test_innovation_covariance_is_hph_plus_r() -> None:
     assert gating.innovation_covariance(p, h, np.array([[1.0]]))[0, 0] == pytest.approx(5.0)
 
 
+def test_innovation_variances_are_the_diagonal_of_s() -> None:
+    """From H's non-zero columns only, the diagonal of the dense H P H^T + R."""
+    rng = np.random.default_rng(4)
+    a = rng.normal(size=(40, 60))
+    p = a @ a.T
+    h = np.zeros((6, 40))
+    h[:, [2, 7, 30]] = rng.normal(size=(6, 3))
+    b = rng.normal(size=(6, 6))
+    r = b @ b.T
+    np.testing.assert_allclose(gating.innovation_variances(p, h, r),
+                               np.diag(gating.innovation_covariance(p, h, r)), rtol=1e-12)
+
+
 def test_threshold_variance_inflates_beyond_the_threshold() -> None:
     # Park et al. 2019, section III-D: ||f|| - g beyond 0.059 m/s^2 inflates the tilt noise
     assert gating.threshold_variance(0.10, 0.059, 0.01, 0.2) == pytest.approx(0.04)

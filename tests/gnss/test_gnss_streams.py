@@ -1,0 +1,66 @@
+"""The GNSS receiver's random streams (layout in ``simulator.sensors.gnss_observables``): a
+named child stream depends only on its parent's seed and its name; the same scenario and seed
+give identical streams (rover, base, canyon, carrier phase); a process that draws a different
+number of values (here the C/N0 fading, switched off) redraws none of the drive-long errors
+(receiver clock, signal-in-space error, ionosphere, troposphere) of rover or base."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from simulator.dataset.generate import generate_streams
+from simulator.stochastic import child_rng, stream_rng
+from tests.conftest import scenario_data
+
+CANYON_DRIVE = [{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 10.0, "accel": 2.0}},
+                {"straight": {"length": 150, "zone": "canyon"}}, {"straight": {"length": 100}}]
+
+
+def _streams(**gnss) -> dict[str, pd.DataFrame]:
+    data = scenario_data(
+        CANYON_DRIVE, environment={"zones": {"canyon": {"sky": "canyon"}}},
+        sensors={"gnss": {"preset": "dual-band", "rate": 2, "outputs": ["raw"], **gnss},
+                 "gnss_base": {"offset": {"east": 2000.0}, "rate": 1}})
+    return generate_streams(data, show_progress=False).streams
+
+
+@pytest.fixture(scope="module")
+def first():
+    return _streams()
+
+
+def test_a_child_stream_depends_only_on_the_seed_and_its_name():
+    parent = stream_rng(1, "gnss")
+    before = child_rng(parent, "receiver_clock").standard_normal(4)
+    parent.standard_normal(1000)
+    child_rng(parent, "sis").standard_normal(1000)
+    np.testing.assert_array_equal(child_rng(parent, "receiver_clock").standard_normal(4), before)
+    assert not np.any(child_rng(parent, "sis").standard_normal(4) == before)
+    assert not np.any(child_rng(stream_rng(2, "gnss"), "receiver_clock").standard_normal(4)
+                      == before)
+    assert type(child_rng(parent, "sis").bit_generator) is type(parent.bit_generator)
+
+
+def test_same_seed_gives_identical_streams(first):
+    again = _streams()
+    assert {"gnss_raw", "truth_gnss", "gnss_base_raw", "truth_gnss_base"} <= set(first)
+    assert (first["truth_gnss"]["nlos"] == 1).any()  # the canyon's draws are in play
+    for name, frame in first.items():
+        pd.testing.assert_frame_equal(again[name], frame, check_exact=True, obj=name)
+
+
+def test_fewer_fading_draws_redraw_no_drive_long_error(first):
+    """Without C/N0 fading the receiver draws no fading process (n_sat x n_epoch values fewer);
+    the clock, broadcast errors and atmosphere of rover and base are the same to the bit, the
+    C/N0 (which the fading is part of) is not."""
+    unfaded = _streams(cn0_fading=0.0)
+    for name in ("truth_gnss", "truth_gnss_base"):
+        a, b = first[name], unfaded[name]
+        assert len(a) == len(b) > 100  # one row per satellite above the horizon and epoch
+        for column in ("receiver_clock", "receiver_clock_drift", "sis_error", "iono_true",
+                       "tropo_true", "range"):
+            np.testing.assert_array_equal(a[column], b[column], err_msg=f"{name}.{column}")
+    cn0 = first["gnss_raw"].merge(unfaded["gnss_raw"], on=["t", "sv", "signal"])
+    assert not np.allclose(cn0["cn0_x"], cn0["cn0_y"])
