@@ -105,12 +105,17 @@ def write_table(frame: Table, path: Path, units: dict[str, str],
                    write_statistics=False)
 
 
-def read_table(path: Path, columns: list[str] | None = None) -> pd.DataFrame:
-    """Read one Parquet table; raise InputError naming the file if it is missing or corrupt."""
+def read_table(path: Path, columns: list[str] | None = None,
+               read_only: bool = False) -> pd.DataFrame:
+    """Read one Parquet table; raise InputError naming the file if it is missing or corrupt.
+    ``read_only``: each Arrow column released as it is converted, so the table is not held
+    twice, at the price of columns that may not be written in place (for a caller that only
+    reads them)."""
     try:
-        # each Arrow column is released as it is converted: the table is not held twice
-        return pq.read_table(path, columns=columns).to_pandas(split_blocks=True,
-                                                              self_destruct=True)
+        table = pq.read_table(path, columns=columns)
+        if read_only:
+            return table.to_pandas(split_blocks=True, self_destruct=True)
+        return table.to_pandas()
     except FileNotFoundError:
         raise InputError([Problem(str(path), None, "", "file not found")]) from None
     except (pa.ArrowException, OSError) as exc:

@@ -136,7 +136,7 @@ def _parquet(path: Path) -> tuple[pd.DataFrame, list[str], bool]:
         raise _problem(path, f"not a readable Parquet file: {exc}") from None
     if rows > MAX_SOLUTION_ROWS:
         raise _too_many_rows(path, rows)
-    frame = read_table(path, [n for n in names if n in _READ])
+    frame = read_table(path, [n for n in names if n in _READ], read_only=True)
     uses_gnss = read_metadata(path).get(USES_GNSS_KEY, "true") != "false"
     units = {k: v for k, v in read_units(path).items() if k in frame.columns}
     _refuse_text(path, frame, _Rows())
