@@ -4,6 +4,7 @@ definitions written out by hand, and the block-diagonal Kalman prediction agains
 from __future__ import annotations
 
 import numpy as np
+from scipy.linalg import block_diag
 
 from estimators.toolbox import double_difference as ddiff
 from estimators.toolbox.kalman import predict, predict_blocks
@@ -69,12 +70,8 @@ def test_block_prediction_equals_the_full_one():
     q_a = np.diag(rng.uniform(0.1, 1.0, a))
     phi_b = rng.uniform(0.5, 1.0, b)
     q_b = rng.uniform(0.0, 0.2, b)
-    phi = np.zeros((n, n))
-    phi[:a, :a] = phi_a
-    phi[a:, a:] = np.diag(phi_b)
-    q = np.zeros((n, n))
-    q[:a, :a] = q_a
-    q[a:, a:] = np.diag(q_b)
+    phi = block_diag(phi_a, np.diag(phi_b))
+    q = block_diag(q_a, np.diag(q_b))
     x_full, p_full = predict(x, p, phi, q)
     x_block, p_block = predict_blocks(x, p, phi_a, q_a, phi_b, q_b)
     assert np.allclose(x_block, x_full, rtol=1e-12, atol=1e-12)

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.linalg import solve_discrete_are
+from scipy.linalg import block_diag, solve_discrete_are
 
 from estimators.toolbox.kalman import (
     ErrorState,
@@ -184,12 +184,8 @@ def _check_static_prediction(rng: np.random.Generator) -> None:
     q_b = np.where(moving, rng.uniform(0.0, 1e-3, n - a), 0.0)
     x_b, p_b = predict_blocks(x, p, phi_a, q_a, phi_b, q_b)
     x_s, p_s = predict_static(x, p, phi_a, q_a, phi_b, q_b)
-    phi = np.zeros((n, n))
-    phi[:a, :a] = phi_a
-    phi[a:, a:] = np.diag(phi_b)
-    q = np.zeros((n, n))
-    q[:a, :a] = q_a
-    q[a:, a:] = np.diag(q_b)
+    phi = block_diag(phi_a, np.diag(phi_b))
+    q = block_diag(q_a, np.diag(q_b))
     x_d, p_d = predict(x, p, phi, q)
     for expected_x, expected_p in ((x_b, p_b), (x_d, p_d)):
         scale = np.sqrt(np.diag(p) + np.diag(p_d))
