@@ -40,11 +40,33 @@ its std columns the keyframe's marginal covariance plus the preintegration's. At
 map the navigation-frame rotation covariance to ZYX Euler angles (``_euler_sigma``).
 
 ``fgo_tc`` is the same smoother on the raw measurements: each epoch's corrected pseudoranges
-and pseudorange rates (``toolbox.gnss_model``: broadcast corrections, Sagnac rotation) against
-the antenna's position and velocity and a two-state receiver clock per keyframe [c dt, c dt']
-linked by the oscillator's process noise (``gnss_model.clock_noise``); code sigma the
-receiver's reported one in quadrature with the horizontal UERE scaled by C/N0, range-rate sigma
-the receiver's (at least 2 cm/s); one clock, so the first system's satellites only.
+and pseudorange rates (``toolbox.gnss_model``: broadcast corrections, Sagnac rotation; the
+L1/E1/B1 signals) against the antenna's position and velocity and a two-state receiver clock
+per keyframe [c dt, c dt'] linked by the oscillator's process noise
+(``gnss_model.clock_noise``); one clock, so the first system's satellites only. A
+pseudorange's error is not white (docs/gnss-errors.md): taken as white with the receiver's
+reported 1-sigma, the smoother averaged drive-long errors away (quickstart seed 1: down
+(error / sigma)^2 26.8). Its drive-long parts are variables, as the tightly coupled filters
+carry them as states (``tc_ekf``; Brown & Hwang, 4th ed., the augmented state of coloured
+measurement noise), each a first-order Gauss-Markov process of ``RANGE_ERROR_TAU_S``:
+
+* the broadcast ionosphere's relative residual common to the satellites, one variable with
+  each satellite's broadcast delay I as its coefficient, 1-sigma sqrt((scale - 1)^2
+  + (1 - s^2) (scale residual)^2) from the receiver datasheet's ``iono_scale`` and
+  ``iono_residual`` (``simulator.datasheet.iono_residual_fractions``; s =
+  ``IONO_FIELD_OWN_SHARE``, the field's share that differs between satellites);
+* one per satellite: the signal-in-space error, the field's own share s (scale residual) I
+  and the troposphere's zenith residual over sin(elevation), in quadrature;
+* the rest of the reported variance (code noise and multipath after the Hatch filter) white,
+  inflated by the correlated-noise factor of the carrier-smoothing time
+  (``gnss_model.correlated_noise_inflation``: the white noise of the same low-frequency
+  spectrum), with the reflected-signal share its C/N0 deficit announces (p (20 m)^2,
+  ``gnss_model.nlos_sigma``, as ``gnss_wls``).
+
+A range-error variable stands for ``RANGE_ERROR_STEP_S`` (its timestamp refreshed at each
+use, so that the fixed-lag window keeps it), then a new one follows, linked by the process's
+transition; one that left the window in an outage starts again from the stationary prior.
+Range-rate sigma: the receiver's (at least 2 cm/s).
 
 Public classes
 --------------
@@ -54,6 +76,7 @@ FgoLooselyCoupled, FgoTightlyCoupled.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
@@ -62,9 +85,18 @@ from estimators.base import Estimator
 from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import FixAccuracy, fix_error_model
-from estimators.toolbox.gnss_model import clock_noise, predict, raw_epoch
+from estimators.toolbox.gnss_model import (
+    NLOS_SIGMA_M,
+    clock_noise,
+    correlated_noise_inflation,
+    nlos_sigma,
+    predict,
+    raw_epoch,
+    select,
+    single_frequency,
+)
 from estimators.toolbox.installation import Installation
-from simulator.datasheet import fix_uere_m
+from simulator.datasheet import IONO_FIELD_OWN_SHARE, cn0_template, iono_residual_fractions
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -84,6 +116,10 @@ ODOMETER_SCALE = 0.03     # unmodelled odometer scale error, 1-sigma
 DEFAULT_UERE_M = 3.0  # a datasheet without a receiver error budget
 FIX_VELOCITY_SIGMA_M_S = np.array([0.1, 0.1, 0.2])  # NED, without the fix's own std_v*
 DEFAULT_DOP = 1.5
+SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``tc_ekf``)
+PSEUDORANGE_FLOOR_M = 0.1  # white 1-sigma left of a pseudorange at least, before inflation
+RANGE_ERROR_TAU_S = 1800.0  # correlation time of the drive-long range errors (docs/gnss-errors.md)
+RANGE_ERROR_STEP_S = 5.0  # a range-error variable stands for this long (a constant meanwhile)
 
 OUTPUT_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
                   "std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd",
@@ -154,10 +190,17 @@ class FgoLooselyCoupled(Estimator):
         imu = sheet.get("imu") or {}
         gyro, accel = imu.get("gyro") or {}, imu.get("accel") or {}
         params = gtsam.PreintegrationCombinedParams.MakeSharedD(float(self._g0[2]))
-        params.setGyroscopeCovariance(np.eye(3) * max(float(gyro.get("noise_density") or 0),
-                                                      1e-5) ** 2)
-        params.setAccelerometerCovariance(np.eye(3) * max(float(
-            accel.get("noise_density") or 0), 1e-4) ** 2)
+        self._gyro_psd = max(_sheet_value(gyro, "noise_density"), 1e-5) ** 2
+        self._accel_psd = max(_sheet_value(accel, "noise_density"), 1e-4) ** 2
+        # scale factor, misalignment (each 1-sigma) and the gyro's g-sensitivity, as white
+        # noise over SCALE_FACTOR_TIME_S (``_scale_noise``)
+        self._gyro_scale = (_sheet_value(gyro, "scale_factor"),
+                            _sheet_value(gyro, "misalignment"))
+        self._accel_scale = (_sheet_value(accel, "scale_factor"),
+                             _sheet_value(accel, "misalignment"))
+        self._g_sensitivity = _sheet_value(gyro, "g_sensitivity")
+        params.setGyroscopeCovariance(np.eye(3) * self._gyro_psd)
+        params.setAccelerometerCovariance(np.eye(3) * self._accel_psd)
         params.setIntegrationCovariance(np.eye(3) * 1e-8)
         params.setBiasOmegaCovariance(np.eye(3) * _random_walk(gyro))
         params.setBiasAccCovariance(np.eye(3) * _random_walk(accel))
@@ -258,7 +301,14 @@ class FgoLooselyCoupled(Estimator):
         lat, lon, alt = ecef_to_geodetic(self._origin + self._c_ne0 @ pos)
         g_here = self._c_ne0.T @ ned_to_ecef_matrix(lat, lon) @ gravity_ned(
             np.array([lat]), np.array([alt])).ravel()
-        force = force + self._state.pose().rotation().matrix().T @ (g_here - self._g0)
+        rot_t = self._state.pose().rotation().matrix().T
+        force = force + rot_t @ (g_here - self._g0)
+        motion = force + rot_t @ self._g0  # the specific force less gravity, body axes
+        self._params.setGyroscopeCovariance(np.diag(
+            self._gyro_psd + _scale_noise(self._gyro_scale, rate)
+            + SCALE_FACTOR_TIME_S * (self._g_sensitivity**2) * float(motion @ motion)))
+        self._params.setAccelerometerCovariance(np.diag(
+            self._accel_psd + _scale_noise(self._accel_scale, motion)))
         self._pim.integrateMeasurement(force, rate, dt)
         self._t_imu = t
         self._last_rate, self._last_force = rate, force
@@ -422,8 +472,9 @@ def _fix_error(measured: np.ndarray, arm: np.ndarray, pose_key: int, error_key: 
 def _markov_error(phi: float, before: int, after: int, this, values, jacobians):
     """Custom-factor error of a first-order Gauss-Markov step: e_k - phi e_(k-1)."""
     if jacobians is not None:
-        jacobians[0] = -phi * np.eye(3)
-        jacobians[1] = np.eye(3)
+        dim = len(values.atVector(after))
+        jacobians[0] = -phi * np.eye(dim)
+        jacobians[1] = np.eye(dim)
     return values.atVector(after) - phi * values.atVector(before)
 
 
@@ -438,6 +489,26 @@ def _odometer_rows(rows: list[int], measured: np.ndarray, arm_term: np.ndarray, 
     return error[rows]
 
 
+def _sheet_value(group: dict, key: str) -> float:
+    """A datasheet value as one number (the largest axis of a per-axis list), 0 when absent or
+    given as a known value ({fixed: ...})."""
+    value = group.get(key)
+    if value is None or isinstance(value, dict):
+        return 0.0
+    return float(np.max(np.abs(np.atleast_1d(np.asarray(value, dtype=float)))))
+
+
+def _scale_noise(scale: tuple[float, float], reading: np.ndarray) -> np.ndarray:
+    """Per axis, the white-noise PSD of a triad's scale-factor error s and misalignment m
+    (1-sigma each) on a reading x: the error s x_i + m (x_j, x_k) of axis i has the variance
+    s^2 x_i^2 + m^2 (|x|^2 - x_i^2), taken as white over ``SCALE_FACTOR_TIME_S`` (PSD: that
+    times the time; a constant error adds up over a turn or an acceleration, as the filters'
+    datasheet tuning takes it, ``tc_ekf``)."""
+    sf, mis = scale
+    x2 = reading * reading
+    return SCALE_FACTOR_TIME_S * (sf * sf * x2 + mis * mis * (float(x2.sum()) - x2))
+
+
 def _random_walk(group: dict) -> float:
     """Continuous-time bias random-walk PSD from a datasheet group: the random walk's own PSD
     plus the bias instability B as a random walk over BIAS_TIME_S (2 B^2 / tau), at least
@@ -449,13 +520,15 @@ def _random_walk(group: dict) -> float:
 
 class FgoTightlyCoupled(FgoLooselyCoupled):
     """Fixed-lag factor-graph smoother on pseudoranges and pseudorange rates with receiver
-    clock states (``fgo_lc``'s IMU, odometer and NHC factors)."""
+    clock states, the pseudoranges' drive-long errors as variables (``_range_budget``), and
+    ``fgo_lc``'s IMU, odometer and NHC factors."""
 
     name = "fgo_tc"
     needs = ("imu", "gnss_raw")
     uses = ("odometer",)
     paper = ("baseline: GTSAM fixed-lag smoother, IMU preintegration (Forster et al. 2017) "
-             "with pseudorange, Doppler, clock, odometer and non-holonomic factors")
+             "with pseudorange, Doppler, clock, range-error, odometer and non-holonomic "
+             "factors")
     defaults = {**FgoLooselyCoupled.defaults, "elevation_mask": 10.0}
     config_help = {**FgoLooselyCoupled.config_help,
                    "elevation_mask": ("deg", "satellites below this elevation are left out")}
@@ -469,8 +542,11 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
         self._t_c = 0.0
         self._c_last = np.zeros(2)
         self._c_cov = np.eye(2)
-        self._sigma_floor = fix_uere_m(self.datasheet.get("gnss") or {}, ionosphere=False) \
-            or DEFAULT_UERE_M
+        gnss = self.datasheet.get("gnss") or {}
+        self._budget = _range_budget(gnss)
+        self._template = cn0_template(gnss)
+        self._chains = {}  # "iono" or a satellite -> (its current variable, created at)
+        self._n_vars = 0
 
     def _c(self, k: int) -> int:
         return self._g.symbol("c", k)
@@ -480,6 +556,7 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
 
     def on_gnss_raw(self, t: float, block: np.ndarray) -> None:
         cols = self._raw
+        block = single_frequency(block, cols)
         if "health" in cols:
             block = block[block[:, cols["health"]] == 0]
         if "elevation" in cols:
@@ -487,25 +564,54 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
         ep = raw_epoch(block, cols)
         ok = (np.isfinite(ep.pseudorange) & np.isfinite(ep.range_rate)
               & np.isfinite(ep.sat_pos).all(axis=1))
-        if "system_code" in cols:  # one clock: the first system's satellites only
-            codes = block[:, cols["system_code"]]
-            ok &= codes == codes[ok][0] if ok.any() else ok
+        codes = block[:, cols["system_code"]] if "system_code" in cols \
+            else np.zeros(len(block))
+        if ok.any():  # one clock: the first system's satellites only
+            ok &= codes == codes[ok][0]
         if ok.sum() < 4:
             if t - self._t_key >= float(self.config["keyframe_interval"]):
                 self._keyframe(t, None)
             return
-        cn0 = block[:, cols["cn0"]][ok] if "cn0" in cols else np.full(ok.sum(), 45.0)
-        sigma_code = np.hypot(np.nan_to_num(ep.pseudorange_std[ok], nan=1.0),
-                              self._sigma_floor / np.sqrt(np.clip(
-                                  10 ** ((cn0 - 45.0) / 20.0), 0.1, 1.0)))
-        sigma_rate = np.where(np.isfinite(ep.range_rate_std[ok]), ep.range_rate_std[ok], 0.1)
-        self._keyframe(t, (ep.sat_pos[ok], ep.sat_vel[ok], ep.pseudorange[ok],
-                           ep.range_rate[ok], sigma_code, np.maximum(sigma_rate, 0.02)))
+        ep = select(ep, ok)
+        iono, bias, white = self._budget.sigmas(ep)
+        if self._template is not None and np.isfinite(ep.cn0).all():
+            white = nlos_sigma(white, ep.cn0, ep.elevation, self._template, NLOS_SIGMA_M)
+        sigma_rate = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, 0.1)
+        sats = codes[ok] * 1000 + ep.sv
+        self._keyframe(t, (ep, sats, iono, bias, white, np.maximum(sigma_rate, 0.02)))
+
+    def _chain(self, graph, values, stamps: dict, current, name: object, t: float,
+               sigma: float) -> int:
+        """The variable of a drive-long range error ``name`` at ``t`` (a first-order
+        Gauss-Markov process of 1-sigma ``sigma``, correlation time ``RANGE_ERROR_TAU_S``):
+        the chain's variable while it is younger than ``RANGE_ERROR_STEP_S`` (a constant over
+        that step), else a new one linked to it by the process's transition, or a new one
+        with the stationary prior when the chain is new or has left the window."""
+        gtsam = self._g
+        key, since = self._chains.get(name, (None, 0.0))
+        if key is not None and current.exists(key) and t - since < RANGE_ERROR_STEP_S:
+            stamps[key] = t
+            return key
+        self._n_vars += 1
+        new = gtsam.symbol("r", self._n_vars)
+        if key is not None and current.exists(key):
+            phi = math.exp(-(t - since) / RANGE_ERROR_TAU_S)
+            graph.add(gtsam.CustomFactor(
+                gtsam.noiseModel.Isotropic.Sigma(1, sigma * math.sqrt(1.0 - phi * phi)),
+                [key, new], partial(_markov_error, phi, key, new)))
+            values.insert(new, phi * current.atVector(key))
+        else:
+            graph.add(gtsam.PriorFactorVector(new, np.zeros(1),
+                                              gtsam.noiseModel.Isotropic.Sigma(1, sigma)))
+            values.insert(new, np.zeros(1))
+        self._chains[name] = (new, t)
+        stamps[new] = t
+        return new
 
     def _gnss_factors(self, graph, values, stamps: dict, k: int, t: float,
                       epoch: tuple) -> None:
         gtsam = self._g
-        sat_pos, sat_vel, rho, rate, sigma_code, sigma_rate = epoch
+        ep, sats, iono, bias, white, sigma_rate = epoch
         c_key = self._c(k)
         current = self._smoother.calculateEstimate()
         if self._c_key is None:
@@ -513,8 +619,9 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
             antenna = self._origin + self._c_ne0 @ (pose.translation()
                                                     + pose.rotation().matrix() @ self._antenna)
             v_ecef = self._c_ne0 @ values.atVector(self._v(k))
-            geometric, geometric_rate, _ = predict(sat_pos, sat_vel, antenna, v_ecef)
-            start = np.array([np.median(rho - geometric), np.median(rate - geometric_rate)])
+            geometric, geometric_rate, _ = predict(ep.sat_pos, ep.sat_vel, antenna, v_ecef)
+            start = np.array([np.median(ep.pseudorange - geometric),
+                              np.median(ep.range_rate - geometric_rate)])
             graph.add(gtsam.PriorFactorVector(c_key, start,
                                               gtsam.noiseModel.Diagonal.Sigmas([30.0, 3.0])))
             values.insert(c_key, start)
@@ -532,11 +639,22 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
                     c_key, phi @ self._c_last,
                     gtsam.noiseModel.Gaussian.Covariance(phi @ self._c_cov @ phi.T + q)))
                 values.insert(c_key, phi @ self._c_last)
-        sigma = np.concatenate([sigma_code, sigma_rate])
+        keys = [self._x(k), self._v(k), c_key]
+        gains = []  # per error variable: its coefficient on each pseudorange
+        if self._budget.iono_relative > 0.0:
+            keys.append(self._chain(graph, values, stamps, current, "iono", t,
+                                    self._budget.iono_relative))
+            gains.append(iono)
+        for i, (sat, sigma) in enumerate(zip(sats, bias, strict=True)):
+            if sigma > 0.0:
+                keys.append(self._chain(graph, values, stamps, current, float(sat), t,
+                                        float(sigma)))
+                gains.append(np.eye(len(sats))[i])
         graph.add(gtsam.CustomFactor(
-            gtsam.noiseModel.Diagonal.Sigmas(sigma), [self._x(k), self._v(k), c_key],
-            partial(_range_error, epoch[:4], self._antenna, self._origin, self._c_ne0,
-                    self._x(k), self._v(k), c_key)))
+            gtsam.noiseModel.Diagonal.Sigmas(np.concatenate([white, sigma_rate])), keys,
+            partial(_range_error, (ep.sat_pos, ep.sat_vel, ep.pseudorange, ep.range_rate),
+                    np.array(gains).reshape(len(gains), len(sats)), self._antenna,
+                    self._origin, self._c_ne0, keys)))
         stamps[c_key] = t
         self._c_key, self._t_c = c_key, t
 
@@ -552,6 +670,54 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
         return [*row, float(self._c_last[0] + self._c_last[1] * dt), float(self._c_last[1])]
 
 
+@dataclass(frozen=True)
+class _RangeBudget:
+    """A pseudorange's error split by time behaviour, from the receiver's datasheet
+    (``simulator.datasheet``; docs/gnss-errors.md): ``iono_relative`` the 1-sigma of the
+    broadcast ionosphere's relative residual common to the epoch's satellites (times each
+    satellite's broadcast delay I), ``iono_own`` that of each satellite's own share, ``sis``
+    the signal-in-space error, ``tropo_zenith`` the troposphere's zenith residual, and
+    ``inflation`` the factor on the rest (code noise and multipath after the Hatch filter,
+    correlated over its time: ``gnss_model.correlated_noise_inflation``)."""
+
+    iono_relative: float
+    iono_own: float
+    sis: float
+    tropo_zenith: float
+    inflation: float
+
+    def sigmas(self, ep) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Per satellite of a ``RawEpoch``: the common ionosphere variable's coefficient I
+        (m per unit relative residual), the 1-sigma of its own drive-long error
+        sqrt(sis^2 + (own I)^2 + (tropo / sin(el))^2), and the white 1-sigma of the rest:
+        the reported variance less those (at least ``PSEUDORANGE_FLOOR_M``), inflated; without
+        a reported 1-sigma ``DEFAULT_UERE_M``."""
+        delay = np.nan_to_num(ep.iono) if ep.iono is not None else np.zeros(len(ep.sv))
+        el = ep.elevation if ep.elevation is not None else np.full(len(ep.sv), np.nan)
+        mapping = 1.0 / np.sin(np.clip(np.nan_to_num(el, nan=math.pi / 6), 0.05, None))
+        bias2 = (self.sis**2 + (self.iono_own * delay) ** 2
+                 + (self.tropo_zenith * mapping) ** 2)
+        reported = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
+                            DEFAULT_UERE_M)
+        rest2 = reported**2 - bias2 - (self.iono_relative * delay) ** 2
+        white = np.sqrt(np.maximum(rest2, PSEUDORANGE_FLOOR_M**2)) * self.inflation
+        return delay, np.sqrt(bias2), white
+
+
+def _range_budget(gnss: dict) -> _RangeBudget:
+    """``_RangeBudget`` of a receiver datasheet block (zeros where it is silent: the reported
+    1-sigma white): the ionosphere field's ``IONO_FIELD_OWN_SHARE`` of each satellite's own,
+    the rest of it common with the part (``iono_scale`` - 1) the broadcast model misses."""
+    common, field = iono_residual_fractions(gnss)
+    interval = 1.0 / float(gnss.get("rate") or 1.0)
+    return _RangeBudget(
+        iono_relative=math.hypot(common, math.sqrt(1.0 - IONO_FIELD_OWN_SHARE**2) * field),
+        iono_own=IONO_FIELD_OWN_SHARE * field, sis=float(gnss.get("sis_error") or 0.0),
+        tropo_zenith=float(gnss.get("tropo_residual") or 0.0),
+        inflation=correlated_noise_inflation(float(gnss.get("carrier_smoothing") or 0.0),
+                                             interval))
+
+
 def _clock_error(phi: np.ndarray, before: int, after: int, this, values, jacobians):
     """Custom-factor error of the two-state clock: c_k - Phi c_(k-1)."""
     if jacobians is not None:
@@ -560,20 +726,25 @@ def _clock_error(phi: np.ndarray, before: int, after: int, this, values, jacobia
     return values.atVector(after) - phi @ values.atVector(before)
 
 
-def _range_error(epoch: tuple, arm: np.ndarray, origin: np.ndarray, c_ne: np.ndarray,
-                 pose_key: int, vel_key: int, clock_key: int, this, values, jacobians):
+def _range_error(epoch: tuple, gains: np.ndarray, arm: np.ndarray, origin: np.ndarray,
+                 c_ne: np.ndarray, keys: list[int], this, values, jacobians):
     """Custom-factor error of an epoch's corrected pseudoranges and range rates against the
-    antenna's state (``toolbox.gnss_model.predict``: Sagnac rotation, flight time) and the
-    clock [cb, d]; Jacobians on the pose tangent (rotation, translation), the velocity and
-    the clock (the range rates' dependence on the position is left out: 1e-4 of theirs)."""
+    antenna's state (``toolbox.gnss_model.predict``: Sagnac rotation, flight time), the clock
+    [cb, d] and the drive-long range errors (keys after the pose, velocity and clock; row j of
+    ``gains`` the coefficients of the j-th on the pseudoranges); Jacobians on the pose tangent
+    (rotation, translation), the velocity, the clock and the range errors (the range rates'
+    dependence on the position is left out: 1e-4 of theirs)."""
     sat_pos, sat_vel, rho, rate = epoch
-    pose = values.atPose3(pose_key)
+    pose = values.atPose3(keys[0])
     rot = pose.rotation().matrix()
-    v = values.atVector(vel_key)
-    clock = values.atVector(clock_key)
+    v = values.atVector(keys[1])
+    clock = values.atVector(keys[2])
+    errors = np.array([values.atVector(key)[0] for key in keys[3:]])
     antenna = origin + c_ne @ (pose.translation() + rot @ arm)
     predicted, predicted_rate, los = predict(sat_pos, sat_vel, antenna, c_ne @ v,
                                              clock[0], clock[1])
+    if len(errors):
+        predicted = predicted + errors @ gains
     m = len(rho)
     if jacobians is not None:
         los_local = los @ c_ne  # (m, 3): unit vectors in the frame at the origin
@@ -590,4 +761,8 @@ def _range_error(epoch: tuple, arm: np.ndarray, origin: np.ndarray, c_ne: np.nda
         jacobians[0] = pose_jac
         jacobians[1] = vel_jac
         jacobians[2] = clock_jac
+        for j in range(len(errors)):
+            column = np.zeros((2 * m, 1))
+            column[:m, 0] = gains[j]
+            jacobians[3 + j] = column
     return np.concatenate([predicted - rho, predicted_rate - rate])
