@@ -12,7 +12,14 @@ rate enters as GTSAM's Coriolis rate, constant in that frame):
   ``CombinedImuFactor``, the bias a random walk). The white noises are the datasheet's noise
   densities; the bias random walk is the datasheet's rate/acceleration random walk plus the
   bias instability B as a random walk over ``BIAS_TIME_S`` (2 B^2 / tau); the first bias has
-  the datasheet's turn-on bias as its prior. The normal-gravity change across the drive (the
+  the datasheet's turn-on bias as its prior. The triads' scale-factor and misalignment errors
+  and the gyro's g-sensitivity (datasheet 1-sigmas) are white noise over
+  ``SCALE_FACTOR_TIME_S`` on the readings of each IMU sample, the specific force taken less
+  gravity (``_scale_noise``; the shared parameters are set before each sample is integrated):
+  without them the preintegration trusted the IMU to 2 mm/s per second through a 2 m/s^2
+  acceleration that a 1 mrad misalignment alone turns into 2 mm/s^2 of vertical error, and the
+  smoother averaged the fixes' vertical velocity over its whole window (quickstart seed 1:
+  down velocity (error / sigma)^2 4.1 -> 0.66). The normal-gravity change across the drive (the
   local vertical turns by d / R from the frame's origin) is added to each specific-force sample
   with the current attitude, so the constant gravity of the preintegration stays exact.
 * GNSS: the fix's position at the antenna (the datasheet's lever arm) is the antenna's

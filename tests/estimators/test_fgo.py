@@ -1,7 +1,7 @@
 """``fgo_lc`` and ``fgo_tc``, the GTSAM fixed-lag smoothers, on the quickstart drive: the loosely
-coupled one estimates the IMU's turn-on biases (against truth_sensors), follows the truth and
-claims north and down sigmas of the size of its errors; the tightly coupled one follows the
-truth and the receiver clock."""
+coupled one estimates the IMU's turn-on biases (against truth_sensors) and follows the truth; the
+tightly coupled one follows the truth and the receiver clock; both know their own error (the
+consistency bounds of docs/scores.md)."""
 
 from __future__ import annotations
 
@@ -33,22 +33,29 @@ def test_estimates_the_turn_on_biases(solved):
             < 0.05  # m/s^2, of turn-on biases up to 1.2 m/s^2
 
 
-def test_follows_the_truth_with_honest_position_sigmas(solved):
-    """On one seed the mean (error/sigma)^2 of a position axis is nearly one draw of a
-    chi-square with one degree of freedom (the fix error is correlated over the drive), so the
-    per-seed bound is the issue's per-seed one, 10; the 0.3-3 bound is on the mean over seeds
-    (docs/fgo.md)."""
-    dataset, solutions, scores = solved
+def test_follows_the_truth(solved):
+    _, _, scores = solved
     assert scores["fgo_lc"]["horizontal"]["rms"] < scores["gnss_only"]["horizontal"]["rms"] + 0.3
     assert scores["fgo_lc"]["attitude"]["yaw_rms"] < 2.0
-    frame = solutions["fgo_lc"][0]
-    truth = dataset.read("truth")
-    late = frame["t"].to_numpy() > 60.0
-    north = np.radians(frame["lat"] - np.interp(frame["t"], truth["t"], truth["lat"])) * 6.371e6
-    down = -(frame["alt"] - np.interp(frame["t"], truth["t"], truth["alt"]))
-    for error, sigma in ((north, frame["std_n"]), (down, frame["std_d"])):
-        nse = float(np.mean((error.to_numpy()[late] / sigma.to_numpy()[late]) ** 2))
-        assert 0.0 < nse < 10.0
+
+
+@pytest.mark.parametrize("label", ["fgo_lc", "fgo_tc"])
+def test_knows_its_own_error(solved, label):
+    """The consistency bounds of docs/scores.md on this seed: per axis of position, velocity
+    and attitude, the mean (error / sigma)^2 after the first 60 s below the per-seed ceiling,
+    10; and within the goal, 0.3-3, for the velocity and attitude axes, whose errors change
+    sign many times over the drive. A position axis's error is mostly the drive-long range
+    error (the fix's, or the pseudoranges'), whose value over one drive is one draw: its mean
+    (error / sigma)^2 on one seed is nearly a chi-square of one degree of freedom, below 0.3
+    in 42 % of seeds, so the goal is a mean over seeds (docs/fgo.md), not asserted here."""
+    from simulator.scoring.consistency import normalised_errors
+
+    dataset, solutions, _ = solved
+    nse = normalised_errors(dataset.read("truth"), solutions[label][0])
+    for axis, value in nse.items():
+        assert 0.0 < value < 10.0, (axis, value)
+        if axis not in ("n", "e", "d"):
+            assert 0.3 <= value <= 3.0, (axis, value)
 
 
 def test_tightly_coupled_follows_the_truth_and_the_clock(solved):
