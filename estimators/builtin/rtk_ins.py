@@ -62,7 +62,16 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   uses no code (``held_code``): the rover's carrier-smoothed code errors stay correlated over
   the smoothing (100 s), and its thousand rows per 100 s weighted as independent pull the
   held ambiguities and the position by centimetres over minutes, where the phases alone
-  know them to millimetres.
+  know them to millimetres. ``hold_after`` > 1 holds a full fix only once the same integers
+  (per signal and reference) were fixed at that many consecutive epochs, RTKLIB's minimum
+  fix count to hold (option ``pos2-arminfix``, 10 by default; Takasu, RTKLIB ver. 2.4.2
+  manual); the epochs before are fixed without a hold. ``release_window`` > 0 watches the
+  held epochs: their phase innovations are chi-square with the rows' count if the held
+  integers are right
+  (Bar-Shalom, Li & Kirubarajan 2001, section 5.4.2), so when the NIS summed over the window
+  exceeds the ``release_probability`` quantile of the summed rows every held ambiguity is
+  released (new float states), the test a single row's ``slip_sigmas`` cannot make when
+  wrong integers spread their misfit over the epoch's rows. Both are off by default.
 * **Odometer and NHC** (``odometer``, ``nhc``) when the dataset has an odometer: the body
   velocity of the rear axle [v_odo, 0, 0] (``aiding.odometer``), its noise the odometer's
   datasheet resolution and age and a 3 % scale, the lateral and vertical the car's physics
