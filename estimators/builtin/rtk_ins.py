@@ -29,9 +29,12 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   elevation model of RTKLIB's ``err`` option); the single differences are independent, the
   double differences share their reference's variance (``double_difference_covariance``).
   The code's sigma is scaled by the correlated-noise inflation of ``code_correlation_time``
-  at ``gnss_interval`` (``gnss_model.correlated_noise_inflation``), the phase's by that of
-  ``phase_correlation_time``. Each DD code row passes a chi-square gate
-  (``gate_probability``).
+  at ``gnss_interval`` (``gnss_model.correlated_noise_inflation``; by default the rover's
+  carrier-smoothing window from the datasheet, ``gnss.carrier_smoothing``: a smoothed code's
+  errors stay for that long, and weighted as white a thousand rows of decimetres off
+  together bias the float ambiguities beyond their sigma and the partial fixes built on
+  them), the phase's by that of ``phase_correlation_time``. Each DD code row passes a
+  chi-square gate (``gate_probability``).
 * **Ionosphere**: one state per satellite, g_s, the horizontal gradient of the L1 vertical
   delay along the baseline at the satellite's pierce point, in parts per million (a
   Gauss-Markov process, 1-sigma ``iono_ppm``, ``iono_correlation_time``); the satellite's
@@ -131,7 +134,7 @@ DEFAULTS = {
     "base_phase_std": 0.002,
     "iono_ppm": 1.5,
     "iono_correlation_time": 600.0,
-    "code_correlation_time": 0.0,
+    "code_correlation_time": None,
     "phase_correlation_time": 0.4,
     "gnss_interval": 0.1,
     "gate_probability": 0.999,
@@ -172,8 +175,8 @@ CONFIG_HELP = {
                      "obliquity factor)"),
     "iono_correlation_time": ("s", "correlation time of the ionosphere states"),
     "code_correlation_time": ("s", "correlation time of the code errors the weights count "
-                                   "(0: white; the rover's carrier-smoothing window, say 100, "
-                                   "weights a smoothed code as correlated)"),
+                                   "(0: white; null: the datasheet's gnss.carrier_smoothing, "
+                                   "the window of the rover's smoothed code)"),
     "phase_correlation_time": ("s", "correlation time of the carrier-phase errors the "
                                     "weights count (multipath along the road, 0: white)"),
     "gnss_interval": ("s", "the epoch interval the correlations are counted at (the "
@@ -340,8 +343,11 @@ class RtkInsEkf(Estimator):
                              extra_tau=np.r_[np.full(n_slots, np.inf),
                                              np.full(n_iono, cfg["iono_correlation_time"])],
                              sparse=True)
+        code_tau = cfg["code_correlation_time"]
+        if code_tau is None:
+            code_tau = (self.datasheet.get("gnss") or {}).get("carrier_smoothing") or 0.0
         self._code_inflation = gnss_model.correlated_noise_inflation(
-            float(cfg["code_correlation_time"]), float(cfg["gnss_interval"]))
+            float(code_tau), float(cfg["gnss_interval"]))
         self._phase_inflation = gnss_model.correlated_noise_inflation(
             float(cfg["phase_correlation_time"]), float(cfg["gnss_interval"]))
         self._mask = math.radians(cfg["elevation_mask"])
