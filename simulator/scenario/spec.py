@@ -136,8 +136,8 @@ def _check_base(sensors: dict, path: Path, ctx: Context) -> None:
 # and 10 min): 230 and 473 MB with GPS alone (40.6 kB per epoch beyond the truth samples), 611
 # MB over 10 min with three GPS signals (24 kB more): twice the raw figures. The rover and
 # base of four systems on two signals, raw only, at 10 Hz: 759 MB at 5 min and 1307 MB at 10
-# min (91 kB per receiver-epoch), so the estimate (104 kB) holds that hour (36 000 epochs
-# each) at 7.5 GB.
+# min (91 kB per receiver-epoch), and the whole hour (36 000 epochs each) 5.17 GB once each
+# receiver's rows were held once; the estimate (104 kB) holds that hour at 7.5 GB.
 BYTES_PER_TRUTH_SAMPLE = 1000
 BYTES_PER_SYSTEM_EPOCH = 20_000
 BYTES_PER_EXTRA_SIGNAL_EPOCH = 6_000
