@@ -117,16 +117,7 @@ from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
-from estimators.toolbox.range_bias import (
-    IONO_CORRELATION_TIME_S,
-    RANGE_BIAS_CHANNELS,
-    RANGE_BIAS_TIME_S,
-    SIS_ERROR_M,
-    RangeBiasChannels,
-    broadcast_iono_delay,
-    iono_residual,
-    satellite_sigma,
-)
+from estimators.toolbox.range_bias import RangeBiasChannels
 from estimators.toolbox.sensor_datasheet import (
     ACCEL_NOISE_FLOOR,
     GYRO_NOISE_FLOOR,
@@ -134,6 +125,7 @@ from estimators.toolbox.sensor_datasheet import (
 )
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
+from simulator.datasheet import IONO_FIELD_OWN_SHARE, iono_residual_fractions
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -186,6 +178,11 @@ TUNINGS = ("datasheet", "paper")
 TUNED_KEYS = tuple(PAPER_TUNING)
 STANDARD_GRAVITY = 9.80665  # m/s^2
 SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
+RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
+RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
+SIS_ERROR_M = 0.5  # m: the signal-in-space error without a receiver datasheet (IS-GPS-200 URA)
+IONO_CORRELATION_TIME_S = 1800.0  # s: the broadcast ionosphere residual's (docs/gnss-errors.md)
+KLOBUCHAR_RESIDUAL = 0.5  # the broadcast model leaves about half the delay (Klobuchar 1987)
 
 
 DEFAULTS = {
@@ -288,7 +285,7 @@ class _TightlyCoupled(Estimator):
         self.n_states += int(self._sf is not None)
         gnss = self.datasheet.get("gnss") or {}
         self._sis = float(gnss.get("sis_error", SIS_ERROR_M))
-        self._iono_field = iono_residual(gnss)[1]
+        self._iono_field = _iono_residual(gnss)[1]
         # 1 / correlation time of the states after the 17 (Gauss-Markov), 1/s
         self._inv_tau = np.r_[np.full(int(self._iono), 1.0 / IONO_CORRELATION_TIME_S),
                               np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S),
@@ -353,8 +350,8 @@ class _TightlyCoupled(Estimator):
                 gyro_z_scale_factor_std=g.scale_factor,
                 accel_z_misalignment_std=a.misalignment,
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
-                iono_scale_std=float(np.hypot(*iono_residual(gnss))),
-                iono_common=iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
+                iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
+                iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
         tuned = {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
         tuned["iono_common"] = min(base.get("iono_common", tuned["iono_scale_std"]),
                                    tuned["iono_scale_std"])
@@ -404,7 +401,7 @@ class _TightlyCoupled(Estimator):
     def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """R of an epoch's pseudoranges and range rates: the receiver's reported variances
         (the config's when the stream has none), less what states carry: the ionosphere
-        residual common to the satellites (``range_bias.iono_residual``) and each satellite's slowly
+        residual common to the satellites (``_iono_residual``) and each satellite's slowly
         varying error (``_range_bias_sigma``); the rest (tracking noise and multipath after the
         carrier smoothing) scaled by the correlated-noise inflation of
         ``pseudorange_correlation_time``."""
@@ -412,7 +409,7 @@ class _TightlyCoupled(Estimator):
         var = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
                        cfg["pseudorange_std"]) ** 2
         if self._iono:
-            var = var - (self.tuning["iono_common"] * broadcast_iono_delay(ep)) ** 2
+            var = var - (self.tuning["iono_common"] * _iono_delay(ep)) ** 2
         if self._channels is not None:
             var = var - self._range_bias_sigma(ep) ** 2
         var = np.maximum(var, PSEUDORANGE_STD_FLOOR**2)
@@ -423,8 +420,8 @@ class _TightlyCoupled(Estimator):
     def _range_bias_sigma(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """Prior 1-sigma (m) of each satellite's range-error state: the signal-in-space error
         and the satellite's own share of the ionosphere field, sqrt(sis^2 + (s field I)^2),
-        s = ``IONO_FIELD_OWN_SHARE``, I the broadcast delay (``toolbox.range_bias``)."""
-        return satellite_sigma(self._sis, self._iono_field, broadcast_iono_delay(ep))
+        s = ``IONO_FIELD_OWN_SHARE``, I the broadcast delay (``_iono_residual``)."""
+        return np.hypot(self._sis, IONO_FIELD_OWN_SHARE * self._iono_field * _iono_delay(ep))
 
     def _channel_rows(self, ep: gnss_model.RawEpoch, t: float, p: np.ndarray
                       ) -> tuple[gnss_model.RawEpoch, np.ndarray, np.ndarray]:
@@ -534,6 +531,22 @@ class _TightlyCoupled(Estimator):
 
     def update(self, t: float, ep: gnss_model.RawEpoch | None) -> None:
         raise NotImplementedError
+
+
+def _iono_residual(receiver: dict) -> tuple[float, float]:
+    """The broadcast ionosphere's relative residual from the receiver's datasheet
+    (``simulator.datasheet.iono_residual_fractions``): its part common to the satellites and
+    the 1-sigma of the field's (``KLOBUCHAR_RESIDUAL`` and 0 without a datasheet)."""
+    if "iono_scale" not in receiver:
+        return KLOBUCHAR_RESIDUAL, 0.0
+    return iono_residual_fractions(receiver)
+
+
+def _iono_delay(ep: gnss_model.RawEpoch) -> np.ndarray:
+    """The broadcast ionosphere delay of each satellite (m; 0 where the stream has none)."""
+    if ep.iono is None:
+        return np.zeros(len(ep.sv))
+    return np.nan_to_num(ep.iono)
 
 
 def _antenna_ecef(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, lever: np.ndarray,
@@ -739,7 +752,7 @@ class TcUkf(_TightlyCoupled):
             pr, rate, _ = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, pts[:, 16],
                                              pts[:, 17])
             if self._iono:
-                pr = pr + pts[:, N_NOMINAL, None] * broadcast_iono_delay(ep)[None, :]
+                pr = pr + pts[:, N_NOMINAL, None] * _iono_delay(ep)[None, :]
             if self._channels is not None:  # nominal index: tangent + 1 (the quaternion's 4)
                 pr = pr + pts[:, self._channel + 1]
             parts += [pr, rate]
@@ -944,7 +957,7 @@ class TcEkf(_TightlyCoupled):
             h_pr[:, 6:9] = u @ skew(c_bn @ self._lever)
             h_pr[:, 15] = 1.0
             if self._iono:
-                iono = broadcast_iono_delay(ep)
+                iono = _iono_delay(ep)
                 pr = pr + self._extra[IONO - N_STATES] * iono
                 h_pr[:, IONO] = iono
             if self._channels is not None:

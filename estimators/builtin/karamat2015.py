@@ -106,19 +106,13 @@ the estimate towards zero while its variance shrank), a zero-rate update while t
 stand still (``zero_rate_update``: the gyro's mean rate is its bias plus the Earth rate's up
 component, with the gyro's white noise; not in the paper), the azimuth's white noise the
 gyro's noise density plus its scale factor and misalignment times the turn rate over
-``SCALE_FACTOR_TIME_S``; the pseudoranges' slowly varying errors as states after the
-sixteen (``toolbox.range_bias.RangeErrorStates``, as ``tc_ekf`` carries them; tight coupling):
-a scale of the broadcast ionosphere delay common to the satellites (the receiver datasheet's
-``iono_scale`` and ``iono_residual``) and one range-error channel per satellite (its
-signal-in-space error and its own share of the ionosphere field), Gauss-Markov over 30 min;
-white in R, as before, the filter averaged them over epochs (a drive-long error is not reduced
-by averaging) and grew sure of a height metres off in a canyon; the pseudoranges' R the rest of
-the reported variance (tracking noise and multipath) scaled by the correlated-noise inflation
-of the receiver's carrier smoothing (``gnss_model.correlated_noise_inflation``), and a
-chi-square gate (1 dof, 0.999, ``gate_probability``) against H P H^T plus that rest, which
-drops the NLOS ranges of a canyon, each pseudorange's R with the reflected-signal (NLOS)
-share its C/N0 deficit announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``;
-the gate leaves it out: with the NLOS share in it too it passed more reflected ranges, the
+``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
+correlated-noise inflation of the receiver's carrier smoothing
+(``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
+``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
+of a canyon, each pseudorange's R with the reflected-signal (NLOS) share its C/N0 deficit
+announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``; the gate keeps the
+reported variance alone: with the NLOS share in it too it passed more reflected ranges, the
 unseen canyon's height 2.5 -> 4.7 over seeds 1-3), the range rates'
 with the rear axle's sideways motion that eqs. 4-5 leave out (the tyres' slip in a turn,
 ``toolbox.constraints.NonholonomicNoise``, along the body's right axis: in the sharp junction
@@ -160,7 +154,6 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
-from estimators.toolbox.range_bias import RangeErrorStates
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from simulator.datasheet import Cn0Template, cn0_template
 from simulator.earth import (
@@ -397,14 +390,7 @@ class RissTcEkf(Estimator):
         self._heading_offset = 0.0  # direction of travel minus azimuth state, while moving
         d_e, d_n, _, _ = self._arm_offset()
         self._lat, self._lon = self._moved(-d_n, -d_e)  # the rear axle at the start (at rest)
-        # the pseudoranges' slowly varying errors as states after the navigation states
-        # (datasheet tuning, tight coupling; module docstring)
-        self._range_errors = (RangeErrorStates(self._n, self.datasheet.get("gnss") or {})
-                              if self._sheet_tuning and self._tight else None)
-        extra = self._range_errors.prior_variance() if self._range_errors else np.zeros(0)
-        self._n_all = self._n + len(extra)
-        self._filter = ErrorState(np.diag(np.r_[[p0_sigma[s] ** 2 for s in STATES[:self._n]],
-                                                extra]))
+        self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n]]))
         # the reported yaw's variance at the last moving row and the azimuth state's then
         self._stop_heading_var = self._stop_az_var = float(self._filter.p[_I["A"], _I["A"]])
         self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
@@ -496,7 +482,7 @@ class RissTcEkf(Estimator):
         rows = rows[np.isfinite(rows[:, self._col_pr])]
         if len(rows) == 0:
             return
-        self._update_ranges(t, gnss_model.raw_epoch(gnss_model.single_frequency(
+        self._update_ranges(gnss_model.raw_epoch(gnss_model.single_frequency(
             rows, self.columns["gnss_raw"]), self.columns["gnss_raw"]))
 
     def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
@@ -511,7 +497,7 @@ class RissTcEkf(Estimator):
         dz = np.array([(lat_i - math.radians(lat)) * (rm + self._h),
                        (lon_i - math.radians(lon)) * (rn + self._h) * math.cos(self._lat),
                        self._h - alt, ve_i - ve, vn_i - vn, self._vu + vd])
-        h = np.zeros((6, self._n_all))
+        h = np.zeros((6, self._n))
         h[:, :6] = np.eye(6)
         r = np.diag([3.0**2, 3.0**2, 5.0**2, 0.1**2, 0.1**2, 0.15**2])
         forward = np.array([math.sin(self._az), math.cos(self._az), 0.0]) * math.cos(self._pitch)
@@ -676,11 +662,7 @@ class RissTcEkf(Estimator):
             q_d = self._direction_noise(q_d, dt, wz_c)
         if self._vu_eq6:
             phi, q_d = self._vertical_velocity_is_eq6(phi, q_d, dt)
-        if self._range_errors is None:
-            self._filter.predict(phi, q_d)
-            return
-        self._filter.predict_blocks(phi, q_d, *self._range_errors.transition(dt))
-        self._range_errors.predict(dt)
+        self._filter.predict(phi, q_d)
 
     def _direction_noise(self, q_d: np.ndarray, dt: float, wz_c: float) -> np.ndarray:
         """The horizontal velocity's direction turns by the same gyro rate as the azimuth
@@ -720,7 +702,7 @@ class RissTcEkf(Estimator):
         is the gyro bias plus the Earth rate's up component (eq. 1 at rest, dA/dt = 0), with
         the gyro's white noise averaged over the interval (a zero-rate update; not in the
         paper, ``zero_rate_update``)."""
-        h = np.zeros((1, self._n_all))
+        h = np.zeros((1, self._n))
         h[0, _I["bz"]] = 1.0
         dz = np.array([self._bz + OMEGA_E_RAD_S * math.sin(lat) - wz])
         self._filter.update(dz, h, np.array([[self._zero_rate_psd / interval_s]]))
@@ -734,7 +716,7 @@ class RissTcEkf(Estimator):
         wz_c = wz - self._bz
         fx_est = -g * math.sin(r) * math.cos(p) - vo * wz_c + self._bx
         fy_est = g * math.sin(p) + self._ao + self._by
-        h = np.zeros((2, self._n_all))
+        h = np.zeros((2, self._n))
         h[0, i["r"]] = -g * math.cos(r) * math.cos(p)
         h[0, i["p"]] = g * math.sin(r) * math.sin(p)
         h[0, i["vo"]] = -wz_c
@@ -748,18 +730,10 @@ class RissTcEkf(Estimator):
         self._filter.update(dz, h, np.eye(2) * sigma**2)
         self._feedback()
 
-    def _update_ranges(self, t: float, epoch: gnss_model.RawEpoch) -> None:
+    def _update_ranges(self, epoch: gnss_model.RawEpoch) -> None:
         """Eqs. 45-49: dz = rho_RISS - rho_GPS and the same for the rates, predicted by the
         shared model (``estimators.toolbox.gnss_model``: Sagnac, broadcast corrections), with
-        H = [-los^T C_n^e, +1 for the clock] (eqs. 46-49 with errors as estimate minus truth);
-        with range-error states (``tuning: datasheet``) their estimates added to the predicted
-        pseudoranges and their entries in the rows (``toolbox.range_bias``), and R the rest of
-        the reported variance."""
-        if self._range_errors is not None:
-            channel = self._range_errors.assign(epoch, t, self._filter.p)
-            epoch, channel = gnss_model.select(epoch, channel >= 0), channel[channel >= 0]
-            if len(epoch.sv) == 0:
-                return
+        H = [-los^T C_n^e, +1 for the clock] (eqs. 46-49 with errors as estimate minus truth)."""
         lat, lon, ve, vn = self._imu()
         pos = geodetic_to_ecef(lat, lon, self._h).reshape(3)
         c_ne = ned_to_ecef_matrix(lat, lon)
@@ -774,12 +748,7 @@ class RissTcEkf(Estimator):
         jac = gnss_model.los_jacobians(los)  # [-los (ECEF), 1]
         d_ned = jac[:, :3] @ c_ne  # d rho / d (north, east, down) of the antenna
         m = len(rho)
-        h = np.zeros((2 * m, self._n_all))
-        var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
-        if self._range_errors is not None:
-            rho = rho + self._range_errors.correction(epoch, channel)
-            self._range_errors.fill_rows(h[:m], epoch, channel)
-            var_pr = self._range_errors.remaining_variance(epoch, var_pr)
+        h = np.zeros((2 * m, self._n))
         h[:m, _I["N"]] = d_ned[:, 0]
         h[:m, _I["E"]] = d_ned[:, 1]
         h[:m, _I["h"]] = -d_ned[:, 2]  # d(down) = -dh
@@ -789,6 +758,7 @@ class RissTcEkf(Estimator):
         h[m:, _I["vu"]] = -d_ned[:, 2]
         h[m:, _I["cd"]] = 1.0
         dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
+        var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
         var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
         var_nlos = self._nlos_variance(epoch)
         r = np.diag(np.concatenate([var_pr * self._pr_inflation**2 + var_nlos, var_rate]))
@@ -813,7 +783,7 @@ class RissTcEkf(Estimator):
         receiver's reported sigma does not hold: p (20 m)^2, p the probability that it is
         reflected given its C/N0 deficit below the receiver's template (``tuning: datasheet``
         with a template, C/N0 and elevations; ``gnss_model.nlos_sigma``, as ``gnss_wls``). In
-        R only: the gate leaves it out."""
+        R only: the gate tests against the reported variance."""
         if (self._cn0_template is None or epoch.cn0 is None or epoch.elevation is None):
             return 0.0
         cn0 = np.where(np.isfinite(epoch.cn0), epoch.cn0, np.inf)  # none: not reflected
@@ -876,8 +846,6 @@ class RissTcEkf(Estimator):
             self._by -= dx[i["by"]]
             self._c_vo += dx[i["vo"]]
             self._vo -= dx[i["vo"]]
-        if self._range_errors is not None:
-            self._range_errors.feedback(dx[self._n:])
 
     # --- the IMU from the mechanised point ------------------------------------------------------
     def _arm_offset(self) -> tuple[float, float, float, float]:

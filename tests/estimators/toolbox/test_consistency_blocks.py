@@ -1,11 +1,9 @@
 """The toolbox blocks the tightly coupled filters' consistency rests on, each against something
 independent of itself: the Euler-angle covariance against a Monte Carlo of the attitude
 perturbation, the range-error channels against their bookkeeping contract and the closed-form
-Gauss-Markov variance, the range-error block's rows against its own prediction's derivative
-and its share of the variance against the simulator's reported budget, the datasheet reader
-against a preset's own figures, the row gate against scipy's chi-square quantile, the
-re-acquisition's covariance matching against a position error of known size, the sigma-point
-measurement prediction against H P H^T."""
+Gauss-Markov variance, the datasheet reader against a preset's own figures, the row gate
+against scipy's chi-square quantile, the re-acquisition's covariance matching against a
+position error of known size, the sigma-point measurement prediction against H P H^T."""
 
 from __future__ import annotations
 
@@ -14,15 +12,12 @@ import pytest
 from scipy.stats import chi2
 
 from estimators.toolbox.gating import matching_variance, rows_passing
-from estimators.toolbox.gnss_model import RawEpoch
 from estimators.toolbox.kalman import update
 from estimators.toolbox.nav_error import euler_covariance, perturb
-from estimators.toolbox.range_bias import RangeBiasChannels, RangeErrorStates
+from estimators.toolbox.range_bias import RangeBiasChannels
 from estimators.toolbox.sensor_datasheet import BIAS_INSTABILITY_TIME_S, ImuDatasheet
 from estimators.toolbox.ukf import SigmaPointFilter
 from simulator.earth import euler_to_quat, quat_to_euler, wrap_angle
-from simulator.gnss.errors import pseudorange_sigma
-from simulator.sensors.gnss import PRESETS
 
 
 def test_euler_covariance_matches_a_monte_carlo_of_small_attitude_errors():
@@ -68,57 +63,6 @@ def test_range_bias_channels_keep_reuse_and_reset():
     np.testing.assert_allclose(phi, np.exp(-0.1))
     # stationary: phi^2 sigma^2 + q = sigma^2
     np.testing.assert_allclose(phi**2 * ch.sigma**2 + q, ch.sigma**2)
-
-
-def _epoch(sv: list[float], iono_m: list[float]) -> RawEpoch:
-    m = len(sv)
-    return RawEpoch(np.array(sv, dtype=float), np.zeros((m, 3)), np.zeros((m, 3)), np.zeros(m),
-                    np.zeros(m), np.full(m, np.nan), np.full(m, np.nan), np.array(iono_m))
-
-
-def test_range_error_states_rows_are_the_derivative_of_their_correction():
-    """The block's pseudorange rows are d(correction) / d(estimate): a numerical derivative of
-    what the estimates add to the predicted ranges, so that closed-loop feedback removes what
-    an update estimated."""
-    receiver = PRESETS["automotive"]
-    block = RangeErrorStates(first=3, receiver=receiver, n_channels=4)
-    p = np.zeros((3 + block.n, 3 + block.n))
-    ep = _epoch([5.0, 9.0, 14.0], [4.0, 6.5, 9.0])
-    idx = block.assign(ep, 0.0, p)
-    assert list(idx) == [4, 5, 6]  # the ionosphere scale is state 3
-    block.estimate[:] = np.random.default_rng(1).normal(size=block.n)
-    h = np.zeros((3, 3 + block.n))
-    block.fill_rows(h, ep, idx)
-    base = block.correction(ep, idx)
-    for k in range(block.n):
-        block.estimate[k] += 1e-3
-        np.testing.assert_allclose((block.correction(ep, idx) - base) / 1e-3, h[:, 3 + k],
-                                   atol=1e-9)
-        block.estimate[k] -= 1e-3
-    block.feedback(block.estimate.copy())  # closed loop: everything removed
-    np.testing.assert_allclose(block.correction(ep, idx), 0.0)
-    phi, q = block.transition(60.0)
-    sigma2 = np.r_[block.iono_sigma**2, block.channels.sigma**2]
-    np.testing.assert_allclose(phi**2 * sigma2 + q, sigma2)  # stationary
-
-
-def test_range_error_states_carry_no_more_than_the_receiver_reports():
-    """The variance the states take out of R is the simulator's own drive-long terms (signal
-    in space and the ionosphere's residual, ``simulator.gnss.errors.pseudorange_sigma``) at
-    most: what is left in R is at least the reported variance without them."""
-    receiver = dict(PRESETS["automotive"])
-    block = RangeErrorStates(first=0, receiver=receiver)
-    iono = np.array([2.0, 5.0, 12.0])
-    ep = _epoch([1.0, 2.0, 3.0], list(iono))
-    terms = {"code_sigma": np.zeros((3, 1)), "multipath_sigma": np.zeros((3, 1)),
-             "rate_sigma": np.zeros((3, 1))}
-    cfg = {**receiver, "tropo_residual": 0.0}
-    drive_long = pseudorange_sigma(cfg, terms, iono[:, None], np.ones((3, 1)), 1.0,
-                                   np.array([10.0]))[0][:, 0] ** 2
-    carried = block.carried_variance(ep)
-    assert np.all(carried <= drive_long + 1e-12) and np.all(carried > 0.5 * drive_long)
-    reported = drive_long + 0.3**2
-    np.testing.assert_allclose(block.remaining_variance(ep, reported), reported - carried)
 
 
 def test_imu_datasheet_reads_the_largest_axis_and_the_bias_walk():
