@@ -15,7 +15,9 @@ The fit separates where the vehicle goes (geometry) from when it gets there (tim
   ``max_curvature`` (a car's tightest turn, ``min_radius`` of a SUMO drive's ``fit``), the
   knots are spread further apart where the fitted path turns more sharply than that, by the
   ratio of its curvature to the limit over the knot spacing on either side, and the path
-  fitted again, until no point of it turns tighter (at most ``_WIDEN_PASSES`` passes): a
+  fitted again, until no point of it turns tighter (at most ``_WIDEN_PASSES`` passes, the
+  knots at most ``_WIDEST_KNOTS_M`` apart: a U-turn that SUMO draws within the road's width
+  stays tighter, since a wider one would leave the road): a
   junction's turn that SUMO draws on a radius of 2 m, which no car can drive, becomes the
   wider turn that cuts its corner, still held to the road on both sides of it. The
   spline's own arc length sigma(u) is integrated (Gauss-Legendre), and its heading psi and grade
@@ -66,6 +68,9 @@ _DENSE_M = 0.25  # spacing of the arc-length grid the heading and grade are samp
 _PENALTY = 0.1  # weight of the P-spline roughness penalty (per squared metre of residual)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)  # arc-length quadrature per dense interval
 _WIDEN_PASSES = 12  # at most this many refits spreading the knots of a too-sharp turn
+# knots spread at most this far apart for a too-sharp turn, m: a turn that would need more
+# (a U-turn SUMO draws within a road's width) cannot be widened and still follow the road
+_WIDEST_KNOTS_M = 12.0
 
 
 @dataclass
@@ -263,12 +268,16 @@ def _drivable_fit(u: np.ndarray, points: np.ndarray, spacing: np.ndarray,
     from scipy.ndimage import maximum_filter1d
 
     curve = _lsq_quintic(u, points, spacing)
+    widest = np.maximum(spacing, _WIDEST_KNOTS_M)
     for _ in range(_WIDEN_PASSES if max_curvature > 0 else 0):
         excess = np.abs(plan_curvature(curve, u)) / max_curvature
         if excess.max() <= 1.0:
             break
         reach = 2 * int(np.ceil(spacing.max() / max(u[1] - u[0], 1e-9))) + 1
-        spacing = spacing * maximum_filter1d(np.maximum(excess, 1.0), reach)
+        wider = np.minimum(spacing * maximum_filter1d(np.maximum(excess, 1.0), reach), widest)
+        if np.array_equal(wider, spacing):
+            break
+        spacing = wider
         curve = _lsq_quintic(u, points, spacing)
     return curve
 
