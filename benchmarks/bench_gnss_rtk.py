@@ -1,14 +1,18 @@
 """Benchmark: an hour of four-system, dual-frequency GNSS with carrier phase for a rover and a
 base station, at 1 Hz (or 10 Hz).
 
-Run:  python benchmarks/bench_gnss_rtk.py [--rate 10] [--repeat 3]
+Run:  python benchmarks/bench_gnss_rtk.py [--rate 10] [--repeat 3] [--minutes 60]
+      python benchmarks/bench_gnss_rtk.py --rate 10 --minutes 5 --scenario S.yaml
+      /usr/bin/time -v landnav generate S.yaml -o DIR   # the whole job's peak memory
 
-A 20 m/s straight drive of one hour (after 10 s standing) near Seoul on 2024-05-01 03:00 UTC;
-the `dual-band` rover (GPS 1C 2L, Galileo 1C 7Q, BeiDou 2I 7I, GLONASS 1C 2C, carrier phase)
-and a `dual-band` base 5 km east, on the default sky (GPS almanac, nominal Galileo, BeiDou and
-GLONASS: 111 satellites). The timing is the in-process CPU time (``time.process_time``) of
-``Gnss.generate`` with the base attached (both receivers' raw and truth tables), best of
-``--repeat``; the truth trajectory is built once beforehand.
+A 20 m/s straight drive of one hour (``--minutes``; after 10 s standing) near Seoul on
+2024-05-01 03:00 UTC; the `dual-band` rover (GPS 1C 2L, Galileo 1C 7Q, BeiDou 2I 7I, GLONASS 1C
+2C, carrier phase) and a `dual-band` base 5 km east, on the default sky (GPS almanac, nominal
+Galileo, BeiDou and GLONASS: 111 satellites). The timing is the in-process CPU time
+(``time.process_time``) of ``Gnss.generate`` with the base attached (both receivers' raw and
+truth tables), best of ``--repeat``; the truth trajectory is built once beforehand.
+``--scenario`` writes the drive as a scenario file instead, for a whole ``landnav generate``
+(its peak memory: the job-size estimate of ``simulator.scenario.spec``).
 """
 
 from __future__ import annotations
@@ -16,6 +20,8 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
+import yaml
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))
@@ -33,17 +39,22 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rate", type=float, default=1.0, help="epoch rate, Hz")
     parser.add_argument("--repeat", type=int, default=3, help="timed runs (the best reported)")
+    parser.add_argument("--minutes", type=float, default=60.0, help="drive length, min")
+    parser.add_argument("--scenario", type=Path, help="write the drive's scenario here and stop")
     args = parser.parse_args()
     data = {"name": "bench", "seed": 1,
             "start": {"utc": "2024-05-01T03:00:00Z", "lat": 37.5, "lon": 127.0, "alt": 40.0,
                       "heading": 30.0},
             "trajectory": {"kind": "segments", "rate": 10, "segments": [
                 {"stop": {"duration": 10}}, {"accelerate": {"to_speed": 20.0, "accel": 1.0}},
-                {"straight": {"duration": 3560}}]},
+                {"straight": {"duration": 60.0 * args.minutes - 40.0}}]},
             "sensors": {"gnss": {"rate": args.rate, "preset": "dual-band", "outputs": ["raw"],
                                  "systems": SYSTEMS},
                         "gnss_base": {"offset": {"east": 5000.0}, "rate": args.rate,
                                       "preset": "dual-band", "systems": SYSTEMS}}}
+    if args.scenario is not None:
+        args.scenario.write_text(yaml.safe_dump(data, sort_keys=False))
+        return
     scenario = validate_data(data, "bench")
     truth = build_drive(scenario).truth
     blocks = scenario["sensors"]

@@ -128,24 +128,33 @@ def _check_base(sensors: dict, path: Path, ctx: Context) -> None:
 # drive with every sensor (IMU 100 Hz, odometer, barometer, magnetometer, GNSS fix and raw at
 # 1 Hz, 31 satellites): peak RSS 233 MB at 10 min, 347 MB at 30 min, 527 MB at 60 min, so
 # 0.35 GB per drive hour (1 kB per truth sample at 100 Hz) over 0.17 GB. A GNSS epoch costs by
-# what it tracks: 10 Hz GNSS (fix and raw) with a 100 Hz IMU, drives of 2 and 10 min, peaked at
-# 230 and 473 MB with GPS alone (40.6 kB per epoch beyond the truth samples), 365 and 1026 MB
-# with GPS, Galileo, BeiDou and GLONASS (128 kB), 611 MB over 10 min with three GPS signals
-# instead of one (24 kB more): 40 kB per system and 12 kB per further signal of a system.
+# what it tracks and outputs. Raw measurements only, 5-minute drives at 10 Hz (3000 epochs),
+# one receiver: 298 MB with GPS L1 alone, 314 MB with three GPS signals, 456 MB with GPS,
+# Galileo, BeiDou and GLONASS on one signal each, 519 MB on two each: about 20 kB per system
+# (by its satellites: 0.66 kB per satellite-epoch, GPS's 31 the most of the four skies) and
+# 3-5 kB per further signal, taken as 6 kB. With fixes as well (10 Hz, 100 Hz IMU, drives of 2
+# and 10 min): 230 and 473 MB with GPS alone (40.6 kB per epoch beyond the truth samples), 611
+# MB over 10 min with three GPS signals (24 kB more): twice the raw figures. The rover and
+# base of four systems on two signals, raw only, at 10 Hz: 759 MB at 5 min and 1307 MB at 10
+# min (91 kB per receiver-epoch), and the whole hour (36 000 epochs each) 5.17 GB once each
+# receiver's rows were held once; the estimate (104 kB) holds that hour at 7.5 GB.
 BYTES_PER_TRUTH_SAMPLE = 1000
-BYTES_PER_SYSTEM_EPOCH = 40_000
-BYTES_PER_EXTRA_SIGNAL_EPOCH = 12_000
+BYTES_PER_SYSTEM_EPOCH = 20_000
+BYTES_PER_EXTRA_SIGNAL_EPOCH = 6_000
+FIX_FACTOR = 2  # an epoch of a receiver that also computes fixes
 MAX_TRUTH_SAMPLES = 10_000_000  # about 28 h at 100 Hz: 10 GB
 MAX_JOB_BYTES = 10e9
 
 
 def _gnss_epoch_bytes(gnss: dict) -> int:
     """What one epoch of a GNSS receiver costs a generation, by the systems and signals it
-    tracks (measured: see above); each system tracks one signal where none are named."""
+    tracks and whether it computes fixes (measured: see above); each system tracks one signal
+    where none are named."""
     signals = gnss.get("signals") or {}
-    return sum(BYTES_PER_SYSTEM_EPOCH
-               + BYTES_PER_EXTRA_SIGNAL_EPOCH * max(len(signals.get(system) or ()) - 1, 0)
-               for system in gnss.get("systems") or ("gps",))
+    raw = sum(BYTES_PER_SYSTEM_EPOCH
+              + BYTES_PER_EXTRA_SIGNAL_EPOCH * max(len(signals.get(system) or ()) - 1, 0)
+              for system in gnss.get("systems") or ("gps",))
+    return raw * (FIX_FACTOR if "fix" in (gnss.get("outputs") or ()) else 1)
 
 
 def _check_job_size(value: dict, duration_s: float, path: Path, ctx: Context) -> None:

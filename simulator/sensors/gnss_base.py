@@ -121,9 +121,9 @@ class GnssBase(PresetSensor):
         self.drawn.update(base.drawn)
         self.drawn["position"] = {"lat": np.degrees(lat), "lon": np.degrees(lon), "alt": alt,
                                   "x": float(pos[0]), "y": float(pos[1]), "z": float(pos[2])}
-        step = int(round(rover.rate_hz / self.rate_hz))
-        keep = np.round(t * self.rate_hz, 9) % 1 == 0 if step > 1 else np.ones(n, bool)
-        kept_t = t[keep]
+        if int(round(rover.rate_hz / self.rate_hz)) == 1:  # every epoch kept: no copy
+            return {"gnss_base_raw": base.raw, "truth_gnss_base": base.truth}
+        kept_t = t[np.round(t * self.rate_hz, 9) % 1 == 0]
         return {"gnss_base_raw": base.raw[base.raw["t"].isin(kept_t)].reset_index(drop=True),
                 "truth_gnss_base": base.truth[base.truth["t"].isin(kept_t)]
                 .reset_index(drop=True)}

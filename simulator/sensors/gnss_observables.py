@@ -172,19 +172,22 @@ def _rows(t: np.ndarray, svs: np.ndarray, rows: np.ndarray, mask: np.ndarray,
 
 def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFrame:
     """The pieces' rows in one table, in the order of their keys (each column its own new
-    array: the table takes them as they are, without copying them into blocks)."""
+    array: the table takes them as they are, without copying them into blocks). The pieces
+    are emptied column by column as the table takes them, so the rows are held about once,
+    not twice (the peak memory of a long, fast-rate drive)."""
     import pandas as pd
 
-    order = np.argsort(np.concatenate([p["_key"] for p in pieces]), kind="stable")
     sizes = [len(p["_key"]) for p in pieces]
+    order = np.argsort(np.concatenate([p.pop("_key") for p in pieces]), kind="stable")
     columns = {}
     for name in names:
-        if isinstance(pieces[0][name], str):  # a text per piece: taken from the distinct ones
-            texts = sorted({p[name] for p in pieces})
-            codes = np.repeat([texts.index(p[name]) for p in pieces], sizes)
+        values = [p.pop(name) for p in pieces]
+        if isinstance(values[0], str):  # a text per piece: taken from the distinct ones
+            texts = sorted(set(values))
+            codes = np.repeat([texts.index(v) for v in values], sizes)
             columns[name] = pd.Series(texts).array.take(np.take(codes, order))
         else:
-            columns[name] = np.take(np.concatenate([p[name] for p in pieces]), order)
+            columns[name] = np.take(np.concatenate(values), order)
     return pd.DataFrame(columns, copy=False)
 
 
@@ -230,6 +233,20 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     shared : Shared, optional
         The first receiver's shared draws; None for the first receiver (it draws them).
     """
+    raw_pieces, truth_pieces, rest = _measure(cfg, t, dt_s, sky, ant, rng, reception, shared)
+    # the table rows, sorted once the per-satellite arrays of ``_measure`` are gone
+    raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0]]
+    truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0]]
+    return Observed(raw=_sorted(raw_pieces, raw_names), truth=_sorted(truth_pieces, truth_names),
+                    **rest)
+
+
+def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
+             rng: np.random.Generator,
+             reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
+             shared: Shared | None) -> tuple[list[dict], list[dict], dict]:
+    """``observe``'s measurements as unsorted row pieces per signal (``_rows``: raw and
+    truth), with the receiver's clock (m, m/s), what it drew and the shared draws."""
     eph, idx, svs = sky["eph"], sky["idx"], sky["svs"]
     n_sat, n_ep = idx.shape
     geo = model = signal_geometry_chunks(eph, idx, sky["t_gps"], ant, sky["day_of_year"],
@@ -442,10 +459,8 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
         raw_pieces.append(_rows(t, svs, sel, tracked_s, raw, order, len(codes)))
         truth_pieces.append(_rows(t, svs, sel, v["have"] & (v["el"] > 0), truth, order,
                                   len(codes)))
-    raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0]]
-    truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0]]
-    return Observed(raw=_sorted(raw_pieces, raw_names), truth=_sorted(truth_pieces, truth_names),
-                    clock_m=rx_clock, drift_m_s=rx_drift, drawn=drawn, shared=shared)
+    return raw_pieces, truth_pieces, {"clock_m": rx_clock, "drift_m_s": rx_drift,
+                                      "drawn": drawn, "shared": shared}
 
 
 CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives

@@ -11,7 +11,15 @@ The fit separates where the vehicle goes (geometry) from when it gets there (tim
   metres, or every ``knot_time`` seconds of travel where that is longer (de Boor, *A Practical
   Guide to Splines*, ch. XIV). The knot spacing bounds how sharp a corner can be, so a kink in
   SUMO's lane polylines (or in an OpenStreetMap way) or SUMO's non-smooth headings become a
-  smooth curve, never a yaw-rate spike; the penalty damps the ringing next to a kink. The
+  smooth curve, never a yaw-rate spike; the penalty damps the ringing next to a kink. With a
+  ``max_curvature`` (a car's tightest turn, ``min_radius`` of a SUMO drive's ``fit``), the
+  knots are spread further apart where the fitted path turns more sharply than that, by the
+  ratio of its curvature to the limit over the knot spacing on either side, and the path
+  fitted again, until no point of it turns tighter (at most ``_WIDEN_PASSES`` passes, the
+  knots at most ``_WIDEST_KNOTS_M`` apart: a U-turn that SUMO draws within the road's width
+  stays tighter, since a wider one would leave the road): a
+  junction's turn that SUMO draws on a radius of 2 m, which no car can drive, becomes the
+  wider turn that cuts its corner, still held to the road on both sides of it. The
   spline's own arc length sigma(u) is integrated (Gauss-Legendre), and its heading psi and grade
   angle gamma (both C4 in u) are re-interpolated as quintic splines of sigma, so that
   integrating the unit tangent along sigma reproduces the spline curve and curvature
@@ -35,7 +43,8 @@ Statistical Science 11(2), 1996.
 
 Public names
 ------------
-FittedDrive, LocalFrame, fit_drive, fit_along, local_frame, start_block, zone_intervals.
+FittedDrive, LocalFrame, fit_drive, fit_along, local_frame, plan_curvature, start_block,
+zone_intervals.
 """
 
 from __future__ import annotations
@@ -58,6 +67,10 @@ _RESAMPLE_M = 1.0  # spacing of the resampled path used for the geometry fit, m
 _DENSE_M = 0.25  # spacing of the arc-length grid the heading and grade are sampled on, m
 _PENALTY = 0.1  # weight of the P-spline roughness penalty (per squared metre of residual)
 _GL_X, _GL_W = np.polynomial.legendre.leggauss(4)  # arc-length quadrature per dense interval
+_WIDEN_PASSES = 12  # at most this many refits spreading the knots of a too-sharp turn
+# knots spread at most this far apart for a too-sharp turn, m: a turn that would need more
+# (a U-turn SUMO draws within a road's width) cannot be widened and still follow the road
+_WIDEST_KNOTS_M = 12.0
 
 
 @dataclass
@@ -107,7 +120,7 @@ def start_block(frame: LocalFrame, fitted: FittedDrive) -> dict:
 def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
               time_window: float = 0.5, knot_time: float = 0.4, standstill_m: float = 1e-3,
               zones: list[tuple[float, float, str]] | None = None,
-              convergence: float = 0.0) -> FittedDrive:
+              convergence: float = 0.0, max_curvature: float = 0.0) -> FittedDrive:
     """Fit a smooth road profile to sampled positions.
 
     Parameters
@@ -128,6 +141,9 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
         Zone intervals in the input's time; shifted with it.
     convergence : float
         True-heading change per metre east of the frame's origin, rad/m (``LocalFrame``).
+    max_curvature : float
+        The largest horizontal curvature the fitted path may have, 1/m (see the module doc);
+        0: no limit.
 
     Returns
     -------
@@ -161,7 +177,8 @@ def fit_drive(t: np.ndarray, enu: np.ndarray, knot_spacing: float = 3.0,
         path = np.stack([np.interp(u_grid, chord[moving], enu[moving, i]) for i in range(3)], -1)
     dt = np.diff(t)
     speed = np.interp(u_grid, chord[1:][step > 0], (step / dt)[step > 0])
-    curve = _lsq_quintic(u_grid, path, np.maximum(knot_spacing, knot_time * speed))
+    curve = _drivable_fit(u_grid, path, np.maximum(knot_spacing, knot_time * speed),
+                          max_curvature)
 
     u_dense = np.linspace(0.0, total, int(np.ceil(total / _DENSE_M)) + 1)
     sigma = _arc_length(curve, u_dense)
@@ -242,6 +259,36 @@ def _lsq_quintic(u: np.ndarray, points: np.ndarray, spacing: np.ndarray):
     diff = diff[k:-k] if diff.shape[0] > 2 * k else diff[:0]
     normal = (basis.T @ basis + _PENALTY * (diff.T @ diff)).tocsc()
     return BSpline(knots, spsolve(normal, basis.T @ points), k, axis=0)
+
+
+def _drivable_fit(u: np.ndarray, points: np.ndarray, spacing: np.ndarray,
+                  max_curvature: float):
+    """``_lsq_quintic`` with the knots spread apart, pass by pass, where the curve turns more
+    sharply than ``max_curvature`` (1/m; 0: the plain fit; see the module doc)."""
+    from scipy.ndimage import maximum_filter1d
+
+    curve = _lsq_quintic(u, points, spacing)
+    widest = np.maximum(spacing, _WIDEST_KNOTS_M)
+    for _ in range(_WIDEN_PASSES if max_curvature > 0 else 0):
+        excess = np.abs(plan_curvature(curve, u)) / max_curvature
+        if excess.max() <= 1.0:
+            break
+        reach = 2 * int(np.ceil(spacing.max() / max(u[1] - u[0], 1e-9))) + 1
+        wider = np.minimum(spacing * maximum_filter1d(np.maximum(excess, 1.0), reach), widest)
+        if np.array_equal(wider, spacing):
+            break
+        spacing = wider
+        curve = _lsq_quintic(u, points, spacing)
+    return curve
+
+
+def plan_curvature(curve, u: np.ndarray) -> np.ndarray:
+    """The horizontal curvature (1/m, + turning right, clockwise seen from above: east x, north
+    y) of a 3-D spline curve (east, north, up) of a parameter u at u: (y' x'' - x' y'') / (x'^2
+    + y'^2)^(3/2)."""
+    d1, d2 = curve(u, 1), curve(u, 2)
+    cross = d1[:, 1] * d2[:, 0] - d1[:, 0] * d2[:, 1]
+    return cross / np.hypot(d1[:, 0], d1[:, 1]) ** 3
 
 
 def _arc_length(curve, u: np.ndarray) -> np.ndarray:

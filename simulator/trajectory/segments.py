@@ -219,6 +219,10 @@ class RoadProfile:
     # speed bumps as (start s, length, height), m: their shape is also in ``grade`` (a rigid
     # body rides over it); the vehicle model takes it out there and puts it under the wheels
     bumps: list[tuple[float, float, float]] = field(default_factory=list)
+    # True: the car body's side slip lags the path over the rear axle's distance (the kinematic
+    # bicycle model, ``simulator.vehicle.body.relaxed_slip``), for a path whose curvature
+    # changes within metres (SUMO's junctions); False: the bicycle model's steady state at once
+    slip_relaxation: bool = False
 
     def direction_at(self, t: np.ndarray) -> np.ndarray | float:
         """d(t), +1 forward and -1 reversing, at times t (the scalar 1.0 if never reversing)."""

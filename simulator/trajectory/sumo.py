@@ -88,6 +88,9 @@ FIT_FIELD = Record({
                         doc="knots at least this much travel time apart"),
     "time_window": Number("s", 0.5, gt=0, max=10.0,
                           doc="half-width of the kernel smoothing the distance in time"),
+    "min_radius": Number("m", 4.5, min=0, max=100.0,
+                         doc="tightest turn of the car's centre of gravity: the path is widened "
+                             "where SUMO turns tighter (a mid-size car at full lock); 0: none"),
 }, default={})
 
 SUMO_FIELD = Record({
@@ -431,6 +434,11 @@ def _require_sumo() -> None:
                            "the checkout, or pip install 'landnav[sumo]'")
 
 
+def _max_curvature(min_radius_m: float) -> float:
+    """The fit's curvature limit (1/m) of ``fit.min_radius`` (0: none)."""
+    return 1.0 / min_radius_m if min_radius_m > 0 else 0.0
+
+
 def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | None:
     """The ``PROFILE_BUILDERS`` entry of kind ``sumo`` (see the module docstring).
 
@@ -448,7 +456,8 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
         fitted = fit_drive(drive.t, frame.enu, traj["fit"]["knot_spacing"],
                            traj["fit"]["time_window"], traj["fit"]["knot_time"],
                            zones=zone_intervals(drive.t, drive.zone),
-                           convergence=frame.convergence)
+                           convergence=frame.convergence,
+                           max_curvature=_max_curvature(traj["fit"]["min_radius"]))
     except (NetworkError, RouteError) as exc:
         key = ("trajectory",) + (exc.key if isinstance(exc, NetworkError)
                                  else ("route",) + exc.key)
@@ -462,4 +471,5 @@ def build_sumo_profile(scenario: dict, ctx: Context | None) -> RoadProfile | Non
         ctx.error(("trajectory",), str(exc))
         return None
     fitted.profile.start = start_block(frame, fitted)
+    fitted.profile.slip_relaxation = True  # SUMO turns at junctions within a few metres
     return fitted.profile

@@ -17,6 +17,21 @@ each as a piecewise quintic of time that the exact kinematics differentiate.
   the centre of gravity is now -v along the path, so the same geometry gives beta = d kappa
   (l_r - m l_f v^2 / (L C_r)): the kinematic -l_r kappa at reversing speeds (the whole
   expression times d; d is constant between standstills, so its rates are d times those).
+* Side slip lagging the path (``RoadProfile.slip_relaxation``, SUMO drives): the steady state
+  above holds only while the curvature changes slowly. Taken at once, it moves the rear axle
+  sideways by l_r dbeta/dt = l_r^2 v dkappa/ds (the body yaws by the slip's rate besides the
+  path's), 0.8 m/s in a SUMO junction turned within a few metres, which no car does: its rear
+  wheels roll along the body. The kinematic bicycle model's rear wheel (Rajamani 2012, section
+  2.2, with delta_r = 0: the velocity of the rear axle lies along the body, so that the yaw
+  rate is psi_dot = V sin beta / l_r) with the rear tyres' slip angle of the linear model
+  (section 2.3: alpha_r = (l_r psi_dot - V_y) / V_x), at the quasi-static rear force m l_f
+  a_y / L that gives the steady state above, is, for small angles, l_r psi_dot = v (beta +
+  gain v^2 kappa); with psi_dot = v kappa - dbeta/dt (the body's yaw is the path's heading
+  minus the slip) that is dbeta/ds = (beta_ss - beta) / l_r: a first-order lag in the distance
+  travelled, relaxation length l_r, towards the steady state beta_ss above (``relaxed_slip``).
+  It leaves a turn of constant curvature as it was, and the rear axle then moves sideways only
+  by the tyres' slip (-gain v^3 kappa). Driving forward only (a SUMO drive never reverses;
+  reversing, the same constraint is unstable, the pushed trailer's).
 * Heave, pitch, roll, surge and sway: ``suspension.simulate`` on the grid of the truth, driven
   by the road's heights and slopes under the wheels (``road``) and by the longitudinal, lateral
   and vertical accelerations of the path. On a vertical curve (a grade change, dgamma/ds) the
@@ -33,7 +48,7 @@ channels are C2 and exactly differentiable, and on the grid they equal the model
 
 Public names
 ------------
-BodyMotion, build_body, quintic_hermite_basis, side_slip, level_road.
+BodyMotion, build_body, quintic_hermite_basis, side_slip, relaxed_slip, level_road.
 """
 
 from __future__ import annotations
@@ -98,6 +113,54 @@ def side_slip(kappa: np.ndarray, dkappa: np.ndarray, d2kappa: np.ndarray, v: np.
     g_t = -2 * gain * v * a
     g_tt = -2 * gain * (a * a + v * jerk)
     return kappa * g, k_t * g + kappa * g_t, k_tt * g + 2 * k_t * g_t + kappa * g_tt
+
+
+_RELAX_BLOCK = 50.0  # relaxation lengths of travel per closed-form block of ``relaxed_slip``
+
+
+def relaxed_slip(s: np.ndarray, v: np.ndarray, a: np.ndarray,
+                 steady: tuple[np.ndarray, np.ndarray, np.ndarray],
+                 l_r: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The side slip lagging its steady state over the distance travelled (module doc):
+    dbeta/ds = (beta_ss - beta) / l_r from beta = beta_ss at the first sample, and its first two
+    time derivatives, on a grid.
+
+    Parameters
+    ----------
+    s, v, a : arrays, shape (n,)
+        Distance travelled (m, non-decreasing), speed (m/s, >= 0) and its rate on the grid.
+    steady : three arrays, shape (n,)
+        beta_ss (rad) and its first two time derivatives (``side_slip``).
+    l_r : float
+        Distance of the centre of gravity ahead of the rear axle, m: the relaxation length.
+
+    The recursion is the filter's exact step for a steady state linear in s between samples
+    (first-order hold: with x = ds / l_r, beta' = e^-x beta + (1 - e^-x) beta_ss + (beta_ss' -
+    beta_ss) (1 - (1 - e^-x) / x)), so a clothoid at any speed is followed to rounding; it is
+    solved in closed form over blocks of ``_RELAX_BLOCK`` relaxation lengths (the block's
+    partial sums scaled by e^(s / l_r), as ``stochastic.ar1_filter``), the blocks one after
+    another. The rates follow from the differential equation itself: dbeta/dt = v (beta_ss -
+    beta) / l_r, d2beta/dt2 = (a (beta_ss - beta) + v (dbeta_ss/dt - dbeta/dt)) / l_r."""
+    target, target_rate, _ = steady
+    x = np.diff(s) / l_r
+    fall = -np.expm1(-x)  # 1 - e^-x
+    ramp = np.divide(x - fall, x, out=0.5 * x, where=x > 1e-6)  # 1 - (1 - e^-x) / x
+    step_in = fall * target[:-1] + np.diff(target) * ramp
+    depth = (s - s[0]) / l_r
+    beta = np.empty_like(target)
+    beta[0] = target[0]
+    block = np.floor(depth / _RELAX_BLOCK)
+    starts = np.concatenate([[0], np.flatnonzero(np.diff(block)) + 1])
+    ends = np.concatenate([starts[1:], [len(s) - 1]])
+    for i0, i1 in zip(starts, ends, strict=True):  # one pass per block, not per sample
+        if i1 <= i0:
+            continue
+        grow = np.exp(depth[i0 + 1:i1 + 1] - depth[i0])  # e^(distance from the block's start)
+        beta[i0 + 1:i1 + 1] = (beta[i0] + np.cumsum(step_in[i0:i1] * grow)) / grow
+    lag = target - beta
+    rate = v * lag / l_r
+    accel = (a * lag + v * (target_rate - rate)) / l_r
+    return beta, rate, accel
 
 
 def level_road(profile: RoadProfile) -> RoadProfile:
@@ -250,7 +313,13 @@ def build_body(profile: RoadProfile, params: dict, t_grid: np.ndarray,
         ride[10] -= amplitude * omega**2 * sin
     l_f, l_r = axle_distances(params)
     gain = params["mass"] * l_f / (params["wheelbase"] * params["rear_cornering"])
-    slip = [d * x for x in side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)]
+    steady = side_slip(kappa, dkappa, d2kappa, v, a, jerk, l_r, gain)
+    if profile.slip_relaxation:
+        if np.any(np.asarray(d) < 0):
+            raise ValueError("the side slip's lag is modelled driving forward only")
+        slip = list(relaxed_slip(s, v, a, steady, l_r))
+    else:
+        slip = [d * x for x in steady]
     k = len(CHANNELS)
     nodes = np.empty((3 * k, len(t)), order="F")
     for order in range(3):  # the channels; then their rates, then their accelerations

@@ -37,13 +37,18 @@ def short_drive(tmp_path_factory):
     return process(tmp_path_factory.mktemp("rtk_short"), seed=1, short=True)
 
 
-@pytest.mark.xfail(strict=True, reason="not shown at seed 1 since the GNSS multipath processes "
-                   "are drawn exactly at the epochs (new random streams): rtk_ins_ekf fixes "
-                   "94.0 % with 7.2 % wrong fixes, 7.2 cm RMS (RTKLIB 99.5 %, 2.1 cm); the same "
-                   "with the moving rover's carrier multipath left unattenuated (so the streams, "
-                   "not the loop model); seed 2 on the same code: 97.9 %, no wrong fix, 1.5 cm")
-def test_short_drive_fixes_precisely_and_refixes_before_rtklib(short_drive):
+def test_short_drive_fixes_precisely(short_drive):
+    """Seed 1 of the short drive: the per-seed claims (fixed epochs, fixed RMS, wrong fixes,
+    (error/sigma)^2 under 10). With the code weighted as white it failed: 37.6 % of the fixes
+    wrong, partial fixes of a biased float (docs/rtk-ins.md, 'Wrong fixes at seed 1')."""
     _check_seed(short_drive)
+
+
+@pytest.mark.xfail(strict=True, reason="not shown at seed 1: the re-fix after the tunnel takes "
+                   "2.3 s against RTKLIB's 0.2 s, and the east and down (error/sigma)^2 are "
+                   "0.23 and 0.17 (sigmas pessimistic since the code is weighted over its "
+                   "100 s smoothing; docs/rtk-ins.md)")
+def test_short_drive_refixes_before_rtklib_and_is_consistent(short_drive):
     assert median_refix(short_drive["rtk_ins_ekf"]) < median_refix(short_drive["rtklib"])
     nse = short_drive["consistency"]["position"]["nse"]
     assert all(0.3 <= nse[a] <= 3.0 for a in AXES), nse

@@ -64,3 +64,24 @@ def test_fewer_fading_draws_redraw_no_drive_long_error(first):
             np.testing.assert_array_equal(a[column], b[column], err_msg=f"{name}.{column}")
     cn0 = first["gnss_raw"].merge(unfaded["gnss_raw"], on=["t", "sv", "signal"])
     assert not np.allclose(cn0["cn0_x"], cn0["cn0_y"])
+
+
+def test_rows_gathered_in_key_order_as_pandas_sorts_them():
+    """The signals' row pieces become one table in the order of their keys, each value in its
+    row, as pandas' stable sort of the concatenated pieces has them; the pieces are emptied
+    as the table takes their columns (the rows are not held twice)."""
+    from simulator.sensors.gnss_observables import _sorted
+
+    rng = np.random.default_rng(3)
+    pieces = []
+    for text in ("1C", "2L", "1C"):  # a text column: one value per piece
+        n = int(rng.integers(5, 40))
+        pieces.append({"_key": rng.integers(0, 30, n), "x": rng.standard_normal(n),
+                       "k": rng.integers(0, 9, n), "signal": text})
+    expected = pd.concat([pd.DataFrame({**p, "signal": [p["signal"]] * len(p["_key"])})
+                          for p in pieces], ignore_index=True)
+    expected = expected.sort_values("_key", kind="stable").drop(columns="_key")
+    table = _sorted(pieces, ["x", "k", "signal"])
+    pd.testing.assert_frame_equal(table.reset_index(drop=True),
+                                  expected.reset_index(drop=True), check_dtype=False)
+    assert all(not p for p in pieces)

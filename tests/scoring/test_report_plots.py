@@ -49,6 +49,7 @@ def test_nees_bounds_are_the_chi_square_95_percent_quantiles():
 
 def test_lines_break_where_rows_are_missing():
     import numpy as np
+    from matplotlib.figure import Figure
 
-    t, y = plots._gaps(np.array([0.0, 0.1, 0.2, 5.0, 5.1]), np.arange(5.0))
+    t, y = plots.time_series(Figure(), np.array([0.0, 0.1, 0.2, 5.0, 5.1]), np.arange(5.0))
     assert np.isnan(t[3]) and np.isnan(y[3]) and len(t) == 6

@@ -152,15 +152,20 @@ def _runs(mask: np.ndarray, t: np.ndarray) -> list[tuple[float, float]]:
 
 def test_fitted_path_stays_on_sumo_path(hilly_city):
     """Truth positions at SUMO's sample times against SUMO's positions, in the same local
-    frame: 99 % within 0.2 m, all within 0.8 m horizontally; heights within 0.1 m."""
+    frame: 99 % within 0.5 m horizontally (0.41 m measured; 0.2 m held before SUMO's
+    too-sharp turns were widened, which moved about 1 % of the samples, in those turns,
+    further); heights within 0.1 m. All within the fit's
+    ``min_radius`` (4.5 m): where SUMO turns tighter than a car can, the fit widens the turn
+    and cuts its corner, by (R - r)(sqrt(2) - 1) in a right-angle turn widened from r to R and
+    by up to R - r in a U-turn (2.2 m at worst on this drive; 0.5 m without the widening)."""
     truth, drive, frame = hilly_city
     k = truth.inertial(drive.t)
     ned = earth.ecef_to_ned(earth.geodetic_to_ecef(k["lat"], k["lon"], k["alt"]),
                             *frame.reference)
     # the frame's up is height above the reference, not the tangent plane's up
     horizontal = np.hypot(ned[:, 1] - frame.enu[:, 0], ned[:, 0] - frame.enu[:, 1])
-    assert np.percentile(horizontal, 99) < 0.2
-    assert horizontal.max() < 0.8
+    assert np.percentile(horizontal, 99) < 0.5
+    assert horizontal.max() < 4.5
     assert np.max(np.abs(k["alt"] - frame.reference[2] - frame.enu[:, 2])) < 0.1
 
 
