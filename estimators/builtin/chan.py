@@ -115,6 +115,7 @@ from numba import njit
 from estimators.base import NAV_COLUMNS, STD_COLUMNS, Estimator
 from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.config_help import shared_help
+from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.range_bias import RangeBiasChannels
@@ -177,7 +178,6 @@ PAPER_TUNING = {
 TUNINGS = ("datasheet", "paper")
 TUNED_KEYS = tuple(PAPER_TUNING)
 STANDARD_GRAVITY = 9.80665  # m/s^2
-SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s, over which it adds up
 RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
 RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
 SIS_ERROR_M = 0.5  # m: the signal-in-space error without a receiver datasheet (IS-GPS-200 URA)

@@ -91,7 +91,7 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
-from estimators.toolbox.datasheet import FixAccuracy, fix_error_model
+from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S, FixAccuracy, fix_error_model
 from estimators.toolbox.gnss_model import (
     NLOS_SIGMA_M,
     clock_noise,
@@ -123,7 +123,6 @@ ODOMETER_SCALE = 0.03     # unmodelled odometer scale error, 1-sigma
 DEFAULT_UERE_M = 3.0  # a datasheet without a receiver error budget
 FIX_VELOCITY_SIGMA_M_S = np.array([0.1, 0.1, 0.2])  # NED, without the fix's own std_v*
 DEFAULT_DOP = 1.5
-SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``tc_ekf``)
 PSEUDORANGE_FLOOR_M = 0.1  # white 1-sigma left of a pseudorange at least, before inflation
 RANGE_ERROR_TAU_S = 1800.0  # correlation time of the drive-long range errors (docs/gnss-errors.md)
 RANGE_ERROR_STEP_S = 5.0  # a range-error variable stands for this long (a constant meanwhile)

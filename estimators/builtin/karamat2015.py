@@ -151,6 +151,7 @@ import numpy as np
 from estimators.base import Estimator
 from estimators.toolbox import gating, gnss_model
 from estimators.toolbox.constraints import NonholonomicNoise
+from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.installation import Installation
 from estimators.toolbox.kalman import ErrorState
@@ -170,7 +171,6 @@ from simulator.units import DEG, DEG_RT_H, MILLI_G
 STATES = ("N", "E", "h", "ve", "vn", "vu", "A", "ao", "bz", "cb", "cd",
           "r", "p", "bx", "by", "vo")
 _I = {name: i for i, name in enumerate(STATES)}
-SCALE_FACTOR_TIME_S = 4.0  # s: a quarter turn of 30 m radius at 12 m/s (as ``chan``)
 REACQUIRE_EPOCHS = 3  # epochs with most pseudoranges gated out before the covariance is matched
 DEFAULT_WHEELBASE_M = 2.7  # a saloon's, where the datasheet gives none
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock

@@ -81,6 +81,8 @@ from simulator.datasheet import range_error_budget
 CORRELATED_TAU_S = 1800.0  # ionosphere and ephemeris residuals change over tens of minutes
 RANGE_RATE_SIGMA_M_S = 0.05  # a car receiver's range-rate noise (u-blox NEO-M8: 0.05 m/s)
 DEFAULT_BIAS_TAU_S = 600.0  # correlation time of the in-run bias when the sheet gives none
+SCALE_FACTOR_TIME_S = 4.0  # s: a scale-factor error adds up over a quarter turn of 30 m radius
+# at 12 m/s; filters without scale-factor states take it as white noise over that time
 NLOS_TIME_CONSTANT_S = 60.0  # a reflected fix error's correlation time (module docstring)
 NLOS_WHITE_SHARE = np.array([0.5, 0.5, 0.1])  # its variance's white share, NED (docstring)
 FIX_STD_COLUMNS = ("std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd")
