@@ -65,16 +65,7 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   uses no code (``held_code``): the rover's carrier-smoothed code errors stay correlated over
   the smoothing (100 s), and its thousand rows per 100 s weighted as independent pull the
   held ambiguities and the position by centimetres over minutes, where the phases alone
-  know them to millimetres. ``hold_after`` > 1 holds a full fix only once the same integers
-  (per signal and reference) were fixed at that many consecutive epochs, RTKLIB's minimum
-  fix count to hold (option ``pos2-arminfix``, 10 by default; Takasu, RTKLIB ver. 2.4.2
-  manual); the epochs before are fixed without a hold. ``release_window`` > 0 watches the
-  held epochs: their phase innovations are chi-square with the rows' count if the held
-  integers are right
-  (Bar-Shalom, Li & Kirubarajan 2001, section 5.4.2), so when the NIS summed over the window
-  exceeds the ``release_probability`` quantile of the summed rows every held ambiguity is
-  released (new float states), the test a single row's ``slip_sigmas`` cannot make when
-  wrong integers spread their misfit over the epoch's rows. Both are off by default.
+  know them to millimetres.
 * **Odometer and NHC** (``odometer``, ``nhc``) when the dataset has an odometer: the body
   velocity of the rear axle [v_odo, 0, 0] (``aiding.odometer``), its noise the odometer's
   datasheet resolution and age and a 3 % scale, the lateral and vertical the car's physics
@@ -93,7 +84,6 @@ RtkInsEkf.
 from __future__ import annotations
 
 import math
-from collections import deque
 
 import numpy as np
 
@@ -146,9 +136,6 @@ DEFAULTS = {
     "fixed_position_std": 0.05,
     "hold": True,
     "hold_std": 0.01,
-    "hold_after": 1,
-    "release_window": 0.0,
-    "release_probability": 0.9999,
     "held_code": False,
     "slip_geometry_free": 0.05,
     "slip_sigmas": 6.0,
@@ -193,12 +180,6 @@ CONFIG_HELP = {
                                 "is at most this on every axis"),
     "hold": ("", "fix and hold: a full fix constrains the float ambiguities"),
     "hold_std": ("cycles", "1-sigma of the hold's ambiguity measurements"),
-    "hold_after": ("", "consecutive epochs with the same full fix before it is held "
-                       "(RTKLIB's pos2-arminfix)"),
-    "release_window": ("s", "held epochs whose phase NIS is summed for the release test "
-                            "(0: no release test)"),
-    "release_probability": ("", "chi-square probability of the release test: the hold is "
-                                "released when the window's NIS exceeds its quantile"),
     "held_code": ("", "use the double-differenced code in an epoch whose ambiguities are all "
                       "held (its errors, correlated over the carrier smoothing, pull a held "
                       "solution by centimetres)"),
@@ -371,9 +352,6 @@ class RtkInsEkf(Estimator):
         self._fixed_p: np.ndarray | None = None
         self._phase_rows: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
         self._held_epoch = False  # the epoch's double differences all held
-        # the last full fix (signal, reference, integer) and how many epochs in a row had it
-        self._streak: tuple[tuple | None, int] = (None, 0)
-        self._hold_nis: deque[tuple[float, float, float]] = deque()  # held epochs' (t, NIS, dof)
         self._groups = np.zeros(0, dtype=np.int64)  # the epoch's signals' groups
         self._pending = np.zeros(0, dtype=bool)  # half cycle unresolved, per signal
         self.nis_gnss = np.nan
@@ -473,7 +451,6 @@ class RtkInsEkf(Estimator):
             self._last_seen[int(key)] = t
         self._iono, self._iono_scale = self._assign_iono(t, rover)
         self._update(rover, base, slots)
-        self._watch_hold(t)
         self._resolve(rover, slots)
         self._status_t = t
 
@@ -688,30 +665,6 @@ class RtkInsEkf(Estimator):
         self.nis_gnss_dof = float(len(dz))
         self._phase_rows = (sig, refs, slots)
 
-    def _watch_hold(self, t: float) -> None:
-        """Release every held ambiguity when the held epochs' phase innovations of the last
-        ``release_window`` s fail their chi-square test (the sum of their NIS against the
-        ``release_probability`` quantile of the summed rows): integers held wrong make the
-        phases disagree with the INS as the geometry moves, which one epoch's row test
-        (``slip_sigmas``) does not see."""
-        window = self._hold_nis
-        if (not self._held_epoch or not np.isfinite(self.nis_gnss)
-                or self.config["release_window"] <= 0.0):
-            window.clear()
-            return
-        window.append((t, self.nis_gnss, self.nis_gnss_dof))
-        while window[0][0] <= t - self.config["release_window"] + 1e-6:
-            window.popleft()
-        nis = sum(w[1] for w in window)
-        dof = int(sum(w[2] for w in window))
-        if nis > gating.chi2_threshold(dof, float(self.config["release_probability"])):
-            for key in list(self._held):
-                self._release(key)
-            window.clear()
-            self._held_epoch = False
-            self._phase_rows = None
-            self._streak = (None, 0)
-
     def _held_keys(self) -> np.ndarray:
         """The keys of the held ambiguities."""
         return np.fromiter(self._held, dtype=np.int64, count=len(self._held))
@@ -767,25 +720,17 @@ class RtkInsEkf(Estimator):
             return
         self._ratio = res.ratio
         if not res.fixed:
-            self._streak = (None, 0)
             return
         p_xa = p[:N_STATES, amb] @ d.T
         gain = np.linalg.solve(q_a, p_xa.T).T  # P_xa Q_a^-1
         fixed_p = p[:N_STATES, :N_STATES] - gain @ (q_a - res.q_fixed) @ gain.T
         if np.max(np.diag(fixed_p)[:3]) > cfg["fixed_position_std"] ** 2:
-            self._streak = (None, 0)
             return  # a partial fix that leaves the position a float one
         self._fixed_dx = gain @ (a - res.a_fixed)
         self._fixed_p = fixed_p
         self._status = 2.0
         self._n_fixed = res.n_fixed
-        if not (cfg["hold"] and res.n_fixed == len(a)):
-            self._streak = (None, 0)
-            return
-        fix = tuple(zip(rover.keys[sig].tolist(), rover.keys[refs].tolist(),
-                        res.a_fixed.astype(np.int64).tolist(), strict=True))
-        self._streak = (fix, self._streak[1] + 1 if fix == self._streak[0] else 1)
-        if self._streak[1] >= cfg["hold_after"]:
+        if cfg["hold"] and res.n_fixed == len(a):
             hold = float(cfg["hold_std"])
             h = np.zeros((len(a), ins.n_states))
             h[:, amb] = d
