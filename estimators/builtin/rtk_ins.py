@@ -33,8 +33,13 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   carrier-smoothing window from the datasheet, ``gnss.carrier_smoothing``: a smoothed code's
   errors stay for that long, and weighted as white a thousand rows of decimetres off
   together bias the float ambiguities beyond their sigma and the partial fixes built on
-  them), the phase's by that of ``phase_correlation_time``. Each DD code row passes a
-  chi-square gate (``gate_probability``).
+  them), the phase's by that of ``phase_correlation_time``. The first epoch of a rover
+  signal's code arc (the filter's first use of it since the receiver's tracking, and so its
+  smoothing, began) counts at the plain ``code_std``: the information of n samples of a
+  first-order Gauss-Markov error about a constant is (n (1 - phi) + 2 phi) / (1 + phi) times
+  one sample's, one for the first sample and (1 - phi) / (1 + phi), the inverse square of the
+  inflation, for each later one. Each DD code row passes a chi-square gate
+  (``gate_probability``).
 * **Ionosphere**: one state per satellite, g_s, the horizontal gradient of the L1 vertical
   delay along the baseline at the satellite's pierce point, in parts per million (a
   Gauss-Markov process, 1-sigma ``iono_ppm``, ``iono_correlation_time``); the satellite's
@@ -56,7 +61,12 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
 * **Integer ambiguities**: after each update the double-differenced float ambiguities a = D x_a
   (covariance D P D^T) are resolved by LAMBDA with the ratio test and partial fixing
   (``toolbox.ambiguity.resolve``: Chang, Yang & Zhou 2005; ``ratio_threshold``,
-  ``min_success_rate``, ``min_fixed``). A fixed epoch's solution is the float one conditioned
+  ``min_success_rate``, ``min_fixed``): a subset is fixed when its ratio test passes and
+  either its bootstrapped success rate reaches ``min_success_rate`` or the ratio test's
+  failure rate for the float covariance, by Monte Carlo (``failure_samples``), is at most 1 -
+  ``min_success_rate`` (the fixed failure-rate ratio test, Verhagen & Teunissen 2013). Each
+  group's reference is a held signal if it has one, else one whose half cycle is resolved.
+  A fixed epoch's solution is the float one conditioned
   on the integers: dx = P_xa Q_a^-1 (a - a_fixed), P = P - P_xa Q_a^-1 (Q_a - Q_fixed)
   Q_a^-1 P_ax (Teunissen 1995). **Fix and hold** (``hold``): when every double difference is
   fixed, the integers are applied to the filter as measurements of 1-sigma ``hold_std``
@@ -133,6 +143,7 @@ DEFAULTS = {
     "ratio_threshold": 3.0,
     "min_success_rate": 0.999,
     "min_fixed": 4,
+    "failure_samples": 2000,
     "fixed_position_std": 0.05,
     "hold": True,
     "hold_std": 0.01,
@@ -176,6 +187,10 @@ CONFIG_HELP = {
     "ratio_threshold": ("", "LAMBDA ratio test: second-best over best squared norm"),
     "min_success_rate": ("", "bootstrapped success rate a fixed subset must reach"),
     "min_fixed": ("", "fewest double-differenced ambiguities a fix may hold"),
+    "failure_samples": ("", "Monte Carlo samples of the ratio test's failure rate, which "
+                            "accepts a subset whose bootstrapped success rate falls short "
+                            "when at most 1 - min_success_rate (0: the bootstrapped rate "
+                            "alone)"),
     "fixed_position_std": ("m", "a fix counts (and is written) when its position 1-sigma "
                                 "is at most this on every axis"),
     "hold": ("", "fix and hold: a full fix constrains the float ambiguities"),
@@ -338,6 +353,7 @@ class RtkInsEkf(Estimator):
         self._iono_free = list(range(n_slots + n_iono - 1, n_slots - 1, -1))
         self._iono_seen: dict[int, float] = {}
         self._held: set[int] = set()
+        self._code_used: set[int] = set()  # rover signals whose code arc the filter has used
         self._last_seen: dict[int, float] = {}
         # per receiver (rover, base): each signal's lock time and half-cycle flag, each
         # satellite's geometry-free phase, when last seen
@@ -465,9 +481,11 @@ class RtkInsEkf(Estimator):
                                            self._gf_track, strict=True):
             half = (ep.lli & HALF_CYCLE) != 0
             known, prev_t, prev = signals.swap(ep.keys, t, np.stack([ep.lock, half], axis=1))
-            lost = ((ep.lli & LOSS_OF_LOCK) != 0) | (known & (
-                (ep.lock < prev[:, 0] - 1e-6) | (t - prev_t > max_gap) | ((prev[:, 1] == 1.0)
-                                                                          & ~half)))
+            relocked = ((ep.lli & LOSS_OF_LOCK) != 0) | (known & (
+                (ep.lock < prev[:, 0] - 1e-6) | (t - prev_t > max_gap)))
+            lost = relocked | (known & (prev[:, 1] == 1.0) & ~half)
+            if ep is rover:  # a new tracking arc restarts the receiver's carrier smoothing
+                self._code_used.difference_update(ep.keys[relocked].tolist())
             sats, gf = _geometry_free(ep.keys, ep.raw_phase_m)
             known, prev_t, prev = satellites.swap(sats, t, gf[:, None])
             jumped = sats[known & (t - prev_t <= max_gap)
@@ -565,7 +583,10 @@ class RtkInsEkf(Estimator):
         cfg = self.config
         sin_el = np.maximum(np.sin(rover.elevation), 0.1)
         if code:
-            rover_std = cfg["code_std"] * self._code_inflation
+            # a code arc's first epoch in the filter counts at its marginal sigma, the later
+            # ones at what they add to it (module docstring)
+            seen = np.isin(rover.keys, self._code_keys())
+            rover_std = cfg["code_std"] * np.where(seen, self._code_inflation, 1.0)
             base_std = cfg["base_code_std"]
         else:
             rover_std = cfg["phase_std"] * self._phase_inflation
@@ -621,7 +642,9 @@ class RtkInsEkf(Estimator):
         geometry = self._geometry(rover, base)
         sd_phase = rover.phase - base.phase
         for _ in range(2):
-            priority = np.where(np.isin(rover.keys, self._held_keys()), 2, 1)
+            # a held reference first, then one whose half cycle is resolved
+            priority = (np.where(np.isin(rover.keys, self._held_keys()), 2, 0)
+                        + np.where(self._pending, 0, 1))
             dz_p, h_p, r_p, sig, refs = self._rows(rover, base, geometry, slots >= 0, priority,
                                                    sd_phase, slots)
             s_p = gating.innovation_variances(ins.kf.p, h_p, r_p)
@@ -650,6 +673,7 @@ class RtkInsEkf(Estimator):
             s_c = gating.innovation_variances(ins.kf.p, h_c, r_c)
             keep = gating.rows_passing(dz_c, s_c, float(self.config["gate_probability"]))
             dz_c, h_c, r_c = dz_c[keep], h_c[keep], r_c[np.ix_(keep, keep)]
+            self._code_used.update(rover.keys.tolist())
         else:
             dz_c, h_c, r_c = np.zeros(0), np.zeros((0, ins.n_states)), np.zeros((0, 0))
         dz = np.concatenate([dz_c, dz_p])
@@ -664,6 +688,10 @@ class RtkInsEkf(Estimator):
         self.nis_gnss = gating.normalised_innovation_squared(dz, s)
         self.nis_gnss_dof = float(len(dz))
         self._phase_rows = (sig, refs, slots)
+
+    def _code_keys(self) -> np.ndarray:
+        """The rover signals whose current code arc the filter has used."""
+        return np.fromiter(self._code_used, dtype=np.int64, count=len(self._code_used))
 
     def _held_keys(self) -> np.ndarray:
         """The keys of the held ambiguities."""
@@ -715,7 +743,7 @@ class RtkInsEkf(Estimator):
         q_a = d @ p[amb, amb] @ d.T
         try:
             res = ambiguity.resolve(a, q_a, cfg["ratio_threshold"], cfg["min_success_rate"],
-                                    int(cfg["min_fixed"]))
+                                    int(cfg["min_fixed"]), int(cfg["failure_samples"]))
         except np.linalg.LinAlgError:
             return
         self._ratio = res.ratio

@@ -27,7 +27,7 @@ test passes (partial ambiguity resolution, Teunissen, Joosten & Tiberius 1999, I
 
 Public names
 ------------
-decorrelate, search, ils, ratio, bootstrap_success_rate, resolve, Resolution.
+decorrelate, search, ils, ratio, bootstrap_success_rate, ratio_failure_rate, resolve, Resolution.
 """
 
 from __future__ import annotations
@@ -227,6 +227,42 @@ def ils(a_float: np.ndarray, q: np.ndarray,
     return np.round(a_int) + shift, norms
 
 
+@njit(cache=True)
+def _ratio_failures_kernel(samples: np.ndarray, low: np.ndarray, d: np.ndarray,
+                           threshold: float) -> int:
+    """How many of the float vectors ``samples`` (rows, errors about the true integers 0)
+    pass the ratio test at ``threshold`` with a best integer vector other than 0."""
+    failures = 0
+    for k in range(samples.shape[0]):
+        best, norms = _search_kernel(samples[k], low, d, 2)
+        first = 0 if norms[0] <= norms[1] else 1
+        wrong = False
+        for i in range(best.shape[1]):
+            if best[first, i] != 0.0:
+                wrong = True
+                break
+        if wrong and norms[1 - first] >= threshold * norms[first]:
+            failures += 1
+    return failures
+
+
+def ratio_failure_rate(low: np.ndarray, d: np.ndarray, threshold: float,
+                       samples: int = 2000) -> float:
+    """The failure rate of ILS with the ratio test at ``threshold``: the probability that the
+    test accepts an integer vector other than the true one, for the decorrelated problem
+    ``low``, ``d`` (``decorrelate``), by Monte Carlo (``samples`` float vectors drawn from
+    N(0, low^T diag(d) low), a fixed generator: the same problem gives the same rate). The
+    fixed failure-rate ratio test accepts a fix when this is below a chosen rate (Teunissen &
+    Verhagen 2009, J. Geodesy 83; Verhagen & Teunissen 2013, J. Geodesy 87, section 3)."""
+    rng = np.random.default_rng(0)
+    draws = rng.standard_normal((int(samples), d.size)) * np.sqrt(d)  # in the L^T-space
+    floats = draws @ low  # each row x = L^T u, covariance L^T diag(d) L
+    failures = _ratio_failures_kernel(np.ascontiguousarray(floats),
+                                      np.ascontiguousarray(low, dtype=float),
+                                      np.ascontiguousarray(d, dtype=float), float(threshold))
+    return failures / float(samples)
+
+
 def ratio(norms: np.ndarray) -> float:
     """The ratio test statistic: second-best over best squared norm (inf if the best is 0)."""
     if norms[0] <= 0.0:
@@ -266,14 +302,20 @@ class Resolution:
 
 
 def resolve(a_float: np.ndarray, q: np.ndarray, ratio_threshold: float = 3.0,
-            min_success_rate: float = 0.999, min_fixed: int = 4) -> Resolution:
+            min_success_rate: float = 0.999, min_fixed: int = 4,
+            failure_samples: int = 0) -> Resolution:
     """Full, then partial, ambiguity resolution with validation.
 
     The decorrelated ambiguities are fixed from the most precise (last) one upward: the largest
     subset ``z[p:]`` whose bootstrapped success rate reaches ``min_success_rate`` is searched
     (ILS on that subset, conditioned on nothing else), and accepted when its ratio test reaches
     ``ratio_threshold``; if not, the subset shrinks by one until fewer than ``min_fixed``
-    remain. The accepted integers ``z_s`` constrain the whole vector by the conditional
+    remain. With ``failure_samples`` > 0 the bootstrapped rate is the sufficient condition, not
+    the necessary one: the largest subset whose ratio test passes though its bootstrapped rate
+    falls short is accepted when the test's failure rate at ``ratio_threshold``
+    (``ratio_failure_rate`` with that many samples) is at most 1 - ``min_success_rate`` (the
+    fixed failure-rate ratio test; one such Monte Carlo per call, the largest subset's). The
+    accepted integers ``z_s`` constrain the whole vector by the conditional
     (least-squares) update ``a = a_float - Q_{a z_s} Q_{z_s}^-1 (z_s_float - z_s)``, ``Q_a|z =
     Q - Q_{a z_s} Q_{z_s}^-1 Q_{z_s a}`` (Teunissen 1995, eq. 9 of the fixed solution).
     """
@@ -286,16 +328,22 @@ def resolve(a_float: np.ndarray, q: np.ndarray, ratio_threshold: float = 3.0,
     q_z = z.T @ q @ z
     last_ratio = 0.0
     factors = _bootstrap_factors(d)
+    monte_carlo = failure_samples > 0
     for start in range(n - min_fixed + 1 if n >= min_fixed else 0):
         sub = slice(start, n)
         rate = float(np.prod(factors[sub]))
-        if rate < min_success_rate:
+        if rate < min_success_rate and not monte_carlo:
             continue
         low_s, d_s = _ltdl(q_z[sub, sub])
         z_int, norms = search(z_float_all[sub], low_s, d_s, 2)
         last_ratio = ratio(norms)
         if last_ratio < ratio_threshold:
             continue
+        if rate < min_success_rate:
+            monte_carlo = False  # this subset's test is the one Monte Carlo of the call
+            failure = ratio_failure_rate(low_s, d_s, ratio_threshold, failure_samples)
+            if failure > 1.0 - min_success_rate:
+                continue
         z_sel = z[:, sub]  # a -> z_s = z_sel^T a
         cross = q @ z_sel
         gain = np.linalg.solve(q_z[sub, sub], cross.T).T
