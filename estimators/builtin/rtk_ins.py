@@ -33,8 +33,9 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   carrier-smoothing window from the datasheet, ``gnss.carrier_smoothing``: a smoothed code's
   errors stay for that long, and weighted as white a thousand rows of decimetres off
   together bias the float ambiguities beyond their sigma and the partial fixes built on
-  them), the phase's by that of ``phase_correlation_time``. The first epoch of a rover
-  signal's code arc (the filter's first use of it since the receiver's tracking, and so its
+  them), the rover's phase by that of ``phase_correlation_time`` (the reflections change
+  as the car moves; the base's still antenna has white phase errors). The first epoch of a
+  rover signal's code arc (the filter's first use of it since the receiver's tracking, and so its
   smoothing, began) counts at the plain ``code_std``: the information of n samples of a
   first-order Gauss-Markov error about a constant is (n (1 - phi) + 2 phi) / (1 + phi) times
   one sample's, one for the first sample and (1 - phi) / (1 + phi), the inverse square of the
@@ -130,8 +131,8 @@ DEFAULTS = {
     "elevation_mask": 15.0,
     "code_std": 0.3,
     "base_code_std": 0.3,
-    "phase_std": 0.003,
-    "base_phase_std": 0.002,
+    "phase_std": 0.002,
+    "base_phase_std": 0.001,
     "iono_ppm": 1.5,
     "iono_correlation_time": 600.0,
     "code_correlation_time": None,
@@ -175,7 +176,7 @@ CONFIG_HELP = {
     "code_correlation_time": ("s", "correlation time of the code errors the weights count "
                                    "(0: white; null: the datasheet's gnss.carrier_smoothing, "
                                    "the window of the rover's smoothed code)"),
-    "phase_correlation_time": ("s", "correlation time of the carrier-phase errors the "
+    "phase_correlation_time": ("s", "correlation time of the rover's carrier-phase errors the "
                                     "weights count (multipath along the road, 0: white)"),
     "gnss_interval": ("s", "the epoch interval the correlations are counted at (the "
                            "rover's; set it for a receiver at another rate than 10 Hz)"),
@@ -590,7 +591,7 @@ class RtkInsEkf(Estimator):
             base_std = cfg["base_code_std"]
         else:
             rover_std = cfg["phase_std"] * self._phase_inflation
-            base_std = cfg["base_phase_std"] * self._phase_inflation
+            base_std = cfg["base_phase_std"]  # a still antenna: its reflections do not move
         return (rover_std**2 + base_std**2) / sin_el**2
 
     def _rows(self, rover: _Epoch, base: _Epoch, geometry: tuple[np.ndarray, np.ndarray,
