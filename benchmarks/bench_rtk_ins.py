@@ -7,8 +7,10 @@ Run:  python benchmarks/bench_rtk_ins.py [--seed 1] [--short] [--systems gps,gal
 rtk_ins_ekf is timed inside the causal replay (``time.process_time`` around ``run_estimator``:
 every message handed, a solution row at 10 Hz), after a short warm-up run that loads the numba
 kernels; rnx2rtkp (Debian ``rtklib``, kinematic L1+L2, fix-and-hold) by the CPU time of its
-process on the RINEX export of the same dataset. Both solutions' fix rates are printed beside
-the times (``tests/rtk_drive.py`` does the work, as the tests do).
+process on the RINEX export of the same dataset. Both solutions' rtk scores (fixed epochs,
+wrong fixes, fixed RMS, first fix, re-fix after each tunnel) and rtk_ins_ekf's position
+(error/sigma)^2 are printed beside the times (``tests/rtk_drive.py`` does the work, as the
+tests do).
 """
 
 from __future__ import annotations
@@ -40,8 +42,14 @@ def main() -> None:
     for name, cpu in fig["cpu_s"].items():
         print(f"{name:12s} {cpu:7.2f} s CPU for {duration:.0f} s of drive: "
               f"{duration / cpu:6.1f} x real time")
-    print(f"fix rate: rtk_ins_ekf {fig['rtk_ins_ekf']['fix_rate']:.4f}, "
-          f"rnx2rtkp {fig['rtklib']['fix_rate']:.4f}")
+    for name in ("rtk_ins_ekf", "rtklib"):
+        rtk = fig[name]
+        print(f"{name:12s} fixed {rtk['fix_rate']:.4f}, wrong {rtk['wrong_fix_rate']}, fixed "
+              f"3-D RMS {rtk['fixed_rms']:.4f} m, first fix {rtk['time_to_first_fix']:.1f} s, "
+              f"re-fix {[None if x is None else round(x, 1) for x in rtk['refix_times']]} s")
+    nse = fig["consistency"]["position"]["nse"]
+    print(f"rtk_ins_ekf position (error/sigma)^2 n / e / d: "
+          f"{nse['n']:.2f} / {nse['e']:.2f} / {nse['d']:.2f}")
 
 
 if __name__ == "__main__":

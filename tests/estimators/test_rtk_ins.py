@@ -44,11 +44,14 @@ def test_short_drive_fixes_precisely(short_drive):
     _check_seed(short_drive)
 
 
-@pytest.mark.xfail(strict=True, reason="not shown at seed 1: the re-fix after the tunnel takes "
-                   "2.3 s against RTKLIB's 0.2 s, and the east and down (error/sigma)^2 are "
-                   "0.23 and 0.17 (sigmas pessimistic since the code is weighted over its "
-                   "100 s smoothing; docs/rtk-ins.md)")
-def test_short_drive_refixes_before_rtklib_and_is_consistent(short_drive):
+def test_short_drive_fixes_as_often_as_rtklib_refixes_first_and_is_consistent(short_drive):
+    """Seed 1 of the short drive: at least RTKLIB's fix rate (100 % against 99.36 %), the
+    re-fix after the tunnel before RTKLIB's (0.0 s against 0.2 s) and the position's
+    (error/sigma)^2 within 0.3-3 per axis (1.13 / 0.30 / 0.61). It failed (96.8 %, 2.3 s;
+    0.81 / 0.23 / 0.17) before the fixed failure-rate ratio test, the code arc's first epoch
+    at its marginal sigma, the ionosphere states kept through the tunnel and the phase budget
+    of the truth's terms (docs/rtk-ins.md, 'First fix, re-fix and the phase budget')."""
+    assert short_drive["rtk_ins_ekf"]["fix_rate"] >= short_drive["rtklib"]["fix_rate"]
     assert median_refix(short_drive["rtk_ins_ekf"]) < median_refix(short_drive["rtklib"])
     nse = short_drive["consistency"]["position"]["nse"]
     assert all(0.3 <= nse[a] <= 3.0 for a in AXES), nse
