@@ -35,8 +35,9 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   together bias the float ambiguities beyond their sigma and the partial fixes built on
   them), the rover's phase by that of ``phase_correlation_time`` (the reflections change
   as the car moves; the base's still antenna has white phase errors). The first epoch of a
-  rover signal's code arc (the filter's first use of it since the receiver's tracking, and so its
-  smoothing, began) counts at the plain ``code_std``: the information of n samples of a
+  rover signal's code arc (the filter's first use of it since the receiver's tracking, and so
+  its smoothing, began) counts at its marginal sigma ``code_arc_std`` (the raw code's, the
+  smoothing barely begun), not inflated: the information of n samples of a
   first-order Gauss-Markov error about a constant is (n (1 - phi) + 2 phi) / (1 + phi) times
   one sample's, one for the first sample and (1 - phi) / (1 + phi), the inverse square of the
   inflation, for each later one. Each DD code row passes a chi-square gate
@@ -133,7 +134,8 @@ DEFAULTS = {
     "elevation_mask": 15.0,
     "code_std": 0.3,
     "base_code_std": 0.3,
-    "phase_std": 0.002,
+    "code_arc_std": 0.6,
+    "phase_std": 0.003,
     "base_phase_std": 0.001,
     "iono_ppm": 1.5,
     "iono_correlation_time": 600.0,
@@ -169,6 +171,8 @@ CONFIG_HELP = {
     "elevation_mask": ("deg", "satellites below it are not used"),
     "code_std": ("m", "rover pseudorange 1-sigma at zenith (over sin(elevation) below)"),
     "base_code_std": ("m", "base pseudorange 1-sigma at zenith"),
+    "code_arc_std": ("m", "rover pseudorange 1-sigma at zenith in the first epoch of a "
+                          "tracking arc the filter uses (its smoothing has barely begun)"),
     "phase_std": ("m", "rover carrier-phase 1-sigma at zenith"),
     "base_phase_std": ("m", "base carrier-phase 1-sigma at zenith"),
     "iono_ppm": ("", "1-sigma of each satellite's ionosphere state: the single-difference L1 "
@@ -592,7 +596,8 @@ class RtkInsEkf(Estimator):
             # a code arc's first epoch in the filter counts at its marginal sigma, the later
             # ones at what they add to it (module docstring)
             seen = np.isin(rover.keys, self._code_keys())
-            rover_std = cfg["code_std"] * np.where(seen, self._code_inflation, 1.0)
+            rover_std = np.where(seen, cfg["code_std"] * self._code_inflation,
+                                 cfg["code_arc_std"])
             base_std = cfg["base_code_std"]
         else:
             rover_std = cfg["phase_std"] * self._phase_inflation
