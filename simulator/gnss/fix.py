@@ -22,8 +22,8 @@ errors, from what the receiver measures itself:
 * reflected (NLOS) signals, announced by their C/N0 deficit below the receiver's direct-signal
   template (``simulator.datasheet.cn0_template``): with p_i the probability that signal i is
   reflected (``simulator.datasheet.nlos_probability``) and its extra path d ~ N(mu, s^2)
-  (``NLOS_EXTRA_PATH_MEAN_M``, ``NLOS_EXTRA_PATH_SIGMA_M``), the delay p_i-Bernoulli times d
-  has mean p_i mu and variance p_i (mu^2 + s^2) - (p_i mu)^2. The mean is kept, as a second
+  (``simulator.datasheet.nlos_delay_moments``), the delay p_i-Bernoulli times d has mean
+  p_i mu and variance p_i (mu^2 + s^2) - (p_i mu)^2. The mean is kept, as a second
   rank-one term: an extra path is never negative, so reflections from the two sides of a
   street cancel across it and add up in the height (the fix sinks, as the simulated canyons'
   fixes do by 10-40 m).
@@ -66,6 +66,7 @@ from simulator.datasheet import (
     Cn0Template,
     cn0_template,
     iono_residual_fractions,
+    nlos_delay_moments,
     nlos_probability,
 )
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
@@ -79,11 +80,6 @@ if TYPE_CHECKING:
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
 _MAX_CONDITION = 1e12  # a normal matrix beyond this is singular in float64 (no fix)
-# the receiver's model of a reflected signal's extra path, m: the extra paths of
-# scenarios/urban_canyon.yaml, seed 1 (mean 15.7 m, 1-sigma 5.9 m; 8-27 m, 5-95 %), the
-# spread widened to 8 m for streets of other widths
-NLOS_EXTRA_PATH_MEAN_M = 15.0
-NLOS_EXTRA_PATH_SIGMA_M = 8.0
 
 
 def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
@@ -289,9 +285,8 @@ class AccuracyModel:
             deficit = np.where(mask, self.template.expected_dbhz(elevation_rad) - cn0_dbhz,
                                np.nan)
             p = nlos_probability(deficit, self.template.scatter_db)
-            mean = p * NLOS_EXTRA_PATH_MEAN_M
-            variance = variance + p * (NLOS_EXTRA_PATH_MEAN_M**2
-                                       + NLOS_EXTRA_PATH_SIGMA_M**2) - mean**2
+            mean, mean_square = nlos_delay_moments(p)
+            variance = variance + mean_square - mean**2
             terms.append(mean)
         return np.where(mask, variance, 0.0), terms
 
