@@ -52,7 +52,7 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
   p (mu^2 + s^2) - (p mu)^2. An extra path is never negative, so the mean matters:
   reflections from the two sides of a street cancel across it and add up in the height and
   the clock. Read by the receiver's own accuracy (``simulator.gnss.fix``) and by
-  ``riss3d_tc_ekf`` (``toolbox.gnss_model.nlos_delay``).
+  ``fgo_tc`` (``toolbox.gnss_model.nlos_delay``).
 
 Public names
 ------------

@@ -77,9 +77,9 @@ measurement noise), each a first-order Gauss-Markov process of ``RANGE_ERROR_TAU
   (``gnss_model.correlated_noise_inflation``: the white noise of the same low-frequency
   spectrum); and the reflected-signal (NLOS) delay its C/N0 deficit announces, its expected
   value p mu taken off the pseudorange and its variance p (mu^2 + s^2) - (p mu)^2 added
-  (``gnss_model.nlos_delay``, as ``riss3d_tc_ekf``; an extra path is never negative, and as
-  a zero-mean p (20 m)^2 the unseen canyon's reflections sank the height: seed 2 height
-  (error / sigma)^2 5.4 -> 3.8).
+  (``gnss_model.nlos_delay``, the model of the receiver's own fix accuracy; an extra path
+  is never negative, and as a zero-mean p (20 m)^2 the unseen canyon's reflections sank
+  the height: seed 2 height (error / sigma)^2 5.4 -> 3.8).
 
 A range-error variable stands for ``RANGE_ERROR_STEP_S`` (its timestamp refreshed at each
 use, so that the fixed-lag window keeps it), then a new one follows, linked by the process's

@@ -108,18 +108,12 @@ component, with the gyro's white noise; not in the paper), the azimuth's white n
 gyro's noise density plus its scale factor and misalignment times the turn rate over
 ``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
 correlated-noise inflation of the receiver's carrier smoothing
-(``gnss_model.correlated_noise_inflation``), its ionosphere share correlated between the
-satellites as the receiver datasheet's model says (``_range_covariance``,
-``toolbox.iono_field``), and a chi-square gate (1 dof, 0.999,
+(``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
 ``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon whose delay is far beyond the model's (a reflection off a far facade); each
-pseudorange's expected reflected-signal (NLOS) delay p mu taken off and its variance
-p (mu^2 + s^2) - (p mu)^2 added to R (p the probability its C/N0 deficit announces, mu and s
-the extra path's model of the receiver's own fix accuracy: ``gnss_model.nlos_delay``). An
-extra path is never negative: with the share as a zero-mean p (20 m)^2 in R, the reflected
-ranges that passed the gate (NIS 0.4-0.9) sank the SUMO canyon's height by 10-35 m
-(height (error / sigma)^2 10 over seeds 1-3; the gate keeps the reported variance alone:
-with the NLOS share in it too it passed more reflected ranges), the range rates'
+of a canyon, each pseudorange's R with the reflected-signal (NLOS) share its C/N0 deficit
+announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``; the gate keeps the
+reported variance alone: with the NLOS share in it too it passed more reflected ranges, the
+unseen canyon's height 2.5 -> 4.7 over seeds 1-3), the range rates'
 with the rear axle's sideways motion that eqs. 4-5 leave out (the tyres' slip in a turn,
 ``toolbox.constraints.NonholonomicNoise``, along the body's right axis: in the sharp junction
 turns of a SUMO city, 60 deg/s at 5 m/s, the rear axle moves up to 6 deg off the heading, and
@@ -160,10 +154,9 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.installation import Installation
-from estimators.toolbox.iono_field import residual_terms
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
-from simulator.datasheet import Cn0Template, cn0_template, iono_residual_fractions
+from simulator.datasheet import Cn0Template, cn0_template
 from simulator.earth import (
     OMEGA_E_RAD_S,
     geodetic_to_ecef,
@@ -181,7 +174,6 @@ _I = {name: i for i, name in enumerate(STATES)}
 REACQUIRE_EPOCHS = 3  # epochs with most pseudoranges gated out before the covariance is matched
 DEFAULT_WHEELBASE_M = 2.7  # a saloon's, where the datasheet gives none
 SIMPLIFIED_STATES = 11  # the earlier model: position, velocity, azimuth, a_od, b_z, clock
-PR_OWN_FLOOR_M2 = 0.01  # a pseudorange's own variance at least, before the inflation
 
 # Gauss-Markov models (steady-state sigma, correlation time s) of the filter, chosen from the
 # IMU300CC of the paper's Table 1: the gyro and accelerometer biases start at the Table 1
@@ -439,7 +431,6 @@ class RissTcEkf(Estimator):
         sheet = ImuDatasheet.from_datasheet(self.datasheet)
         self._sheet_tuning = tuning == "datasheet" and sheet is not None
         self._cn0_template: Cn0Template | None = None
-        self._iono_fractions: tuple[float, float] | None = None
         if not self._sheet_tuning:
             return p0, q_white, gm
         g, a = sheet.gyro, sheet.accel
@@ -458,7 +449,6 @@ class RissTcEkf(Estimator):
             gm[name] = (walk, math.inf)
         receiver = self.datasheet.get("gnss") or {}
         self._cn0_template = cn0_template(receiver)
-        self._iono_fractions = iono_residual_fractions(receiver)
         self._pr_inflation = gnss_model.correlated_noise_inflation(
             float(receiver.get("carrier_smoothing") or 0.0), 1.0)
         if self._gate_p is None:
@@ -767,13 +757,11 @@ class RissTcEkf(Estimator):
         h[m:, _I["vn"]] = d_ned[:, 0]
         h[m:, _I["vu"]] = -d_ned[:, 2]
         h[m:, _I["cd"]] = 1.0
-        mean_nlos, var_nlos = self._nlos_delay(epoch)
-        dz = np.concatenate([rho + mean_nlos - epoch.pseudorange, rate - epoch.range_rate])
+        dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
         var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
         var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
-        r = np.zeros((2 * m, 2 * m))
-        r[:m, :m] = self._range_covariance(epoch, var_pr, var_nlos)
-        r[m:, m:] = np.diag(var_rate)
+        var_nlos = self._nlos_variance(epoch)
+        r = np.diag(np.concatenate([var_pr * self._pr_inflation**2 + var_nlos, var_rate]))
         # the mechanised velocity carries the white noise of the last odometer speed: it enters
         # every predicted rate through the forward axis, so R gains sigma^2 g g^T
         forward = np.array([math.cos(self._az), math.sin(self._az), 0.0]) * math.cos(self._pitch)
@@ -790,36 +778,17 @@ class RissTcEkf(Estimator):
         self.nis_gnss_dof = float(keep.sum())
         self._feedback()
 
-    def _range_covariance(self, epoch: gnss_model.RawEpoch, var_pr: np.ndarray,
-                          var_nlos: np.ndarray | float) -> np.ndarray:
-        """The pseudoranges' R: the reported variance scaled by the correlated-noise inflation,
-        plus the reflected-signal variance. With ``tuning: datasheet`` and the broadcast
-        delays, the ionosphere's residual that the reported variance holds is correlated
-        between the satellites as the receiver datasheet's model says
-        (``iono_field.residual_terms``: common, the field's value and gradient over the sky,
-        the rest each satellite's own), so R = k^2 (diag(own) + S^T S) + diag(NLOS): taken as
-        independent between satellites, the common part (which the clock and height absorb)
-        went into the horizontal sigma, 2.3-2.9 m on the unseen canyon's open start against
-        errors of 0.04-0.4 m, and the field's gradient, which moves the position, was
-        averaged down."""
-        if self._iono_fractions is None or epoch.iono is None:
-            return np.diag(var_pr * self._pr_inflation**2 + var_nlos)
-        shared, own_iono = residual_terms(np.nan_to_num(epoch.iono), epoch.elevation,
-                                          epoch.azimuth, *self._iono_fractions)
-        own = np.maximum(var_pr - np.sum(shared**2, axis=0) + own_iono, PR_OWN_FLOOR_M2)
-        return (self._pr_inflation**2 * (np.diag(own) + shared.T @ shared)
-                + np.diag(np.broadcast_to(var_nlos, len(var_pr))))
-
-    def _nlos_delay(self, epoch: gnss_model.RawEpoch
-                    ) -> tuple[np.ndarray | float, np.ndarray | float]:
-        """Each pseudorange's expected delay from a reflected (NLOS) signal's extra path and
-        its variance, which the receiver's reported sigma does not hold
-        (``gnss_model.nlos_delay``: the probability that it is reflected given its C/N0
-        deficit below the receiver's template, and the extra path's model of the receiver's
-        own fix accuracy); zero without a template, C/N0 or elevations (``tuning: paper``)."""
+    def _nlos_variance(self, epoch: gnss_model.RawEpoch) -> np.ndarray | float:
+        """Each pseudorange's variance from a reflected (NLOS) signal's extra path, which the
+        receiver's reported sigma does not hold: p (20 m)^2, p the probability that it is
+        reflected given its C/N0 deficit below the receiver's template (``tuning: datasheet``
+        with a template, C/N0 and elevations; ``gnss_model.nlos_sigma``, as ``gnss_wls``). In
+        R only: the gate tests against the reported variance."""
         if (self._cn0_template is None or epoch.cn0 is None or epoch.elevation is None):
-            return 0.0, 0.0
-        return gnss_model.nlos_delay(epoch.cn0, epoch.elevation, self._cn0_template)
+            return 0.0
+        cn0 = np.where(np.isfinite(epoch.cn0), epoch.cn0, np.inf)  # none: not reflected
+        return gnss_model.nlos_sigma(np.zeros(len(cn0)), cn0, epoch.elevation,
+                                     self._cn0_template, gnss_model.NLOS_SIGMA_M) ** 2
 
     def _side_slip_variance(self, d_ned: np.ndarray) -> np.ndarray:
         """The range rates' covariance from the rear axle's sideways motion, which eqs. 4-5

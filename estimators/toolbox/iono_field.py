@@ -38,7 +38,7 @@ elevation in semicircles), the offset psi times the shell's radius along the azi
 variance shared by the satellites (c / |c|, g0 and the scaled gradient) with their
 coefficients in metres, and each satellite's own variance (f I_i)^2 r(x_i); a satellite
 without elevation or azimuth keeps the whole field as its own. Read by ``fgo_tc`` (the
-shared quantities as variables) and ``riss3d_tc_ekf`` (as a correlated R).
+shared quantities as variables).
 
 Public names
 ------------

@@ -102,12 +102,11 @@ def test_paper_tuning_claims_far_more_than_it_has(quickstart):
 
 def test_karamat_position_is_consistent_in_the_canyon(canyon):
     """riss3d_tc_ekf's datasheet tuning (the yaw's sigma that of the velocity's direction, the
-    range rates' side-slip noise, the pseudoranges' expected NLOS delay taken off and its
-    variance in R, R's ionosphere share correlated between satellites) on the canyon's first
+    range rates' side-slip noise, the pseudoranges' NLOS share in R) on the canyon's first
     150 s, seed 1 (a junction turn, a red-light stop, reflected ranges): north and east within
-    the goal of docs/scores.md (0.3-3), no axis above 10. Measured: north 1.71, east 0.36,
-    height 0.27 (7.9 with the NLOS share a zero-mean variance: the reflected ranges sank the
-    height, docs/scores.md), yaw 0.17 (too cautious at the stop)."""
+    the goal of docs/scores.md (0.3-3), no axis above 10. Measured: north 0.53, east 0.63,
+    height 7.9 (the canyon's height, docs/reproduction_karamat2015.md, "Consistency"), yaw
+    0.20 (too cautious at the stop)."""
     nse = _nse(canyon, "riss3d_tc_ekf")
     assert {"n", "e", "d", "yaw"} <= set(nse)
     assert 0.3 < nse["n"] < 3.0 and 0.3 < nse["e"] < 3.0, nse
