@@ -147,79 +147,73 @@ class Observed:
 
 
 class _Table:
-    """One stream table's rows, written in place as each signal is measured: a signal's
-    (satellite, epoch) samples where its mask is set go straight to their rows, in the order of
-    epochs, then satellites (PRN order), then the receiver's signals (a counting rank: every
-    signal's mask is known before the first is measured, so nothing is sorted or copied twice).
-    A text value (one per signal) is kept per signal and spread over its rows at the end."""
+    """One stream table's rows: each signal's (satellite, epoch) samples where its mask is set,
+    taken in the signal's own order, and the place of each in the table, which is in the order
+    of epochs, then satellites (PRN order), then the receiver's signals. The places are a
+    counting rank: every signal's mask is known before the first signal's rows are taken, so
+    nothing is sorted. A text value (one per signal) is spread over the signal's rows."""
 
     def __init__(self, t: np.ndarray, svs: np.ndarray,
                  masks: list[tuple[np.ndarray, np.ndarray]]):
         """``masks``: per signal in the receiver's order, its satellites' rows of ``svs`` and
         its (satellite, epoch) mask of the samples that are rows."""
-        import pandas as pd
-
-        self._pd = pd
         self.t, self.svs = t, svs
-        count = np.zeros((len(t), len(svs)), dtype=np.int64)
+        count = np.zeros((len(svs), len(t)), dtype=np.int32)
         for sel, mask in masks:  # one pass per signal
-            count[:, sel] += mask.T
-        # each (epoch, satellite)'s first row; moved on as each of its signals takes its row
-        self.next_row = np.cumsum(count.ravel()) - count.ravel()
-        self.n_rows = int(count.sum())
-        self.columns: dict[str, np.ndarray] = {}
-        self.texts: dict[str, list[str]] = {}
-        self.signal_of_row = np.empty(self.n_rows, dtype=np.int16)
-        self.n_signals = 0
+            count[sel] += mask
+        per_slot = count.T.ravel()  # epoch by epoch, satellites in order
+        # each (epoch, satellite)'s first row, moved on as each of its signals takes its row
+        self.next_row = np.cumsum(per_slot, dtype=np.int64) - per_slot
+        self.source = np.empty(int(per_slot.sum()), dtype=np.int64)  # each row's sample
+        self.pieces: list[dict[str, np.ndarray | str]] = []
+        self.n_taken = 0
 
     def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str]
             ) -> None:
         """The next signal's rows: ``columns`` of (satellite, epoch) arrays over ``sel``'s
         satellites (or broadcastable to them; a text value stays one text) where ``mask``."""
-        ep, sat = np.nonzero(mask.T)
-        flat = sat * mask.shape[1] + ep  # the samples' places in a (satellite, epoch) array
+        sat, ep = np.nonzero(mask)
         slot = ep * len(self.svs) + sel[sat]
         rows = self.next_row[slot]
         self.next_row[slot] += 1
-        self.signal_of_row[rows] = self.n_signals
-        self.n_signals += 1
-        values = {"t": self.t[ep], "sv": self.svs[sel[sat]]}
+        self.source[rows] = np.arange(self.n_taken, self.n_taken + len(sat))
+        self.n_taken += len(sat)
+        piece: dict[str, np.ndarray | str] = {"t": self.t[ep], "sv": self.svs[sel[sat]]}
         for key, value in columns.items():
-            if isinstance(value, str):
-                self.texts.setdefault(key, []).append(value)
-                continue
-            if value.shape == mask.shape:
-                values[key] = np.take(value, flat)
+            if isinstance(value, str):  # kept as it is: ``frame`` spreads it over the rows
+                piece[key] = value
+            elif value.shape == mask.shape:
+                piece[key] = value[mask]
             elif value.shape == (mask.shape[0], 1):  # one value per satellite
-                values[key] = value[sat, 0]
+                piece[key] = value[sat, 0]
             elif value.shape == (1, mask.shape[1]):  # one value per epoch
-                values[key] = value[0, ep]
+                piece[key] = value[0, ep]
             else:
-                values[key] = np.broadcast_to(value, mask.shape)[sat, ep]
-        for key, value in values.items():
-            out = self.columns.get(key)
-            if out is None:
-                out = self.columns[key] = np.empty(self.n_rows, dtype=value.dtype)
-            elif out.dtype != value.dtype:  # as concatenating the signals' rows would
-                out = self.columns[key] = out.astype(np.result_type(out, value))
-            out[rows] = value
-
-    def frame(self, names: list[str]) -> pd.DataFrame:
-        """The table of the columns ``names`` (each array taken as it is, not copied)."""
-        columns = {}
-        for name in names:
-            if name in self.texts:  # a text per signal: taken from the distinct ones
-                values = self.texts.pop(name)
-                texts = sorted(set(values))
-                code = np.array([texts.index(v) for v in values], dtype=np.int64)
-                columns[name] = self._pd.Series(texts).array.take(code[self.signal_of_row])
-            else:
-                columns[name] = self.columns.pop(name)
-        return self._pd.DataFrame(columns, copy=False)
+                piece[key] = np.broadcast_to(value, mask.shape)[mask]
+        self.pieces.append(piece)
 
     def names(self, order: tuple[str, ...]) -> list[str]:
         """The columns of ``order`` this table has."""
-        return [c for c in order if c in self.columns or c in self.texts]
+        return [c for c in order if c in self.pieces[0]]
+
+    def frame(self, names: list[str]) -> pd.DataFrame:
+        """The table of the columns ``names`` in its rows' order (each column its own new
+        array: the table takes them as they are, without copying them into blocks). The
+        pieces are emptied column by column as the table takes them, so the rows are held
+        about once, not twice (the peak memory of a long, fast-rate drive)."""
+        import pandas as pd
+
+        sizes = [len(p["t"]) for p in self.pieces]
+        columns = {}
+        for name in names:
+            values = [p.pop(name) for p in self.pieces]
+            if isinstance(values[0], str):  # a text per piece: taken from the distinct ones
+                texts = sorted(set(values))
+                codes = np.repeat([texts.index(v) for v in values], sizes)
+                columns[name] = pd.Series(texts).array.take(np.take(codes, self.source))
+            else:
+                columns[name] = np.take(np.concatenate(values), self.source)
+        return pd.DataFrame(columns, copy=False)
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
