@@ -402,7 +402,8 @@ def hatch_filter(x: np.ndarray, tracked: np.ndarray, dt_s: float, time_constant_
     k0 = np.minimum(arc_start + first_fixed, n_ep - 1)
     carried = mean[..., rows, k0 - 1] - run[..., rows, k0 - 1]
     steps = np.maximum(pos - first_fixed + 1, 0)
-    fixed = run + np.power(a, steps) * carried
+    # a^steps from a table of the whole powers (the same pow of each, without one per sample)
+    fixed = run + np.power(a, np.arange(int(steps.max(initial=0)) + 1))[steps] * carried
     return np.where(tracked, np.where(pos < first_fixed, mean, fixed), 0.0)
 
 
