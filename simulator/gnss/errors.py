@@ -92,6 +92,11 @@ from typing import Any
 
 import numpy as np
 
+from simulator.datasheet import (  # the field's scales: the receivers' model reads them too
+    EARTH_MEAN_RADIUS_KM,
+    IONO_CORRELATION_LENGTH_KM,
+    IONO_SHELL_HEIGHT_KM,
+)
 from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
@@ -108,9 +113,8 @@ OSCILLATORS: dict[str, dict[str, float]] = {
 # docstring: the NGA precise ephemeris against the broadcast file on 2015-07-19, 0.33 / 0.80 m)
 SIS_RECORD_SHARE = (0.33 / 0.80) ** 2
 IONO_CORRELATION_TIME_S = 1800.0  # variations of the true/Klobuchar ratio
-IONO_CORRELATION_LENGTH_KM = 1000.0  # L of the field's correlation exp(-d^2 / (2 L^2))
 IONO_FIELD_WAVES = 64  # plane waves summed to draw the field (its variance is exact)
-IONO_SHELL_RADIUS_KM = 6371.0 + 350.0  # Klobuchar's shell: mean Earth radius + 350 km
+IONO_SHELL_RADIUS_KM = EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM  # Klobuchar's shell
 # the field is evaluated every 10 s and interpolated linearly between: a pierce point moves by
 # under 2 km in 10 s (a satellite's at about 0.1 km/s, a car's at its speed), 1/500 of L, so
 # the interpolation changes the field by under 1e-5 of its sigma
