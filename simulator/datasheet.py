@@ -32,16 +32,17 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
     times ``KLOBUCHAR_NIGHT_SLANT_M``, the broadcast model's night-time vertical delay of 5 ns
     (IS-GPS-200 20.3.3.5.2.5, its smallest value) at the obliquity of 30 deg elevation, 1.77:
     the part of the day's slant delay (3.9-8.2 m, 5-95 %, on the quickstart) that is not
-    absorbed by the receiver clock. That sum is the height's (``correlated_m``). The
-    horizontal axes (``correlated_horizontal_m``) leave out the common part |scale - 1|: one
-    fraction of every satellite's delay moves the clock and the height, not the horizontal
-    position (on the quickstart, seeds 1-20 after 60 s: 0.02 m^2 north and east against
-    9.4 m^2 down), so only the field's 1-sigma stays there. Checked against the simulated
-    fixes (the ensemble over seeds 1-20 of the fix error at each epoch after 60 s, per unit
-    DOP, HDOP / sqrt(2) per horizontal axis): the quickstart 1.35 m north, 1.22 m east,
-    1.80 m down, ``benchmarks/consistency/open_road.yaml`` 1.21, 1.18 and 2.16 m; this budget
-    gives 0.95 m horizontally (the night's ionosphere: both drives are at midday, when the
-    broadcast delay is two to three times the floor) and 2.2 m down for the automotive preset.
+    absorbed by the receiver clock. Checked against the simulated fixes (the ensemble over
+    seeds 1-20 of the fix error at each epoch after 60 s, per unit DOP, HDOP / sqrt(2) per
+    horizontal axis): the quickstart 1.35 m north, 1.22 m east, 1.80 m down,
+    ``benchmarks/consistency/open_road.yaml`` 1.21, 1.18 and 2.16 m; this budget gives 2.2 m
+    for the automotive preset, on every axis. The horizontal axes do not see the common part
+    |scale - 1| (0.02 m^2 north and east against 9.4 m^2 down on the quickstart), but a
+    budget of the field alone at the night floor (0.95 m) was below these midday drives'
+    horizontal error, and the filters that take the fix's reported accuracy beyond the budget
+    as short-lived went overconfident on their seeds of large drive-long error (docs/scores.md,
+    "The ionosphere field's correlation"); the budget cannot know the hour, the fix's report
+    (``simulator.gnss.fix``) does.
   - code tracking noise (``tracking_noise``, lowered by the Hatch filter to 1 / sqrt(2N - 1),
     N = ``carrier_smoothing`` x ``rate`` epochs) and code multipath (``multipath``), correlated
     over the carrier-smoothing time (``RangeErrorBudget.smoothed_m``).
@@ -148,25 +149,18 @@ class RangeErrorBudget:
     """A receiver's user range error, m, by time behaviour (module docstring): ``sis``,
     ``ionosphere`` and ``troposphere`` stay over a drive; ``smoothed`` (code noise after the
     Hatch filter, and multipath) is correlated over ``smoothing_s`` (0: white at the fix
-    rate). ``ionosphere_horizontal`` is the ionosphere's share that moves the horizontal
-    position (the field's, without the part common to the satellites)."""
+    rate)."""
 
     sis: float
     ionosphere: float
     troposphere: float
     smoothed: float
     smoothing_s: float
-    ionosphere_horizontal: float = 0.0
 
     def correlated_m(self, ionosphere: bool = True) -> float:
-        """The drive-long part, m, as the height sees it; ``ionosphere=False`` without the
-        ionosphere."""
+        """The drive-long part, m; ``ionosphere=False`` without the ionosphere."""
         return math.sqrt(self.sis**2 + (self.ionosphere * ionosphere) ** 2
                          + self.troposphere**2)
-
-    def correlated_horizontal_m(self) -> float:
-        """The drive-long part, m, as the horizontal axes see it (module docstring)."""
-        return math.sqrt(self.sis**2 + self.ionosphere_horizontal**2 + self.troposphere**2)
 
 
 def range_error_budget(gnss: Mapping[str, Any]) -> RangeErrorBudget:
@@ -180,8 +174,7 @@ def range_error_budget(gnss: Mapping[str, Any]) -> RangeErrorBudget:
                             ionosphere=(common + field) * KLOBUCHAR_NIGHT_SLANT_M,
                             troposphere=_value(gnss, "tropo_residual") * TROPO_MAPPING_30_DEG,
                             smoothed=math.hypot(noise, _value(gnss, "multipath")),
-                            smoothing_s=smoothing,
-                            ionosphere_horizontal=field * KLOBUCHAR_NIGHT_SLANT_M)
+                            smoothing_s=smoothing)
 
 
 def fix_uere_m(gnss: Mapping[str, Any], ionosphere: bool = True) -> float:

@@ -48,20 +48,12 @@ def test_automotive_budget_worked_by_hand():
     assert math.isclose(b.correlated_m(), math.sqrt(0.25 + (0.8 * 2.6532) ** 2 + 0.01),
                         rel_tol=1e-4)
     assert math.isclose(b.correlated_m(ionosphere=False), math.sqrt(0.26))
-    # the horizontal axes: the field's 1-sigma alone, 1.5 x 0.2 of the night floor (the part
-    # |1.5 - 1| common to the satellites goes into the clock and the height)
-    assert math.isclose(b.correlated_horizontal_m(),
-                        math.sqrt(0.25 + (0.3 * 2.6532) ** 2 + 0.01), rel_tol=1e-4)
 
 
 def test_consumers_read_the_one_budget():
     b = range_error_budget(AUTOMOTIVE)
     model = fix_error_model({"gnss": AUTOMOTIVE})
     assert model.correlated_range == b.correlated_m()
-    assert model.correlated_horizontal == b.correlated_horizontal_m()
-    np.testing.assert_allclose(model.correlated_sigma(math.sqrt(2.0), 2.0),
-                               [b.correlated_horizontal_m(), b.correlated_horizontal_m(),
-                                2.0 * b.correlated_m()], rtol=1e-12)
     # the smoothed error's white equivalent at 1 Hz: sigma sqrt(2 T / dt), T = 100 s
     assert math.isclose(model.white_range, b.smoothed * math.sqrt(200.0))
     assert fix_uere_m(AUTOMOTIVE) == math.hypot(b.correlated_m(), b.smoothed)

@@ -20,9 +20,7 @@ that tunes itself "from the datasheet" means the same thing.
 
   - correlated over the drive (``correlated_sigma``, correlation time ``CORRELATED_TAU_S``):
     signal in space, the ionosphere's and the troposphere's residuals. Per axis: north and
-    east HDOP / sqrt(2) times the budget's horizontal range error (without the ionosphere's
-    part common to the satellites, which the clock and the height take:
-    ``RangeErrorBudget.correlated_horizontal_m``), down VDOP times its whole range error.
+    east HDOP / sqrt(2), down VDOP times that range error.
   - the rest, code tracking noise after the Hatch filter and multipath: correlated over the
     carrier-smoothing time T, so given to the filter as the white noise of the same
     low-frequency spectrum, variance 2 sigma^2 T / dt at the fix interval dt (Brown & Hwang,
@@ -164,19 +162,10 @@ class FixErrorModel:
     correlated_tau: float
     range_rate: float
     smoothed_range: float = 0.0
-    correlated_horizontal: float | None = None
-
-    @property
-    def _correlated_ned(self) -> np.ndarray:
-        """The drive-long range error per NED axis, m (``correlated_horizontal`` north and
-        east, the whole ``correlated_range`` down)."""
-        horizontal = (self.correlated_range if self.correlated_horizontal is None
-                      else self.correlated_horizontal)
-        return np.array([horizontal, horizontal, self.correlated_range])
 
     def correlated_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m) of the drive-long correlated error at these DOPs."""
-        return self._correlated_ned * _axes(hdop, vdop)
+        return self.correlated_range * _axes(hdop, vdop)
 
     def white_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m) of the white-equivalent remainder at these DOPs."""
@@ -190,7 +179,7 @@ class FixErrorModel:
         """NED 1-sigma (m) of a fix's reported position error beyond this budget at its DOPs
         (the correlated and smoothed parts in quadrature): 0 where the report is within it or
         not finite."""
-        budget = (self._correlated_ned**2 + self.smoothed_range**2) * _axes(hdop, vdop) ** 2
+        budget = (self.correlated_range**2 + self.smoothed_range**2) * _axes(hdop, vdop) ** 2
         extra = np.nan_to_num(np.asarray(reported, dtype=float) ** 2 - budget, nan=0.0)
         return np.sqrt(np.maximum(extra, 0.0))
 
@@ -218,8 +207,7 @@ def fix_error_model(datasheet: Mapping[str, Any]) -> FixErrorModel:
         white *= math.sqrt(2.0 * budget.smoothing_s * float(gnss.get("rate") or 1.0))
     return FixErrorModel(correlated_range=max(budget.correlated_m(), 0.1),
                          white_range=max(white, 0.1), correlated_tau=CORRELATED_TAU_S,
-                         range_rate=RANGE_RATE_SIGMA_M_S, smoothed_range=budget.smoothed,
-                         correlated_horizontal=max(budget.correlated_horizontal_m(), 0.1))
+                         range_rate=RANGE_RATE_SIGMA_M_S, smoothed_range=budget.smoothed)
 
 
 class FixAccuracy:
