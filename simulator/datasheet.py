@@ -18,9 +18,9 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
   the thin shell 350 km up (the geometry the broadcast model uses; ``pierce_chord_km``) and
   L = ``IONO_CORRELATION_LENGTH_KM`` (docs/gnss-errors.md). Signals close in the sky share
   their residual, which the clock and the height then take: taken as independent, the field
-  made the receiver's horizontal 1-sigma 1.6-2.2 times the horizontal error over twenty seeds
-  of two open-sky drives (variance 0.27 and 0.17 of it north; the field's independent model
-  2.6 m^2 north against 0.84 m^2 realised on the quickstart, 1.2 m^2 with this covariance).
+  made the receiver's horizontal 1-sigma 1.5-2.4 times the rms horizontal error over twenty
+  seeds of two open-sky drives (the field's independent model 2.6 m^2 north against 0.84 m^2
+  realised on the quickstart, 1.2 m^2 with this covariance).
 * ``range_error_budget``: a fix's user range error, split by time behaviour (Kaplan & Hegarty
   2017, section 10.2; Misra & Enge 2011, section 6.1: a fix's 1-sigma is DOP x UERE):
 

@@ -23,7 +23,7 @@ errors, from what the receiver measures itself:
   the satellites by their pierce points' separation (``simulator.datasheet.
   iono_field_covariance``), also taken out of the diagonal: signals close in the sky share it,
   so it too goes mostly into the clock and the height (taken as independent, it made the
-  horizontal 1-sigma 1.6-2.2 times the error over twenty seeds of two open-sky drives);
+  horizontal 1-sigma 1.5-2.4 times the rms error over twenty seeds of two open-sky drives);
 * reflected (NLOS) signals, announced by their C/N0 deficit below the receiver's direct-signal
   template (``simulator.datasheet.cn0_template``): with p_i the probability that signal i is
   reflected (``simulator.datasheet.nlos_probability``) and its extra path d ~ N(mu, s^2)
