@@ -110,6 +110,7 @@ from estimators.base import NAV_COLUMNS, Estimator
 from estimators.builtin.cho2006_tuning import (
     LATERAL_HOLD_S,
     PAPER_R,
+    ROLL_GRADIENT_SPREAD,
     TUNINGS,
     TURN_HOLD_S,
     Tuning,
@@ -629,6 +630,29 @@ class _Drm1(_ChoDr):
         init = self.initial
         return np.array([0.0, 0.0, float(init.velocity[0]), float(init.velocity[1]),
                          float(init.attitude[2]), 0.0, 0.0, 0.0])
+
+    def _inputs(self, u: np.ndarray) -> np.ndarray:
+        """The lateral specific force of a body rolled out of a turn (datasheet tuning on a
+        car): the y accelerometer tilts with the roll phi = -k a_y (``cho2006_tuning``) and
+        senses gravity's share g k a_y beside the lateral acceleration a_y = V w_z, which the
+        level frame of eq. 2 would take for acceleration (8 % of every turn's at 5 deg/g)."""
+        k = self._tuning.roll_gradient
+        if not k:
+            return u
+        x = self._estimate()[0]
+        return np.array([u[0], u[1] - self._g * k * math.hypot(x[2], x[3]) * u[2], u[2]])
+
+    def _q_step(self, u: np.ndarray) -> np.ndarray:
+        """Q with the lateral acceleration error of the roll gradient's spread (``cho2006_
+        tuning.ROLL_GRADIENT_SPREAD``, held over a turn: ``TURN_HOLD_S``)."""
+        if not self._tuning.roll_gradient:
+            return self._tuning.q
+        x = self._estimate()[0]
+        error = self._g * ROLL_GRADIENT_SPREAD * math.hypot(x[2], x[3]) * u[2]
+        q = self._tuning.q.copy()
+        q[2, 2] += error**2 * TURN_HOLD_S
+        q[3, 3] += error**2 * TURN_HOLD_S
+        return q
 
     def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
                     dt: float) -> np.ndarray:
