@@ -81,7 +81,12 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   velocity instead (``Drm1Ekf._update``): eq. 18's speed left the cross-track velocity to
   the position alone, which the body's roll and the road's bank push and a street canyon's
   reflected fixes barely hold (sumo_city_canyon seed 1 north (error / sigma)^2 7.8 -> 1.3,
-  parking_garage seed 3 yaw 7.2 -> 0.74).
+  parking_garage seed 3 yaw 7.2 -> 0.74). Its position is then the truth plus the fix's
+  correlated north and east error, two states sized by the receiver's budget at the first
+  fix's HDOP (``toolbox.datasheet.fix_error_model``, as ``dr2d_odo_ekf`` carries them), plus
+  the budget's white part and the reported excess: with the velocity known to the fix's
+  Doppler the inflated white R (``FIX_CORRELATION_S``) averaged the drive-long error away
+  (sumo_city north 8.4 over three seeds, worst 22).
 * Eq. 18 converts GPS latitude and longitude to metres with one Earth radius R_e; we use the
   WGS-84 meridian and transverse radii at the start (``simulator.earth``).
 * No Earth rate (the paper ignores it); the standstill calibration removes its vertical part.
@@ -348,10 +353,12 @@ class _ChoDr(Estimator):
         """Q (variance growth per second) over a step with inputs ``u``."""
         return self._tuning.q
 
+    _fix_states = 0  # the fix's correlated error states after the bias states (DRM1)
+
     @property
     def _bias_states(self) -> int:
         """Accelerometer-bias states appended to the paper's eight (datasheet tuning)."""
-        return len(self._tuning.p0) - 8
+        return len(self._tuning.p0) - 8 - (self._fix_states if self._datasheet else 0)
 
     # -- to be provided by the model and filter -------------------------------------------
     def _initial_state(self) -> np.ndarray:
@@ -723,6 +730,22 @@ class Drm1Ekf(_Drm1, _Ekf):
             h[2] = 0.0  # no speed row: the EKF leaves it out
         return zhat, h
 
+    _fix_states = 2
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        """The fix's HDOP and reported position 1-sigma kept for ``_update``, and the fix's
+        correlated-error states sized at the first fix by its HDOP (datasheet tuning)."""
+        hdop = float(row[self._fix_cols[5]])
+        self._fix_report = (hdop, self._accuracy.read(row)[0])
+        if self._datasheet and not getattr(self, "_fix_sized", False) and math.isfinite(hdop):
+            k = len(self._x) - 2
+            sigma = self._fix_model.correlated_sigma(hdop, math.nan)[:2]
+            self._p[k:, :] = 0.0
+            self._p[:, k:] = 0.0
+            self._p[k:, k:] = np.diag(sigma**2)
+            self._fix_sized = True
+        super().on_gnss_fix(t, row)
+
     def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
                    ) -> tuple[float, float]:
         """Eq. 18's speed row, and the fix's velocity with its reported 1-sigma kept for
@@ -740,9 +763,20 @@ class Drm1Ekf(_Drm1, _Ekf):
         self._fix_velocity = None
         if not (self._datasheet and vel is not None and math.isfinite(vel[2] + vel[3])):
             return super()._update(z, r)
+        # the position: the truth plus the fix's correlated error (two states) plus white
+        # noise, and the reported excess (reflections) as white noise beside it
+        hdop, std_pos = self._fix_report
+        k = len(self._x) - 2
         h = np.eye(4, len(self._x))
+        h[0, k], h[1, k + 1] = 1.0, 1.0
         nu = np.array([z[0], z[1], vel[0], vel[1]]) - self._x[:4]
-        rr = np.diag([r[0, 0], r[1, 1], max(vel[2], MIN_SPEED_SIGMA_M_S) ** 2,
+        nu[:2] -= self._x[k:]
+        white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
+        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
+        pos = white + excess
+        if self._p[4, 4] >= ALIGNED_HEADING_VAR:  # as ``on_gnss_fix`` weighs them then
+            pos = np.maximum(pos, PAPER_R.diagonal()[:2])
+        rr = np.diag([pos[0], pos[1], max(vel[2], MIN_SPEED_SIGMA_M_S) ** 2,
                       max(vel[3], MIN_SPEED_SIGMA_M_S) ** 2])
         self._x, self._p, s = kf_update(self._x, self._p, nu, h, rr)
         self._x[4] = wrap_angle(self._x[4])
