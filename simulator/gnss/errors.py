@@ -187,8 +187,16 @@ def _sum_of_waves(k: np.ndarray, phase: np.ndarray, amp: np.ndarray, pierce_km: 
     (3, n_sat, n_t) and amplitudes (M, n_t)."""
     x, y, z = pierce_km
     out = np.zeros(np.shape(x))
+    wave, term = np.empty(np.shape(x)), np.empty(np.shape(x))  # reused by every wave
     for m in range(len(k)):  # a loop over the waves; each is vectorised over signals x epochs
-        out += amp[m] * np.cos(k[m, 0] * x + k[m, 1] * y + k[m, 2] * z + phase[m])
+        # amp_m cos(k_m . x + p_m), summed in the order (k0 x + k1 y) + k2 z, then + p_m
+        np.multiply(x, k[m, 0], out=wave)
+        wave += np.multiply(y, k[m, 1], out=term)
+        wave += np.multiply(z, k[m, 2], out=term)
+        wave += phase[m]
+        np.cos(wave, out=wave)
+        wave *= amp[m]
+        out += wave
     return np.sqrt(2.0 / len(k)) * out
 
 
@@ -402,7 +410,8 @@ def hatch_filter(x: np.ndarray, tracked: np.ndarray, dt_s: float, time_constant_
     k0 = np.minimum(arc_start + first_fixed, n_ep - 1)
     carried = mean[..., rows, k0 - 1] - run[..., rows, k0 - 1]
     steps = np.maximum(pos - first_fixed + 1, 0)
-    fixed = run + np.power(a, steps) * carried
+    # a^steps from a table of the whole powers (the same pow of each, without one per sample)
+    fixed = run + np.power(a, np.arange(int(steps.max(initial=0)) + 1))[steps] * carried
     return np.where(tracked, np.where(pos < first_fixed, mean, fixed), 0.0)
 
 
