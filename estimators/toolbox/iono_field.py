@@ -49,7 +49,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from simulator.datasheet import IONO_CORRELATION_LENGTH_KM, IONO_SHELL_RADIUS_KM
+from simulator.datasheet import (
+    EARTH_MEAN_RADIUS_KM,
+    IONO_CORRELATION_LENGTH_KM,
+    IONO_SHELL_HEIGHT_KM,
+)
 
 # the quantities shared by an epoch's satellites (``residual_terms``)
 SHARED_TERMS = ("iono_common", "iono_field", "iono_north", "iono_east")
@@ -60,7 +64,7 @@ def pierce_offsets_km(elevation_rad: np.ndarray, azimuth_rad: np.ndarray) -> np.
     the receiver's zenith pierce point, along the shell (module docstring)."""
     el_sc = np.asarray(elevation_rad, dtype=float) / np.pi
     psi = (0.0137 / (el_sc + 0.11) - 0.022) * np.pi
-    distance = IONO_SHELL_RADIUS_KM * psi
+    distance = (EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM) * psi
     az = np.asarray(azimuth_rad, dtype=float)
     return np.stack([distance * np.cos(az), distance * np.sin(az)], axis=-1)
 

@@ -92,7 +92,11 @@ from typing import Any
 
 import numpy as np
 
-from simulator.datasheet import IONO_CORRELATION_LENGTH_KM, IONO_SHELL_RADIUS_KM
+from simulator.datasheet import (  # the field's scales: the receivers' model reads them too
+    EARTH_MEAN_RADIUS_KM,
+    IONO_CORRELATION_LENGTH_KM,
+    IONO_SHELL_HEIGHT_KM,
+)
 from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
@@ -110,6 +114,7 @@ OSCILLATORS: dict[str, dict[str, float]] = {
 SIS_RECORD_SHARE = (0.33 / 0.80) ** 2
 IONO_CORRELATION_TIME_S = 1800.0  # variations of the true/Klobuchar ratio
 IONO_FIELD_WAVES = 64  # plane waves summed to draw the field (its variance is exact)
+IONO_SHELL_RADIUS_KM = EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM  # Klobuchar's shell
 # the field is evaluated every 10 s and interpolated linearly between: a pierce point moves by
 # under 2 km in 10 s (a satellite's at about 0.1 km/s, a car's at its speed), 1/500 of L, so
 # the interpolation changes the field by under 1e-5 of its sigma
