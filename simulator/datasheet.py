@@ -73,7 +73,7 @@ pseudorange noise) and the exporters (a ROS fix's covariance).
 
 Public names
 ------------
-iono_residual_fractions, iono_field_covariance, pierce_chord_km, RangeErrorBudget,
+iono_residual_fractions, iono_field_covariance, pierce_angle_sc, pierce_chord_km, RangeErrorBudget,
 range_error_budget, fix_uere_m, Cn0Template, cn0_template, nominal_cn0_dbhz, nlos_probability,
 nlos_delay_moments, NLOS_EXTRA_PATH_MEAN_M, NLOS_EXTRA_PATH_SIGMA_M, KLOBUCHAR_NIGHT_SLANT_M,
 TROPO_MAPPING_30_DEG, IONO_FIELD_OWN_SHARE, IONO_CORRELATION_LENGTH_KM, IONO_SHELL_HEIGHT_KM,
@@ -128,17 +128,26 @@ def iono_residual_fractions(gnss: Mapping[str, Any]) -> tuple[float, float]:
     return abs(scale - 1.0), scale * _value(gnss, "iono_residual")
 
 
+def pierce_angle_sc(elevation_rad: np.ndarray) -> np.ndarray:
+    """Earth-centred angle (semicircles) from the receiver to a signal's ionospheric pierce
+    point, the broadcast model's approximation of the thin shell ``IONO_SHELL_HEIGHT_KM`` up:
+    psi = 0.0137 / (E + 0.11) - 0.022, E the elevation in semicircles (IS-GPS-200, Figure 20-4).
+    The one home of the pierce-point geometry: the simulator's ionosphere, the receiver's
+    accuracy and ``fgo_tc``'s field variables all read it."""
+    el_sc = np.asarray(elevation_rad, dtype=float) / np.pi
+    return 0.0137 / (el_sc + 0.11) - 0.022
+
+
 def pierce_chord_km(azimuth_rad: np.ndarray, elevation_rad: np.ndarray) -> np.ndarray:
     """Chord (km) between the pierce points of each pair of signals on the thin shell
     ``IONO_SHELL_HEIGHT_KM`` up: shape (..., k, k) for signals along the last axis. Each pierce
-    point lies psi = pi/2 - E - asin(R cos E / (R + h)) of Earth-central angle from the
-    receiver towards the signal's azimuth (the thin-shell geometry, Klobuchar 1987); the angle
-    c between two follows from the spherical law of cosines, cos c = cos psi_i cos psi_j +
-    sin psi_i sin psi_j cos(az_i - az_j), and the chord is 2 (R + h) sin(c / 2)."""
-    el = np.clip(np.asarray(elevation_rad, dtype=float), 0.0, None)
+    point lies ``pierce_angle_sc`` psi of Earth-central angle from the receiver towards the
+    signal's azimuth; the angle c between two follows from the spherical law of cosines, cos c
+    = cos psi_i cos psi_j + sin psi_i sin psi_j cos(az_i - az_j), and the chord is
+    2 (R + h) sin(c / 2)."""
     az = np.asarray(azimuth_rad, dtype=float)
     shell = EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM
-    psi = 0.5 * np.pi - el - np.arcsin(EARTH_MEAN_RADIUS_KM * np.cos(el) / shell)
+    psi = np.pi * pierce_angle_sc(np.clip(np.asarray(elevation_rad, dtype=float), 0.0, None))
     cos_c = (np.cos(psi)[..., :, None] * np.cos(psi)[..., None, :]
              + np.sin(psi)[..., :, None] * np.sin(psi)[..., None, :]
              * np.cos(az[..., :, None] - az[..., None, :]))

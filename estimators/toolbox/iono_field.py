@@ -31,8 +31,8 @@ field's variance at 45 deg elevation (x of 340 km), 16 % at 20 deg (840 km), hal
 (1280 km).
 
 The pierce point's Earth-centred angle from the receiver is the broadcast model's own
-approximation, psi = 0.0137 / (E + 0.11) - 0.022 semicircles (IS-GPS-200, Figure 20-4; E the
-elevation in semicircles), the offset psi times the shell's radius along the azimuth.
+approximation (``simulator.datasheet.pierce_angle_sc``, IS-GPS-200 Figure 20-4), the offset
+psi times the shell's radius along the azimuth.
 
 ``residual_terms`` puts the two together on an epoch's pseudoranges: four quantities of unit
 variance shared by the satellites (c / |c|, g0 and the scaled gradient) with their
@@ -53,6 +53,7 @@ from simulator.datasheet import (
     EARTH_MEAN_RADIUS_KM,
     IONO_CORRELATION_LENGTH_KM,
     IONO_SHELL_HEIGHT_KM,
+    pierce_angle_sc,
 )
 
 # the quantities shared by an epoch's satellites (``residual_terms``)
@@ -62,8 +63,7 @@ SHARED_TERMS = ("iono_common", "iono_field", "iono_north", "iono_east")
 def pierce_offsets_km(elevation_rad: np.ndarray, azimuth_rad: np.ndarray) -> np.ndarray:
     """North and east offsets (km, shape (m, 2)) of the signals' ionospheric pierce points from
     the receiver's zenith pierce point, along the shell (module docstring)."""
-    el_sc = np.asarray(elevation_rad, dtype=float) / np.pi
-    psi = (0.0137 / (el_sc + 0.11) - 0.022) * np.pi
+    psi = pierce_angle_sc(elevation_rad) * np.pi
     distance = (EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM) * psi
     az = np.asarray(azimuth_rad, dtype=float)
     return np.stack([distance * np.cos(az), distance * np.sin(az)], axis=-1)

@@ -64,9 +64,9 @@ def test_the_field_covariance_is_the_simulated_fields():
 
 
 def test_the_pierce_chords_are_the_simulators_within_its_approximation():
-    """The receivers' thin-shell chords against the distances between the simulator's
-    Klobuchar pierce points (its approximate psi = 0.0137 / (E + 0.11) - 0.022 semicircles):
-    within 5 % or 20 km."""
+    """The receivers' chords on the shell against the distances between the simulator's own
+    pierce points (``pierce_points_km``: the same Earth-centred angle, but the broadcast model's
+    latitude clipping and its longitude step of psi sin(az) / cos(lat)): within 5 % or 20 km."""
     az, el = SKY[:, 0], SKY[:, 1]
     points = pierce_points_km(LAT, LON, az, el)
     distance = np.linalg.norm(points[:, :, None] - points[:, None, :], axis=0)
