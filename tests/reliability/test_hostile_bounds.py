@@ -37,6 +37,11 @@ GNSS = "  gnss: {rate: 1, outputs: [fix]}\n"
     (straight_drive(100).replace(
         "start: {lat: 37.5, lon: 127.0}",
         "start: {lat: 37.5, lon: 127.0, utc: '9999-12-31T23:59:59-01:00'}"), "is after 2200"),
+    # its offset takes it before year 1 in UTC: early, not late (was 'is after 2200')
+    (straight_drive(100).replace(
+        "start: {lat: 37.5, lon: 127.0}",
+        "start: {lat: 37.5, lon: 127.0, utc: '0001-01-01T00:00:00+14:00'}"),
+     "is before 1980-01-06T00:00:00Z (the GPS epoch"),
 ])
 def test_validation_refuses_unbounded_drives(tmp_path, capsys, scenario, words):
     (tmp_path / "s.yaml").write_text(scenario)
