@@ -30,6 +30,11 @@ GNSS = "  gnss: {rate: 1, outputs: [fix]}\n"
     (straight_drive(100, sensors="  gnss: {rate: 10, systems: [gps, galileo, beidou, glonass]}"
                                  "\n").replace("{length: 100}", "{duration: 32400}"),
      "need about 55.1 GB (tracking gps, galileo, beidou, glonass)"),
+    # 27 h with odometer, barometer and magnetometer at 100 Hz: 12.6 GB, validated before
+    (straight_drive(100, sensors="  imu: {preset: ideal, rate: 100}\n  odometer: {rate: 100}\n"
+                                 "  baro: {rate: 100}\n  mag: {rate: 100}\n").replace(
+        "{length: 100}", "{duration: 97000}"),
+     "and 2.91e+07 odometer, barometer and magnetometer samples need about 12.6 GB"),
     (straight_drive(1e300), "is beyond any value a scenario describes"),
     # a sensor at 1e-300 Hz: a truth of one row and an IMU interval of 1e300 s, written
     (straight_drive(100, sensors="  imu: {preset: ideal, rate: 1e-300}\n"),
