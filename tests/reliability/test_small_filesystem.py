@@ -25,8 +25,8 @@ SCENARIO = straight_drive(100, sensors="  imu: {preset: ideal, rate: 50}\n  odom
                                        "  gnss: {rate: 1, outputs: [fix, raw]}\n",
                           tail="estimators: [dead_reckoning]\n")
 
-# case: (arguments, KiB left free, the output the message names); the dataset is 240 KiB, a
-# run's folder 1 MiB; each case fails part-way through its output's files
+# case: (arguments, KiB left free, the output the message names, DISK the small disk); the
+# dataset is 240 KiB, a run's folder 1 MiB; each case fails part-way through its output's files
 CASES = {
     "generate": (["generate", "s.yaml", "-o", "disk/out"], 40, "disk/out"),
     "estimate": (["estimate", "DATASET", "-e", "dead_reckoning", "-o", "disk/sol.parquet"], 4,
@@ -35,6 +35,9 @@ CASES = {
                         "disk/report", "--json", "disk/scores.json"], 100, "disk/report"),
     "export into new folders": (["export", "DATASET", "--rinex", "disk/new/rinex", "--nmea",
                                  "disk/new.nmea"], 8, "disk/new/rinex/ds."),
+    # checked in the temporary folder first, which is on the full disk (was 'cannot write to
+    # the standard output': Arrow's error carried no error number)
+    "twin": (["twin", "DATASET", "-o", "disk/twin.yaml"], 8, "DISK/tmp"),
     "run, the dataset written": (["run", "s.yaml", "-o", "disk/out"], 300, "disk/out"),
     "run, nothing written": (["run", "s.yaml", "-o", "disk/out"], 8, "disk/out"),
 }
@@ -61,8 +64,9 @@ def small_disk(tmp_path):
 @pytest.mark.parametrize("case", [pytest.param(c, marks=SLOW) if c.startswith("run") else c
                                   for c in CASES])
 def test_a_full_file_system_leaves_nothing_and_one_message(dataset, tmp_path, small_disk, case):
-    run, _ = small_disk
+    run, disk = small_disk
     args, free_kib, named = CASES[case]
+    named = named.replace("DISK", str(disk))
     (tmp_path / "s.yaml").write_text(SCENARIO)
     if "sol.parquet" in args:
         assert main(["estimate", str(dataset), "-e", "dead_reckoning", "-o",
