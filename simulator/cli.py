@@ -88,6 +88,9 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to write
         return 1
     except OSError as exc:  # the standard output is full or failing (the files are written)
+        if exc.filename is not None:  # a file's error that no writer named: not the output
+            print(f"error: {exc.filename}: {exc.strerror or exc}", file=sys.stderr)
+            return 2
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         print(f"error: cannot write to the standard output: {exc.strerror or exc}",
               file=sys.stderr)

@@ -174,5 +174,8 @@ REQUIRED = {
     "truth_gnss_base": ("t", "sv"),
     "truth_sensors": ("t",),
 }
+# where a position (latitude and longitude in degrees, ellipsoidal height in metres) can lie:
+# anything else in a truth or a solution is a unit or format mistake, or no land vehicle's
+POSITION_SPANS = {"lat": (-90.0, 90.0), "lon": (-180.0, 360.0), "alt": (-1e5, 1e5)}
 # every other column of a stream is numeric
 TEXT_COLUMNS = ("zone", "kind", "detail", "system", "signal")

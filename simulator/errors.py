@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import stat
 from dataclasses import dataclass
 
@@ -64,10 +65,15 @@ class StorageError(InputError):
 def storage_error(path: object, exc: BaseException) -> StorageError | None:
     """``exc`` as a ``StorageError`` naming ``path`` when it is an ``OSError`` the storage
     raised (``STORAGE_ERRNOS``), else None."""
-    if not isinstance(exc, OSError) or exc.errno not in STORAGE_ERRNOS:
+    if not isinstance(exc, OSError):
         return None
-    reason = ("no space left on the device" if exc.errno == errno.ENOSPC
-              else os.strerror(exc.errno))
+    number = exc.errno
+    if number is None:  # Arrow's writers give the system's error number only in the text
+        found = re.search(r"\[errno (\d+)\]", str(exc), re.IGNORECASE)
+        number = int(found.group(1)) if found else None
+    if number not in STORAGE_ERRNOS:
+        return None
+    reason = "no space left on the device" if number == errno.ENOSPC else os.strerror(number)
     return StorageError(str(path), reason)
 
 

@@ -256,14 +256,32 @@ def _refuse_existing(path: Path, force: bool, want_dir: bool, kind: str | None =
                              "what landnav wrote: remove it yourself or name another output")
 
 
-def make_parent(path: Path) -> None:
-    """Make the folder ``path`` goes into; InputError naming what is in the way."""
+def make_parent(path: Path) -> list[Path]:
+    """Make the folder ``path`` goes into; InputError naming what is in the way. Returns the
+    folders made, outermost first (``_remove_made`` removes them when no output is written)."""
+    missing = []
+    for folder in path.parents:
+        if os.path.lexists(folder):
+            break
+        missing.append(folder)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except FileExistsError:
         raise _problem(path, f"cannot be created: {path.parent} is a file, not a folder") from None
     except OSError as exc:
+        _remove_made(missing[::-1])
         raise os_problem(path.parent, exc) from None
+    return missing[::-1]
+
+
+def _remove_made(folders: list[Path]) -> None:
+    """Remove the folders ``make_parent`` made (innermost first) that are still empty: an
+    output that was not written leaves no folder of its own behind."""
+    for folder in reversed(folders):
+        try:
+            folder.rmdir()
+        except OSError:
+            return
 
 
 def _pid_alive(pid: int) -> bool:
@@ -361,7 +379,7 @@ def atomic_output_dir(out_dir: Path | str, force: bool, inputs: Iterable[Path | 
     out_dir = Path(out_dir)
     inputs = list(inputs)
     _check_target(out_dir, force, True, inputs, None, honour_lock)
-    make_parent(out_dir)
+    made = make_parent(out_dir)
     tmp = out_dir.parent / f".{out_dir.name}.tmp"
     claimed: list[Path] = []
     try:
@@ -378,6 +396,7 @@ def atomic_output_dir(out_dir: Path | str, force: bool, inputs: Iterable[Path | 
     except BaseException as exc:
         for folder in claimed:
             shutil.rmtree(folder, ignore_errors=True)
+        _remove_made(made)
         if isinstance(exc, OSError):
             raise os_problem(out_dir, exc) from None
         if isinstance(exc, InputError):  # a problem inside: named by the output, not its draft
@@ -412,27 +431,37 @@ def atomic_output_file(path: Path | str, force: bool, inputs: Iterable[Path | st
     path = Path(path)
     inputs = list(inputs)
     _check_target(path, force, False, inputs, kind, True)
-    make_parent(path)
-    with private_temp_dir(path.parent, path.name) as folder:
-        tmp = folder / path.name
-        try:
+    made = make_parent(path)
+    try:
+        with private_temp_dir(path.parent, path.name) as folder:
+            tmp = folder / path.name
             yield tmp
             _check_target(path, force, False, inputs, kind, True)
-            if force:
-                os.replace(tmp, path)
-            else:
-                try:
-                    os.link(tmp, path)  # fails if the name exists: never replaces another's file
-                except FileExistsError:
-                    raise _problem(path, "already exists (created while this ran); use --force "
-                                         "to overwrite it") from None
-                except OSError as exc:
-                    if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV):
-                        raise
-                    _refuse_existing(path, force, want_dir=False)  # no hard links here
-                    os.replace(tmp, path)
-        except OSError as exc:
-            raise os_problem(path, exc) from None
+            _move_into_place(tmp, path, force)
+    except OSError as exc:
+        _remove_made(made)
+        raise os_problem(path, exc) from None
+    except BaseException:
+        _remove_made(made)
+        raise
+
+
+def _move_into_place(tmp: Path, path: Path, force: bool) -> None:
+    """``tmp`` renamed to ``path``: replacing it with ``force``, else only if the name is
+    still free (a hard link, which fails atomically if it exists)."""
+    if force:
+        os.replace(tmp, path)
+        return
+    try:
+        os.link(tmp, path)  # fails if the name exists: never replaces another's file
+    except FileExistsError:
+        raise _problem(path, "already exists (created while this ran); use --force "
+                             "to overwrite it") from None
+    except OSError as exc:
+        if exc.errno not in (errno.EPERM, errno.ENOTSUP, errno.EXDEV):
+            raise
+        _refuse_existing(path, force, want_dir=False)  # no hard links here
+        os.replace(tmp, path)
 
 
 def replace_file(path: Path, write: Callable[[Path], object]) -> None:

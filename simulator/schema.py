@@ -214,8 +214,8 @@ class DateTime(Field):
         if stamp.tzinfo is not None:
             try:
                 stamp = stamp.astimezone(dt.UTC).replace(tzinfo=None)
-            except OverflowError:
-                stamp = dt.datetime.max
+            except OverflowError:  # beyond year 1 or 9999 in UTC: the side its offset pushes
+                stamp = dt.datetime.min if stamp.year == 1 else dt.datetime.max
         if stamp >= LATEST_TIME:
             return ctx.error(path, f"{value!r} is after {LATEST_TIME.isoformat()}Z: a drive "
                                    "starts before then (GPS weeks, leap seconds and the file "

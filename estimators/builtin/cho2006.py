@@ -76,7 +76,17 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   eqs. 33-34 term by term (5 m/s and 0.1 m/s^2 on each velocity axis). Its specific force is
   resolved at the step's mid heading and its position moves with the mean of the old and new
   velocity (``drm1_transition``). Its speed measurement is linearised (and left out below
-  0.5 m/s, where the speed's direction is undefined).
+  0.5 m/s, where the speed's direction is undefined). With the datasheet tuning a fix that
+  reports its velocity's 1-sigma updates DRM1's two velocity states with its north and east
+  velocity instead (``Drm1Ekf._update``): eq. 18's speed left the cross-track velocity to
+  the position alone, which the body's roll and the road's bank push and a street canyon's
+  reflected fixes barely hold (sumo_city_canyon seed 1 north (error / sigma)^2 7.8 -> 1.3,
+  parking_garage seed 3 yaw 7.2 -> 0.74). Its position is then the truth plus the fix's
+  correlated north and east error, two states sized by the receiver's budget at the first
+  fix's HDOP (``toolbox.datasheet.fix_error_model``, as ``dr2d_odo_ekf`` carries them), plus
+  the budget's white part and the reported excess: with the velocity known to the fix's
+  Doppler the inflated white R (``FIX_CORRELATION_S``) averaged the drive-long error away
+  (sumo_city north 8.4 over three seeds, worst 22).
 * Eq. 18 converts GPS latitude and longitude to metres with one Earth radius R_e; we use the
   WGS-84 meridian and transverse radii at the start (``simulator.earth``).
 * No Earth rate (the paper ignores it); the standstill calibration removes its vertical part.
@@ -109,7 +119,9 @@ import numpy as np
 from estimators.base import NAV_COLUMNS, Estimator
 from estimators.builtin.cho2006_tuning import (
     LATERAL_HOLD_S,
+    MIN_SPEED_SIGMA_M_S,
     PAPER_R,
+    ROLL_GRADIENT_SPREAD,
     TUNINGS,
     TURN_HOLD_S,
     Tuning,
@@ -341,10 +353,12 @@ class _ChoDr(Estimator):
         """Q (variance growth per second) over a step with inputs ``u``."""
         return self._tuning.q
 
+    _fix_states = 0  # the fix's correlated error states after the bias states (DRM1)
+
     @property
     def _bias_states(self) -> int:
         """Accelerometer-bias states appended to the paper's eight (datasheet tuning)."""
-        return len(self._tuning.p0) - 8
+        return len(self._tuning.p0) - 8 - (self._fix_states if self._datasheet else 0)
 
     # -- to be provided by the model and filter -------------------------------------------
     def _initial_state(self) -> np.ndarray:
@@ -630,6 +644,29 @@ class _Drm1(_ChoDr):
         return np.array([0.0, 0.0, float(init.velocity[0]), float(init.velocity[1]),
                          float(init.attitude[2]), 0.0, 0.0, 0.0])
 
+    def _inputs(self, u: np.ndarray) -> np.ndarray:
+        """The lateral specific force of a body rolled out of a turn (datasheet tuning on a
+        car): the y accelerometer tilts with the roll phi = -k a_y (``cho2006_tuning``) and
+        senses gravity's share g k a_y beside the lateral acceleration a_y = V w_z, which the
+        level frame of eq. 2 would take for acceleration (8 % of every turn's at 5 deg/g)."""
+        k = self._tuning.roll_gradient
+        if not k:
+            return u
+        x = self._estimate()[0]
+        return np.array([u[0], u[1] - self._g * k * math.hypot(x[2], x[3]) * u[2], u[2]])
+
+    def _q_step(self, u: np.ndarray) -> np.ndarray:
+        """Q with the lateral acceleration error of the roll gradient's spread (``cho2006_
+        tuning.ROLL_GRADIENT_SPREAD``, held over a turn: ``TURN_HOLD_S``)."""
+        if not self._tuning.roll_gradient:
+            return self._tuning.q
+        x = self._estimate()[0]
+        error = self._g * ROLL_GRADIENT_SPREAD * math.hypot(x[2], x[3]) * u[2]
+        q = self._tuning.q.copy()
+        q[2, 2] += error**2 * TURN_HOLD_S
+        q[3, 3] += error**2 * TURN_HOLD_S
+        return q
+
     def _transition(self, x: np.ndarray, w: np.ndarray | None, u: np.ndarray,
                     dt: float) -> np.ndarray:
         return drm1_transition(x, w, u, dt, self._g)
@@ -692,6 +729,58 @@ class Drm1Ekf(_Drm1, _Ekf):
         if np.hypot(x[0, 2], x[0, 3]) < MIN_SPEED_UPDATE_M_S:
             h[2] = 0.0  # no speed row: the EKF leaves it out
         return zhat, h
+
+    _fix_states = 2
+
+    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
+        """The fix's HDOP and reported position 1-sigma kept for ``_update``, and the fix's
+        correlated-error states sized at the first fix by its HDOP (datasheet tuning)."""
+        hdop = float(row[self._fix_cols[5]])
+        self._fix_report = (hdop, self._accuracy.read(row)[0])
+        if self._datasheet and not getattr(self, "_fix_sized", False) and math.isfinite(hdop):
+            k = len(self._x) - 2
+            sigma = self._fix_model.correlated_sigma(hdop, math.nan)[:2]
+            self._p[k:, :] = 0.0
+            self._p[:, k:] = 0.0
+            self._p[k:, k:] = np.diag(sigma**2)
+            self._fix_sized = True
+        super().on_gnss_fix(t, row)
+
+    def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
+                   ) -> tuple[float, float]:
+        """Eq. 18's speed row, and the fix's velocity with its reported 1-sigma kept for
+        ``_update`` (datasheet tuning)."""
+        self._fix_velocity = (vn, ve, float(std_vel[0]), float(std_vel[1]))
+        return super()._fix_speed(vn, ve, x, std_vel)
+
+    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """With the datasheet tuning and a fix that reports its velocity's 1-sigma: the fix's
+        north and east velocity in place of eq. 18's speed, DRM1's two velocity states
+        measured directly (the speed leaves the cross-track velocity to the position alone,
+        whose reflected fixes in a street canyon weigh little, while the drive's roll and
+        grade push it; and it leaves the heading to the acceleration's direction)."""
+        vel = getattr(self, "_fix_velocity", None)
+        self._fix_velocity = None
+        if not (self._datasheet and vel is not None and math.isfinite(vel[2] + vel[3])):
+            return super()._update(z, r)
+        # the position: the truth plus the fix's correlated error (two states) plus white
+        # noise, and the reported excess (reflections) as white noise beside it
+        hdop, std_pos = self._fix_report
+        k = len(self._x) - 2
+        h = np.eye(4, len(self._x))
+        h[0, k], h[1, k + 1] = 1.0, 1.0
+        nu = np.array([z[0], z[1], vel[0], vel[1]]) - self._x[:4]
+        nu[:2] -= self._x[k:]
+        white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
+        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
+        pos = white + excess
+        if self._p[4, 4] >= ALIGNED_HEADING_VAR:  # as ``on_gnss_fix`` weighs them then
+            pos = np.maximum(pos, PAPER_R.diagonal()[:2])
+        rr = np.diag([pos[0], pos[1], max(vel[2], MIN_SPEED_SIGMA_M_S) ** 2,
+                      max(vel[3], MIN_SPEED_SIGMA_M_S) ** 2])
+        self._x, self._p, s = kf_update(self._x, self._p, nu, h, rr)
+        self._x[4] = wrap_angle(self._x[4])
+        return nu, s
 
 
 class Drm2Ekf(_Drm2, _Ekf):

@@ -54,9 +54,16 @@ the paper's printed values, or values derived from what a user knows.
     ``rear_axle``, where the wheels roll without side slip) moves sideways at w_z times that
     distance, the kinematic side slip (5 deg in a 20 m turn); its error (the gyro's noise,
     and the understeer that cancels it near 20 m/s: ``LATERAL_FRACTION`` of it) enters Q;
-  - DRM1's accelerometer biases also take the road's grade and bank as a random walk
-    (``ROAD_SLOPE_SIGMA`` per ``ROAD_SLOPE_HOLD_S``): its level frame (eq. 2) senses g
-    sin(grade) as acceleration;
+  - DRM1's accelerometer biases also take the road's grade and bank, in their prior (the
+    start's road, ``ROAD_SLOPE_SIGMA``: a crowned road's camber alone, 1-2 %, is the size of
+    a MEMS turn-on bias, and a sigma of the bias alone left SUMO canyon's yaw at 11) and as
+    a random walk (``ROAD_SLOPE_SIGMA`` per ``ROAD_SLOPE_HOLD_S``): its level frame (eq. 2)
+    senses g sin(grade) as acceleration. On a car its y accelerometer rolls out of a turn
+    with the body by ``ROLL_GRADIENT`` per lateral acceleration and senses gravity's share,
+    g k V w_z, 8 % of the turn's acceleration at 5 deg/g, which the level frame integrates
+    into cross-track velocity of one sign per turn (0.6 m/s after a 90 deg junction at 5 m/s);
+    DRM1 removes it (``Drm1._inputs``) and takes the gradient's spread
+    (``ROLL_GRADIENT_SPREAD``, Gillespie's 3-7 deg/g) as velocity noise held over a turn;
   - a stop: the odometer's zero reading bounds the speed by the wheel's cut-off
     (``stopped_speed_sigma``), and a zero held for 2 s is a stop.
 
@@ -75,6 +82,7 @@ from typing import Any
 
 import numpy as np
 
+from estimators.toolbox.datasheet import fix_error_model
 from estimators.toolbox.gnss_model import correlated_noise_inflation
 from estimators.toolbox.installation import Installation
 from simulator.earth import G0_M_S2 as G0
@@ -105,6 +113,7 @@ MIN_SPEED_SIGMA_M_S = 0.01
 CAR_ACCEL_SIGMA_M_S2 = 0.05  # planar model's forward-acceleration error on a real body, 1 s
 ROLL_GRADIENT = 5.0 * DEG / G0  # rad per m/s^2: a passenger car's 3-7 deg/g (Gillespie 1992)
 ROLL_SIGMA = 0.75 * DEG  # rad: the roll gradient's spread and the camber's net share
+ROLL_GRADIENT_SPREAD = 2.0 * DEG / G0  # rad per m/s^2: Gillespie's 3-7 deg/g about ROLL_GRADIENT
 ROAD_SLOPE_SIGMA = 0.03  # rad: grade and bank of a road, which DRM1's level frame ignores
 ROAD_SLOPE_HOLD_S = 20.0  # s over which a road keeps its grade
 TURN_HOLD_S = 10.0
@@ -254,18 +263,22 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
     bias_p0, bias_q = [], []
     for a in accel_axes:
         sigma, growth = _bias_terms(accel, a)
-        bias_p0.append(max(sigma, MIN_BIAS_SIGMA) ** 2)
-        road = (G0 * ROAD_SLOPE_SIGMA) ** 2 / ROAD_SLOPE_HOLD_S if model == "drm1" else 0.0
-        bias_q.append(growth + road)
-    roll = model == "drm2" and car
+        road = (G0 * ROAD_SLOPE_SIGMA) ** 2 if model == "drm1" else 0.0
+        bias_p0.append(max(sigma, MIN_BIAS_SIGMA) ** 2 + road)  # the start's grade and bank
+        bias_q.append(growth + road / ROAD_SLOPE_HOLD_S)
     rear = Installation.from_datasheet(datasheet).rear_axle
-    arm = float(-rear[0]) if roll and rear is not None else 0.0
+    arm = float(-rear[0]) if model == "drm2" and car and rear is not None else 0.0
     q[2:4] = np.maximum(q[2:4], MIN_ACCEL_NOISE**2 if model == "drm1" else
                         [MIN_ACCEL_NOISE**2, MIN_GYRO_NOISE**2])
     q[4] = max(q[4], MIN_GYRO_NOISE**2)
     lateral_noise = arm * _axis(gyro.get("noise_density"), 2) * math.sqrt(DR_RATE_HZ)
+    if model == "drm1":  # the fix's correlated north and east error (sized again at a fix)
+        fix = fix_error_model(datasheet)
+        sigma = fix.correlated_sigma(1.0, 2.0)[:2]
+        bias_p0 += list(sigma**2)
+        bias_q += list(2.0 * sigma**2 / fix.correlated_tau)
     return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate,
-                  ROLL_GRADIENT if roll else 0.0, ROLL_SIGMA if roll else 0.0, arm, lateral_noise)
+                  ROLL_GRADIENT if car else 0.0, ROLL_SIGMA if car else 0.0, arm, lateral_noise)
 
 
 def stopped_speed_sigma(datasheet: Mapping[str, Any]) -> float:

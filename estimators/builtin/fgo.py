@@ -58,17 +58,28 @@ carry them as states (``tc_ekf``; Brown & Hwang, 4th ed., the augmented state of
 measurement noise), each a first-order Gauss-Markov process of ``RANGE_ERROR_TAU_S``:
 
 * the broadcast ionosphere's relative residual common to the satellites, one variable with
-  each satellite's broadcast delay I as its coefficient, 1-sigma sqrt((scale - 1)^2
-  + (1 - s^2) (scale residual)^2) from the receiver datasheet's ``iono_scale`` and
-  ``iono_residual`` (``simulator.datasheet.iono_residual_fractions``; s =
-  ``IONO_FIELD_OWN_SHARE``, the field's share that differs between satellites);
-* one per satellite: the signal-in-space error, the field's own share s (scale residual) I
-  and the troposphere's zenith residual over sin(elevation), in quadrature;
+  each satellite's broadcast delay I as its coefficient, 1-sigma |scale - 1| from the receiver
+  datasheet's ``iono_scale`` (``simulator.datasheet.iono_residual_fractions``);
+* the residual's smooth field over the sky (1-sigma f = scale ``iono_residual``): three
+  variables shared by the satellites, the field's value and its north and east gradient at
+  the receiver's zenith pierce point, with coefficients I rho (1, x_n / L, x_e / L) from each
+  satellite's pierce-point offset x (``toolbox.iono_field``). A gradient across the sky is a
+  range error growing with the direction to the satellite, which the position takes in
+  whole; with the field taken as common plus an independent share per satellite
+  (``IONO_FIELD_OWN_SHARE``), quickstart seed 2's east had (error / sigma)^2 15.4: a
+  drive-long 2.2 m against a sigma of 0.5-0.7 m, the gradient's 2.3 m of east in the
+  least-squares position (the simulated residual of each satellite, ``truth_gnss``);
+* one per satellite: the signal-in-space error, the field's remainder f I sqrt(1 - rho^2
+  (1 + |x|^2 / L^2)) and the troposphere's zenith residual over sin(elevation), in
+  quadrature;
 * the rest of the reported variance (code noise and multipath after the Hatch filter) white,
   inflated by the correlated-noise factor of the carrier-smoothing time
   (``gnss_model.correlated_noise_inflation``: the white noise of the same low-frequency
-  spectrum), with the reflected-signal share its C/N0 deficit announces (p (20 m)^2,
-  ``gnss_model.nlos_sigma``, as ``gnss_wls``).
+  spectrum); and the reflected-signal (NLOS) delay its C/N0 deficit announces, its expected
+  value p mu taken off the pseudorange and its variance p (mu^2 + s^2) - (p mu)^2 added
+  (``gnss_model.nlos_delay``, the model of the receiver's own fix accuracy; an extra path
+  is never negative, and as a zero-mean p (20 m)^2 the unseen canyon's reflections sank
+  the height: seed 2 height (error / sigma)^2 5.4 -> 3.8).
 
 A range-error variable stands for ``RANGE_ERROR_STEP_S`` (its timestamp refreshed at each
 use, so that the fixed-lag window keeps it), then a new one follows, linked by the process's
@@ -83,7 +94,7 @@ FgoLooselyCoupled, FgoTightlyCoupled.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -93,17 +104,17 @@ from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S, FixAccuracy, fix_error_model
 from estimators.toolbox.gnss_model import (
-    NLOS_SIGMA_M,
     clock_noise,
     correlated_noise_inflation,
-    nlos_sigma,
+    nlos_delay,
     predict,
     raw_epoch,
     select,
     single_frequency,
 )
 from estimators.toolbox.installation import Installation
-from simulator.datasheet import IONO_FIELD_OWN_SHARE, cn0_template, iono_residual_fractions
+from estimators.toolbox.iono_field import SHARED_TERMS, residual_terms
+from simulator.datasheet import cn0_template, iono_residual_fractions
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -579,12 +590,14 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
                 self._keyframe(t, None)
             return
         ep = select(ep, ok)
-        iono, bias, white = self._budget.sigmas(ep)
+        shared, bias, white = self._budget.sigmas(ep)
         if self._template is not None and np.isfinite(ep.cn0).all():
-            white = nlos_sigma(white, ep.cn0, ep.elevation, self._template, NLOS_SIGMA_M)
+            mean, variance = nlos_delay(ep.cn0, ep.elevation, self._template)
+            ep = replace(ep, pseudorange=ep.pseudorange - mean)
+            white = np.sqrt(white**2 + variance)
         sigma_rate = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, 0.1)
         sats = codes[ok] * 1000 + ep.sv
-        self._keyframe(t, (ep, sats, iono, bias, white, np.maximum(sigma_rate, 0.02)))
+        self._keyframe(t, (ep, sats, shared, bias, white, np.maximum(sigma_rate, 0.02)))
 
     def _chain(self, graph, values, stamps: dict, current, name: object, t: float,
                sigma: float) -> int:
@@ -617,7 +630,7 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
     def _gnss_factors(self, graph, values, stamps: dict, k: int, t: float,
                       epoch: tuple) -> None:
         gtsam = self._g
-        ep, sats, iono, bias, white, sigma_rate = epoch
+        ep, sats, shared, bias, white, sigma_rate = epoch
         c_key = self._c(k)
         current = self._smoother.calculateEstimate()
         if self._c_key is None:
@@ -647,10 +660,11 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
                 values.insert(c_key, phi @ self._c_last)
         keys = [self._x(k), self._v(k), c_key]
         gains = []  # per error variable: its coefficient on each pseudorange
-        if self._budget.iono_relative > 0.0:
-            keys.append(self._chain(graph, values, stamps, current, "iono", t,
-                                    self._budget.iono_relative))
-            gains.append(iono)
+        for name, used, gain in zip(SHARED_TERMS, self._budget.shared_in_use(), shared,
+                                    strict=True):
+            if used:
+                keys.append(self._chain(graph, values, stamps, current, name, t, 1.0))
+                gains.append(gain)
         for i, (sat, sigma) in enumerate(zip(sats, bias, strict=True)):
             if sigma > 0.0:
                 keys.append(self._chain(graph, values, stamps, current, float(sat), t,
@@ -679,46 +693,54 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
 @dataclass(frozen=True)
 class _RangeBudget:
     """A pseudorange's error split by time behaviour, from the receiver's datasheet
-    (``simulator.datasheet``; docs/gnss-errors.md): ``iono_relative`` the 1-sigma of the
+    (``simulator.datasheet``; docs/gnss-errors.md): ``iono_common`` the 1-sigma of the
     broadcast ionosphere's relative residual common to the epoch's satellites (times each
-    satellite's broadcast delay I), ``iono_own`` that of each satellite's own share, ``sis``
-    the signal-in-space error, ``tropo_zenith`` the troposphere's zenith residual, and
-    ``inflation`` the factor on the rest (code noise and multipath after the Hatch filter,
-    correlated over its time: ``gnss_model.correlated_noise_inflation``)."""
+    satellite's broadcast delay I), ``iono_field`` that of its smooth field over the sky
+    (``toolbox.iono_field``: its value and gradient at the receiver's zenith pierce point are
+    shared, the rest each satellite's own), ``sis`` the signal-in-space error, ``tropo_zenith``
+    the troposphere's zenith residual, and ``inflation`` the factor on the rest (code noise
+    and multipath after the Hatch filter, correlated over its time:
+    ``gnss_model.correlated_noise_inflation``)."""
 
-    iono_relative: float
-    iono_own: float
+    iono_common: float
+    iono_field: float
     sis: float
     tropo_zenith: float
     inflation: float
 
     def sigmas(self, ep) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per satellite of a ``RawEpoch``: the common ionosphere variable's coefficient I
-        (m per unit relative residual), the 1-sigma of its own drive-long error
-        sqrt(sis^2 + (own I)^2 + (tropo / sin(el))^2), and the white 1-sigma of the rest:
-        the reported variance less those (at least ``PSEUDORANGE_FLOOR_M``), inflated; without
-        a reported 1-sigma ``DEFAULT_UERE_M``."""
+        """Per satellite of a ``RawEpoch``: the coefficients (4, m), m, of the ionosphere's
+        shared unit-variance quantities on its pseudorange (``iono_field.residual_terms``:
+        the common residual, the field's value and its north and east gradient); the 1-sigma
+        of its own drive-long error sqrt(sis^2 + its share of the field + (tropo /
+        sin(el))^2); and the white 1-sigma of the rest: the reported variance less those (at
+        least ``PSEUDORANGE_FLOOR_M``), inflated; without a reported 1-sigma
+        ``DEFAULT_UERE_M``."""
         delay = np.nan_to_num(ep.iono) if ep.iono is not None else np.zeros(len(ep.sv))
         el = ep.elevation if ep.elevation is not None else np.full(len(ep.sv), np.nan)
         mapping = 1.0 / np.sin(np.clip(np.nan_to_num(el, nan=math.pi / 6), 0.05, None))
-        bias2 = (self.sis**2 + (self.iono_own * delay) ** 2
-                 + (self.tropo_zenith * mapping) ** 2)
+        shared, own_iono = residual_terms(delay, ep.elevation, ep.azimuth, self.iono_common,
+                                          self.iono_field)
+        bias2 = self.sis**2 + own_iono + (self.tropo_zenith * mapping) ** 2
         reported = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
                             DEFAULT_UERE_M)
-        rest2 = reported**2 - bias2 - (self.iono_relative * delay) ** 2
+        rest2 = reported**2 - bias2 - np.sum(shared**2, axis=0)
         white = np.sqrt(np.maximum(rest2, PSEUDORANGE_FLOOR_M**2)) * self.inflation
-        return delay, np.sqrt(bias2), white
+        return shared, np.sqrt(bias2), white
+
+    def shared_in_use(self) -> np.ndarray:
+        """Which of the ``SHARED_TERMS`` this receiver's ionosphere has (the common residual
+        with iono_scale other than 1, the field's three with a residual)."""
+        return np.array([self.iono_common > 0.0] + [self.iono_field > 0.0] * 3)
 
 
 def _range_budget(gnss: dict) -> _RangeBudget:
     """``_RangeBudget`` of a receiver datasheet block (zeros where it is silent: the reported
-    1-sigma white): the ionosphere field's ``IONO_FIELD_OWN_SHARE`` of each satellite's own,
-    the rest of it common with the part (``iono_scale`` - 1) the broadcast model misses."""
+    1-sigma white)."""
     common, field = iono_residual_fractions(gnss)
     interval = 1.0 / float(gnss.get("rate") or 1.0)
     return _RangeBudget(
-        iono_relative=math.hypot(common, math.sqrt(1.0 - IONO_FIELD_OWN_SHARE**2) * field),
-        iono_own=IONO_FIELD_OWN_SHARE * field, sis=float(gnss.get("sis_error") or 0.0),
+        iono_common=common, iono_field=field, sis=float(gnss.get("sis_error") or 0.0),
         tropo_zenith=float(gnss.get("tropo_residual") or 0.0),
         inflation=correlated_noise_inflation(float(gnss.get("carrier_smoothing") or 0.0),
                                              interval))

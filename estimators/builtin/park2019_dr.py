@@ -91,7 +91,13 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   below x with k a random-constant state, prior ``NonholonomicNoise.pitch_compliance``), in
   the position, the course (the tyres' slip and the fix's velocity noise its variance; the
   fix's velocity noise the speed's) and the g-slave (the specific force loses d v/dt + w x v
-  of that velocity, the odometer's acceleration over 0.5 s); what it leaves out (the tyres'
+  of that velocity, the odometer's acceleration over 0.5 s, the IMU's sideways L dw_z/dt from
+  the gyro over one step; the tilt is taken from the specific force and the attitude averaged
+  over the odometer acceleration's 0.5 s, the window that acceleration is the mean of: the
+  step's own specific force against it lagged the acceleration by 0.25 s, which the jerk of
+  SUMO's junctions turned into a roll and pitch error of one sign, and through the turns the
+  accelerometers' tilt states took it for their bias, sumo_city_canyon seed 1 roll (error /
+  sigma)^2 7.0 -> 0.58); what it leaves out (the tyres'
   slip, the suspension's travel: ``NonholonomicNoise``) is velocity noise correlated over
   1 s; the g-slave's variance adds the odometer acceleration's noise (two speeds of the
   datasheet's noise 0.5 s apart) and the tyres' slip turned by the yaw rate; the gyro scale
@@ -324,7 +330,6 @@ class _OdometerDeadReckoning(Estimator):
     def _take_inputs(self) -> None:
         self._u = 0.0  # latest odometer reading, m/s
         self._u_history: list[tuple[float, float]] = []
-        self._w_history: list[tuple[float, float]] = []  # (t, yaw rate) of the last steps
         self._accel = 0.0  # along-track acceleration from the odometer, m/s^2
         self._imu = _StepAccumulator(self.columns["imu"], self.imu_output == "increment",
                                      self.initial.t)
@@ -492,6 +497,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
         # the odometer's acceleration: two speeds ACCEL_WINDOW_S apart
         self._accel_sigma = (math.sqrt(2.0) * odometer_speed_sigma(self.datasheet, 1.0)
                              / ACCEL_WINDOW_S)
+        # the g-slave's steps over the odometer acceleration's window: (dt, specific force
+        # less the car's acceleration but the along-track one, nominal roll, pitch)
+        self._window: list[tuple[float, np.ndarray, float, float]] = []
         self._rate_prev = np.zeros(3)
         p[SQUAT, SQUAT] = self._car.pitch_compliance**2 if site.rear_axle is not None else 0.0
         p[NLOS, NLOS] = np.eye(3)  # unit states (their gain is the fix's excess)
@@ -609,8 +617,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
         f_b = np.array(acc.dvel) / dt
         acc.reset()
         rate = dtheta / dt
-        if self._sheet:
-            self._track_yaw_accel(acc.t, float(rate[2]))
+        self._step_dt = dt
+        if self._sheet:  # the yaw rate's change over the step (the gyro's noise is small)
+            self._yaw_accel = (rate[2] - self._rate_prev[2]) / dt
             v_body = self._body_velocity(rate)
         else:
             v_body = np.array([self._s * self._u, 0.0, 0.0])
@@ -628,16 +637,6 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._kf.predict(self._eye + self._f * dt, q_d)
         if self._imu.has_accel:
             self._step_one(f_b, rate)
-
-    def _track_yaw_accel(self, t: float, yaw_rate: float) -> None:
-        """The yaw rate's change per second over the last ACCEL_WINDOW_S (the window of the
-        odometer's acceleration), for the IMU's sideways acceleration ahead of the rear axle."""
-        hist = self._w_history
-        hist.append((t, yaw_rate))
-        while len(hist) > 2 and t - hist[1][0] >= ACCEL_WINDOW_S:
-            hist.pop(0)
-        t0, w0 = hist[0]
-        self._yaw_accel = (yaw_rate - w0) / (t - t0) if t - t0 > 0 else 0.0
 
     def _body_velocity(self, rate: np.ndarray) -> np.ndarray:
         """The IMU's body-frame velocity on the car (``car_body_velocity``)."""
@@ -681,16 +680,21 @@ class Dr3dEkf(_OdometerDeadReckoning):
         if self._sheet:  # a = d v_b/dt + w x v_b of the IMU's velocity on the car
             v = self._v_body
             moving = 1.0 if self._u != 0.0 else 0.0
-            f_b = f_b - np.array([self._s * self._accel + rate[1] * v[2] - rate[2] * v[1],
+            f_b = f_b - np.array([rate[1] * v[2] - rate[2] * v[1],
                                   moving * self._rear_lever * self._yaw_accel + rate[2] * v[0]
                                   - rate[0] * v[2],
                                   rate[0] * v[1] - rate[1] * v[0]])
+            f_tilt, roll, pitch = self._window_mean(f_b, roll, pitch)
+            f_tilt[0] -= self._s * self._accel
+            f_b = f_b - np.array([self._s * self._accel, 0.0, 0.0])
             roll, pitch = roll + self._tilt_bias[0], pitch + self._tilt_bias[1]
             h[:, TILT] = np.eye(2)
-        roll_acc = math.atan2(-f_b[1], -f_b[2])
-        pitch_acc = math.atan2(f_b[0], math.hypot(f_b[1], f_b[2]))
+        else:
+            f_tilt = f_b
+        roll_acc = math.atan2(-f_tilt[1], -f_tilt[2])
+        pitch_acc = math.atan2(f_tilt[0], math.hypot(f_tilt[1], f_tilt[2]))
         dz = [math.remainder(roll - roll_acc, 2.0 * math.pi), pitch - pitch_acc]
-        norm = math.sqrt(f_b @ f_b)
+        norm = math.sqrt(f_b @ f_b)  # rule 1 on the step's own specific force
         if self._u == 0.0:
             self._still_norm_sum += norm
             self._still_steps += 1
@@ -721,6 +725,23 @@ class Dr3dEkf(_OdometerDeadReckoning):
         self._kf.update(np.concatenate(dzs), np.vstack(rows), np.diag(variances))
         self._feedback()
 
+    def _window_mean(self, f_b: np.ndarray, roll: float, pitch: float
+                     ) -> tuple[np.ndarray, float, float]:
+        """The step's specific force (less the car's acceleration but the along-track one),
+        roll and pitch averaged over the steps of the odometer acceleration's window, whose
+        mean that acceleration is: the window's mean specific force is compared with the
+        window's mean acceleration, and the tilt it gives with the window's mean attitude
+        (the step's alone against the window's acceleration lagged it by ACCEL_WINDOW_S / 2,
+        which a junction's jerk turned into degrees of tilt)."""
+        win = self._window
+        win.append((self._step_dt, f_b, roll, pitch))
+        span = sum(w[0] for w in win)
+        while span - win[0][0] >= ACCEL_WINDOW_S - 1e-9:
+            span -= win.pop(0)[0]
+        f_mean = sum(w[0] * w[1] for w in win) / span
+        return (f_mean, sum(w[0] * w[2] for w in win) / span,
+                sum(w[0] * w[3] for w in win) / span)
+
     def _tilt_model_variance(self, rate: np.ndarray) -> float:
         """What the car's acceleration removed from the g-slave leaves (``tuning:
         datasheet``), as the white-equivalent variance at the step's rate of errors
@@ -748,14 +769,24 @@ class Dr3dEkf(_OdometerDeadReckoning):
         pos[1] -= dx[1] / ((re + pos[2]) * math.cos(pos[0]))
         pos[2] += dx[2]
         self._s -= dx[3]
+        tilt = self._cbn[2, 0], self._cbn[2, 1], self._cbn[2, 2]
         self._q, self._cbn = attitude_step(self._q, dx[4:7], self._zero3)
         self._bias -= dx[7:10]
         if self._sheet:
+            self._shift_window(*tilt)
             self._tilt_bias -= dx[TILT]
             self._baro_bias -= dx[BARO]
             self._fix_error -= dx[FIX]
             self._squat -= dx[SQUAT]
             self._nlos -= dx[NLOS]
+
+    def _shift_window(self, c20: float, c21: float, c22: float) -> None:
+        """A correction's roll and pitch change (from the attitude's last row before it) added
+        to the window's stored attitudes (``_window_mean``), which were the same estimate's."""
+        c = self._cbn
+        d_roll = (math.atan2(c[2, 1], c[2, 2]) - math.atan2(c21, c22))
+        d_pitch = math.asin(c20) - math.asin(c[2, 0])
+        self._window = [(dt, f, r + d_roll, p + d_pitch) for dt, f, r, p in self._window]
 
     def solution(self, t: float) -> list[float]:
         p = self._kf.p

@@ -39,7 +39,8 @@ The constants (speed of light, the GPS Earth rotation rate) are imported from th
 Public names
 ------------
 RawEpoch, single_frequency, raw_epoch, select, predict, los_jacobians, antenna_offset,
-clock_transition, clock_noise, correlated_noise_inflation, nlos_sigma, NLOS_SIGMA_M, TCXO_H0,
+clock_transition, clock_noise, correlated_noise_inflation, nlos_sigma, nlos_delay, NLOS_SIGMA_M,
+TCXO_H0,
 TCXO_H_MINUS2.
 """
 
@@ -50,7 +51,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from simulator.datasheet import Cn0Template, nlos_probability
+from simulator.datasheet import Cn0Template, nlos_delay_moments, nlos_probability
 from simulator.gnss.constants import C_M_S, OMEGA_E_DOT_RAD_S
 
 SAGNAC_ITERATIONS = 2  # flight-time iterations: the second changes the range by < 1e-6 m
@@ -69,8 +70,8 @@ class RawEpoch:
     (frame of transmission), m and m/s; pseudorange : corrected pseudorange rho_c, m;
     range_rate : corrected pseudorange rate rho_dot_c, m/s; pseudorange_std, range_rate_std : the
     receiver's reported 1-sigma (NaN when the stream has none); iono : the broadcast
-    ionosphere delay removed from the pseudorange, m; elevation : rad; cn0 : dB-Hz (each NaN
-    when the stream lacks the column).
+    ionosphere delay removed from the pseudorange, m; elevation : rad; cn0 : dB-Hz; azimuth :
+    rad, from north through east (each NaN when the stream lacks the column).
     """
 
     sv: np.ndarray
@@ -83,6 +84,7 @@ class RawEpoch:
     iono: np.ndarray | None = None
     elevation: np.ndarray | None = None
     cn0: np.ndarray | None = None
+    azimuth: np.ndarray | None = None
 
 
 L1_BAND_HZ = (1559e6, 1592e6)  # the L1/E1/B1 band (B1I 1561.098, L1/E1 1575.42 MHz)
@@ -118,7 +120,8 @@ def raw_epoch(block: np.ndarray, columns: Mapping[str, int]) -> RawEpoch:
         range_rate=c("pseudorange_rate") + c("sat_clock_drift"),
         pseudorange_std=optional("pseudorange_std"),
         range_rate_std=optional("pseudorange_rate_std"),
-        iono=optional("iono"), elevation=optional("elevation"), cn0=optional("cn0"))
+        iono=optional("iono"), elevation=optional("elevation"), cn0=optional("cn0"),
+        azimuth=optional("azimuth"))
 
 
 def select(epoch: RawEpoch, keep: np.ndarray) -> RawEpoch:
@@ -254,3 +257,17 @@ def nlos_sigma(sigma: np.ndarray, cn0: np.ndarray, elevation: np.ndarray,
     path's spread, 20 m there)."""
     p = nlos_probability(template.expected_dbhz(elevation) - cn0, template.scatter_db)
     return np.sqrt(sigma**2 + p * nlos_sigma_m**2)
+
+
+def nlos_delay(cn0: np.ndarray, elevation: np.ndarray, template: Cn0Template
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """Each pseudorange's expected reflected-signal (NLOS) delay and its variance (m, m^2), from
+    the probability p that its C/N0 deficit below the template at its elevation announces
+    (``nlos_probability``) and the receiver's model of a reflection's extra path
+    (``simulator.datasheet.nlos_delay_moments``, the model of the receiver's own fix
+    accuracy): p mu and p (mu^2 + s^2) - (p mu)^2. A signal without C/N0 (NaN) is taken as
+    direct."""
+    deficit = template.expected_dbhz(elevation) - np.where(np.isfinite(cn0), cn0, np.inf)
+    p = nlos_probability(deficit, template.scatter_db)
+    mean, mean_square = nlos_delay_moments(p)
+    return mean, mean_square - mean**2

@@ -93,6 +93,30 @@ def _anees_lines(summary: dict) -> list[str]:
                              "missing", "verdict"], rows)]
 
 
+def _paired_lines(summary: dict) -> list[str]:
+    """One row per pair of labels, sweep point and score compared seed by seed."""
+    keys = list(summary["sweep"])
+    rows = []
+    for c in summary.get("paired") or []:
+        if not c["seeds"]:
+            continue
+        low, high = c["interval"]
+        rows.append([c["a"], c["b"], *(str(c["sweep"][k]) for k in keys), c["score"],
+                     format_number(c["median_difference"]),
+                     f"{format_number(low)} to {format_number(high)}",
+                     f"{c['a_smaller']} of {c['seeds']}",
+                     "-" if c["sign_test_p"] is None else f"{c['sign_test_p']:.2g}",
+                     str(c["missing"])])
+    if not rows:
+        return ["Fewer than two estimators with a common score: nothing to compare."]
+    return ["Each pair of estimators on the same seeds: the median over the seeds of the "
+            "difference a - b (metres; negative: a's error is smaller), its 95 % bootstrap "
+            "interval, on how many seeds a's is smaller, and the two-sided sign test's "
+            "p-value; `missing` counts the seeds where one of the two lacks the score.", "",
+            *markdown_table(["a", "b", *keys, "score", "median a - b", "95 % interval",
+                             "a smaller", "sign test p", "missing"], rows)]
+
+
 def _failure_lines(runs: pd.DataFrame, keys: list[str]) -> list[str]:
     failed = runs[runs["status"] == STATUS_FAILED]
     if failed.empty:
@@ -170,7 +194,8 @@ def write_campaign_report(directory: Path, runs: pd.DataFrame, summary: dict) ->
              "window's end; `(k missing)` counts the runs without the score, which the "
              "statistics cannot include. A solution without GNSS has no outage scores.", "",
              *_summary_lines(summary), "", "## Consistency over the runs (ANEES)", "",
-             *_anees_lines(summary), "", "## Failed runs", "", *_failure_lines(runs, keys), ""]
+             *_anees_lines(summary), "", "## Paired comparison", "", *_paired_lines(summary),
+             "", "## Failed runs", "", *_failure_lines(runs, keys), ""]
     for column, title, name in _PLOTTED:
         if _has(summary, column):
             _box_plot(runs, summary, column, title, directory / PLOTS / f"{name}.png")

@@ -30,7 +30,13 @@ from simulator.campaign.plan import PLAN_FORMAT
 from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, score_unit
 from simulator.dataset.parquet import read_table, write_table
 from simulator.errors import InputError, Problem
-from simulator.outputs import make_parent, open_lock_file, real_subfolder, replace_file
+from simulator.outputs import (
+    make_parent,
+    open_lock_file,
+    os_problem,
+    real_subfolder,
+    replace_file,
+)
 
 CAMPAIGN_FILE = "campaign.json"
 PARTS = "parts"  # sub-folder with one Parquet file per finished run
@@ -87,8 +93,11 @@ def campaign_lock(out: Path) -> Iterator[None]:
             break
         os.close(fd)  # the holder removed it between our open and our lock: take the new one
     try:
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        try:
+            os.ftruncate(fd, 0)
+            os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        except OSError as exc:  # a full disk: the lock's few bytes cannot be written
+            raise os_problem(out, exc) from None
         yield
     finally:
         path.unlink(missing_ok=True)

@@ -5,7 +5,8 @@ the runs that succeeded and have it, how many of the runs scored on its group la
 no score of the group, such as the outages of a solution without GNSS, is not scored on it),
 how many runs there were and how
 many failed, and the average NEES over the runs of each consistency block with its chi-square
-95 % band (``anees``, ``simulator.scoring.consistency.anees``).
+95 % band (``anees``, ``simulator.scoring.consistency.anees``), and every pair of labels
+compared seed by seed (``paired``, ``simulator.campaign.paired``).
 
 Public names
 ------------
@@ -19,6 +20,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from simulator.campaign.paired import paired_comparisons
 from simulator.campaign.worker import RUN_COLUMNS, STATUS_FAILED, STATUS_OK
 from simulator.scoring.consistency import AXIS_BLOCKS, BLOCKS, PLANAR_BLOCKS, anees
 
@@ -86,7 +88,8 @@ def summarise(runs: pd.DataFrame, labels: list[str], points: list[dict[str, Any]
     (the swept values), ``runs``, ``ok``, ``failed``, ``scores`` {column: {mean, median, p95,
     count, missing}} (the statistics None where no run has the score; ``missing`` the runs that
     succeeded and have another score of its group but not this one) and ``anees`` {block:
-    {anees, expected, lower, upper, runs, missing}} for each consistency block some run has.
+    {anees, expected, lower, upper, runs, missing}} for each consistency block some run has;
+    and ``paired``, the pairs of labels compared seed by seed (``paired_comparisons``).
     """
     keys = list(points[0]) if points else []
     scores = score_columns(runs, keys)
@@ -106,4 +109,6 @@ def summarise(runs: pd.DataFrame, labels: list[str], points: list[dict[str, Any]
                            for c in scores},
                 "anees": _anees(ok),
             })
-    return {"format": SUMMARY_FORMAT, **header, "groups": groups}
+    plain = [{k: _plain(v) for k, v in point.items()} for point in points]
+    return {"format": SUMMARY_FORMAT, **header, "groups": groups,
+            "paired": paired_comparisons(runs, labels, plain)}

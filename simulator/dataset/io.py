@@ -180,7 +180,7 @@ def stream_problem(name: str, frame: pd.DataFrame, columns: list[str] | None = N
     """What is wrong with a stream table read from a dataset, or None: a required column
     missing, a column that should be numeric and is not, times that are not finite or run
     backwards, an IMU or truth without samples, an IMU sample with no value or beyond any
-    IMU's range."""
+    IMU's range, a truth position missing or where none can be."""
     from pandas.api.types import is_numeric_dtype
 
     wanted = col.REQUIRED.get(name, ())
@@ -209,6 +209,8 @@ def stream_problem(name: str, frame: pd.DataFrame, columns: list[str] | None = N
             return f"row {_first(reversed_rows)} ends before it starts"
     if name in ("imu", "truth") and columns is None and len(frame) == 0:
         return "no samples"
+    if name == "truth":
+        return _position_problem(frame)
     if name == "imu":
         axes = frame[[a for a in col.IMU_AXES if a in frame]].to_numpy(dtype=float)
         bad = ~np.isfinite(axes).all(axis=1)
@@ -234,6 +236,21 @@ def _imu_range_problem(frame: pd.DataFrame) -> str | None:
             i = int(values.argmax())
             return (f"{axis} = {frame[axis].iloc[i]:.6g} at row {i} is beyond any IMU's range "
                     f"(|{axis}| <= {limit:g} in SI units)")
+    return None
+
+
+def _position_problem(frame: pd.DataFrame) -> str | None:
+    """A truth position that is missing or lies where no position can (``POSITION_SPANS``)."""
+    for name, (low, high) in col.POSITION_SPANS.items():
+        if name not in frame:
+            continue
+        values = frame[name].to_numpy(dtype=float)
+        bad = ~((values >= low) & (values <= high))
+        if bad.any():
+            i = _first(bad)
+            when = f" (t = {frame['t'].iloc[i]:.6f} s)" if "t" in frame else ""
+            return (f"{name} = {values[i]:.6g} at row {i}{when} is "
+                    f"no position (outside [{low:g}, {high:g}] in degrees and metres)")
     return None
 
 

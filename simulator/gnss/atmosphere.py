@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from simulator.datasheet import pierce_angle_sc
 from simulator.gnss.constants import C_M_S
 
 SECONDS_PER_DAY = 86400.0
@@ -34,8 +35,7 @@ def klobuchar_pierce_point(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad
     (E the elevation in semicircles; the model's approximation of a thin shell 350 km up)
     along the azimuth, the latitude clipped to +-0.416. Arguments in rad, broadcast together."""
     az = np.asarray(azimuth_rad, dtype=float)
-    el_sc = np.asarray(elevation_rad, dtype=float) / np.pi  # semicircles
-    psi = 0.0137 / (el_sc + 0.11) - 0.022  # Earth-centred angle to the pierce point
+    psi = pierce_angle_sc(elevation_rad)  # Earth-centred angle to the pierce point
     phi_i = np.clip(np.asarray(lat_rad, dtype=float) / np.pi + psi * np.cos(az), -0.416, 0.416)
     lam_i = np.asarray(lon_rad, dtype=float) / np.pi + psi * np.sin(az) / np.cos(phi_i * np.pi)
     return phi_i, lam_i
@@ -69,7 +69,10 @@ def klobuchar_delay(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.nd
     phi_m = phi_i + 0.064 * np.cos((lam_i - 1.617) * np.pi)  # geomagnetic latitude
     t = np.mod(4.32e4 * lam_i + np.asarray(gps_tow_s, dtype=float), SECONDS_PER_DAY)  # local time
     slant = klobuchar_obliquity(elevation_rad)
-    powers = phi_m[..., None] ** np.arange(4)
+    # phi_m^0..3; the powers 0 and 1 are exact, so only 2 and 3 go through pow
+    powers = np.empty(np.shape(phi_m) + (4,))
+    powers[..., 0], powers[..., 1] = 1.0, phi_m
+    powers[..., 2:] = phi_m[..., None] ** np.arange(2, 4)
     amp = np.maximum(powers @ np.asarray(alpha, dtype=float), 0.0)
     per = np.maximum(powers @ np.asarray(beta, dtype=float), 72000.0)
     x = 2.0 * np.pi * (t - 50400.0) / per

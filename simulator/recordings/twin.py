@@ -25,7 +25,7 @@ import yaml
 
 from simulator.dataset.io import Dataset
 from simulator.errors import InputError, Problem
-from simulator.outputs import atomic_output_file
+from simulator.outputs import atomic_output_file, os_problem
 
 SENSOR_STREAMS = {"imu": "imu", "odometer": "odometer", "gnss": "gnss_fix", "baro": "baro",
                   "mag": "mag"}
@@ -85,10 +85,13 @@ def write_twin(dataset: Dataset, scenario_path: str | Path, force: bool = False)
     text = (f"# The twin of {dataset.path}: the simulator driven along its reference\n"
             f"# trajectory ({log.name}) with the sensors of its datasheet.\n"
             + yaml.safe_dump(data, sort_keys=False))
-    with tempfile.TemporaryDirectory() as check:  # validated before anything is written
-        drive.to_parquet(Path(check) / log.name, index=False)
-        (Path(check) / out.name).write_text(text, encoding="utf-8")
-        load_scenario(Path(check) / out.name)
+    try:
+        with tempfile.TemporaryDirectory() as check:  # validated before anything is written
+            drive.to_parquet(Path(check) / log.name, index=False)
+            (Path(check) / out.name).write_text(text, encoding="utf-8")
+            load_scenario(Path(check) / out.name)
+    except OSError as exc:  # the temporary folder is full or read-only
+        raise os_problem(tempfile.gettempdir(), exc) from None
     with (atomic_output_file(log, force, [dataset.path], "twin-drive") as log_tmp,
           atomic_output_file(out, force, [dataset.path], "twin-scenario") as out_tmp):
         drive.to_parquet(log_tmp, index=False)

@@ -64,8 +64,6 @@ MAX_SOLUTION_BYTES = 2 * 1024**3
 _CHUNK_ROWS = 200_000
 _MAX_HEADER_CHARS = 65_536  # an RTKLIB header line longer than this is no header
 MIN_EARTH_RADIUS_M = 6.3e6  # an ECEF position nearer the Earth's centre is no position
-# a height outside this span (m, ellipsoidal) is no land vehicle's: a unit or a format mistake
-HEIGHT_SPAN_M = (-1e5, 1e5)
 _UNITS = {**col.SOLUTION, **col.SOLUTION_STD, **col.SENSOR_ERRORS}
 # the columns a solution file is read for (any other column is left unread)
 _READ = {**_UNITS, **col.SOLUTION_NIS, **col.SOLUTION_FIX}
@@ -481,9 +479,9 @@ def _refuse_text(path: Path, frame: pd.DataFrame, where: _Rows,
 def _refuse_out_of_range(path: Path, frame: pd.DataFrame, where: _Rows) -> None:
     """Refuse an infinite value in any column, and a latitude, longitude (deg) or height (m)
     that no position has, naming the first such row and its column (NaN is a missing value)."""
-    spans = {"lat": (-90.0, 90.0, "a latitude in degrees"),
-             "lon": (-180.0, 360.0, "a longitude in degrees"),
-             "alt": (*HEIGHT_SPAN_M, "a land vehicle's ellipsoidal height in metres")}
+    what = {"lat": "a latitude in degrees", "lon": "a longitude in degrees",
+            "alt": "a land vehicle's ellipsoidal height in metres"}
+    spans = {k: (*span, what[k]) for k, span in col.POSITION_SPANS.items()}
     for name in frame.columns:
         values = frame[name].to_numpy(float)
         low, high, what = spans.get(name, (-np.inf, np.inf, ""))

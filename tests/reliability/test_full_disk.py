@@ -4,9 +4,10 @@ left (no ``.NAME.tmp``, no half-written file), the inputs unchanged, the tempora
 The full disk is stood in for by the file-size limit (``RLIMIT_FSIZE``, set with
 ``resource.setrlimit`` in the command's own process, ``SIGXFSZ`` ignored): a write that would
 pass it fails with ``OSError`` (``EFBIG``) at the write call, as one on a full disk fails with
-``ENOSPC``, through the same code. A small file system of its own (tmpfs, a loop device) would
-need root, which CI lacks; a writer patched to fail would not exercise the real writers (pyarrow,
-matplotlib, the isolated estimator's answer)."""
+``ENOSPC``, through the same code; it needs no mount, so it also runs where
+``test_small_filesystem`` (a real tmpfs in a private mount namespace) is skipped, and it reaches
+a Dask worker's process. A writer patched to fail would not exercise the real writers
+(pyarrow, matplotlib, the isolated estimator's answer)."""
 
 from __future__ import annotations
 
@@ -22,7 +23,7 @@ from pathlib import Path
 import pytest
 
 from simulator.cli import main
-from tests.reliability.checks import tree
+from tests.reliability.checks import one_message, tree
 from tests.reliability.drives import shared_dataset, straight_drive  # noqa: F401 (fixture)
 
 REPO = Path(__file__).resolve().parents[2]
@@ -85,14 +86,6 @@ CAMPAIGN = straight_drive(100, sensors="  imu: {preset: ideal, rate: 50}\n  odom
                           tail="estimators: [dead_reckoning]\n")
 
 
-def _message(stderr: str) -> str:
-    """The one line a stopped command printed (progress lines apart)."""
-    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("runs: ")]
-    assert len(lines) == 1, stderr
-    assert lines[0].startswith("error: ") and "Traceback" not in stderr
-    return lines[0]
-
-
 @pytest.fixture
 def short_tmp_path():
     """A folder with a short path: a campaign's workers listen on a Unix socket in TMPDIR,
@@ -115,7 +108,7 @@ def test_a_campaign_stops_on_a_full_disk_and_resumes(short_tmp_path, monkeypatch
     before = tree(short_tmp_path)
     done = _landnav_on_a_full_disk([*args, "--runs", "3"], short_tmp_path, 20_000)
     assert done.returncode == 2, done.stderr
-    message = _message(done.stderr)
+    message = one_message(done.stderr)
     assert f"error: {short_tmp_path / 'tmp'}: cannot write here: File too large" in message
     assert "1 finished run(s) kept in mc" in message and "run the same command again" in message
     assert list((short_tmp_path / "tmp").iterdir()) == []
@@ -157,7 +150,7 @@ def test_a_campaign_on_dask_workers_stops_on_their_full_disk(tmp_path, monkeypat
             cluster.stdin.close()  # the cluster ends
     printed = capsys.readouterr()
     assert code == 2, printed.err
-    message = _message(printed.err)
+    message = one_message(printed.err)
     assert f"error: {tmp_path / 'tmp'}: cannot write here: File too large" in message
     assert "on the Dask worker's host" in message and "0 finished run(s) kept in mc" in message
     assert [p.name for p in (tmp_path / "tmp").iterdir()] == ["dask-scratch-space"]

@@ -30,6 +30,11 @@ GNSS = "  gnss: {rate: 1, outputs: [fix]}\n"
     (straight_drive(100, sensors="  gnss: {rate: 10, systems: [gps, galileo, beidou, glonass]}"
                                  "\n").replace("{length: 100}", "{duration: 32400}"),
      "need about 55.1 GB (tracking gps, galileo, beidou, glonass)"),
+    # 27 h with odometer, barometer and magnetometer at 100 Hz: 12.6 GB, validated before
+    (straight_drive(100, sensors="  imu: {preset: ideal, rate: 100}\n  odometer: {rate: 100}\n"
+                                 "  baro: {rate: 100}\n  mag: {rate: 100}\n").replace(
+        "{length: 100}", "{duration: 97000}"),
+     "and 2.91e+07 odometer, barometer and magnetometer samples need about 12.6 GB"),
     (straight_drive(1e300), "is beyond any value a scenario describes"),
     # a sensor at 1e-300 Hz: a truth of one row and an IMU interval of 1e300 s, written
     (straight_drive(100, sensors="  imu: {preset: ideal, rate: 1e-300}\n"),
@@ -37,6 +42,11 @@ GNSS = "  gnss: {rate: 1, outputs: [fix]}\n"
     (straight_drive(100).replace(
         "start: {lat: 37.5, lon: 127.0}",
         "start: {lat: 37.5, lon: 127.0, utc: '9999-12-31T23:59:59-01:00'}"), "is after 2200"),
+    # its offset takes it before year 1 in UTC: early, not late (was 'is after 2200')
+    (straight_drive(100).replace(
+        "start: {lat: 37.5, lon: 127.0}",
+        "start: {lat: 37.5, lon: 127.0, utc: '0001-01-01T00:00:00+14:00'}"),
+     "is before 1980-01-06T00:00:00Z (the GPS epoch"),
 ])
 def test_validation_refuses_unbounded_drives(tmp_path, capsys, scenario, words):
     (tmp_path / "s.yaml").write_text(scenario)

@@ -1,6 +1,7 @@
 """Corrupt datasets on every command that reads one (estimate, score, export): a missing or
 non-numeric column, manifest entries of the wrong type, stream files outside the folder, events
-without an end, IMU samples without values, truth whose time runs backwards. Each gives exit 2,
+without an end, IMU samples without values, truth whose time runs backwards or whose position
+is none. Each gives exit 2,
 one message naming the file and what is wrong, no traceback, and nothing written."""
 
 from __future__ import annotations
@@ -122,6 +123,10 @@ CORRUPTIONS: dict[str, tuple[Callable[[Path], None], str]] = {
                                                           lambda t: _set_column(
         t, "pseudorange", np.r_[np.inf, t.column("pseudorange").to_numpy()[1:]])),
         "it cannot be exported"),
+    # scored as 1232 km of horizontal error, exit 0, before
+    "truth latitude 1e300": (lambda ds: _rewrite(ds / "truth.parquet", lambda t: _set_column(
+        t, "lat", np.r_[t.column("lat").to_numpy()[:5], 1e300, t.column("lat").to_numpy()[6:]])),
+        "truth.parquet: corrupt truth stream: lat = 1e+300 at row 5"),
 }
 # which command reads which stream
 COMMANDS = {
@@ -142,6 +147,7 @@ READS = {
     "imu sample of 1e300": ("estimate",), "imu unit deg/s": ("estimate",),
     "broadcast ionosphere as text": ("export",), "gps week -5": ("export",),
     "gnss_fix latitude 1e300": ("export",), "gnss_raw pseudorange infinite": ("export",),
+    "truth latitude 1e300": ("score",),
 }
 
 

@@ -246,3 +246,19 @@ def test_campaign_outputs_that_cannot_be_written(tmp_path, capsys, where, words)
            "/proc": Path("/proc/landnav-mc")}[where]
     refused(["campaign", str(scenario), "--runs", "1", "--workers", "1", "-o", str(out)],
             capsys, [tmp_path], words)
+
+
+def test_a_file_error_no_writer_named_is_not_blamed_on_the_standard_output(monkeypatch,
+                                                                              capsys):
+    """An ``OSError`` naming a file that reaches the command line untranslated is one message
+    naming that file (it was printed as 'cannot write to the standard output' before, as a
+    campaign's lock on a full disk showed)."""
+    import simulator.commands.schema as schema
+
+    def fails(args):
+        raise OSError(28, "No space left on device", "out/.mc.lock")
+
+    monkeypatch.setattr(schema, "run", fails)
+    assert main(["schema"]) == 2
+    printed = capsys.readouterr()
+    assert printed.err == "error: out/.mc.lock: No space left on device\n"
