@@ -20,20 +20,23 @@ The pseudoranges' errors are not independent: the broadcast ionosphere's residua
 common to an epoch's satellites. The simulated true delay is ``iono_scale`` (1 + ``iono_residual``
 g) times the broadcast model's (``simulator.datasheet.iono_residual_fractions``), so c I_i,
 c = |scale - 1|, is exactly common to them, each scaled by its own broadcast delay I_i; the
-field g is correlated between pierce points by a geometry a snapshot does not know, and is
-left with each satellite's own errors (the conservative side). Their covariance is R =
-diag(sigma_i^2 - a_i^2) + a a^T, a_i = c I_i, and the solution is generalised least squares
-with W = R^-1 (Aitken 1935; a common error scaled by each satellite's delay is mostly taken by
-the clock and the height). With the reported variances as independent the horizontal sigma
-was 3-20 times the error on open sky (mean (error / sigma)^2 north 0.002-0.07 on four drives);
-with the field's common part (sqrt(0.75) of it) in a as well, the quickstart's east axis
-reached 22 (seeds 1-10: mean 5.7). The fault test is r^T W r against chi-square (false alarm
-1e-3); when it fails, the measurement excluded is the one whose Pope tau statistic (Baarda's
-normalised residual over the a-posteriori sigma_0, Pope 1976) is the largest and over its
-critical value at 1e-3: one outlier among good measurements stands out and goes; errors spread
-over every satellite (a variance the model understates) exclude none, and are left to the
-variance factor below (with the w-test, which takes sigma_0 as 1, they stripped good
-satellites one by one).
+field's part f g_i I_i (f = scale residual) is correlated between the satellites by their
+pierce points' separation, the covariance F = (f I_i)(f I_j) exp(-d_ij^2 / (2 L^2))
+(``simulator.datasheet.iono_field_covariance``, as the receiver's own fix accuracy takes it).
+Their covariance is R = diag(sigma_i^2 - a_i^2 - F_ii) + a a^T + F, a_i = c I_i, and the
+solution is generalised least squares with W = R^-1 (Aitken 1935; an error shared by the
+satellites is mostly taken by the clock and the height). With the reported variances as
+independent the horizontal sigma was 3-20 times the error on open sky (mean (error / sigma)^2
+north 0.002-0.07 on four drives); with the field's common part (sqrt(0.75) of it) in a as a
+rank-one term, the quickstart's east axis reached 22 (seeds 1-10: mean 5.7): a field that
+changes across the sky is not one common fraction. Without the stream's azimuths and
+elevations the field stays with each satellite's own errors. The fault test is r^T W r
+against chi-square (false alarm 1e-3); when it fails, the measurement excluded is the one
+whose Pope tau statistic (Baarda's normalised residual over the a-posteriori sigma_0, Pope
+1976) is the largest and over its critical value at 1e-3: one outlier among good
+measurements stands out and goes; errors spread over every satellite (a variance the model
+understates) exclude none, and are left to the variance factor below (with the w-test, which
+takes sigma_0 as 1, they stripped good satellites one by one).
 
 Reflected signals (NLOS). In a street canyon a satellite behind a building is often tracked by
 its reflection off a facade: an extra path of tens of metres that the receiver's reported
@@ -80,7 +83,7 @@ from scipy.stats import t as student_t
 
 from estimators.base import Estimator
 from estimators.toolbox.gnss_model import NLOS_SIGMA_M, nlos_sigma, predict, raw_epoch
-from simulator.datasheet import cn0_template, iono_residual_fractions
+from simulator.datasheet import cn0_template, iono_field_covariance, iono_residual_fractions
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 
 C_N0_FLOOR_M = 0.5      # a: the sigma of a strong signal, m
@@ -117,7 +120,7 @@ class GnssWls(Estimator):
         self._t = math.nan
         self._mask = math.radians(float(self.config["elevation_mask"]))
         gnss = self.datasheet.get("gnss") or {}
-        self._iono_common = iono_residual_fractions(gnss)[0]
+        self._iono_common, self._iono_field = iono_residual_fractions(gnss)
         self._cn0_template = cn0_template(gnss)
         self._nlos_sigma_m = float(self.config["nlos_sigma"])
 
@@ -152,7 +155,12 @@ class GnssWls(Estimator):
             sigma = nlos_sigma(sigma, cn0, block[:, cols["elevation"]][ok],
                                self._cn0_template, self._nlos_sigma_m)
         iono = np.zeros(len(rho)) if ep.iono is None else np.nan_to_num(ep.iono[ok])
-        cov = _range_covariance(sigma, self._iono_common * iono)
+        field = None
+        if self._iono_field > 0 and "elevation" in cols and "azimuth" in cols:
+            field = iono_field_covariance(self._iono_field, iono,
+                                          block[:, cols["azimuth"]][ok],
+                                          block[:, cols["elevation"]][ok])
+        cov = _range_covariance(sigma, self._iono_common * iono, field)
         clock_cols = np.zeros((len(rho), n_clock))
         clock_cols[np.arange(len(rho)), system_index] = 1.0
         used = np.ones(len(rho), dtype=bool)
@@ -260,12 +268,17 @@ def tau_critical(dof: int, false_alarm: float) -> float:
     return float(math.sqrt(dof) * t / math.sqrt(dof - 1 + t * t))
 
 
-def _range_covariance(sigma: np.ndarray, common: np.ndarray) -> np.ndarray:
-    """R = diag(sigma^2 - common^2) + common common^T (module docstring): the reported 1-sigma
-    of each pseudorange with the part ``common`` (m) correlated between them; the independent
-    part keeps at least a tenth of the reported sigma."""
-    own = np.maximum(sigma**2 - common**2, (0.1 * sigma) ** 2)
-    return np.diag(own) + np.outer(common, common)
+def _range_covariance(sigma: np.ndarray, common: np.ndarray, field: np.ndarray | None = None
+                      ) -> np.ndarray:
+    """R = diag(sigma^2 - common^2 - F_ii) + common common^T + F (module docstring): the
+    reported 1-sigma of each pseudorange with the part ``common`` (m) common to them and the
+    ionosphere field's covariance F (None: none); the independent part keeps at least a tenth
+    of the reported sigma."""
+    shared = np.outer(common, common)
+    if field is not None:
+        shared = shared + field
+    own = np.maximum(sigma**2 - np.diag(shared), (0.1 * sigma) ** 2)
+    return np.diag(own) + shared
 
 
 def _wls(h: np.ndarray, residual: np.ndarray, weight: np.ndarray) -> np.ndarray:

@@ -69,7 +69,10 @@ def klobuchar_delay(lat_rad: np.ndarray, lon_rad: np.ndarray, azimuth_rad: np.nd
     phi_m = phi_i + 0.064 * np.cos((lam_i - 1.617) * np.pi)  # geomagnetic latitude
     t = np.mod(4.32e4 * lam_i + np.asarray(gps_tow_s, dtype=float), SECONDS_PER_DAY)  # local time
     slant = klobuchar_obliquity(elevation_rad)
-    powers = phi_m[..., None] ** np.arange(4)
+    # phi_m^0..3; the powers 0 and 1 are exact, so only 2 and 3 go through pow
+    powers = np.empty(np.shape(phi_m) + (4,))
+    powers[..., 0], powers[..., 1] = 1.0, phi_m
+    powers[..., 2:] = phi_m[..., None] ** np.arange(2, 4)
     amp = np.maximum(powers @ np.asarray(alpha, dtype=float), 0.0)
     per = np.maximum(powers @ np.asarray(beta, dtype=float), 72000.0)
     x = 2.0 * np.pi * (t - 50400.0) / per

@@ -338,7 +338,10 @@ def _keplerian(eph: dict[str, np.ndarray], t: np.ndarray, skip: np.ndarray
     mk = eph["m0"] + n * tk
     ek = np.array(mk, dtype=float)
     for _ in range(_KEPLER_ITERATIONS):  # Newton on E - e sin E = M
-        ek = ek - (ek - e * np.sin(ek) - mk) / (1.0 - e * np.cos(ek))
+        step = ek - (ek - e * np.sin(ek) - mk) / (1.0 - e * np.cos(ek))
+        if np.array_equal(step, ek):  # a fixed point: the steps left would not change it
+            break
+        ek = step
     sin_e, cos_e = np.sin(ek), np.cos(ek)
     one_minus = 1.0 - e * cos_e
     nu = np.arctan2(np.sqrt(1.0 - e**2) * sin_e, cos_e - e)  # true anomaly

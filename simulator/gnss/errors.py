@@ -92,6 +92,11 @@ from typing import Any
 
 import numpy as np
 
+from simulator.datasheet import (  # the field's scales: the receivers' model reads them too
+    EARTH_MEAN_RADIUS_KM,
+    IONO_CORRELATION_LENGTH_KM,
+    IONO_SHELL_HEIGHT_KM,
+)
 from simulator.gnss.atmosphere import klobuchar_pierce_point
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
@@ -108,9 +113,8 @@ OSCILLATORS: dict[str, dict[str, float]] = {
 # docstring: the NGA precise ephemeris against the broadcast file on 2015-07-19, 0.33 / 0.80 m)
 SIS_RECORD_SHARE = (0.33 / 0.80) ** 2
 IONO_CORRELATION_TIME_S = 1800.0  # variations of the true/Klobuchar ratio
-IONO_CORRELATION_LENGTH_KM = 1000.0  # L of the field's correlation exp(-d^2 / (2 L^2))
 IONO_FIELD_WAVES = 64  # plane waves summed to draw the field (its variance is exact)
-IONO_SHELL_RADIUS_KM = 6371.0 + 350.0  # Klobuchar's shell: mean Earth radius + 350 km
+IONO_SHELL_RADIUS_KM = EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM  # Klobuchar's shell
 # the field is evaluated every 10 s and interpolated linearly between: a pierce point moves by
 # under 2 km in 10 s (a satellite's at about 0.1 km/s, a car's at its speed), 1/500 of L, so
 # the interpolation changes the field by under 1e-5 of its sigma
@@ -187,8 +191,16 @@ def _sum_of_waves(k: np.ndarray, phase: np.ndarray, amp: np.ndarray, pierce_km: 
     (3, n_sat, n_t) and amplitudes (M, n_t)."""
     x, y, z = pierce_km
     out = np.zeros(np.shape(x))
+    wave, term = np.empty(np.shape(x)), np.empty(np.shape(x))  # reused by every wave
     for m in range(len(k)):  # a loop over the waves; each is vectorised over signals x epochs
-        out += amp[m] * np.cos(k[m, 0] * x + k[m, 1] * y + k[m, 2] * z + phase[m])
+        # amp_m cos(k_m . x + p_m), summed in the order (k0 x + k1 y) + k2 z, then + p_m
+        np.multiply(x, k[m, 0], out=wave)
+        wave += np.multiply(y, k[m, 1], out=term)
+        wave += np.multiply(z, k[m, 2], out=term)
+        wave += phase[m]
+        np.cos(wave, out=wave)
+        wave *= amp[m]
+        out += wave
     return np.sqrt(2.0 / len(k)) * out
 
 
@@ -402,7 +414,8 @@ def hatch_filter(x: np.ndarray, tracked: np.ndarray, dt_s: float, time_constant_
     k0 = np.minimum(arc_start + first_fixed, n_ep - 1)
     carried = mean[..., rows, k0 - 1] - run[..., rows, k0 - 1]
     steps = np.maximum(pos - first_fixed + 1, 0)
-    fixed = run + np.power(a, steps) * carried
+    # a^steps from a table of the whole powers (the same pow of each, without one per sample)
+    fixed = run + np.power(a, np.arange(int(steps.max(initial=0)) + 1))[steps] * carried
     return np.where(tracked, np.where(pos < first_fixed, mean, fixed), 0.0)
 
 

@@ -481,7 +481,9 @@ class Gnss(PresetSensor):
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
                                healthy_only=False, system=systems[:, None])
         self._check_coverage(idx, t, truth, max_age)
-        gathered = gather(eph, idx)
+        # only the records' fields used per epoch (a whole record per satellite and epoch is
+        # gigabytes for a fast-rate hour)
+        gathered = gather(eph, idx, ("health", "tgd", "tgd2", "group_delay"))
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}

@@ -146,49 +146,74 @@ class Observed:
     shared: Shared
 
 
-def _rows(t: np.ndarray, svs: np.ndarray, rows: np.ndarray, mask: np.ndarray,
-          columns: dict[str, np.ndarray], order: int, n_signals: int) -> dict[str, np.ndarray]:
-    """(satellite, epoch) arrays of the satellites ``rows`` (of ``svs``) as stream columns
-    where ``mask`` (a text value stays one text, for the whole column), with a sort key
-    ``_key`` putting epochs first, then satellites in PRN order, then signals in the
-    receiver's order."""
-    ep, sat = np.nonzero(mask.T)
-    flat = sat * mask.shape[1] + ep  # the samples' places in a (satellite, epoch) array
-    out = {"t": t[ep], "sv": svs[rows[sat]]}
-    for key, value in columns.items():
-        if isinstance(value, str):  # kept as it is: ``_sorted`` spreads it over the rows
-            out[key] = value
-        elif value.shape == mask.shape:
-            out[key] = np.take(value, flat)
-        elif value.shape == (mask.shape[0], 1):  # one value per satellite
-            out[key] = value[sat, 0]
-        elif value.shape == (1, mask.shape[1]):  # one value per epoch
-            out[key] = value[0, ep]
-        else:
-            out[key] = np.broadcast_to(value, mask.shape)[sat, ep]
-    out["_key"] = (ep.astype(np.int64) * len(svs) + rows[sat]) * n_signals + order
-    return out
+class _Table:
+    """One stream table's rows: each signal's (satellite, epoch) samples where its mask is set,
+    taken in the signal's own order, and the place of each in the table, which is in the order
+    of epochs, then satellites (PRN order), then the receiver's signals. The places are a
+    counting rank: every signal's mask is known before the first signal's rows are taken, so
+    nothing is sorted. A text value (one per signal) is spread over the signal's rows."""
 
+    def __init__(self, t: np.ndarray, svs: np.ndarray,
+                 masks: list[tuple[np.ndarray, np.ndarray]]):
+        """``masks``: per signal in the receiver's order, its satellites' rows of ``svs`` and
+        its (satellite, epoch) mask of the samples that are rows."""
+        self.t, self.svs = t, svs
+        count = np.zeros((len(svs), len(t)), dtype=np.int32)
+        for sel, mask in masks:  # one pass per signal
+            count[sel] += mask
+        per_slot = count.T.ravel()  # epoch by epoch, satellites in order
+        # each (epoch, satellite)'s first row, moved on as each of its signals takes its row
+        self.next_row = np.cumsum(per_slot, dtype=np.int64) - per_slot
+        self.source = np.empty(int(per_slot.sum()), dtype=np.int64)  # each row's sample
+        self.pieces: list[dict[str, np.ndarray | str]] = []
+        self.n_taken = 0
 
-def _sorted(pieces: list[dict[str, np.ndarray]], names: list[str]) -> pd.DataFrame:
-    """The pieces' rows in one table, in the order of their keys (each column its own new
-    array: the table takes them as they are, without copying them into blocks). The pieces
-    are emptied column by column as the table takes them, so the rows are held about once,
-    not twice (the peak memory of a long, fast-rate drive)."""
-    import pandas as pd
+    def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str]
+            ) -> None:
+        """The next signal's rows: ``columns`` of (satellite, epoch) arrays over ``sel``'s
+        satellites (or broadcastable to them; a text value stays one text) where ``mask``."""
+        sat, ep = np.nonzero(mask)
+        slot = ep * len(self.svs) + sel[sat]
+        rows = self.next_row[slot]
+        self.next_row[slot] += 1
+        self.source[rows] = np.arange(self.n_taken, self.n_taken + len(sat))
+        self.n_taken += len(sat)
+        piece: dict[str, np.ndarray | str] = {"t": self.t[ep], "sv": self.svs[sel[sat]]}
+        for key, value in columns.items():
+            if isinstance(value, str):  # kept as it is: ``frame`` spreads it over the rows
+                piece[key] = value
+            elif value.shape == mask.shape:
+                piece[key] = value[mask]
+            elif value.shape == (mask.shape[0], 1):  # one value per satellite
+                piece[key] = value[sat, 0]
+            elif value.shape == (1, mask.shape[1]):  # one value per epoch
+                piece[key] = value[0, ep]
+            else:
+                piece[key] = np.broadcast_to(value, mask.shape)[mask]
+        self.pieces.append(piece)
 
-    sizes = [len(p["_key"]) for p in pieces]
-    order = np.argsort(np.concatenate([p.pop("_key") for p in pieces]), kind="stable")
-    columns = {}
-    for name in names:
-        values = [p.pop(name) for p in pieces]
-        if isinstance(values[0], str):  # a text per piece: taken from the distinct ones
-            texts = sorted(set(values))
-            codes = np.repeat([texts.index(v) for v in values], sizes)
-            columns[name] = pd.Series(texts).array.take(np.take(codes, order))
-        else:
-            columns[name] = np.take(np.concatenate(values), order)
-    return pd.DataFrame(columns, copy=False)
+    def names(self, order: tuple[str, ...]) -> list[str]:
+        """The columns of ``order`` this table has."""
+        return [c for c in order if c in self.pieces[0]]
+
+    def frame(self, names: list[str]) -> pd.DataFrame:
+        """The table of the columns ``names`` in its rows' order (each column its own new
+        array: the table takes them as they are, without copying them into blocks). The
+        pieces are emptied column by column as the table takes them, so the rows are held
+        about once, not twice (the peak memory of a long, fast-rate drive)."""
+        import pandas as pd
+
+        sizes = [len(p["t"]) for p in self.pieces]
+        columns = {}
+        for name in names:
+            values = [p.pop(name) for p in self.pieces]
+            if isinstance(values[0], str):  # a text per piece: taken from the distinct ones
+                texts = sorted(set(values))
+                codes = np.repeat([texts.index(v) for v in values], sizes)
+                columns[name] = pd.Series(texts).array.take(np.take(codes, self.source))
+            else:
+                columns[name] = np.take(np.concatenate(values), self.source)
+        return pd.DataFrame(columns, copy=False)
 
 
 def _switches(state: np.ndarray) -> np.ndarray:
@@ -233,20 +258,18 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     shared : Shared, optional
         The first receiver's shared draws; None for the first receiver (it draws them).
     """
-    raw_pieces, truth_pieces, rest = _measure(cfg, t, dt_s, sky, ant, rng, reception, shared)
-    # the table rows, sorted once the per-satellite arrays of ``_measure`` are gone
-    raw_names = [c for c in col.GNSS_RAW if c in raw_pieces[0]]
-    truth_names = [c for c in col.TRUTH_GNSS if c in truth_pieces[0]]
-    return Observed(raw=_sorted(raw_pieces, raw_names), truth=_sorted(truth_pieces, truth_names),
-                    **rest)
+    raw, truth, rest = _measure(cfg, t, dt_s, sky, ant, rng, reception, shared)
+    # the tables, made once the per-satellite arrays of ``_measure`` are gone
+    return Observed(raw=raw.frame(raw.names(col.GNSS_RAW)),
+                    truth=truth.frame(truth.names(col.TRUTH_GNSS)), **rest)
 
 
 def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
              rng: np.random.Generator,
              reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
-             shared: Shared | None) -> tuple[list[dict], list[dict], dict]:
-    """``observe``'s measurements as unsorted row pieces per signal (``_rows``: raw and
-    truth), with the receiver's clock (m, m/s), what it drew and the shared draws."""
+             shared: Shared | None) -> tuple[_Table, _Table, dict]:
+    """``observe``'s measurements as the rows of its raw and truth tables (``_Table``), with
+    the receiver's clock (m, m/s), what it drew and the shared draws."""
     eph, idx, svs = sky["eph"], sky["idx"], sky["svs"]
     n_sat, n_ep = idx.shape
     geo = model = signal_geometry_chunks(eph, idx, sky["t_gps"], ant, sky["day_of_year"],
@@ -356,33 +379,47 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         return child_rng(rng, f"{signal_name}/{process}")
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
-    raw_pieces, truth_pieces = [], []
-    for order, (letter, code) in enumerate(codes):  # one pass per signal, vectorised
+    sels = {letter: np.flatnonzero(system_of == letter) for letter, _ in codes}
+    for letter, sel in sels.items():
+        # a system's satellites are consecutive rows of the sky: views, not copies
+        rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
+                else sel)
+        views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
+    # what each signal tracks, first: every table row is then known before any is written
+    tracking = {}
+    for letter, code in codes:  # one pass per signal, vectorised
+        v = views[letter]
+        if code == PRIMARY_SIGNAL[letter]:
+            tracking[letter, code] = v["cn0"], v["tracked"]
+            continue
+        cn0_true = v["signal_cn0"] + signal(letter, code).cn0_offset_db
+        cn0_out = cn0_true + cfg["cn0_noise"] * stream(f"{letter}{code}", "cn0_noise"
+                                                        ).standard_normal(v["el"].shape)
+        tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
+        if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
+            tracked_s &= v["tracked"]
+        tracking[letter, code] = cn0_out, tracked_s
+    in_truth = {letter: v["have"] & (v["el"] > 0) for letter, v in views.items()}
+    raw_table = _Table(t, svs, [(sels[letter], tracking[letter, code][1])
+                                for letter, code in codes])
+    truth_table = _Table(t, svs, [(sels[letter], in_truth[letter]) for letter, code in codes])
+    for letter, code in codes:  # one pass per signal, vectorised
         spec = signal(letter, code)
-        sel = np.flatnonzero(system_of == letter)
+        sel = sels[letter]
         signal_name = f"{letter}{code}"  # its processes' streams are named after it
-        if letter not in views:
-            # a system's satellites are consecutive rows of the sky: views, not copies
-            rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
-                    else sel)
-            views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
         v = views[letter]
         shape = (len(sel), n_ep)
         # per satellite (GLONASS: its FDMA channel)
         freq = carrier_frequency_hz(letter, code, v["channel"])[:, None]
         lam = C_M_S / freq
         k_iono = iono_factor(freq)
+        cn0_out, tracked_s = tracking.pop((letter, code))
         if code == PRIMARY_SIGNAL[letter]:  # the error terms drawn for the primary signals
-            cn0_true, cn0_out, tracked_s = v["signal_cn0"], v["cn0"], v["tracked"]
+            cn0_true = v["signal_cn0"]
             code_sigma, code_noise = v["code_sigma"], v["code_noise"]
             rate_sigma, rate_noise = v["rate_sigma"], v["rate_noise"]
         else:
             cn0_true = v["signal_cn0"] + spec.cn0_offset_db
-            cn0_out = cn0_true + cfg["cn0_noise"] * stream(signal_name, "cn0_noise"
-                                                            ).standard_normal(shape)
-            tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
-            if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
-                tracked_s &= v["tracked"]
             code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
                                              cfg["correlator_spacing"], cfg["integration_time"]
                                              ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
@@ -456,11 +493,10 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
             truth.update(ambiguity=arcs.ambiguity, half_cycle=arcs.half,
                          cycle_slip=arcs.cycle_slip, arc=arcs.arc, carrier_multipath=carrier_mp,
                          phase_noise=phase_noise)
-        raw_pieces.append(_rows(t, svs, sel, tracked_s, raw, order, len(codes)))
-        truth_pieces.append(_rows(t, svs, sel, v["have"] & (v["el"] > 0), truth, order,
-                                  len(codes)))
-    return raw_pieces, truth_pieces, {"clock_m": rx_clock, "drift_m_s": rx_drift,
-                                      "drawn": drawn, "shared": shared}
+        raw_table.add(sel, tracked_s, raw)
+        truth_table.add(sel, in_truth[letter], truth)
+    return raw_table, truth_table, {"clock_m": rx_clock, "drift_m_s": rx_drift,
+                                    "drawn": drawn, "shared": shared}
 
 
 CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives

@@ -66,22 +66,33 @@ def test_fewer_fading_draws_redraw_no_drive_long_error(first):
     assert not np.allclose(cn0["cn0_x"], cn0["cn0_y"])
 
 
-def test_rows_gathered_in_key_order_as_pandas_sorts_them():
-    """The signals' row pieces become one table in the order of their keys, each value in its
-    row, as pandas' stable sort of the concatenated pieces has them; the pieces are emptied
-    as the table takes their columns (the rows are not held twice)."""
-    from simulator.sensors.gnss_observables import _sorted
+def test_rows_in_epoch_satellite_signal_order_as_pandas_sorts_them():
+    """Each signal's (satellite, epoch) samples become one table in the order of epochs, then
+    satellites, then the receiver's signals, each value in its row, as pandas' stable sort of
+    the signals' rows has them (the table's counting rank against a sort); the pieces are
+    emptied as the table takes their columns (the rows are not held twice)."""
+    from simulator.sensors.gnss_observables import _Table
 
     rng = np.random.default_rng(3)
-    pieces = []
-    for text in ("1C", "2L", "1C"):  # a text column: one value per piece
-        n = int(rng.integers(5, 40))
-        pieces.append({"_key": rng.integers(0, 30, n), "x": rng.standard_normal(n),
-                       "k": rng.integers(0, 9, n), "signal": text})
-    expected = pd.concat([pd.DataFrame({**p, "signal": [p["signal"]] * len(p["_key"])})
-                          for p in pieces], ignore_index=True)
-    expected = expected.sort_values("_key", kind="stable").drop(columns="_key")
-    table = _sorted(pieces, ["x", "k", "signal"])
-    pd.testing.assert_frame_equal(table.reset_index(drop=True),
-                                  expected.reset_index(drop=True), check_dtype=False)
-    assert all(not p for p in pieces)
+    t, svs = np.arange(7) * 0.5, np.array([3, 5, 8, 11, 12])
+    # (system's satellites, text) per signal in the receiver's order: two systems, one with
+    # two signals
+    signals = [(np.array([0, 2, 3]), "1C"), (np.array([0, 2, 3]), "2L"), (np.array([1, 4]), "1C")]
+    masks = [rng.random((len(sel), len(t))) < 0.6 for sel, _ in signals]
+    values = [rng.standard_normal((len(sel), len(t))) for sel, _ in signals]
+    per_satellite = [rng.integers(0, 9, (len(sel), 1)) for sel, _ in signals]
+    table = _Table(t, svs, [(sel, m) for (sel, _), m in zip(signals, masks, strict=True)])
+    expected = []
+    for order, ((sel, text), mask, x, k) in enumerate(
+            zip(signals, masks, values, per_satellite, strict=True)):
+        table.add(sel, mask, {"x": x, "k": k, "signal": text})
+        sat, ep = np.nonzero(mask)
+        expected.append(pd.DataFrame({"t": t[ep], "sv": svs[sel[sat]], "x": x[sat, ep],
+                                      "k": k[sat, 0], "signal": text, "_row": sel[sat],
+                                      "_order": order}))
+    want = (pd.concat(expected, ignore_index=True)
+            .sort_values(["t", "_row", "_order"], kind="stable")
+            .drop(columns=["_row", "_order"]).reset_index(drop=True))
+    got = table.frame(["t", "sv", "x", "k", "signal"])
+    pd.testing.assert_frame_equal(got, want, check_dtype=False)
+    assert all(not p for p in table.pieces)
