@@ -93,7 +93,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.stats import norm
 
 C_M_S = 299_792_458.0  # speed of light, m/s
 KLOBUCHAR_NIGHT_SLANT_M = 5e-9 * C_M_S * 1.77  # the broadcast model's night floor at 30 deg, m
@@ -247,6 +246,9 @@ def nlos_probability(deficit_db: np.ndarray, scatter_db: float) -> np.ndarray:
     least ``OPEN_SKY_NLOS_SHARE``. The last axis holds one epoch's signals (an array of shape
     (epochs, signals) gives each epoch its own prior); 0 where the deficit is not finite (no
     signal)."""
+    # imported here: scipy.stats is a second of every process's start-up, only this needs it
+    from scipy.stats import norm
+
     deficit = np.asarray(deficit_db, dtype=float)
     finite = np.isfinite(deficit)
     d = np.where(finite, deficit, 0.0)

@@ -1,5 +1,6 @@
-"""Test estimators for campaigns: one that fails, one that kills its worker process, one that
-logs every run it makes."""
+"""Test estimators for campaigns and plug-in runs: one that holds its start, one that fails, one
+that kills its worker process, one that logs every run it makes. Light to import (numpy and
+landnav's estimator base only): each campaign worker and plug-in check imports it afresh."""
 
 from __future__ import annotations
 
@@ -8,7 +9,24 @@ import time
 
 import numpy as np
 
-from tests.scoring_helpers import HoldStart
+from estimators.base import Estimator
+
+
+class HoldStart(Estimator):
+    """Test estimator: holds its initial state (the truth perturbed by the scenario's ``init``)
+    whatever the IMU says, so its errors are the truth's motion since the start."""
+
+    name = "hold_start"
+    needs = ("imu",)
+    paper = "test double"
+
+    def on_imu(self, t: float, row: np.ndarray) -> None:
+        """Ignore the IMU."""
+
+    def solution(self, t: float) -> list[float]:
+        lat, lon, alt = self.initial.position
+        return [np.degrees(lat), np.degrees(lon), alt, *self.initial.velocity,
+                *self.initial.attitude]
 
 
 class Fails(HoldStart):

@@ -17,7 +17,6 @@ import pandas as pd
 import pytest
 from matplotlib.figure import Figure
 
-from estimators.base import Estimator
 from simulator import columns as col
 from simulator.dataset.generate import build_truth
 from simulator.dataset.io import write_dataset
@@ -74,23 +73,6 @@ def write_scoring_dataset(directory: Path, truth: pd.DataFrame,
         write_dataset(tmp, {"scenario": {"name": "test"}, "seed": 0},
                       {"truth": truth, "events": events(*outages)})
     return directory
-
-
-class HoldStart(Estimator):
-    """Test estimator: holds its initial state (the truth perturbed by the scenario's ``init``)
-    whatever the IMU says, so its errors are the truth's motion since the start."""
-
-    name = "hold_start"
-    needs = ("imu",)
-    paper = "test double"
-
-    def on_imu(self, t: float, row: np.ndarray) -> None:
-        """Ignore the IMU."""
-
-    def solution(self, t: float) -> list[float]:
-        lat, lon, alt = self.initial.position
-        return [np.degrees(lat), np.degrees(lon), alt, *self.initial.velocity,
-                *self.initial.attitude]
 
 
 @contextmanager

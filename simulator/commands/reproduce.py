@@ -95,8 +95,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                    help="shortened drives (each experiment's quick overrides) and 3 seeds "
                         "unless --runs says otherwise, and no variant (a claim judged again "
                         "under another value of a deciding condition) nor the experiments "
-                        "only variants read: a check in minutes, not the paper's full "
-                        "protocol")
+                        "only variants read, nor the checks of entries left to the full run "
+                        "(Karamat's ablation variants): a check in minutes, not the paper's "
+                        "full protocol")
     p.add_argument("-o", "--output", required=True, metavar="DIR", help="report folder")
     p.add_argument("--workers", type=int, default=None, metavar="W",
                    help="local worker processes (default: the CPU count)")

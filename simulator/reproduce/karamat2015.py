@@ -432,7 +432,8 @@ PROTOCOL = Experiment(
     "partial_outages", SCENARIO,
     {label: {"name": "riss3d_tc_ekf", "config": config}
      for label, config in {**VARIANTS, **ABLATION_VARIANTS}.items()},
-    measure_protocol, quick_overrides=tuple(protocol_overrides(4, SITE1_OFFSET_S)))
+    measure_protocol, quick_overrides=tuple(protocol_overrides(4, SITE1_OFFSET_S)),
+    quick_entries=tuple(VARIANTS))  # the ablation variants run in the full protocol only
 PROTOCOL_5MG = Experiment(
     "partial_outages_5mg", SCENARIO, {"tight": {"name": "riss3d_tc_ekf",
                                                 "config": VARIANTS["tight"]}},
@@ -610,7 +611,7 @@ PAPER = Paper(
                 f"{what} (mean window maximum over 3-0 satellites)",
                 "the paper attributes its gain to the tilt and accelerometer-error states",
                 [*CONDITIONS, KINGSTON], partial(judge_ablation, variant=v),
-                kind="check", experiments=PROTOCOL_ONLY)
+                kind="check", experiments=PROTOCOL_ONLY, full_only=v in ABLATION_VARIANTS)
           for v, what in (("no_accel_bias", "its accelerometer-bias states"),
                           ("no_tilt", "its tilt-error states"),
                           ("no_speed_error", "its odometer speed-error state"),

@@ -77,6 +77,9 @@ class Experiment:
     history: Callable[[Dataset, Mapping[str, pd.DataFrame]], pd.DataFrame] | None = None
     # seeds of a run without --quick when more than the run's: where a verdict sits at an edge
     full_runs: int | None = None
+    # the labels --quick replays (empty: every entry); the others are read only by claims left
+    # to the full run (``Claim.full_only``)
+    quick_entries: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -127,7 +130,8 @@ class Claim:
     if any, only gives landnav's figure for it (the word is "not testable", never one from
     evidence). A claim judged again under another value of a deciding condition names the
     default claim in ``variant_of`` and the value in ``variant`` ("fix noise 1.5 m"); the
-    summary tallies the default rows only.
+    summary tallies the default rows only. A check that reads entries ``--quick`` does not
+    replay (``Experiment.quick_entries``) is ``full_only``.
 
     ``experiments`` names the experiments whose tables the judge reads (it is given those only,
     so a judge reading another one fails); empty: every experiment of the paper. ``landnav
@@ -145,6 +149,7 @@ class Claim:
     variant_of: str = field(default="", kw_only=True)  # key of the default claim of a sweep
     variant: str = field(default="", kw_only=True)     # the swept condition's value, in words
     experiments: tuple[str, ...] = field(default=(), kw_only=True)  # keys the judge reads
+    full_only: bool = field(default=False, kw_only=True)  # a check --quick leaves to the full run
 
     def __post_init__(self) -> None:
         if isinstance(self.conditions, str) or not all(isinstance(c, str)
@@ -158,6 +163,8 @@ class Claim:
             raise ValueError(f"claim {self.key}: a testable claim needs a judge")
         if bool(self.variant_of) != bool(self.variant):
             raise ValueError(f"claim {self.key}: variant_of and variant go together")
+        if self.full_only and self.kind != "check":
+            raise ValueError(f"claim {self.key}: only a check is left to the full run")
         object.__setattr__(self, "experiments", tuple(self.experiments))
 
 
@@ -190,9 +197,10 @@ class Paper:
 
     def quick(self) -> Paper:
         """The paper as ``landnav reproduce --quick`` runs it: its claims that are no variant
-        of another (a swept condition's other values are left to the full run) and the
-        experiments those claims read."""
-        claims = tuple(c for c in self.claims if not c.variant_of)
+        of another (a swept condition's other values are left to the full run) nor
+        ``full_only``, the experiments those claims read, each with its ``quick_entries``."""
+        claims = tuple(c for c in self.claims if not c.variant_of and not c.full_only)
         read = {e.key for c in claims if c.judge is not None for e in self.read_by(c)}
-        return replace(self, claims=claims,
-                       experiments=tuple(e for e in self.experiments if e.key in read))
+        return replace(self, claims=claims, experiments=tuple(
+            replace(e, entries={k: e.entries[k] for k in e.quick_entries}) if e.quick_entries
+            else e for e in self.experiments if e.key in read))

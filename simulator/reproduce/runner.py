@@ -126,6 +126,7 @@ class _Task:
     seed: int
     overrides: tuple[str, ...]
     with_history: bool = False
+    quick: bool = False  # the experiment as --quick runs it (``Paper.quick``)
 
 
 def _execute(task: _Task) -> tuple[tuple[dict[str, float], pd.DataFrame | None] | None,
@@ -134,7 +135,7 @@ def _execute(task: _Task) -> tuple[tuple[dict[str, float], pd.DataFrame | None] 
     traceback, CPU seconds)."""
     start = time.process_time()
     try:
-        paper = load_paper(task.paper)
+        paper = load_paper(task.paper).quick() if task.quick else load_paper(task.paper)
         experiment = next(e for e in paper.experiments if e.key == task.experiment)
         with tempfile.TemporaryDirectory(prefix="landnav-reproduce-") as work:
             result = measure_seed(experiment, task.seed, task.overrides, Path(work),
@@ -279,7 +280,7 @@ def reproduce(papers: Sequence[str], runs: int | None, quick: bool, out: Path | 
             scenario_path(experiment.scenario)
     seeds = seeds_of(runs or (QUICK_SEEDS if quick else FULL_SEEDS))
     tasks = [_Task(p.key, e.key, seed, tuple(experiment_overrides(e, quick)),
-                   seed == seeds[0] and e.history is not None)
+                   seed == seeds[0] and e.history is not None, quick)
              for p in loaded for e in p.experiments for seed in experiment_seeds(e, seeds, quick)]
     figures: dict[tuple[str, str], dict[int, dict[str, float]]] = {}
     histories: dict[tuple[str, str], pd.DataFrame] = {}

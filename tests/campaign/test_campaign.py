@@ -18,8 +18,8 @@ from simulator.campaign.plan import plan_campaign
 from simulator.campaign.worker import execute_run, flatten_scores
 from simulator.cli import main
 
-HOLD = {"name": "tests.scoring_helpers:HoldStart", "label": "hold"}
-SHIFTED = {"name": "tests.scoring_helpers:HoldStart", "label": "shifted",
+HOLD = {"name": "tests.campaign_estimators:HoldStart", "label": "hold"}
+SHIFTED = {"name": "tests.campaign_estimators:HoldStart", "label": "shifted",
            "init": {"position_error": [3.0, -4.0, 0.0]}}
 FAILS = {"name": "tests.campaign_estimators:Fails", "label": "fails"}
 

@@ -167,7 +167,7 @@ def _scenario(tmp_path: Path, estimators: list) -> Path:
 
 
 def test_run_generates_estimates_scores_and_reports(tmp_path, capsys):
-    entry = {"name": "tests.scoring_helpers:HoldStart", "label": "hold",
+    entry = {"name": "tests.campaign_estimators:HoldStart", "label": "hold",
              "init": {"position_error": [3.0, -4.0, 0.0]}}
     out = tmp_path / "run"
     assert main(["run", str(_scenario(tmp_path, [entry])), "-o", str(out)]) == 0

@@ -164,14 +164,22 @@ def test_every_registered_paper_loads_with_unique_keys_and_module_level_measures
 
 @pytest.mark.parametrize("key", paper_keys())
 def test_quick_runs_the_claims_that_are_no_variant_and_only_the_experiments_they_read(key):
-    """``--quick`` (``Paper.quick``): every claim but the variants, every experiment a kept
-    claim's judge reads, and no other; every experiment of the full paper is read by a claim."""
+    """``--quick`` (``Paper.quick``): every claim but the variants and the ``full_only``
+    checks, every experiment a kept claim's judge reads, and no other, each with its
+    ``quick_entries`` (all entries when it names none); every experiment of the full paper is
+    read by a claim. (That the kept claims are judged from the entries left is asserted on the
+    quick run itself: tests/reproduce/test_reproduce_cli.py.)"""
     paper = load_paper(key)
     quick = paper.quick()
-    assert [c.key for c in quick.claims] == [c.key for c in paper.claims if not c.variant_of]
+    assert [c.key for c in quick.claims] == [c.key for c in paper.claims
+                                            if not c.variant_of and not c.full_only]
     read = {e.key for c in quick.claims if c.judge is not None for e in paper.read_by(c)}
     assert [e.key for e in quick.experiments] == [e.key for e in paper.experiments
                                                  if e.key in read]
+    full = {e.key: e for e in paper.experiments}
+    for e in quick.experiments:
+        kept = full[e.key].quick_entries or tuple(full[e.key].entries)
+        assert list(e.entries) == list(kept) and set(kept) <= set(full[e.key].entries)
     assert {e.key for c in paper.claims if c.judge is not None for e in paper.read_by(c)} == \
         {e.key for e in paper.experiments}
 
