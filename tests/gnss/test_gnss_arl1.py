@@ -105,12 +105,17 @@ def residuals(obs: pd.DataFrame, nav: pd.DataFrame, rx: np.ndarray,
     return out
 
 
-def navigation(hour: StaticHour) -> pd.DataFrame:
-    path = hour.folder / hour.nav_name
+def _refdata(path: Path) -> Path:
+    """``path`` when the shared reference data are beside the checkout; the test skipped with
+    the reason otherwise (a user's clone has no shared/ folder)."""
     if not path.exists():
         pytest.skip(f"reference data {path} not available (needs the shared/ folder beside "
                     "the repository checkout)")
-    return read_rinex_nav(path)
+    return path
+
+
+def navigation(hour: StaticHour) -> pd.DataFrame:
+    return read_rinex_nav(_refdata(hour.folder / hour.nav_name))
 
 
 def real_observations(hour: StaticHour) -> pd.DataFrame:
@@ -120,7 +125,7 @@ def real_observations(hour: StaticHour) -> pd.DataFrame:
     meas = [hour.code, "D1", "S1"] if hour.code == "P1" else [hour.code]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
-        ds = georinex.load(hour.folder / hour.obs_name, meas=meas)
+        ds = georinex.load(_refdata(hour.folder / hour.obs_name), meas=meas)
     frame = ds.to_dataframe().reset_index().dropna(subset=meas[:2])
     frame = frame[(frame[hour.code] > 0) & frame["sv"].str.startswith("G")]
     tow = ((frame["time"] - pd.Timestamp(1980, 1, 6)).dt.total_seconds()
