@@ -302,4 +302,8 @@ def test_rinex_station_hour(tmp_path):
     assert 0.4 < np.std(residual) < 1.2
     scores = tmp_path / "s.json"
     assert main(["score", str(out), "-e", "gnss_wls", "--json", str(scores)]) == 0
-    assert json.loads(scores.read_text())["gnss_wls"]["horizontal"]["rms"] < 3.0
+    wls = json.loads(scores.read_text())["gnss_wls"]
+    assert wls["horizontal"]["rms"] < 3.0
+    # its sigma against the station's published position: no axis overconfident on a real
+    # receiver (one hour is one draw of the ionosphere's drive-long error, so no lower bound)
+    assert max(wls["consistency"]["position"]["nse"].values()) < 3.0
