@@ -5,6 +5,7 @@ still alive (``alive``)."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from simulator.cli import main
@@ -36,10 +37,14 @@ def refused(args: list[str], capsys, watch: list[Path], words: str,
     return text
 
 
+PROGRESS_LINE = re.compile(r"^[\w -]+: \d+ (of \d+ done|done in |done; )")  # simulator.progress
+
+
 def one_message(stderr: str) -> str:
-    """The one line a stopped command printed (a campaign's progress lines apart), asserted
-    to be an error and no traceback."""
-    lines = [line for line in stderr.splitlines() if line.strip() and not line.startswith("runs: ")]
+    """The one line a stopped command printed (its progress lines apart), asserted to be an
+    error and no traceback."""
+    lines = [line for line in stderr.splitlines()
+             if line.strip() and not PROGRESS_LINE.match(line)]
     assert len(lines) == 1, stderr
     assert lines[0].startswith("error: ") and "Traceback" not in stderr
     return lines[0]

@@ -40,6 +40,9 @@ CASES = {
     "twin": (["twin", "DATASET", "-o", "disk/twin.yaml"], 8, "DISK/tmp"),
     "run, the dataset written": (["run", "s.yaml", "-o", "disk/out"], 300, "disk/out"),
     "run, nothing written": (["run", "s.yaml", "-o", "disk/out"], 8, "disk/out"),
+    # nothing is written until the papers' runs are complete: the report's first file fails
+    "reproduce": (["reproduce", "tan2008", "--quick", "--runs", "1", "-o", "disk/repro"], 8,
+                  "disk/repro"),
 }
 
 
@@ -61,8 +64,8 @@ def small_disk(tmp_path):
     return run, disk
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, marks=SLOW) if c.startswith("run") else c
-                                  for c in CASES])
+@pytest.mark.parametrize("case", [pytest.param(c, marks=SLOW)
+                                  if c.startswith(("run", "reproduce")) else c for c in CASES])
 def test_a_full_file_system_leaves_nothing_and_one_message(dataset, tmp_path, small_disk, case):
     run, disk = small_disk
     args, free_kib, named = CASES[case]
