@@ -14,17 +14,17 @@ counted as ``missing``, never dropped silently.
 
 Public names
 ------------
-PAIRED_SCORES, BOOTSTRAP_RESAMPLES, paired_comparisons.
+PAIRED_SCORES, BOOTSTRAP_RESAMPLES, median_interval, paired_comparisons.
 """
 
 from __future__ import annotations
 
+import math
 from itertools import combinations
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy.stats import binomtest
 
 from simulator.campaign.worker import STATUS_OK
 
@@ -35,12 +35,19 @@ BOOTSTRAP_RESAMPLES = 2000
 _BOOTSTRAP_SEED = 0
 
 
-def _median_interval(d: np.ndarray) -> tuple[float, float]:
-    """The 95 % percentile-bootstrap interval of the median of ``d``."""
-    rng = np.random.default_rng(_BOOTSTRAP_SEED)
-    medians = np.median(d[rng.integers(0, d.size, (BOOTSTRAP_RESAMPLES, d.size))], axis=1)
+def median_interval(values: np.ndarray, resamples: int = BOOTSTRAP_RESAMPLES,
+                    seed: int = _BOOTSTRAP_SEED) -> tuple[float, float, float]:
+    """The median of ``values`` and its 95 % percentile-bootstrap interval (Efron & Tibshirani
+    1993, ch. 13: the 2.5 and 97.5 percentiles of the medians of ``resamples`` resamples drawn
+    with the generator of ``seed``); NaN for no values. Also the reproduction's
+    (``simulator.reproduce.evidence``)."""
+    if not len(values):
+        return math.nan, math.nan, math.nan
+    rng = np.random.default_rng(seed)
+    draws = rng.integers(0, len(values), size=(resamples, len(values)))
+    medians = np.median(values[draws], axis=1)
     low, high = np.percentile(medians, [2.5, 97.5])
-    return float(low), float(high)
+    return float(np.median(values)), float(low), float(high)
 
 
 def _compare(a: pd.Series, b: pd.Series) -> dict[str, Any]:
@@ -54,10 +61,13 @@ def _compare(a: pd.Series, b: pd.Series) -> dict[str, Any]:
                            "a_smaller": int((d < 0).sum()), "b_smaller": int((d > 0).sum()),
                            "sign_test_p": None}
     if d.size:
-        out["median_difference"] = float(np.median(d))
-        out["interval"] = list(_median_interval(d))
+        median, low, high = median_interval(d)
+        out["median_difference"] = median
+        out["interval"] = [low, high]
     decided = out["a_smaller"] + out["b_smaller"]
     if decided:
+        from scipy.stats import binomtest  # here: scipy.stats costs a second to import
+
         out["sign_test_p"] = float(binomtest(out["a_smaller"], decided, 0.5).pvalue)
     return out
 

@@ -46,6 +46,8 @@ from typing import Literal
 
 import numpy as np
 
+from simulator.campaign.paired import median_interval
+
 __all__ = ["ALPHA", "BOOTSTRAP_RESAMPLES", "BOOTSTRAP_SEED", "Better", "Evidence", "Magnitude",
            "evidence_text", "one_sample_evidence", "paired_evidence", "verdict_word"]
 
@@ -106,14 +108,9 @@ def _values(values: Sequence[float | None] | np.ndarray) -> np.ndarray:
 
 
 def _median_interval(effects: np.ndarray) -> tuple[float, float, float]:
-    """Median of ``effects`` and its percentile-bootstrap 95 % interval."""
-    if not len(effects):
-        return math.nan, math.nan, math.nan
-    rng = np.random.default_rng(BOOTSTRAP_SEED)
-    draws = rng.integers(0, len(effects), size=(BOOTSTRAP_RESAMPLES, len(effects)))
-    medians = np.median(effects[draws], axis=1)
-    low, high = np.percentile(medians, [2.5, 97.5])
-    return float(np.median(effects)), float(low), float(high)
+    """Median of ``effects`` and its percentile-bootstrap 95 % interval (``median_interval``
+    with the reproduction's resamples and seed)."""
+    return median_interval(effects, BOOTSTRAP_RESAMPLES, BOOTSTRAP_SEED)
 
 
 def _sign_p(wins: int, trials: int) -> float:
