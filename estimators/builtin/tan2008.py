@@ -54,14 +54,17 @@ What the paper gives and what is chosen here:
   put. ``datasheet``: from what a user knows of the sensors (``toolbox.datasheet``, as
   ``ins_odo_ekf``): the IMU's noise densities, in-run bias instability and turn-on bias range
   (P0), its scale factors as bias process noise; the fix's error as three Gauss-Markov states
-  of the receiver's correlated error budget (30 min, sized by the first fix's DOPs) plus the
+  of the drive-long part of the fix's reported accuracy (30 min; unit states whose gain at
+  each fix is ``FixErrorModel.correlated_gain``, the report less the budget's smoothed part,
+  capped at the budget's correlated part: on open sky the budget alone was above the
+  report, and the filter too cautious horizontally) plus the
   white equivalent of its smoothed noise, behind a chi-square gate (0.999), and the fix's
   velocity (Tan uses positions only, and with the white equivalent of the smoothed position
   noise alone the velocity's sigma was ten times its error). What the fix reports of its
   own accuracy (``std_*`` of ``gnss_fix``, the receiver's least squares with its reflected
   signals; ``toolbox.datasheet.FixAccuracy``) is taken as ``ins_odo_ekf`` takes it: the
   position's 1-sigma beyond the budget (reflected signals) as three unit NLOS states after
-  the fix's (``datasheet.nlos_position_rows``), the velocity's 1-sigma as its noise. In a
+  the fix's (``datasheet.fix_position_rows``), the velocity's 1-sigma as its noise. In a
   street canyon the reflected fixes sink by 20-50 m at a VDOP of 1.5-2.9, reporting 20-37 m
   for it; with the DOPs' 3 m the filter followed them down under a 3.5 m sigma and held the
   offset in its 30-minute fix-error states (the unseen canyon's height (error / sigma)^2
@@ -114,9 +117,9 @@ from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
     fix_error_model,
+    fix_position_rows,
     fix_velocity_sigma,
     imu_error_model,
-    nlos_position_rows,
 )
 from estimators.toolbox.gating import FixNoiseMatching
 from estimators.toolbox.ins_error import BG, N_STATES
@@ -197,12 +200,10 @@ class TanLinearisedKF(Estimator):
             p0[9:12], p0[12:15] = noise.accel_bias_initial, noise.gyro_bias_initial
             self._fix_model = fix_error_model(self.datasheet)
             # the fix's correlated error, then its reflected (NLOS) error as unit states
-            markov = dict(extra_sigma=np.r_[self._fix_model.correlated_sigma(1.0, 2.0),
-                                            np.ones(3)],
+            markov = dict(extra_sigma=np.ones(6),  # unit states: their gains at each fix
                           extra_tau=np.r_[np.full(3, self._fix_model.correlated_tau),
                                           np.full(3, NLOS_TIME_CONSTANT_S)])
         self._noise = noise
-        self._dop_known = False
         c = self.columns["gnss_fix"]
         self._dop = [c.get("hdop"), c.get("vdop")]
         self._accuracy = FixAccuracy(c)
@@ -333,19 +334,14 @@ class TanLinearisedKF(Estimator):
                        self.R_HEADING)
 
     def _datasheet_fix(self, row: np.ndarray, pos: np.ndarray) -> None:
-        """The fix as the antenna plus its correlated error (three Gauss-Markov states, sized
-        at the first fix's DOPs) and a white remainder, gated (``tuning: datasheet``)."""
+        """The fix as the antenna plus its drive-long error (three unit Gauss-Markov states,
+        their gain the part of the fix's reported accuracy, ``fix_position_rows``) and a white
+        remainder, gated (``tuning: datasheet``)."""
         ins, model = self.ins, self._fix_model
         dops = [float(row[i]) if i is not None else math.nan for i in self._dop]
-        if not self._dop_known:
-            for k, sigma in enumerate(model.correlated_sigma(*dops)):
-                ins.set_extra_sigma(k, float(sigma))
-            self._dop_known = True
         dz, h = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna, ins.n_states)
-        dz += ins.extra[:3]
-        h[:, N_STATES:N_STATES + 3] = np.eye(3)
         std_pos, std_vel = self._accuracy.read(row)
-        r = nlos_position_rows(model, std_pos, *dops, dz, h, ins.extra[3:6], N_STATES + 3)
+        r = fix_position_rows(model, std_pos, *dops, dz, h, ins.extra[:6], N_STATES)
         rows = slice(0, 3) if math.isfinite(pos[2]) else slice(0, 2)
         ins.gated_update(dz[rows], h[rows], r[rows, rows], GATE_PROBABILITY)
         v_fix = row[self._vel_idx]

@@ -29,8 +29,27 @@ that tunes itself "from the datasheet" means the same thing.
   - velocity: 0.05 m/s per range rate (u-blox NEO-M8 data sheet; the ``automotive`` FLL's
     0.024-0.08 m/s at 45-35 dB-Hz, docs/gnss-errors.md) times the DOP.
   - what the fix itself reports (``FixAccuracy``: its ``std_*`` columns, a receiver's own
-    accuracy, ``simulator.gnss.fix``): its velocity 1-sigma replaces the datasheet's; its
-    position 1-sigma beyond the budget's (``FixErrorModel.excess_sigma``: the variance over
+    accuracy, ``simulator.gnss.fix``; a real receiver's NMEA GST standard deviations of the
+    latitude, longitude and altitude errors, or u-blox's hAcc and vAcc: the pseudorange errors'
+    statistics mapped into the position, G Sigma G^T of the weighted least squares, Misra &
+    Enge 2011, section 6.1, the whole error with no split by time behaviour): its velocity
+    1-sigma replaces the datasheet's. Its position 1-sigma r sizes the drive-long part at each
+    fix (``FixErrorModel.correlated_gain``): the report's variance less the budget's smoothed
+    part, r^2 - (s DOP)^2, capped at the budget's correlated part (c DOP)^2. The budget cannot
+    know the hour or the sky: its correlated 2.2 m of range error (the ``automotive``
+    receiver) is a bound for a midday ionosphere, while the fix's report holds the day's
+    broadcast delays and the satellites' geometry per axis (on the unseen ``open_road``, seed
+    1, the report per unit DOP (HDOP / sqrt(2) horizontally) is 1.98 m north, 1.63 m east,
+    2.47 m down at its median, on ``sumo_city`` 1.84, 1.31 and 2.05; the simulated fixes'
+    realised error per unit DOP over twenty seeds, ``simulator.datasheet``, 1.2-1.35 m
+    horizontally), so a filter sized by the
+    budget alone was too cautious horizontally on open sky (mean (error / sigma)^2 0.06-0.1
+    on some drives' north or east). The receiver's report in the first epochs after a start
+    is large (the carrier smoothing not yet converged: 4.05 m per DOP north at the first fix
+    of ``open_road`` seed 1), so the part is not sized once at the first fix: a filter
+    carries it as a unit-variance Gauss-Markov state per axis whose fix row is the gain
+    times the state, e = g_k u (as the reflected-fix states below). Its position 1-sigma
+    beyond the budget's (``FixErrorModel.excess_sigma``: the variance over
     the correlated and smoothed parts at the DOPs) is error the budget does not hold, the
     reflected (NLOS) signals of a street canyon. That excess is not white: a reflection's extra
     path lasts while the street's geometry does (the fixes of the simulated canyons, their
@@ -57,11 +76,20 @@ that tunes itself "from the datasheet" means the same thing.
   the first and the last tooth edge inside it (``tooth_timing``, ``simulator.sensors.odometer``),
   both stamped at the interval's end (the ``automotive`` CAN speed at 50 Hz, 20 ms latency:
   30.0 ms against the truth's speed and acceleration by least squares above 4 m/s, 39 ms at
-  1-4 m/s where the edges are sparse; ``sumo_city_canyon`` seed 1).
+  1-4 m/s where the edges are sparse; ``sumo_city_canyon`` seed 1). A CAN speed's age grows
+  where its edges are sparse, at a reading v (``odometer_window_s(datasheet, v)``): with
+  edges g = 1 / (``ticks_per_meter`` v) apart, the last edge before the stamp is on average
+  g / 2 old, and the span it is timed over is the window's edges, dt - g on average, when
+  g <= dt / 2, else one edge pair, g (the first edge is at least the one before the last):
+  the mean's age is the latency plus g / 2 + span / 2, that is latency + max(dt / 2, g)
+  (the ``automotive`` wheel's 42.5 mm teeth at 1 m/s: 62 ms, at its 2 km/h cut-off 97 ms;
+  taken as 30 ms, the speed of the last second of a stop at 2 m/s^2 read 0.06-0.13 m/s
+  fast, ``sumo_city`` seed 1). The same g is its spread (a bound: the age is uniform over
+  g around its mean).
 
 Public names
 ------------
-ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, nlos_position_rows,
+ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, fix_position_rows,
 fix_velocity_sigma, ground_track_sigma, odometer_speed_sigma, odometer_delay_s, odometer_window_s,
 CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S.
 """
@@ -167,6 +195,16 @@ class FixErrorModel:
         """NED 1-sigma (m) of the drive-long correlated error at these DOPs."""
         return self.correlated_range * _axes(hdop, vdop)
 
+    def correlated_gain(self, reported: np.ndarray, hdop: float, vdop: float) -> np.ndarray:
+        """NED 1-sigma (m) of the drive-long error of a fix that reports its own position
+        1-sigma ``reported`` (module docstring): sqrt(r^2 - (s DOP)^2), within 0 and
+        ``correlated_sigma``; ``correlated_sigma`` on an axis whose report is not finite."""
+        axes = _axes(hdop, vdop)
+        budget = self.correlated_range * axes
+        own = np.asarray(reported, dtype=float) ** 2 - (self.smoothed_range * axes) ** 2
+        return np.where(np.isfinite(own), np.sqrt(np.clip(np.nan_to_num(own), 0.0, budget**2)),
+                        budget)
+
     def white_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m) of the white-equivalent remainder at these DOPs."""
         return self.white_range * _axes(hdop, vdop)
@@ -224,17 +262,21 @@ class FixAccuracy:
         return std[:3], std[3:]
 
 
-def nlos_position_rows(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float,
-                       dz: np.ndarray, h: np.ndarray, nlos: np.ndarray, first: int
-                       ) -> np.ndarray:
-    """A fix's position rows with the reflected-fix states (module docstring): adds their part
-    e = gain u to the innovation rows ``dz`` (3,) and to ``h`` (3, n) in place, for the states'
-    estimate ``nlos`` (3,) at column ``first``, and returns the rows' noise covariance (3, 3):
-    the white remainder at the DOPs and the excess's white share (``FixErrorModel.nlos_split``
-    of the fix's ``reported`` position 1-sigma)."""
-    gain, white = model.nlos_split(reported, hdop, vdop)
-    dz += gain * nlos
-    h[:, first:first + 3] = np.diag(gain)
+def fix_position_rows(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float,
+                      dz: np.ndarray, h: np.ndarray, states: np.ndarray, first: int
+                      ) -> np.ndarray:
+    """A fix's position rows with its error states (module docstring): six unit states, the
+    drive-long error's (north, east, down) at column ``first`` and the reflected fixes' after
+    them, of estimate ``states`` (6,). Adds their part e = g u to the innovation rows ``dz``
+    (3,) and to ``h`` (3, n) in place, the gains ``FixErrorModel.correlated_gain`` and the
+    excess's (``FixErrorModel.nlos_split``) of the fix's ``reported`` position 1-sigma, and
+    returns the rows' noise covariance (3, 3): the white remainder at the DOPs and the
+    excess's white share."""
+    correlated = model.correlated_gain(reported, hdop, vdop)
+    nlos, white = model.nlos_split(reported, hdop, vdop)
+    dz += correlated * states[:3] + nlos * states[3:6]
+    h[:, first:first + 3] = np.diag(correlated)
+    h[:, first + 3:first + 6] = np.diag(nlos)
     return np.diag(model.white_sigma(hdop, vdop) ** 2 + white)
 
 
@@ -278,16 +320,23 @@ def odometer_speed_sigma(datasheet: Mapping[str, Any], speed: float = 1.0) -> fl
     return math.hypot(ODOMETER_FLOOR_M_S, step / math.sqrt(12.0))
 
 
-def odometer_delay_s(datasheet: Mapping[str, Any]) -> float:
-    """Age of the odometer's speed at its time stamp, s (module docstring)."""
+def odometer_delay_s(datasheet: Mapping[str, Any], speed: float = math.inf) -> float:
+    """Age of the odometer's speed at its time stamp, s, for a reading ``speed`` (m/s; the
+    default: fast enough that a CAN speed's edges are dense), module docstring."""
     odo = datasheet.get("odometer") or {}
-    return float(odo.get("latency") or 0.0) + odometer_window_s(datasheet)
+    return float(odo.get("latency") or 0.0) + odometer_window_s(datasheet, speed)
 
 
-def odometer_window_s(datasheet: Mapping[str, Any]) -> float:
-    """Half the interval a counted speed is the mean over, s (module docstring): the share of
-    ``odometer_delay_s`` beyond the latency, and its spread (0 for an instantaneous speed)."""
+def odometer_window_s(datasheet: Mapping[str, Any], speed: float = math.inf) -> float:
+    """The share of ``odometer_delay_s`` beyond the latency, and its spread, s (module
+    docstring): half the interval a counted speed is the mean over; for a CAN speed timed by
+    its tooth edges (``tooth_timing``) at a reading ``speed`` (m/s, not 0) the larger of that
+    and the edges' spacing in time; 0 for an instantaneous speed."""
     odo = datasheet.get("odometer") or {}
-    if float(odo.get("ticks_per_meter") or 0.0) > 0:
-        return 0.5 / float(odo.get("rate") or 10.0)
-    return 0.0
+    ticks = float(odo.get("ticks_per_meter") or 0.0)
+    if ticks <= 0:
+        return 0.0
+    half = 0.5 / float(odo.get("rate") or 10.0)
+    if odo.get("tooth_timing") and speed != 0.0:
+        return max(half, 1.0 / (ticks * abs(speed)))
+    return half
