@@ -76,10 +76,11 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   IMU (``toolbox.datasheet``), and the states Park's model lacks, without which it claimed a
   confidence it did not have (0.12 deg of roll against 5 deg of error on the quickstart): the
   fix's drive-long error (north, east and, in 3-D, down; ``toolbox.datasheet.
-  fix_error_model``: unit states whose gain at each fix is the part of the fix's reported
-  accuracy beyond the budget's smoothed noise, capped at the budget's correlated part,
-  ``FixErrorModel.correlated_gain``; sized by the budget alone, 2.2 m of range error, the
-  position was too cautious on open sky; its white remainder as the GPS noise);
+  fix_error_model``: unit states whose gain at each fix is the drive-long part of the fix's
+  reported accuracy, per unit DOP the smallest report so far less the budget's smoothed
+  noise, capped at the budget's correlated part, ``FixSplit``; sized by the budget alone,
+  2.2 m of range error, the position was too cautious on open sky; its white remainder as
+  the GPS noise);
   in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
   dominant error) and the barometer offset's error (set at the first good fix, a random walk
   of the datasheet's weather drift; its white noise the sensor's); in 2-D the z gyro's
@@ -107,9 +108,9 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   factor is bias process noise (a helix turns it into yaw); each fix row passes a chi-square
   gate (0.999) against reflected canyon heights. Both filters read the fix's own accuracy
   (``std_*`` of ``gnss_fix``, ``toolbox.datasheet.FixAccuracy``): its velocity 1-sigma sets the
-  speed's and the course's noise, and its position 1-sigma beyond the budget (the reflected
-  signals of a street canyon) is carried by unit NLOS states (north, east and, in 3-D, down;
-  ``FixErrorModel.nlos_split``): on the SUMO canyon's seeds 1-2 dr3d_ekf's height went from
+  speed's and the course's noise, and its position 1-sigma beyond its drive-long and smoothed
+  parts (the reflected signals of a street canyon) is carried by unit NLOS states (north, east
+  and, in 3-D, down; ``FixSplit``): on the SUMO canyon's seeds 1-2 dr3d_ekf's height went from
   11 / 27 to 1.0 / 2.3 and dr2d_odo_ekf's north from 10 / 2.5 to 0.7 / 1.1.
 
 Public names
@@ -130,6 +131,7 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
+    FixSplit,
     fix_error_model,
     ground_track_sigma,
     imu_error_model,
@@ -478,6 +480,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         the datasheet's IMU (``toolbox.datasheet``) and P0 with the six added states."""
         imu = self._imu_model = imu_error_model(self.datasheet)
         self._fix_model = fix_error_model(self.datasheet)
+        self._fix_split = FixSplit(self._fix_model)
         baro = self.datasheet.get("baro") or {}
         self._baro_rate_sigma = float(baro.get("weather_drift") or 0.0) * METRES_PER_PASCAL
         self._baro_noise = math.hypot(float(baro.get("noise") or 0.0),
@@ -522,12 +525,13 @@ class Dr3dEkf(_OdometerDeadReckoning):
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
         dops = float(row[fx.hdop]), float(row[fx.vdop])
         std_pos, speed_sigma, cross_sigma = fx.reported(row)
+        if self._sheet:  # the report's drive-long part, reflected excess and white noise
+            correlated, gain, white = self._fix_split.split(std_pos, *dops)
         if good_height and math.isfinite(self._baro_h):
             if self._sheet and self._baro_offset is None:  # the offset's error is a state
                 self._baro_offset = self._baro_h - alt
                 self._reset_states(slice(BARO, BARO + 1), np.sqrt(
-                    self._fix_model.correlated_gain(std_pos, *dops)[2:] ** 2
-                    + self._fix_model.white_sigma(*dops)[2:] ** 2))
+                    correlated[2:] ** 2 + self._fix_model.white_sigma(*dops)[2:] ** 2))
             elif not self._sheet:
                 self._track_baro_offset(t, self._baro_h - alt)
         n = 3 if good_height else 2
@@ -535,11 +539,9 @@ class Dr3dEkf(_OdometerDeadReckoning):
         dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=n_x)
         var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
         if self._sheet:  # the fix is the truth plus its drive-long error, plus white noise
-            correlated = self._fix_model.correlated_gain(std_pos, *dops)
             dz += correlated * self._fix_error
             h_pos[:, FIX] = np.diag(correlated)
-            gain, white = self._fix_model.nlos_split(std_pos, *dops)
-            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:n])
+            var = list(white[:n])
             dz += gain * self._nlos
             h_pos[:, NLOS] = np.diag(gain)
         keep = np.arange(n)
@@ -845,6 +847,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
             gyro_noise, bias_sigma, bias_tau, bias_initial = (
                 imu.gyro_noise, imu.gyro_bias_sigma, imu.gyro_bias_tau, imu.gyro_bias_initial)
             self._fix_model = fix_error_model(self.datasheet)
+            self._fix_split = FixSplit(self._fix_model)
             self._gyro_scale = imu.gyro_scale_sigma
             self._rate = 0.0
         p0 = np.zeros((n, n))
@@ -855,7 +858,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._q_c = np.zeros(n)
         if self._sheet:
             # the fix's drive-long north, east error: unit states, their gain the part of the
-            # fix's reported accuracy (toolbox.datasheet.FixErrorModel.correlated_gain)
+            # fix's reported accuracy (toolbox.datasheet.FixSplit)
             p0[5:7, 5:7] = np.eye(2)
             self._f[5:7, 5:7] = np.eye(2) * (-1.0 / self._fix_model.correlated_tau)
             self._q_c[5:7] = 2.0 / self._fix_model.correlated_tau
@@ -922,11 +925,10 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         if self._sheet:  # the fix is the truth plus its drive-long error, plus white noise
             dops = float(row[fx.hdop]), float(row[fx.vdop])
             std_pos, speed_sigma, _ = fx.reported(row)
-            correlated = self._fix_model.correlated_gain(std_pos, *dops)[:2]
-            dz = dz + correlated * self._fix_error
-            h[:, 5:7] = np.diag(correlated)
-            gain, white = self._fix_model.nlos_split(std_pos, *dops)
-            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:2])
+            correlated, gain, white = self._fix_split.split(std_pos, *dops)
+            dz = dz + correlated[:2] * self._fix_error
+            h[:, 5:7] = np.diag(correlated[:2])
+            var = list(white[:2])
             dz = dz + gain[:2] * self._nlos
             h[:, 7:9] = np.diag(gain[:2])
             speed_var = (speed_sigma if math.isfinite(speed_sigma)

@@ -68,7 +68,7 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
   +1 to +7 m height offset of a single-frequency fix is this error, docs/gnss-errors.md):
   unit states whose gain at each fix is the part of the fix's reported accuracy beyond the
   budget's smoothed noise, capped at the budget's correlated part
-  (``FixErrorModel.correlated_gain``; sized by the budget alone, 2.2 m of range error, the
+  (``toolbox.datasheet.FixSplit``; sized by the budget alone, 2.2 m of range error, the
   position was too cautious on open sky, where the report is smaller), plus the white
   equivalent of its smoothed noise, and its velocity at 0.05 m/s per range rate times the
   DOP, each behind a chi-square gate (0.999; after five rejections in a row the next fix is
@@ -79,9 +79,9 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
   dead reckoning between reflected fixes claimed 0.04 m/s against a 0.1 m/s north velocity
   error, vn (error / sigma)^2 3.7-3.8 on seeds 1-2, 1.9-2.4 with the state). The fix's own
   accuracy (``std_*``, ``toolbox.datasheet.FixAccuracy``) sets its velocity noise, and its
-  position 1-sigma beyond the budget (reflected signals) is carried by three unit NLOS states
-  after the fix's (``FixErrorModel.nlos_split``): the canyon's height went from 6.0-6.5 to
-  0.14-0.39 (seeds 1-2).
+  position 1-sigma beyond its drive-long and smoothed parts (reflected signals) is carried
+  by three unit NLOS states after the fix's (``FixSplit``): the canyon's height went from
+  6.0-6.5 to 0.14-0.39 (seeds 1-2).
   With a datasheet that gives the gyros' scale factor, three yaw-response states follow the
   15 (``InsFilter``'s: the z gyro's scale factor and the x and y gyros' misalignment towards
   z, random constants of the datasheet's 1-sigma; ``yaw_response_states: false`` leaves them
@@ -135,6 +135,7 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
+    FixSplit,
     fix_error_model,
     fix_position_rows,
     fix_velocity_sigma,
@@ -268,6 +269,7 @@ class ParkInsOdometer(Estimator):
         p0 = self.P0_SIGMA.copy()
         p0[9:12], p0[12:15] = imu.accel_bias_initial, imu.gyro_bias_initial
         self._fix_model = fix_error_model(self.datasheet)
+        self._fix_split = FixSplit(self._fix_model)
         self._odo_sigma = odometer_speed_sigma(self.datasheet)
         self._odo_still_sigma = odometer_speed_sigma(self.datasheet, 0.0)
         odo_rate = float((self.datasheet.get("odometer") or {}).get("rate") or 10.0)
@@ -301,10 +303,10 @@ class ParkInsOdometer(Estimator):
             return
         dops = [float(row[i]) if i is not None else math.nan for i in self._dop]
         model = self._fix_model
-        # the fix's drive-long error and the error it reports beyond the budget
+        # the fix's drive-long error and the error it reports beyond it
         # (reflections): unit states, their gains from its reported accuracy
         std_pos, std_vel = self._accuracy.read(row)
-        r_p = fix_position_rows(model, std_pos, *dops, dz_p, h_p, ins.extra[:6],
+        r_p = fix_position_rows(self._fix_split, std_pos, *dops, dz_p, h_p, ins.extra[:6],
                                 ins.extra_start)
         # a fix that does not fit (a reflected signal's metres) is left out, not averaged in
         ins.gated_update(dz_p, h_p, r_p, GATE_PROBABILITY)

@@ -33,38 +33,45 @@ that tunes itself "from the datasheet" means the same thing.
     latitude, longitude and altitude errors, or u-blox's hAcc and vAcc: the pseudorange errors'
     statistics mapped into the position, G Sigma G^T of the weighted least squares, Misra &
     Enge 2011, section 6.1, the whole error with no split by time behaviour): its velocity
-    1-sigma replaces the datasheet's. Its position 1-sigma r sizes the drive-long part at each
-    fix (``FixErrorModel.correlated_gain``): the report's variance less the budget's smoothed
-    part, r^2 - (s DOP)^2, capped at the budget's correlated part (c DOP)^2. The budget cannot
-    know the hour or the sky: its correlated 2.2 m of range error (the ``automotive``
+    1-sigma replaces the datasheet's. Its position 1-sigma r sizes the drive-long part
+    (``FixSplit``): per axis and unit DOP, the smallest report so far less the budget's
+    smoothed part, sqrt(r^2 - (s DOP)^2) / DOP, at most the budget's correlated range error c.
+    The budget cannot know the hour or the sky: its correlated 2.2 m (the ``automotive``
     receiver) is a bound for a midday ionosphere, while the fix's report holds the day's
     broadcast delays and the satellites' geometry per axis (on the unseen ``open_road``, seed
     1, the report per unit DOP (HDOP / sqrt(2) horizontally) is 1.98 m north, 1.63 m east,
     2.47 m down at its median, on ``sumo_city`` 1.84, 1.31 and 2.05; the simulated fixes'
     realised error per unit DOP over twenty seeds, ``simulator.datasheet``, 1.2-1.35 m
-    horizontally), so a filter sized by the
-    budget alone was too cautious horizontally on open sky (mean (error / sigma)^2 0.06-0.1
-    on some drives' north or east). The receiver's report in the first epochs after a start
-    is large (the carrier smoothing not yet converged: 4.05 m per DOP north at the first fix
-    of ``open_road`` seed 1), so the part is not sized once at the first fix: a filter
-    carries it as a unit-variance Gauss-Markov state per axis whose fix row is the gain
-    times the state, e = g_k u (as the reflected-fix states below). Its position 1-sigma
-    beyond the budget's (``FixErrorModel.excess_sigma``: the variance over
-    the correlated and smoothed parts at the DOPs) is error the budget does not hold, the
-    reflected (NLOS) signals of a street canyon. That excess is not white: a reflection's extra
-    path lasts while the street's geometry does (the fixes of the simulated canyons, their
-    error over the excess: the height's stays near -1.2 for minutes, the horizontal's
-    correlation is 0.2-0.6 after 20 s and 0.0-0.4 after 40 s, seeds 1-5 of canyon,
-    urban_canyon and sumo_city_canyon), so a filter carries it as states: a unit-variance
-    first-order Gauss-Markov u per axis of correlation time ``NLOS_TIME_CONSTANT_S`` whose
-    fix row is the excess, e = excess_k u (a known time-varying gain on a stationary process:
-    zero on open sky, where u is unobserved and inert). Not all of it is slow: from one epoch
-    to the next the horizontal error over the excess keeps a correlation of only 0.4-0.8 (the
-    set of reflected satellites changes), the height's 0.8-0.9. ``FixErrorModel.nlos_split``
-    gives the share ``NLOS_WHITE_SHARE`` of the excess variance (north, east, down: 0.5, 0.5,
-    0.1, the drives' lag-one correlation rounded down) to the fix's white noise and the rest
-    to the states' gain; with all of it slow the filter read the epoch-to-epoch jumps as
-    motion (the unseen canyon's 2-D yaw error 2-3 deg against a sigma of 0.7-1 deg).
+    horizontally), so a filter sized by the budget alone was too cautious horizontally on
+    open sky (mean (error / sigma)^2 0.04-0.1 on some drives' north or east). Why the
+    smallest: the drive-long error (ionosphere, orbits) changes over tens of minutes, while
+    the report rises from one epoch to the next with the signals the receiver suspects (a
+    faded direct signal's share of a reflection's extra path: 1.3-2.5 m per VDOP from one
+    fix to the next on the unseen canyon's open stretches, seed 1; the first fixes, before
+    the carrier smoothing converges: 4.05 m per DOP north at the first fix of ``open_road``
+    seed 1); those rises are the excess below, not a larger drive-long error (taken as the
+    drive-long part at each fix, the report's jumps moved the filter's modelled fix error
+    with them: the unseen canyon's height (error / sigma)^2 0.31 -> 4.1, seeds 1-3). A filter
+    carries the part as a unit-variance Gauss-Markov state per axis whose fix row is its
+    1-sigma at the fix's DOPs times the state, e = g_k u (as the reflected-fix states
+    below). The report's variance beyond that part and the smoothed one
+    (``FixErrorModel.excess_sigma``: beyond the budget, for a filter that takes the budget's
+    correlated part) is error the budget does not hold, the reflected (NLOS) signals of a
+    street canyon. That excess
+    is not white: a reflection's extra path lasts while the street's geometry does (the fixes of
+    the simulated canyons, their error over the excess: the height's stays near -1.2 for
+    minutes, the horizontal's correlation is 0.2-0.6 after 20 s and 0.0-0.4 after 40 s, seeds
+    1-5 of canyon, urban_canyon and sumo_city_canyon), so a filter carries it as states: a
+    unit-variance first-order Gauss-Markov u per axis of correlation time
+    ``NLOS_TIME_CONSTANT_S`` whose fix row is the excess, e = excess_k u (a known time-varying
+    gain on a stationary process: zero on open sky, where u is unobserved and inert). Not all of
+    it is slow: from one epoch to the next the horizontal error over the excess keeps a
+    correlation of only 0.4-0.8 (the set of reflected satellites changes), the height's 0.8-0.9.
+    ``FixErrorModel.nlos_split`` gives the share ``NLOS_WHITE_SHARE`` of the excess variance
+    (north, east, down: 0.5, 0.5, 0.1, the drives' lag-one correlation rounded down) to the
+    fix's white noise and the rest to the states' gain; with all of it slow the filter read the
+    epoch-to-epoch jumps as motion (the unseen canyon's 2-D yaw error 2-3 deg against a sigma of
+    0.7-1 deg).
 
 * ``odometer_speed_sigma``: the white 1-sigma of an odometer's speed: the tick count's
   quantisation, 1 / (``ticks_per_meter`` dt) over an interval dt = 1 / ``rate``, uniform, so
@@ -89,7 +96,8 @@ that tunes itself "from the datasheet" means the same thing.
 
 Public names
 ------------
-ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, fix_position_rows,
+ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, FixSplit,
+fix_position_rows,
 fix_velocity_sigma, ground_track_sigma, odometer_speed_sigma, odometer_delay_s, odometer_window_s,
 CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S.
 """
@@ -195,16 +203,6 @@ class FixErrorModel:
         """NED 1-sigma (m) of the drive-long correlated error at these DOPs."""
         return self.correlated_range * _axes(hdop, vdop)
 
-    def correlated_gain(self, reported: np.ndarray, hdop: float, vdop: float) -> np.ndarray:
-        """NED 1-sigma (m) of the drive-long error of a fix that reports its own position
-        1-sigma ``reported`` (module docstring): sqrt(r^2 - (s DOP)^2), within 0 and
-        ``correlated_sigma``; ``correlated_sigma`` on an axis whose report is not finite."""
-        axes = _axes(hdop, vdop)
-        budget = self.correlated_range * axes
-        own = np.asarray(reported, dtype=float) ** 2 - (self.smoothed_range * axes) ** 2
-        return np.where(np.isfinite(own), np.sqrt(np.clip(np.nan_to_num(own), 0.0, budget**2)),
-                        budget)
-
     def white_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m) of the white-equivalent remainder at these DOPs."""
         return self.white_range * _axes(hdop, vdop)
@@ -262,22 +260,49 @@ class FixAccuracy:
         return std[:3], std[3:]
 
 
-def fix_position_rows(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float,
+class FixSplit:
+    """A fix stream's reported position 1-sigma split by time behaviour (module docstring),
+    fix after fix: the drive-long part (its 1-sigma per unit DOP the smallest report so far
+    less the smoothed part, at most the budget's correlated range error), the budget's
+    smoothed part, and the excess beyond both (the reflected fixes' states' gain and the
+    white share, ``NLOS_WHITE_SHARE``)."""
+
+    def __init__(self, model: FixErrorModel):
+        self.model = model
+        self.range_m = np.full(3, model.correlated_range)  # drive-long, per unit DOP, NED
+
+    def split(self, reported: np.ndarray, hdop: float, vdop: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(drive-long 1-sigma (3,), m; the reflected-fix states' gain (3,), m; the white
+        noise's variance (3,), m^2) of a fix of ``reported`` position 1-sigma (NED; NaN: no
+        report on that axis, the budget's part and no excess) at its DOPs."""
+        model = self.model
+        axes = _axes(hdop, vdop)
+        report2 = np.asarray(reported, dtype=float) ** 2
+        smoothed2 = (model.smoothed_range * axes) ** 2
+        finite = np.isfinite(report2)
+        own = np.sqrt(np.maximum(np.where(finite, report2, 0.0) - smoothed2, 0.0)) / axes
+        self.range_m = np.where(finite, np.minimum(self.range_m, own), self.range_m)
+        gain = self.range_m * axes
+        excess2 = np.where(finite, np.maximum(report2 - gain**2 - smoothed2, 0.0), 0.0)
+        return (gain, np.sqrt((1.0 - NLOS_WHITE_SHARE) * excess2),
+                model.white_sigma(hdop, vdop) ** 2 + NLOS_WHITE_SHARE * excess2)
+
+
+def fix_position_rows(fix_split: FixSplit, reported: np.ndarray, hdop: float, vdop: float,
                       dz: np.ndarray, h: np.ndarray, states: np.ndarray, first: int
                       ) -> np.ndarray:
     """A fix's position rows with its error states (module docstring): six unit states, the
     drive-long error's (north, east, down) at column ``first`` and the reflected fixes' after
     them, of estimate ``states`` (6,). Adds their part e = g u to the innovation rows ``dz``
-    (3,) and to ``h`` (3, n) in place, the gains ``FixErrorModel.correlated_gain`` and the
-    excess's (``FixErrorModel.nlos_split``) of the fix's ``reported`` position 1-sigma, and
-    returns the rows' noise covariance (3, 3): the white remainder at the DOPs and the
-    excess's white share."""
-    correlated = model.correlated_gain(reported, hdop, vdop)
-    nlos, white = model.nlos_split(reported, hdop, vdop)
+    (3,) and to ``h`` (3, n) in place, the gains ``FixSplit.split`` gives for the fix's
+    ``reported`` position 1-sigma, and returns the rows' noise covariance (3, 3): the white
+    remainder at the DOPs and the excess's white share."""
+    correlated, nlos, white = fix_split.split(reported, hdop, vdop)
     dz += correlated * states[:3] + nlos * states[3:6]
     h[:, first:first + 3] = np.diag(correlated)
     h[:, first + 3:first + 6] = np.diag(nlos)
-    return np.diag(model.white_sigma(hdop, vdop) ** 2 + white)
+    return np.diag(white)
 
 
 def fix_velocity_sigma(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float
