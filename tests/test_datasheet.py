@@ -69,39 +69,41 @@ def test_an_ideal_receiver_has_no_error_and_the_filters_keep_a_floor():
 
 
 def test_fix_split_takes_the_smallest_report_as_the_drive_long_part():
-    """Per axis and unit DOP (HDOP / sqrt(2) north and east, VDOP down): the drive-long part is
-    the smallest report so far less the smoothed part, at most the budget's correlated range;
-    what a later, larger report holds beyond it and the smoothed part is the reflected
-    excess, split into the states' gain and the white share; an axis without a report keeps
-    its part and has no excess."""
+    """Per horizontal axis and unit DOP (HDOP / sqrt(2)): the drive-long part is the smallest
+    report so far less the smoothed part, at most the budget's correlated range; down (VDOP)
+    it is the budget's. What a report holds beyond the part and the smoothed noise is the
+    reflected excess, split into the states' gain and the white share; an axis without a
+    report keeps its part and has no excess."""
     model = fix_error_model({"gnss": AUTOMOTIVE})
     c, s = model.correlated_range, model.smoothed_range
     split = FixSplit(model)
     hdop, vdop = math.sqrt(2.0), 2.0  # unit DOP per horizontal axis, 2 down
     axes = np.array([1.0, 1.0, 2.0])
     white = model.white_sigma(hdop, vdop) ** 2
+
+    def check(report, dops, part):
+        gain, nlos, noise = split.split(report, *dops)
+        scale = np.array([dops[0] / math.sqrt(2.0)] * 2 + [dops[1]])
+        np.testing.assert_allclose(gain, part * scale)
+        excess2 = np.where(np.isfinite(report), np.maximum(
+            np.nan_to_num(report) ** 2 - (part**2 + s**2) * scale**2, 0.0), 0.0)
+        np.testing.assert_allclose(nlos**2, (1 - NLOS_WHITE_SHARE) * excess2, atol=1e-12)
+        np.testing.assert_allclose(noise, model.white_sigma(*dops) ** 2
+                                   + NLOS_WHITE_SHARE * excess2)
+        return excess2
+
     # a first fix above the budget (the carrier smoothing not yet converged): the budget's
     # part, the rest excess
-    first = np.array([4.0, 4.0, 9.0])
-    gain, nlos, noise = split.split(first, hdop, vdop)
-    np.testing.assert_allclose(gain, c * axes)
-    excess2 = first**2 - (c**2 + s**2) * axes**2
-    np.testing.assert_allclose(nlos, np.sqrt((1 - NLOS_WHITE_SHARE) * excess2))
-    np.testing.assert_allclose(noise, white + NLOS_WHITE_SHARE * excess2)
-    # a clean open-sky report below the budget: its part beyond the smoothed noise
+    excess2 = check(np.array([4.0, 4.0, 9.0]), (hdop, vdop), np.full(3, c))
+    np.testing.assert_allclose(excess2, np.array([16.0, 16.0, 81.0]) - (c**2 + s**2) * axes**2)
+    # a clean open-sky report below the budget: north and east its part beyond the smoothed
+    # noise, no excess; down the budget's part, its report within it
     clean = np.array([1.5, 1.2, 3.0])
-    gain, nlos, noise = split.split(clean, hdop, vdop)
-    np.testing.assert_allclose(gain, np.sqrt(clean**2 - s**2 * axes**2))
-    np.testing.assert_allclose(nlos, 0.0, atol=1e-12)
-    np.testing.assert_allclose(noise, white)
+    part = np.r_[np.sqrt(clean[:2] ** 2 - s**2), c]
+    excess2 = check(clean, (hdop, vdop), part)
+    np.testing.assert_allclose(excess2, 0.0, atol=1e-12)
+    assert np.allclose(split.split(clean, hdop, vdop)[2], white)
     # a report that rises again (a faded signal) is excess over the part, which stays; the
     # down axis unreported keeps its part; a DOP twice as large doubles the part
-    rise = np.array([4.0, 3.0, np.nan])
-    part = np.sqrt(clean**2 - s**2 * axes**2) / axes
-    gain, nlos, noise = split.split(rise, 2.0 * hdop, 2.0 * vdop)
-    np.testing.assert_allclose(gain, 2.0 * axes * part)
-    excess2 = np.r_[rise[:2] ** 2 - (2.0 * part[:2]) ** 2 - (2.0 * s) ** 2, 0.0]
-    assert (excess2[:2] > 0).all()
-    np.testing.assert_allclose(nlos**2, (1 - NLOS_WHITE_SHARE) * excess2, atol=1e-12)
-    np.testing.assert_allclose(noise, model.white_sigma(2 * hdop, 2 * vdop) ** 2
-                               + NLOS_WHITE_SHARE * excess2)
+    excess2 = check(np.array([4.0, 3.0, np.nan]), (2.0 * hdop, 2.0 * vdop), part)
+    assert (excess2[:2] > 0).all() and excess2[2] == 0.0
