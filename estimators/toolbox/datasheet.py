@@ -62,8 +62,8 @@ that tunes itself "from the datasheet" means the same thing.
     (4.8), ``ins_lkf`` 0.78 (1.6) -> 4.0 (7.0), seeds 1-3, mean (largest)); the budget's
     larger part covers that pull. A filter
     carries the part as a unit-variance Gauss-Markov state per axis whose fix row is its
-    1-sigma at the fix's DOPs times the state, e = g_k u (as the reflected-fix states
-    below). The report's variance beyond that part and the smoothed one
+    1-sigma at the first fix's DOPs times the state, e = g_k u, g_k shrinking with the
+    smallest report. The report's variance beyond that part and the smoothed one
     (``FixErrorModel.excess_sigma``: beyond the budget, for a filter that takes the budget's
     correlated part) is error the budget does not hold, the reflected (NLOS) signals of a
     street canyon. That excess
@@ -281,12 +281,15 @@ class FixSplit:
     def __init__(self, model: FixErrorModel):
         self.model = model
         self.range_m = np.full(3, model.correlated_range)  # drive-long, per unit DOP, NED
+        self.first_axes: np.ndarray | None = None  # the first fix's DOP per axis
 
     def split(self, reported: np.ndarray, hdop: float, vdop: float
               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(drive-long 1-sigma (3,), m; the reflected-fix states' gain (3,), m; the white
-        noise's variance (3,), m^2) of a fix of ``reported`` position 1-sigma (NED; NaN: no
-        report on that axis, the budget's part and no excess) at its DOPs."""
+        """(drive-long 1-sigma (3,), m, at the first fix's DOPs (the states' size, as a
+        filter sized them once before: scaled by each fix's DOPs, a street canyon's jumps of
+        VDOP from 1.7 to 5.5 moved the modelled error with them); the reflected-fix states'
+        gain (3,), m; the white noise's variance (3,), m^2) of a fix of ``reported`` position
+        1-sigma (NED; NaN: no report on that axis, no excess) at its DOPs."""
         model = self.model
         axes = _axes(hdop, vdop)
         report2 = np.asarray(reported, dtype=float) ** 2
@@ -295,9 +298,11 @@ class FixSplit:
         own = np.sqrt(np.maximum(np.where(finite, report2, 0.0) - smoothed2, 0.0)) / axes
         self.range_m = np.where(finite & REPORTED_AXES, np.minimum(self.range_m, own),
                                 self.range_m)
-        gain = self.range_m * axes
-        excess2 = np.where(finite, np.maximum(report2 - gain**2 - smoothed2, 0.0), 0.0)
-        return (gain, np.sqrt((1.0 - NLOS_WHITE_SHARE) * excess2),
+        if self.first_axes is None:
+            self.first_axes = axes
+        excess2 = np.where(finite, np.maximum(report2 - (self.range_m * axes) ** 2 - smoothed2,
+                                              0.0), 0.0)
+        return (self.range_m * self.first_axes, np.sqrt((1.0 - NLOS_WHITE_SHARE) * excess2),
                 model.white_sigma(hdop, vdop) ** 2 + NLOS_WHITE_SHARE * excess2)
 
 
