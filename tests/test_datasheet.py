@@ -71,9 +71,10 @@ def test_an_ideal_receiver_has_no_error_and_the_filters_keep_a_floor():
 def test_fix_split_takes_the_smallest_report_as_the_drive_long_part():
     """Per horizontal axis and unit DOP (HDOP / sqrt(2)): the drive-long part is the smallest
     report so far less the smoothed part, at most the budget's correlated range; down (VDOP)
-    it is the budget's. What a report holds beyond the part and the smoothed noise is the
-    reflected excess, split into the states' gain and the white share; an axis without a
-    report keeps its part and has no excess."""
+    it is the budget's; its 1-sigma is taken at the first fix's DOPs. What a report holds
+    beyond the part and the smoothed noise at its own DOPs is the reflected excess, split
+    into the states' gain and the white share; an axis without a report keeps its part and
+    has no excess."""
     model = fix_error_model({"gnss": AUTOMOTIVE})
     c, s = model.correlated_range, model.smoothed_range
     split = FixSplit(model)
@@ -84,7 +85,7 @@ def test_fix_split_takes_the_smallest_report_as_the_drive_long_part():
     def check(report, dops, part):
         gain, nlos, noise = split.split(report, *dops)
         scale = np.array([dops[0] / math.sqrt(2.0)] * 2 + [dops[1]])
-        np.testing.assert_allclose(gain, part * scale)
+        np.testing.assert_allclose(gain, part * axes)  # the first fix's DOPs
         excess2 = np.where(np.isfinite(report), np.maximum(
             np.nan_to_num(report) ** 2 - (part**2 + s**2) * scale**2, 0.0), 0.0)
         np.testing.assert_allclose(nlos**2, (1 - NLOS_WHITE_SHARE) * excess2, atol=1e-12)
@@ -104,6 +105,7 @@ def test_fix_split_takes_the_smallest_report_as_the_drive_long_part():
     np.testing.assert_allclose(excess2, 0.0, atol=1e-12)
     assert np.allclose(split.split(clean, hdop, vdop)[2], white)
     # a report that rises again (a faded signal) is excess over the part, which stays; the
-    # down axis unreported keeps its part; a DOP twice as large doubles the part
+    # down axis unreported keeps its part; at twice the DOPs the excess is over twice the
+    # part's 1-sigma, the states' size stays
     excess2 = check(np.array([4.0, 3.0, np.nan]), (2.0 * hdop, 2.0 * vdop), part)
     assert (excess2[:2] > 0).all() and excess2[2] == 0.0

@@ -49,29 +49,28 @@ that tunes itself "from the datasheet" means the same thing.
     faded direct signal's share of a reflection's extra path: 1.3-2.5 m per VDOP from one
     fix to the next on the unseen canyon's open stretches, seed 1; the first fixes, before
     the carrier smoothing converges: 4.05 m per DOP north at the first fix of ``open_road``
-    seed 1); those rises are the excess below, not a larger drive-long error (taken as the
-    drive-long part at each fix, the report's jumps moved the filter's modelled fix error
-    with them: the unseen canyon's height (error / sigma)^2 0.31 -> 4.1, seeds 1-3). Only
-    north and east (``REPORTED_AXES``): the height keeps the budget's part, because a street
-    canyon's reflections sink the fix (an extra path is never negative, so their mean adds
-    up in the height and the clock, ``simulator.datasheet.nlos_delay_moments``), which the
-    excess's zero-mean states below do not hold; sized by the report the height's drive-long
-    part was 1.3-1.5 m per VDOP on open stretches, and the reflected fixes of a canyon pulled
-    the filter's height 2-3 m down under a sigma of 2.1 m that the clean fixes after it then
-    held (the unseen canyon's height (error / sigma)^2 ``ins_odo_ekf`` 0.31 (0.49) -> 3.2
-    (4.8), ``ins_lkf`` 0.78 (1.6) -> 4.0 (7.0), seeds 1-3, mean (largest)); the budget's
-    larger part covers that pull. A filter
-    carries the part as a unit-variance Gauss-Markov state per axis whose fix row is its
-    1-sigma at the first fix's DOPs times the state, e = g_k u, g_k shrinking with the
+    seed 1); those rises are the excess below, not a larger drive-long error (taken at each
+    fix, with the states' gain at each fix's DOPs, the report's jumps and a canyon's jumps of
+    VDOP, 1.7 to 5.5, moved the filter's modelled fix error with them: the unseen canyon's
+    height (error / sigma)^2 0.31 -> 4.1, seeds 1-3). Only north and east
+    (``REPORTED_AXES``): the height keeps the budget's part. A street canyon's reflections
+    sink the fix (an extra path is never negative, so their mean adds up in the height and the
+    clock, ``simulator.datasheet.nlos_delay_moments``), which the excess's zero-mean states
+    below do not hold: its reflected fixes pulled the filter's height 2-3 m down (seed 2), which the
+    budget's larger part covers; with the height's part from the report (1.3-1.5 m per VDOP
+    on the canyon's open stretches) the unseen canyon's seed 2 height (error / sigma)^2 was
+    1.3 (``ins_odo_ekf``) and 2.0 (``ins_lkf``), against 0.44 and 0.68 with the budget's (seed 1:
+    0.02 and 0.06 against 0.004 and 0.09): within the goal either way, kept on the budget. The
+    filters carry the part as a unit-variance Gauss-Markov state per axis whose fix row is
+    its 1-sigma at the first fix's DOPs times the state, e = g_k u, g_k shrinking with the
     smallest report. The report's variance beyond that part and the smoothed one
     (``FixErrorModel.excess_sigma``: beyond the budget, for a filter that takes the budget's
-    correlated part) is error the budget does not hold, the reflected (NLOS) signals of a
-    street canyon. That excess
-    is not white: a reflection's extra path lasts while the street's geometry does (the fixes of
-    the simulated canyons, their error over the excess: the height's stays near -1.2 for
-    minutes, the horizontal's correlation is 0.2-0.6 after 20 s and 0.0-0.4 after 40 s, seeds
-    1-5 of canyon, urban_canyon and sumo_city_canyon), so a filter carries it as states: a
-    unit-variance first-order Gauss-Markov u per axis of correlation time
+    correlated part) is error the budget does not hold, the reflected (NLOS) signals of a street
+    canyon. That excess is not white: a reflection's extra path lasts while the street's
+    geometry does (the fixes of the simulated canyons, their error over the excess: the height's
+    stays near -1.2 for minutes, the horizontal's correlation is 0.2-0.6 after 20 s and 0.0-0.4
+    after 40 s, seeds 1-5 of canyon, urban_canyon and sumo_city_canyon), so a filter carries it
+    as states: a unit-variance first-order Gauss-Markov u per axis of correlation time
     ``NLOS_TIME_CONSTANT_S`` whose fix row is the excess, e = excess_k u (a known time-varying
     gain on a stationary process: zero on open sky, where u is unobserved and inert). Not all of
     it is slow: from one epoch to the next the horizontal error over the excess keeps a
