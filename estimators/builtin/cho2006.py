@@ -335,6 +335,7 @@ class _ChoDr(Estimator):
         self._matching = FixNoiseMatching()
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
         self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
+        self._fix_sized = not self._datasheet  # the fix-error states sized at a first fix
         x0 = self._initial_state()
         self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
                            self._tuning.p0.copy())
@@ -353,7 +354,8 @@ class _ChoDr(Estimator):
         """Q (variance growth per second) over a step with inputs ``u``."""
         return self._tuning.q
 
-    _fix_states = 0  # the fix's correlated error states after the bias states (DRM1)
+    _fix_states = 2  # the fix's correlated north and east error, the last states (datasheet)
+    _velocity_needs_heading = False  # velocity rows only once the heading is found (DRM2)
 
     @property
     def _bias_states(self) -> int:
@@ -496,6 +498,14 @@ class _ChoDr(Estimator):
             return
         x, p = self._predicted()
         std_pos, std_vel = self._accuracy.read(row)
+        if not self._fix_sized and math.isfinite(hdop):
+            self._size_fix_states(self._fix_model.reported_drive_long_sigma(
+                std_pos, hdop, math.nan)[:2])
+            x, p = self._predicted()
+        if (np.isfinite(std_vel[:2]).all()
+                and not (self._velocity_needs_heading and p[4, 4] >= ALIGNED_HEADING_VAR)):
+            self._velocity_update(z[:2], np.array([vn, ve]), std_pos, std_vel[:2], hdop, x, p)
+            return
         z[2], speed_sigma = self._fix_speed(vn, ve, x, std_vel)
         reported = bool(np.isfinite(std_pos[:2]).all())
         excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan) if reported else None
@@ -512,6 +522,60 @@ class _ChoDr(Estimator):
         self._update(z, r)
         if not reported:  # the fix's scatter learnt from its innovations instead
             self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
+
+    def _velocity_update(self, pos: np.ndarray, vel: np.ndarray, std_pos: np.ndarray,
+                         std_vel: np.ndarray, hdop: float, x: np.ndarray, p: np.ndarray
+                         ) -> None:
+        """A fix that reports its velocity's 1-sigma ``std_vel`` (datasheet tuning): its north
+        and east position ``pos`` and velocity ``vel`` (``_fix_rows``). The position is the
+        truth plus the fix's correlated error (two states, ``_size_fix_states``) plus the
+        budget's white part and the reported excess (reflections) as white noise; the
+        velocity's noise is the reported one (and the IMU's lateral velocity error across the
+        heading, ``_velocity_noise``). Weighted as eq. 35 weighs the fixes until the heading
+        is found, and down to the 99.9 % gate beyond it, as ``on_gnss_fix``."""
+        white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
+        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
+        r = np.zeros((4, 4))
+        r[[0, 1], [0, 1]] = white + excess
+        aligned = p[4, 4] < ALIGNED_HEADING_VAR
+        if not aligned:
+            r[[0, 1], [0, 1]] = np.maximum(r[[0, 1], [0, 1]], PAPER_R.diagonal()[:2])
+        r[2:, 2:] = self._velocity_noise(x, np.maximum(std_vel, MIN_SPEED_SIGMA_M_S))
+        z = np.concatenate([pos, vel])
+        zhat, h = self._fix_rows(x[None, :])
+        nu = (z - zhat[0])[:2]
+        d2 = normalised_innovation_squared(nu, (h[:2] @ p @ h[:2].T) + r[:2, :2])
+        gate = chi2_threshold(2, GATE_PROBABILITY)
+        if d2 > gate and aligned:
+            r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
+        self._nonlinear_update(z, r)
+
+    def _size_fix_states(self, sigma: np.ndarray) -> None:
+        """The fix's correlated-error states (north, east) given the 1-sigma ``sigma`` (m),
+        uncorrelated with the rest: at the first fix, from its own report
+        (``FixErrorModel.reported_drive_long_sigma``)."""
+        k = len(self._estimate()[0]) - self._fix_states
+        self._set_covariance_block(k, np.diag(sigma**2))
+        self._fix_sized = True
+
+    def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """h(x) = [P_N + e_N, P_E + e_E, v_N, v_E] of a fix (``_velocity_update``) for states
+        (k, n) with the fix's correlated error e (the last two states), and its Jacobian at
+        the first row."""
+        raise NotImplementedError
+
+    def _velocity_noise(self, x: np.ndarray, std_vel: np.ndarray) -> np.ndarray:
+        """2 x 2 noise of a fix's north and east velocity rows with 1-sigma ``std_vel``."""
+        return np.diag(std_vel**2)
+
+    def _set_covariance_block(self, first: int, block: np.ndarray) -> None:
+        """The states from ``first`` on given the covariance ``block``, uncorrelated with the
+        others."""
+        raise NotImplementedError
+
+    def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
+        """Update with ``z`` of ``_fix_rows`` and its noise ``r``."""
+        raise NotImplementedError
 
     def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
                    ) -> tuple[float, float]:
@@ -615,6 +679,29 @@ class _Drm2(_ChoDr):
         c, s = math.cos(float(x[4])), math.sin(float(x[4]))
         return vn * c + ve * s, math.hypot(c * std_vel[0], s * std_vel[1])
 
+    _velocity_needs_heading = True  # its velocity rows turn with the heading
+
+    def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The fix's position with its correlated error, and its velocity: the speed V along
+        the heading and the IMU's lateral velocity ``lat`` across it (eq. 5); the cross-track
+        row observes the heading directly, which eq. 18's speed leaves to the position."""
+        k = x.shape[1] - self._fix_states
+        v, psi, lat = x[:, 2], x[:, 4], self._lateral
+        c, s = np.cos(psi), np.sin(psi)
+        zs = np.column_stack([x[:, 0] + x[:, k], x[:, 1] + x[:, k + 1],
+                              v * c - lat * s, v * s + lat * c])
+        h = np.zeros((4, x.shape[1]))
+        h[0, 0] = h[1, 1] = h[0, k] = h[1, k + 1] = 1.0
+        h[2, 2], h[3, 2] = c[0], s[0]
+        h[2, 4], h[3, 4] = -v[0] * s[0] - lat * c[0], v[0] * c[0] - lat * s[0]
+        return zs, h
+
+    def _velocity_noise(self, x: np.ndarray, std_vel: np.ndarray) -> np.ndarray:
+        """The fix's velocity noise and the error of the IMU's lateral velocity across the
+        heading (``Tuning.lateral_variance``)."""
+        across = np.array([-math.sin(float(x[4])), math.cos(float(x[4]))])
+        return np.diag(std_vel**2) + self._lateral_var * np.outer(across, across)
+
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
         v, th, psi, lat = x[2], x[3], x[4], self._lateral
@@ -683,6 +770,13 @@ class _Drm1(_ChoDr):
             h[2, 2:4] = x[0, 2:4] / speed[0]
         return np.column_stack([x[:, 0], x[:, 1], speed]), h
 
+    def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The fix's position with its correlated error, and DRM1's two velocity states."""
+        k = x.shape[1] - self._fix_states
+        h = np.eye(4, x.shape[1])
+        h[0, k], h[1, k + 1] = 1.0, 1.0
+        return np.column_stack([x[:, 0] + x[:, k], x[:, 1] + x[:, k + 1], x[:, 2], x[:, 3]]), h
+
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
         return [*self._row(x, p, x[2], x[3], math.nan, p[2:4, 2:4]), math.sqrt(p[4, 4]),
@@ -714,6 +808,16 @@ class _Ekf(_ChoDr):
         h = np.eye(len(self._x))[index]
         self._x, self._p, _ = kf_update(self._x, self._p, z - self._x[index], h, r)
 
+    def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
+        zhat, h = self._fix_rows(self._x[None, :])
+        self._x, self._p, _ = kf_update(self._x, self._p, z - zhat[0], h, r)
+        self._x[4] = wrap_angle(self._x[4])
+
+    def _set_covariance_block(self, first: int, block: np.ndarray) -> None:
+        self._p[first:, :] = 0.0
+        self._p[:, first:] = 0.0
+        self._p[first:, first:] = block
+
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._x, self._p
 
@@ -729,58 +833,6 @@ class Drm1Ekf(_Drm1, _Ekf):
         if np.hypot(x[0, 2], x[0, 3]) < MIN_SPEED_UPDATE_M_S:
             h[2] = 0.0  # no speed row: the EKF leaves it out
         return zhat, h
-
-    _fix_states = 2
-
-    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        """The fix's HDOP and reported position 1-sigma kept for ``_update``, and the fix's
-        correlated-error states sized at the first fix by its HDOP (datasheet tuning)."""
-        hdop = float(row[self._fix_cols[5]])
-        self._fix_report = (hdop, self._accuracy.read(row)[0])
-        if self._datasheet and not getattr(self, "_fix_sized", False) and math.isfinite(hdop):
-            k = len(self._x) - 2
-            sigma = self._fix_model.correlated_sigma(hdop, math.nan)[:2]
-            self._p[k:, :] = 0.0
-            self._p[:, k:] = 0.0
-            self._p[k:, k:] = np.diag(sigma**2)
-            self._fix_sized = True
-        super().on_gnss_fix(t, row)
-
-    def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
-                   ) -> tuple[float, float]:
-        """Eq. 18's speed row, and the fix's velocity with its reported 1-sigma kept for
-        ``_update`` (datasheet tuning)."""
-        self._fix_velocity = (vn, ve, float(std_vel[0]), float(std_vel[1]))
-        return super()._fix_speed(vn, ve, x, std_vel)
-
-    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """With the datasheet tuning and a fix that reports its velocity's 1-sigma: the fix's
-        north and east velocity in place of eq. 18's speed, DRM1's two velocity states
-        measured directly (the speed leaves the cross-track velocity to the position alone,
-        whose reflected fixes in a street canyon weigh little, while the drive's roll and
-        grade push it; and it leaves the heading to the acceleration's direction)."""
-        vel = getattr(self, "_fix_velocity", None)
-        self._fix_velocity = None
-        if not (self._datasheet and vel is not None and math.isfinite(vel[2] + vel[3])):
-            return super()._update(z, r)
-        # the position: the truth plus the fix's correlated error (two states) plus white
-        # noise, and the reported excess (reflections) as white noise beside it
-        hdop, std_pos = self._fix_report
-        k = len(self._x) - 2
-        h = np.eye(4, len(self._x))
-        h[0, k], h[1, k + 1] = 1.0, 1.0
-        nu = np.array([z[0], z[1], vel[0], vel[1]]) - self._x[:4]
-        nu[:2] -= self._x[k:]
-        white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
-        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
-        pos = white + excess
-        if self._p[4, 4] >= ALIGNED_HEADING_VAR:  # as ``on_gnss_fix`` weighs them then
-            pos = np.maximum(pos, PAPER_R.diagonal()[:2])
-        rr = np.diag([pos[0], pos[1], max(vel[2], MIN_SPEED_SIGMA_M_S) ** 2,
-                      max(vel[3], MIN_SPEED_SIGMA_M_S) ** 2])
-        self._x, self._p, s = kf_update(self._x, self._p, nu, h, rr)
-        self._x[4] = wrap_angle(self._x[4])
-        return nu, s
 
 
 class Drm2Ekf(_Drm2, _Ekf):
@@ -862,6 +914,21 @@ class Drm2Spkf(_Drm2):
         h = np.eye(len(self._ukf.x))[index]
         self._ukf.x, self._ukf.p, _ = kf_update(self._ukf.x, self._ukf.p,
                                                 z - self._ukf.x[index], h, r)
+
+    def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
+        if self._ukf.sigma is not None:
+            self._ukf.covariance()  # eq. 26
+        self._since_draw = 0.0
+        self._ukf.update(lambda xs: self._fix_rows(xs)[0], z, r)  # eqs. 27-32
+        self._repair_covariance()
+
+    def _set_covariance_block(self, first: int, block: np.ndarray) -> None:
+        if self._ukf.sigma is not None:
+            self._ukf.covariance(redraw=True)
+        self._since_draw = 0.0
+        self._ukf.p[first:, :] = 0.0
+        self._ukf.p[:, first:] = 0.0
+        self._ukf.p[first:, first:] = block
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._ukf.x, self._ukf.p

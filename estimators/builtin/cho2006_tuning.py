@@ -272,11 +272,11 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
                         [MIN_ACCEL_NOISE**2, MIN_GYRO_NOISE**2])
     q[4] = max(q[4], MIN_GYRO_NOISE**2)
     lateral_noise = arm * _axis(gyro.get("noise_density"), 2) * math.sqrt(DR_RATE_HZ)
-    if model == "drm1":  # the fix's correlated north and east error (sized again at a fix)
-        fix = fix_error_model(datasheet)
-        sigma = fix.correlated_sigma(1.0, 2.0)[:2]
-        bias_p0 += list(sigma**2)
-        bias_q += list(2.0 * sigma**2 / fix.correlated_tau)
+    # the fix's correlated north and east error (sized again at the first fix, from its report)
+    fix = fix_error_model(datasheet)
+    sigma = fix.correlated_sigma(1.0, 2.0)[:2]
+    bias_p0 += list(sigma**2)
+    bias_q += list(2.0 * sigma**2 / fix.correlated_tau)
     return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate,
                   ROLL_GRADIENT if car else 0.0, ROLL_SIGMA if car else 0.0, arm, lateral_noise)
 

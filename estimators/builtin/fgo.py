@@ -25,8 +25,11 @@ rate enters as GTSAM's Coriolis rate, constant in that frame):
 * GNSS: the fix's position at the antenna (the datasheet's lever arm) is the antenna's
   position plus the fix's own error, as the filters model it (``toolbox.datasheet.
   fix_error_model``): its drive-long part (the signal-in-space error and the ionosphere's
-  residual, the budget's correlated range error times the DOP) a first-order Gauss-Markov
-  state of correlation time ``CORRELATED_TAU_S`` (30 min), plus white noise, the smoothed
+  residual) a first-order Gauss-Markov state of correlation time ``CORRELATED_TAU_S``
+  (30 min), its 1-sigma per axis the fix's own report less the smoothed part, at most the
+  budget's correlated range error times the DOP (``reported_drive_long_sigma``: the
+  budget's 1.7 m per axis on open sky against a report of 1.0-1.5 m left the horizontal
+  (error / sigma)^2 at 0.08-0.5), plus white noise, the smoothed
   error's white equivalent in quadrature with the fix's reported accuracy beyond the budget
   (``excess_sigma``: the reflected signals of a canyon; ``std_*`` of ``gnss_fix``). The
   horizontal sigma was once the budget without the ionosphere (0.6 m of range error for the
@@ -403,8 +406,8 @@ class FgoLooselyCoupled(Estimator):
         hdop = hdop if math.isfinite(hdop) else DEFAULT_DOP
         vdop = vdop if math.isfinite(vdop) else 2 * DEFAULT_DOP
         model = self._fix_model
-        sigma = model.correlated_sigma(hdop, vdop)
         std_pos, std_vel = self._accuracy.read(row)
+        sigma = model.reported_drive_long_sigma(std_pos, hdop, vdop)
         white = np.hypot(model.white_sigma(hdop, vdop), model.excess_sigma(std_pos, hdop, vdop))
         e_key = self._e(k)
         current = self._smoother.calculateEstimate()
