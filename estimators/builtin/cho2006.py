@@ -22,16 +22,15 @@ filter on a real car needs: accelerometer-bias states (DRM2's pitch and forward 
 unobservable combination, eq. 11, so without the bias state its pitch claims the bias's
 accuracy), DRM2's pitch rate corrected for the body's roll in turns, the IMU's lateral velocity
 about the rear axle (in the position and, as w_z times it, in the speed's dynamics:
-``drm2_transition``), DRM2's speed row as the fix's velocity along the heading
-(``_Drm2._fix_speed``: eq. 18's norm is rectified at a stop), fixes weighted down beyond a
-99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop (the DR running
-on until the stop is confirmed, since a wheel below its cut-off may still roll). The SPKF's
-``sigma_set: auto | simplex | symmetric`` picks the point set; ``auto`` (the default) is the
-paper's simplex set with the paper's tuning and the symmetric set with the datasheet's: the
-simplex set's non-zero third moments move unobservable states under eq. 33's 180 deg heading
-prior (docs/reproduction_cho2006.md), and with the datasheet's R it lost the heading at the
-start on 3 of 10 seeds of two drives (urban canyon, garage), where the symmetric set converged
-on every seed.
+``drm2_transition``), the fix's velocity and correlated error (below), fixes weighted down
+beyond a 99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop
+(the DR running on until the stop is confirmed, since a wheel below its cut-off may still
+roll). The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set; ``auto`` (the
+default) is the paper's simplex set with the paper's tuning and the symmetric set with the
+datasheet's: the simplex set's non-zero third moments move unobservable states under eq. 33's
+180 deg heading prior (docs/reproduction_cho2006.md), and with the datasheet's R it lost the
+heading at the start on 3 of 10 seeds of two drives (urban canyon, garage), where the symmetric
+set converged on every seed.
 
 Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction_cho2006.md)
 ----------------------------------------------------------------------------------------
@@ -76,17 +75,27 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   eqs. 33-34 term by term (5 m/s and 0.1 m/s^2 on each velocity axis). Its specific force is
   resolved at the step's mid heading and its position moves with the mean of the old and new
   velocity (``drm1_transition``). Its speed measurement is linearised (and left out below
-  0.5 m/s, where the speed's direction is undefined). With the datasheet tuning a fix that
-  reports its velocity's 1-sigma updates DRM1's two velocity states with its north and east
-  velocity instead (``Drm1Ekf._update``): eq. 18's speed left the cross-track velocity to
-  the position alone, which the body's roll and the road's bank push and a street canyon's
+  0.5 m/s, where the speed's direction is undefined).
+* The fix with the datasheet tuning (``_ChoDr._velocity_update``), when it reports its
+  velocity's 1-sigma: its north and east velocity replace eq. 18's speed. DRM1's two
+  velocity states are measured directly: the speed left the cross-track velocity to the
+  position alone, which the body's roll and the road's bank push and a street canyon's
   reflected fixes barely hold (sumo_city_canyon seed 1 north (error / sigma)^2 7.8 -> 1.3,
-  parking_garage seed 3 yaw 7.2 -> 0.74). Its position is then the truth plus the fix's
-  correlated north and east error, two states sized by the receiver's budget at the first
-  fix's HDOP (``toolbox.datasheet.fix_error_model``, as ``dr2d_odo_ekf`` carries them), plus
-  the budget's white part and the reported excess: with the velocity known to the fix's
-  Doppler the inflated white R (``FIX_CORRELATION_S``) averaged the drive-long error away
-  (sumo_city north 8.4 over three seeds, worst 22).
+  parking_garage seed 3 yaw 7.2 -> 0.74). DRM2's velocity is V along the heading and the
+  IMU's lateral velocity across it (eq. 5), so the cross-track row measures the heading
+  (V times its error), which the speed along the heading (eq. 18) left to the position's
+  slow turn: with it DRM2's yaw claimed 3-4 times its error (SUMO city (error / sigma)^2
+  0.04-0.13, seeds 1-3); it waits until the heading is found (before, the speed row of
+  ``_Drm2._fix_speed``). The position is the truth plus the fix's correlated north and
+  east error, two unit-variance states times each fix's own drive-long 1-sigma
+  (``toolbox.datasheet.FixErrorModel.reported_drive_long_sigma``: the reported 1-sigma less
+  the smoothed part, at most the receiver budget's correlated part), plus the
+  budget's white part and the reported excess (reflections) as white noise. With the
+  velocity known to the fix's Doppler a white R, even inflated over ``FIX_CORRELATION_S``,
+  averaged the drive-long error away (DRM2 on the SUMO city: a fix 3.1 m north of the truth
+  for the whole drive against a north sigma of 1.0 m, seed 3 (error / sigma)^2 9.1; DRM1
+  before its states 8.4 over three seeds, worst 22); the budget's 1.7 m per axis against a
+  report of 1.0-1.5 m on open sky made it cautious (DRM1 open-road north 0.06).
 * Eq. 18 converts GPS latitude and longitude to metres with one Earth radius R_e; we use the
   WGS-84 meridian and transverse radii at the start (``simulator.earth``).
 * No Earth rate (the paper ignores it); the standstill calibration removes its vertical part.
@@ -335,7 +344,7 @@ class _ChoDr(Estimator):
         self._matching = FixNoiseMatching()
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
         self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
-        self._fix_sized = not self._datasheet  # the fix-error states sized at a first fix
+        self._fix_gain = np.ones(2)  # the fix-error states' gain at the last fix, m
         x0 = self._initial_state()
         self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
                            self._tuning.p0.copy())
@@ -498,11 +507,7 @@ class _ChoDr(Estimator):
             return
         x, p = self._predicted()
         std_pos, std_vel = self._accuracy.read(row)
-        if not self._fix_sized and math.isfinite(hdop):
-            self._size_fix_states(self._fix_model.reported_drive_long_sigma(
-                std_pos, hdop, math.nan)[:2])
-            x, p = self._predicted()
-        if (np.isfinite(std_vel[:2]).all()
+        if (np.isfinite(std_vel[:2]).all() and math.isfinite(hdop)
                 and not (self._velocity_needs_heading and p[4, 4] >= ALIGNED_HEADING_VAR)):
             self._velocity_update(z[:2], np.array([vn, ve]), std_pos, std_vel[:2], hdop, x, p)
             return
@@ -528,11 +533,16 @@ class _ChoDr(Estimator):
                          ) -> None:
         """A fix that reports its velocity's 1-sigma ``std_vel`` (datasheet tuning): its north
         and east position ``pos`` and velocity ``vel`` (``_fix_rows``). The position is the
-        truth plus the fix's correlated error (two states, ``_size_fix_states``) plus the
+        truth plus the fix's correlated error, e = g u: two unit-variance Gauss-Markov states
+        u whose gain g is this fix's drive-long 1-sigma from its own report
+        (``FixErrorModel.reported_drive_long_sigma``; a receiver's report is 2-3 m for the
+        first half minute, while its Hatch filters converge, then 1.2-1.5 m on open sky, so
+        states sized once at the first fix kept the budget's), plus the
         budget's white part and the reported excess (reflections) as white noise; the
         velocity's noise is the reported one (and the IMU's lateral velocity error across the
         heading, ``_velocity_noise``). Weighted as eq. 35 weighs the fixes until the heading
         is found, and down to the 99.9 % gate beyond it, as ``on_gnss_fix``."""
+        self._fix_gain = self._fix_model.reported_drive_long_sigma(std_pos, hdop, math.nan)[:2]
         white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
         excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
         r = np.zeros((4, 4))
@@ -550,28 +560,15 @@ class _ChoDr(Estimator):
             r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
         self._nonlinear_update(z, r)
 
-    def _size_fix_states(self, sigma: np.ndarray) -> None:
-        """The fix's correlated-error states (north, east) given the 1-sigma ``sigma`` (m),
-        uncorrelated with the rest: at the first fix, from its own report
-        (``FixErrorModel.reported_drive_long_sigma``)."""
-        k = len(self._estimate()[0]) - self._fix_states
-        self._set_covariance_block(k, np.diag(sigma**2))
-        self._fix_sized = True
-
     def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """h(x) = [P_N + e_N, P_E + e_E, v_N, v_E] of a fix (``_velocity_update``) for states
-        (k, n) with the fix's correlated error e (the last two states), and its Jacobian at
-        the first row."""
+        """h(x) = [P_N + g_N u_N, P_E + g_E u_E, v_N, v_E] of a fix (``_velocity_update``) for
+        states (k, n) with the fix's correlated error g u (the last two states u, the gain g
+        ``_fix_gain``), and its Jacobian at the first row."""
         raise NotImplementedError
 
     def _velocity_noise(self, x: np.ndarray, std_vel: np.ndarray) -> np.ndarray:
         """2 x 2 noise of a fix's north and east velocity rows with 1-sigma ``std_vel``."""
         return np.diag(std_vel**2)
-
-    def _set_covariance_block(self, first: int, block: np.ndarray) -> None:
-        """The states from ``first`` on given the covariance ``block``, uncorrelated with the
-        others."""
-        raise NotImplementedError
 
     def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
         """Update with ``z`` of ``_fix_rows`` and its noise ``r``."""
@@ -685,13 +682,14 @@ class _Drm2(_ChoDr):
         """The fix's position with its correlated error, and its velocity: the speed V along
         the heading and the IMU's lateral velocity ``lat`` across it (eq. 5); the cross-track
         row observes the heading directly, which eq. 18's speed leaves to the position."""
-        k = x.shape[1] - self._fix_states
+        k, (g_n, g_e) = x.shape[1] - self._fix_states, self._fix_gain
         v, psi, lat = x[:, 2], x[:, 4], self._lateral
         c, s = np.cos(psi), np.sin(psi)
-        zs = np.column_stack([x[:, 0] + x[:, k], x[:, 1] + x[:, k + 1],
+        zs = np.column_stack([x[:, 0] + g_n * x[:, k], x[:, 1] + g_e * x[:, k + 1],
                               v * c - lat * s, v * s + lat * c])
         h = np.zeros((4, x.shape[1]))
-        h[0, 0] = h[1, 1] = h[0, k] = h[1, k + 1] = 1.0
+        h[0, 0] = h[1, 1] = 1.0
+        h[0, k], h[1, k + 1] = g_n, g_e
         h[2, 2], h[3, 2] = c[0], s[0]
         h[2, 4], h[3, 4] = -v[0] * s[0] - lat * c[0], v[0] * c[0] - lat * s[0]
         return zs, h
@@ -772,10 +770,11 @@ class _Drm1(_ChoDr):
 
     def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """The fix's position with its correlated error, and DRM1's two velocity states."""
-        k = x.shape[1] - self._fix_states
+        k, (g_n, g_e) = x.shape[1] - self._fix_states, self._fix_gain
         h = np.eye(4, x.shape[1])
-        h[0, k], h[1, k + 1] = 1.0, 1.0
-        return np.column_stack([x[:, 0] + x[:, k], x[:, 1] + x[:, k + 1], x[:, 2], x[:, 3]]), h
+        h[0, k], h[1, k + 1] = g_n, g_e
+        return np.column_stack([x[:, 0] + g_n * x[:, k], x[:, 1] + g_e * x[:, k + 1], x[:, 2],
+                                x[:, 3]]), h
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
@@ -812,11 +811,6 @@ class _Ekf(_ChoDr):
         zhat, h = self._fix_rows(self._x[None, :])
         self._x, self._p, _ = kf_update(self._x, self._p, z - zhat[0], h, r)
         self._x[4] = wrap_angle(self._x[4])
-
-    def _set_covariance_block(self, first: int, block: np.ndarray) -> None:
-        self._p[first:, :] = 0.0
-        self._p[:, first:] = 0.0
-        self._p[first:, first:] = block
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._x, self._p
@@ -921,14 +915,6 @@ class Drm2Spkf(_Drm2):
         self._since_draw = 0.0
         self._ukf.update(lambda xs: self._fix_rows(xs)[0], z, r)  # eqs. 27-32
         self._repair_covariance()
-
-    def _set_covariance_block(self, first: int, block: np.ndarray) -> None:
-        if self._ukf.sigma is not None:
-            self._ukf.covariance(redraw=True)
-        self._since_draw = 0.0
-        self._ukf.p[first:, :] = 0.0
-        self._ukf.p[:, first:] = 0.0
-        self._ukf.p[first:, first:] = block
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._ukf.x, self._ukf.p
