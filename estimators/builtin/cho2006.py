@@ -626,24 +626,26 @@ class _Drm2(_ChoDr):
         return np.array([0.0, 0.0, v, float(init.attitude[1]), yaw, 0.0, 0.0, 0.0])
 
     def _inputs(self, u: np.ndarray) -> np.ndarray:
-        """The pitch and heading rates of a body rolled by phi and pitched by theta (datasheet
-        tuning; ZYX Euler rates): theta_dot = w_y cos(phi) - w_z sin(phi), psi_dot = (w_y
-        sin(phi) + w_z cos(phi)) / cos(theta), where eqs. 24d-e integrate w_y and w_z alone.
-        On a car phi = -k V w_z (``cho2006_tuning``), so the pitch rate is w_y + k V w_z^2 to
-        first order; the heading rate's error w_z (1 - cos(phi) / cos(theta)) - w_y sin(phi)
-        is w_z phi^2 / 2 for a level turn (w_y = psi_dot sin(phi)): 0.16 deg over
-        ``urban_canyon``'s 90 deg turns at 0.67 g (3.4 deg of roll), which a heading measured
-        by the fix's cross-track velocity under an ideal gyro's process noise kept (yaw
-        (error / sigma)^2 29). Given phi, the rate's error in a wrong phi is theta_dot
-        times it, to first order: nil on a level road. The theta is the pitch state."""
-        if not self._datasheet:
-            return u
+        """The pitch and heading rates of a body rolled by phi in a turn (datasheet tuning on a
+        car; ZYX Euler rates on a level road): theta_dot = w_y cos(phi) - w_z sin(phi),
+        psi_dot = w_y sin(phi) + w_z cos(phi), where eqs. 24d-e integrate w_y and w_z alone.
+        The roll is phi = -k V w_z (``cho2006_tuning``), so the pitch rate is w_y + k V w_z^2
+        to first order, and w_z alone loses w_z phi^2 / 2 of the heading rate (w_y = psi_dot
+        sin(phi) in the turn): 0.16 deg over ``urban_canyon``'s 90 deg turns at 0.67 g (3.4
+        deg of roll), which the heading measured by the fix's cross-track velocity under an
+        ideal gyro's process noise kept (seeds 1-2 yaw (error / sigma)^2 34 and 33). An error
+        in phi moves this rate by theta_dot times it, to first order: nil in a level turn.
+        The pitch's 1 / cos(theta) is left out: taken at the pitch state, whose error is the
+        forward accelerometer's bias over g (1-2 deg), it put tan(theta) times that error into
+        the heading rate on the garage's 7 deg ramps (unseen garage seed 2 yaw 0.47 -> 7.0),
+        a coupling the propagation's Jacobian does not carry."""
         k, arm = self._tuning.roll_gradient, self._tuning.rear_axle_m
-        x = self._estimate()[0]
-        roll = -k * x[2] * u[2]
+        if not (k or arm):
+            return u
+        roll = -k * self._estimate()[0][2] * u[2]
         out = np.append(u, arm * u[2])  # the IMU's lateral velocity (``_measure``)
-        out[1] += k * x[2] * u[2] ** 2
-        out[2] = (u[1] * math.sin(roll) + u[2] * math.cos(roll)) / math.cos(x[3])
+        out[1] += k * self._estimate()[0][2] * u[2] ** 2
+        out[2] = u[1] * math.sin(roll) + u[2] * math.cos(roll)
         self._lateral = float(out[3])
         self._lateral_var = self._tuning.lateral_variance(self._lateral)
         return out
