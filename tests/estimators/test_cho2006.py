@@ -12,11 +12,13 @@ import numpy as np
 import pytest
 
 from estimators.builtin.cho2006 import (
+    Drm2Ekf,
     drm1_jacobian,
     drm1_transition,
     drm2_jacobian,
     drm2_transition,
 )
+from estimators.builtin.cho2006_tuning import ROLL_GRADIENT, Tuning
 from estimators.registry import get_estimator
 from simulator.dataset.generate import generate_dataset
 from simulator.dataset.io import Dataset, open_dataset
@@ -84,6 +86,28 @@ def test_an_imu_ahead_of_the_rear_axle_keeps_its_speed_on_a_circle():
     for _ in range(100):
         x_rigid = drm2_transition(x_rigid, None, u[:3], dt, G)
     assert x_rigid[0, 2] == pytest.approx(v0 - arm * w * w * 10.0)
+
+
+def test_drm2_heading_rate_of_a_rolled_body_is_the_euler_rate():
+    """A level turn at psi_dot = 0.55 rad/s and 12 m/s (``urban_canyon``'s junctions), the
+    body rolled out of it by phi = -k V psi_dot: its gyros read w_y = psi_dot sin(phi), w_z =
+    psi_dot cos(phi) (ZYX Euler rates, theta = 0). The heading rate DRM2 integrates is
+    psi_dot to within the roll model's own second-order slip (it takes phi from w_z, not
+    psi_dot), far inside the w_z phi^2 / 2 that w_z alone loses."""
+    psi_dot, speed = 0.55, 12.0
+    roll = -ROLL_GRADIENT * speed * psi_dot
+    filt = Drm2Ekf.__new__(Drm2Ekf)
+    filt._tuning = Tuning(np.eye(11), np.eye(11), roll_gradient=ROLL_GRADIENT,
+                          rear_axle_m=1.7)
+    filt._x = np.array([0.0, 0.0, speed, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    filt._p = np.eye(11)
+    u = np.array([0.0, psi_dot * math.sin(roll), psi_dot * math.cos(roll)])
+    lost = psi_dot - u[2]
+    assert lost == pytest.approx(psi_dot * roll**2 / 2.0, rel=1e-3)
+    out = filt._inputs(u)
+    assert abs(out[2] - psi_dot) < 1e-3 * lost
+    assert out[1] == pytest.approx(u[1] + ROLL_GRADIENT * speed * u[2] ** 2)  # pitch rate
+    assert out[3] == pytest.approx(1.7 * u[2])  # the IMU's lateral velocity
 
 
 def test_drm2_transition_matrix_has_the_terms_of_eq_17():
