@@ -106,14 +106,20 @@ the estimate towards zero while its variance shrank), a zero-rate update while t
 stand still (``zero_rate_update``: the gyro's mean rate is its bias plus the Earth rate's up
 component, with the gyro's white noise; not in the paper), the azimuth's white noise the
 gyro's noise density plus its scale factor and misalignment times the turn rate over
-``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
+``SCALE_FACTOR_TIME_S``; the broadcast ionosphere's residual shared by the satellites as
+four Gauss-Markov states of 30 min (its part common to them, its field's value and north and
+east gradient at the zenith pierce point; each pseudorange's row their coefficients,
+``toolbox.range_budget``, as ``fgo_tc`` carries them: as white R it held an error the
+position does not get), the pseudoranges' R the rest of the reported variance scaled by the
 correlated-noise inflation of the receiver's carrier smoothing
 (``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
-``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon, each pseudorange's R with the reflected-signal (NLOS) share its C/N0 deficit
-announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``; the gate keeps the
-reported variance alone: with the NLOS share in it too it passed more reflected ranges, the
-unseen canyon's height 2.5 -> 4.7 over seeds 1-3), the range rates'
+``gate_probability``) against H P H^T plus that uninflated rest, which drops the NLOS ranges
+of a canyon; after the gate each pseudorange's expected reflected-signal (NLOS) delay, from
+the probability its C/N0 deficit announces, is taken off and its variance added to R
+(``gnss_model.nlos_delay``, as ``fgo_tc``; the reflected ranges that pass the gate, all
+delayed, sank the height and clock together: the SUMO canyon's height 10 -> 2.0 over seeds
+1-3; with a zero-mean NLOS share in the gate too it passed more reflected ranges), the range
+rates'
 with the rear axle's sideways motion that eqs. 4-5 leave out (the tyres' slip in a turn,
 ``toolbox.constraints.NonholonomicNoise``, along the body's right axis: in the sharp junction
 turns of a SUMO city, 60 deg/s at 5 m/s, the rear axle moves up to 6 deg off the heading, and
