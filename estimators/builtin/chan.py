@@ -285,6 +285,8 @@ class _TightlyCoupled(Estimator):
         self._iono_used = (self._budget.shared_in_use() if tun["iono_scale_std"] > 0.0
                            else np.zeros(len(SHARED_TERMS), dtype=bool))
         self._iono = bool(self._iono_used.any())
+        self._terms_key: bytes | None = None  # the pseudoranges of ``_terms``
+        self._terms = (np.zeros((0, 0)), np.zeros(0))
         self._n_iono = int(self._iono_used.sum())
         self.n_states = N_STATES + self._n_iono
         n_channels = int(tun["range_bias_channels"])
@@ -443,16 +445,27 @@ class _TightlyCoupled(Estimator):
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
         return np.diag(np.concatenate([var, rr**2]))
 
+    def _budget_terms(self, ep: gnss_model.RawEpoch) -> tuple[np.ndarray, np.ndarray]:
+        """The ionosphere states' coefficients (n_iono, m), m, on the epoch's pseudoranges
+        and each satellite's own drive-long 1-sigma (``RangeBudget.sigmas``), computed once
+        per set of pseudoranges (an update asks several times)."""
+        key = ep.pseudorange.tobytes()
+        if self._terms_key != key:
+            shared, own, _ = self._budget.sigmas(ep, self.config["pseudorange_std"])
+            self._terms = (shared[self._iono_used], own)
+            self._terms_key = key
+        return self._terms
+
     def _range_bias_sigma(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """Prior 1-sigma (m) of each satellite's range-error state: the signal-in-space error,
         the ionosphere field's remainder at its pierce point and the troposphere's residual
         (``RangeBudget.sigmas``)."""
-        return self._budget.sigmas(ep, self.config["pseudorange_std"])[1]
+        return self._budget_terms(ep)[1]
 
     def _iono_gains(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """Coefficients (n_iono, m), m, of the ionosphere states on the epoch's pseudoranges
         (``iono_field.residual_terms``)."""
-        return self._budget.sigmas(ep, self.config["pseudorange_std"])[0][self._iono_used]
+        return self._budget_terms(ep)[0]
 
     def _channel_rows(self, ep: gnss_model.RawEpoch, t: float, p: np.ndarray
                       ) -> tuple[gnss_model.RawEpoch, np.ndarray, np.ndarray]:
