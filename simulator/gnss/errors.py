@@ -63,7 +63,7 @@ Time behaviour (issue 19):
 Public names
 ------------
 OSCILLATORS, SIS_RECORD_SHARE, IONO_CORRELATION_TIME_S, IONO_CORRELATION_LENGTH_KM,
-IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S,
+IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S, SMOOTHING_GROUP_SAMPLES,
 REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, IONO_GRID_STEP,
 loop_time_constant_s,
 decorrelation_coordinate, gauss_markov_along, pierce_points_km, iono_field_correlation,
@@ -98,6 +98,7 @@ from simulator.datasheet import (  # the field's scales: the receivers' model re
     IONO_SHELL_HEIGHT_KM,
 )
 from simulator.gnss.atmosphere import klobuchar_pierce_point
+from simulator.gnss.chunks import epoch_chunks
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
 from simulator.stochastic import ar1_filter, child_rng, gauss_markov, gauss_markov_at
@@ -119,6 +120,8 @@ IONO_SHELL_RADIUS_KM = EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM  # Klobuchar'
 # under 2 km in 10 s (a satellite's at about 0.1 km/s, a car's at its speed), 1/500 of L, so
 # the interpolation changes the field by under 1e-5 of its sigma
 IONO_FIELD_STEP_S = 10.0
+# satellites x epochs carrier-smoothed together (``smooth_code_errors``): 1 MB per array
+SMOOTHING_GROUP_SAMPLES = 2**17
 REPORTED_PR_STD_FLOOR_M = 0.1  # the smallest pseudorange 1-sigma the receiver reports
 REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it reports
 # the amplitudes of the ionosphere field's waves are drawn once per correlation time (30 min)
@@ -259,7 +262,10 @@ class IonoField:
         k = np.arange(n_ep)
         i = np.minimum(np.searchsorted(coarse, k, side="right") - 1, len(coarse) - 2)
         w = (k - coarse[i]) / (coarse[i + 1] - coarse[i])
-        return values[:, i] * (1.0 - w) + values[:, i + 1] * w
+        out = np.empty((values.shape[0], n_ep))
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            out[:, cols] = values[:, i[cols]] * (1.0 - w[cols]) + values[:, i[cols] + 1] * w[cols]
+        return out
 
 
 def iono_field_at_epochs(rng: np.random.Generator, pierce_km: np.ndarray, dt_s: float
@@ -443,14 +449,19 @@ def smooth_code_errors(cfg: dict, terms: dict[str, np.ndarray], iono_true_m: np.
     rows = np.flatnonzero(tracked.any(axis=1))  # the satellites ever tracked
     if cfg["carrier_smoothing"] <= 0 or rows.size == 0:
         return terms
-    iono = iono_true_m[rows]
-    stacked = np.stack([terms["code_noise"][rows], terms["multipath"][rows], 2.0 * iono])
-    smooth = hatch_filter(stacked, tracked[rows], dt_s, cfg["carrier_smoothing"])
     out = dict(terms)
-    for key, value in (("code_noise", smooth[0] + smooth[2] - 2.0 * iono),
-                       ("multipath", smooth[1])):
+    for key in ("code_noise", "multipath"):
         out[key] = terms[key].copy()
-        out[key][rows] = np.where(tracked[rows], value, terms[key][rows])
+    # the satellites in groups of about SMOOTHING_GROUP_SAMPLES samples: each row is filtered
+    # alone, so the groups change nothing but the size of the filter's temporaries
+    groups = -(-rows.size * tracked.shape[1] // SMOOTHING_GROUP_SAMPLES)
+    for part in np.array_split(rows, groups):  # one pass per group of satellites
+        iono = iono_true_m[part]
+        stacked = np.stack([terms["code_noise"][part], terms["multipath"][part], 2.0 * iono])
+        smooth = hatch_filter(stacked, tracked[part], dt_s, cfg["carrier_smoothing"])
+        for key, value in (("code_noise", smooth[0] + smooth[2] - 2.0 * iono),
+                           ("multipath", smooth[1])):
+            out[key][part] = np.where(tracked[part], value, terms[key][part])
     return out
 
 

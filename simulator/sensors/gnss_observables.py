@@ -80,6 +80,7 @@ from simulator.gnss.carrier import (
     reflection_path_rate_m_s,
     slip_probability,
 )
+from simulator.gnss.chunks import epoch_chunks
 from simulator.gnss.constants import C_M_S, F_L1_HZ
 from simulator.gnss.ephemeris import STATE_KEYS, gather, satellite_state
 from simulator.gnss.errors import (
@@ -168,17 +169,19 @@ class _Table:
         self.pieces: list[dict[str, np.ndarray | str]] = []
         self.n_taken = 0
 
-    def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str]
-            ) -> None:
+    def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str],
+            first_epoch: int = 0) -> None:
         """The next signal's rows: ``columns`` of (satellite, epoch) arrays over ``sel``'s
-        satellites (or broadcastable to them; a text value stays one text) where ``mask``."""
+        satellites (or broadcastable to them; a text value stays one text) where ``mask``,
+        whose epochs begin at ``first_epoch`` (a chunk of the drive's)."""
         sat, ep = np.nonzero(mask)
-        slot = ep * len(self.svs) + sel[sat]
+        piece: dict[str, np.ndarray | str] = {"t": self.t[first_epoch + ep],
+                                              "sv": self.svs[sel[sat]]}
+        slot = (first_epoch + ep) * len(self.svs) + sel[sat]
         rows = self.next_row[slot]
         self.next_row[slot] += 1
         self.source[rows] = np.arange(self.n_taken, self.n_taken + len(sat))
         self.n_taken += len(sat)
-        piece: dict[str, np.ndarray | str] = {"t": self.t[ep], "sv": self.svs[sel[sat]]}
         for key, value in columns.items():
             if isinstance(value, str):  # kept as it is: ``frame`` spreads it over the rows
                 piece[key] = value
@@ -221,6 +224,17 @@ def _switches(state: np.ndarray) -> np.ndarray:
     out = np.zeros_like(state)
     out[:, 1:] = state[:, 1:] != state[:, :-1]
     return out
+
+
+def _gradient_part(values: np.ndarray, cols: slice, dt_s: float, times: int = 1) -> np.ndarray:
+    """``np.gradient`` along the epochs (axis 1) of ``values``, applied ``times`` times, at the
+    epochs ``cols`` only: from those epochs and ``times`` neighbours on each side (central
+    differences inside the drive, one-sided at its ends, as on the whole array)."""
+    lo, hi = max(cols.start - times, 0), min(cols.stop + times, values.shape[1])
+    part = values[:, lo:hi]
+    for _ in range(times):
+        part = np.gradient(part, dt_s, axis=1)
+    return part[:, cols.start - lo:cols.stop - lo]
 
 
 def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int, n_ep: int,
@@ -282,9 +296,14 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
                                  cfg["multipath_correlation_time"])
     los, nlos, extra, loss = reception(
         az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
-    signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
-                  + draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_sat))
-    cn0 = signal_cn0 + cfg["cn0_noise"] * child_rng(rng, "cn0_noise").standard_normal(el.shape)
+    fading = draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_sat)
+    cn0_noise = child_rng(rng, "cn0_noise").standard_normal(el.shape)
+    signal_cn0, cn0 = np.empty((n_sat, n_ep)), np.empty((n_sat, n_ep))
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        signal_cn0[:, cols] = (cn0_model(el[:, cols], cfg["cn0_zenith"], cfg["cn0_horizon"])
+                               - loss[:, cols] + fading[:, cols])
+        cn0[:, cols] = signal_cn0[:, cols] + cfg["cn0_noise"] * cn0_noise[:, cols]
+    del fading, cn0_noise
     have = idx >= 0
     visible = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos)
     tracked = visible & (cn0 >= cfg["cn0_threshold"])
@@ -293,46 +312,33 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
                                                          cfg["clock"], n_ep, dt_s)
     # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
     # (below the horizon, where nothing is tracked, the pierce point of the horizon)
-    pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
+    pierce = np.empty((3, n_sat, n_ep))
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        pierce[:, :, cols] = pierce_points_km(ant["lat"][cols], ant["lon"][cols], az[:, cols],
+                                              np.maximum(el[:, cols], 0.0))
     err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, idx,
                            None if shared is None else shared)
     if shared is None:
         shared = _shared_draws(rng, cfg, err, len(eph["toe_s"]), n_ep, dt_s, ant, geo["los"])
     else:  # the orbit error seen along this receiver's lines of sight
-        orbit = shared.orbit_m[np.maximum(idx, 0)]
-        err["sis"] = np.where(have, err["sis"] + np.einsum(
-            "sek,sek->se", orbit, geo["los"] - shared.los), 0.0)
+        sis = np.empty((n_sat, n_ep))
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            orbit = shared.orbit_m[np.maximum(idx[:, cols], 0)]
+            sis[:, cols] = np.where(have[:, cols], err["sis"][:, cols] + np.einsum(
+                "sek,sek->se", orbit, geo["los"][:, cols] - shared.los[:, cols]), 0.0)
+        err["sis"] = sis
     drawn = {"clock": drawn_clock, "tropo_zenith_error_m": shared.tropo_zenith_m,
              "tropo_gradient_m_per_km": (shared.tropo_gradient * 1e3).tolist()}
 
     # the atmosphere this receiver sees
-    mapping = model["tropo"] / model["zenith"]
     ned = ecef_to_ned(ant["pos"], *shared.origin_lla)
     tropo_zenith = shared.tropo_zenith_m + ned[:, :2] @ shared.tropo_gradient
-    tropo_true = model["tropo"] + tropo_zenith[None, :] * mapping
-    tid = shared.tid_sigma_m * shared.tid(pierce) * klobuchar_obliquity(np.maximum(el, 0.0))
-    iono_true = model["iono"] * err["iono_ratio"] + tid
-    # its rate: the broadcast model's along the geometry times the ratio, plus the (slow)
-    # change of the ratio and of the disturbances
-    iono_true_rate = model["iono_rate"] * err["iono_ratio"]
-    if n_ep > 1:
-        iono_true_rate = iono_true_rate + model["iono"] * np.gradient(
-            err["iono_ratio"], dt_s, axis=1) + np.gradient(tid, dt_s, axis=1)
-    tropo_true_rate = model["tropo_rate"] * (1.0 + tropo_zenith[None, :] / model["zenith"])
-
+    tid = shared.tid(pierce)
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        tid[:, cols] *= shared.tid_sigma_m
+        tid[:, cols] *= klobuchar_obliquity(np.maximum(el[:, cols], 0.0))
     rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
-    rng_m = geo["range"]
-    # the satellite clock against GPS time: the broadcast one of the primary signal (GPS: L1,
-    # T_GD applied) against its system's time plus the broadcast system-time offset, as a
-    # receiver applying GGTO / tau_GPS has it
-    sat_clock = C_M_S * (geo["clock_s"] + geo["system_time_offset_s"])
-    sat_drift = C_M_S * geo["clock_drift_s_s"]
     system_of = sky["systems"]
-    # the broadcast clock's reference (the ionosphere-free pair, without the primary signal's
-    # group delay): the carrier's clock; each code's own group delay is taken from it
-    # (signals.signal_group_delay_s)
-    reference_clock = sat_clock + C_M_S * sky["primary_delay_s"]
-    nlos_delay = np.where(nlos & ~los, extra, 0.0)
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
     quadrature = gauss_markov_along(u, n_sat, child_rng(rng, "multipath_quadrature"))
@@ -340,12 +346,46 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
     # the antenna's velocity it sets how fast the reflection's carrier phase turns
     from scipy.special import ndtr  # imported on first use, as in simulator.gnss.carrier
 
-    wall_normal = np.pi * ndtr(gauss_markov_along(u, n_sat, child_rng(rng, "reflector_normal")))
+    wall_unit = gauss_markov_along(u, n_sat, child_rng(rng, "reflector_normal"))
     moving = bool(np.any(ant["v_ned"] != 0.0))
-    path_rate = (reflection_path_rate_m_s(ant["v_ned"], az, el, wall_normal) if moving
-                 else None)  # standing still, the loop's gain is 1
-    los_jerk = (np.gradient(np.gradient(geo["range_rate"], dt_s, axis=1), dt_s, axis=1)
-                if n_ep > 2 else np.zeros((n_sat, n_ep)))
+    names = ["mapping", "tropo_true", "iono_true", "iono_true_rate", "tropo_true_rate",
+             "sat_drift", "reference_clock", "nlos_delay", "los_jerk"] + ["path_rate"] * moving
+    shared_terms = {name: np.empty((n_sat, n_ep)) for name in names}
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        m = {k: a[:, cols] for k, a in model.items()}
+        out = {name: a[:, cols] for name, a in shared_terms.items()}
+        ratio = err["iono_ratio"][:, cols]
+        out["mapping"][...] = mapping = m["tropo"] / m["zenith"]
+        out["tropo_true"][...] = m["tropo"] + tropo_zenith[None, cols] * mapping
+        out["iono_true"][...] = m["iono"] * ratio + tid[:, cols]
+        # its rate: the broadcast model's along the geometry times the ratio, plus the (slow)
+        # change of the ratio and of the disturbances
+        iono_true_rate = m["iono_rate"] * ratio
+        if n_ep > 1:
+            iono_true_rate = (iono_true_rate
+                              + m["iono"] * _gradient_part(err["iono_ratio"], cols, dt_s)
+                              + _gradient_part(tid, cols, dt_s))
+        out["iono_true_rate"][...] = iono_true_rate
+        out["tropo_true_rate"][...] = m["tropo_rate"] * (1.0 + tropo_zenith[None, cols]
+                                                         / m["zenith"])
+        # the satellite clock against GPS time: the broadcast one of the primary signal (GPS:
+        # L1, T_GD applied) against its system's time plus the broadcast system-time offset,
+        # as a receiver applying GGTO / tau_GPS has it
+        sat_clock = C_M_S * (m["clock_s"] + m["system_time_offset_s"])
+        out["sat_drift"][...] = C_M_S * m["clock_drift_s_s"]
+        # the broadcast clock's reference (the ionosphere-free pair, without the primary
+        # signal's group delay): the carrier's clock; each code's own group delay is taken
+        # from it (signals.signal_group_delay_s)
+        out["reference_clock"][...] = sat_clock + C_M_S * sky["primary_delay_s"][:, cols]
+        out["nlos_delay"][...] = np.where(nlos[:, cols] & ~los[:, cols], extra[:, cols], 0.0)
+        if moving:  # standing still, the loop's gain is 1
+            out["path_rate"][...] = reflection_path_rate_m_s(
+                ant["v_ned"][cols], az[:, cols], el[:, cols],
+                np.pi * ndtr(wall_unit[:, cols]))
+        out["los_jerk"][...] = (_gradient_part(geo["range_rate"], cols, dt_s, times=2)
+                                if n_ep > 2 else 0.0)
+    del wall_unit
+    path_rate = shared_terms.get("path_rate")
     reflected = _switches(nlos & ~los)  # a switch between direct and reflected: lock lost
     scale = cfg["tracking_noise"]
 
@@ -354,21 +394,16 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
     per_satellite = {
         "el": el, "az": az, "signal_cn0": signal_cn0, "cn0": cn0, "tracked": tracked,
         "visible": visible, "have": have, "los": los, "nlos_only": nlos & ~los,
-        "reflected": reflected, "range": rng_m, "range_rate": geo["range_rate"],
-        "tau_rate": geo["tau_rate"], "pos": geo["pos"], "vel": geo["vel"],
-        "sat_drift": sat_drift, "reference_clock": reference_clock, "iono_true": iono_true,
-        "iono_true_rate": iono_true_rate, "tropo_true": tropo_true,
-        "tropo_true_rate": tropo_true_rate, "model_iono": model["iono"],
-        "model_tropo": model["tropo"], "mapping": mapping, "sis": err["sis"],
-        "nlos_delay": nlos_delay, "multipath_unit": err["multipath_unit"],
+        "reflected": reflected, "range": geo["range"], "range_rate": geo["range_rate"],
+        "tau_rate": geo["tau_rate"], "pos": geo["pos"], "vel": geo["vel"], **shared_terms,
+        "model_iono": model["iono"], "model_tropo": model["tropo"], "sis": err["sis"],
+        "multipath_unit": err["multipath_unit"],
         "quadrature": quadrature, "multipath_sigma": err["multipath_sigma"],
         "code_sigma": err["code_sigma"], "code_noise": err["code_noise"],
         "rate_sigma": err["rate_sigma"], "rate_noise": err["rate_noise"],
-        "los_jerk": los_jerk, "health": sky["health"].astype(np.int64),
+        "health": sky["health"].astype(np.int64),
         "primary_delay_s": sky["primary_delay_s"], "tgd_s": sky["tgd_s"],
         "tgd2_s": sky["tgd2_s"], "channel": sky["channel"]}
-    if path_rate is not None:
-        per_satellite["path_rate"] = path_rate
     views: dict[str, dict[str, np.ndarray]] = {}
 
     def unit_gm(tau_s: float, rows: np.ndarray, stream: np.random.Generator) -> np.ndarray:
@@ -429,77 +464,98 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
                                                     cfg["integration_time"])
             rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel,
                                               stream(signal_name, "rate_noise"))
-        code_mp, carrier_mp = reflection_multipath(
-            v["multipath_unit"], v["quadrature"], v["multipath_sigma"], cfg["multipath_delay"],
-            freq - F_L1_HZ, lam)
-        if path_rate is not None:  # the loop follows the carrier multipath: its gain at the
-            # fringe frequency
-            carrier_mp *= pll_response(v["path_rate"] / lam, cfg["pll_bandwidth"])
-        iono_s = k_iono * v["iono_true"]
+        # what needs the whole drive (the draws, the smoothing and the arcs along the epochs)
+        # first; the elementwise rest chunk by chunk (``epoch_chunks``)
+        code_mp, carrier_mp = np.empty(shape), np.empty(shape)
+        iono_s = np.empty(shape)
+        chance = np.zeros(shape)  # a slip only matters where the signal is tracked
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            code_mp[:, cols], carrier_mp[:, cols] = reflection_multipath(
+                v["multipath_unit"][:, cols], v["quadrature"][:, cols],
+                v["multipath_sigma"][:, cols], cfg["multipath_delay"], freq - F_L1_HZ, lam)
+            if path_rate is not None:  # the loop follows the carrier multipath: its gain at
+                # the fringe frequency
+                carrier_mp[:, cols] *= pll_response(v["path_rate"][:, cols] / lam,
+                                                    cfg["pll_bandwidth"])
+            np.multiply(k_iono, v["iono_true"][:, cols], out=iono_s[:, cols])
+            if cfg["carrier_phase"] and scale > 0:
+                here = tracked_s[:, cols]
+                sigma_cycles = scale * pll_sigma_cycles(cn0_true[:, cols], cfg["pll_bandwidth"],
+                                                        cfg["integration_time"])
+                stress = dynamic_stress_cycles(v["los_jerk"][:, cols], lam, cfg["pll_bandwidth"])
+                chance[:, cols][here] = slip_probability(sigma_cycles[here], stress[here],
+                                                         cfg["pll_bandwidth"], dt_s, spec.pilot)
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
-        group_delay = C_M_S * signal_group_delay_s(letter, code, v["primary_delay_s"],
-                                                   v["tgd_s"], v["tgd2_s"])
-        sat_clock_s = v["reference_clock"] - group_delay
-        pseudorange = (v["range"] + rx_clock - sat_clock_s + iono_s + v["tropo_true"]
-                       + v["sis"] + terms["multipath"] + v["nlos_delay"] + terms["code_noise"])
-        rate = (v["range_rate"] + rx_drift - v["sat_drift"] * (1.0 - v["tau_rate"])
-                + v["tropo_true_rate"] - k_iono * v["iono_true_rate"] + rate_noise)
-        pr_std, rate_std = pseudorange_sigma(
-            cfg, {"code_sigma": code_sigma, "multipath_sigma": v["multipath_sigma"],
-                  "rate_sigma": rate_sigma}, k_iono * v["model_iono"], v["mapping"], dt_s,
-            speed)
-        raw = {"system": letter, "signal": code, "frequency": freq,
-               "pseudorange": pseudorange, "pseudorange_rate": rate, "doppler": -rate / lam,
-               "cn0": cn0_out, "sat_x": v["pos"][..., 0], "sat_y": v["pos"][..., 1],
-               "sat_z": v["pos"][..., 2], "sat_vx": v["vel"][..., 0],
-               "sat_vy": v["vel"][..., 1], "sat_vz": v["vel"][..., 2],
-               "sat_clock": sat_clock_s, "sat_clock_drift": v["sat_drift"],
-               "iono": k_iono * v["model_iono"], "tropo": v["model_tropo"], "elevation": v["el"],
-               "azimuth": v["az"], "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
-               "health": v["health"], "group_delay": group_delay}
-        truth = {"system": letter, "signal": code, "frequency": freq,
-                 "tracked": tracked_s.astype(np.int8), "los": v["los"].astype(np.int8),
-                 "nlos": v["nlos_only"].astype(np.int8), "elevation": v["el"],
-                 "azimuth": v["az"], "range": v["range"], "range_rate": v["range_rate"],
-                 "receiver_clock": rx_clock[None, :], "receiver_clock_drift": rx_drift[None, :],
-                 "iono_true": iono_s, "tropo_true": v["tropo_true"],
-                 "iono_true_rate": k_iono * v["iono_true_rate"],
-                 "tropo_true_rate": v["tropo_true_rate"],
-                 "sis_error": v["sis"], "multipath": terms["multipath"],
-                 "nlos_delay": v["nlos_delay"], "code_noise": terms["code_noise"],
-                 "rate_noise": rate_noise, "antenna_x": ant["pos"][None, :, 0],
-                 "antenna_y": ant["pos"][None, :, 1], "antenna_z": ant["pos"][None, :, 2],
-                 "group_delay": group_delay}
         if cfg["carrier_phase"]:
-            sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
-                                                    cfg["integration_time"])
-            phase_noise = lam * sigma_cycles * stream(signal_name, "phase_noise"
-                                                      ).standard_normal(shape)
-            stress = dynamic_stress_cycles(v["los_jerk"], lam, cfg["pll_bandwidth"])
-            chance = np.zeros(shape)  # a slip only matters where the signal is tracked
-            if scale > 0:
-                chance[tracked_s] = slip_probability(sigma_cycles[tracked_s], stress[tracked_s],
-                                                     cfg["pll_bandwidth"], dt_s, spec.pilot)
+            phase_draw = stream(signal_name, "phase_noise").standard_normal(shape)
             slips = draw_slips(stream(signal_name, "cycle_slips").random(shape), chance,
                                tracked_s)
             arcs = phase_arcs(stream(signal_name, "phase_arcs"), tracked_s, slips,
                               v["reflected"], dt_s, spec.pilot, spec.frame_s)
-            phase_m = (v["range"] + rx_clock - v["reference_clock"] - iono_s
-                       + v["tropo_true"] + v["sis"] + carrier_mp + v["nlos_delay"]
-                       + phase_noise)
-            raw.update(carrier_phase=phase_m / lam + arcs.ambiguity + arcs.half,
-                       lli=arcs.lli, lock_time=arcs.lock_time)
-            truth.update(ambiguity=arcs.ambiguity, half_cycle=arcs.half,
-                         cycle_slip=arcs.cycle_slip, arc=arcs.arc, carrier_multipath=carrier_mp,
-                         phase_noise=phase_noise)
-        raw_table.add(sel, tracked_s, raw)
-        truth_table.add(sel, in_truth[letter], truth)
+        whole = {**v, "iono_s": iono_s, "carrier_mp": carrier_mp, "tracked_s": tracked_s,
+                 "in_truth": in_truth[letter], "cn0_true": cn0_true, "cn0_out": cn0_out,
+                 "code_sigma": code_sigma, "rate_sigma": rate_sigma, "rate_noise": rate_noise,
+                 "smoothed_multipath": terms["multipath"],
+                 "smoothed_code_noise": terms["code_noise"]}
+        if cfg["carrier_phase"]:
+            whole.update(phase_draw=phase_draw, **vars(arcs))
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            w = {k: a[:, cols] for k, a in whole.items() if np.ndim(a) > 1}
+            group_delay = C_M_S * signal_group_delay_s(letter, code, w["primary_delay_s"],
+                                                       w["tgd_s"], w["tgd2_s"])
+            sat_clock_s = w["reference_clock"] - group_delay
+            clock, drift = rx_clock[cols], rx_drift[cols]
+            pseudorange = (w["range"] + clock - sat_clock_s + w["iono_s"] + w["tropo_true"]
+                           + w["sis"] + w["smoothed_multipath"] + w["nlos_delay"]
+                           + w["smoothed_code_noise"])
+            rate = (w["range_rate"] + drift - w["sat_drift"] * (1.0 - w["tau_rate"])
+                    + w["tropo_true_rate"] - k_iono * w["iono_true_rate"] + w["rate_noise"])
+            pr_std, rate_std = pseudorange_sigma(
+                cfg, {"code_sigma": w["code_sigma"], "multipath_sigma": w["multipath_sigma"],
+                      "rate_sigma": w["rate_sigma"]}, k_iono * w["model_iono"], w["mapping"],
+                dt_s, speed[cols])
+            raw = {"system": letter, "signal": code, "frequency": freq,
+                   "pseudorange": pseudorange, "pseudorange_rate": rate, "doppler": -rate / lam,
+                   "cn0": w["cn0_out"], "sat_x": w["pos"][..., 0], "sat_y": w["pos"][..., 1],
+                   "sat_z": w["pos"][..., 2], "sat_vx": w["vel"][..., 0],
+                   "sat_vy": w["vel"][..., 1], "sat_vz": w["vel"][..., 2],
+                   "sat_clock": sat_clock_s, "sat_clock_drift": w["sat_drift"],
+                   "iono": k_iono * w["model_iono"], "tropo": w["model_tropo"],
+                   "elevation": w["el"], "azimuth": w["az"], "pseudorange_std": pr_std,
+                   "pseudorange_rate_std": rate_std, "health": w["health"],
+                   "group_delay": group_delay}
+            antenna = ant["pos"][None, cols]
+            truth = {"system": letter, "signal": code, "frequency": freq,
+                     "tracked": w["tracked_s"].astype(np.int8), "los": w["los"].astype(np.int8),
+                     "nlos": w["nlos_only"].astype(np.int8), "elevation": w["el"],
+                     "azimuth": w["az"], "range": w["range"], "range_rate": w["range_rate"],
+                     "receiver_clock": clock[None, :], "receiver_clock_drift": drift[None, :],
+                     "iono_true": w["iono_s"], "tropo_true": w["tropo_true"],
+                     "iono_true_rate": k_iono * w["iono_true_rate"],
+                     "tropo_true_rate": w["tropo_true_rate"], "sis_error": w["sis"],
+                     "multipath": w["smoothed_multipath"], "nlos_delay": w["nlos_delay"],
+                     "code_noise": w["smoothed_code_noise"], "rate_noise": w["rate_noise"],
+                     "antenna_x": antenna[..., 0], "antenna_y": antenna[..., 1],
+                     "antenna_z": antenna[..., 2], "group_delay": group_delay}
+            if cfg["carrier_phase"]:
+                sigma_cycles = scale * pll_sigma_cycles(w["cn0_true"], cfg["pll_bandwidth"],
+                                                        cfg["integration_time"])
+                phase_noise = lam * sigma_cycles * w["phase_draw"]
+                phase_m = (w["range"] + clock - w["reference_clock"] - w["iono_s"]
+                           + w["tropo_true"] + w["sis"] + w["carrier_mp"] + w["nlos_delay"]
+                           + phase_noise)
+                raw.update(carrier_phase=phase_m / lam + w["ambiguity"] + w["half"],
+                           lli=w["lli"], lock_time=w["lock_time"])
+                truth.update(ambiguity=w["ambiguity"], half_cycle=w["half"],
+                             cycle_slip=w["cycle_slip"], arc=w["arc"],
+                             carrier_multipath=w["carrier_mp"], phase_noise=phase_noise)
+            raw_table.add(sel, w["tracked_s"], raw, cols.start)
+            truth_table.add(sel, w["in_truth"], truth, cols.start)
     return raw_table, truth_table, {"clock_m": rx_clock, "drift_m_s": rx_drift,
                                     "drawn": drawn, "shared": shared}
 
 
-CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives
 COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
 BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
 # what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
@@ -544,7 +600,8 @@ def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.
 def signal_geometry_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
                        ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
                        beta: list[float]) -> dict[str, np.ndarray]:
-    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time and only
+    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time
+    (``simulator.gnss.chunks``) and only
     for the satellites that may be above the horizon in each chunk; the others keep elevation
     -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
     n_sat, n_ep = idx.shape
@@ -553,8 +610,7 @@ def signal_geometry_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: n
                       alpha, beta)
     fill = {"elevation": -np.pi / 2, "zenith": 1.0}
     out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
-    for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
-        cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
         ant_c = {k: v[cols] for k, v in ant.items()}
         rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
         part = _signals(gather(eph, idx[rows, cols], STATE_KEYS), t_gps[cols], ant_c,
