@@ -133,7 +133,8 @@ class Shared:
     tropo_gradient: np.ndarray  # zenith residual change per metre north, east
     orbit_m: np.ndarray  # per broadcast record, (n_records, 3)
     origin_lla: tuple[float, float, float]
-    los: np.ndarray  # the first receiver's lines of sight (n_sat, n_epoch, 3)
+    los_rows: np.ndarray  # the satellites (rows of the sky) the first receiver measured
+    los: np.ndarray  # its lines of sight to them (len(los_rows), n_epoch, 3)
     second_rng: np.random.Generator  # the second receiver's own random stream
 
 
@@ -149,10 +150,11 @@ class Observed:
 
 class _Table:
     """One stream table's rows: each signal's (satellite, epoch) samples where its mask is set,
-    taken in the signal's own order, and the place of each in the table, which is in the order
-    of epochs, then satellites (PRN order), then the receiver's signals. The places are a
-    counting rank: every signal's mask is known before the first signal's rows are taken, so
-    nothing is sorted. A text value (one per signal) is spread over the signal's rows."""
+    written straight to their places in the table's columns, which are in the order of epochs,
+    then satellites (PRN order), then the receiver's signals. The places are a counting rank:
+    every signal's mask is known before the first signal's rows are written, so nothing is
+    sorted, and each column is allocated once, at the table's size. A text value (one per
+    signal) is spread over the signal's rows."""
 
     def __init__(self, t: np.ndarray, svs: np.ndarray,
                  masks: list[tuple[np.ndarray, np.ndarray]]):
@@ -165,9 +167,22 @@ class _Table:
         per_slot = count.T.ravel()  # epoch by epoch, satellites in order
         # each (epoch, satellite)'s first row, moved on as each of its signals takes its row
         self.next_row = np.cumsum(per_slot, dtype=np.int64) - per_slot
-        self.source = np.empty(int(per_slot.sum()), dtype=np.int64)  # each row's sample
-        self.pieces: list[dict[str, np.ndarray | str]] = []
-        self.n_taken = 0
+        self.n_rows = int(per_slot.sum())
+        self.columns: dict[str, np.ndarray] = {}
+        self.texts: dict[str, list[str]] = {}  # a text column's distinct values; its codes
+        # are in ``columns``
+
+    def _write(self, key: str, rows: np.ndarray, values: np.ndarray) -> None:
+        """``values`` into column ``key`` at ``rows``; a column whose values come in several
+        types takes the type they all fit (as concatenating them would)."""
+        column = self.columns.get(key)
+        if column is None:
+            column = self.columns[key] = np.empty(self.n_rows, dtype=values.dtype)
+        elif column.dtype != values.dtype:
+            kind = np.promote_types(column.dtype, values.dtype)
+            if kind != column.dtype:
+                column = self.columns[key] = column.astype(kind)
+        column[rows] = values
 
     def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str],
             first_epoch: int = 0) -> None:
@@ -175,47 +190,41 @@ class _Table:
         satellites (or broadcastable to them; a text value stays one text) where ``mask``,
         whose epochs begin at ``first_epoch`` (a chunk of the drive's)."""
         sat, ep = np.nonzero(mask)
-        piece: dict[str, np.ndarray | str] = {"t": self.t[first_epoch + ep],
-                                              "sv": self.svs[sel[sat]]}
         slot = (first_epoch + ep) * len(self.svs) + sel[sat]
         rows = self.next_row[slot]
         self.next_row[slot] += 1
-        self.source[rows] = np.arange(self.n_taken, self.n_taken + len(sat))
-        self.n_taken += len(sat)
+        self._write("t", rows, self.t[first_epoch + ep])
+        self._write("sv", rows, self.svs[sel[sat]])
         for key, value in columns.items():
-            if isinstance(value, str):  # kept as it is: ``frame`` spreads it over the rows
-                piece[key] = value
+            if isinstance(value, str):  # its code among the column's texts
+                texts = self.texts.setdefault(key, [])
+                if value not in texts:
+                    texts.append(value)
+                self._write(key, rows, np.full(len(rows), texts.index(value), dtype=np.int16))
             elif value.shape == mask.shape:
-                piece[key] = value[mask]
+                self._write(key, rows, value[mask])
             elif value.shape == (mask.shape[0], 1):  # one value per satellite
-                piece[key] = value[sat, 0]
+                self._write(key, rows, value[sat, 0])
             elif value.shape == (1, mask.shape[1]):  # one value per epoch
-                piece[key] = value[0, ep]
+                self._write(key, rows, value[0, ep])
             else:
-                piece[key] = np.broadcast_to(value, mask.shape)[mask]
-        self.pieces.append(piece)
+                self._write(key, rows, np.broadcast_to(value, mask.shape)[mask])
 
     def names(self, order: tuple[str, ...]) -> list[str]:
         """The columns of ``order`` this table has."""
-        return [c for c in order if c in self.pieces[0]]
+        return [c for c in order if c in self.columns]
 
     def frame(self, names: list[str]) -> pd.DataFrame:
-        """The table of the columns ``names`` in its rows' order (each column its own new
-        array: the table takes them as they are, without copying them into blocks). The
-        pieces are emptied column by column as the table takes them, so the rows are held
-        about once, not twice (the peak memory of a long, fast-rate drive)."""
+        """The table of the columns ``names`` (each column its own array: the table takes them
+        as they are, without copying them into blocks)."""
         import pandas as pd
 
-        sizes = [len(p["t"]) for p in self.pieces]
         columns = {}
         for name in names:
-            values = [p.pop(name) for p in self.pieces]
-            if isinstance(values[0], str):  # a text per piece: taken from the distinct ones
-                texts = sorted(set(values))
-                codes = np.repeat([texts.index(v) for v in values], sizes)
-                columns[name] = pd.Series(texts).array.take(np.take(codes, self.source))
-            else:
-                columns[name] = np.take(np.concatenate(values), self.source)
+            values = self.columns.pop(name)
+            if name in self.texts:  # the texts of the codes
+                values = pd.Series(self.texts[name]).array.take(values)
+            columns[name] = values
         return pd.DataFrame(columns, copy=False)
 
 
@@ -238,18 +247,18 @@ def _gradient_part(values: np.ndarray, cols: slice, dt_s: float, times: int = 1)
 
 
 def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int, n_ep: int,
-                  dt_s: float, ant: dict, los: np.ndarray) -> Shared:
+                  dt_s: float, ant: dict, los_rows: np.ndarray, los: np.ndarray) -> Shared:
     """The first receiver's draws a second one shares, each from its own named stream (module
     docstring), and the second receiver's own stream."""
     tid = IonoField(child_rng(rng, "iono_tid"), n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
     gradient = cfg["tropo_gradient"] * child_rng(rng, "tropo_gradient").standard_normal(2)
     orbit = ORBIT_ERROR_M * child_rng(rng, "orbit_error").standard_normal((n_records, 3))
-    return Shared(sis=err["sis"], iono_field=err["iono_field"], tid=tid,
+    return Shared(sis=err["sis_all"], iono_field=err["iono_field"], tid=tid,
                   tid_sigma_m=cfg["iono_gradient"] * TID_LENGTH_KM * 1e3,
                   tropo_zenith_m=float(err["tropo_zenith"]), tropo_gradient=gradient,
                   orbit_m=orbit,
                   origin_lla=(float(ant["lat"][0]), float(ant["lon"][0]), float(ant["alt"][0])),
-                  los=los, second_rng=child_rng(rng, "second_receiver"))
+                  los_rows=los_rows, los=los, second_rng=child_rng(rng, "second_receiver"))
 
 
 def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
@@ -284,20 +293,30 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
              shared: Shared | None) -> tuple[_Table, _Table, dict]:
     """``observe``'s measurements as the rows of its raw and truth tables (``_Table``), with
     the receiver's clock (m, m/s), what it drew and the shared draws."""
-    eph, idx, svs = sky["eph"], sky["idx"], sky["svs"]
-    n_sat, n_ep = idx.shape
-    geo = model = signal_geometry_chunks(eph, idx, sky["t_gps"], ant, sky["day_of_year"],
-                                         sky["alpha"], sky["beta"])
+    eph = sky["eph"]
+    n_all, n_ep = sky["idx"].shape
+    # the satellites that may rise above the horizon; the others are never measured (their
+    # processes are drawn all the same, so that every stream draws what it always drew)
+    rows, geo = signal_geometry_chunks(eph, sky["idx"], sky["t_gps"], ant, sky["day_of_year"],
+                                       sky["alpha"], sky["beta"])
+    model = geo
+    idx, svs = sky["idx"][rows], sky["svs"][rows]
+    n_sat = len(rows)
     el, az = geo["elevation"], geo["azimuth"]
 
     # what the receiver tracks: the C/N0 fades with the motion (correlated like the
     # multipath), the receiver's estimate of it adds white noise
     u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
                                  cfg["multipath_correlation_time"])
-    los, nlos, extra, loss = reception(
-        az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
-    fading = draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_sat)
-    cn0_noise = child_rng(rng, "cn0_noise").standard_normal(el.shape)
+    # the environment sees every satellite (a canyon draws per satellite of the sky)
+    sky_az, sky_el = np.zeros((n_all, n_ep)), np.full((n_all, n_ep), -np.pi / 2)
+    sky_az[rows], sky_el[rows] = az, el
+    los, nlos, extra, loss = (a[rows] for a in reception(
+        sky_az, sky_el,
+        lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"])))
+    del sky_az, sky_el
+    fading = draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_all, rows)
+    cn0_noise = child_rng(rng, "cn0_noise").standard_normal((n_all, n_ep))[rows]
     signal_cn0, cn0 = np.empty((n_sat, n_ep)), np.empty((n_sat, n_ep))
     for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
         signal_cn0[:, cols] = (cn0_model(el[:, cols], cfg["cn0_zenith"], cfg["cn0_horizon"])
@@ -316,16 +335,22 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
     for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
         pierce[:, :, cols] = pierce_points_km(ant["lat"][cols], ant["lon"][cols], az[:, cols],
                                               np.maximum(el[:, cols], 0.0))
-    err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, idx,
-                           None if shared is None else shared)
+    err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, sky["idx"],
+                           None if shared is None else shared, rows)
     if shared is None:
-        shared = _shared_draws(rng, cfg, err, len(eph["toe_s"]), n_ep, dt_s, ant, geo["los"])
+        shared = _shared_draws(rng, cfg, err, len(eph["toe_s"]), n_ep, dt_s, ant, rows,
+                               geo["los"])
     else:  # the orbit error seen along this receiver's lines of sight
+        # the first receiver's lines of sight of these satellites (zero where it had none)
+        at = np.minimum(np.searchsorted(shared.los_rows, rows), len(shared.los_rows) - 1)
+        common = np.flatnonzero(shared.los_rows[at] == rows)
         sis = np.empty((n_sat, n_ep))
         for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            first_los = np.zeros((n_sat, cols.stop - cols.start, 3))
+            first_los[common] = shared.los[at[common], cols]
             orbit = shared.orbit_m[np.maximum(idx[:, cols], 0)]
             sis[:, cols] = np.where(have[:, cols], err["sis"][:, cols] + np.einsum(
-                "sek,sek->se", orbit, geo["los"][:, cols] - shared.los[:, cols]), 0.0)
+                "sek,sek->se", orbit, geo["los"][:, cols] - first_los), 0.0)
         err["sis"] = sis
     drawn = {"clock": drawn_clock, "tropo_zenith_error_m": shared.tropo_zenith_m,
              "tropo_gradient_m_per_km": (shared.tropo_gradient * 1e3).tolist()}
@@ -338,15 +363,16 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         tid[:, cols] *= shared.tid_sigma_m
         tid[:, cols] *= klobuchar_obliquity(np.maximum(el[:, cols], 0.0))
     rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
-    system_of = sky["systems"]
+    system_of = sky["systems"][rows]
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
-    quadrature = gauss_markov_along(u, n_sat, child_rng(rng, "multipath_quadrature"))
+    quadrature = gauss_markov_along(u, n_all, child_rng(rng, "multipath_quadrature"),
+                                    columns=rows)
     # the reflecting plane's normal (uniform in direction, changing as the reflectors do): with
     # the antenna's velocity it sets how fast the reflection's carrier phase turns
     from scipy.special import ndtr  # imported on first use, as in simulator.gnss.carrier
 
-    wall_unit = gauss_markov_along(u, n_sat, child_rng(rng, "reflector_normal"))
+    wall_unit = gauss_markov_along(u, n_all, child_rng(rng, "reflector_normal"), columns=rows)
     moving = bool(np.any(ant["v_ned"] != 0.0))
     names = ["mapping", "tropo_true", "iono_true", "iono_true_rate", "tropo_true_rate",
              "sat_drift", "reference_clock", "nlos_delay", "los_jerk"] + ["path_rate"] * moving
@@ -376,7 +402,7 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         # the broadcast clock's reference (the ionosphere-free pair, without the primary
         # signal's group delay): the carrier's clock; each code's own group delay is taken
         # from it (signals.signal_group_delay_s)
-        out["reference_clock"][...] = sat_clock + C_M_S * sky["primary_delay_s"][:, cols]
+        out["reference_clock"][...] = sat_clock + C_M_S * sky["primary_delay_s"][rows, cols]
         out["nlos_delay"][...] = np.where(nlos[:, cols] & ~los[:, cols], extra[:, cols], 0.0)
         if moving:  # standing still, the loop's gain is 1
             out["path_rate"][...] = reflection_path_rate_m_s(
@@ -401,13 +427,18 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         "quadrature": quadrature, "multipath_sigma": err["multipath_sigma"],
         "code_sigma": err["code_sigma"], "code_noise": err["code_noise"],
         "rate_sigma": err["rate_sigma"], "rate_noise": err["rate_noise"],
-        "health": sky["health"].astype(np.int64),
-        "primary_delay_s": sky["primary_delay_s"], "tgd_s": sky["tgd_s"],
-        "tgd2_s": sky["tgd2_s"], "channel": sky["channel"]}
+        "health": sky["health"][rows].astype(np.int64),
+        "primary_delay_s": sky["primary_delay_s"][rows], "tgd_s": sky["tgd_s"][rows],
+        "tgd2_s": sky["tgd2_s"][rows], "channel": sky["channel"][rows]}
     views: dict[str, dict[str, np.ndarray]] = {}
 
-    def unit_gm(tau_s: float, rows: np.ndarray, stream: np.random.Generator) -> np.ndarray:
-        return gauss_markov(n_ep, dt_s, np.ones(len(rows)), tau_s, stream).T
+    def unit_gm(tau_s: float, letter: str, stream: np.random.Generator) -> np.ndarray:
+        return gauss_markov(n_ep, dt_s, np.ones(len(sky_sels[letter])), tau_s, stream,
+                            columns=kept[letter]).T
+
+    def draw(letter: str, values: Callable[[tuple[int, int]], np.ndarray]) -> np.ndarray:
+        """A draw of one value per satellite of the system and epoch, the measured ones."""
+        return values((len(sky_sels[letter]), n_ep))[kept[letter]]
 
     def stream(signal_name: str, process: str) -> np.random.Generator:
         """One signal's process's own stream (module docstring)."""
@@ -415,11 +446,14 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     sels = {letter: np.flatnonzero(system_of == letter) for letter, _ in codes}
+    # each system's satellites in the sky, and where the measured ones are among them
+    sky_sels = {letter: np.flatnonzero(sky["systems"] == letter) for letter in sels}
+    kept = {letter: np.searchsorted(sky_sels[letter], rows[sel]) for letter, sel in sels.items()}
     for letter, sel in sels.items():
         # a system's satellites are consecutive rows of the sky: views, not copies
-        rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
-                else sel)
-        views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
+        block = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
+                 else sel)
+        views[letter] = {k: np.asarray(v)[block] for k, v in per_satellite.items()}
     # what each signal tracks, first: every table row is then known before any is written
     tracking = {}
     for letter, code in codes:  # one pass per signal, vectorised
@@ -428,8 +462,8 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
             tracking[letter, code] = v["cn0"], v["tracked"]
             continue
         cn0_true = v["signal_cn0"] + signal(letter, code).cn0_offset_db
-        cn0_out = cn0_true + cfg["cn0_noise"] * stream(f"{letter}{code}", "cn0_noise"
-                                                        ).standard_normal(v["el"].shape)
+        cn0_out = cn0_true + cfg["cn0_noise"] * draw(
+            letter, stream(f"{letter}{code}", "cn0_noise").standard_normal)
         tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
         if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
             tracked_s &= v["tracked"]
@@ -458,12 +492,12 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
             code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
                                              cfg["correlator_spacing"], cfg["integration_time"]
                                              ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
-            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel,
-                                              stream(signal_name, "code_noise"))
+            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]),
+                                              letter, stream(signal_name, "code_noise"))
             rate_sigma = scale * lam * fll_sigma_hz(cn0_true, cfg["fll_bandwidth"],
                                                     cfg["integration_time"])
-            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel,
-                                              stream(signal_name, "rate_noise"))
+            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]),
+                                              letter, stream(signal_name, "rate_noise"))
         # what needs the whole drive (the draws, the smoothing and the arcs along the epochs)
         # first; the elementwise rest chunk by chunk (``epoch_chunks``)
         code_mp, carrier_mp = np.empty(shape), np.empty(shape)
@@ -488,8 +522,8 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
         if cfg["carrier_phase"]:
-            phase_draw = stream(signal_name, "phase_noise").standard_normal(shape)
-            slips = draw_slips(stream(signal_name, "cycle_slips").random(shape), chance,
+            phase_draw = draw(letter, stream(signal_name, "phase_noise").standard_normal)
+            slips = draw_slips(draw(letter, stream(signal_name, "cycle_slips").random), chance,
                                tracked_s)
             arcs = phase_arcs(stream(signal_name, "phase_arcs"), tracked_s, slips,
                               v["reflected"], dt_s, spec.pilot, spec.frame_s)
@@ -598,23 +632,32 @@ def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.
 
 
 def signal_geometry_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
-                       ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
-                       beta: list[float]) -> dict[str, np.ndarray]:
-    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time
-    (``simulator.gnss.chunks``) and only
-    for the satellites that may be above the horizon in each chunk; the others keep elevation
-    -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
-    n_sat, n_ep = idx.shape
+                           ant: dict[str, np.ndarray], day_of_year: np.ndarray,
+                           alpha: list[float], beta: list[float]
+                           ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """``_signals`` of the satellites that may be above the horizon, evaluated
+    ``CHUNK_EPOCHS`` at a time (``simulator.gnss.chunks``) and in each chunk only for the
+    satellites that may be above the horizon then: the satellites (rows of idx, ascending)
+    that may be above it in some chunk, and their signals over every epoch, (rows, n_epoch)
+    arrays in which the epochs of a chunk where a satellite stays below keep elevation -90 deg
+    (never tracked), a unit zenith delay and zeros elsewhere. The other satellites are never
+    above the horizon: nothing of them is measured."""
+    n_ep = idx.shape[1]
+    screened = []
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        ant_c = {k: v[cols] for k, v in ant.items()}
+        screened.append((cols, ant_c, _maybe_above_horizon(eph, idx[:, cols], t_gps[cols],
+                                                           ant_c)))
+    rows = np.unique(np.concatenate([np.zeros(0, dtype=int)] + [r for _, _, r in screened]))
     first = {k: v[:1] for k, v in ant.items()}
     shapes = _signals(gather(eph, idx[:1, :1], STATE_KEYS), t_gps[:1], first, day_of_year[:1],
                       alpha, beta)
     fill = {"elevation": -np.pi / 2, "zenith": 1.0}
-    out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
-    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
-        ant_c = {k: v[cols] for k, v in ant.items()}
-        rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
-        part = _signals(gather(eph, idx[rows, cols], STATE_KEYS), t_gps[cols], ant_c,
+    out = {k: np.full((len(rows), n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
+    for cols, ant_c, up in screened:  # one pass per chunk of epochs
+        part = _signals(gather(eph, idx[up, cols], STATE_KEYS), t_gps[cols], ant_c,
                         day_of_year[cols], alpha, beta)
+        at = np.searchsorted(rows, up)
         for key in _KEPT:
-            out[key][rows, cols] = part[key]
-    return out
+            out[key][at, cols] = part[key]
+    return rows, out
