@@ -263,7 +263,8 @@ def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int
 
 def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
             rng: np.random.Generator,
-            reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
+            reception: Callable[[np.ndarray, np.ndarray, Callable, np.ndarray],
+                                tuple[np.ndarray, ...]],
             shared: Shared | None = None) -> Observed:
     """Every signal's measurements of one receiver (module docstring).
 
@@ -276,8 +277,9 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     ant : dict of ndarray
         The antenna over the epochs (``Gnss.antenna``).
     reception : callable
-        (azimuth, elevation, antenna gain) -> (los, nlos, extra path, C/N0 loss), the
-        environment's effect on each signal.
+        (azimuth, elevation, antenna gain, rows) -> (los, nlos, extra path, C/N0 loss), the
+        environment's effect on each signal of the satellites ``rows`` (of the sky's) whose
+        azimuth and elevation it is given.
     shared : Shared, optional
         The first receiver's shared draws; None for the first receiver (it draws them).
     """
@@ -289,7 +291,8 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
 
 def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
              rng: np.random.Generator,
-             reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
+             reception: Callable[[np.ndarray, np.ndarray, Callable, np.ndarray],
+                                 tuple[np.ndarray, ...]],
              shared: Shared | None) -> tuple[_Table, _Table, dict]:
     """``observe``'s measurements as the rows of its raw and truth tables (``_Table``), with
     the receiver's clock (m, m/s), what it drew and the shared draws."""
@@ -308,13 +311,9 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
     # multipath), the receiver's estimate of it adds white noise
     u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
                                  cfg["multipath_correlation_time"])
-    # the environment sees every satellite (a canyon draws per satellite of the sky)
-    sky_az, sky_el = np.zeros((n_all, n_ep)), np.full((n_all, n_ep), -np.pi / 2)
-    sky_az[rows], sky_el[rows] = az, el
-    los, nlos, extra, loss = (a[rows] for a in reception(
-        sky_az, sky_el,
-        lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"])))
-    del sky_az, sky_el
+    los, nlos, extra, loss = reception(
+        az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]),
+        rows)
     fading = draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_all, rows)
     cn0_noise = child_rng(rng, "cn0_noise").standard_normal((n_all, n_ep))[rows]
     signal_cn0, cn0 = np.empty((n_sat, n_ep)), np.empty((n_sat, n_ep))
