@@ -153,7 +153,7 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False,
     phi = np.broadcast_to(np.asarray(phi, dtype=kind), (m,))
     gain_in = np.broadcast_to(np.asarray(gain_in, dtype=float), (m,))
     gain_out = np.broadcast_to(np.asarray(gain_out, dtype=float), (m,))
-    if n == 0:
+    if n == 0 or m == 0:
         return x[:, 0] if flat else x
     with np.errstate(divide="ignore"):
         decay = -np.log(phi)  # -ln phi per column (its real part |ln |phi||), inf for phi = 0
