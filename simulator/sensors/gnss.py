@@ -100,11 +100,7 @@ from simulator.gnss.constellation import (
     missing_systems,
     sky_navigation,
 )
-from simulator.gnss.ephemeris import (
-    ephemeris_arrays,
-    gather,
-    select_ephemeris,
-)
+from simulator.gnss.ephemeris import ephemeris_arrays, select_ephemeris
 from simulator.gnss.errors import (
     OSCILLATORS,
 )
@@ -484,9 +480,6 @@ class Gnss(PresetSensor):
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
                                healthy_only=False, system=systems[:, None])
         self._check_coverage(idx, t, truth, max_age)
-        # only the records' fields used per epoch (a whole record per satellite and epoch is
-        # gigabytes for a fast-rate hour)
-        gathered = gather(eph, idx, ("health", "tgd", "tgd2", "group_delay"))
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
@@ -500,12 +493,7 @@ class Gnss(PresetSensor):
             list(zip(systems, svs, strict=True))].to_numpy()
         return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "systems": systems,
                 "channel": np.nan_to_num(channel.astype(float)), "t_gps": tow0 + t,
-                "health": np.where(idx >= 0, gathered["health"], 0.0),
-                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0),
-                "tgd2_s": np.where(idx >= 0, gathered["tgd2"], 0.0),
-                "primary_delay_s": np.where(idx >= 0, gathered["group_delay"], 0.0),
-                "alpha": alpha,
-                "beta": beta, "day_of_year": day_of_year}
+                "alpha": alpha, "beta": beta, "day_of_year": day_of_year}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         cfg = self.config

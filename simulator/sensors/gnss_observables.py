@@ -323,6 +323,14 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         cn0[:, cols] = signal_cn0[:, cols] + cfg["cn0_noise"] * cn0_noise[:, cols]
     del fading, cn0_noise
     have = idx >= 0
+    # the broadcast record's fields each signal carries (0 where no record): only the fields
+    # used, only for these satellites (a whole record per satellite and epoch is gigabytes
+    # for a fast-rate hour)
+    gathered = gather(eph, idx, ("health", "tgd", "tgd2", "group_delay"))
+    record = {name: np.where(have, gathered[key], 0.0) for name, key in (
+        ("health", "health"), ("tgd_s", "tgd"), ("tgd2_s", "tgd2"),
+        ("primary_delay_s", "group_delay"))}
+    del gathered
     visible = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos)
     tracked = visible & (cn0 >= cfg["cn0_threshold"])
 
@@ -401,7 +409,7 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         # the broadcast clock's reference (the ionosphere-free pair, without the primary
         # signal's group delay): the carrier's clock; each code's own group delay is taken
         # from it (signals.signal_group_delay_s)
-        out["reference_clock"][...] = sat_clock + C_M_S * sky["primary_delay_s"][rows, cols]
+        out["reference_clock"][...] = sat_clock + C_M_S * record["primary_delay_s"][:, cols]
         out["nlos_delay"][...] = np.where(nlos[:, cols] & ~los[:, cols], extra[:, cols], 0.0)
         if moving:  # standing still, the loop's gain is 1
             out["path_rate"][...] = reflection_path_rate_m_s(
@@ -426,9 +434,9 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
         "quadrature": quadrature, "multipath_sigma": err["multipath_sigma"],
         "code_sigma": err["code_sigma"], "code_noise": err["code_noise"],
         "rate_sigma": err["rate_sigma"], "rate_noise": err["rate_noise"],
-        "health": sky["health"][rows].astype(np.int64),
-        "primary_delay_s": sky["primary_delay_s"][rows], "tgd_s": sky["tgd_s"][rows],
-        "tgd2_s": sky["tgd2_s"][rows], "channel": sky["channel"][rows]}
+        "health": record["health"].astype(np.int64),
+        "primary_delay_s": record["primary_delay_s"], "tgd_s": record["tgd_s"],
+        "tgd2_s": record["tgd2_s"], "channel": sky["channel"][rows]}
     views: dict[str, dict[str, np.ndarray]] = {}
 
     def unit_gm(tau_s: float, letter: str, stream: np.random.Generator) -> np.ndarray:
