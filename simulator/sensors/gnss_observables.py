@@ -27,6 +27,15 @@ from T_GD, BGD or TGD1/TGD2: ``simulator.gnss.signals.signal_group_delay_s``; th
 carries no hardware delay). The carrier phase has RINEX's sign: it grows with the range, as
 the pseudorange does.
 
+How it is computed: only the satellites that may rise above the horizon during the drive
+(``signal_geometry_chunks``) are measured; every random process is still drawn for every
+satellite of the sky, in the same order, and the measured ones keep theirs, so a draw never
+depends on which satellites rise. What runs along the epochs (the draws, the carrier
+smoothing, the phase arcs, the rates by central differences) sees the whole drive; what is
+elementwise over satellites x epochs is computed a chunk of epochs at a time
+(``simulator.gnss.chunks``), and each signal's rows go straight to their places in the tables.
+The numbers are those of one pass over the whole drive (the chunk size changes none of them).
+
 Random streams: every error process draws from its own stream, the child of the receiver's
 stream (the rover's: the sensor stream ``gnss``) named after the process
 (``simulator.stochastic.child_rng``), so a process that draws more or fewer numbers (a new
