@@ -35,6 +35,7 @@ from test_gnss_orbits import read_sp3_positions
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
 from simulator.gnss.constants import C_M_S, SECONDS_PER_WEEK
 from simulator.gnss.ephemeris import ephemeris_arrays, gather, satellite_state, select_ephemeris
+from simulator.gnss.fix import primary_rows
 from simulator.timebase import gps_to_utc
 
 CASES = {
@@ -102,6 +103,33 @@ def broadcast_against_precise(nav: pd.DataFrame) -> pd.DataFrame:
     return out
 
 
+def ionosphere_against_klobuchar(nav: pd.DataFrame, real: pd.DataFrame) -> pd.DataFrame:
+    """The true L1 ionosphere against the broadcast (Klobuchar) delay K, a K + b fitted (b
+    takes the receiver's bias), for the station (from its dual-frequency code) and for the
+    geodetic preset's simulated hour (seed 1), printed; the real residuals with both. The
+    simulated receiver's L1 C/A rows only (``primary_rows``: its L2 and L5 rows carry their own
+    signal's delay, (f_L1 / f)^2 times L1's)."""
+    lat, lon, alt = ecef_to_geodetic(ARL1_XYZ)
+    start = {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": float(alt),
+             "heading": 0.0}
+    truth = drive([{"stop": {"duration": 3570}}], start=start, utc=gps_to_utc(WEEK, 0.0),
+                  rate_hz=1.0)
+    out = receiver(preset="geodetic", rate=1 / 30, constellation=str(FOLDER / "arlm200a.15n")
+                   ).generate(truth, np.random.default_rng(1))
+    keys = ["t", "sv", "signal"]
+    sim = primary_rows(out["gnss_raw"]).merge(out["truth_gnss"][keys + ["iono_true"]], on=keys)
+    both = real.merge(dual_frequency_iono(nav), on=["tow", "sv"]).merge(
+        sim.rename(columns={"t": "tow"})[["tow", "sv", "iono", "iono_true"]], on=["tow", "sv"])
+    design = np.column_stack([both["iono"], np.ones(len(both))])
+    for name, column in (("real (dual-frequency)", "iono_dual"), ("simulated, seed 1",
+                                                                  "iono_true")):
+        coef, *_ = np.linalg.lstsq(design, both[column], rcond=None)
+        left = both[column] - design @ coef
+        print(f"{name}: ionosphere = {coef[0]:.2f} K + {coef[1]:.2f} m, the rest's std "
+              f"{left.std():.2f} m ({len(both)} residuals)")
+    return both
+
+
 def main() -> None:
     nav = _nav()
     real = residuals(_real_observations(), nav, ARL1_XYZ)
@@ -132,24 +160,7 @@ def main() -> None:
         print(f"  {name}: hour-mean spread above 30 deg {hour_mean_spread(corrected):.2f} m "
               f"(as filed {hour_mean_spread(merged):.2f} m, at the SP3 epochs)")
 
-    # the true ionosphere against Klobuchar: a K + b fitted (b takes the receiver's bias)
-    lat, lon, alt = ecef_to_geodetic(ARL1_XYZ)
-    start = {"lat": float(np.degrees(lat)), "lon": float(np.degrees(lon)), "alt": float(alt),
-             "heading": 0.0}
-    truth = drive([{"stop": {"duration": 3570}}], start=start, utc=gps_to_utc(WEEK, 0.0),
-                  rate_hz=1.0)
-    out = receiver(preset="geodetic", rate=1 / 30, constellation=str(FOLDER / "arlm200a.15n")
-                   ).generate(truth, np.random.default_rng(1))
-    sim = out["gnss_raw"].merge(out["truth_gnss"][["t", "sv", "iono_true"]], on=["t", "sv"])
-    both = real.merge(dual_frequency_iono(nav), on=["tow", "sv"]).merge(
-        sim.rename(columns={"t": "tow"})[["tow", "sv", "iono", "iono_true"]], on=["tow", "sv"])
-    design = np.column_stack([both["iono"], np.ones(len(both))])
-    for name, column in (("real (dual-frequency)", "iono_dual"), ("simulated, seed 1",
-                                                                  "iono_true")):
-        coef, *_ = np.linalg.lstsq(design, both[column], rcond=None)
-        left = both[column] - design @ coef
-        print(f"{name}: ionosphere = {coef[0]:.2f} K + {coef[1]:.2f} m, the rest's std "
-              f"{left.std():.2f} m ({len(both)} residuals)")
+    both = ionosphere_against_klobuchar(nav, real)
 
     # the real P1 residual split by the station's own dual-frequency code: its ionosphere and
     # T_GD part (I_dual - K) and what is left, the ionosphere-free residual (signal in space,

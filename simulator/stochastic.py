@@ -153,7 +153,7 @@ def ar1_filter(u: np.ndarray, phi: float | np.ndarray, overwrite: bool = False,
     phi = np.broadcast_to(np.asarray(phi, dtype=kind), (m,))
     gain_in = np.broadcast_to(np.asarray(gain_in, dtype=float), (m,))
     gain_out = np.broadcast_to(np.asarray(gain_out, dtype=float), (m,))
-    if n == 0:
+    if n == 0 or m == 0:
         return x[:, 0] if flat else x
     with np.errstate(divide="ignore"):
         decay = -np.log(phi)  # -ln phi per column (its real part |ln |phi||), inf for phi = 0
@@ -215,7 +215,7 @@ def random_walk(n: int, dt_s: float, density: np.ndarray, rng: np.random.Generat
 
 
 def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarray,
-                 rng: np.random.Generator) -> np.ndarray:
+                 rng: np.random.Generator, columns: np.ndarray | None = None) -> np.ndarray:
     """Stationary first-order Gauss-Markov process, exact discretisation (Gelb 1974, Table 3.8-1).
 
     x[k+1] = exp(-dt/tau) x[k] + sigma sqrt(1 - exp(-2 dt/tau)) w[k], x[0] ~ N(0, sigma^2).
@@ -226,15 +226,22 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
     dt_s : sample interval, s.
     sigma : stationary standard deviation per axis, shape (m,).
     tau_s : correlation time, s: one for all axes or one per axis, shape (m,).
+    columns : only these axes (indices into the m) are returned: all m are drawn, as without
+        ``columns``, and only these filtered (each axis is filtered alone, so they are the
+        same numbers); one ``tau_s`` for all axes.
 
     Returns
     -------
-    ndarray, shape (n, m)
+    ndarray, shape (n, m), or (n, len(columns))
     """
     sigma = np.atleast_1d(np.asarray(sigma, dtype=float))
     phi, q_unit = gauss_markov_discrete(tau_s, 1.0, dt_s)
     drive = rng.standard_normal((n, sigma.size))
     drive[0] = rng.standard_normal(sigma.size)  # the stationary state x[0] / sigma
+    if columns is not None:
+        if np.ndim(tau_s) != 0:
+            raise ValueError("columns needs one correlation time for all axes")
+        drive, sigma = drive[:, columns], sigma[columns]
     drive[0] /= np.sqrt(q_unit)  # which the filter's gain_in turns back into N(0, 1)
     return ar1_filter(drive, phi, overwrite=True, gain_in=np.sqrt(q_unit), gain_out=sigma)
 
@@ -245,7 +252,8 @@ def gauss_markov(n: int, dt_s: float, sigma: np.ndarray, tau_s: float | np.ndarr
 _GM_MAX_STEP = 30.0
 
 
-def gauss_markov_at(points: np.ndarray, rows: int, rng: np.random.Generator) -> np.ndarray:
+def gauss_markov_at(points: np.ndarray, rows: int, rng: np.random.Generator,
+                    columns: np.ndarray | None = None) -> np.ndarray:
     """Unit-variance Gauss-Markov processes sampled exactly at ascending points (shape (n,), in
     correlation lengths: any coordinate along which the process decorrelates, such as time /
     tau or distance / D), one per column: shape (n, rows), correlation exp(-|p_i - p_j|).
@@ -256,10 +264,14 @@ def gauss_markov_at(points: np.ndarray, rows: int, rng: np.random.Generator) -> 
     as ``ar1_filter`` does: over a block of points within ``_AR1_BLOCK_LOG_RANGE`` of its first
     point p_b, x_k = e^{-(p_k - p_b)} (e^{-(p_b - p_{b-1})} x_{b-1}
     + cumsum_j e^{p_j - p_b} g_j w_j), one pass per block (about (p_n - p_0) / 300 of them).
+    With ``columns`` (indices into the rows), only those processes: all are drawn, and only
+    these solved (each alone: the same numbers).
     """
     p = np.asarray(points, dtype=float)
     n = len(p)
     x = rng.standard_normal((n, rows))
+    if columns is not None:
+        x = x[:, columns]
     if n < 2:
         return x
     step = np.diff(p)

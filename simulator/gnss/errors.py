@@ -63,7 +63,7 @@ Time behaviour (issue 19):
 Public names
 ------------
 OSCILLATORS, SIS_RECORD_SHARE, IONO_CORRELATION_TIME_S, IONO_CORRELATION_LENGTH_KM,
-IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S,
+IONO_FIELD_WAVES, IONO_SHELL_RADIUS_KM, IONO_FIELD_STEP_S, SMOOTHING_GROUP_SAMPLES,
 REPORTED_PR_STD_FLOOR_M, REPORTED_RATE_STD_FLOOR_M_S, IONO_GRID_STEP,
 loop_time_constant_s,
 decorrelation_coordinate, gauss_markov_along, pierce_points_km, iono_field_correlation,
@@ -98,6 +98,7 @@ from simulator.datasheet import (  # the field's scales: the receivers' model re
     IONO_SHELL_HEIGHT_KM,
 )
 from simulator.gnss.atmosphere import klobuchar_pierce_point
+from simulator.gnss.chunks import epoch_chunks
 from simulator.gnss.constants import LAMBDA_L1_M
 from simulator.gnss.receiver import clock_process, dll_sigma_m, fll_sigma_hz, multipath_sigma_m
 from simulator.stochastic import ar1_filter, child_rng, gauss_markov, gauss_markov_at
@@ -119,6 +120,8 @@ IONO_SHELL_RADIUS_KM = EARTH_MEAN_RADIUS_KM + IONO_SHELL_HEIGHT_KM  # Klobuchar'
 # under 2 km in 10 s (a satellite's at about 0.1 km/s, a car's at its speed), 1/500 of L, so
 # the interpolation changes the field by under 1e-5 of its sigma
 IONO_FIELD_STEP_S = 10.0
+# satellites x epochs carrier-smoothed together (``smooth_code_errors``): 1 MB per array
+SMOOTHING_GROUP_SAMPLES = 2**17
 REPORTED_PR_STD_FLOOR_M = 0.1  # the smallest pseudorange 1-sigma the receiver reports
 REPORTED_RATE_STD_FLOOR_M_S = 0.01  # the smallest pseudorange-rate 1-sigma it reports
 # the amplitudes of the ionosphere field's waves are drawn once per correlation time (30 min)
@@ -145,16 +148,19 @@ def decorrelation_coordinate(t_s: np.ndarray, distance_m: np.ndarray, distance_s
 
 
 def gauss_markov_along(u: np.ndarray, rows: int, rng: np.random.Generator,
-                       step: float | None = None) -> np.ndarray:
+                       step: float | None = None, columns: np.ndarray | None = None
+                       ) -> np.ndarray:
     """Unit-variance processes with correlation exp(-|u_i - u_j|) at the points u (ascending,
     shape (n,)), one per row: shape (rows, n). Without ``step``, the exact Gauss-Markov process
     at the points themselves (``simulator.stochastic.gauss_markov_at``). With ``step``, the
     exact process on a grid of ``step`` in u, interpolated linearly at u: smoother between grid
     points, where the variance falls to (1 + e^-step) / 2 at the middle (0.68 for a step of 1:
-    the ionosphere field's amplitudes, whose rate this keeps at that of a quiet ionosphere)."""
+    the ionosphere field's amplitudes, whose rate this keeps at that of a quiet ionosphere).
+    ``columns`` (without ``step``): only those rows of the processes, the same numbers
+    (``gauss_markov_at``)."""
     u = np.asarray(u, dtype=float)
     if step is None:
-        return gauss_markov_at(u, rows, rng).T
+        return gauss_markov_at(u, rows, rng, columns).T
     grid = u[0] + np.arange(int(np.ceil((u[-1] - u[0]) / step)) + 2) * step
     values = gauss_markov(len(grid), step, np.ones(rows), 1.0, rng)
     pos = (u - grid[0]) / step
@@ -259,7 +265,10 @@ class IonoField:
         k = np.arange(n_ep)
         i = np.minimum(np.searchsorted(coarse, k, side="right") - 1, len(coarse) - 2)
         w = (k - coarse[i]) / (coarse[i + 1] - coarse[i])
-        return values[:, i] * (1.0 - w) + values[:, i + 1] * w
+        out = np.empty((values.shape[0], n_ep))
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            out[:, cols] = values[:, i[cols]] * (1.0 - w[cols]) + values[:, i[cols] + 1] * w[cols]
+        return out
 
 
 def iono_field_at_epochs(rng: np.random.Generator, pierce_km: np.ndarray, dt_s: float
@@ -279,13 +288,15 @@ def draw_receiver_clock(rng: np.random.Generator, oscillator: str, n: int, dt_s:
     return bias, drift, {"oscillator": oscillator, "bias_s": bias0, "drift_s_s": drift0}
 
 
-def draw_fading(rng: np.random.Generator, cfg: dict, u: np.ndarray, n_sat: int) -> np.ndarray:
-    """C/N0 fading, dB, shape (n_sat, n_epoch): ``cn0_fading`` times a unit process correlated
-    in the motion coordinate ``u`` (``decorrelation_coordinate``), not white from epoch to
-    epoch: the fading comes from the same reflections as the multipath."""
+def draw_fading(rng: np.random.Generator, cfg: dict, u: np.ndarray, n_sat: int,
+                rows: np.ndarray | None = None) -> np.ndarray:
+    """C/N0 fading, dB, shape (n_sat, n_epoch) (or of the satellites ``rows`` only, the same
+    numbers): ``cn0_fading`` times a unit process correlated in the motion coordinate ``u``
+    (``decorrelation_coordinate``), not white from epoch to epoch: the fading comes from the
+    same reflections as the multipath."""
     if cfg["cn0_fading"] == 0:
-        return np.zeros((n_sat, len(u)))
-    return cfg["cn0_fading"] * gauss_markov_along(u, n_sat, rng)
+        return np.zeros((n_sat if rows is None else len(rows), len(u)))
+    return cfg["cn0_fading"] * gauss_markov_along(u, n_sat, rng, columns=rows)
 
 
 def draw_sis(rng: np.random.Generator, sigma_m: float, record: np.ndarray) -> np.ndarray:
@@ -303,10 +314,11 @@ def draw_sis(rng: np.random.Generator, sigma_m: float, record: np.ndarray) -> np
 
 def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndarray,
                      cn0_dbhz: np.ndarray, dt_s: float, u: np.ndarray,
-                     pierce_km: np.ndarray, record: np.ndarray, shared: Any = None
-                     ) -> dict[str, np.ndarray]:
+                     pierce_km: np.ndarray, record: np.ndarray, shared: Any = None,
+                     rows: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Every error term of the raw measurements before the receiver's carrier smoothing,
-    shape (n_sat, n_epoch) unless noted.
+    shape (n_sat, n_epoch) unless noted; with ``rows``, of those satellites only (the terms
+    of every satellite are drawn, so the numbers are the same).
 
     Parameters
     ----------
@@ -316,7 +328,8 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         ``multipath``, ``code_noise``, ``rate_noise``), so no term's draws move another's.
     cfg : dict
         The resolved ``sensors.gnss`` block (error levels and tracking-loop parameters).
-    elevation_rad, cn0_dbhz : ndarray, shape (n_sat, n_epoch)
+    elevation_rad, cn0_dbhz : ndarray, shape (n_sat, n_epoch) (with ``rows``: (len(rows),
+        n_epoch))
         Elevation and true C/N0 of each signal.
     dt_s : float
         Epoch interval.
@@ -326,14 +339,17 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
         The signals' ionospheric pierce points (``pierce_points_km``).
     record : ndarray of int, shape (n_sat, n_epoch)
         Index of the broadcast record each signal is computed from (-1: none), for the
-        signal-in-space error (``draw_sis``).
+        signal-in-space error (``draw_sis``), of every satellite.
     shared : optional
         Another receiver's draws of the same drive (its ``sis``, ``iono_field`` and
         ``tropo_zenith_m``), taken instead of drawing them: a second receiver's sky.
+    rows : ndarray of int, optional
+        The satellites (rows of ``record``) whose terms are wanted.
 
     Returns
     -------
-    dict with ``sis`` (m); ``iono_ratio`` (true / broadcast ionosphere, module docstring) and
+    dict with ``sis`` (m; ``sis_all`` that of every satellite, for a second receiver);
+    ``iono_ratio`` (true / broadcast ionosphere, module docstring) and
     ``iono_field`` (its ``IonoField``, None without variation, for a second receiver);
     ``tropo_zenith`` (scalar, m: the zenith troposphere the model misses, for the whole drive);
     ``multipath`` and ``multipath_sigma`` (m, correlated in u); ``code_noise`` and
@@ -341,28 +357,32 @@ def draw_error_terms(rng: np.random.Generator, cfg: dict, elevation_rad: np.ndar
     loop's time constant); ``rate_noise`` and ``rate_sigma`` (m/s, the FLL's likewise).
     """
     shape = elevation_rad.shape
-    n_sat, n_ep = shape
+    n_ep = shape[1]
+    n_sat = record.shape[0]  # every satellite's processes are drawn
     scale = cfg["tracking_noise"]
 
-    def unit_gm(rows: int, tau_s: float, name: str) -> np.ndarray:  # (rows, n_ep), unit variance
-        return gauss_markov(n_ep, dt_s, np.ones(rows), tau_s, child_rng(rng, name)).T
+    def unit_gm(count: int, tau_s: float, name: str) -> np.ndarray:  # unit variance
+        return gauss_markov(n_ep, dt_s, np.ones(count), tau_s, child_rng(rng, name),
+                            columns=rows).T
 
     # the ionosphere's error: a field smooth over the pierce points and in time (module
     # docstring), so that nearby signals share it and its rate (which the carrier smoothing's
     # code-carrier divergence sees) stays at the mm/s of a quiet ionosphere
     if shared is None:
-        out = {"sis": draw_sis(child_rng(rng, "sis"), cfg["sis_error"], record)}
+        out = {"sis_all": draw_sis(child_rng(rng, "sis"), cfg["sis_error"], record)}
         out["iono_field"] = (IonoField(child_rng(rng, "iono_field"), n_ep, dt_s)
                              if cfg["iono_residual"] > 0 else None)
     else:
-        out = {"sis": shared.sis, "iono_field": shared.iono_field}
+        out = {"sis_all": shared.sis, "iono_field": shared.iono_field}
+    out["sis"] = out["sis_all"] if rows is None else out["sis_all"][rows]
     field = (out["iono_field"](pierce_km) if out["iono_field"] is not None
              else np.zeros(shape))
     out["iono_ratio"] = cfg["iono_scale"] * (1.0 + cfg["iono_residual"] * field)
     out["tropo_zenith"] = (cfg["tropo_residual"] * child_rng(rng, "tropo_zenith").standard_normal()
                            if shared is None else shared.tropo_zenith_m)
     out["multipath_sigma"] = multipath_sigma_m(elevation_rad, cfg["multipath"])
-    out["multipath_unit"] = gauss_markov_along(u, n_sat, child_rng(rng, "multipath"))
+    out["multipath_unit"] = gauss_markov_along(u, n_sat, child_rng(rng, "multipath"),
+                                               columns=rows)
     out["multipath"] = out["multipath_sigma"] * out["multipath_unit"]
     out["code_sigma"] = scale * dll_sigma_m(cn0_dbhz, cfg["dll_bandwidth"],
                                             cfg["correlator_spacing"], cfg["integration_time"])
@@ -443,14 +463,19 @@ def smooth_code_errors(cfg: dict, terms: dict[str, np.ndarray], iono_true_m: np.
     rows = np.flatnonzero(tracked.any(axis=1))  # the satellites ever tracked
     if cfg["carrier_smoothing"] <= 0 or rows.size == 0:
         return terms
-    iono = iono_true_m[rows]
-    stacked = np.stack([terms["code_noise"][rows], terms["multipath"][rows], 2.0 * iono])
-    smooth = hatch_filter(stacked, tracked[rows], dt_s, cfg["carrier_smoothing"])
     out = dict(terms)
-    for key, value in (("code_noise", smooth[0] + smooth[2] - 2.0 * iono),
-                       ("multipath", smooth[1])):
+    for key in ("code_noise", "multipath"):
         out[key] = terms[key].copy()
-        out[key][rows] = np.where(tracked[rows], value, terms[key][rows])
+    # the satellites in groups of about SMOOTHING_GROUP_SAMPLES samples: each row is filtered
+    # alone, so the groups change nothing but the size of the filter's temporaries
+    groups = -(-rows.size * tracked.shape[1] // SMOOTHING_GROUP_SAMPLES)
+    for part in np.array_split(rows, groups):  # one pass per group of satellites
+        iono = iono_true_m[part]
+        stacked = np.stack([terms["code_noise"][part], terms["multipath"][part], 2.0 * iono])
+        smooth = hatch_filter(stacked, tracked[part], dt_s, cfg["carrier_smoothing"])
+        for key, value in (("code_noise", smooth[0] + smooth[2] - 2.0 * iono),
+                           ("multipath", smooth[1])):
+            out[key][part] = np.where(tracked[part], value, terms[key][part])
     return out
 
 

@@ -60,7 +60,7 @@ Kaplan & Hegarty 2017, section 11.2.1 (weighted least squares).
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -76,6 +76,7 @@ from simulator.datasheet import (
     nlos_probability,
 )
 from simulator.earth import ecef_to_geodetic, ned_to_ecef_matrix
+from simulator.gnss.chunks import epoch_chunks
 from simulator.gnss.constants import C_M_S
 from simulator.gnss.receiver import light_time_factor, rotate_to_reception_frame
 from simulator.gnss.signals import PRIMARY_SIGNAL
@@ -86,6 +87,9 @@ if TYPE_CHECKING:
 
 _GAUSS_NEWTON_ITERATIONS = 10  # from the Earth's centre: converged to < 1e-6 m after 7
 _MAX_CONDITION = 1e12  # a normal matrix beyond this is singular in float64 (no fix)
+# epochs whose accuracies are computed together: their epochs x satellites x satellites arrays
+# (the ionosphere field's covariance) stay a few megabytes
+FIX_CHUNK_EPOCHS = 512
 
 
 def pack_epochs(epoch: np.ndarray, n_epochs: int, *values: np.ndarray
@@ -462,8 +466,13 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
     fix_type = np.where(ok, 2, np.where(held, 1, 0))
     fix_type[~(hdop <= dop_mask)] = 0
     ok = fix_type > 0
-    errors = AccuracyModel.of_receiver(receiver).range_errors(sigma_pr_p, cn0_p, el_p, az_p,
-                                                              iono_p, mask)
+    model = AccuracyModel.of_receiver(receiver)
+
+    def errors(epochs: slice | np.ndarray) -> tuple[np.ndarray, list[np.ndarray],
+                                                   np.ndarray | None]:
+        return model.range_errors(sigma_pr_p[epochs], cn0_p[epochs], el_p[epochs],
+                                  az_p[epochs], iono_p[epochs], mask[epochs])
+
     std_pos, std_vel = _fix_accuracy(pos, clock, vel, drift, (pos_p, vel_p, pr_p, rate_p),
                                      (w_pr_p, w_rate_p), errors, mask, held, last_alt)
     if smoothing_time_constant_s > 0 and n > 1:
@@ -489,15 +498,18 @@ def receiver_fixes(t: np.ndarray, raw: pd.DataFrame, smoothing_time_constant_s: 
 
 def _fix_accuracy(pos: np.ndarray, clock: np.ndarray, vel: np.ndarray, drift: np.ndarray,
                   packed: tuple[np.ndarray, ...], weights: tuple[np.ndarray, np.ndarray],
-                  errors: tuple[np.ndarray, list[np.ndarray], np.ndarray | None],
+                  errors: Callable[[slice | np.ndarray],
+                                   tuple[np.ndarray, list[np.ndarray], np.ndarray | None]],
                   mask: np.ndarray,
                   held: np.ndarray, held_alt: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The NED 1-sigma of each epoch's position and velocity (module docstring). A 2D fix's
     held height is one more equation of unit weight, as it was solved, whose error has the
-    variance of the last 3D fix's height; its vertical accuracies are NaN."""
+    variance of the last 3D fix's height; its vertical accuracies are NaN. ``errors`` gives
+    ``AccuracyModel.range_errors`` of some epochs: the accuracies are computed
+    ``FIX_CHUNK_EPOCHS`` epochs at a time (``simulator.gnss.chunks``), since the ionosphere
+    field's covariance and the residuals' map are epochs x satellites x satellites."""
     sat_pos, sat_vel, pr, rate = packed
     w_pr, w_rate = weights
-    variance, common, field = errors
     n = len(pos)
     h, finite = _ned_design(sat_pos, pos, mask)
     rx = np.where(finite[:, None], pos, 0.0)
@@ -507,25 +519,32 @@ def _fix_accuracy(pos: np.ndarray, clock: np.ndarray, vel: np.ndarray, drift: np
     h = np.concatenate([h, np.zeros((n, 1, 4))], axis=1)
     h[held, -1, 2] = 1.0
     hold_weight = held.astype(float)[:, None]
-    no_hold = np.zeros((n, 1))
     pr_residual = np.concatenate([np.where(mask, pr - rng - clock[:, None], 0.0),
                                   np.where(held, held_alt - alt, 0.0)[:, None]], axis=1)
     weight = np.concatenate([w_pr, hold_weight], axis=1)
-    variance = np.concatenate([variance, no_hold], axis=1)
-    common = [np.concatenate([c, no_hold], axis=1) for c in common]
-    if field is not None:  # the held height's row is correlated with no range
-        field = np.pad(field, ((0, 0), (0, 1), (0, 1)))
-    cov, factor = least_squares_accuracy(h, weight, variance, common, pr_residual, field)
-    std_pos = _scaled_sigma(cov, factor)
+
+    def position_sigma(epochs: slice | np.ndarray, hold_variance: np.ndarray) -> np.ndarray:
+        variance, common, field = errors(epochs)
+        hold = hold_variance[:, None]
+        variance = np.concatenate([variance, hold], axis=1)
+        common = [np.concatenate([c, np.zeros_like(hold)], axis=1) for c in common]
+        if field is not None:  # the held height's row is correlated with no range
+            field = np.pad(field, ((0, 0), (0, 1), (0, 1)))
+        cov, factor = least_squares_accuracy(h[epochs], weight[epochs], variance, common,
+                                             pr_residual[epochs], field)
+        return _scaled_sigma(cov, factor)
+
+    std_pos = np.empty((n, 3))
+    for epochs in epoch_chunks(n, FIX_CHUNK_EPOCHS):  # one pass per chunk of epochs
+        std_pos[epochs] = position_sigma(epochs, np.zeros(epochs.stop - epochs.start))
     if held.any():  # again with the held height's variance: the last 3D fix's
         import pandas as pd
 
         vertical = pd.Series(np.where(held, np.nan, std_pos[:, 2] ** 2)).ffill().to_numpy()
-        variance[held, -1] = np.nan_to_num(vertical[held])
-        cov, factor = least_squares_accuracy(h[held], weight[held], variance[held],
-                                             [c[held] for c in common], pr_residual[held],
-                                             None if field is None else field[held])
-        std_pos[held] = _scaled_sigma(cov, factor)
+        at = np.flatnonzero(held)
+        for part in epoch_chunks(len(at), FIX_CHUNK_EPOCHS):  # one pass per chunk of them
+            epochs = at[part]
+            std_pos[epochs] = position_sigma(epochs, np.nan_to_num(vertical[epochs]))
         std_pos[held, 2] = np.nan
     # velocity: y = rate f - los . v_s = -los . v + f drift (``solve_velocity``), f within
     # 1e-5 of 1 in the geometry
@@ -534,11 +553,15 @@ def _fix_accuracy(pos: np.ndarray, clock: np.ndarray, vel: np.ndarray, drift: np
     rate_residual = rate * f - np.einsum("nki,nki->nk", los, vs - np.nan_to_num(vel)[:, None])
     rate_residual = np.where(mask, rate_residual - f * drift[:, None], 0.0)
     rate_variance = np.where(mask, 1.0 / np.where(mask, w_rate, 1.0), 0.0)
-    cov, factor = least_squares_accuracy(
-        h, np.concatenate([w_rate, hold_weight], axis=1),
-        np.concatenate([rate_variance, no_hold], axis=1), [],
-        np.concatenate([rate_residual, no_hold], axis=1))
-    std_vel = _scaled_sigma(cov, factor)
+    no_hold = np.zeros((n, 1))
+    rate_weight = np.concatenate([w_rate, hold_weight], axis=1)
+    rate_variance = np.concatenate([rate_variance, no_hold], axis=1)
+    rate_residual = np.concatenate([rate_residual, no_hold], axis=1)
+    std_vel = np.empty((n, 3))
+    for epochs in epoch_chunks(n, FIX_CHUNK_EPOCHS):  # one pass per chunk of epochs
+        cov, factor = least_squares_accuracy(h[epochs], rate_weight[epochs],
+                                             rate_variance[epochs], [], rate_residual[epochs])
+        std_vel[epochs] = _scaled_sigma(cov, factor)
     std_vel[held, 2] = np.nan
     return std_pos, std_vel
 

@@ -100,11 +100,7 @@ from simulator.gnss.constellation import (
     missing_systems,
     sky_navigation,
 )
-from simulator.gnss.ephemeris import (
-    ephemeris_arrays,
-    gather,
-    select_ephemeris,
-)
+from simulator.gnss.ephemeris import ephemeris_arrays, select_ephemeris
 from simulator.gnss.errors import (
     OSCILLATORS,
 )
@@ -389,7 +385,8 @@ class Gnss(PresetSensor):
 
     def sky(self, truth: Kinematics, t: np.ndarray, az: np.ndarray, el: np.ndarray,
             yaw: np.ndarray, distance: np.ndarray, rng: np.random.Generator,
-            antenna_gain_db: Callable[[np.ndarray], np.ndarray] | None = None
+            antenna_gain_db: Callable[[np.ndarray], np.ndarray] | None = None,
+            rows: np.ndarray | None = None, n_sky: int | None = None
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Line of sight, NLOS, NLOS extra path (m) and C/N0 loss (dB) per satellite and epoch
         from the environment zones (``sky``: open, none, canyon).
@@ -406,7 +403,9 @@ class Gnss(PresetSensor):
         is the reflection point. Diffuse scattering off the facade across the street
         (``scattering_coefficient``) arrives from that facade, where the antenna's gain
         (``antenna_gain_db`` against elevation) differs from its gain toward the satellite.
-        Each canyon zone draws from its own stream (``rng``'s child named after the zone)."""
+        Each canyon zone draws from its own stream (``rng``'s child named after the zone).
+        ``az`` and ``el`` may be those of some satellites only, ``rows`` of the ``n_sky`` of the
+        sky: the draws are those of every satellite, of which these keep their own."""
         los = np.ones(el.shape, dtype=bool)
         nlos = np.zeros(el.shape, dtype=bool)
         extra = np.zeros(el.shape)
@@ -425,10 +424,10 @@ class Gnss(PresetSensor):
                     zone_rng, streets, zone["block_length"], zone["cross_street_width"],
                     zone["facade_length"], zone["building_gap"], zone["building_height"],
                     zone["building_height_spread"])
+                draws = zone_rng.standard_normal((el.shape[0] if n_sky is None else n_sky,
+                                                  buildings.count))
                 facade_loss = np.maximum(zone["nlos_attenuation"] + zone["nlos_attenuation_spread"]
-                                         * zone_rng.standard_normal((el.shape[0],
-                                                                     buildings.count)),
-                                         0.0)
+                                         * (draws if rows is None else draws[rows]), 0.0)
                 # traced only for the satellites above the horizon (about 40 % of them)
                 shape = el[:, here].shape
                 up = el[:, here] > 0
@@ -481,9 +480,6 @@ class Gnss(PresetSensor):
         idx = select_ephemeris(eph, svs[:, None], tow0 + t[None, :], max_age_s=max_age,
                                healthy_only=False, system=systems[:, None])
         self._check_coverage(idx, t, truth, max_age)
-        # only the records' fields used per epoch (a whole record per satellite and epoch is
-        # gigabytes for a fast-rate hour)
-        gathered = gather(eph, idx, ("health", "tgd", "tgd2", "group_delay"))
         alpha = list(nav.attrs.get("iono_alpha", DEFAULT_IONO_ALPHA))
         beta = list(nav.attrs.get("iono_beta", DEFAULT_IONO_BETA))
         self.drawn["broadcast_iono"] = {"alpha": alpha, "beta": beta}
@@ -497,12 +493,7 @@ class Gnss(PresetSensor):
             list(zip(systems, svs, strict=True))].to_numpy()
         return {"nav": nav, "eph": eph, "idx": idx, "svs": svs, "systems": systems,
                 "channel": np.nan_to_num(channel.astype(float)), "t_gps": tow0 + t,
-                "health": np.where(idx >= 0, gathered["health"], 0.0),
-                "tgd_s": np.where(idx >= 0, gathered["tgd"], 0.0),
-                "tgd2_s": np.where(idx >= 0, gathered["tgd2"], 0.0),
-                "primary_delay_s": np.where(idx >= 0, gathered["group_delay"], 0.0),
-                "alpha": alpha,
-                "beta": beta, "day_of_year": day_of_year}
+                "alpha": alpha, "beta": beta, "day_of_year": day_of_year}
 
     def generate(self, truth: Kinematics, rng: np.random.Generator) -> dict[str, pd.DataFrame]:
         cfg = self.config
@@ -511,10 +502,11 @@ class Gnss(PresetSensor):
         sky = self.broadcast(truth, t)
         ant = self.antenna(truth, t)
 
-        def reception(az: np.ndarray, el: np.ndarray, antenna_gain_db: Callable
-                      ) -> tuple[np.ndarray, ...]:
+        def reception(az: np.ndarray, el: np.ndarray, antenna_gain_db: Callable,
+                      rows: np.ndarray) -> tuple[np.ndarray, ...]:
             return self.sky(truth, t, az, el, ant["yaw"], ant["distance"],
-                            child_rng(rng, "environment"), antenna_gain_db)
+                            child_rng(rng, "environment"), antenna_gain_db, rows,
+                            len(sky["svs"]))
 
         rover = observe(cfg, t, dt_s, sky, ant, rng, reception)
         self.drawn.update(rover.drawn)

@@ -112,7 +112,8 @@ class GnssBase(PresetSensor):
                "v_ned": np.zeros((n, 3)), "lat": np.full(n, lat), "lon": np.full(n, lon),
                "alt": np.full(n, alt), "yaw": np.zeros(n), "distance": np.zeros(n)}
 
-        def open_sky(az: np.ndarray, el: np.ndarray, gain: object) -> tuple[np.ndarray, ...]:
+        def open_sky(az: np.ndarray, el: np.ndarray, gain: object, rows: np.ndarray
+                     ) -> tuple[np.ndarray, ...]:
             return (np.ones(el.shape, bool), np.zeros(el.shape, bool), np.zeros(el.shape),
                     np.zeros(el.shape))
 

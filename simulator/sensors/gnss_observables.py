@@ -27,6 +27,15 @@ from T_GD, BGD or TGD1/TGD2: ``simulator.gnss.signals.signal_group_delay_s``; th
 carries no hardware delay). The carrier phase has RINEX's sign: it grows with the range, as
 the pseudorange does.
 
+How it is computed: only the satellites that may rise above the horizon during the drive
+(``signal_geometry_chunks``) are measured; every random process is still drawn for every
+satellite of the sky, in the same order, and the measured ones keep theirs, so a draw never
+depends on which satellites rise. What runs along the epochs (the draws, the carrier
+smoothing, the phase arcs, the rates by central differences) sees the whole drive; what is
+elementwise over satellites x epochs is computed a chunk of epochs at a time
+(``simulator.gnss.chunks``), and each signal's rows go straight to their places in the tables.
+The numbers are those of one pass over the whole drive (the chunk size changes none of them).
+
 Random streams: every error process draws from its own stream, the child of the receiver's
 stream (the rover's: the sensor stream ``gnss``) named after the process
 (``simulator.stochastic.child_rng``), so a process that draws more or fewer numbers (a new
@@ -80,6 +89,7 @@ from simulator.gnss.carrier import (
     reflection_path_rate_m_s,
     slip_probability,
 )
+from simulator.gnss.chunks import epoch_chunks
 from simulator.gnss.constants import C_M_S, F_L1_HZ
 from simulator.gnss.ephemeris import STATE_KEYS, gather, satellite_state
 from simulator.gnss.errors import (
@@ -132,7 +142,8 @@ class Shared:
     tropo_gradient: np.ndarray  # zenith residual change per metre north, east
     orbit_m: np.ndarray  # per broadcast record, (n_records, 3)
     origin_lla: tuple[float, float, float]
-    los: np.ndarray  # the first receiver's lines of sight (n_sat, n_epoch, 3)
+    los_rows: np.ndarray  # the satellites (rows of the sky) the first receiver measured
+    los: np.ndarray  # its lines of sight to them (len(los_rows), n_epoch, 3)
     second_rng: np.random.Generator  # the second receiver's own random stream
 
 
@@ -148,10 +159,11 @@ class Observed:
 
 class _Table:
     """One stream table's rows: each signal's (satellite, epoch) samples where its mask is set,
-    taken in the signal's own order, and the place of each in the table, which is in the order
-    of epochs, then satellites (PRN order), then the receiver's signals. The places are a
-    counting rank: every signal's mask is known before the first signal's rows are taken, so
-    nothing is sorted. A text value (one per signal) is spread over the signal's rows."""
+    written straight to their places in the table's columns, which are in the order of epochs,
+    then satellites (PRN order), then the receiver's signals. The places are a counting rank:
+    every signal's mask is known before the first signal's rows are written, so nothing is
+    sorted, and each column is allocated once, at the table's size. A text value (one per
+    signal) is spread over the signal's rows."""
 
     def __init__(self, t: np.ndarray, svs: np.ndarray,
                  masks: list[tuple[np.ndarray, np.ndarray]]):
@@ -164,55 +176,64 @@ class _Table:
         per_slot = count.T.ravel()  # epoch by epoch, satellites in order
         # each (epoch, satellite)'s first row, moved on as each of its signals takes its row
         self.next_row = np.cumsum(per_slot, dtype=np.int64) - per_slot
-        self.source = np.empty(int(per_slot.sum()), dtype=np.int64)  # each row's sample
-        self.pieces: list[dict[str, np.ndarray | str]] = []
-        self.n_taken = 0
+        self.n_rows = int(per_slot.sum())
+        self.columns: dict[str, np.ndarray] = {}
+        self.texts: dict[str, list[str]] = {}  # a text column's distinct values; its codes
+        # are in ``columns``
 
-    def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str]
-            ) -> None:
+    def _write(self, key: str, rows: np.ndarray, values: np.ndarray) -> None:
+        """``values`` into column ``key`` at ``rows``; a column whose values come in several
+        types takes the type they all fit (as concatenating them would)."""
+        column = self.columns.get(key)
+        if column is None:
+            column = self.columns[key] = np.empty(self.n_rows, dtype=values.dtype)
+        elif column.dtype != values.dtype:
+            kind = np.promote_types(column.dtype, values.dtype)
+            if kind != column.dtype:
+                column = self.columns[key] = column.astype(kind)
+        column[rows] = values
+
+    def add(self, sel: np.ndarray, mask: np.ndarray, columns: dict[str, np.ndarray | str],
+            first_epoch: int = 0) -> None:
         """The next signal's rows: ``columns`` of (satellite, epoch) arrays over ``sel``'s
-        satellites (or broadcastable to them; a text value stays one text) where ``mask``."""
+        satellites (or broadcastable to them; a text value stays one text) where ``mask``,
+        whose epochs begin at ``first_epoch`` (a chunk of the drive's)."""
         sat, ep = np.nonzero(mask)
-        slot = ep * len(self.svs) + sel[sat]
+        slot = (first_epoch + ep) * len(self.svs) + sel[sat]
         rows = self.next_row[slot]
         self.next_row[slot] += 1
-        self.source[rows] = np.arange(self.n_taken, self.n_taken + len(sat))
-        self.n_taken += len(sat)
-        piece: dict[str, np.ndarray | str] = {"t": self.t[ep], "sv": self.svs[sel[sat]]}
+        self._write("t", rows, self.t[first_epoch + ep])
+        self._write("sv", rows, self.svs[sel[sat]])
         for key, value in columns.items():
-            if isinstance(value, str):  # kept as it is: ``frame`` spreads it over the rows
-                piece[key] = value
+            if isinstance(value, str):  # its code among the column's texts
+                texts = self.texts.setdefault(key, [])
+                if value not in texts:
+                    texts.append(value)
+                self._write(key, rows, np.full(len(rows), texts.index(value), dtype=np.int16))
             elif value.shape == mask.shape:
-                piece[key] = value[mask]
+                self._write(key, rows, value[mask])
             elif value.shape == (mask.shape[0], 1):  # one value per satellite
-                piece[key] = value[sat, 0]
+                self._write(key, rows, value[sat, 0])
             elif value.shape == (1, mask.shape[1]):  # one value per epoch
-                piece[key] = value[0, ep]
+                self._write(key, rows, value[0, ep])
             else:
-                piece[key] = np.broadcast_to(value, mask.shape)[mask]
-        self.pieces.append(piece)
+                self._write(key, rows, np.broadcast_to(value, mask.shape)[mask])
 
     def names(self, order: tuple[str, ...]) -> list[str]:
         """The columns of ``order`` this table has."""
-        return [c for c in order if c in self.pieces[0]]
+        return [c for c in order if c in self.columns]
 
     def frame(self, names: list[str]) -> pd.DataFrame:
-        """The table of the columns ``names`` in its rows' order (each column its own new
-        array: the table takes them as they are, without copying them into blocks). The
-        pieces are emptied column by column as the table takes them, so the rows are held
-        about once, not twice (the peak memory of a long, fast-rate drive)."""
+        """The table of the columns ``names`` (each column its own array: the table takes them
+        as they are, without copying them into blocks)."""
         import pandas as pd
 
-        sizes = [len(p["t"]) for p in self.pieces]
         columns = {}
         for name in names:
-            values = [p.pop(name) for p in self.pieces]
-            if isinstance(values[0], str):  # a text per piece: taken from the distinct ones
-                texts = sorted(set(values))
-                codes = np.repeat([texts.index(v) for v in values], sizes)
-                columns[name] = pd.Series(texts).array.take(np.take(codes, self.source))
-            else:
-                columns[name] = np.take(np.concatenate(values), self.source)
+            values = self.columns.pop(name)
+            if name in self.texts:  # the texts of the codes
+                values = pd.Series(self.texts[name]).array.take(values)
+            columns[name] = values
         return pd.DataFrame(columns, copy=False)
 
 
@@ -223,24 +244,36 @@ def _switches(state: np.ndarray) -> np.ndarray:
     return out
 
 
+def _gradient_part(values: np.ndarray, cols: slice, dt_s: float, times: int = 1) -> np.ndarray:
+    """``np.gradient`` along the epochs (axis 1) of ``values``, applied ``times`` times, at the
+    epochs ``cols`` only: from those epochs and ``times`` neighbours on each side (central
+    differences inside the drive, one-sided at its ends, as on the whole array)."""
+    lo, hi = max(cols.start - times, 0), min(cols.stop + times, values.shape[1])
+    part = values[:, lo:hi]
+    for _ in range(times):
+        part = np.gradient(part, dt_s, axis=1)
+    return part[:, cols.start - lo:cols.stop - lo]
+
+
 def _shared_draws(rng: np.random.Generator, cfg: dict, err: dict, n_records: int, n_ep: int,
-                  dt_s: float, ant: dict, los: np.ndarray) -> Shared:
+                  dt_s: float, ant: dict, los_rows: np.ndarray, los: np.ndarray) -> Shared:
     """The first receiver's draws a second one shares, each from its own named stream (module
     docstring), and the second receiver's own stream."""
     tid = IonoField(child_rng(rng, "iono_tid"), n_ep, dt_s, TID_LENGTH_KM, TID_TIME_S)
     gradient = cfg["tropo_gradient"] * child_rng(rng, "tropo_gradient").standard_normal(2)
     orbit = ORBIT_ERROR_M * child_rng(rng, "orbit_error").standard_normal((n_records, 3))
-    return Shared(sis=err["sis"], iono_field=err["iono_field"], tid=tid,
+    return Shared(sis=err["sis_all"], iono_field=err["iono_field"], tid=tid,
                   tid_sigma_m=cfg["iono_gradient"] * TID_LENGTH_KM * 1e3,
                   tropo_zenith_m=float(err["tropo_zenith"]), tropo_gradient=gradient,
                   orbit_m=orbit,
                   origin_lla=(float(ant["lat"][0]), float(ant["lon"][0]), float(ant["alt"][0])),
-                  los=los, second_rng=child_rng(rng, "second_receiver"))
+                  los_rows=los_rows, los=los, second_rng=child_rng(rng, "second_receiver"))
 
 
 def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
             rng: np.random.Generator,
-            reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
+            reception: Callable[[np.ndarray, np.ndarray, Callable, np.ndarray],
+                                tuple[np.ndarray, ...]],
             shared: Shared | None = None) -> Observed:
     """Every signal's measurements of one receiver (module docstring).
 
@@ -253,8 +286,9 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
     ant : dict of ndarray
         The antenna over the epochs (``Gnss.antenna``).
     reception : callable
-        (azimuth, elevation, antenna gain) -> (los, nlos, extra path, C/N0 loss), the
-        environment's effect on each signal.
+        (azimuth, elevation, antenna gain, rows) -> (los, nlos, extra path, C/N0 loss), the
+        environment's effect on each signal of the satellites ``rows`` (of the sky's) whose
+        azimuth and elevation it is given.
     shared : Shared, optional
         The first receiver's shared draws; None for the first receiver (it draws them).
     """
@@ -266,14 +300,20 @@ def observe(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.
 
 def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np.ndarray],
              rng: np.random.Generator,
-             reception: Callable[[np.ndarray, np.ndarray, Callable], tuple[np.ndarray, ...]],
+             reception: Callable[[np.ndarray, np.ndarray, Callable, np.ndarray],
+                                 tuple[np.ndarray, ...]],
              shared: Shared | None) -> tuple[_Table, _Table, dict]:
     """``observe``'s measurements as the rows of its raw and truth tables (``_Table``), with
     the receiver's clock (m, m/s), what it drew and the shared draws."""
-    eph, idx, svs = sky["eph"], sky["idx"], sky["svs"]
-    n_sat, n_ep = idx.shape
-    geo = model = signal_geometry_chunks(eph, idx, sky["t_gps"], ant, sky["day_of_year"],
-                                         sky["alpha"], sky["beta"])
+    eph = sky["eph"]
+    n_all, n_ep = sky["idx"].shape
+    # the satellites that may rise above the horizon; the others are never measured (their
+    # processes are drawn all the same, so that every stream draws what it always drew)
+    rows, geo = signal_geometry_chunks(eph, sky["idx"], sky["t_gps"], ant, sky["day_of_year"],
+                                       sky["alpha"], sky["beta"])
+    model = geo
+    idx, svs = sky["idx"][rows], sky["svs"][rows]
+    n_sat = len(rows)
     el, az = geo["elevation"], geo["azimuth"]
 
     # what the receiver tracks: the C/N0 fades with the motion (correlated like the
@@ -281,11 +321,25 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
     u = decorrelation_coordinate(t, ant["distance"], cfg["multipath_distance"],
                                  cfg["multipath_correlation_time"])
     los, nlos, extra, loss = reception(
-        az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]))
-    signal_cn0 = (cn0_model(el, cfg["cn0_zenith"], cfg["cn0_horizon"]) - loss
-                  + draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_sat))
-    cn0 = signal_cn0 + cfg["cn0_noise"] * child_rng(rng, "cn0_noise").standard_normal(el.shape)
+        az, el, lambda elevation: cn0_model(elevation, cfg["cn0_zenith"], cfg["cn0_horizon"]),
+        rows)
+    fading = draw_fading(child_rng(rng, "cn0_fading"), cfg, u, n_all, rows)
+    cn0_noise = child_rng(rng, "cn0_noise").standard_normal((n_all, n_ep))[rows]
+    signal_cn0, cn0 = np.empty((n_sat, n_ep)), np.empty((n_sat, n_ep))
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        signal_cn0[:, cols] = (cn0_model(el[:, cols], cfg["cn0_zenith"], cfg["cn0_horizon"])
+                               - loss[:, cols] + fading[:, cols])
+        cn0[:, cols] = signal_cn0[:, cols] + cfg["cn0_noise"] * cn0_noise[:, cols]
+    del fading, cn0_noise
     have = idx >= 0
+    # the broadcast record's fields each signal carries (0 where no record): only the fields
+    # used, only for these satellites (a whole record per satellite and epoch is gigabytes
+    # for a fast-rate hour)
+    gathered = gather(eph, idx, ("health", "tgd", "tgd2", "group_delay"))
+    record = {name: np.where(have, gathered[key], 0.0) for name, key in (
+        ("health", "health"), ("tgd_s", "tgd"), ("tgd2_s", "tgd2"),
+        ("primary_delay_s", "group_delay"))}
+    del gathered
     visible = have & (el > np.radians(cfg["elevation_mask"])) & (los | nlos)
     tracked = visible & (cn0 >= cfg["cn0_threshold"])
 
@@ -293,59 +347,87 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
                                                          cfg["clock"], n_ep, dt_s)
     # the tracking jitter follows the signal's C/N0, not the noise of its reported estimate
     # (below the horizon, where nothing is tracked, the pierce point of the horizon)
-    pierce = pierce_points_km(ant["lat"], ant["lon"], az, np.maximum(el, 0.0))
-    err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, idx,
-                           None if shared is None else shared)
+    pierce = np.empty((3, n_sat, n_ep))
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        pierce[:, :, cols] = pierce_points_km(ant["lat"][cols], ant["lon"][cols], az[:, cols],
+                                              np.maximum(el[:, cols], 0.0))
+    err = draw_error_terms(rng, cfg, el, signal_cn0, dt_s, u, pierce, sky["idx"],
+                           None if shared is None else shared, rows)
     if shared is None:
-        shared = _shared_draws(rng, cfg, err, len(eph["toe_s"]), n_ep, dt_s, ant, geo["los"])
+        shared = _shared_draws(rng, cfg, err, len(eph["toe_s"]), n_ep, dt_s, ant, rows,
+                               geo["los"])
     else:  # the orbit error seen along this receiver's lines of sight
-        orbit = shared.orbit_m[np.maximum(idx, 0)]
-        err["sis"] = np.where(have, err["sis"] + np.einsum(
-            "sek,sek->se", orbit, geo["los"] - shared.los), 0.0)
+        # the first receiver's lines of sight of these satellites (zero where it had none)
+        at = np.minimum(np.searchsorted(shared.los_rows, rows), len(shared.los_rows) - 1)
+        common = np.flatnonzero(shared.los_rows[at] == rows)
+        sis = np.empty((n_sat, n_ep))
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            first_los = np.zeros((n_sat, cols.stop - cols.start, 3))
+            first_los[common] = shared.los[at[common], cols]
+            orbit = shared.orbit_m[np.maximum(idx[:, cols], 0)]
+            sis[:, cols] = np.where(have[:, cols], err["sis"][:, cols] + np.einsum(
+                "sek,sek->se", orbit, geo["los"][:, cols] - first_los), 0.0)
+        err["sis"] = sis
     drawn = {"clock": drawn_clock, "tropo_zenith_error_m": shared.tropo_zenith_m,
              "tropo_gradient_m_per_km": (shared.tropo_gradient * 1e3).tolist()}
 
     # the atmosphere this receiver sees
-    mapping = model["tropo"] / model["zenith"]
     ned = ecef_to_ned(ant["pos"], *shared.origin_lla)
     tropo_zenith = shared.tropo_zenith_m + ned[:, :2] @ shared.tropo_gradient
-    tropo_true = model["tropo"] + tropo_zenith[None, :] * mapping
-    tid = shared.tid_sigma_m * shared.tid(pierce) * klobuchar_obliquity(np.maximum(el, 0.0))
-    iono_true = model["iono"] * err["iono_ratio"] + tid
-    # its rate: the broadcast model's along the geometry times the ratio, plus the (slow)
-    # change of the ratio and of the disturbances
-    iono_true_rate = model["iono_rate"] * err["iono_ratio"]
-    if n_ep > 1:
-        iono_true_rate = iono_true_rate + model["iono"] * np.gradient(
-            err["iono_ratio"], dt_s, axis=1) + np.gradient(tid, dt_s, axis=1)
-    tropo_true_rate = model["tropo_rate"] * (1.0 + tropo_zenith[None, :] / model["zenith"])
-
+    tid = shared.tid(pierce)
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        tid[:, cols] *= shared.tid_sigma_m
+        tid[:, cols] *= klobuchar_obliquity(np.maximum(el[:, cols], 0.0))
     rx_clock, rx_drift = C_M_S * bias_s, C_M_S * drift_s_s
-    rng_m = geo["range"]
-    # the satellite clock against GPS time: the broadcast one of the primary signal (GPS: L1,
-    # T_GD applied) against its system's time plus the broadcast system-time offset, as a
-    # receiver applying GGTO / tau_GPS has it
-    sat_clock = C_M_S * (geo["clock_s"] + geo["system_time_offset_s"])
-    sat_drift = C_M_S * geo["clock_drift_s_s"]
-    system_of = sky["systems"]
-    # the broadcast clock's reference (the ionosphere-free pair, without the primary signal's
-    # group delay): the carrier's clock; each code's own group delay is taken from it
-    # (signals.signal_group_delay_s)
-    reference_clock = sat_clock + C_M_S * sky["primary_delay_s"]
-    nlos_delay = np.where(nlos & ~los, extra, 0.0)
+    system_of = sky["systems"][rows]
     speed = np.linalg.norm(ant["v_ned"], axis=1)
     # the reflection's quadrature component (its in-phase one is the code multipath's process)
-    quadrature = gauss_markov_along(u, n_sat, child_rng(rng, "multipath_quadrature"))
+    quadrature = gauss_markov_along(u, n_all, child_rng(rng, "multipath_quadrature"),
+                                    columns=rows)
     # the reflecting plane's normal (uniform in direction, changing as the reflectors do): with
     # the antenna's velocity it sets how fast the reflection's carrier phase turns
     from scipy.special import ndtr  # imported on first use, as in simulator.gnss.carrier
 
-    wall_normal = np.pi * ndtr(gauss_markov_along(u, n_sat, child_rng(rng, "reflector_normal")))
+    wall_unit = gauss_markov_along(u, n_all, child_rng(rng, "reflector_normal"), columns=rows)
     moving = bool(np.any(ant["v_ned"] != 0.0))
-    path_rate = (reflection_path_rate_m_s(ant["v_ned"], az, el, wall_normal) if moving
-                 else None)  # standing still, the loop's gain is 1
-    los_jerk = (np.gradient(np.gradient(geo["range_rate"], dt_s, axis=1), dt_s, axis=1)
-                if n_ep > 2 else np.zeros((n_sat, n_ep)))
+    names = ["mapping", "tropo_true", "iono_true", "iono_true_rate", "tropo_true_rate",
+             "sat_drift", "reference_clock", "nlos_delay", "los_jerk"] + ["path_rate"] * moving
+    shared_terms = {name: np.empty((n_sat, n_ep)) for name in names}
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        m = {k: a[:, cols] for k, a in model.items()}
+        out = {name: a[:, cols] for name, a in shared_terms.items()}
+        ratio = err["iono_ratio"][:, cols]
+        out["mapping"][...] = mapping = m["tropo"] / m["zenith"]
+        out["tropo_true"][...] = m["tropo"] + tropo_zenith[None, cols] * mapping
+        out["iono_true"][...] = m["iono"] * ratio + tid[:, cols]
+        # its rate: the broadcast model's along the geometry times the ratio, plus the (slow)
+        # change of the ratio and of the disturbances
+        iono_true_rate = m["iono_rate"] * ratio
+        if n_ep > 1:
+            iono_true_rate = (iono_true_rate
+                              + m["iono"] * _gradient_part(err["iono_ratio"], cols, dt_s)
+                              + _gradient_part(tid, cols, dt_s))
+        out["iono_true_rate"][...] = iono_true_rate
+        out["tropo_true_rate"][...] = m["tropo_rate"] * (1.0 + tropo_zenith[None, cols]
+                                                         / m["zenith"])
+        # the satellite clock against GPS time: the broadcast one of the primary signal (GPS:
+        # L1, T_GD applied) against its system's time plus the broadcast system-time offset,
+        # as a receiver applying GGTO / tau_GPS has it
+        sat_clock = C_M_S * (m["clock_s"] + m["system_time_offset_s"])
+        out["sat_drift"][...] = C_M_S * m["clock_drift_s_s"]
+        # the broadcast clock's reference (the ionosphere-free pair, without the primary
+        # signal's group delay): the carrier's clock; each code's own group delay is taken
+        # from it (signals.signal_group_delay_s)
+        out["reference_clock"][...] = sat_clock + C_M_S * record["primary_delay_s"][:, cols]
+        out["nlos_delay"][...] = np.where(nlos[:, cols] & ~los[:, cols], extra[:, cols], 0.0)
+        if moving:  # standing still, the loop's gain is 1
+            out["path_rate"][...] = reflection_path_rate_m_s(
+                ant["v_ned"][cols], az[:, cols], el[:, cols],
+                np.pi * ndtr(wall_unit[:, cols]))
+        out["los_jerk"][...] = (_gradient_part(geo["range_rate"], cols, dt_s, times=2)
+                                if n_ep > 2 else 0.0)
+    del wall_unit
+    path_rate = shared_terms.get("path_rate")
     reflected = _switches(nlos & ~los)  # a switch between direct and reflected: lock lost
     scale = cfg["tracking_noise"]
 
@@ -354,25 +436,25 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
     per_satellite = {
         "el": el, "az": az, "signal_cn0": signal_cn0, "cn0": cn0, "tracked": tracked,
         "visible": visible, "have": have, "los": los, "nlos_only": nlos & ~los,
-        "reflected": reflected, "range": rng_m, "range_rate": geo["range_rate"],
-        "tau_rate": geo["tau_rate"], "pos": geo["pos"], "vel": geo["vel"],
-        "sat_drift": sat_drift, "reference_clock": reference_clock, "iono_true": iono_true,
-        "iono_true_rate": iono_true_rate, "tropo_true": tropo_true,
-        "tropo_true_rate": tropo_true_rate, "model_iono": model["iono"],
-        "model_tropo": model["tropo"], "mapping": mapping, "sis": err["sis"],
-        "nlos_delay": nlos_delay, "multipath_unit": err["multipath_unit"],
+        "reflected": reflected, "range": geo["range"], "range_rate": geo["range_rate"],
+        "tau_rate": geo["tau_rate"], "pos": geo["pos"], "vel": geo["vel"], **shared_terms,
+        "model_iono": model["iono"], "model_tropo": model["tropo"], "sis": err["sis"],
+        "multipath_unit": err["multipath_unit"],
         "quadrature": quadrature, "multipath_sigma": err["multipath_sigma"],
         "code_sigma": err["code_sigma"], "code_noise": err["code_noise"],
         "rate_sigma": err["rate_sigma"], "rate_noise": err["rate_noise"],
-        "los_jerk": los_jerk, "health": sky["health"].astype(np.int64),
-        "primary_delay_s": sky["primary_delay_s"], "tgd_s": sky["tgd_s"],
-        "tgd2_s": sky["tgd2_s"], "channel": sky["channel"]}
-    if path_rate is not None:
-        per_satellite["path_rate"] = path_rate
+        "health": record["health"].astype(np.int64),
+        "primary_delay_s": record["primary_delay_s"], "tgd_s": record["tgd_s"],
+        "tgd2_s": record["tgd2_s"], "channel": sky["channel"][rows]}
     views: dict[str, dict[str, np.ndarray]] = {}
 
-    def unit_gm(tau_s: float, rows: np.ndarray, stream: np.random.Generator) -> np.ndarray:
-        return gauss_markov(n_ep, dt_s, np.ones(len(rows)), tau_s, stream).T
+    def unit_gm(tau_s: float, letter: str, stream: np.random.Generator) -> np.ndarray:
+        return gauss_markov(n_ep, dt_s, np.ones(len(sky_sels[letter])), tau_s, stream,
+                            columns=kept[letter]).T
+
+    def draw(letter: str, values: Callable[[tuple[int, int]], np.ndarray]) -> np.ndarray:
+        """A draw of one value per satellite of the system and epoch, the measured ones."""
+        return values((len(sky_sels[letter]), n_ep))[kept[letter]]
 
     def stream(signal_name: str, process: str) -> np.random.Generator:
         """One signal's process's own stream (module docstring)."""
@@ -380,11 +462,14 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
 
     codes = [(SYSTEMS[name], code) for name in cfg["systems"] for code in cfg["signals"][name]]
     sels = {letter: np.flatnonzero(system_of == letter) for letter, _ in codes}
+    # each system's satellites in the sky, and where the measured ones are among them
+    sky_sels = {letter: np.flatnonzero(sky["systems"] == letter) for letter in sels}
+    kept = {letter: np.searchsorted(sky_sels[letter], rows[sel]) for letter, sel in sels.items()}
     for letter, sel in sels.items():
         # a system's satellites are consecutive rows of the sky: views, not copies
-        rows = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
-                else sel)
-        views[letter] = {k: np.asarray(v)[rows] for k, v in per_satellite.items()}
+        block = (slice(sel[0], sel[-1] + 1) if sel.size and sel[-1] - sel[0] + 1 == sel.size
+                 else sel)
+        views[letter] = {k: np.asarray(v)[block] for k, v in per_satellite.items()}
     # what each signal tracks, first: every table row is then known before any is written
     tracking = {}
     for letter, code in codes:  # one pass per signal, vectorised
@@ -393,8 +478,8 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
             tracking[letter, code] = v["cn0"], v["tracked"]
             continue
         cn0_true = v["signal_cn0"] + signal(letter, code).cn0_offset_db
-        cn0_out = cn0_true + cfg["cn0_noise"] * stream(f"{letter}{code}", "cn0_noise"
-                                                        ).standard_normal(v["el"].shape)
+        cn0_out = cn0_true + cfg["cn0_noise"] * draw(
+            letter, stream(f"{letter}{code}", "cn0_noise").standard_normal)
         tracked_s = v["visible"] & (cn0_out >= cfg["cn0_threshold"])
         if code.endswith("W"):  # semicodeless P(Y): aided by the L1 C/A loops
             tracked_s &= v["tracked"]
@@ -423,83 +508,104 @@ def _measure(cfg: dict, t: np.ndarray, dt_s: float, sky: dict, ant: dict[str, np
             code_sigma = scale * dll_sigma_m(cn0_true, cfg["dll_bandwidth"],
                                              cfg["correlator_spacing"], cfg["integration_time"]
                                              ) * (_CA_CHIP_RATE_HZ / spec.chip_rate_hz)
-            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]), sel,
-                                              stream(signal_name, "code_noise"))
+            code_noise = code_sigma * unit_gm(loop_time_constant_s(cfg["dll_bandwidth"]),
+                                              letter, stream(signal_name, "code_noise"))
             rate_sigma = scale * lam * fll_sigma_hz(cn0_true, cfg["fll_bandwidth"],
                                                     cfg["integration_time"])
-            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]), sel,
-                                              stream(signal_name, "rate_noise"))
-        code_mp, carrier_mp = reflection_multipath(
-            v["multipath_unit"], v["quadrature"], v["multipath_sigma"], cfg["multipath_delay"],
-            freq - F_L1_HZ, lam)
-        if path_rate is not None:  # the loop follows the carrier multipath: its gain at the
-            # fringe frequency
-            carrier_mp *= pll_response(v["path_rate"] / lam, cfg["pll_bandwidth"])
-        iono_s = k_iono * v["iono_true"]
+            rate_noise = rate_sigma * unit_gm(loop_time_constant_s(cfg["fll_bandwidth"]),
+                                              letter, stream(signal_name, "rate_noise"))
+        # what needs the whole drive (the draws, the smoothing and the arcs along the epochs)
+        # first; the elementwise rest chunk by chunk (``epoch_chunks``)
+        code_mp, carrier_mp = np.empty(shape), np.empty(shape)
+        iono_s = np.empty(shape)
+        chance = np.zeros(shape)  # a slip only matters where the signal is tracked
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            code_mp[:, cols], carrier_mp[:, cols] = reflection_multipath(
+                v["multipath_unit"][:, cols], v["quadrature"][:, cols],
+                v["multipath_sigma"][:, cols], cfg["multipath_delay"], freq - F_L1_HZ, lam)
+            if path_rate is not None:  # the loop follows the carrier multipath: its gain at
+                # the fringe frequency
+                carrier_mp[:, cols] *= pll_response(v["path_rate"][:, cols] / lam,
+                                                    cfg["pll_bandwidth"])
+            np.multiply(k_iono, v["iono_true"][:, cols], out=iono_s[:, cols])
+            if cfg["carrier_phase"] and scale > 0:
+                here = tracked_s[:, cols]
+                sigma_cycles = scale * pll_sigma_cycles(cn0_true[:, cols], cfg["pll_bandwidth"],
+                                                        cfg["integration_time"])
+                stress = dynamic_stress_cycles(v["los_jerk"][:, cols], lam, cfg["pll_bandwidth"])
+                chance[:, cols][here] = slip_probability(sigma_cycles[here], stress[here],
+                                                         cfg["pll_bandwidth"], dt_s, spec.pilot)
         terms = smooth_code_errors(cfg, {"code_noise": code_noise, "multipath": code_mp},
                                    iono_s, tracked_s, dt_s)
-        group_delay = C_M_S * signal_group_delay_s(letter, code, v["primary_delay_s"],
-                                                   v["tgd_s"], v["tgd2_s"])
-        sat_clock_s = v["reference_clock"] - group_delay
-        pseudorange = (v["range"] + rx_clock - sat_clock_s + iono_s + v["tropo_true"]
-                       + v["sis"] + terms["multipath"] + v["nlos_delay"] + terms["code_noise"])
-        rate = (v["range_rate"] + rx_drift - v["sat_drift"] * (1.0 - v["tau_rate"])
-                + v["tropo_true_rate"] - k_iono * v["iono_true_rate"] + rate_noise)
-        pr_std, rate_std = pseudorange_sigma(
-            cfg, {"code_sigma": code_sigma, "multipath_sigma": v["multipath_sigma"],
-                  "rate_sigma": rate_sigma}, k_iono * v["model_iono"], v["mapping"], dt_s,
-            speed)
-        raw = {"system": letter, "signal": code, "frequency": freq,
-               "pseudorange": pseudorange, "pseudorange_rate": rate, "doppler": -rate / lam,
-               "cn0": cn0_out, "sat_x": v["pos"][..., 0], "sat_y": v["pos"][..., 1],
-               "sat_z": v["pos"][..., 2], "sat_vx": v["vel"][..., 0],
-               "sat_vy": v["vel"][..., 1], "sat_vz": v["vel"][..., 2],
-               "sat_clock": sat_clock_s, "sat_clock_drift": v["sat_drift"],
-               "iono": k_iono * v["model_iono"], "tropo": v["model_tropo"], "elevation": v["el"],
-               "azimuth": v["az"], "pseudorange_std": pr_std, "pseudorange_rate_std": rate_std,
-               "health": v["health"], "group_delay": group_delay}
-        truth = {"system": letter, "signal": code, "frequency": freq,
-                 "tracked": tracked_s.astype(np.int8), "los": v["los"].astype(np.int8),
-                 "nlos": v["nlos_only"].astype(np.int8), "elevation": v["el"],
-                 "azimuth": v["az"], "range": v["range"], "range_rate": v["range_rate"],
-                 "receiver_clock": rx_clock[None, :], "receiver_clock_drift": rx_drift[None, :],
-                 "iono_true": iono_s, "tropo_true": v["tropo_true"],
-                 "iono_true_rate": k_iono * v["iono_true_rate"],
-                 "tropo_true_rate": v["tropo_true_rate"],
-                 "sis_error": v["sis"], "multipath": terms["multipath"],
-                 "nlos_delay": v["nlos_delay"], "code_noise": terms["code_noise"],
-                 "rate_noise": rate_noise, "antenna_x": ant["pos"][None, :, 0],
-                 "antenna_y": ant["pos"][None, :, 1], "antenna_z": ant["pos"][None, :, 2],
-                 "group_delay": group_delay}
         if cfg["carrier_phase"]:
-            sigma_cycles = scale * pll_sigma_cycles(cn0_true, cfg["pll_bandwidth"],
-                                                    cfg["integration_time"])
-            phase_noise = lam * sigma_cycles * stream(signal_name, "phase_noise"
-                                                      ).standard_normal(shape)
-            stress = dynamic_stress_cycles(v["los_jerk"], lam, cfg["pll_bandwidth"])
-            chance = np.zeros(shape)  # a slip only matters where the signal is tracked
-            if scale > 0:
-                chance[tracked_s] = slip_probability(sigma_cycles[tracked_s], stress[tracked_s],
-                                                     cfg["pll_bandwidth"], dt_s, spec.pilot)
-            slips = draw_slips(stream(signal_name, "cycle_slips").random(shape), chance,
+            phase_draw = draw(letter, stream(signal_name, "phase_noise").standard_normal)
+            slips = draw_slips(draw(letter, stream(signal_name, "cycle_slips").random), chance,
                                tracked_s)
             arcs = phase_arcs(stream(signal_name, "phase_arcs"), tracked_s, slips,
                               v["reflected"], dt_s, spec.pilot, spec.frame_s)
-            phase_m = (v["range"] + rx_clock - v["reference_clock"] - iono_s
-                       + v["tropo_true"] + v["sis"] + carrier_mp + v["nlos_delay"]
-                       + phase_noise)
-            raw.update(carrier_phase=phase_m / lam + arcs.ambiguity + arcs.half,
-                       lli=arcs.lli, lock_time=arcs.lock_time)
-            truth.update(ambiguity=arcs.ambiguity, half_cycle=arcs.half,
-                         cycle_slip=arcs.cycle_slip, arc=arcs.arc, carrier_multipath=carrier_mp,
-                         phase_noise=phase_noise)
-        raw_table.add(sel, tracked_s, raw)
-        truth_table.add(sel, in_truth[letter], truth)
+        whole = {**v, "iono_s": iono_s, "carrier_mp": carrier_mp, "tracked_s": tracked_s,
+                 "in_truth": in_truth[letter], "cn0_true": cn0_true, "cn0_out": cn0_out,
+                 "code_sigma": code_sigma, "rate_sigma": rate_sigma, "rate_noise": rate_noise,
+                 "smoothed_multipath": terms["multipath"],
+                 "smoothed_code_noise": terms["code_noise"]}
+        if cfg["carrier_phase"]:
+            whole.update(phase_draw=phase_draw, **vars(arcs))
+        for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+            w = {k: a[:, cols] for k, a in whole.items() if np.ndim(a) > 1}
+            group_delay = C_M_S * signal_group_delay_s(letter, code, w["primary_delay_s"],
+                                                       w["tgd_s"], w["tgd2_s"])
+            sat_clock_s = w["reference_clock"] - group_delay
+            clock, drift = rx_clock[cols], rx_drift[cols]
+            pseudorange = (w["range"] + clock - sat_clock_s + w["iono_s"] + w["tropo_true"]
+                           + w["sis"] + w["smoothed_multipath"] + w["nlos_delay"]
+                           + w["smoothed_code_noise"])
+            rate = (w["range_rate"] + drift - w["sat_drift"] * (1.0 - w["tau_rate"])
+                    + w["tropo_true_rate"] - k_iono * w["iono_true_rate"] + w["rate_noise"])
+            pr_std, rate_std = pseudorange_sigma(
+                cfg, {"code_sigma": w["code_sigma"], "multipath_sigma": w["multipath_sigma"],
+                      "rate_sigma": w["rate_sigma"]}, k_iono * w["model_iono"], w["mapping"],
+                dt_s, speed[cols])
+            raw = {"system": letter, "signal": code, "frequency": freq,
+                   "pseudorange": pseudorange, "pseudorange_rate": rate, "doppler": -rate / lam,
+                   "cn0": w["cn0_out"], "sat_x": w["pos"][..., 0], "sat_y": w["pos"][..., 1],
+                   "sat_z": w["pos"][..., 2], "sat_vx": w["vel"][..., 0],
+                   "sat_vy": w["vel"][..., 1], "sat_vz": w["vel"][..., 2],
+                   "sat_clock": sat_clock_s, "sat_clock_drift": w["sat_drift"],
+                   "iono": k_iono * w["model_iono"], "tropo": w["model_tropo"],
+                   "elevation": w["el"], "azimuth": w["az"], "pseudorange_std": pr_std,
+                   "pseudorange_rate_std": rate_std, "health": w["health"],
+                   "group_delay": group_delay}
+            antenna = ant["pos"][None, cols]
+            truth = {"system": letter, "signal": code, "frequency": freq,
+                     "tracked": w["tracked_s"].astype(np.int8), "los": w["los"].astype(np.int8),
+                     "nlos": w["nlos_only"].astype(np.int8), "elevation": w["el"],
+                     "azimuth": w["az"], "range": w["range"], "range_rate": w["range_rate"],
+                     "receiver_clock": clock[None, :], "receiver_clock_drift": drift[None, :],
+                     "iono_true": w["iono_s"], "tropo_true": w["tropo_true"],
+                     "iono_true_rate": k_iono * w["iono_true_rate"],
+                     "tropo_true_rate": w["tropo_true_rate"], "sis_error": w["sis"],
+                     "multipath": w["smoothed_multipath"], "nlos_delay": w["nlos_delay"],
+                     "code_noise": w["smoothed_code_noise"], "rate_noise": w["rate_noise"],
+                     "antenna_x": antenna[..., 0], "antenna_y": antenna[..., 1],
+                     "antenna_z": antenna[..., 2], "group_delay": group_delay}
+            if cfg["carrier_phase"]:
+                sigma_cycles = scale * pll_sigma_cycles(w["cn0_true"], cfg["pll_bandwidth"],
+                                                        cfg["integration_time"])
+                phase_noise = lam * sigma_cycles * w["phase_draw"]
+                phase_m = (w["range"] + clock - w["reference_clock"] - w["iono_s"]
+                           + w["tropo_true"] + w["sis"] + w["carrier_mp"] + w["nlos_delay"]
+                           + phase_noise)
+                raw.update(carrier_phase=phase_m / lam + w["ambiguity"] + w["half"],
+                           lli=w["lli"], lock_time=w["lock_time"])
+                truth.update(ambiguity=w["ambiguity"], half_cycle=w["half"],
+                             cycle_slip=w["cycle_slip"], arc=w["arc"],
+                             carrier_multipath=w["carrier_mp"], phase_noise=phase_noise)
+            raw_table.add(sel, w["tracked_s"], raw, cols.start)
+            truth_table.add(sel, w["in_truth"], truth, cols.start)
     return raw_table, truth_table, {"clock_m": rx_clock, "drift_m_s": rx_drift,
                                     "drawn": drawn, "shared": shared}
 
 
-CHUNK_EPOCHS = 3600  # epochs evaluated together: bounds the memory of long, fast-rate drives
 COARSE_STEP_S = 60.0  # satellites move < 0.6 deg in elevation in this time
 BELOW_HORIZON_MARGIN_RAD = np.radians(-5.0)  # skipped if lower than this all chunk long
 # what the measurements need of ``_signals`` (the intermediate lines of sight are dropped)
@@ -542,23 +648,32 @@ def _maybe_above_horizon(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.
 
 
 def signal_geometry_chunks(eph: dict[str, np.ndarray], idx: np.ndarray, t_gps: np.ndarray,
-                       ant: dict[str, np.ndarray], day_of_year: np.ndarray, alpha: list[float],
-                       beta: list[float]) -> dict[str, np.ndarray]:
-    """``_signals`` for every satellite x epoch, evaluated ``CHUNK_EPOCHS`` at a time and only
-    for the satellites that may be above the horizon in each chunk; the others keep elevation
-    -90 deg (never tracked), a unit zenith delay and zeros elsewhere."""
-    n_sat, n_ep = idx.shape
+                           ant: dict[str, np.ndarray], day_of_year: np.ndarray,
+                           alpha: list[float], beta: list[float]
+                           ) -> tuple[np.ndarray, dict[str, np.ndarray]]:
+    """``_signals`` of the satellites that may be above the horizon, evaluated
+    ``CHUNK_EPOCHS`` at a time (``simulator.gnss.chunks``) and in each chunk only for the
+    satellites that may be above the horizon then: the satellites (rows of idx, ascending)
+    that may be above it in some chunk, and their signals over every epoch, (rows, n_epoch)
+    arrays in which the epochs of a chunk where a satellite stays below keep elevation -90 deg
+    (never tracked), a unit zenith delay and zeros elsewhere. The other satellites are never
+    above the horizon: nothing of them is measured."""
+    n_ep = idx.shape[1]
+    screened = []
+    for cols in epoch_chunks(n_ep):  # one pass per chunk of epochs
+        ant_c = {k: v[cols] for k, v in ant.items()}
+        screened.append((cols, ant_c, _maybe_above_horizon(eph, idx[:, cols], t_gps[cols],
+                                                           ant_c)))
+    rows = np.unique(np.concatenate([np.zeros(0, dtype=int)] + [r for _, _, r in screened]))
     first = {k: v[:1] for k, v in ant.items()}
     shapes = _signals(gather(eph, idx[:1, :1], STATE_KEYS), t_gps[:1], first, day_of_year[:1],
                       alpha, beta)
     fill = {"elevation": -np.pi / 2, "zenith": 1.0}
-    out = {k: np.full((n_sat, n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
-    for start in range(0, n_ep, CHUNK_EPOCHS):  # one pass per chunk of epochs
-        cols = slice(start, min(start + CHUNK_EPOCHS, n_ep))
-        ant_c = {k: v[cols] for k, v in ant.items()}
-        rows = _maybe_above_horizon(eph, idx[:, cols], t_gps[cols], ant_c)
-        part = _signals(gather(eph, idx[rows, cols], STATE_KEYS), t_gps[cols], ant_c,
+    out = {k: np.full((len(rows), n_ep) + shapes[k].shape[2:], fill.get(k, 0.0)) for k in _KEPT}
+    for cols, ant_c, up in screened:  # one pass per chunk of epochs
+        part = _signals(gather(eph, idx[up, cols], STATE_KEYS), t_gps[cols], ant_c,
                         day_of_year[cols], alpha, beta)
+        at = np.searchsorted(rows, up)
         for key in _KEPT:
-            out[key][rows, cols] = part[key]
-    return out
+            out[key][at, cols] = part[key]
+    return rows, out

@@ -6,6 +6,7 @@ or at a rate that does not divide the rover's is refused."""
 from __future__ import annotations
 
 import numpy as np
+import pandas as pd
 import pytest
 
 from simulator.dataset.generate import generate_streams
@@ -102,3 +103,35 @@ def test_double_differenced_ionosphere_grows_with_the_baseline():
 def test_bad_base_or_signal_blocks_are_refused(sensors, message):
     with pytest.raises(InputError, match=message):
         scenario_data([{"stop": {"duration": 10}}], sensors=sensors)
+
+
+def test_chunks_and_satellite_groups_change_no_number(monkeypatch):
+    """The measurements computed a few epochs at a time (``simulator.gnss.chunks``: chunks of
+    37 epochs, the carrier smoothing in groups of 500 samples, the fixes' accuracy 29 epochs
+    at a time) are, bit for bit, those of one pass over the whole drive: rover (through a
+    canyon and a tunnel), base and fixes, four systems on two frequencies, carrier phase."""
+    from simulator.gnss import chunks, errors, fix
+
+    data = scenario_data(
+        [{"stop": {"duration": 10}}, {"accelerate": {"to_speed": 12.0, "accel": 1.5}},
+         {"straight": {"length": 300, "zone": "street"}},
+         {"straight": {"length": 150, "zone": "tunnel"}}, {"straight": {"length": 200}}],
+        environment={"zones": {"street": {"sky": "canyon"}, "tunnel": {"sky": "none"}}},
+        sensors={"gnss": {"preset": "dual-band", "rate": 2, "outputs": ["raw", "fix"],
+                          "systems": ["gps", "galileo", "beidou", "glonass"]},
+                 "gnss_base": {"offset": {"east": 2000.0}, "rate": 2, "preset": "dual-band",
+                               "systems": ["gps", "galileo", "beidou", "glonass"]}})
+    monkeypatch.setattr(chunks, "CHUNK_EPOCHS", 37)
+    monkeypatch.setattr(errors, "SMOOTHING_GROUP_SAMPLES", 500)
+    monkeypatch.setattr(fix, "FIX_CHUNK_EPOCHS", 29)
+    small = generate_streams(data, show_progress=False).streams
+    monkeypatch.setattr(chunks, "CHUNK_EPOCHS", 10**9)
+    monkeypatch.setattr(errors, "SMOOTHING_GROUP_SAMPLES", 10**12)
+    monkeypatch.setattr(fix, "FIX_CHUNK_EPOCHS", 10**9)
+    whole = generate_streams(data, show_progress=False).streams
+    names = ("gnss_raw", "truth_gnss", "gnss_fix", "gnss_base_raw", "truth_gnss_base")
+    for name in names:
+        pd.testing.assert_frame_equal(small[name], whole[name], check_exact=True)
+    raw = small["gnss_raw"]
+    assert len(small["gnss_fix"]) > 2 * 37 and set(raw["system"]) == {"G", "E", "C", "R"}
+    assert (raw["lli"] > 0).any() and len(small["gnss_base_raw"]) > 1000

@@ -10,6 +10,7 @@ from gnss_helpers import drive, receiver
 
 from simulator import columns as col
 from simulator.earth import ecef_to_geodetic, geodetic_to_ecef, ned_to_ecef_matrix
+from simulator.gnss import chunks
 from simulator.gnss.atmosphere import saastamoinen_zenith
 from simulator.gnss.constants import C_M_S, LAMBDA_L1_M
 from simulator.gnss.errors import iono_field_correlation, pierce_points_km
@@ -279,7 +280,7 @@ def test_chunked_evaluation_with_horizon_screen_changes_nothing(monkeypatch):
     truth = drive([{"stop": {"duration": 5}}, {"accelerate": {"to_speed": 15, "accel": 2.0}},
                    {"straight": {"length": 3000}}], rate_hz=1.0)
     chunked = receiver().generate(truth, np.random.default_rng(11))
-    monkeypatch.setattr(gnss_module, "CHUNK_EPOCHS", 10**9)
+    monkeypatch.setattr(chunks, "CHUNK_EPOCHS", 10**9)
     monkeypatch.setattr(gnss_module, "BELOW_HORIZON_MARGIN_RAD", -np.pi)
     whole = receiver().generate(truth, np.random.default_rng(11))
     for name in ("gnss_raw", "gnss_fix", "truth_gnss"):
@@ -290,9 +291,7 @@ def test_chunked_evaluation_with_horizon_screen_changes_nothing(monkeypatch):
 @pytest.fixture(autouse=True)
 def _small_chunks(monkeypatch):
     """Every test here runs with short chunks, so chunk boundaries are crossed."""
-    import simulator.sensors.gnss_observables as gnss_module
-
-    monkeypatch.setattr(gnss_module, "CHUNK_EPOCHS", 97)
+    monkeypatch.setattr(chunks, "CHUNK_EPOCHS", 97)
 
 
 def test_a_drive_entirely_without_sky_gives_empty_raw_and_no_fix():

@@ -69,8 +69,9 @@ def test_fewer_fading_draws_redraw_no_drive_long_error(first):
 def test_rows_in_epoch_satellite_signal_order_as_pandas_sorts_them():
     """Each signal's (satellite, epoch) samples become one table in the order of epochs, then
     satellites, then the receiver's signals, each value in its row, as pandas' stable sort of
-    the signals' rows has them (the table's counting rank against a sort); the pieces are
-    emptied as the table takes their columns (the rows are not held twice)."""
+    the signals' rows has them (the table's counting rank against a sort), whether a signal's
+    epochs come at once or in chunks; the frame takes the table's columns (the rows are not
+    held twice)."""
     from simulator.sensors.gnss_observables import _Table
 
     rng = np.random.default_rng(3)
@@ -85,7 +86,8 @@ def test_rows_in_epoch_satellite_signal_order_as_pandas_sorts_them():
     expected = []
     for order, ((sel, text), mask, x, k) in enumerate(
             zip(signals, masks, values, per_satellite, strict=True)):
-        table.add(sel, mask, {"x": x, "k": k, "signal": text})
+        for cols in (slice(0, 4), slice(4, 7)):  # in two chunks of epochs
+            table.add(sel, mask[:, cols], {"x": x[:, cols], "k": k, "signal": text}, cols.start)
         sat, ep = np.nonzero(mask)
         expected.append(pd.DataFrame({"t": t[ep], "sv": svs[sel[sat]], "x": x[sat, ep],
                                       "k": k[sat, 0], "signal": text, "_row": sel[sat],
@@ -95,4 +97,4 @@ def test_rows_in_epoch_satellite_signal_order_as_pandas_sorts_them():
             .drop(columns=["_row", "_order"]).reset_index(drop=True))
     got = table.frame(["t", "sv", "x", "k", "signal"])
     pd.testing.assert_frame_equal(got, want, check_dtype=False)
-    assert all(not p for p in table.pieces)
+    assert not table.columns
