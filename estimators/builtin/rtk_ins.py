@@ -160,6 +160,7 @@ DEFAULTS = {
     "initial_position_std": 1.0,
     "initial_velocity_std": 0.2,
     "initial_attitude_std": [1.0, 1.0, 3.0],
+    "scale_noise_window": 1.0,
     "odometer": True,
     "odometer_rate": 10.0,
     "nhc": True,
@@ -211,6 +212,10 @@ CONFIG_HELP = {
     "max_gap": ("s", "a signal unseen for longer starts a new ambiguity"),
     **shared_help("initial_position_std", "initial_velocity_std", "initial_attitude_std",
                   "nhc_point"),
+    "scale_noise_window": ("s", "the IMU's scale-factor errors drive its bias states by the "
+                                "change of the mean rate and specific force from one window "
+                                "of this length to the next (0: from one flush to the next, "
+                                "where the car body's vibration counts as a change)"),
     "odometer": ("", "odometer speed updates (when the dataset has an odometer)"),
     "odometer_rate": ("Hz", "odometer updates per second at most (the samples between are "
                             "not used)"),
@@ -345,7 +350,7 @@ class RtkInsEkf(Estimator):
                              extra_sigma=np.zeros(n_slots + n_iono),
                              extra_tau=np.r_[np.full(n_slots, np.inf),
                                              np.full(n_iono, cfg["iono_correlation_time"])],
-                             sparse=True)
+                             sparse=True, scale_noise_window=cfg["scale_noise_window"])
         code_tau = cfg["code_correlation_time"]
         if code_tau is None:
             code_tau = (self.datasheet.get("gnss") or {}).get("carrier_smoothing") or 0.0
