@@ -228,6 +228,17 @@ OUTPUT_COLUMNS = (*SOLUTION_COLUMNS, "fix_status", "ratio", "fixed_ambiguities",
                   "nis_gnss_dof")
 
 
+def _zero_nan(x: np.ndarray) -> np.ndarray:
+    """``x`` with its NaN (a correction the receiver did not give) as zero."""
+    return np.where(np.isnan(x), 0.0, x)
+
+
+def _members(keys: np.ndarray, known: set[int]) -> np.ndarray:
+    """Whether each of ``keys`` is in ``known`` (a few dozen keys: a set lookup each, where
+    ``np.isin`` sorts both)."""
+    return np.fromiter((k in known for k in keys.tolist()), dtype=bool, count=len(keys))
+
+
 class _Epoch:
     """One receiver's signals of an epoch, sorted by signal key, with the broadcast
     corrections applied: ``code`` and ``phase`` (m) are rho + receiver clock (+ lambda N for
@@ -250,11 +261,11 @@ class _Epoch:
         self.wavelength = C_M_S / freq
         self.gamma = (F_L1_HZ / freq) ** 2
         clock = c("sat_clock")
-        iono, tropo = np.nan_to_num(c("iono")), np.nan_to_num(c("tropo"))
-        delay = np.nan_to_num(c("group_delay")) if "group_delay" in cols else 0.0
+        iono, tropo = _zero_nan(c("iono")), _zero_nan(c("tropo"))
+        delay = _zero_nan(c("group_delay")) if "group_delay" in cols else 0.0
         self.code = c("pseudorange") + clock - iono - tropo
         self.phase = self.wavelength * c("carrier_phase") + clock + delay + iono - tropo
-        self.lli = np.nan_to_num(c("lli")).astype(np.int64)
+        self.lli = _zero_nan(c("lli")).astype(np.int64)
         self.lock = c("lock_time") if "lock_time" in cols else np.full(len(keys), np.inf)
         self.elevation = c("elevation")
         self.sat_pos = block[:, [cols["sat_x"], cols["sat_y"], cols["sat_z"]]]
@@ -600,7 +611,7 @@ class RtkInsEkf(Estimator):
         if code:
             # a code arc's first epoch in the filter counts at its marginal sigma, the later
             # ones at what they add to it (module docstring)
-            seen = np.isin(rover.keys, self._code_keys())
+            seen = _members(rover.keys, self._code_used)
             rover_std = np.where(seen, cfg["code_std"] * self._code_inflation,
                                  cfg["code_arc_std"])
             base_std = cfg["base_code_std"]
@@ -659,7 +670,7 @@ class RtkInsEkf(Estimator):
         sd_phase = rover.phase - base.phase
         for _ in range(2):
             # a held reference first, then one whose half cycle is resolved
-            priority = (np.where(np.isin(rover.keys, self._held_keys()), 2, 0)
+            priority = (np.where(_members(rover.keys, self._held), 2, 0)
                         + np.where(self._pending, 0, 1))
             dz_p, h_p, r_p, sig, refs = self._rows(rover, base, geometry, slots >= 0, priority,
                                                    sd_phase, slots)
@@ -705,19 +716,11 @@ class RtkInsEkf(Estimator):
         self.nis_gnss_dof = float(len(dz))
         self._phase_rows = (sig, refs, slots)
 
-    def _code_keys(self) -> np.ndarray:
-        """The rover signals whose current code arc the filter has used."""
-        return np.fromiter(self._code_used, dtype=np.int64, count=len(self._code_used))
-
-    def _held_keys(self) -> np.ndarray:
-        """The keys of the held ambiguities."""
-        return np.fromiter(self._held, dtype=np.int64, count=len(self._held))
-
     def _all_held(self, rover: _Epoch, sig: np.ndarray, refs: np.ndarray) -> bool:
         """Whether the epoch's double differences (signals ``sig`` against ``refs``) are at
         least ``min_fixed`` and all of held ambiguities."""
         return len(sig) >= self.config["min_fixed"] and bool(
-            np.isin(rover.keys[np.r_[sig, refs]], self._held_keys()).all())
+            _members(rover.keys[np.r_[sig, refs]], self._held).all())
 
     def _reassign(self, rover: _Epoch, base: _Epoch, slots: np.ndarray) -> np.ndarray:
         """Slots again after resets: the reset signals start new ambiguities."""
