@@ -5,7 +5,10 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   strapdown of ``toolbox.strapdown``, the error model of ``toolbox.ins_error``, the Joseph
   update of ``toolbox.kalman``; Groves 2013, chapter 14), its IMU noise from the datasheet
   (``toolbox.datasheet.imu_error_model``), closed loop, the IMU's mounting and the antenna's
-  lever arm from the installation (``toolbox.installation``).
+  lever arm from the installation (``toolbox.installation``). Its scale-factor and
+  g-sensitivity noise counts the change of the mean readings from one ``scale_noise_window``
+  to the next, not from one propagation step to the next, where the car body's vibration
+  would count as a change of the biases (docs/rtk-ins.md, "Consistency").
 * **Ambiguities**: one state per signal (satellite and band) for the between-receiver
   single-difference ambiguity N_rover - N_base in cycles, a random constant, after the 15
   (``ambiguity_states`` slots, taken as satellites rise and given back when they set; the

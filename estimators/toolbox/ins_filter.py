@@ -151,6 +151,12 @@ class InsFilter:
     yaw_response_sigma : (3,), optional
         1-sigma of the yaw-response states (module docstring; x, y gyro misalignment towards
         z, z gyro scale factor, dimensionless); None: no such states.
+    scale_noise_window : float
+        s; 0: the scale-factor and g-sensitivity noise (``InsNoise``) counts the change of the
+        mean reading from one flush to the next. Above 0: from one window of this length to
+        the next, added at the flush that completes a window, so that a vibration that
+        averages out within the window (a car body's, 1-20 Hz) is not taken for a change of
+        the bias while a manoeuvre still is.
     """
 
     def __init__(self, initial: InitialState, imu_columns: Mapping[str, int], increments: bool,
