@@ -7,7 +7,7 @@ latitude and longitude; GGA field 9 is the altitude above mean sea level (the ge
 ellipsoidal height is their sum. N is EGM96 at the fix's position (``simulator.geoid``, the
 barometer's geoid); a real receiver uses its own built-in geoid, often a coarser grid, so its N
 may differ by a metre or two. Epochs without a fix give GGA quality 0, RMC status V and empty
-position fields, as receivers do.
+position fields, as receivers do; so does an epoch flagged as a fix whose position is not finite.
 
 Public functions
 ----------------
@@ -69,9 +69,12 @@ def _count(value: float, digits: int = 2) -> str:
 
 def _epoch_sentences(stamp: dt.datetime, fix: dict, sats: pd.DataFrame) -> list[str]:
     hms = stamp.strftime("%H%M%S") + f".{stamp.microsecond // 10000:02d}"
-    has_fix = bool(np.isfinite(fix["fix"]) and fix["fix"] > 0)
-    lat, ns = _latlon(fix["lat"], "NS", 2)
-    lon, ew = _latlon(fix["lon"], "EW", 3)
+    # a fix flag without a finite position (a hand-edited or faulted stream) is no fix
+    has_fix = bool(np.isfinite(fix["fix"]) and fix["fix"] > 0
+                   and np.isfinite(fix["lat"]) and np.isfinite(fix["lon"])
+                   and np.isfinite(fix["alt"]))
+    lat, ns = _latlon(fix["lat"] if has_fix else np.nan, "NS", 2)
+    lon, ew = _latlon(fix["lon"] if has_fix else np.nan, "EW", 3)
     knots = fix["speed"] * KNOTS_PER_M_S
     course = np.degrees(fix["course"])
     hdop, vdop = fix["hdop"], fix["vdop"]

@@ -173,6 +173,24 @@ def test_nmea_sentences_parse_with_valid_checksums(exported):
     np.testing.assert_allclose(speed[with_fix] * 1852 / 3600, fix["speed"][with_fix], atol=1e-3)
 
 
+def test_nmea_epoch_without_a_finite_position_is_no_fix(exported):
+    """A fix row flagged as a fix whose latitude is NaN (a faulted or hand-edited stream) gives
+    GGA quality 0 and RMC status V with empty position fields, not quality 1 with no position."""
+    from simulator.gnss.nmea import nmea_sentences
+
+    _, ds = exported
+    fix = ds.read("gnss_fix").iloc[:3].copy()
+    fix["fix"] = 2
+    fix.loc[fix.index[1], "lat"] = np.nan
+    gga = [line for line in nmea_sentences(fix, ds.read("gnss_raw"), 2000, 0.0)
+           if line.startswith("$GPGGA")]
+    rmc = [line for line in nmea_sentences(fix, ds.read("gnss_raw"), 2000, 0.0)
+           if line.startswith("$GPRMC")]
+    assert [g.split(",")[6] for g in gga] == ["1", "0", "1"]
+    assert gga[1].split(",")[2:6] == ["", "", "", ""]
+    assert [r.split(",")[2] for r in rmc] == ["A", "V", "A"]
+
+
 def test_library_export_equals_the_command(exported, tmp_path):
     """``simulator.dataset.export`` (what notebooks call) writes the files ``landnav export``
     writes, byte for byte apart from the RINEX header's creation time; refuses to overwrite
