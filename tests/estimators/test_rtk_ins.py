@@ -92,8 +92,8 @@ ACCEPTANCE_SEEDS = tuple(range(1, 11))
 
 @pytest.fixture(scope="module")
 def acceptance(tmp_path_factory):
-    """The issue's acceptance drive: 20 minutes, three systems on two bands, ten seeds
-    (about an hour of CPU)."""
+    """The acceptance drive: 20 minutes, three systems on two bands, ten seeds
+    (about half an hour of CPU: 75 s of replay and 80 s of rnx2rtkp per seed)."""
     need_rnx2rtkp()
     work = tmp_path_factory.mktemp("rtk_acceptance")
     return [process(work, seed, short=False, systems=THREE_SYSTEMS)
