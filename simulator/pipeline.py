@@ -147,12 +147,12 @@ def score(dataset: Dataset, solutions: Solutions) -> Evaluation:
 
 
 def write_report(directory: str | Path, evaluation: Evaluation, title: str,
-                 note: str | None = None) -> Path:
-    """Write ``report.md`` (metrics, per-outage table) and its ``plots/`` into ``directory``
-    (made if missing), and ``report.html``, the same page with every plot embedded
-    (``simulator.html_report``); the path of ``report.md``."""
+                 note: str | None = None, plots: bool = True) -> Path:
+    """Write ``report.md`` (metrics, per-outage table) and its ``plots/`` (unless ``plots`` is
+    false) into ``directory`` (made if missing), and ``report.html``, the same page with every
+    plot embedded (``simulator.html_report``); the path of ``report.md``."""
     Path(directory).mkdir(parents=True, exist_ok=True)
-    path = report.write_report(Path(directory), evaluation, title, note)
+    path = report.write_report(Path(directory), evaluation, title, note, plots)
     write_html_report(path)
     return path
 
@@ -167,11 +167,13 @@ class RunResult:
 
 
 def run(scenario: Scenario, out_dir: str | Path, force: bool = False,
-        show_progress: bool = False, time_limit_s: float | None = None) -> RunResult:
+        show_progress: bool = False, time_limit_s: float | None = None,
+        plots: bool = True) -> RunResult:
     """The main job into one directory, written under a temporary name and renamed when
     complete: the dataset, every estimator the scenario names, their solutions, the scores and
-    the report. A label that cannot name a file is refused before anything is written; each
-    estimator (its import and check, then its replay) may take ``time_limit_s`` (``estimate``).
+    the report (with its plots unless ``plots`` is false). A label that cannot name a file is
+    refused before anything is written; each estimator (its import and check, then its
+    replay) may take ``time_limit_s`` (``estimate``).
     """
     out = Path(out_dir)
     entries = scenario.data["estimators"]
@@ -190,5 +192,5 @@ def run(scenario: Scenario, out_dir: str | Path, force: bool = False,
         evaluation = score(dataset, solutions)
         write_scores(evaluation.scores(), tmp / "scores.json")
         write_report(tmp, evaluation, f"{scenario.name} (seed {scenario.seed})",
-                     note=None if entries else NO_ESTIMATOR)
+                     note=None if entries else NO_ESTIMATOR, plots=plots)
     return RunResult(out, evaluation)

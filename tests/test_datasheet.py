@@ -9,7 +9,7 @@ import math
 
 import numpy as np
 
-from estimators.toolbox.datasheet import fix_error_model
+from estimators.toolbox.datasheet import MIN_DRIVE_LONG_SIGMA_M, fix_error_model
 from simulator.datasheet import (
     KLOBUCHAR_NIGHT_SLANT_M,
     fix_uere_m,
@@ -65,3 +65,25 @@ def test_an_ideal_receiver_has_no_error_and_the_filters_keep_a_floor():
     assert iono_residual_fractions({}) == (0.0, 0.0)
     model = fix_error_model({"gnss": ideal})
     assert model.correlated_range == 0.1 and model.white_range == 0.1
+
+
+def test_the_reported_drive_long_sigma_splits_the_report_without_loss():
+    """A fix's reported 1-sigma per axis is split into the drive-long part, the budget's
+    smoothed part and the excess beyond the budget (reflections), in quadrature: below the
+    budget the drive-long part is the report less the smoothed part, above it the budget's
+    correlated part and the rest the excess; the budget's where the fix reports nothing, and
+    at least the floor where it reports less than its smoothed part."""
+    model = fix_error_model({"gnss": AUTOMOTIVE})
+    hdop, vdop = 1.2, 2.0
+    axes = np.array([hdop / math.sqrt(2.0), hdop / math.sqrt(2.0), vdop])
+    budget = model.correlated_range * axes
+    smoothed = model.smoothed_range * axes
+    reported = np.array([0.6 * budget[0], 3.0 * budget[1], math.nan])
+    drive_long = model.reported_drive_long_sigma(reported, hdop, vdop)
+    assert math.isclose(drive_long[0], math.sqrt(reported[0] ** 2 - smoothed[0] ** 2))
+    assert drive_long[1] == budget[1] and drive_long[2] == budget[2]
+    excess = model.excess_sigma(reported, hdop, vdop)
+    np.testing.assert_allclose((drive_long**2 + smoothed**2 + excess**2)[:2],
+                               reported[:2] ** 2, rtol=1e-12)
+    tiny = model.reported_drive_long_sigma(np.array([0.01, 0.01, 0.01]), hdop, vdop)
+    np.testing.assert_array_equal(tiny, MIN_DRIVE_LONG_SIGMA_M)

@@ -22,16 +22,15 @@ filter on a real car needs: accelerometer-bias states (DRM2's pitch and forward 
 unobservable combination, eq. 11, so without the bias state its pitch claims the bias's
 accuracy), DRM2's pitch rate corrected for the body's roll in turns, the IMU's lateral velocity
 about the rear axle (in the position and, as w_z times it, in the speed's dynamics:
-``drm2_transition``), DRM2's speed row as the fix's velocity along the heading
-(``_Drm2._fix_speed``: eq. 18's norm is rectified at a stop), fixes weighted down beyond a
-99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop (the DR running
-on until the stop is confirmed, since a wheel below its cut-off may still roll). The SPKF's
-``sigma_set: auto | simplex | symmetric`` picks the point set; ``auto`` (the default) is the
-paper's simplex set with the paper's tuning and the symmetric set with the datasheet's: the
-simplex set's non-zero third moments move unobservable states under eq. 33's 180 deg heading
-prior (docs/reproduction_cho2006.md), and with the datasheet's R it lost the heading at the
-start on 3 of 10 seeds of two drives (urban canyon, garage), where the symmetric set converged
-on every seed.
+``drm2_transition``), the fix's velocity and correlated error (below), fixes weighted down
+beyond a 99.9 % chi-square gate, and, with an odometer, a zero-velocity update at each stop
+(the DR running on until the stop is confirmed, since a wheel below its cut-off may still
+roll). The SPKF's ``sigma_set: auto | simplex | symmetric`` picks the point set; ``auto`` (the
+default) is the paper's simplex set with the paper's tuning and the symmetric set with the
+datasheet's: the simplex set's non-zero third moments move unobservable states under eq. 33's
+180 deg heading prior (docs/reproduction_cho2006.md), and with the datasheet's R it lost the
+heading at the start on 3 of 10 seeds of two drives (urban canyon, garage), where the symmetric
+set converged on every seed.
 
 Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction_cho2006.md)
 ----------------------------------------------------------------------------------------
@@ -76,17 +75,27 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
   eqs. 33-34 term by term (5 m/s and 0.1 m/s^2 on each velocity axis). Its specific force is
   resolved at the step's mid heading and its position moves with the mean of the old and new
   velocity (``drm1_transition``). Its speed measurement is linearised (and left out below
-  0.5 m/s, where the speed's direction is undefined). With the datasheet tuning a fix that
-  reports its velocity's 1-sigma updates DRM1's two velocity states with its north and east
-  velocity instead (``Drm1Ekf._update``): eq. 18's speed left the cross-track velocity to
-  the position alone, which the body's roll and the road's bank push and a street canyon's
+  0.5 m/s, where the speed's direction is undefined).
+* The fix with the datasheet tuning (``_ChoDr._velocity_update``), when it reports its
+  velocity's 1-sigma: its north and east velocity replace eq. 18's speed. DRM1's two
+  velocity states are measured directly: the speed left the cross-track velocity to the
+  position alone, which the body's roll and the road's bank push and a street canyon's
   reflected fixes barely hold (sumo_city_canyon seed 1 north (error / sigma)^2 7.8 -> 1.3,
-  parking_garage seed 3 yaw 7.2 -> 0.74). Its position is then the truth plus the fix's
-  correlated north and east error, two states sized by the receiver's budget at the first
-  fix's HDOP (``toolbox.datasheet.fix_error_model``, as ``dr2d_odo_ekf`` carries them), plus
-  the budget's white part and the reported excess: with the velocity known to the fix's
-  Doppler the inflated white R (``FIX_CORRELATION_S``) averaged the drive-long error away
-  (sumo_city north 8.4 over three seeds, worst 22).
+  parking_garage seed 3 yaw 7.2 -> 0.74). DRM2's velocity is V along the heading and the
+  IMU's lateral velocity across it (eq. 5), so the cross-track row measures the heading
+  (V times its error), which the speed along the heading (eq. 18) left to the position's
+  slow turn: with it DRM2's yaw claimed 3-4 times its error (SUMO city (error / sigma)^2
+  0.04-0.13, seeds 1-3); it waits until the heading is found (before, the speed row of
+  ``_Drm2._fix_speed``). The position is the truth plus the fix's correlated north and
+  east error, two unit-variance states times each fix's own drive-long 1-sigma
+  (``toolbox.datasheet.FixErrorModel.reported_drive_long_sigma``: the reported 1-sigma less
+  the smoothed part, at most the receiver budget's correlated part), plus the
+  budget's white part and the reported excess (reflections) as white noise. With the
+  velocity known to the fix's Doppler a white R, even inflated over ``FIX_CORRELATION_S``,
+  averaged the drive-long error away (DRM2 on the SUMO city: a fix 3.1 m north of the truth
+  for the whole drive against a north sigma of 1.0 m, seed 3 (error / sigma)^2 9.1; DRM1
+  before its states 8.4 over three seeds, worst 22); the budget's 1.7 m per axis against a
+  report of 1.0-1.5 m on open sky made it cautious (DRM1 open-road north 0.06).
 * Eq. 18 converts GPS latitude and longitude to metres with one Earth radius R_e; we use the
   WGS-84 meridian and transverse radii at the start (``simulator.earth``).
 * No Earth rate (the paper ignores it); the standstill calibration removes its vertical part.
@@ -335,6 +344,7 @@ class _ChoDr(Estimator):
         self._matching = FixNoiseMatching()
         self._stop_sigma = stopped_speed_sigma(self.datasheet)
         self._odo_stop = False  # a stop seen by the odometer, not yet confirmed still
+        self._fix_gain = np.ones(2)  # the fix-error states' gain at the last fix, m
         x0 = self._initial_state()
         self._start_filter(np.concatenate([x0, np.zeros(len(self._tuning.p0) - len(x0))]),
                            self._tuning.p0.copy())
@@ -353,7 +363,8 @@ class _ChoDr(Estimator):
         """Q (variance growth per second) over a step with inputs ``u``."""
         return self._tuning.q
 
-    _fix_states = 0  # the fix's correlated error states after the bias states (DRM1)
+    _fix_states = 2  # the fix's correlated north and east error, the last states (datasheet)
+    _velocity_needs_heading = False  # velocity rows only once the heading is found (DRM2)
 
     @property
     def _bias_states(self) -> int:
@@ -496,6 +507,10 @@ class _ChoDr(Estimator):
             return
         x, p = self._predicted()
         std_pos, std_vel = self._accuracy.read(row)
+        if (np.isfinite(std_vel[:2]).all() and math.isfinite(hdop)
+                and not (self._velocity_needs_heading and p[4, 4] >= ALIGNED_HEADING_VAR)):
+            self._velocity_update(z[:2], np.array([vn, ve]), std_pos, std_vel[:2], hdop, x, p)
+            return
         z[2], speed_sigma = self._fix_speed(vn, ve, x, std_vel)
         reported = bool(np.isfinite(std_pos[:2]).all())
         excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan) if reported else None
@@ -512,6 +527,52 @@ class _ChoDr(Estimator):
         self._update(z, r)
         if not reported:  # the fix's scatter learnt from its innovations instead
             self._matching.add(nu, hph, self._tuning.white_position_var(hdop))
+
+    def _velocity_update(self, pos: np.ndarray, vel: np.ndarray, std_pos: np.ndarray,
+                         std_vel: np.ndarray, hdop: float, x: np.ndarray, p: np.ndarray
+                         ) -> None:
+        """A fix that reports its velocity's 1-sigma ``std_vel`` (datasheet tuning): its north
+        and east position ``pos`` and velocity ``vel`` (``_fix_rows``). The position is the
+        truth plus the fix's correlated error, e = g u: two unit-variance Gauss-Markov states
+        u whose gain g is this fix's drive-long 1-sigma from its own report
+        (``FixErrorModel.reported_drive_long_sigma``; a receiver's report is 2-3 m for the
+        first half minute, while its Hatch filters converge, then 1.2-1.5 m on open sky, so
+        states sized once at the first fix kept the budget's), plus the
+        budget's white part and the reported excess (reflections) as white noise; the
+        velocity's noise is the reported one (and the IMU's lateral velocity error across the
+        heading, ``_velocity_noise``). Weighted as eq. 35 weighs the fixes until the heading
+        is found, and down to the 99.9 % gate beyond it, as ``on_gnss_fix``."""
+        self._fix_gain = self._fix_model.reported_drive_long_sigma(std_pos, hdop, math.nan)[:2]
+        white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
+        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
+        r = np.zeros((4, 4))
+        r[[0, 1], [0, 1]] = white + excess
+        aligned = p[4, 4] < ALIGNED_HEADING_VAR
+        if not aligned:
+            r[[0, 1], [0, 1]] = np.maximum(r[[0, 1], [0, 1]], PAPER_R.diagonal()[:2])
+        r[2:, 2:] = self._velocity_noise(x, np.maximum(std_vel, MIN_SPEED_SIGMA_M_S))
+        z = np.concatenate([pos, vel])
+        zhat, h = self._fix_rows(x[None, :])
+        nu = (z - zhat[0])[:2]
+        d2 = normalised_innovation_squared(nu, (h[:2] @ p @ h[:2].T) + r[:2, :2])
+        gate = chi2_threshold(2, GATE_PROBABILITY)
+        if d2 > gate and aligned:
+            r[:2, :2] *= d2 / gate  # an outlier (a reflected signal): weighted down to the gate
+        self._nonlinear_update(z, r)
+
+    def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """h(x) = [P_N + g_N u_N, P_E + g_E u_E, v_N, v_E] of a fix (``_velocity_update``) for
+        states (k, n) with the fix's correlated error g u (the last two states u, the gain g
+        ``_fix_gain``), and its Jacobian at the first row."""
+        raise NotImplementedError
+
+    def _velocity_noise(self, x: np.ndarray, std_vel: np.ndarray) -> np.ndarray:
+        """2 x 2 noise of a fix's north and east velocity rows with 1-sigma ``std_vel``."""
+        return np.diag(std_vel**2)
+
+    def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
+        """Update with ``z`` of ``_fix_rows`` and its noise ``r``."""
+        raise NotImplementedError
 
     def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
                    ) -> tuple[float, float]:
@@ -565,14 +626,26 @@ class _Drm2(_ChoDr):
         return np.array([0.0, 0.0, v, float(init.attitude[1]), yaw, 0.0, 0.0, 0.0])
 
     def _inputs(self, u: np.ndarray) -> np.ndarray:
-        """The pitch rate of a body rolling in a turn (datasheet tuning on a car): theta_dot =
-        w_y cos(roll) - w_z sin(roll), roll = -k V w_z (``cho2006_tuning``), so w_y + k V
-        w_z^2 to first order; eq. 24d integrates w_y alone."""
+        """The pitch and heading rates of a body rolled by phi in a turn (datasheet tuning on a
+        car; ZYX Euler rates on a level road): theta_dot = w_y cos(phi) - w_z sin(phi),
+        psi_dot = w_y sin(phi) + w_z cos(phi), where eqs. 24d-e integrate w_y and w_z alone.
+        The roll is phi = -k V w_z (``cho2006_tuning``), so the pitch rate is w_y + k V w_z^2
+        to first order, and w_z alone loses w_z phi^2 / 2 of the heading rate (w_y = psi_dot
+        sin(phi) in the turn): 0.16 deg over ``urban_canyon``'s 90 deg turns at 0.67 g (3.4
+        deg of roll), which the heading measured by the fix's cross-track velocity under an
+        ideal gyro's process noise kept (seeds 1-2 yaw (error / sigma)^2 34 and 33). An error
+        in phi moves this rate by theta_dot times it, to first order: nil in a level turn.
+        The pitch's 1 / cos(theta) is left out: taken at the pitch state, whose error is the
+        forward accelerometer's bias over g (1-2 deg), it put tan(theta) times that error into
+        the heading rate on the garage's 7 deg ramps (unseen garage seed 2 yaw 0.47 -> 7.0),
+        a coupling the propagation's Jacobian does not carry."""
         k, arm = self._tuning.roll_gradient, self._tuning.rear_axle_m
         if not (k or arm):
             return u
+        roll = -k * self._estimate()[0][2] * u[2]
         out = np.append(u, arm * u[2])  # the IMU's lateral velocity (``_measure``)
         out[1] += k * self._estimate()[0][2] * u[2] ** 2
+        out[2] = u[1] * math.sin(roll) + u[2] * math.cos(roll)
         self._lateral = float(out[3])
         self._lateral_var = self._tuning.lateral_variance(self._lateral)
         return out
@@ -614,6 +687,30 @@ class _Drm2(_ChoDr):
         lat^2 / (2 V) of the IMU's lateral velocity lat."""
         c, s = math.cos(float(x[4])), math.sin(float(x[4]))
         return vn * c + ve * s, math.hypot(c * std_vel[0], s * std_vel[1])
+
+    _velocity_needs_heading = True  # its velocity rows turn with the heading
+
+    def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The fix's position with its correlated error, and its velocity: the speed V along
+        the heading and the IMU's lateral velocity ``lat`` across it (eq. 5); the cross-track
+        row observes the heading directly, which eq. 18's speed leaves to the position."""
+        k, (g_n, g_e) = x.shape[1] - self._fix_states, self._fix_gain
+        v, psi, lat = x[:, 2], x[:, 4], self._lateral
+        c, s = np.cos(psi), np.sin(psi)
+        zs = np.column_stack([x[:, 0] + g_n * x[:, k], x[:, 1] + g_e * x[:, k + 1],
+                              v * c - lat * s, v * s + lat * c])
+        h = np.zeros((4, x.shape[1]))
+        h[0, 0] = h[1, 1] = 1.0
+        h[0, k], h[1, k + 1] = g_n, g_e
+        h[2, 2], h[3, 2] = c[0], s[0]
+        h[2, 4], h[3, 4] = -v[0] * s[0] - lat * c[0], v[0] * c[0] - lat * s[0]
+        return zs, h
+
+    def _velocity_noise(self, x: np.ndarray, std_vel: np.ndarray) -> np.ndarray:
+        """The fix's velocity noise and the error of the IMU's lateral velocity across the
+        heading (``Tuning.lateral_variance``)."""
+        across = np.array([-math.sin(float(x[4])), math.cos(float(x[4]))])
+        return np.diag(std_vel**2) + self._lateral_var * np.outer(across, across)
 
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
@@ -683,6 +780,14 @@ class _Drm1(_ChoDr):
             h[2, 2:4] = x[0, 2:4] / speed[0]
         return np.column_stack([x[:, 0], x[:, 1], speed]), h
 
+    def _fix_rows(self, x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The fix's position with its correlated error, and DRM1's two velocity states."""
+        k, (g_n, g_e) = x.shape[1] - self._fix_states, self._fix_gain
+        h = np.eye(4, x.shape[1])
+        h[0, k], h[1, k + 1] = g_n, g_e
+        return np.column_stack([x[:, 0] + g_n * x[:, k], x[:, 1] + g_e * x[:, k + 1], x[:, 2],
+                                x[:, 3]]), h
+
     def solution(self, t: float) -> list[float]:
         x, p = self._estimate()
         return [*self._row(x, p, x[2], x[3], math.nan, p[2:4, 2:4]), math.sqrt(p[4, 4]),
@@ -714,6 +819,11 @@ class _Ekf(_ChoDr):
         h = np.eye(len(self._x))[index]
         self._x, self._p, _ = kf_update(self._x, self._p, z - self._x[index], h, r)
 
+    def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
+        zhat, h = self._fix_rows(self._x[None, :])
+        self._x, self._p, _ = kf_update(self._x, self._p, z - zhat[0], h, r)
+        self._x[4] = wrap_angle(self._x[4])
+
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._x, self._p
 
@@ -729,58 +839,6 @@ class Drm1Ekf(_Drm1, _Ekf):
         if np.hypot(x[0, 2], x[0, 3]) < MIN_SPEED_UPDATE_M_S:
             h[2] = 0.0  # no speed row: the EKF leaves it out
         return zhat, h
-
-    _fix_states = 2
-
-    def on_gnss_fix(self, t: float, row: np.ndarray) -> None:
-        """The fix's HDOP and reported position 1-sigma kept for ``_update``, and the fix's
-        correlated-error states sized at the first fix by its HDOP (datasheet tuning)."""
-        hdop = float(row[self._fix_cols[5]])
-        self._fix_report = (hdop, self._accuracy.read(row)[0])
-        if self._datasheet and not getattr(self, "_fix_sized", False) and math.isfinite(hdop):
-            k = len(self._x) - 2
-            sigma = self._fix_model.correlated_sigma(hdop, math.nan)[:2]
-            self._p[k:, :] = 0.0
-            self._p[:, k:] = 0.0
-            self._p[k:, k:] = np.diag(sigma**2)
-            self._fix_sized = True
-        super().on_gnss_fix(t, row)
-
-    def _fix_speed(self, vn: float, ve: float, x: np.ndarray, std_vel: np.ndarray
-                   ) -> tuple[float, float]:
-        """Eq. 18's speed row, and the fix's velocity with its reported 1-sigma kept for
-        ``_update`` (datasheet tuning)."""
-        self._fix_velocity = (vn, ve, float(std_vel[0]), float(std_vel[1]))
-        return super()._fix_speed(vn, ve, x, std_vel)
-
-    def _update(self, z: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """With the datasheet tuning and a fix that reports its velocity's 1-sigma: the fix's
-        north and east velocity in place of eq. 18's speed, DRM1's two velocity states
-        measured directly (the speed leaves the cross-track velocity to the position alone,
-        whose reflected fixes in a street canyon weigh little, while the drive's roll and
-        grade push it; and it leaves the heading to the acceleration's direction)."""
-        vel = getattr(self, "_fix_velocity", None)
-        self._fix_velocity = None
-        if not (self._datasheet and vel is not None and math.isfinite(vel[2] + vel[3])):
-            return super()._update(z, r)
-        # the position: the truth plus the fix's correlated error (two states) plus white
-        # noise, and the reported excess (reflections) as white noise beside it
-        hdop, std_pos = self._fix_report
-        k = len(self._x) - 2
-        h = np.eye(4, len(self._x))
-        h[0, k], h[1, k + 1] = 1.0, 1.0
-        nu = np.array([z[0], z[1], vel[0], vel[1]]) - self._x[:4]
-        nu[:2] -= self._x[k:]
-        white = self._fix_model.white_sigma(hdop, math.nan)[:2] ** 2
-        excess = self._fix_model.excess_sigma(std_pos, hdop, math.nan)[:2] ** 2
-        pos = white + excess
-        if self._p[4, 4] >= ALIGNED_HEADING_VAR:  # as ``on_gnss_fix`` weighs them then
-            pos = np.maximum(pos, PAPER_R.diagonal()[:2])
-        rr = np.diag([pos[0], pos[1], max(vel[2], MIN_SPEED_SIGMA_M_S) ** 2,
-                      max(vel[3], MIN_SPEED_SIGMA_M_S) ** 2])
-        self._x, self._p, s = kf_update(self._x, self._p, nu, h, rr)
-        self._x[4] = wrap_angle(self._x[4])
-        return nu, s
 
 
 class Drm2Ekf(_Drm2, _Ekf):
@@ -862,6 +920,13 @@ class Drm2Spkf(_Drm2):
         h = np.eye(len(self._ukf.x))[index]
         self._ukf.x, self._ukf.p, _ = kf_update(self._ukf.x, self._ukf.p,
                                                 z - self._ukf.x[index], h, r)
+
+    def _nonlinear_update(self, z: np.ndarray, r: np.ndarray) -> None:
+        if self._ukf.sigma is not None:
+            self._ukf.covariance()  # eq. 26
+        self._since_draw = 0.0
+        self._ukf.update(lambda xs: self._fix_rows(xs)[0], z, r)  # eqs. 27-32
+        self._repair_covariance()
 
     def _estimate(self) -> tuple[np.ndarray, np.ndarray]:
         return self._ukf.x, self._ukf.p

@@ -31,9 +31,11 @@ the paper's printed values, or values derived from what a user knows.
     with the pseudorange-rate noise of an FLL at 40 dB-Hz (``RATE_SIGMA_M_S``, scaled by the
     datasheet's ``tracking_noise``). A fix that reports its own accuracy (``std_*`` of
     ``gnss_fix``, the receiver's least squares with its reflected signals;
-    ``Tuning.reported_r``) replaces the matching: the position's reported 1-sigma beyond the
-    receiver's budget (``toolbox.datasheet.FixErrorModel.excess_sigma``: the reflections,
-    which leave HDOP unchanged) is added to the HDOP's variance and counted as correlated
+    ``Tuning.reported_r``; with its velocity's 1-sigma too, the fix's correlated error is
+    two states instead, ``cho2006._ChoDr._velocity_update``) replaces the matching: the
+    position's reported 1-sigma beyond the receiver's budget
+    (``toolbox.datasheet.FixErrorModel.excess_sigma``: the reflections, which leave HDOP
+    unchanged) is added to the HDOP's variance and counted as correlated
     like it, and the speed row's 1-sigma is the fix's reported velocity 1-sigma along it. With
     the HDOP's 0.04 m/s a canyon's reflected Doppler (0.2-0.6 m/s, reported so) left DRM2's
     velocity (error / sigma)^2 at 2-4 on the unseen canyon, and the matching, which follows
@@ -272,11 +274,9 @@ def datasheet_tuning(model: str, datasheet: Mapping[str, Any], still_s: float) -
                         [MIN_ACCEL_NOISE**2, MIN_GYRO_NOISE**2])
     q[4] = max(q[4], MIN_GYRO_NOISE**2)
     lateral_noise = arm * _axis(gyro.get("noise_density"), 2) * math.sqrt(DR_RATE_HZ)
-    if model == "drm1":  # the fix's correlated north and east error (sized again at a fix)
-        fix = fix_error_model(datasheet)
-        sigma = fix.correlated_sigma(1.0, 2.0)[:2]
-        bias_p0 += list(sigma**2)
-        bias_q += list(2.0 * sigma**2 / fix.correlated_tau)
+    # the fix's correlated north and east error over its 1-sigma at each fix (unit variance)
+    bias_p0 += [1.0, 1.0]
+    bias_q += [2.0 / fix_error_model(datasheet).correlated_tau] * 2
     return Tuning(np.diag([*p0, *bias_p0]), np.diag([*q, *bias_q]), uere, rate,
                   ROLL_GRADIENT if car else 0.0, ROLL_SIGMA if car else 0.0, arm, lateral_noise)
 

@@ -25,8 +25,13 @@ rate enters as GTSAM's Coriolis rate, constant in that frame):
 * GNSS: the fix's position at the antenna (the datasheet's lever arm) is the antenna's
   position plus the fix's own error, as the filters model it (``toolbox.datasheet.
   fix_error_model``): its drive-long part (the signal-in-space error and the ionosphere's
-  residual, the budget's correlated range error times the DOP) a first-order Gauss-Markov
-  state of correlation time ``CORRELATED_TAU_S`` (30 min), plus white noise, the smoothed
+  residual) a unit-variance first-order Gauss-Markov variable u of correlation time
+  ``CORRELATED_TAU_S`` (30 min) times each fix's gain, its drive-long 1-sigma per axis from
+  its own report (``reported_drive_long_sigma``: the reported 1-sigma less the smoothed
+  part, at most the budget's correlated range error times the DOP; the budget's 1.7 m per
+  axis on open sky against a report of 1.0-1.5 m left the horizontal (error / sigma)^2 at
+  0.07-0.9; a receiver reports 2-3 m while its Hatch filters converge, so the gain follows
+  each fix rather than the first), plus white noise, the smoothed
   error's white equivalent in quadrature with the fix's reported accuracy beyond the budget
   (``excess_sigma``: the reflected signals of a canyon; ``std_*`` of ``gnss_fix``). The
   horizontal sigma was once the budget without the ionosphere (0.6 m of range error for the
@@ -403,30 +408,31 @@ class FgoLooselyCoupled(Estimator):
         hdop = hdop if math.isfinite(hdop) else DEFAULT_DOP
         vdop = vdop if math.isfinite(vdop) else 2 * DEFAULT_DOP
         model = self._fix_model
-        sigma = model.correlated_sigma(hdop, vdop)
         std_pos, std_vel = self._accuracy.read(row)
+        gain = model.reported_drive_long_sigma(std_pos, hdop, vdop)  # e = gain u, u unit
         white = np.hypot(model.white_sigma(hdop, vdop), model.excess_sigma(std_pos, hdop, vdop))
         e_key = self._e(k)
         current = self._smoother.calculateEstimate()
+        unit = np.ones(3)
         if self._e_key is None:
             graph.add(gtsam.PriorFactorVector(e_key, np.zeros(3),
-                                              gtsam.noiseModel.Diagonal.Sigmas(sigma)))
+                                              gtsam.noiseModel.Diagonal.Sigmas(unit)))
             values.insert(e_key, np.zeros(3))
         elif current.exists(self._e_key):
             phi = math.exp(-(t - self._t_e) / model.correlated_tau)
             graph.add(gtsam.CustomFactor(
-                gtsam.noiseModel.Diagonal.Sigmas(sigma * math.sqrt(1.0 - phi * phi)),
+                gtsam.noiseModel.Diagonal.Sigmas(unit * math.sqrt(1.0 - phi * phi)),
                 [self._e_key, e_key], partial(_markov_error, phi, self._e_key, e_key)))
             values.insert(e_key, phi * current.atVector(self._e_key))
         else:  # the last error state left the window in an outage: its forecast as prior
             phi = math.exp(-(t - self._t_e) / model.correlated_tau)
-            cov = phi * phi * self._e_cov + np.diag(sigma**2) * (1.0 - phi * phi)
+            cov = phi * phi * self._e_cov + np.eye(3) * (1.0 - phi * phi)
             graph.add(gtsam.PriorFactorVector(e_key, phi * self._e_last,
                                               gtsam.noiseModel.Gaussian.Covariance(cov)))
             values.insert(e_key, phi * self._e_last)
         graph.add(gtsam.CustomFactor(
             gtsam.noiseModel.Diagonal.Sigmas(white),
-            [self._x(k), e_key], partial(_fix_error, ned, self._antenna, self._x(k),
+            [self._x(k), e_key], partial(_fix_error, ned, self._antenna, gain, self._x(k),
                                          e_key)))
         self._e_key, self._t_e = e_key, t
         v_fix = np.array([vn, ve, vd])
@@ -470,19 +476,20 @@ class FgoLooselyCoupled(Estimator):
                 *std_vel, *std_att, *bias.accelerometer(), *bias.gyroscope()]
 
 
-def _fix_error(measured: np.ndarray, arm: np.ndarray, pose_key: int, error_key: int,
-               this, values, jacobians):
+def _fix_error(measured: np.ndarray, arm: np.ndarray, gain: np.ndarray, pose_key: int,
+               error_key: int, this, values, jacobians):
     """Custom-factor error of a fix: antenna position t + R l plus the fix's correlated error
-    e, minus the measured position; Jacobians on the pose tangent (rotation, translation;
-    R' = R Exp(d) moves R l by -R [l x] d, t' = t + R dt) and on e."""
+    gain u (u the unit-variance error variable), minus the measured position; Jacobians on
+    the pose tangent (rotation, translation; R' = R Exp(d) moves R l by -R [l x] d,
+    t' = t + R dt) and on u."""
     pose = values.atPose3(pose_key)
-    err = values.atVector(error_key)
+    err = gain * values.atVector(error_key)
     rot = pose.rotation().matrix()
     if jacobians is not None:
         skew = np.array([[0.0, -arm[2], arm[1]], [arm[2], 0.0, -arm[0]],
                          [-arm[1], arm[0], 0.0]])
         jacobians[0] = np.hstack([-rot @ skew, rot])
-        jacobians[1] = np.eye(3)
+        jacobians[1] = np.diag(gain)
     return pose.translation() + rot @ arm + err - measured
 
 

@@ -28,6 +28,14 @@ that tunes itself "from the datasheet" means the same thing.
     2 sigma^2 T).
   - velocity: 0.05 m/s per range rate (u-blox NEO-M8 data sheet; the ``automotive`` FLL's
     0.024-0.08 m/s at 45-35 dB-Hz, docs/gnss-errors.md) times the DOP.
+  - the drive-long part from the report (``FixErrorModel.reported_drive_long_sigma``): a fix
+    that reports its own position 1-sigma (the receiver's least squares with the
+    ionosphere's common residual and its field over the sky, ``simulator.gnss.fix``) knows
+    its geometry's share of the drive-long error per axis, which the budget's DOP scaling
+    spreads evenly over north and east: its reported variance less the smoothed part, capped
+    at the budget's correlated part (the rest is the excess below). On open sky the report
+    is the smaller (``automotive`` receiver on the unseen open road and SUMO city: north
+    1.4-1.5 m, east 1.0-1.25 m against the budget's 1.7 m per axis, seed 1).
   - what the fix itself reports (``FixAccuracy``: its ``std_*`` columns, a receiver's own
     accuracy, ``simulator.gnss.fix``): its velocity 1-sigma replaces the datasheet's; its
     position 1-sigma beyond the budget's (``FixErrorModel.excess_sigma``: the variance over
@@ -63,7 +71,7 @@ Public names
 ------------
 ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, nlos_position_rows,
 fix_velocity_sigma, ground_track_sigma, odometer_speed_sigma, odometer_delay_s, odometer_window_s,
-CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S.
+CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S, MIN_DRIVE_LONG_SIGMA_M.
 """
 
 from __future__ import annotations
@@ -85,6 +93,7 @@ SCALE_FACTOR_TIME_S = 4.0  # s: a scale-factor error adds up over a quarter turn
 # at 12 m/s; filters without scale-factor states take it as white noise over that time
 NLOS_TIME_CONSTANT_S = 60.0  # a reflected fix error's correlation time (module docstring)
 NLOS_WHITE_SHARE = np.array([0.5, 0.5, 0.1])  # its variance's white share, NED (docstring)
+MIN_DRIVE_LONG_SIGMA_M = 0.1  # the smallest drive-long fix error believed from a report, m
 FIX_STD_COLUMNS = ("std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd")
 
 
@@ -174,6 +183,21 @@ class FixErrorModel:
     def velocity_sigma(self, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m/s) of the fix's velocity at these DOPs."""
         return self.range_rate * _axes(hdop, vdop)
+
+    def reported_drive_long_sigma(self, reported: np.ndarray, hdop: float, vdop: float
+                                  ) -> np.ndarray:
+        """NED 1-sigma (m) of the drive-long correlated error of a fix that reports its own
+        position 1-sigma ``reported`` (module docstring, "the drive-long part from the
+        report"): the reported variance less the budget's smoothed part at the DOPs, at most
+        the budget's ``correlated_sigma`` (what the report holds beyond the budget is the
+        ``excess_sigma``), at least ``MIN_DRIVE_LONG_SIGMA_M``; the budget's on an axis the
+        fix does not report (NaN)."""
+        budget = self.correlated_sigma(hdop, vdop)
+        smoothed = self.smoothed_range * _axes(hdop, vdop)
+        reported = np.asarray(reported, dtype=float)
+        own = np.sqrt(np.maximum(reported**2 - smoothed**2, 0.0))
+        own = np.clip(own, np.minimum(MIN_DRIVE_LONG_SIGMA_M, budget), budget)
+        return np.where(np.isfinite(reported), own, budget)
 
     def excess_sigma(self, reported: np.ndarray, hdop: float, vdop: float) -> np.ndarray:
         """NED 1-sigma (m) of a fix's reported position error beyond this budget at its DOPs

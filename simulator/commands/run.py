@@ -31,6 +31,9 @@ def add_parser(sub: argparse._SubParsersAction) -> None:
                         "then runs in its own process, as every estimator that is not a "
                         "built-in does), and the plug-ins to be imported and checked "
                         "(default 120 s); past it the run stops with exit 2 and writes nothing")
+    p.add_argument("--no-plots", dest="plots", action="store_false",
+                   help="write the report's tables without its plots (drawing them is about "
+                        "a third of a short run; for batches of runs read by scripts)")
     add_scenario_options(p)
     p.set_defaults(run=run)
 
@@ -44,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     scenario = pipeline.load_scenario(args.scenario, args.overrides, args.seed)
     out = Path(args.output) if args.output else Path("runs") / scenario.name
     result = pipeline.run(scenario, out, args.force, show_progress=True,
-                          time_limit_s=args.time_limit)
+                          time_limit_s=args.time_limit, plots=args.plots)
     if scenario.data["estimators"]:
         print_scores(result.evaluation)
     else:

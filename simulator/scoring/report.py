@@ -28,6 +28,7 @@ from simulator.scoring.evaluate import Evaluation
 from simulator.scoring.metrics import OUTAGE_KIND, degraded_windows
 
 PLOTS = "plots"  # sub-directory of the report directory holding the PNGs
+NO_PLOTS = "Plots were not drawn (`--no-plots`)."
 
 # (group, key, row title) of the metrics table, in order
 _TABLE_ROWS = [
@@ -229,7 +230,8 @@ def _plots(ev: Evaluation) -> list[tuple[str, str, Callable[[Evaluation, Path], 
     return out
 
 
-def write_report(directory: Path, ev: Evaluation, title: str, note: str | None = None) -> Path:
+def write_report(directory: Path, ev: Evaluation, title: str, note: str | None = None,
+                 plots: bool = True) -> Path:
     """Write ``report.md`` and ``plots/*.png`` into ``directory`` (which must exist).
 
     Parameters
@@ -238,13 +240,16 @@ def write_report(directory: Path, ev: Evaluation, title: str, note: str | None =
     ev : the evaluation (truth, events, scored solutions, and the dataset for its GNSS plots).
     title : the report's heading (the dataset or scenario).
     note : a paragraph placed under the heading (e.g. "no estimator was named").
+    plots : draw the plots (about a third of a short run's time); without them the report
+        holds the tables alone and says so, and no ``plots/`` is made.
 
     Returns
     -------
     Path of ``report.md``.
     """
     directory = Path(directory)
-    (directory / PLOTS).mkdir(exist_ok=True)
+    if plots:
+        (directory / PLOTS).mkdir(exist_ok=True)
     scores = ev.scores()
     n_outages = int((ev.events["kind"] == OUTAGE_KIND).sum())
     n_degraded = len(degraded_windows(ev.events, ev.canyon_zones))
@@ -266,7 +271,9 @@ def write_report(directory: Path, ev: Evaluation, title: str, note: str | None =
                                  "The dataset has no degraded GNSS window."), "",
                   "## Consistency", "", *_consistency_lines(scores), "",
                   "## Estimated sensor errors", "", *_sensor_lines(scores), ""]
-    for name, heading, draw in _plots(ev):
+    if not plots:
+        lines += [NO_PLOTS, ""]
+    for name, heading, draw in _plots(ev) if plots else ():
         draw(ev, directory / PLOTS / f"{name}.png")
         lines += [f"## {heading}", "", f"![{heading}]({PLOTS}/{name}.png)", ""]
     path = directory / "report.md"

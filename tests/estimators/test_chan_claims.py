@@ -34,9 +34,12 @@ SEED_SETS = seed_sets(SEEDS)  # seeds 1-3 (both window orders of the shortened d
 
 
 def _short_figures(work, seeds) -> pd.DataFrame:
-    """The shortened partial-outage drive, each seed with its own window order."""
+    """The shortened partial-outage drive, the window orders alternating over the seeds:
+    odd seeds in the order of ``reproduce --quick`` (``chan.PARTIAL_OUTAGES.quick_overrides``,
+    that of even arguments of ``short_partial_overrides``), so that seed 1 is computed once
+    for these tests and the quick reproduction (tests/experiment_cache.py)."""
     return pd.concat([run_experiment(chan.PARTIAL_OUTAGES, [seed], work,
-                                     extra_overrides=chan.short_partial_overrides(seed))
+                                     extra_overrides=chan.short_partial_overrides(seed + 1))
                       for seed in seeds])
 
 
@@ -102,8 +105,8 @@ def test_nhc_cut_as_table_1(short_table, satellites, least_cut):
     """The NHC cuts the mean error (the cut over the seeds above zero), and the seeds do not
     contradict the least cut: it lies below the top of their 95 % interval
     (``_cut_interval``). Each seed's cut is one draw of the satellites kept and of the drive's
-    errors, spread by tens of per cent (seeds 1-3: 15.5-37.3 % with 2 satellites, -18.3-34.1 %
-    with 3, 21.1-71.4 % with none), so three seeds cannot show the printed cut; a fixed bound
+    errors, spread by tens of per cent (seeds 1-3: 7.6-76.1 % with 2 satellites, -7.8-35.5 %
+    with 3, 25.4-56.4 % with none), so three seeds cannot show the printed cut; a fixed bound
     on their mean held on one set of draws and not on the next (2 satellites 18.0 then
     20.7 %, 3 satellites 22.0 then 22.9 %). Whether the cut is shown is judged over twenty
     seeds by the reproduction (docs/reproduction_chan.md)."""

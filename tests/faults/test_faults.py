@@ -53,7 +53,8 @@ def test_random_trigger_matches_rate_and_distribution():
     data = scenario_data(long_drive, faults=[{
         "kind": "imu_bias_step", "random": {"rate": "6 /h", "duration": {
             "distribution": "exponential", "mean": 20.0}}}],
-        sensors={"imu": {"preset": "ideal", "rate": 1}})
+        sensors={"imu": {"preset": "ideal", "rate": 1}},
+        vehicle="rigid")  # a random trigger reads the drive's duration only, not the body
     truth = build_truth(data)
     intervals = fault_intervals(data["faults"][0], truth, np.random.default_rng(7))
     hours = truth.duration_s / 3600
