@@ -1,7 +1,8 @@
 """The one receiver error budget (``simulator.datasheet``) against what it is read from: the
 ionosphere fractions against the receiver simulation's own reported pseudorange variance, the
-budget of the ``automotive`` preset against its terms worked by hand, and the consumers (the
-filters' fix model, the exported UERE) against the budget."""
+budget of the ``automotive`` preset against its terms worked by hand, the consumers (the
+filters' fix model, the exported UERE) against the budget, and the filters' split of a fix's
+reported accuracy (``FixSplit``) against its terms worked by hand."""
 
 from __future__ import annotations
 
@@ -9,7 +10,12 @@ import math
 
 import numpy as np
 
-from estimators.toolbox.datasheet import MIN_DRIVE_LONG_SIGMA_M, fix_error_model
+from estimators.toolbox.datasheet import (
+    MIN_DRIVE_LONG_SIGMA_M,
+    NLOS_WHITE_SHARE,
+    FixSplit,
+    fix_error_model,
+)
 from simulator.datasheet import (
     KLOBUCHAR_NIGHT_SLANT_M,
     fix_uere_m,
@@ -65,6 +71,49 @@ def test_an_ideal_receiver_has_no_error_and_the_filters_keep_a_floor():
     assert iono_residual_fractions({}) == (0.0, 0.0)
     model = fix_error_model({"gnss": ideal})
     assert model.correlated_range == 0.1 and model.white_range == 0.1
+
+
+def test_fix_split_takes_the_smallest_report_as_the_drive_long_part():
+    """Per horizontal axis and unit DOP (HDOP / sqrt(2)): the drive-long part is the smallest
+    report so far less the smoothed part, at most the budget's correlated range; down (VDOP)
+    it is the budget's; its 1-sigma is taken at the first fix's DOPs. What a report holds
+    beyond the part and the smoothed noise at its own DOPs is the reflected excess, split
+    into the states' gain and the white share; an axis without a report keeps its part and
+    has no excess."""
+    model = fix_error_model({"gnss": AUTOMOTIVE})
+    c, s = model.correlated_range, model.smoothed_range
+    split = FixSplit(model)
+    hdop, vdop = math.sqrt(2.0), 2.0  # unit DOP per horizontal axis, 2 down
+    axes = np.array([1.0, 1.0, 2.0])
+    white = model.white_sigma(hdop, vdop) ** 2
+
+    def check(report, dops, part):
+        gain, nlos, noise = split.split(report, *dops)
+        scale = np.array([dops[0] / math.sqrt(2.0)] * 2 + [dops[1]])
+        np.testing.assert_allclose(gain, part * axes)  # the first fix's DOPs
+        excess2 = np.where(np.isfinite(report), np.maximum(
+            np.nan_to_num(report) ** 2 - (part**2 + s**2) * scale**2, 0.0), 0.0)
+        np.testing.assert_allclose(nlos**2, (1 - NLOS_WHITE_SHARE) * excess2, atol=1e-12)
+        np.testing.assert_allclose(noise, model.white_sigma(*dops) ** 2
+                                   + NLOS_WHITE_SHARE * excess2)
+        return excess2
+
+    # a first fix above the budget (the carrier smoothing not yet converged): the budget's
+    # part, the rest excess
+    excess2 = check(np.array([4.0, 4.0, 9.0]), (hdop, vdop), np.full(3, c))
+    np.testing.assert_allclose(excess2, np.array([16.0, 16.0, 81.0]) - (c**2 + s**2) * axes**2)
+    # a clean open-sky report below the budget: north and east its part beyond the smoothed
+    # noise, no excess; down the budget's part, its report within it
+    clean = np.array([1.5, 1.2, 3.0])
+    part = np.r_[np.sqrt(clean[:2] ** 2 - s**2), c]
+    excess2 = check(clean, (hdop, vdop), part)
+    np.testing.assert_allclose(excess2, 0.0, atol=1e-12)
+    assert np.allclose(split.split(clean, hdop, vdop)[2], white)
+    # a report that rises again (a faded signal) is excess over the part, which stays; the
+    # down axis unreported keeps its part; at twice the DOPs the excess is over twice the
+    # part's 1-sigma, the states' size stays
+    excess2 = check(np.array([4.0, 3.0, np.nan]), (2.0 * hdop, 2.0 * vdop), part)
+    assert (excess2[:2] > 0).all() and excess2[2] == 0.0
 
 
 def test_the_reported_drive_long_sigma_splits_the_report_without_loss():

@@ -66,15 +66,21 @@ Choices where the paper is silent, ambiguous or wrong (also in docs/reproduction
     white noise over ``SCALE_FACTOR_TIME_S`` (a constant scale-factor error adds up over a
     turn, which a white Q only approximates). The receiver's pseudorange errors are
     correlated in time (docs/gnss-errors.md), so R white at 1 Hz made the filters 10-1000x
-    over-confident (position NEES 40-1989). Modelled as states instead: one Gauss-Markov
-    ionosphere state (the broadcast model's relative residual, a row of the broadcast delay
-    I on every pseudorange; prior sqrt((scale - 1)^2 + (scale residual)^2) of the receiver
-    datasheet's ``iono_scale``, ``iono_residual``; 30 min) and one range-error state per
-    satellite (``toolbox.range_bias``, 16 channels, 30 min: the signal-in-space error and the
-    satellite's own share of the ionosphere field, ``IONO_FIELD_OWN_SHARE``); R keeps the
-    rest of the reported variance (tracking noise and multipath after the carrier smoothing),
-    scaled by the correlated-noise inflation of the datasheet's ``carrier_smoothing``
-    (``gnss_model.correlated_noise_inflation``). A chi-square gate (1 dof, probability
+    over-confident (position NEES 40-1989). Modelled as states instead
+    (``toolbox.range_budget``, as ``fgo_tc`` carries them as variables), each Gauss-Markov of
+    30 min: the broadcast ionosphere's residual shared by the satellites, four unit-variance
+    states (its part common to them, 1-sigma |scale - 1| of the receiver datasheet's
+    ``iono_scale``, and its smooth field's value and north and east gradient at the zenith
+    pierce point, 1-sigma scale ``iono_residual``; each pseudorange's row their coefficients
+    from its broadcast delay I and pierce point, ``toolbox.iono_field``; ``iono_scale_std`` is
+    their combined 1-sigma, 0: none), and one range-error state per satellite
+    (``toolbox.range_bias``, 16 channels: the signal-in-space error, the field's remainder at
+    its pierce point and the troposphere's residual); R keeps the rest of the reported
+    variance (tracking noise and multipath after the carrier smoothing), scaled by the
+    correlated-noise inflation of the datasheet's ``carrier_smoothing``
+    (``gnss_model.correlated_noise_inflation``). The field taken instead as common plus an
+    independent share per satellite missed its gradient across the sky, a range error that
+    the position takes in whole (``toolbox.iono_field``). A chi-square gate (1 dof, probability
     ``gate_probability``, 0.999) drops each pseudorange whose innovation is not plausible
     against H P H^T plus its reported (uninflated) variance: the NLOS delays of a street
     canyon, tens of metres, which no reported sigma contains (Groves 2013, section 17.3.1;
@@ -109,6 +115,8 @@ TcUkf, TcEkf, boxplus, boxminus, error_dynamics.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 from numba import njit
 
@@ -117,8 +125,10 @@ from estimators.toolbox import constraints, gating, gnss_model, nav_error
 from estimators.toolbox.config_help import shared_help
 from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S
 from estimators.toolbox.installation import Installation
+from estimators.toolbox.iono_field import SHARED_TERMS
 from estimators.toolbox.kalman import ErrorState
 from estimators.toolbox.range_bias import RangeBiasChannels
+from estimators.toolbox.range_budget import CORRELATION_TIME_S, RangeBudget, range_budget
 from estimators.toolbox.sensor_datasheet import (
     ACCEL_NOISE_FLOOR,
     GYRO_NOISE_FLOOR,
@@ -126,7 +136,7 @@ from estimators.toolbox.sensor_datasheet import (
 )
 from estimators.toolbox.strapdown import propagate, rk4_step
 from estimators.toolbox.ukf import SigmaPointFilter
-from simulator.datasheet import IONO_FIELD_OWN_SHARE, iono_residual_fractions
+from simulator.datasheet import iono_residual_fractions
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -153,7 +163,7 @@ PAPER = ("Chan, Aung, Thar, Lee, Kaung, 'Robust Navigation System for a Land Veh
 COVARIANCE_RATE_HZ = 10.0  # EKF covariance propagation (and strapdown batch) rate
 CLOCK_INIT_STD = (30.0, 3.0)  # cb (m), d (m/s) after the first epoch's residuals
 NHC_POINTS = ("rear_axle", "imu")
-IONO = 17  # the ionosphere-residual state, after the 17 (datasheet tuning)
+IONO = 17  # the first ionosphere state, after the 17 (datasheet tuning)
 GATE_PROBABILITY = 0.999  # chi-square gate of each pseudorange innovation (1 dof: 10.8)
 PSEUDORANGE_STD_FLOOR = 0.1  # m, what is left of a pseudorange's variance at least
 
@@ -172,16 +182,16 @@ PAPER_TUNING = {
     "accel_z_misalignment_std": 0.0,  # prior of the z accelerometer's two misalignment states
     # s: correlation time of the pseudorange errors (0: white, as the paper treats them)
     "pseudorange_correlation_time": 0.0,
-    "iono_scale_std": 0.0,  # 1-sigma of the ionosphere-residual state (0: no such state)
+    "iono_scale_std": 0.0,  # 1-sigma of the ionosphere's residual, as states (0: none)
     "range_bias_channels": 0,  # per-satellite range-error states (0: none)
 }
 TUNINGS = ("datasheet", "paper")
 TUNED_KEYS = tuple(PAPER_TUNING)
 STANDARD_GRAVITY = 9.80665  # m/s^2
 RANGE_BIAS_CHANNELS = 16  # per-satellite range-error states of the datasheet tuning
-RANGE_BIAS_TIME_S = 1800.0  # s: their correlation time (signal in space, ionosphere field)
+RANGE_BIAS_TIME_S = CORRELATION_TIME_S  # s: their correlation time (signal in space, ...)
 SIS_ERROR_M = 0.5  # m: the signal-in-space error without a receiver datasheet (IS-GPS-200 URA)
-IONO_CORRELATION_TIME_S = 1800.0  # s: the broadcast ionosphere residual's (docs/gnss-errors.md)
+IONO_CORRELATION_TIME_S = CORRELATION_TIME_S  # s: the broadcast ionosphere residual's
 KLOBUCHAR_RESIDUAL = 0.5  # the broadcast model leaves about half the delay (Klobuchar 1987)
 
 
@@ -226,7 +236,8 @@ CONFIG_HELP = {  # key -> (SI unit, meaning), shown by `landnav estimators tc_ek
     "gyro_z_scale_factor_std": ("", "prior of a z-gyro scale-factor state (0: no state)"),
     "accel_z_misalignment_std": ("rad", "prior of two states of the z accelerometer's "
                                         "misalignment towards x and y (0: none)"),
-    "iono_scale_std": ("", "1-sigma of the ionosphere-residual state (0: no such state)"),
+    "iono_scale_std": ("", "1-sigma of the ionosphere's relative residual, carried as states "
+                           "(0: none)"),
     "tuning": ("", "datasheet: the null keys from the manifest's datasheet (default); paper: "
                    "the reproduction's values"),
     "gate_probability": ("", "pseudorange chi-square gate; null: 0.999 (datasheet), off "
@@ -267,8 +278,17 @@ class _TightlyCoupled(Estimator):
         tun = self.tuning
         self._pr_inflation = gnss_model.correlated_noise_inflation(
             tun["pseudorange_correlation_time"], cfg["gnss_interval"])
-        self._iono = tun["iono_scale_std"] > 0.0
-        self.n_states = N_STATES + int(self._iono)
+        gnss = self.datasheet.get("gnss") or {}
+        self._sis = float(gnss.get("sis_error", SIS_ERROR_M))
+        self._budget = self._range_budget(gnss)
+        # the ionosphere's quantities shared by an epoch's satellites (``toolbox.range_budget``)
+        self._iono_used = (self._budget.shared_in_use() if tun["iono_scale_std"] > 0.0
+                           else np.zeros(len(SHARED_TERMS), dtype=bool))
+        self._iono = bool(self._iono_used.any())
+        self._terms_key: bytes | None = None  # the pseudoranges of ``_terms``
+        self._terms = (np.zeros((0, 0)), np.zeros(0))
+        self._n_iono = int(self._iono_used.sum())
+        self.n_states = N_STATES + self._n_iono
         n_channels = int(tun["range_bias_channels"])
         self._channels = (RangeBiasChannels(self.n_states, n_channels, RANGE_BIAS_TIME_S)
                           if n_channels > 0 else None)
@@ -283,11 +303,8 @@ class _TightlyCoupled(Estimator):
         # 0.5 %, which no white Q describes)
         self._sf = self.n_states if tun["gyro_z_scale_factor_std"] > 0.0 else None
         self.n_states += int(self._sf is not None)
-        gnss = self.datasheet.get("gnss") or {}
-        self._sis = float(gnss.get("sis_error", SIS_ERROR_M))
-        self._iono_field = _iono_residual(gnss)[1]
         # 1 / correlation time of the states after the 17 (Gauss-Markov), 1/s
-        self._inv_tau = np.r_[np.full(int(self._iono), 1.0 / IONO_CORRELATION_TIME_S),
+        self._inv_tau = np.r_[np.full(self._n_iono, 1.0 / IONO_CORRELATION_TIME_S),
                               np.full(n_channels, 1.0 / RANGE_BIAS_TIME_S),
                               np.zeros(2 * int(self._mz is not None)),
                               np.zeros(int(self._sf is not None))]
@@ -319,8 +336,7 @@ class _TightlyCoupled(Estimator):
         p0[9:12] = tun["accel_bias_std"]
         p0[12:15] = tun["gyro_bias_std"]
         p0[15:17] = CLOCK_INIT_STD
-        if self._iono:
-            p0[IONO] = tun["iono_scale_std"]
+        p0[IONO:IONO + self._n_iono] = 1.0  # unit-variance quantities (``SHARED_TERMS``)
         if self._sf is not None:
             p0[self._sf] = tun["gyro_z_scale_factor_std"]
         if self._mz is not None:
@@ -351,11 +367,22 @@ class _TightlyCoupled(Estimator):
                 accel_z_misalignment_std=a.misalignment,
                 pseudorange_correlation_time=float(gnss.get("carrier_smoothing") or 0.0),
                 iono_scale_std=float(np.hypot(*_iono_residual(gnss))),
-                iono_common=_iono_residual(gnss)[0], range_bias_channels=RANGE_BIAS_CHANNELS)
-        tuned = {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
-        tuned["iono_common"] = min(base.get("iono_common", tuned["iono_scale_std"]),
-                                   tuned["iono_scale_std"])
-        return tuned
+                range_bias_channels=RANGE_BIAS_CHANNELS)
+        return {k: (cfg[k] if cfg[k] is not None else base[k]) for k in TUNED_KEYS}
+
+    def _range_budget(self, gnss: dict) -> RangeBudget:
+        """The pseudoranges' error split (``toolbox.range_budget``) of the receiver datasheet
+        ``gnss``: the ionosphere's common and field fractions scaled so that together they
+        make ``iono_scale_std`` (the datasheet's, or the config's number), the signal-in-space
+        error (``SIS_ERROR_M`` without a datasheet), the inflation of
+        ``pseudorange_correlation_time``."""
+        common, field = _iono_residual(gnss)
+        total = float(np.hypot(common, field))
+        wanted = self.tuning["iono_scale_std"]
+        common, field = ((common * wanted / total, field * wanted / total) if total > 0.0
+                         else (wanted, 0.0))
+        return replace(range_budget(gnss), iono_common=common, iono_field=field, sis=self._sis,
+                       inflation=self._pr_inflation)
 
     # -- inputs --------------------------------------------------------------------------------
     def _imu_sample(self, t: float, row: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
@@ -391,8 +418,9 @@ class _TightlyCoupled(Estimator):
         q[12:15, 12:15] = np.eye(3) * tun["gyro_bias_walk"] ** 2 * dt
         q[15:17, 15:17] = gnss_model.clock_noise(dt)
         if self._iono:
-            q[IONO, IONO] = (tun["iono_scale_std"] ** 2
-                             * (1.0 - np.exp(-2.0 * dt / IONO_CORRELATION_TIME_S)))
+            iono = slice(IONO, IONO + self._n_iono)
+            q[iono, iono] = np.eye(self._n_iono) * (
+                1.0 - np.exp(-2.0 * dt / IONO_CORRELATION_TIME_S))
         if self._channels is not None:
             ch = slice(self._channels.first, self._channels.first + self._channels.n)
             q[ch, ch] = np.diag(self._channels.transition(dt)[1])
@@ -400,8 +428,8 @@ class _TightlyCoupled(Estimator):
 
     def _measurement_noise(self, ep: gnss_model.RawEpoch) -> np.ndarray:
         """R of an epoch's pseudoranges and range rates: the receiver's reported variances
-        (the config's when the stream has none), less what states carry: the ionosphere
-        residual common to the satellites (``_iono_residual``) and each satellite's slowly
+        (the config's when the stream has none), less what states carry: the ionosphere's
+        residual shared by the satellites (``_iono_gains``) and each satellite's slowly
         varying error (``_range_bias_sigma``); the rest (tracking noise and multipath after the
         carrier smoothing) scaled by the correlated-noise inflation of
         ``pseudorange_correlation_time``."""
@@ -409,7 +437,7 @@ class _TightlyCoupled(Estimator):
         var = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
                        cfg["pseudorange_std"]) ** 2
         if self._iono:
-            var = var - (self.tuning["iono_common"] * _iono_delay(ep)) ** 2
+            var = var - np.sum(self._iono_gains(ep) ** 2, axis=0)
         if self._channels is not None:
             var = var - self._range_bias_sigma(ep) ** 2
         var = np.maximum(var, PSEUDORANGE_STD_FLOOR**2)
@@ -417,11 +445,27 @@ class _TightlyCoupled(Estimator):
         rr = np.where(np.isfinite(ep.range_rate_std), ep.range_rate_std, cfg["range_rate_std"])
         return np.diag(np.concatenate([var, rr**2]))
 
+    def _budget_terms(self, ep: gnss_model.RawEpoch) -> tuple[np.ndarray, np.ndarray]:
+        """The ionosphere states' coefficients (n_iono, m), m, on the epoch's pseudoranges
+        and each satellite's own drive-long 1-sigma (``RangeBudget.sigmas``), computed once
+        per set of pseudoranges (an update asks several times)."""
+        key = ep.pseudorange.tobytes()
+        if self._terms_key != key:
+            shared, own, _ = self._budget.sigmas(ep, self.config["pseudorange_std"])
+            self._terms = (shared[self._iono_used], own)
+            self._terms_key = key
+        return self._terms
+
     def _range_bias_sigma(self, ep: gnss_model.RawEpoch) -> np.ndarray:
-        """Prior 1-sigma (m) of each satellite's range-error state: the signal-in-space error
-        and the satellite's own share of the ionosphere field, sqrt(sis^2 + (s field I)^2),
-        s = ``IONO_FIELD_OWN_SHARE``, I the broadcast delay (``_iono_residual``)."""
-        return np.hypot(self._sis, IONO_FIELD_OWN_SHARE * self._iono_field * _iono_delay(ep))
+        """Prior 1-sigma (m) of each satellite's range-error state: the signal-in-space error,
+        the ionosphere field's remainder at its pierce point and the troposphere's residual
+        (``RangeBudget.sigmas``)."""
+        return self._budget_terms(ep)[1]
+
+    def _iono_gains(self, ep: gnss_model.RawEpoch) -> np.ndarray:
+        """Coefficients (n_iono, m), m, of the ionosphere states on the epoch's pseudoranges
+        (``iono_field.residual_terms``)."""
+        return self._budget_terms(ep)[0]
 
     def _channel_rows(self, ep: gnss_model.RawEpoch, t: float, p: np.ndarray
                       ) -> tuple[gnss_model.RawEpoch, np.ndarray, np.ndarray]:
@@ -540,13 +584,6 @@ def _iono_residual(receiver: dict) -> tuple[float, float]:
     if "iono_scale" not in receiver:
         return KLOBUCHAR_RESIDUAL, 0.0
     return iono_residual_fractions(receiver)
-
-
-def _iono_delay(ep: gnss_model.RawEpoch) -> np.ndarray:
-    """The broadcast ionosphere delay of each satellite (m; 0 where the stream has none)."""
-    if ep.iono is None:
-        return np.zeros(len(ep.sv))
-    return np.nan_to_num(ep.iono)
 
 
 def _antenna_ecef(pos: np.ndarray, v: np.ndarray, c_bn: np.ndarray, lever: np.ndarray,
@@ -752,7 +789,7 @@ class TcUkf(_TightlyCoupled):
             pr, rate, _ = gnss_model.predict(ep.sat_pos, ep.sat_vel, r, v, pts[:, 16],
                                              pts[:, 17])
             if self._iono:
-                pr = pr + pts[:, N_NOMINAL, None] * _iono_delay(ep)[None, :]
+                pr = pr + pts[:, N_NOMINAL:N_NOMINAL + self._n_iono] @ self._iono_gains(ep)
             if self._channels is not None:  # nominal index: tangent + 1 (the quaternion's 4)
                 pr = pr + pts[:, self._channel + 1]
             parts += [pr, rate]
@@ -957,9 +994,9 @@ class TcEkf(_TightlyCoupled):
             h_pr[:, 6:9] = u @ skew(c_bn @ self._lever)
             h_pr[:, 15] = 1.0
             if self._iono:
-                iono = _iono_delay(ep)
-                pr = pr + self._extra[IONO - N_STATES] * iono
-                h_pr[:, IONO] = iono
+                gains = self._iono_gains(ep)
+                pr = pr + self._extra[:self._n_iono] @ gains
+                h_pr[:, IONO:IONO + self._n_iono] = gains.T
             if self._channels is not None:
                 pr = pr + self._extra[channel - N_STATES]
                 h_pr[np.arange(m), channel] = 1.0

@@ -99,7 +99,7 @@ FgoLooselyCoupled, FgoTightlyCoupled.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from functools import partial
 
 import numpy as np
@@ -110,7 +110,6 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S, FixAccuracy, fix_error_model
 from estimators.toolbox.gnss_model import (
     clock_noise,
-    correlated_noise_inflation,
     nlos_delay,
     predict,
     raw_epoch,
@@ -118,8 +117,9 @@ from estimators.toolbox.gnss_model import (
     single_frequency,
 )
 from estimators.toolbox.installation import Installation
-from estimators.toolbox.iono_field import SHARED_TERMS, residual_terms
-from simulator.datasheet import cn0_template, iono_residual_fractions
+from estimators.toolbox.iono_field import SHARED_TERMS
+from estimators.toolbox.range_budget import CORRELATION_TIME_S, range_budget
+from simulator.datasheet import cn0_template
 from simulator.earth import (
     OMEGA_E_RAD_S,
     dcm_to_euler,
@@ -136,11 +136,9 @@ BIAS_TIME_S = 300.0       # the bias instability taken as a random walk over thi
 BIAS_WALK_FLOOR = 1e-16  # an ideal IMU's bias still walks a little (the information stays finite)
 ODOMETER_FLOOR_M_S = 0.1
 ODOMETER_SCALE = 0.03     # unmodelled odometer scale error, 1-sigma
-DEFAULT_UERE_M = 3.0  # a datasheet without a receiver error budget
 FIX_VELOCITY_SIGMA_M_S = np.array([0.1, 0.1, 0.2])  # NED, without the fix's own std_v*
 DEFAULT_DOP = 1.5
-PSEUDORANGE_FLOOR_M = 0.1  # white 1-sigma left of a pseudorange at least, before inflation
-RANGE_ERROR_TAU_S = 1800.0  # correlation time of the drive-long range errors (docs/gnss-errors.md)
+RANGE_ERROR_TAU_S = CORRELATION_TIME_S  # correlation time of the drive-long range errors
 RANGE_ERROR_STEP_S = 5.0  # a range-error variable stands for this long (a constant meanwhile)
 
 OUTPUT_COLUMNS = ("lat", "lon", "alt", "vn", "ve", "vd", "roll", "pitch", "yaw",
@@ -544,7 +542,7 @@ def _random_walk(group: dict) -> float:
 
 class FgoTightlyCoupled(FgoLooselyCoupled):
     """Fixed-lag factor-graph smoother on pseudoranges and pseudorange rates with receiver
-    clock states, the pseudoranges' drive-long errors as variables (``_range_budget``), and
+    clock states, the pseudoranges' drive-long errors as variables (``toolbox.range_budget``), and
     ``fgo_lc``'s IMU, odometer and NHC factors."""
 
     name = "fgo_tc"
@@ -567,7 +565,7 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
         self._c_last = np.zeros(2)
         self._c_cov = np.eye(2)
         gnss = self.datasheet.get("gnss") or {}
-        self._budget = _range_budget(gnss)
+        self._budget = range_budget(gnss)
         self._template = cn0_template(gnss)
         self._chains = {}  # "iono" or a satellite -> (its current variable, created at)
         self._n_vars = 0
@@ -695,62 +693,6 @@ class FgoTightlyCoupled(FgoLooselyCoupled):
             return [*row, math.nan, math.nan]
         dt = t - self._t_c
         return [*row, float(self._c_last[0] + self._c_last[1] * dt), float(self._c_last[1])]
-
-
-@dataclass(frozen=True)
-class _RangeBudget:
-    """A pseudorange's error split by time behaviour, from the receiver's datasheet
-    (``simulator.datasheet``; docs/gnss-errors.md): ``iono_common`` the 1-sigma of the
-    broadcast ionosphere's relative residual common to the epoch's satellites (times each
-    satellite's broadcast delay I), ``iono_field`` that of its smooth field over the sky
-    (``toolbox.iono_field``: its value and gradient at the receiver's zenith pierce point are
-    shared, the rest each satellite's own), ``sis`` the signal-in-space error, ``tropo_zenith``
-    the troposphere's zenith residual, and ``inflation`` the factor on the rest (code noise
-    and multipath after the Hatch filter, correlated over its time:
-    ``gnss_model.correlated_noise_inflation``)."""
-
-    iono_common: float
-    iono_field: float
-    sis: float
-    tropo_zenith: float
-    inflation: float
-
-    def sigmas(self, ep) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """Per satellite of a ``RawEpoch``: the coefficients (4, m), m, of the ionosphere's
-        shared unit-variance quantities on its pseudorange (``iono_field.residual_terms``:
-        the common residual, the field's value and its north and east gradient); the 1-sigma
-        of its own drive-long error sqrt(sis^2 + its share of the field + (tropo /
-        sin(el))^2); and the white 1-sigma of the rest: the reported variance less those (at
-        least ``PSEUDORANGE_FLOOR_M``), inflated; without a reported 1-sigma
-        ``DEFAULT_UERE_M``."""
-        delay = np.nan_to_num(ep.iono) if ep.iono is not None else np.zeros(len(ep.sv))
-        el = ep.elevation if ep.elevation is not None else np.full(len(ep.sv), np.nan)
-        mapping = 1.0 / np.sin(np.clip(np.nan_to_num(el, nan=math.pi / 6), 0.05, None))
-        shared, own_iono = residual_terms(delay, ep.elevation, ep.azimuth, self.iono_common,
-                                          self.iono_field)
-        bias2 = self.sis**2 + own_iono + (self.tropo_zenith * mapping) ** 2
-        reported = np.where(np.isfinite(ep.pseudorange_std), ep.pseudorange_std,
-                            DEFAULT_UERE_M)
-        rest2 = reported**2 - bias2 - np.sum(shared**2, axis=0)
-        white = np.sqrt(np.maximum(rest2, PSEUDORANGE_FLOOR_M**2)) * self.inflation
-        return shared, np.sqrt(bias2), white
-
-    def shared_in_use(self) -> np.ndarray:
-        """Which of the ``SHARED_TERMS`` this receiver's ionosphere has (the common residual
-        with iono_scale other than 1, the field's three with a residual)."""
-        return np.array([self.iono_common > 0.0] + [self.iono_field > 0.0] * 3)
-
-
-def _range_budget(gnss: dict) -> _RangeBudget:
-    """``_RangeBudget`` of a receiver datasheet block (zeros where it is silent: the reported
-    1-sigma white)."""
-    common, field = iono_residual_fractions(gnss)
-    interval = 1.0 / float(gnss.get("rate") or 1.0)
-    return _RangeBudget(
-        iono_common=common, iono_field=field, sis=float(gnss.get("sis_error") or 0.0),
-        tropo_zenith=float(gnss.get("tropo_residual") or 0.0),
-        inflation=correlated_noise_inflation(float(gnss.get("carrier_smoothing") or 0.0),
-                                             interval))
 
 
 def _clock_error(phi: np.ndarray, before: int, after: int, this, values, jacobians):

@@ -106,14 +106,20 @@ the estimate towards zero while its variance shrank), a zero-rate update while t
 stand still (``zero_rate_update``: the gyro's mean rate is its bias plus the Earth rate's up
 component, with the gyro's white noise; not in the paper), the azimuth's white noise the
 gyro's noise density plus its scale factor and misalignment times the turn rate over
-``SCALE_FACTOR_TIME_S``; the pseudoranges' R the reported variance scaled by the
+``SCALE_FACTOR_TIME_S``; the broadcast ionosphere's residual shared by the satellites as
+four Gauss-Markov states of 30 min (its part common to them, its field's value and north and
+east gradient at the zenith pierce point; each pseudorange's row their coefficients,
+``toolbox.range_budget``, as ``fgo_tc`` carries them: as white R it held an error the
+position does not get), the pseudoranges' R the rest of the reported variance scaled by the
 correlated-noise inflation of the receiver's carrier smoothing
 (``gnss_model.correlated_noise_inflation``), and a chi-square gate (1 dof, 0.999,
-``gate_probability``) against H P H^T plus the reported variance that drops the NLOS ranges
-of a canyon, each pseudorange's R with the reflected-signal (NLOS) share its C/N0 deficit
-announces (p (20 m)^2, ``gnss_model.nlos_sigma``, as ``gnss_wls``; the gate keeps the
-reported variance alone: with the NLOS share in it too it passed more reflected ranges, the
-unseen canyon's height 2.5 -> 4.7 over seeds 1-3), the range rates'
+``gate_probability``) against H P H^T plus that uninflated rest, which drops the NLOS ranges
+of a canyon; after the gate each pseudorange's expected reflected-signal (NLOS) delay, from
+the probability its C/N0 deficit announces, is taken off and its variance added to R
+(``gnss_model.nlos_delay``, as ``fgo_tc``; the reflected ranges that pass the gate, all
+delayed, sank the height and clock together: the SUMO canyon's height 10 -> 2.0 over seeds
+1-3; with a zero-mean NLOS share in the gate too it passed more reflected ranges), the range
+rates'
 with the rear axle's sideways motion that eqs. 4-5 leave out (the tyres' slip in a turn,
 ``toolbox.constraints.NonholonomicNoise``, along the body's right axis: in the sharp junction
 turns of a SUMO city, 60 deg/s at 5 m/s, the rear axle moves up to 6 deg off the heading, and
@@ -154,7 +160,14 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import SCALE_FACTOR_TIME_S
 from estimators.toolbox.gauss_markov import gauss_markov_discrete
 from estimators.toolbox.installation import Installation
+from estimators.toolbox.iono_field import SHARED_TERMS
 from estimators.toolbox.kalman import ErrorState
+from estimators.toolbox.range_budget import (
+    CORRELATION_TIME_S,
+    PSEUDORANGE_FLOOR_M,
+    RangeBudget,
+    range_budget,
+)
 from estimators.toolbox.sensor_datasheet import ImuDatasheet
 from simulator.datasheet import Cn0Template, cn0_template
 from simulator.earth import (
@@ -363,7 +376,15 @@ class RissTcEkf(Estimator):
                 gm[name] = (0.0, gm[name][1])
         self._enhanced = cfg["model"] == "enhanced"
         self._tight = cfg["coupling"] == "tight"
-        self._n = len(STATES) if self._enhanced else SIMPLIFIED_STATES
+        self._n_nav = len(STATES) if self._enhanced else SIMPLIFIED_STATES
+        # the ionosphere's residual shared by an epoch's satellites: unit-variance states after
+        # the navigation's (``toolbox.range_budget``; datasheet tuning, tight coupling)
+        self._iono_used = (self._budget.shared_in_use()
+                           if self._budget is not None and self._tight
+                           else np.zeros(len(SHARED_TERMS), dtype=bool))
+        self._n_iono = int(self._iono_used.sum())
+        self._iono_x = np.zeros(self._n_iono)  # their estimates
+        self._n = self._n_nav + self._n_iono
         # F's rows of the frozen states are zeroed: eq. 32 (dv_o' = da_od) would otherwise pass
         # the a_od uncertainty into a frozen speed error, which the updates then correct
         self._frozen = np.array([_I[name] for name in frozen if _I[name] < self._n], dtype=int)
@@ -390,11 +411,15 @@ class RissTcEkf(Estimator):
         self._heading_offset = 0.0  # direction of travel minus azimuth state, while moving
         d_e, d_n, _, _ = self._arm_offset()
         self._lat, self._lon = self._moved(-d_n, -d_e)  # the rear axle at the start (at rest)
-        self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n]]))
+        self._filter = ErrorState(np.diag([p0_sigma[s] ** 2 for s in STATES[:self._n_nav]]
+                                          + [1.0] * self._n_iono))
         # the reported yaw's variance at the last moving row and the azimuth state's then
         self._stop_heading_var = self._stop_az_var = float(self._filter.p[_I["A"], _I["A"]])
-        self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n]])
-        self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n]
+        self._q_white = np.array([q_white.get(s, 0.0) for s in STATES[:self._n_nav]]
+                                 + [0.0] * self._n_iono)
+        self._gm = [(_I[s], sig, tau) for s, (sig, tau) in gm.items() if _I[s] < self._n_nav]
+        self._gm += [(self._n_nav + j, 1.0, CORRELATION_TIME_S)
+                     for j in range(self._n_iono)]
         self._tau = {s: tau for s, (_, tau) in gm.items()}  # s; infinite: a random walk
         self.nis_gnss = self.nis_gnss_dof = math.nan
         self._rejecting = 0  # GNSS epochs in a row in which the gate rejected most ranges
@@ -431,6 +456,7 @@ class RissTcEkf(Estimator):
         sheet = ImuDatasheet.from_datasheet(self.datasheet)
         self._sheet_tuning = tuning == "datasheet" and sheet is not None
         self._cn0_template: Cn0Template | None = None
+        self._budget: RangeBudget | None = None
         if not self._sheet_tuning:
             return p0, q_white, gm
         g, a = sheet.gyro, sheet.accel
@@ -449,8 +475,8 @@ class RissTcEkf(Estimator):
             gm[name] = (walk, math.inf)
         receiver = self.datasheet.get("gnss") or {}
         self._cn0_template = cn0_template(receiver)
-        self._pr_inflation = gnss_model.correlated_noise_inflation(
-            float(receiver.get("carrier_smoothing") or 0.0), 1.0)
+        self._budget = range_budget(receiver, 1.0)
+        self._pr_inflation = self._budget.inflation
         if self._gate_p is None:
             self._gate_p = 0.999
         return p0, q_white, gm
@@ -642,8 +668,11 @@ class RissTcEkf(Estimator):
         return cached
 
     def _predict(self, dt: float, rm: float, rn: float, wz_c: float) -> None:
-        f = system_matrix(self._lat, self._h, self._ve, self._vn, self._heading(), self._pitch,
-                          self._ao, wz_c, self._n)
+        f = np.zeros((self._n, self._n))
+        f[:self._n_nav, :self._n_nav] = system_matrix(
+            self._lat, self._h, self._ve, self._vn, self._heading(), self._pitch, self._ao,
+            wz_c, self._n_nav)
+        self._iono_x *= math.exp(-dt / CORRELATION_TIME_S)
         # rescale d lat, d lon (rad) to north and east metres: F_m = T F T^-1
         scale = np.ones(self._n)
         scale[0] = rm + self._h
@@ -757,10 +786,15 @@ class RissTcEkf(Estimator):
         h[m:, _I["vn"]] = d_ned[:, 0]
         h[m:, _I["vu"]] = -d_ned[:, 2]
         h[m:, _I["cd"]] = 1.0
-        dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
         var_pr = np.where(np.isfinite(epoch.pseudorange_std), epoch.pseudorange_std**2, 9.0)
+        if self._n_iono:  # the shared ionosphere: states, out of R
+            gains = self._budget.sigmas(epoch)[0][self._iono_used]
+            rho = rho + self._iono_x @ gains
+            h[:m, self._n_nav:] = gains.T
+            var_pr = np.maximum(var_pr - np.sum(gains**2, axis=0), PSEUDORANGE_FLOOR_M**2)
+        dz = np.concatenate([rho - epoch.pseudorange, rate - epoch.range_rate])
         var_rate = np.where(np.isfinite(epoch.range_rate_std), epoch.range_rate_std**2, 0.01)
-        var_nlos = self._nlos_variance(epoch)
+        nlos_mean, var_nlos = self._nlos_delay(epoch)
         r = np.diag(np.concatenate([var_pr * self._pr_inflation**2 + var_nlos, var_rate]))
         # the mechanised velocity carries the white noise of the last odometer speed: it enters
         # every predicted rate through the forward axis, so R gains sigma^2 g g^T
@@ -773,22 +807,24 @@ class RissTcEkf(Estimator):
         keep = np.ones(2 * m, dtype=bool)
         if self._gate_p is not None:
             keep[:m] = self._gate_ranges(dz[:m], h[:m], var_pr)
+        dz[:m] += nlos_mean  # the expected reflected delay off the pseudorange, after the gate
         s = self._filter.update(dz[keep], h[keep], r[np.ix_(keep, keep)])
         self.nis_gnss = gating.normalised_innovation_squared(dz[keep], s)
         self.nis_gnss_dof = float(keep.sum())
         self._feedback()
 
-    def _nlos_variance(self, epoch: gnss_model.RawEpoch) -> np.ndarray | float:
-        """Each pseudorange's variance from a reflected (NLOS) signal's extra path, which the
-        receiver's reported sigma does not hold: p (20 m)^2, p the probability that it is
-        reflected given its C/N0 deficit below the receiver's template (``tuning: datasheet``
-        with a template, C/N0 and elevations; ``gnss_model.nlos_sigma``, as ``gnss_wls``). In
-        R only: the gate tests against the reported variance."""
+    def _nlos_delay(self, epoch: gnss_model.RawEpoch) -> tuple[np.ndarray, np.ndarray]:
+        """Each pseudorange's expected reflected-signal (NLOS) delay and its variance, from
+        the probability that its C/N0 deficit below the receiver's template announces
+        (``gnss_model.nlos_delay``, the receiver's own fix-accuracy model of an extra path,
+        as ``fgo_tc``; ``tuning: datasheet`` with a template, C/N0 and elevations; zeros
+        otherwise). The delay is taken off after the gate, which tests the raw innovation
+        against the reported variance: taken off before, a direct signal whose C/N0 faded
+        fails the gate by the delay it does not have."""
+        m = len(epoch.sv)
         if (self._cn0_template is None or epoch.cn0 is None or epoch.elevation is None):
-            return 0.0
-        cn0 = np.where(np.isfinite(epoch.cn0), epoch.cn0, np.inf)  # none: not reflected
-        return gnss_model.nlos_sigma(np.zeros(len(cn0)), cn0, epoch.elevation,
-                                     self._cn0_template, gnss_model.NLOS_SIGMA_M) ** 2
+            return np.zeros(m), np.zeros(m)
+        return gnss_model.nlos_delay(epoch.cn0, epoch.elevation, self._cn0_template)
 
     def _side_slip_variance(self, d_ned: np.ndarray) -> np.ndarray:
         """The range rates' covariance from the rear axle's sideways motion, which eqs. 4-5
@@ -837,6 +873,7 @@ class RissTcEkf(Estimator):
         self._bz -= dx[i["bz"]]
         self._cb -= dx[i["cb"]]
         self._cd -= dx[i["cd"]]
+        self._iono_x -= dx[self._n_nav:]
         if self._enhanced:
             self._c_r += dx[i["r"]]
             self._roll -= dx[i["r"]]

@@ -75,8 +75,12 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   figures stay put. ``datasheet``: the gyro noise, in-run and turn-on bias of the datasheet's
   IMU (``toolbox.datasheet``), and the states Park's model lacks, without which it claimed a
   confidence it did not have (0.12 deg of roll against 5 deg of error on the quickstart): the
-  fix's correlated error (north, east and, in 3-D, down; ``toolbox.datasheet.
-  fix_error_model``, sized by the first fix's DOPs, its white remainder as the GPS noise);
+  fix's drive-long error (north, east and, in 3-D, down; ``toolbox.datasheet.
+  fix_error_model``: unit states whose gain at each fix is the drive-long part of the fix's
+  reported accuracy, per unit DOP the smallest report so far less the budget's smoothed
+  noise, capped at the budget's correlated part, ``FixSplit``; sized by the budget alone,
+  2.2 m of range error, the position was too cautious on open sky; its white remainder as
+  the GPS noise);
   in 3-D the accelerometers' roll and pitch error (their turn-on bias over g, the g-slave's
   dominant error) and the barometer offset's error (set at the first good fix, a random walk
   of the datasheet's weather drift; its white noise the sensor's); in 2-D the z gyro's
@@ -104,9 +108,9 @@ Choices where the paper is silent or inconsistent (also in docs/reproduction_par
   factor is bias process noise (a helix turns it into yaw); each fix row passes a chi-square
   gate (0.999) against reflected canyon heights. Both filters read the fix's own accuracy
   (``std_*`` of ``gnss_fix``, ``toolbox.datasheet.FixAccuracy``): its velocity 1-sigma sets the
-  speed's and the course's noise, and its position 1-sigma beyond the budget (the reflected
-  signals of a street canyon) is carried by unit NLOS states (north, east and, in 3-D, down;
-  ``FixErrorModel.nlos_split``): on the SUMO canyon's seeds 1-2 dr3d_ekf's height went from
+  speed's and the course's noise, and its position 1-sigma beyond its drive-long and smoothed
+  parts (the reflected signals of a street canyon) is carried by unit NLOS states (north, east
+  and, in 3-D, down; ``FixSplit``): on the SUMO canyon's seeds 1-2 dr3d_ekf's height went from
   11 / 27 to 1.0 / 2.3 and dr2d_odo_ekf's north from 10 / 2.5 to 0.7 / 1.1.
 
 Public names
@@ -127,6 +131,7 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
+    FixSplit,
     fix_error_model,
     ground_track_sigma,
     imu_error_model,
@@ -439,9 +444,8 @@ class Dr3dEkf(_OdometerDeadReckoning):
         n = N_DR3D_SHEET if self._sheet else 10
         self._tilt_bias = np.zeros(2)  # accelerometer tilt error estimate (roll, pitch), rad
         self._baro_bias = 0.0  # barometer offset error estimate, m
-        self._fix_error = np.zeros(3)  # the fix's correlated error estimate, NED m
+        self._fix_error = np.zeros(3)  # the fix's drive-long error estimate, units of its gain
         self._nlos = np.zeros(3)  # the reflected fixes' error estimate, units of the excess
-        self._dop_known = False
         if self._sheet:
             p0 = self._datasheet_states(p0)
         self._kf = ErrorState(p0)
@@ -467,6 +471,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
             self._f[TILT, TILT] = -1.0 / self._imu_model.accel_bias_tau
             self._q_c[BARO] = self._baro_rate_sigma**2 * BARO_RATE_TIME_S
             self._f[FIX, FIX] = -1.0 / self._fix_model.correlated_tau
+            self._q_c[FIX] = 2.0 / self._fix_model.correlated_tau
             self._f[NLOS, NLOS] = -np.eye(3) / NLOS_TIME_CONSTANT_S
             self._q_c[NLOS] = 2.0 / NLOS_TIME_CONSTANT_S
 
@@ -475,6 +480,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         the datasheet's IMU (``toolbox.datasheet``) and P0 with the six added states."""
         imu = self._imu_model = imu_error_model(self.datasheet)
         self._fix_model = fix_error_model(self.datasheet)
+        self._fix_split = FixSplit(self._fix_model)
         baro = self.datasheet.get("baro") or {}
         self._baro_rate_sigma = float(baro.get("weather_drift") or 0.0) * METRES_PER_PASCAL
         self._baro_noise = math.hypot(float(baro.get("noise") or 0.0),
@@ -484,8 +490,7 @@ class Dr3dEkf(_OdometerDeadReckoning):
         p[:10, :10] = p0
         p[7:10, 7:10] = np.eye(3) * imu.gyro_bias_initial**2
         p[TILT, TILT] = np.eye(2) * (imu.accel_bias_initial / G0) ** 2
-        p[FIX, FIX] = np.diag(self._fix_model.correlated_sigma(1.0, 2.0) ** 2)  # again at the
-        # first fix, with its DOPs
+        p[FIX, FIX] = np.eye(3)  # unit states (their gain is the fix's drive-long part)
         # the car's body (class docstring): the rear axle behind the IMU, the odometer's point
         # (the centre of gravity) ahead of the rear axle, the tyres' slip and the body's pitch
         site = Installation.from_datasheet(self.datasheet)
@@ -519,27 +524,24 @@ class Dr3dEkf(_OdometerDeadReckoning):
         lat, lon, alt = math.radians(row[fx.lat]), math.radians(row[fx.lon]), float(row[fx.alt])
         good_height = row[fx.fix] >= 2 and row[fx.vdop] <= c["gps_height_max_vdop"]
         dops = float(row[fx.hdop]), float(row[fx.vdop])
+        std_pos, speed_sigma, cross_sigma = fx.reported(row)
+        if self._sheet:  # the report's drive-long part, reflected excess and white noise
+            correlated, gain, white = self._fix_split.split(std_pos, *dops)
         if good_height and math.isfinite(self._baro_h):
             if self._sheet and self._baro_offset is None:  # the offset's error is a state
                 self._baro_offset = self._baro_h - alt
                 self._reset_states(slice(BARO, BARO + 1), np.sqrt(
-                    self._fix_model.correlated_sigma(*dops)[2:] ** 2
-                    + self._fix_model.white_sigma(*dops)[2:] ** 2))
+                    correlated[2:] ** 2 + self._fix_model.white_sigma(*dops)[2:] ** 2))
             elif not self._sheet:
                 self._track_baro_offset(t, self._baro_h - alt)
         n = 3 if good_height else 2
         n_x = len(self._eye)
         dz, h_pos = gnss_position(self._q, self._pos, np.array([lat, lon, alt]), n_states=n_x)
         var = [c["gps_horizontal_sigma"] ** 2] * 2 + [c["gps_vertical_sigma"] ** 2] * (n - 2)
-        if self._sheet:  # the fix is the truth plus its correlated error, plus white noise
-            if not self._dop_known:
-                self._reset_states(FIX, self._fix_model.correlated_sigma(*dops))
-                self._dop_known = True
-            dz += self._fix_error
-            h_pos[:, FIX] = np.eye(3)
-            std_pos, speed_sigma, cross_sigma = fx.reported(row)
-            gain, white = self._fix_model.nlos_split(std_pos, *dops)
-            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:n])
+        if self._sheet:  # the fix is the truth plus its drive-long error, plus white noise
+            dz += correlated * self._fix_error
+            h_pos[:, FIX] = np.diag(correlated)
+            var = list(white[:n])
             dz += gain * self._nlos
             h_pos[:, NLOS] = np.diag(gain)
         keep = np.arange(n)
@@ -591,15 +593,13 @@ class Dr3dEkf(_OdometerDeadReckoning):
 
     # -- filter -----------------------------------------------------------------------------
     def _reset_states(self, states: slice, sigma: np.ndarray) -> None:
-        """Size added states when their size is first known (the fix's DOPs): variance
-        sigma^2, no cross-covariance; a Gauss-Markov state's driving noise with it."""
+        """Size added states when their size is first known (the barometer offset's at the
+        first good fix): variance sigma^2, no cross-covariance."""
         p = self._kf.p
         p[states, :] = 0.0
         p[:, states] = 0.0
         idx = np.arange(len(p))[states]
         p[idx, idx] = np.asarray(sigma) ** 2
-        if states == FIX:
-            self._q_c[FIX] = 2 * np.asarray(sigma) ** 2 / self._fix_model.correlated_tau
 
     def _track_baro_offset(self, t: float, offset: float) -> None:
         if self._baro_offset is None:
@@ -834,9 +834,9 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._yaw = float(init.attitude[2])
         self._speed_error = 0.0  # estimated additive odometer speed error, m/s
         self._bias = 0.0  # z-gyro bias estimate, rad/s
-        self._fix_error = np.zeros(2)  # the fix's correlated north, east error (datasheet), m
+        self._fix_error = np.zeros(2)  # the fix's drive-long north, east error, units of its
+        # gain (datasheet)
         self._nlos = np.zeros(2)  # the reflected fixes' error, units of the fix's excess
-        self._dop_known = False
         self._take_inputs()
         n = 9 if self._sheet else 5
         gyro_noise, bias_sigma, bias_tau, bias_initial = (
@@ -847,6 +847,7 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
             gyro_noise, bias_sigma, bias_tau, bias_initial = (
                 imu.gyro_noise, imu.gyro_bias_sigma, imu.gyro_bias_tau, imu.gyro_bias_initial)
             self._fix_model = fix_error_model(self.datasheet)
+            self._fix_split = FixSplit(self._fix_model)
             self._gyro_scale = imu.gyro_scale_sigma
             self._rate = 0.0
         p0 = np.zeros((n, n))
@@ -856,10 +857,11 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         self._f = np.zeros((n, n))
         self._q_c = np.zeros(n)
         if self._sheet:
-            sigma = self._fix_model.correlated_sigma(1.0, 2.0)[:2]  # again at the first fix
-            p0[5:7, 5:7] = np.diag(sigma**2)
+            # the fix's drive-long north, east error: unit states, their gain the part of the
+            # fix's reported accuracy (toolbox.datasheet.FixSplit)
+            p0[5:7, 5:7] = np.eye(2)
             self._f[5:7, 5:7] = np.eye(2) * (-1.0 / self._fix_model.correlated_tau)
-            self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
+            self._q_c[5:7] = 2.0 / self._fix_model.correlated_tau
             # the reflected fixes' north, east error: unit states, their gain the fix's excess
             p0[7:9, 7:9] = np.eye(2)
             self._f[7:9, 7:9] = -np.eye(2) / NLOS_TIME_CONSTANT_S
@@ -920,21 +922,13 @@ class Dr2dOdoEkf(_OdometerDeadReckoning):
         h = self._eye[:2].copy()
         var = [c["gps_horizontal_sigma"] ** 2] * 2
         speed_var = c["gps_speed_sigma"] ** 2
-        if self._sheet:  # the fix is the truth plus its correlated error, plus white noise
+        if self._sheet:  # the fix is the truth plus its drive-long error, plus white noise
             dops = float(row[fx.hdop]), float(row[fx.vdop])
-            if not self._dop_known:
-                sigma = self._fix_model.correlated_sigma(*dops)[:2]
-                p = self._kf.p
-                p[5:7, :] = 0.0
-                p[:, 5:7] = 0.0
-                p[5:7, 5:7] = np.diag(sigma**2)
-                self._q_c[5:7] = 2 * sigma**2 / self._fix_model.correlated_tau
-                self._dop_known = True
-            dz = dz + self._fix_error
-            h[:, 5:7] = np.eye(2)
             std_pos, speed_sigma, _ = fx.reported(row)
-            gain, white = self._fix_model.nlos_split(std_pos, *dops)
-            var = list((self._fix_model.white_sigma(*dops) ** 2 + white)[:2])
+            correlated, gain, white = self._fix_split.split(std_pos, *dops)
+            dz = dz + correlated[:2] * self._fix_error
+            h[:, 5:7] = np.diag(correlated[:2])
+            var = list(white[:2])
             dz = dz + gain[:2] * self._nlos
             h[:, 7:9] = np.diag(gain[:2])
             speed_var = (speed_sigma if math.isfinite(speed_sigma)

@@ -64,21 +64,24 @@ Outages", IEEE Access 7, 2019, section II-A (eqs. 1-14).
   park2019``) asks for explicitly so that its figures stay put. ``datasheet``: from what a
   user knows of the sensors (``toolbox.datasheet``): the IMU's noise densities, in-run bias
   instability and turn-on bias range, its scale factors as bias process noise; the fix's
-  error as three Gauss-Markov states of the receiver's correlated error budget (correlation
-  time 30 min, sized by the first fix's DOPs; the +1 to +7 m height offset of a
-  single-frequency fix is this error, docs/gnss-errors.md) plus the white equivalent of its
-  smoothed noise, and its velocity at 0.05 m/s per range rate times the DOP, each behind a
-  chi-square gate (0.999; after five rejections in a row the next fix is taken); the
-  odometer's tick quantisation or speed cut-off, its age (latency plus half the counting
+  error as three Gauss-Markov states of its drive-long error (correlation time 30 min; the
+  +1 to +7 m height offset of a single-frequency fix is this error, docs/gnss-errors.md):
+  unit states whose gain at each fix is the part of the fix's reported accuracy beyond the
+  budget's smoothed noise, capped at the budget's correlated part
+  (``toolbox.datasheet.FixSplit``; sized by the budget alone, 2.2 m of range error, the
+  position was too cautious on open sky, where the report is smaller), plus the white
+  equivalent of its smoothed noise, and its velocity at 0.05 m/s per range rate times the
+  DOP, each behind a chi-square gate (0.999; after five rejections in a row the next fix is
+  taken); the odometer's tick quantisation or speed cut-off, its age (latency plus half the counting
   interval) times the acceleration, and the 3 % scale as above (``fix_error_states`` is
   implied, and so is ``odometer_scale_state``: the ``automotive`` odometer reads 0.991 of the
   distance, a constant that white 3 % noise at 10 Hz averaged away, so that the unseen canyon's
   dead reckoning between reflected fixes claimed 0.04 m/s against a 0.1 m/s north velocity
   error, vn (error / sigma)^2 3.7-3.8 on seeds 1-2, 1.9-2.4 with the state). The fix's own
   accuracy (``std_*``, ``toolbox.datasheet.FixAccuracy``) sets its velocity noise, and its
-  position 1-sigma beyond the budget (reflected signals) is carried by three unit NLOS states
-  after the fix's (``FixErrorModel.nlos_split``): the canyon's height went from 6.0-6.5 to
-  0.14-0.39 (seeds 1-2).
+  position 1-sigma beyond its drive-long and smoothed parts (reflected signals) is carried
+  by three unit NLOS states after the fix's (``FixSplit``): the canyon's height went from
+  6.0-6.5 to 0.14-0.39 (seeds 1-2).
   With a datasheet that gives the gyros' scale factor, three yaw-response states follow the
   15 (``InsFilter``'s: the z gyro's scale factor and the x and y gyros' misalignment towards
   z, random constants of the datasheet's 1-sigma; ``yaw_response_states: false`` leaves them
@@ -132,10 +135,11 @@ from estimators.toolbox.constraints import NonholonomicNoise
 from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
+    FixSplit,
     fix_error_model,
+    fix_position_rows,
     fix_velocity_sigma,
     imu_error_model,
-    nlos_position_rows,
     odometer_delay_s,
     odometer_speed_sigma,
     odometer_window_s,
@@ -245,7 +249,6 @@ class ParkInsOdometer(Estimator):
         self._fix_idx = [c["lat"], c["lon"], c["alt"], c["vn"], c["ve"], c["vd"]]
         self._fix = c["fix"]
         self._dop = [c.get("hdop"), c.get("vdop")]
-        self._dop_known = False
         self._accuracy = FixAccuracy(c)
         self._speed = self.columns["odometer"]["speed"]
         self._antenna = site.antenna
@@ -266,13 +269,13 @@ class ParkInsOdometer(Estimator):
         p0 = self.P0_SIGMA.copy()
         p0[9:12], p0[12:15] = imu.accel_bias_initial, imu.gyro_bias_initial
         self._fix_model = fix_error_model(self.datasheet)
+        self._fix_split = FixSplit(self._fix_model)
         self._odo_sigma = odometer_speed_sigma(self.datasheet)
         self._odo_still_sigma = odometer_speed_sigma(self.datasheet, 0.0)
-        self._odo_delay = odometer_delay_s(self.datasheet)
-        self._odo_delay_spread = odometer_window_s(self.datasheet)
         odo_rate = float((self.datasheet.get("odometer") or {}).get("rate") or 10.0)
         self._odo_escape = max(5, math.ceil(ODOMETER_GATE_ESCAPE_S * odo_rate))
-        return imu, p0, self._fix_model.correlated_sigma(1.0, 2.0), self._fix_model.correlated_tau
+        # unit states: their gain at each fix is the drive-long part of its reported accuracy
+        return imu, p0, np.ones(3), self._fix_model.correlated_tau
 
     def on_imu(self, t: float, row: np.ndarray) -> None:
         self.ins.add_imu(t, row)
@@ -289,7 +292,7 @@ class ParkInsOdometer(Estimator):
         pos = np.array([math.radians(values[0]), math.radians(values[1]), values[2]])
         n = ins.n_states
         dz_p, h_p = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna, n)
-        if self._fix_states:  # the fix is the antenna plus its correlated error
+        if self._fix_states and not self._sheet:  # the antenna plus its correlated error
             dz_p += ins.extra[:3]
             h_p[:, ins.extra_start:ins.extra_start + 3] = np.eye(3)
         dz_v, h_v = aiding.gnss_velocity(ins.v, np.nan_to_num(values[3:6]), n, ins.q,
@@ -300,14 +303,11 @@ class ParkInsOdometer(Estimator):
             return
         dops = [float(row[i]) if i is not None else math.nan for i in self._dop]
         model = self._fix_model
-        if not self._dop_known:  # the correlated error's size at this receiver's geometry
-            for k, sigma in enumerate(model.correlated_sigma(*dops)):
-                ins.set_extra_sigma(k, float(sigma))
-            self._dop_known = True
-        # the error the fix reports beyond the budget (reflections): its unit states' gain
+        # the fix's drive-long error and the error it reports beyond it
+        # (reflections): unit states, their gains from its reported accuracy
         std_pos, std_vel = self._accuracy.read(row)
-        r_p = nlos_position_rows(model, std_pos, *dops, dz_p, h_p, ins.extra[3:6],
-                                 ins.extra_start + 3)
+        r_p = fix_position_rows(self._fix_split, std_pos, *dops, dz_p, h_p, ins.extra[:6],
+                                ins.extra_start)
         # a fix that does not fit (a reflected signal's metres) is left out, not averaged in
         ins.gated_update(dz_p, h_p, r_p, GATE_PROBABILITY)
         rows = keep[3:]
@@ -345,12 +345,13 @@ class ParkInsOdometer(Estimator):
             ins.update(dz, h, r)
             return
         # its resolution (or cut-off); the speed is the mean over a window odometer_delay_s
-        # old: the prediction taken back by the acceleration times the delay, the window's
-        # spread as noise
+        # old at this speed (older where a CAN speed's tooth edges are sparse): the
+        # prediction taken back by the acceleration times the delay, the window's spread as
+        # noise
         accel = ins.mean_force[0] + quat_to_dcm(ins.q)[2, 0] * G0
-        dz[0] -= accel * self._odo_delay
+        dz[0] -= accel * odometer_delay_s(self.datasheet, speed)
         sigma = self._odo_sigma if speed != 0.0 else self._odo_still_sigma
-        r[0, 0] = (sigma**2 + (self._odo_delay_spread * accel) ** 2
+        r[0, 0] = (sigma**2 + (odometer_window_s(self.datasheet, speed) * accel) ** 2
                    + (scale_sigma * speed) ** 2)
         if len(r) == 3 and self._slip is not None:
             pitch_accel = accel

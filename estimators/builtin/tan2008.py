@@ -54,19 +54,22 @@ What the paper gives and what is chosen here:
   put. ``datasheet``: from what a user knows of the sensors (``toolbox.datasheet``, as
   ``ins_odo_ekf``): the IMU's noise densities, in-run bias instability and turn-on bias range
   (P0), its scale factors as bias process noise; the fix's error as three Gauss-Markov states
-  of the receiver's correlated error budget (30 min, sized by the first fix's DOPs) plus the
+  of the drive-long part of the fix's reported accuracy (30 min; unit states whose gain at
+  each fix is ``toolbox.datasheet.FixSplit``'s: per unit DOP the smallest report so far
+  less the budget's smoothed part, capped at the budget's correlated part: on open sky the
+  budget alone was above the report, and the filter too cautious horizontally) plus the
   white equivalent of its smoothed noise, behind a chi-square gate (0.999), and the fix's
   velocity (Tan uses positions only, and with the white equivalent of the smoothed position
   noise alone the velocity's sigma was ten times its error). What the fix reports of its
   own accuracy (``std_*`` of ``gnss_fix``, the receiver's least squares with its reflected
   signals; ``toolbox.datasheet.FixAccuracy``) is taken as ``ins_odo_ekf`` takes it: the
-  position's 1-sigma beyond the budget (reflected signals) as three unit NLOS states after
-  the fix's (``datasheet.nlos_position_rows``), the velocity's 1-sigma as its noise. In a
-  street canyon the reflected fixes sink by 20-50 m at a VDOP of 1.5-2.9, reporting 20-37 m
-  for it; with the DOPs' 3 m the filter followed them down under a 3.5 m sigma and held the
-  offset in its 30-minute fix-error states (the unseen canyon's height (error / sigma)^2
-  9.6 and 13.5 on seeds 1 and 2, 0.59 and 1.1 with the report; ``urban_canyon``'s height
-  8.6 and 14, vertical velocity 18 and 18, then 0.19 and 0.60, 1.4 and 0.41). A fix
+  position's 1-sigma beyond its drive-long and smoothed parts (reflected signals) as three unit
+  NLOS states after the fix's (``datasheet.fix_position_rows``), the velocity's 1-sigma as its
+  noise. In a street canyon the reflected fixes sink by 20-50 m at a VDOP of 1.5-2.9, reporting
+  20-37 m for it; with the DOPs' 3 m the filter followed them down under a 3.5 m sigma and held
+  the offset in its 30-minute fix-error states (the unseen canyon's height (error / sigma)^2 9.6
+  and 13.5 on seeds 1 and 2, 0.59 and 1.1 with the report; ``urban_canyon``'s height 8.6 and 14,
+  vertical velocity 18 and 18, then 0.19 and 0.60, 1.4 and 0.41). A fix
   without the columns has its velocity noise raised per axis to the innovations' scatter by
   covariance matching instead (``gating.FixNoiseMatching``: the reflected Doppler is 0.2-0.6
   m/s at the same DOPs; the unseen canyon's seed 1 had velocity north and east 6.4 and 7.7,
@@ -113,10 +116,11 @@ from estimators.toolbox.constraints import NonholonomicNoise, height, nonholonom
 from estimators.toolbox.datasheet import (
     NLOS_TIME_CONSTANT_S,
     FixAccuracy,
+    FixSplit,
     fix_error_model,
+    fix_position_rows,
     fix_velocity_sigma,
     imu_error_model,
-    nlos_position_rows,
 )
 from estimators.toolbox.gating import FixNoiseMatching
 from estimators.toolbox.ins_error import BG, N_STATES
@@ -196,13 +200,12 @@ class TanLinearisedKF(Estimator):
             p0 = self.P0_SIGMA.copy()
             p0[9:12], p0[12:15] = noise.accel_bias_initial, noise.gyro_bias_initial
             self._fix_model = fix_error_model(self.datasheet)
+            self._fix_split = FixSplit(self._fix_model)
             # the fix's correlated error, then its reflected (NLOS) error as unit states
-            markov = dict(extra_sigma=np.r_[self._fix_model.correlated_sigma(1.0, 2.0),
-                                            np.ones(3)],
+            markov = dict(extra_sigma=np.ones(6),  # unit states: their gains at each fix
                           extra_tau=np.r_[np.full(3, self._fix_model.correlated_tau),
                                           np.full(3, NLOS_TIME_CONSTANT_S)])
         self._noise = noise
-        self._dop_known = False
         c = self.columns["gnss_fix"]
         self._dop = [c.get("hdop"), c.get("vdop")]
         self._accuracy = FixAccuracy(c)
@@ -333,19 +336,14 @@ class TanLinearisedKF(Estimator):
                        self.R_HEADING)
 
     def _datasheet_fix(self, row: np.ndarray, pos: np.ndarray) -> None:
-        """The fix as the antenna plus its correlated error (three Gauss-Markov states, sized
-        at the first fix's DOPs) and a white remainder, gated (``tuning: datasheet``)."""
+        """The fix as the antenna plus its drive-long error (three unit Gauss-Markov states,
+        their gain the part of the fix's reported accuracy, ``fix_position_rows``) and a white
+        remainder, gated (``tuning: datasheet``)."""
         ins, model = self.ins, self._fix_model
         dops = [float(row[i]) if i is not None else math.nan for i in self._dop]
-        if not self._dop_known:
-            for k, sigma in enumerate(model.correlated_sigma(*dops)):
-                ins.set_extra_sigma(k, float(sigma))
-            self._dop_known = True
         dz, h = aiding.gnss_position(ins.q, ins.pos, pos, self._antenna, ins.n_states)
-        dz += ins.extra[:3]
-        h[:, N_STATES:N_STATES + 3] = np.eye(3)
         std_pos, std_vel = self._accuracy.read(row)
-        r = nlos_position_rows(model, std_pos, *dops, dz, h, ins.extra[3:6], N_STATES + 3)
+        r = fix_position_rows(self._fix_split, std_pos, *dops, dz, h, ins.extra[:6], N_STATES)
         rows = slice(0, 3) if math.isfinite(pos[2]) else slice(0, 2)
         ins.gated_update(dz[rows], h[rows], r[rows, rows], GATE_PROBABILITY)
         v_fix = row[self._vel_idx]

@@ -37,23 +37,58 @@ that tunes itself "from the datasheet" means the same thing.
     is the smaller (``automotive`` receiver on the unseen open road and SUMO city: north
     1.4-1.5 m, east 1.0-1.25 m against the budget's 1.7 m per axis, seed 1).
   - what the fix itself reports (``FixAccuracy``: its ``std_*`` columns, a receiver's own
-    accuracy, ``simulator.gnss.fix``): its velocity 1-sigma replaces the datasheet's; its
-    position 1-sigma beyond the budget's (``FixErrorModel.excess_sigma``: the variance over
-    the correlated and smoothed parts at the DOPs) is error the budget does not hold, the
-    reflected (NLOS) signals of a street canyon. That excess is not white: a reflection's extra
-    path lasts while the street's geometry does (the fixes of the simulated canyons, their
-    error over the excess: the height's stays near -1.2 for minutes, the horizontal's
-    correlation is 0.2-0.6 after 20 s and 0.0-0.4 after 40 s, seeds 1-5 of canyon,
-    urban_canyon and sumo_city_canyon), so a filter carries it as states: a unit-variance
-    first-order Gauss-Markov u per axis of correlation time ``NLOS_TIME_CONSTANT_S`` whose
-    fix row is the excess, e = excess_k u (a known time-varying gain on a stationary process:
-    zero on open sky, where u is unobserved and inert). Not all of it is slow: from one epoch
-    to the next the horizontal error over the excess keeps a correlation of only 0.4-0.8 (the
-    set of reflected satellites changes), the height's 0.8-0.9. ``FixErrorModel.nlos_split``
-    gives the share ``NLOS_WHITE_SHARE`` of the excess variance (north, east, down: 0.5, 0.5,
-    0.1, the drives' lag-one correlation rounded down) to the fix's white noise and the rest
-    to the states' gain; with all of it slow the filter read the epoch-to-epoch jumps as
-    motion (the unseen canyon's 2-D yaw error 2-3 deg against a sigma of 0.7-1 deg).
+    accuracy, ``simulator.gnss.fix``; a real receiver's NMEA GST standard deviations of the
+    latitude, longitude and altitude errors, or u-blox's hAcc and vAcc: the pseudorange errors'
+    statistics mapped into the position, G Sigma G^T of the weighted least squares, Misra &
+    Enge 2011, section 6.1, the whole error with no split by time behaviour): its velocity
+    1-sigma replaces the datasheet's. For ``ins_odo_ekf``, ``dr3d_ekf``, ``dr2d_odo_ekf``
+    and ``ins_lkf`` its position 1-sigma r sizes the drive-long part (``FixSplit``): per
+    axis and unit DOP, the smallest so far of ``reported_drive_long_sigma`` (the bullet
+    above: sqrt(r^2 - (s DOP)^2), at most the budget's correlated part) over the DOP.
+    The budget cannot know the hour or the sky: its correlated 2.2 m (the ``automotive``
+    receiver) is a bound for a midday ionosphere, while the fix's report holds the day's
+    broadcast delays and the satellites' geometry per axis (on the unseen ``open_road``, seed
+    1, the report per unit DOP (HDOP / sqrt(2) horizontally) is 1.98 m north, 1.63 m east,
+    2.47 m down at its median, on ``sumo_city`` 1.84, 1.31 and 2.05; the simulated fixes'
+    realised error per unit DOP over twenty seeds, ``simulator.datasheet``, 1.2-1.35 m
+    horizontally), so a filter sized by the budget alone was too cautious horizontally on
+    open sky (mean (error / sigma)^2 0.04-0.1 on some drives' north or east). Why the
+    smallest: the drive-long error (ionosphere, orbits) changes over tens of minutes, while
+    the report rises from one epoch to the next with the signals the receiver suspects (a
+    faded direct signal's share of a reflection's extra path: 1.3-2.5 m per VDOP from one
+    fix to the next on the unseen canyon's open stretches, seed 1; the first fixes, before
+    the carrier smoothing converges: 4.05 m per DOP north at the first fix of ``open_road``
+    seed 1); those rises are the excess below, not a larger drive-long error (taken at each
+    fix, with the states' gain at each fix's DOPs, the report's jumps and a canyon's jumps of
+    VDOP, 1.7 to 5.5, moved the filter's modelled fix error with them: the unseen canyon's
+    height (error / sigma)^2 0.31 -> 4.1, seeds 1-3). Only north and east
+    (``REPORTED_AXES``): the height keeps the budget's part. A street canyon's reflections
+    sink the fix (an extra path is never negative, so their mean adds up in the height and the
+    clock, ``simulator.datasheet.nlos_delay_moments``), which the excess's zero-mean states
+    below do not hold: its reflected fixes pulled the filter's height 2-3 m down (seed 2), which the
+    budget's larger part covers; with the height's part from the report (1.3-1.5 m per VDOP
+    on the canyon's open stretches) the unseen canyon's seed 2 height (error / sigma)^2 was
+    1.3 (``ins_odo_ekf``) and 2.0 (``ins_lkf``), against 0.44 and 0.68 with the budget's (seed 1:
+    0.02 and 0.06 against 0.004 and 0.09): within the goal either way, kept on the budget. The
+    filters carry the part as a unit-variance Gauss-Markov state per axis whose fix row is
+    its 1-sigma at the first fix's DOPs times the state, e = g_k u, g_k shrinking with the
+    smallest report. The report's variance beyond that part and the smoothed one
+    (``FixErrorModel.excess_sigma``: beyond the budget, for a filter that takes the budget's
+    correlated part) is error the budget does not hold, the reflected (NLOS) signals of a street
+    canyon. That excess is not white: a reflection's extra path lasts while the street's
+    geometry does (the fixes of the simulated canyons, their error over the excess: the height's
+    stays near -1.2 for minutes, the horizontal's correlation is 0.2-0.6 after 20 s and 0.0-0.4
+    after 40 s, seeds 1-5 of canyon, urban_canyon and sumo_city_canyon), so a filter carries it
+    as states: a unit-variance first-order Gauss-Markov u per axis of correlation time
+    ``NLOS_TIME_CONSTANT_S`` whose fix row is the excess, e = excess_k u (a known time-varying
+    gain on a stationary process: zero on open sky, where u is unobserved and inert). Not all of
+    it is slow: from one epoch to the next the horizontal error over the excess keeps a
+    correlation of only 0.4-0.8 (the set of reflected satellites changes), the height's 0.8-0.9.
+    ``FixErrorModel.nlos_split`` gives the share ``NLOS_WHITE_SHARE`` of the excess variance
+    (north, east, down: 0.5, 0.5, 0.1, the drives' lag-one correlation rounded down) to the
+    fix's white noise and the rest to the states' gain; with all of it slow the filter read the
+    epoch-to-epoch jumps as motion (the unseen canyon's 2-D yaw error 2-3 deg against a sigma of
+    0.7-1 deg).
 
 * ``odometer_speed_sigma``: the white 1-sigma of an odometer's speed: the tick count's
   quantisation, 1 / (``ticks_per_meter`` dt) over an interval dt = 1 / ``rate``, uniform, so
@@ -65,11 +100,21 @@ that tunes itself "from the datasheet" means the same thing.
   the first and the last tooth edge inside it (``tooth_timing``, ``simulator.sensors.odometer``),
   both stamped at the interval's end (the ``automotive`` CAN speed at 50 Hz, 20 ms latency:
   30.0 ms against the truth's speed and acceleration by least squares above 4 m/s, 39 ms at
-  1-4 m/s where the edges are sparse; ``sumo_city_canyon`` seed 1).
+  1-4 m/s where the edges are sparse; ``sumo_city_canyon`` seed 1). A CAN speed's age grows
+  where its edges are sparse, at a reading v (``odometer_window_s(datasheet, v)``): with
+  edges g = 1 / (``ticks_per_meter`` v) apart, the last edge before the stamp is on average
+  g / 2 old, and the span it is timed over is the window's edges, dt - g on average, when
+  g <= dt / 2, else one edge pair, g (the first edge is at least the one before the last):
+  the mean's age is the latency plus g / 2 + span / 2, that is latency + max(dt / 2, g)
+  (the ``automotive`` wheel's 42.5 mm teeth at 1 m/s: 62 ms, at its 2 km/h cut-off 97 ms;
+  taken as 30 ms, the speed of the last second of a stop at 2 m/s^2 read 0.06-0.13 m/s
+  fast, ``sumo_city`` seed 1). The same g is its spread (a bound: the age is uniform over
+  g around its mean).
 
 Public names
 ------------
-ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, nlos_position_rows,
+ImuErrorModel, imu_error_model, FixErrorModel, fix_error_model, FixAccuracy, FixSplit,
+fix_position_rows,
 fix_velocity_sigma, ground_track_sigma, odometer_speed_sigma, odometer_delay_s, odometer_window_s,
 CORRELATED_TAU_S, NLOS_TIME_CONSTANT_S, MIN_DRIVE_LONG_SIGMA_M.
 """
@@ -93,6 +138,7 @@ SCALE_FACTOR_TIME_S = 4.0  # s: a scale-factor error adds up over a quarter turn
 # at 12 m/s; filters without scale-factor states take it as white noise over that time
 NLOS_TIME_CONSTANT_S = 60.0  # a reflected fix error's correlation time (module docstring)
 NLOS_WHITE_SHARE = np.array([0.5, 0.5, 0.1])  # its variance's white share, NED (docstring)
+REPORTED_AXES = np.array([True, True, False])  # axes whose drive-long part the report sizes
 MIN_DRIVE_LONG_SIGMA_M = 0.1  # the smallest drive-long fix error believed from a report, m
 FIX_STD_COLUMNS = ("std_n", "std_e", "std_d", "std_vn", "std_ve", "std_vd")
 
@@ -248,18 +294,56 @@ class FixAccuracy:
         return std[:3], std[3:]
 
 
-def nlos_position_rows(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float,
-                       dz: np.ndarray, h: np.ndarray, nlos: np.ndarray, first: int
-                       ) -> np.ndarray:
-    """A fix's position rows with the reflected-fix states (module docstring): adds their part
-    e = gain u to the innovation rows ``dz`` (3,) and to ``h`` (3, n) in place, for the states'
-    estimate ``nlos`` (3,) at column ``first``, and returns the rows' noise covariance (3, 3):
-    the white remainder at the DOPs and the excess's white share (``FixErrorModel.nlos_split``
-    of the fix's ``reported`` position 1-sigma)."""
-    gain, white = model.nlos_split(reported, hdop, vdop)
-    dz += gain * nlos
-    h[:, first:first + 3] = np.diag(gain)
-    return np.diag(model.white_sigma(hdop, vdop) ** 2 + white)
+class FixSplit:
+    """A fix stream's reported position 1-sigma split by time behaviour (module docstring),
+    fix after fix: the drive-long part (north and east: its 1-sigma per unit DOP the smallest
+    report so far less the smoothed part, at most the budget's correlated range error; down:
+    the budget's), the budget's
+    smoothed part, and the excess beyond both (the reflected fixes' states' gain and the
+    white share, ``NLOS_WHITE_SHARE``)."""
+
+    def __init__(self, model: FixErrorModel):
+        self.model = model
+        self.range_m = np.full(3, model.correlated_range)  # drive-long, per unit DOP, NED
+        self.first_axes: np.ndarray | None = None  # the first fix's DOP per axis
+
+    def split(self, reported: np.ndarray, hdop: float, vdop: float
+              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(drive-long 1-sigma (3,), m, at the first fix's DOPs (the states' size, as a
+        filter sized them once before: scaled by each fix's DOPs, a street canyon's jumps of
+        VDOP from 1.7 to 5.5 moved the modelled error with them); the reflected-fix states'
+        gain (3,), m; the white noise's variance (3,), m^2) of a fix of ``reported`` position
+        1-sigma (NED; NaN: no report on that axis, no excess) at its DOPs."""
+        model = self.model
+        axes = _axes(hdop, vdop)
+        report2 = np.asarray(reported, dtype=float) ** 2
+        smoothed2 = (model.smoothed_range * axes) ** 2
+        finite = np.isfinite(report2)
+        own = model.reported_drive_long_sigma(reported, hdop, vdop) / axes
+        self.range_m = np.where(finite & REPORTED_AXES, np.minimum(self.range_m, own),
+                                self.range_m)
+        if self.first_axes is None:
+            self.first_axes = axes
+        excess2 = np.where(finite, np.maximum(report2 - (self.range_m * axes) ** 2 - smoothed2,
+                                              0.0), 0.0)
+        return (self.range_m * self.first_axes, np.sqrt((1.0 - NLOS_WHITE_SHARE) * excess2),
+                model.white_sigma(hdop, vdop) ** 2 + NLOS_WHITE_SHARE * excess2)
+
+
+def fix_position_rows(fix_split: FixSplit, reported: np.ndarray, hdop: float, vdop: float,
+                      dz: np.ndarray, h: np.ndarray, states: np.ndarray, first: int
+                      ) -> np.ndarray:
+    """A fix's position rows with its error states (module docstring): six unit states, the
+    drive-long error's (north, east, down) at column ``first`` and the reflected fixes' after
+    them, of estimate ``states`` (6,). Adds their part e = g u to the innovation rows ``dz``
+    (3,) and to ``h`` (3, n) in place, the gains ``FixSplit.split`` gives for the fix's
+    ``reported`` position 1-sigma, and returns the rows' noise covariance (3, 3): the white
+    remainder at the DOPs and the excess's white share."""
+    correlated, nlos, white = fix_split.split(reported, hdop, vdop)
+    dz += correlated * states[:3] + nlos * states[3:6]
+    h[:, first:first + 3] = np.diag(correlated)
+    h[:, first + 3:first + 6] = np.diag(nlos)
+    return np.diag(white)
 
 
 def fix_velocity_sigma(model: FixErrorModel, reported: np.ndarray, hdop: float, vdop: float
@@ -302,16 +386,23 @@ def odometer_speed_sigma(datasheet: Mapping[str, Any], speed: float = 1.0) -> fl
     return math.hypot(ODOMETER_FLOOR_M_S, step / math.sqrt(12.0))
 
 
-def odometer_delay_s(datasheet: Mapping[str, Any]) -> float:
-    """Age of the odometer's speed at its time stamp, s (module docstring)."""
+def odometer_delay_s(datasheet: Mapping[str, Any], speed: float = math.inf) -> float:
+    """Age of the odometer's speed at its time stamp, s, for a reading ``speed`` (m/s; the
+    default: fast enough that a CAN speed's edges are dense), module docstring."""
     odo = datasheet.get("odometer") or {}
-    return float(odo.get("latency") or 0.0) + odometer_window_s(datasheet)
+    return float(odo.get("latency") or 0.0) + odometer_window_s(datasheet, speed)
 
 
-def odometer_window_s(datasheet: Mapping[str, Any]) -> float:
-    """Half the interval a counted speed is the mean over, s (module docstring): the share of
-    ``odometer_delay_s`` beyond the latency, and its spread (0 for an instantaneous speed)."""
+def odometer_window_s(datasheet: Mapping[str, Any], speed: float = math.inf) -> float:
+    """The share of ``odometer_delay_s`` beyond the latency, and its spread, s (module
+    docstring): half the interval a counted speed is the mean over; for a CAN speed timed by
+    its tooth edges (``tooth_timing``) at a reading ``speed`` (m/s, not 0) the larger of that
+    and the edges' spacing in time; 0 for an instantaneous speed."""
     odo = datasheet.get("odometer") or {}
-    if float(odo.get("ticks_per_meter") or 0.0) > 0:
-        return 0.5 / float(odo.get("rate") or 10.0)
-    return 0.0
+    ticks = float(odo.get("ticks_per_meter") or 0.0)
+    if ticks <= 0:
+        return 0.0
+    half = 0.5 / float(odo.get("rate") or 10.0)
+    if odo.get("tooth_timing") and speed != 0.0:
+        return max(half, 1.0 / (ticks * abs(speed)))
+    return half

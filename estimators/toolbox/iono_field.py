@@ -37,8 +37,9 @@ psi times the shell's radius along the azimuth.
 ``residual_terms`` puts the two together on an epoch's pseudoranges: four quantities of unit
 variance shared by the satellites (c / |c|, g0 and the scaled gradient) with their
 coefficients in metres, and each satellite's own variance (f I_i)^2 r(x_i); a satellite
-without elevation or azimuth keeps the whole field as its own. Read by ``fgo_tc`` (the
-shared quantities as variables).
+without elevation or azimuth keeps the whole field as its own. Read by
+``toolbox.range_budget`` (for ``fgo_tc``, the shared quantities as variables, and the tightly
+coupled filters, as states).
 
 Public names
 ------------

@@ -102,11 +102,13 @@ def test_paper_tuning_claims_far_more_than_it_has(quickstart):
 
 def test_karamat_position_is_consistent_in_the_canyon(canyon):
     """riss3d_tc_ekf's datasheet tuning (the yaw's sigma that of the velocity's direction, the
-    range rates' side-slip noise, the pseudoranges' NLOS share in R) on the canyon's first
-    150 s, seed 1 (a junction turn, a red-light stop, reflected ranges): north and east within
-    the goal of docs/scores.md (0.3-3), no axis above 10. Measured: north 0.53, east 0.63,
-    height 7.9 (the canyon's height, docs/reproduction_karamat2015.md, "Consistency"), yaw
-    0.20 (too cautious at the stop)."""
+    range rates' side-slip noise, the ionosphere's shared residual as states, the
+    pseudoranges' expected NLOS delay taken off) on the canyon's first 150 s, seed 1 (a
+    junction turn, a red-light stop, reflected ranges): north and east within the goal of
+    docs/scores.md (0.3-3), no axis above 10. Measured: north 0.64, east 0.35, height 1.4
+    (7.9 with the reflected delays zero-mean in R and the ionosphere white,
+    docs/reproduction_karamat2015.md, "Consistency"), yaw 0.17 (too cautious at the
+    stop)."""
     nse = _nse(canyon, "riss3d_tc_ekf")
     assert {"n", "e", "d", "yaw"} <= set(nse)
     assert 0.3 < nse["n"] < 3.0 and 0.3 < nse["e"] < 3.0, nse
