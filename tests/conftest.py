@@ -36,10 +36,10 @@ HEAVY_MODULES = (
     "tests/estimators/test_park2019_dr.py",  # 90
     "tests/estimators/test_karamat2015.py",  # 80
     "tests/estimators/test_chan_claims.py",  # 80
+    "tests/estimators/test_rtk_ins.py",  # 55: the short drive on three systems, RTKLIB too
     "tests/reliability/test_campaign_signals.py",  # 55, most of it waiting on signals
     "tests/test_notebooks.py",  # 30
     "tests/estimators/test_park2019_ins.py",  # 25
-    "tests/estimators/test_rtk_ins.py",  # 20
     "tests/estimators/test_fgo.py",  # 20
     "tests/estimators/test_tan2008.py",  # 15
     "tests/faults/test_faults.py",  # 15

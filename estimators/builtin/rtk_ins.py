@@ -5,7 +5,10 @@ carrier phase against a base station, with integer ambiguity resolution (docs/rt
   strapdown of ``toolbox.strapdown``, the error model of ``toolbox.ins_error``, the Joseph
   update of ``toolbox.kalman``; Groves 2013, chapter 14), its IMU noise from the datasheet
   (``toolbox.datasheet.imu_error_model``), closed loop, the IMU's mounting and the antenna's
-  lever arm from the installation (``toolbox.installation``).
+  lever arm from the installation (``toolbox.installation``). Its scale-factor and
+  g-sensitivity noise counts the change of the mean readings from one ``scale_noise_window``
+  to the next, not from one propagation step to the next, where the car body's vibration
+  would count as a change of the biases (docs/rtk-ins.md, "Consistency").
 * **Ambiguities**: one state per signal (satellite and band) for the between-receiver
   single-difference ambiguity N_rover - N_base in cycles, a random constant, after the 15
   (``ambiguity_states`` slots, taken as satellites rise and given back when they set; the
@@ -160,6 +163,7 @@ DEFAULTS = {
     "initial_position_std": 1.0,
     "initial_velocity_std": 0.2,
     "initial_attitude_std": [1.0, 1.0, 3.0],
+    "scale_noise_window": 1.0,
     "odometer": True,
     "odometer_rate": 10.0,
     "nhc": True,
@@ -211,6 +215,10 @@ CONFIG_HELP = {
     "max_gap": ("s", "a signal unseen for longer starts a new ambiguity"),
     **shared_help("initial_position_std", "initial_velocity_std", "initial_attitude_std",
                   "nhc_point"),
+    "scale_noise_window": ("s", "the IMU's scale-factor errors drive its bias states by the "
+                                "change of the mean rate and specific force from one window "
+                                "of this length to the next (0: from one flush to the next, "
+                                "where the car body's vibration counts as a change)"),
     "odometer": ("", "odometer speed updates (when the dataset has an odometer)"),
     "odometer_rate": ("Hz", "odometer updates per second at most (the samples between are "
                             "not used)"),
@@ -221,6 +229,17 @@ CONFIG_HELP = {
 }
 OUTPUT_COLUMNS = (*SOLUTION_COLUMNS, "fix_status", "ratio", "fixed_ambiguities", "nis_gnss",
                   "nis_gnss_dof")
+
+
+def _zero_nan(x: np.ndarray) -> np.ndarray:
+    """``x`` with its NaN (a correction the receiver did not give) as zero."""
+    return np.where(np.isnan(x), 0.0, x)
+
+
+def _members(keys: np.ndarray, known: set[int]) -> np.ndarray:
+    """Whether each of ``keys`` is in ``known`` (a few dozen keys: a set lookup each, where
+    ``np.isin`` sorts both)."""
+    return np.fromiter((k in known for k in keys.tolist()), dtype=bool, count=len(keys))
 
 
 class _Epoch:
@@ -245,11 +264,11 @@ class _Epoch:
         self.wavelength = C_M_S / freq
         self.gamma = (F_L1_HZ / freq) ** 2
         clock = c("sat_clock")
-        iono, tropo = np.nan_to_num(c("iono")), np.nan_to_num(c("tropo"))
-        delay = np.nan_to_num(c("group_delay")) if "group_delay" in cols else 0.0
+        iono, tropo = _zero_nan(c("iono")), _zero_nan(c("tropo"))
+        delay = _zero_nan(c("group_delay")) if "group_delay" in cols else 0.0
         self.code = c("pseudorange") + clock - iono - tropo
         self.phase = self.wavelength * c("carrier_phase") + clock + delay + iono - tropo
-        self.lli = np.nan_to_num(c("lli")).astype(np.int64)
+        self.lli = _zero_nan(c("lli")).astype(np.int64)
         self.lock = c("lock_time") if "lock_time" in cols else np.full(len(keys), np.inf)
         self.elevation = c("elevation")
         self.sat_pos = block[:, [cols["sat_x"], cols["sat_y"], cols["sat_z"]]]
@@ -345,7 +364,7 @@ class RtkInsEkf(Estimator):
                              extra_sigma=np.zeros(n_slots + n_iono),
                              extra_tau=np.r_[np.full(n_slots, np.inf),
                                              np.full(n_iono, cfg["iono_correlation_time"])],
-                             sparse=True)
+                             sparse=True, scale_noise_window=cfg["scale_noise_window"])
         code_tau = cfg["code_correlation_time"]
         if code_tau is None:
             code_tau = (self.datasheet.get("gnss") or {}).get("carrier_smoothing") or 0.0
@@ -595,7 +614,7 @@ class RtkInsEkf(Estimator):
         if code:
             # a code arc's first epoch in the filter counts at its marginal sigma, the later
             # ones at what they add to it (module docstring)
-            seen = np.isin(rover.keys, self._code_keys())
+            seen = _members(rover.keys, self._code_used)
             rover_std = np.where(seen, cfg["code_std"] * self._code_inflation,
                                  cfg["code_arc_std"])
             base_std = cfg["base_code_std"]
@@ -654,7 +673,7 @@ class RtkInsEkf(Estimator):
         sd_phase = rover.phase - base.phase
         for _ in range(2):
             # a held reference first, then one whose half cycle is resolved
-            priority = (np.where(np.isin(rover.keys, self._held_keys()), 2, 0)
+            priority = (np.where(_members(rover.keys, self._held), 2, 0)
                         + np.where(self._pending, 0, 1))
             dz_p, h_p, r_p, sig, refs = self._rows(rover, base, geometry, slots >= 0, priority,
                                                    sd_phase, slots)
@@ -700,19 +719,11 @@ class RtkInsEkf(Estimator):
         self.nis_gnss_dof = float(len(dz))
         self._phase_rows = (sig, refs, slots)
 
-    def _code_keys(self) -> np.ndarray:
-        """The rover signals whose current code arc the filter has used."""
-        return np.fromiter(self._code_used, dtype=np.int64, count=len(self._code_used))
-
-    def _held_keys(self) -> np.ndarray:
-        """The keys of the held ambiguities."""
-        return np.fromiter(self._held, dtype=np.int64, count=len(self._held))
-
     def _all_held(self, rover: _Epoch, sig: np.ndarray, refs: np.ndarray) -> bool:
         """Whether the epoch's double differences (signals ``sig`` against ``refs``) are at
         least ``min_fixed`` and all of held ambiguities."""
         return len(sig) >= self.config["min_fixed"] and bool(
-            np.isin(rover.keys[np.r_[sig, refs]], self._held_keys()).all())
+            _members(rover.keys[np.r_[sig, refs]], self._held).all())
 
     def _reassign(self, rover: _Epoch, base: _Epoch, slots: np.ndarray) -> np.ndarray:
         """Slots again after resets: the reset signals start new ambiguities."""

@@ -72,7 +72,8 @@ def innovation_variances(p: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndar
     h = np.atleast_2d(h)
     cols = np.flatnonzero(np.any(h != 0.0, axis=0))
     h_c = h[:, cols]
-    return np.einsum("ij,ij->i", h_c @ p[np.ix_(cols, cols)], h_c) + np.diag(np.atleast_2d(r))
+    p_c = p.take(cols, axis=0).take(cols, axis=1)
+    return np.einsum("ij,ij->i", h_c @ p_c, h_c) + np.diag(np.atleast_2d(r))
 
 
 def normalised_innovation_squared(nu: np.ndarray, s: np.ndarray) -> float:

@@ -151,6 +151,12 @@ class InsFilter:
     yaw_response_sigma : (3,), optional
         1-sigma of the yaw-response states (module docstring; x, y gyro misalignment towards
         z, z gyro scale factor, dimensionless); None: no such states.
+    scale_noise_window : float
+        s; 0: the scale-factor and g-sensitivity noise (``InsNoise``) counts the change of the
+        mean reading from one flush to the next. Above 0: from one window of this length to
+        the next, added at the flush that completes a window, so that a vibration that
+        averages out within the window (a car body's, 1-20 Hz) is not taken for a change of
+        the bias while a manoeuvre still is.
     """
 
     def __init__(self, initial: InitialState, imu_columns: Mapping[str, int], increments: bool,
@@ -158,7 +164,8 @@ class InsFilter:
                  initial_biases: np.ndarray | None = None, buffer_size: int = 512,
                  mounting: np.ndarray | None = None, extra_sigma: np.ndarray | None = None,
                  extra_tau: np.ndarray | None = None,
-                 yaw_response_sigma: np.ndarray | None = None, sparse: bool = False):
+                 yaw_response_sigma: np.ndarray | None = None, sparse: bool = False,
+                 scale_noise_window: float = 0.0):
         self.t = float(initial.t)
         self.q = np.array(initial.quaternion, dtype=float)
         self.v = np.array(initial.velocity, dtype=float)
@@ -193,6 +200,9 @@ class InsFilter:
         self.mean_rate_dt = 0.0  # the length of that flush, s
         self.mean_force = np.zeros(3)  # compensated specific force over it, body, m/s^2
         self._mount = None if mounting is None else np.asarray(mounting, dtype=float)
+        self._scale_window = float(scale_noise_window)
+        self._window = np.zeros(7)  # rate and force times dt, and dt, of the window filling
+        self._window_means: np.ndarray | None = None  # rate and force of the last full one
         # equal noise on the three axes: C Q C^T = Q, so G Q G^T does not depend on attitude
         self._gqg = np.zeros((self.n_states, self.n_states))
         self._gqg[:N_STATES, :N_STATES] = noise_psd(
@@ -250,9 +260,12 @@ class InsFilter:
             f_nav[6:9, N_STATES:a] = -c_bn * rate[2]
         # the extra states are uncoupled scalars: the transition is block diagonal
         phi, q_d = discretise(f_nav, self._gqg[:a, :a], dt)
-        if self.mean_rate_dt > 0 and (n.accel_scale_sigma or n.gyro_scale_sigma
-                                      or n.gyro_g_sensitivity):
-            d_rate, d_force = rate - self.mean_rate, f_body - self.mean_force
+        changes = self._reading_changes(rate, f_body, dt) if self._scale_window > 0 else (
+            (rate - self.mean_rate, f_body - self.mean_force) if self.mean_rate_dt > 0
+            else None)
+        if changes is not None and (n.accel_scale_sigma or n.gyro_scale_sigma
+                                    or n.gyro_g_sensitivity):
+            d_rate, d_force = changes
             if a > N_STATES:  # the z rate's scale factor is a state
                 d_rate[2] = 0.0
             ia, ig = np.arange(N_STATES)[BA], np.arange(N_STATES)[BG]
@@ -272,6 +285,23 @@ class InsFilter:
             self.kf.predict(phi, q_d)
         if len(self.extra):
             self.extra *= np.exp(-dt / self._extra_tau)
+
+    def _reading_changes(self, rate: np.ndarray, f_body: np.ndarray, dt: float
+                         ) -> tuple[np.ndarray, np.ndarray] | None:
+        """With ``scale_noise_window``: the change of the mean rate and specific force from
+        the last full window to the one this flush completes, or None while a window fills."""
+        acc = self._window
+        acc[0:3] += rate * dt
+        acc[3:6] += f_body * dt
+        acc[6] += dt
+        if acc[6] < self._scale_window - 1e-9:
+            return None
+        means = acc[0:6] / acc[6]
+        acc[:] = 0.0
+        previous, self._window_means = self._window_means, means
+        if previous is None:
+            return None
+        return means[0:3] - previous[0:3], means[3:6] - previous[3:6]
 
     def update(self, dz: np.ndarray, h: np.ndarray, r: np.ndarray) -> np.ndarray:
         """Measurement update with dz = h(nominal) - z; in closed loop the errors are fed back.

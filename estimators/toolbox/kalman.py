@@ -116,7 +116,7 @@ def update_sparse(x: np.ndarray, p: np.ndarray, innovation: np.ndarray, h: np.nd
     rows = np.flatnonzero(touched)
     h_c = h[:, cols]
     at = np.searchsorted(rows, cols)  # the columns' places among the rows
-    p_rr = p[np.ix_(rows, rows)]
+    p_rr = p.take(rows, axis=0).take(rows, axis=1)
     pht = p_rr[:, at] @ h_c.T  # P H^T on the rows
     s = h_c @ pht[at] + r
     s = 0.5 * (s + s.T)

@@ -198,3 +198,37 @@ def test_yaw_response_states_learn_a_scale_factor_from_headings():
     sigma = np.sqrt(ins.kf.p[17, 17])
     assert sigma < 2e-4 and abs(ins.yaw_response[2] - scale) < 3 * sigma
     assert abs(ins.bg[2]) < 1e-4  # the scale factor is not taken as a bias
+
+
+def _accel_z_bias_growth(window: float, amplitude: float, step: float) -> float:
+    """The growth of the z accelerometer bias variance over 10 s of a level IMU at rest whose
+    z reading vibrates at 5 Hz with ``amplitude`` (m/s^2) and steps by ``step`` at 3 s, with a
+    0.3 % scale-factor uncertainty, flushed every 0.05 s (the drift of the bias itself made
+    negligible)."""
+    noise = InsNoise(1e-9, 1e-12, 1e-9, 1e-12, 1e9, 1e9, accel_scale_sigma=0.003)
+    t, rows, _, init = _turntable(0.0, 0.0, 10.0)
+    rows[:, 6] += amplitude * np.sin(2 * np.pi * 5.0 * t) + step * (t >= 3.0)
+    ins = InsFilter(init, TURNTABLE_COLUMNS, False, QUIET_P0, noise, scale_noise_window=window)
+    for k, row in enumerate(rows):
+        ins.add_imu(row[0], row)
+        if k % 5 == 0:
+            ins.flush()
+    ins.flush()
+    return ins.kf.p[11, 11] - QUIET_P0[11] ** 2
+
+
+def test_scale_noise_on_windows_counts_a_step_and_not_a_vibration():
+    """The scale-factor noise (s dx)^2 from the change dx of the mean reading: on 1 s windows a
+    step of 1 m/s^2 adds s^2 once (0.99 s^2: the trapezoid puts half a sample of it in the
+    window before), where a 5 Hz vibration of 0.3 m/s^2, whole periods in each window, adds
+    nothing; flush by flush (window 0) the vibration adds s^2 times the sum of squares of the
+    changes between the 0.05 s means of its trapezoid increments, computed here from the
+    readings (14.2 (m/s^2)^2 over the 10 s, 0.27 m/s^2 rms)."""
+    s2 = 0.003**2
+    assert _accel_z_bias_growth(1.0, 0.0, 1.0) == pytest.approx(0.99 * s2, rel=0.01)
+    assert _accel_z_bias_growth(1.0, 0.3, 0.0) < 1e-6 * s2
+    t = np.arange(0.0, 10.005, 0.01)
+    vibration = 0.3 * np.sin(2 * np.pi * 5.0 * t)
+    means = (0.5 * (vibration[1:] + vibration[:-1])).reshape(-1, 5).mean(axis=1)
+    expected = s2 * np.sum(np.diff(means) ** 2)
+    assert _accel_z_bias_growth(0.0, 0.3, 0.0) == pytest.approx(expected, rel=1e-6)
