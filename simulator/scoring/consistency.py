@@ -17,7 +17,8 @@ wrapped angle errors; for a 2-D solution the horizontal n/e and the yaw alone):
 
 Everything is taken over the epochs from ``CONSISTENCY_SKIP_S`` after the solution's first row
 (an estimator's start-up transient is not what consistency judges), on the rows where the
-block's errors and sigmas are all finite and the sigmas positive. A block is 2-D when the
+block's errors and sigmas are all finite and the sigmas positive (``with_sigma``: the share of
+the block's epochs with finite errors that have them). A block is 2-D when the
 solution never has a finite down error with its sigma (``horizontal`` replaces ``position``),
 never a finite vertical velocity (``horizontal_velocity`` replaces ``velocity``) or never a finite
 roll and pitch with their sigmas (``yaw`` replaces ``attitude``); an axis with a sigma that no
@@ -165,6 +166,14 @@ def consistency_blocks(errors: pd.DataFrame) -> list[Block]:
     return out
 
 
+def _errors_finite(errors: pd.DataFrame, axes: tuple[str, ...]) -> np.ndarray:
+    """The rows where every error of ``axes`` is finite (a sigma or not)."""
+    finite = np.ones(len(errors), dtype=bool)
+    for axis in axes:
+        finite &= np.isfinite(errors[AXES[axis][0]].to_numpy(float))
+    return finite
+
+
 def _block_scores(errors: pd.DataFrame, block: Block) -> dict | None:
     squares = _squares(errors, block.axes)
     squares = squares[np.isfinite(squares).all(axis=1)]
@@ -172,18 +181,24 @@ def _block_scores(errors: pd.DataFrame, block: Block) -> dict | None:
         return None
     nees = squares.sum(axis=1)
     low, high = chi2_band(block.dim)
+    with_error = int(_errors_finite(errors, block.axes).sum())  # >= len(nees) > 0
     return {"nees": float(nees.mean()), "nees_expected": float(block.dim),
             "inside_95": float(np.mean((nees >= low) & (nees <= high))),
             "epochs": len(nees),
+            "with_sigma": len(nees) / with_error,
             "nse": {axis: float(squares[:, i].mean()) for i, axis in enumerate(block.axes)}}
 
 
 def consistency_scores(errors: pd.DataFrame, skip_s: float = CONSISTENCY_SKIP_S
                        ) -> dict[str, dict | None] | None:
     """``consistency`` of a per-sample error table: per block (``consistency_blocks``)
-    {nees, nees_expected, inside_95, epochs, nse {axis: mean (e/sigma)^2}} over the epochs
-    from ``skip_s`` after the first row, None for a block without such an epoch; None when the
-    solution has no ``std_*`` column."""
+    {nees, nees_expected, inside_95, epochs, with_sigma, nse {axis: mean (e/sigma)^2}} over
+    the epochs from ``skip_s`` after the first row, None for a block without such an epoch;
+    None when the solution has no ``std_*`` column. ``with_sigma`` is the share of the
+    block's epochs with finite errors that carry finite positive sigmas too: the NEES is taken
+    over those alone, so a solution that writes NaN or 0 as the sigma of its worst epochs
+    leaves them out of its NEES and shows it here (1 for a solution with a sigma at every
+    epoch)."""
     if not any(std in errors for std in col.SOLUTION_STD):
         return None
     later = _after_skip(errors, skip_s)

@@ -163,16 +163,18 @@ def _consistency_lines(scores: dict[str, dict]) -> list[str]:
             axes = ", ".join(f"{axis} {format_number(v)}" for axis, v in c["nse"].items())
             rows.append([label, block, format_number(c["nees"]),
                          format_number(c["nees_expected"]), format_number(c["inside_95"]),
-                         axes])
+                         format_number(c.get("with_sigma")), axes])
     if not rows:
         return ["No solution writes standard deviations (`std_*` columns)."]
     lines = [f"After each solution's first {CONSISTENCY_SKIP_S:g} s. NEES is the time average "
              "of eᵀP⁻¹e (P diagonal from the 1-sigma columns), expected its dimension for a "
              "consistent filter; `inside 95 %` the share of epochs inside the chi-square 95 % "
-             "band (0.95 for a consistent filter); `(e/σ)²` the mean per axis (1 when "
-             "consistent, above: overconfident, below: too cautious).", "",
+             "band (0.95 for a consistent filter); `with σ` the share of the epochs with an "
+             "error that carry a sigma (the others, a NaN or zero sigma, are left out of the "
+             "NEES: below 1, the figures hold for part of the drive); `(e/σ)²` the mean per "
+             "axis (1 when consistent, above: overconfident, below: too cautious).", "",
              *markdown_table(["solution", "block", "NEES", "expected", "inside 95 %",
-                              "(e/σ)² per axis"], rows)]
+                              "with σ", "(e/σ)² per axis"], rows)]
     nis = [[label, format_number(s["nis"]["mean"]), format_number(s["nis"]["expected"]),
             str(s["nis"]["updates"])] for label, s in scores.items() if s.get("nis")]
     if nis:

@@ -70,11 +70,30 @@ def test_known_errors_and_sigmas_give_their_normalised_squares(truth):
         assert c[block]["nees"] == pytest.approx(nees, abs=1e-3)
         assert c[block]["nees_expected"] == dim
         assert c[block]["epochs"] == later
+        assert c[block]["with_sigma"] == 1.0
         low, high = chi2_band(dim)
         assert c[block]["inside_95"] == (1.0 if low <= nees <= high else 0.0)
         assert c[block]["nse"] == pytest.approx({a: expected[a] for a in axes}, abs=1e-4)
     # the skip is a parameter: without it the early north error (200 sigma) dominates
     assert normalised_errors(truth, sol, skip_s=0.0)["n"] > 100.0
+
+
+def test_a_solution_that_hides_its_worst_epochs_behind_nan_or_zero_sigmas_shows_it(truth):
+    """NaN or 0 as the sigma of the epochs with a 30 m error leaves them out of the NEES (a
+    sigma of 0 claims no error at all, so it cannot be scored) and ``with_sigma`` says for
+    which share of the drive the figures hold."""
+    sol = offset_solution(truth.iloc[::10], dpos=(1.0, 0.0, 0.0))
+    sol["std_n"], sol["std_e"], sol["std_d"] = 1.0, 1.0, 1.0
+    later = (sol["t"] >= sol["t"].iloc[0] + 60.0).to_numpy()
+    worst = later & (np.cumsum(later) % 2 == 0)  # every other scored epoch
+    sol.loc[worst, "lat"] += 30.0 / 6.4e6 * 180.0 / np.pi  # 30 m north
+    sol.loc[worst, "std_n"] = np.nan
+    sol.loc[worst & (np.cumsum(worst) % 2 == 0), "std_n"] = 0.0
+    c = score_solution(truth, events(), sol)["consistency"]["position"]
+    assert c["nse"]["n"] == pytest.approx(1.0, abs=1e-3)  # the hidden epochs are not in it
+    assert c["with_sigma"] == pytest.approx(1.0 - worst.sum() / later.sum())
+    assert 0.45 < c["with_sigma"] < 0.55
+    json.dumps(c, allow_nan=False)
 
 
 def test_a_2d_solution_is_judged_on_horizontal_position_and_yaw(truth):
